@@ -1,0 +1,122 @@
+// The constant model built from a scene: DOF layout, lumped masses, banded stiffness of the
+// wires, supports, droppers, pantographs and collectors, the design (static) geometry and the
+// stability limit. Like MuJoCo's mjModel it never changes during a pass; everything that
+// changes lives in State (state.hpp).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/scene.hpp"
+
+namespace catenary_sim {
+
+// One tensioned wire of a tension section, meshed with pre-stressed Euler-Bernoulli (Hermite)
+// beam elements (eq. 3). Its stiffness is stored as a block-tridiagonal band of 2x2 blocks
+// (w, theta per node): that is exactly the bandwidth of a beam, so a product costs O(nodes).
+struct Wire {
+  std::string name;
+  bool is_contact_wire = false;
+  WireSpec spec;
+  std::vector<double> x;         // m, node stations along the line
+  std::vector<double> height;    // m, design height of each node (static shape, no pantograph)
+  std::vector<double> slope;     // rad, design rotation of each node
+  int w_dof = 0;                 // global index of node 0's vertical displacement
+  int theta_dof = -1;            // global index of node 0's rotation; -1: rotations condensed
+  // K band: diagonal blocks per node and the coupling block of element e (node e -> e+1).
+  std::vector<double> d_ww, d_wt, d_tt;        // size nodes
+  std::vector<double> e_ww, e_wt, e_tw, e_tt;  // size nodes-1; e_wt = K(w_e, theta_e+1), e_tw = K(theta_e, w_e+1)
+  // Condensed rotations: LDL^T factors of the tridiagonal K_theta_theta, reused every step.
+  std::vector<double> tt_inv_pivot, tt_lower;
+  std::vector<int> support_nodes;  // node index of each support along this wire, in order
+
+  int nodes() const { return static_cast<int>(x.size()); }
+  // Index of the element containing station xs (clamped to the wire), by bisection.
+  int element_at(double xs) const;
+};
+
+// Tension-only dropper between a contact-wire node and a messenger node.
+struct Dropper {
+  int contact_dof = 0, messenger_dof = 0;
+  double x = 0.0;               // m
+  double stiffness = 0.0;       // N/m, EA / unstretched length
+  double static_tension = 0.0;  // N, in the design state
+  double length = 0.0;          // m, design (stretched) length
+  double unstretched_length = 0.0;
+};
+
+// An elastic support: steady arm on the contact wire (eq. 4) or messenger support spring.
+struct SupportSpring {
+  int dof = 0;
+  double stiffness = 0.0;     // N/m
+  double static_force = 0.0;  // N, f0 of eq. 4 (balanced in the constant load vector)
+  double x = 0.0;
+  int span_index = 0;         // support i is at the start of span i
+  bool steady_arm = false;
+};
+
+struct Collector {
+  int pantograph = 0;
+  double offset = 0.0;  // m along the track from the pantograph reference point
+};
+
+struct Pantograph {
+  std::string name;
+  double position = 0.0;  // m behind the train front
+  bool moving_force = false;
+  int first_dof = -1;     // head DOF; masses follow down the chain
+  std::vector<double> masses, stiffness, damping;
+  double static_uplift = 0.0, aero_coefficient = 0.0;
+  std::vector<int> collectors;  // indices into Model::collectors
+  double reference_height = 0.0;  // m: absolute head height at displacement 0
+  std::vector<double> spring_preload;  // N: compression of each spring at displacement 0
+  int masses_count() const { return static_cast<int>(masses.size()); }
+};
+
+struct Model {
+  Scene scene;
+  std::vector<Wire> wires;            // [0] contact wire, [1] messenger if any
+  std::vector<int> contact_wires;     // indices into wires that collectors touch
+  std::vector<Dropper> droppers;
+  std::vector<SupportSpring> springs;
+  std::vector<Pantograph> pantographs;
+  std::vector<Collector> collectors;
+  std::vector<double> support_x;      // m, station of every support
+
+  int n_dof = 0;
+  int n_catenary_dof = 0;       // catenary DOFs come first, pantograph DOFs after
+  Eigen::VectorXd mass;         // lumped, kg (or kg m^2 for lumped rotations); 0 on fixed DOFs
+  Eigen::VectorXd inv_mass;     // 0 on fixed (rigidly supported) DOFs, which therefore never move
+  Eigen::VectorXd load;         // constant load: gravity, support preloads and -K y_design (N)
+  double alpha = 0.0, beta = 0.0;  // Rayleigh, eq. 5 (catenary only)
+  double contact_stiffness = 0.0, rub_length = 0.0;
+  int max_contact_nodes = 2;    // nodes a distributed contact can touch (sizes the workspace)
+
+  double omega_max = 0.0;       // rad/s, highest eigenfrequency of the assembled system
+  double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction
+  double dt = 0.0;              // s, the step in use
+  double train_start = 0.0, train_end = 0.0;  // m, front of the train
+  double line_length = 0.0;
+  double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire
+};
+
+// Builds the model, solves the design statics (dropper lengths for the presag) and the stability
+// limit. Throws SceneError for a scene that cannot be built (e.g. dt above the stability limit).
+Model build_model(const Scene& scene);
+
+// y = K x for the linear part of the system with every dropper and contact active (the collectors
+// at the train position `front`): used for the stability limit and by tests. x and y have n_dof
+// entries; `scratch` must have room for the condensed rotations (max wire nodes).
+void apply_stiffness(const Model& model, double front, const double* x, double* y, double* scratch);
+
+// Stiffness-only internal force of one wire: f(w) -= K z over the wire's nodes (rotations
+// condensed or taken from z). `theta` is scratch (nodes entries) and returns the rotations used.
+void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta);
+
+// Weights of the contact wire's nodes for a distributed contact centred at xc (eq. 10-13): the
+// collector height is sum w_i y_i (eq. 12) and its force is spread as F w_i. Returns the count,
+// at most model.max_contact_nodes; 0 if xc is off the wire.
+int contact_weights(const Wire& wire, double rub_length, double xc, int* node, double* weight);
+
+}  // namespace catenary_sim

@@ -1,0 +1,126 @@
+// The scene: everything a pass needs, as plain data in SI units, loaded from YAML and validated.
+// A scene holds only what it needs: the messenger, droppers, steady arms and pantographs are
+// optional, so a scene may be a single tensioned wire between two supports under a moving force.
+#pragma once
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace YAML {
+class Node;
+}
+
+namespace catenary_sim {
+
+// Thrown for any invalid scene input; the message names the field, the value and what is allowed.
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A tensioned wire modelled as a pre-stressed Euler-Bernoulli beam (paper eq. 3).
+struct WireSpec {
+  double linear_mass = 0.0;        // rhoA, kg/m
+  double bending_stiffness = 0.0;  // EI, N m^2
+  double tension = 0.0;            // T, N
+};
+
+struct ContactWireSpec : WireSpec {
+  double presag = 0.0;  // m, sag prescribed at mid-span (parabolic over the span), set by the droppers
+};
+
+struct DropperSpec {
+  std::vector<std::vector<double>> positions;  // per span, m from the span's first support
+  double axial_stiffness = 0.0;                // EA, N
+  double linear_mass = 0.0;                    // kg/m
+  double clamp_mass_contact = 0.0;             // kg, clamp on the contact wire
+  double clamp_mass_messenger = 0.0;           // kg, clamp on the messenger
+};
+
+// An elastic support (steady arm, eq. 4, or messenger support); absent = rigid.
+struct SupportSpec {
+  double stiffness = 0.0;  // N/m
+  double mass = 0.0;       // kg, lumped on the wire node
+};
+
+struct CollectorSpec {
+  double offset = 0.0;  // m along the track from the pantograph's reference point (+ = ahead)
+};
+
+struct PantographSpec {
+  std::string name;
+  double position = 0.0;  // m behind the train's front
+  bool moving_force = false;  // true: a plain moving force, no masses
+  // Lumped-mass chain, head first (paper Fig. 3 / eq. 9): masses[i] is joined to masses[i+1]
+  // (the last to the roof) by stiffness[i] and damping[i].
+  std::vector<double> masses;     // kg
+  std::vector<double> stiffness;  // N/m
+  std::vector<double> damping;    // N s/m
+  double static_uplift = 0.0;     // N, static contact force at the working height
+  double aero_coefficient = 0.0;  // N s^2/m^2, adds aero_coefficient * v^2 to the uplift
+  std::vector<CollectorSpec> collectors;
+};
+
+struct ContactSpec {
+  double stiffness = 50000.0;  // k0, N/m: collector spring of eq. 9, zeroed when contact is lost (eq. 25)
+  double rub_length = 0.0;     // l, m: length of the cosine distribution (eq. 13); 0 = point contact
+};
+
+enum class RotaryInertia { kCondensed, kLumped };
+
+struct NumericsSpec {
+  double element_length = 0.25;  // m, target; segments between supports and droppers are split evenly
+  std::optional<double> dt;      // s; empty = automatic (safety_factor times the stability limit)
+  double safety_factor = 0.9;    // for automatic dt
+  RotaryInertia rotary_inertia = RotaryInertia::kCondensed;
+  double divergence_limit = 5.0;  // m: any displacement beyond this stops the run as diverged
+};
+
+struct OutputSpec {
+  // Analysis section for the statistics, in span indices [first, last) counted from 0.
+  // Default: all spans but the first two and the last two.
+  std::optional<int> analysis_first_span;
+  std::optional<int> analysis_last_span;
+  double filter_cutoff = 20.0;  // Hz, low-pass for the filtered statistics
+  double sample_rate = 0.0;     // Hz for the CSV time series; 0 = every step
+};
+
+struct Scene {
+  std::string name;
+  double gravity = 9.81;               // m/s^2
+  double contact_wire_height = 5.3;    // m above the rail at the supports
+  double encumbrance = 1.2;            // m, messenger above contact wire at the supports
+  std::vector<double> spans;           // m, span lengths in order
+  ContactWireSpec contact_wire;
+  std::optional<WireSpec> messenger;
+  std::optional<DropperSpec> droppers;
+  std::optional<SupportSpec> steady_arms;         // intermediate contact-wire supports
+  std::optional<SupportSpec> messenger_supports;  // intermediate messenger supports
+  double rayleigh_alpha = 0.0;  // 1/s, eq. 5
+  double rayleigh_beta = 0.0;   // s, eq. 5
+  std::vector<PantographSpec> pantographs;
+  ContactSpec contact;
+  double train_speed = 0.0;                // m/s
+  std::optional<double> train_start;      // m, train front at t = 0; default: rearmost pantograph at 0
+  std::optional<double> train_end;        // m, the pass ends when the train front reaches it
+  NumericsSpec numerics;
+  OutputSpec output;
+
+  double line_length() const;
+  // Span index [first, last) of the statistics section, resolved against the defaults.
+  int analysis_first() const;
+  int analysis_last() const;
+};
+
+// Loads and validates; throws SceneError. `overrides` are "dotted.key=value" pairs applied to the
+// YAML tree before validation (the same keys as the file, e.g. "numerics.element_length=0.125").
+Scene load_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
+Scene load_scene_string(const std::string& yaml, const std::vector<std::string>& overrides = {});
+Scene scene_from_yaml(const YAML::Node& root);
+// Checks cross-field consistency; throws SceneError. Called by the loaders; call it again after
+// changing a Scene in code.
+void validate(const Scene& scene);
+
+}  // namespace catenary_sim

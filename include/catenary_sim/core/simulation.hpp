@@ -1,0 +1,46 @@
+// The public face of the core: a pass of one scene, stepped at a fixed dt, with validated
+// commands (train speed, uplift), reset, and snapshots of the initial state.
+#pragma once
+
+#include <string>
+
+#include "catenary_sim/core/model.hpp"
+#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/state.hpp"
+
+namespace catenary_sim {
+
+class Simulation {
+ public:
+  // Builds the model and the initial state (eq. 23, 24). Throws SceneError.
+  explicit Simulation(const Scene& scene);
+
+  const Model& model() const { return model_; }
+  const State& state() const { return state_; }
+
+  StepStatus step() { return catenary_sim::step(model_, state_); }
+  bool finished() const { return state_.status == StepStatus::kFinished || state_.front >= model_.train_end; }
+  // Human-readable status, naming the DOF and time of a divergence.
+  std::string status_message() const;
+
+  // New pass from the start at the initial static state. The clock keeps running when
+  // keep_time is true (a live node must never move time backwards); commands stay in effect.
+  void reset(bool keep_time = true);
+
+  // Commands. On rejection they return false, fill `error` with the value and the allowed range,
+  // and leave the state untouched.
+  bool set_target_speed(double speed_mps, std::string* error);
+  bool set_max_acceleration(double accel_mps2, std::string* error);
+  // pantograph < 0: all pantographs.
+  bool set_uplift(int pantograph, double force_n, std::string* error);
+
+  static constexpr double kMaxSpeed = 150.0;   // m/s (540 km/h)
+  static constexpr double kMaxUplift = 1000.0;  // N
+
+ private:
+  Model model_;
+  State initial_;
+  State state_;
+};
+
+}  // namespace catenary_sim

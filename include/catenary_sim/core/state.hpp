@@ -1,0 +1,63 @@
+// The mutable state of a pass (MuJoCo's mjData to the Model's mjModel): displacements, half-step
+// velocities, train kinematics, commands in effect, the contact and dropper activity of the last
+// step, and preallocated workspace so that step() never allocates.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "catenary_sim/core/model.hpp"
+
+namespace catenary_sim {
+
+enum class StepStatus {
+  kOk = 0,
+  kDiverged,   // a displacement left the divergence limit or became NaN/inf: the run is stopped
+  kFinished,   // the train front reached the end of the pass; step() does nothing more
+};
+
+struct State {
+  double time = 0.0;       // s, simulation time since the pass started
+  std::int64_t steps = 0;
+  double front = 0.0;      // m, train front position along the line
+  double speed = 0.0;      // m/s, train speed now
+  double target_speed = 0.0;      // m/s, commanded speed the train accelerates toward
+  double max_acceleration = 0.0;  // m/s^2, |dv/dt| limit toward target_speed (0: jump)
+  std::vector<double> uplift;     // N, static uplift in effect per pantograph (eq. 9 thrust F)
+
+  // q of eq. 21 as displacements from the design state, and q_dot_{n-1/2} (eq. 20, 26).
+  Eigen::VectorXd u, v;
+
+  // Observations of the last step, at time t_n (before the update), which was observed_time with
+  // the train front at observed_front.
+  double observed_time = 0.0, observed_front = 0.0;
+  std::vector<double> contact_force;     // N, >= 0, per collector x contact wire (eq. 22, 25)
+  std::vector<double> collector_height;  // m, weighted wire height under each collector (eq. 12)
+  std::vector<std::uint8_t> dropper_slack;  // 1 where the dropper carried no tension
+
+  StepStatus status = StepStatus::kOk;
+  int diverged_dof = -1;
+
+  // Workspace, sized once by make_state().
+  Eigen::VectorXd force, z;
+  std::vector<double> theta;
+  std::vector<int> weight_node;
+  std::vector<double> weight;
+};
+
+// A state sized for the model with zero displacement (the design state, no pantograph force).
+State make_state(const Model& model);
+
+// Advances one fixed dt with the explicit central differences of eq. 19-21 (half-step velocity).
+// Never reads a clock, never allocates, never logs. Returns the state's status.
+StepStatus step(const Model& model, State& state);
+
+// Absolute height of a contact collector's pantograph head (m); NaN for a moving force.
+double head_height(const Model& model, const State& state, int pantograph);
+// Position of a pantograph's reference point along the line (m).
+double pantograph_position(const Model& model, const State& state, int pantograph);
+// Sum of the contact forces of one pantograph over its collectors and the contact wires (N).
+double total_contact_force(const Model& model, const State& state, int pantograph);
+
+}  // namespace catenary_sim

@@ -1,0 +1,59 @@
+// Pass statistics as EN 50318 / EN 50317 use them: contact force low-pass filtered (zero phase),
+// over an analysis section, per pantograph.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/model.hpp"
+#include "catenary_sim/core/state.hpp"
+
+namespace catenary_sim {
+
+struct ForceStatistics {
+  double mean = 0.0, std_dev = 0.0, max = 0.0, min = 0.0;  // N
+  double stat_max = 0.0, stat_min = 0.0;                   // N, mean +- 3 std_dev
+};
+
+struct PantographStatistics {
+  std::string name;
+  ForceStatistics filtered;    // contact force low-pass filtered at the cutoff (zero phase)
+  ForceStatistics unfiltered;  // as computed, at every step
+  double contact_loss_percent = 0.0;   // share of steps in the section with zero total force
+  double max_uplift_at_support_m = 0.0;  // largest steady-arm uplift in the section (NaN: no steady arms)
+  std::size_t samples = 0;
+};
+
+// Zero-phase low-pass: a 4th-order Butterworth run forward and backward (filtfilt), with odd
+// reflection padding at both ends. fs and fc in Hz.
+std::vector<double> lowpass_zero_phase(const std::vector<double>& x, double fs, double fc);
+
+ForceStatistics force_statistics(const std::vector<double>& x);
+
+// Records one pass at every step and reduces it to statistics and a decimated time series.
+class PassRecorder {
+ public:
+  PassRecorder(const Model& model, double sample_rate_hz = 0.0);
+  void record(const Model& model, const State& state);  // after each successful step()
+  std::vector<PantographStatistics> statistics(const Model& model) const;
+
+  // Time series at the output sample rate (every step when 0).
+  struct Row {
+    double time;
+    std::vector<double> values;
+  };
+  std::vector<std::string> columns() const { return columns_; }
+  const std::vector<Row>& rows() const { return rows_; }
+
+ private:
+  double sample_period_;
+  double next_sample_ = 0.0;
+  std::vector<std::string> columns_;
+  std::vector<Row> rows_;
+  std::vector<double> time_;
+  std::vector<std::vector<double>> position_, force_;  // per pantograph, every step
+  std::vector<int> steady_arm_springs_;                 // indices into model.springs
+  std::vector<std::vector<double>> max_uplift_;        // per pantograph, per steady arm
+};
+
+}  // namespace catenary_sim

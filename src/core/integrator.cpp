@@ -1,0 +1,158 @@
+// Explicit central differences with the half-step velocity (paper eq. 19-21, 26):
+//   v_{n+1/2} = v_{n-1/2} + dt M^-1 (R_n - K_n q_n - C_n v_{n-1/2} - phi^T lambda_n)
+//   q_{n+1}   = q_n + dt v_{n+1/2}
+// with C_n = alpha M + beta K_n (eq. 5), droppers switched by their tension every step, and the
+// massless collectors condensed: the collector sits on the weighted wire height (eq. 12) and its
+// spring k0 carries the contact force (eq. 22) while that force is compressive (eq. 25).
+#include <algorithm>
+#include <cmath>
+
+#include "catenary_sim/core/state.hpp"
+
+namespace catenary_sim {
+
+State make_state(const Model& m) {
+  State s;
+  s.u = Eigen::VectorXd::Zero(m.n_dof);
+  s.v = Eigen::VectorXd::Zero(m.n_dof);
+  s.force = Eigen::VectorXd::Zero(m.n_dof);
+  s.z = Eigen::VectorXd::Zero(m.n_dof);
+  int max_nodes = 1;
+  for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
+  s.theta.assign(max_nodes, 0.0);
+  s.weight_node.assign(m.max_contact_nodes, 0);
+  s.weight.assign(m.max_contact_nodes, 0.0);
+  s.contact_force.assign(m.collectors.size() * m.contact_wires.size(), 0.0);
+  s.collector_height.assign(m.collectors.size() * m.contact_wires.size(), 0.0);
+  s.dropper_slack.assign(m.droppers.size(), 0);
+  s.uplift.resize(m.pantographs.size());
+  for (std::size_t i = 0; i < m.pantographs.size(); ++i) s.uplift[i] = m.pantographs[i].static_uplift;
+  s.front = m.train_start;
+  s.speed = s.target_speed = m.scene.train_speed;
+  return s;
+}
+
+double pantograph_position(const Model& m, const State& s, int p) { return s.front - m.pantographs[p].position; }
+
+double head_height(const Model& m, const State& s, int p) {
+  const Pantograph& pg = m.pantographs[p];
+  if (pg.moving_force) return std::nan("");
+  return pg.reference_height + s.u[pg.first_dof];
+}
+
+double total_contact_force(const Model& m, const State& s, int p) {
+  double f = 0.0;
+  const std::size_t nw = m.contact_wires.size();
+  for (int ci : m.pantographs[p].collectors)
+    for (std::size_t k = 0; k < nw; ++k) f += s.contact_force[ci * nw + k];
+  return f;
+}
+
+StepStatus step(const Model& m, State& s) {
+  if (s.status != StepStatus::kOk) return s.status;
+  if (s.front >= m.train_end) {
+    s.status = StepStatus::kFinished;
+    return s.status;
+  }
+  const int n = m.n_dof, nc = m.n_catenary_dof;
+  const double dt = m.dt, beta = m.beta, alpha = m.alpha;
+  double* u = s.u.data();
+  double* v = s.v.data();
+  double* f = s.force.data();
+  double* z = s.z.data();
+  const double* load = m.load.data();
+  const double* mass = m.mass.data();
+
+  s.observed_time = s.time;
+  s.observed_front = s.front;
+  // Stiffness-proportional damping acts through K on z = q_n + beta q_dot_{n-1/2} (eq. 5, 19).
+  for (int i = 0; i < nc; ++i) {
+    z[i] = u[i] + beta * v[i];
+    f[i] = load[i] - alpha * mass[i] * v[i];
+  }
+  for (int i = nc; i < n; ++i) f[i] = 0.0;
+  for (const Wire& w : m.wires) wire_elastic_force(w, z, f, s.theta.data());
+  for (const SupportSpring& sp : m.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
+
+  // Droppers work only in tension; the switch is decided on the elastic stretch.
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+    const Dropper& d = m.droppers[k];
+    const double stretch = u[d.messenger_dof] - u[d.contact_dof];
+    const bool taut = d.static_tension + d.stiffness * stretch > 0.0;
+    s.dropper_slack[k] = !taut;
+    if (!taut) continue;
+    const double t = std::max(0.0, d.static_tension + d.stiffness * (z[d.messenger_dof] - z[d.contact_dof]));
+    f[d.contact_dof] += t;
+    f[d.messenger_dof] -= t;
+  }
+
+  // Pantographs: lumped chains (eq. 9), uplift on the lowest mass.
+  const double v2 = s.speed * s.speed;
+  const std::size_t nw = m.contact_wires.size();
+  for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
+    const Pantograph& p = m.pantographs[pi];
+    const double uplift = s.uplift[pi] + p.aero_coefficient * v2;
+    if (!p.moving_force) {
+      const int nm = p.masses_count(), a0 = p.first_dof;
+      for (int i = 0; i < nm; ++i) {
+        const int a = a0 + i;
+        const bool roof = i + 1 == nm;
+        const double ub = roof ? 0.0 : u[a + 1], vb = roof ? 0.0 : v[a + 1];
+        const double c = p.spring_preload[i] + p.stiffness[i] * (ub - u[a]) + p.damping[i] * (vb - v[a]);
+        f[a] += c;
+        if (!roof) f[a + 1] -= c;
+      }
+      f[a0 + nm - 1] += uplift;
+    }
+    const double head = p.moving_force ? 0.0 : p.reference_height + u[p.first_dof];
+    const double x_ref = s.front - p.position;
+    for (int ci : p.collectors) {
+      const double xc = x_ref + m.collectors[ci].offset;
+      for (std::size_t wk = 0; wk < nw; ++wk) {
+        const Wire& w = m.wires[m.contact_wires[wk]];
+        const std::size_t idx = ci * nw + wk;
+        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
+        double yw = 0.0;
+        for (int a = 0; a < cnt; ++a) yw += s.weight[a] * (w.height[s.weight_node[a]] + u[w.w_dof + s.weight_node[a]]);
+        s.collector_height[idx] = cnt ? yw : std::nan("");
+        double fc = 0.0;
+        if (cnt) {
+          if (p.moving_force) fc = wk == 0 ? uplift / p.collectors.size() : 0.0;
+          else fc = std::max(0.0, m.contact_stiffness * (head - yw));  // eq. 22 with eq. 25
+        }
+        s.contact_force[idx] = fc;
+        if (fc == 0.0) continue;
+        if (!p.moving_force) f[p.first_dof] -= fc;
+        for (int a = 0; a < cnt; ++a) f[w.w_dof + s.weight_node[a]] += fc * s.weight[a];
+      }
+    }
+  }
+
+  // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. Any displacement beyond
+  // the divergence limit (or NaN) stops the run before it is passed on.
+  const double* im = m.inv_mass.data();
+  const double limit = m.scene.numerics.divergence_limit;
+  int bad = -1;
+  for (int i = 0; i < n; ++i) {
+    const double vn = v[i] + dt * im[i] * f[i];
+    const double un = u[i] + dt * vn;
+    if (!(std::fabs(un) <= limit)) bad = i;
+    v[i] = vn;
+    u[i] = un;
+  }
+  if (bad >= 0) {
+    s.status = StepStatus::kDiverged;
+    s.diverged_dof = bad;
+    return s.status;
+  }
+
+  // Train kinematics: toward the commanded speed within the acceleration limit.
+  const double dv = s.target_speed - s.speed, dvmax = s.max_acceleration * dt;
+  s.speed = (s.max_acceleration <= 0.0 || std::fabs(dv) <= dvmax) ? s.target_speed : s.speed + std::copysign(dvmax, dv);
+  s.front += s.speed * dt;
+  s.time += dt;
+  ++s.steps;
+  return s.status;
+}
+
+}  // namespace catenary_sim

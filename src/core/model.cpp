@@ -1,0 +1,471 @@
+#include "catenary_sim/core/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "catenary_sim/core/beam.hpp"
+#include "catenary_sim/core/stability.hpp"
+#include "catenary_sim/core/statics.hpp"
+
+namespace catenary_sim {
+namespace {
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+// Node stations: every support and dropper is a node; the segments between them are split into
+// equal elements no longer than the requested length.
+std::vector<double> mesh_stations(const Scene& s, std::vector<double>& support_x) {
+  std::vector<double> breaks;
+  double x0 = 0.0;
+  support_x.assign(1, 0.0);
+  for (std::size_t i = 0; i < s.spans.size(); ++i) {
+    breaks.push_back(x0);
+    if (s.droppers)
+      for (double p : s.droppers->positions[i]) breaks.push_back(x0 + p);
+    x0 += s.spans[i];
+    support_x.push_back(x0);
+  }
+  breaks.push_back(x0);
+  std::vector<double> x;
+  for (std::size_t i = 0; i + 1 < breaks.size(); ++i) {
+    const double len = breaks[i + 1] - breaks[i];
+    const int n = std::max(1, static_cast<int>(std::ceil(len / s.numerics.element_length - 1e-9)));
+    for (int k = 0; k < n; ++k) x.push_back(breaks[i] + len * k / n);
+  }
+  x.push_back(x0);
+  return x;
+}
+
+int node_at(const std::vector<double>& x, double xs) {
+  const auto it = std::lower_bound(x.begin(), x.end(), xs - 1e-9);
+  return static_cast<int>(it - x.begin());
+}
+
+void assemble_band(Wire& w) {
+  const int n = w.nodes();
+  w.d_ww.assign(n, 0.0);
+  w.d_wt.assign(n, 0.0);
+  w.d_tt.assign(n, 0.0);
+  w.e_ww.assign(n - 1, 0.0);
+  w.e_wt.assign(n - 1, 0.0);
+  w.e_tw.assign(n - 1, 0.0);
+  w.e_tt.assign(n - 1, 0.0);
+  for (int e = 0; e + 1 < n; ++e) {
+    const Matrix4 k = beam_stiffness(w.x[e + 1] - w.x[e], w.spec.bending_stiffness, w.spec.tension);
+    w.d_ww[e] += k[0][0];
+    w.d_wt[e] += k[0][1];
+    w.d_tt[e] += k[1][1];
+    w.d_ww[e + 1] += k[2][2];
+    w.d_wt[e + 1] += k[2][3];
+    w.d_tt[e + 1] += k[3][3];
+    w.e_ww[e] = k[0][2];
+    w.e_wt[e] = k[0][3];
+    w.e_tw[e] = k[1][2];
+    w.e_tt[e] = k[1][3];
+  }
+  // LDL^T of the tridiagonal K_theta_theta, for condensing massless rotations.
+  w.tt_inv_pivot.assign(n, 0.0);
+  w.tt_lower.assign(n, 0.0);
+  double d = w.d_tt[0];
+  w.tt_inv_pivot[0] = 1.0 / d;
+  for (int i = 1; i < n; ++i) {
+    const double l = w.e_tt[i - 1] / d;
+    d = w.d_tt[i] - l * w.e_tt[i - 1];
+    w.tt_lower[i] = l;
+    w.tt_inv_pivot[i] = 1.0 / d;
+  }
+}
+
+}  // namespace
+
+int Wire::element_at(double xs) const {
+  const int n = nodes();
+  const auto it = std::upper_bound(x.begin(), x.end(), xs);
+  const int e = static_cast<int>(it - x.begin()) - 1;
+  return std::clamp(e, 0, n - 2);
+}
+
+void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta) {
+  const int n = wire.nodes();
+  const double* w = z + wire.w_dof;
+  double* fw = f + wire.w_dof;
+  const double* dww = wire.d_ww.data();
+  const double* dwt = wire.d_wt.data();
+  const double* eww = wire.e_ww.data();
+  const double* ewt = wire.e_wt.data();
+  const double* etw = wire.e_tw.data();
+  const double* t;
+  if (wire.theta_dof < 0) {
+    // Massless rotations, condensed exactly: K_tt theta = -K_tw w (tridiagonal, LDL^T reused).
+    const double* lo = wire.tt_lower.data();
+    const double* ip = wire.tt_inv_pivot.data();
+    double prev = 0.0;
+    for (int i = 0; i < n; ++i) {
+      double r = -dwt[i] * w[i];
+      if (i + 1 < n) r -= etw[i] * w[i + 1];
+      if (i > 0) r -= ewt[i - 1] * w[i - 1];
+      prev = r - lo[i] * prev;
+      theta[i] = prev;
+    }
+    theta[n - 1] *= ip[n - 1];
+    for (int i = n - 2; i >= 0; --i) theta[i] = theta[i] * ip[i] - lo[i + 1] * theta[i + 1];
+    t = theta;
+  } else {
+    t = z + wire.theta_dof;
+    double* ft = f + wire.theta_dof;
+    const double* dtt = wire.d_tt.data();
+    const double* ett = wire.e_tt.data();
+    for (int i = 0; i < n; ++i) ft[i] -= dwt[i] * w[i] + dtt[i] * t[i];
+    for (int e = 0; e + 1 < n; ++e) {
+      ft[e] -= etw[e] * w[e + 1] + ett[e] * t[e + 1];
+      ft[e + 1] -= ewt[e] * w[e] + ett[e] * t[e];
+    }
+    std::copy(t, t + n, theta);
+  }
+  fw[0] -= dww[0] * w[0] + dwt[0] * t[0];
+  for (int i = 1; i < n; ++i) {
+    const int e = i - 1;
+    fw[i] -= dww[i] * w[i] + dwt[i] * t[i] + eww[e] * w[e] + etw[e] * t[e];
+    fw[e] -= eww[e] * w[i] + ewt[e] * t[i];
+  }
+}
+
+int contact_weights(const Wire& wire, double rub_length, double xc, int* node, double* weight) {
+  const double x0 = wire.x.front(), x1 = wire.x.back();
+  if (rub_length <= 0.0) {
+    if (xc < x0 || xc > x1) return 0;
+    const int e = wire.element_at(xc);
+    const double xi = (xc - wire.x[e]) / (wire.x[e + 1] - wire.x[e]);
+    node[0] = e;
+    node[1] = e + 1;
+    weight[0] = 1.0 - xi;
+    weight[1] = xi;
+    return 2;
+  }
+  const double a = xc - 0.5 * rub_length, b = xc + 0.5 * rub_length;
+  if (b <= x0 || a >= x1) return 0;
+  const int ea = wire.element_at(a), eb = wire.element_at(b);
+  const int count = eb - ea + 2;
+  for (int k = 0; k < count; ++k) {
+    node[k] = ea + k;
+    weight[k] = 0.0;
+  }
+  // Exact integrals of f(s) = (1 + cos(2 pi s / l)) / l (eq. 13) against the linear
+  // interpolation of the wire between nodes.
+  const double kw = 2.0 * M_PI / rub_length, il = 1.0 / rub_length;
+  auto F0 = [&](double s) { return (s + std::sin(kw * s) / kw) * il; };
+  auto F1 = [&](double s) { return (0.5 * s * s + s * std::sin(kw * s) / kw + std::cos(kw * s) / (kw * kw)) * il; };
+  double total = 0.0;
+  for (int e = ea; e <= eb; ++e) {
+    const double xa = wire.x[e], xb = wire.x[e + 1];
+    const double s1 = std::max(a, xa) - xc, s2 = std::min(b, xb) - xc;
+    if (s2 <= s1) continue;
+    const double i0 = F0(s2) - F0(s1), i1 = F1(s2) - F1(s1);
+    const double right = (i1 + (xc - xa) * i0) / (xb - xa);
+    weight[e - ea] += i0 - right;
+    weight[e - ea + 1] += right;
+    total += i0;
+  }
+  if (total <= 1e-12) return 0;
+  // Renormalise where the rub zone hangs over the end of the wire, so that eq. 11 holds.
+  for (int k = 0; k < count; ++k) weight[k] /= total;
+  return count;
+}
+
+void apply_stiffness(const Model& m, double front, const double* x, double* y, double* scratch) {
+  std::fill(y, y + m.n_dof, 0.0);
+  for (const Wire& w : m.wires) wire_elastic_force(w, x, y, scratch);  // y = -K x so far
+  for (const SupportSpring& s : m.springs) y[s.dof] -= s.stiffness * x[s.dof];
+  for (const Dropper& d : m.droppers) {
+    const double t = d.stiffness * (x[d.messenger_dof] - x[d.contact_dof]);
+    y[d.contact_dof] += t;
+    y[d.messenger_dof] -= t;
+  }
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  for (const Pantograph& p : m.pantographs) {
+    if (p.moving_force) continue;
+    for (int i = 0; i < p.masses_count(); ++i) {
+      const int a = p.first_dof + i;
+      const double below = i + 1 < p.masses_count() ? x[a + 1] : 0.0;
+      const double c = p.stiffness[i] * (below - x[a]);
+      y[a] += c;
+      if (i + 1 < p.masses_count()) y[a + 1] -= c;
+    }
+    for (int ci : p.collectors) {
+      const double xc = front - p.position + m.collectors[ci].offset;
+      for (int wi : m.contact_wires) {
+        const Wire& w = m.wires[wi];
+        const int n = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+        double yw = 0.0;
+        for (int k = 0; k < n; ++k) yw += weight[k] * x[w.w_dof + node[k]];
+        if (n == 0) continue;
+        const double f = m.contact_stiffness * (x[p.first_dof] - yw);
+        y[p.first_dof] -= f;
+        for (int k = 0; k < n; ++k) y[w.w_dof + node[k]] += f * weight[k];
+      }
+    }
+  }
+  for (int i = 0; i < m.n_dof; ++i) y[i] = -y[i];
+}
+
+Model build_model(const Scene& scene) {
+  validate(scene);
+  Model m;
+  m.scene = scene;
+  const bool lumped_rot = scene.numerics.rotary_inertia == RotaryInertia::kLumped;
+  const std::vector<double> x = mesh_stations(scene, m.support_x);
+  const int n = static_cast<int>(x.size());
+  m.line_length = scene.line_length();
+  m.alpha = scene.rayleigh_alpha;
+  m.beta = scene.rayleigh_beta;
+  m.contact_stiffness = scene.contact.stiffness;
+  m.rub_length = scene.contact.rub_length;
+
+  // DOF layout: per wire the vertical displacements, then (lumped rotary inertia only) the
+  // rotations; the pantograph masses last.
+  int dof = 0;
+  auto add_wire = [&](const std::string& name, const WireSpec& spec, bool contact) {
+    Wire w;
+    w.name = name;
+    w.is_contact_wire = contact;
+    w.spec = spec;
+    w.x = x;
+    w.w_dof = dof;
+    dof += n;
+    if (lumped_rot) {
+      w.theta_dof = dof;
+      dof += n;
+    }
+    for (double sx : m.support_x) w.support_nodes.push_back(node_at(x, sx));
+    assemble_band(w);
+    m.wires.push_back(std::move(w));
+  };
+  add_wire("contact_wire", scene.contact_wire, true);
+  m.contact_wires.push_back(0);
+  if (scene.messenger) add_wire("messenger", *scene.messenger, false);
+  m.n_catenary_dof = dof;
+
+  for (std::size_t i = 0; i < scene.pantographs.size(); ++i) {
+    const PantographSpec& ps = scene.pantographs[i];
+    Pantograph p;
+    p.name = ps.name;
+    p.position = ps.position;
+    p.moving_force = ps.moving_force;
+    p.masses = ps.masses;
+    p.stiffness = ps.stiffness;
+    p.damping = ps.damping;
+    p.static_uplift = ps.static_uplift;
+    p.aero_coefficient = ps.aero_coefficient;
+    if (!p.moving_force) {
+      p.first_dof = dof;
+      dof += p.masses_count();
+    }
+    for (const CollectorSpec& c : ps.collectors) {
+      p.collectors.push_back(static_cast<int>(m.collectors.size()));
+      m.collectors.push_back(Collector{static_cast<int>(i), c.offset});
+    }
+    m.pantographs.push_back(std::move(p));
+  }
+  m.n_dof = dof;
+
+  // Lumped masses (HRZ for the beams) and which DOFs are held rigidly.
+  m.mass = Eigen::VectorXd::Zero(dof);
+  std::vector<bool> fixed(dof, false);
+  const double g = scene.gravity;
+  for (Wire& w : m.wires) {
+    for (int e = 0; e + 1 < n; ++e) {
+      const double he = x[e + 1] - x[e];
+      m.mass[w.w_dof + e] += beam_translational_mass(he, w.spec.linear_mass);
+      m.mass[w.w_dof + e + 1] += beam_translational_mass(he, w.spec.linear_mass);
+      if (lumped_rot) {
+        m.mass[w.theta_dof + e] += beam_rotary_mass(he, w.spec.linear_mass);
+        m.mass[w.theta_dof + e + 1] += beam_rotary_mass(he, w.spec.linear_mass);
+      }
+    }
+    const bool contact = w.is_contact_wire;
+    const std::optional<SupportSpec>& spring = contact ? scene.steady_arms : scene.messenger_supports;
+    const int ns = static_cast<int>(w.support_nodes.size());
+    for (int k = 0; k < ns; ++k) {
+      const int node = w.support_nodes[k];
+      const bool end = k == 0 || k == ns - 1;  // anchors of the tension section
+      if (end || !spring) {
+        fixed[w.w_dof + node] = true;
+      } else {
+        m.mass[w.w_dof + node] += spring->mass;
+        m.springs.push_back(SupportSpring{w.w_dof + node, spring->stiffness, 0.0, x[node], k, contact});
+      }
+    }
+  }
+
+  // Droppers: nodes and clamp masses; lengths and tensions come from the design statics below.
+  const Wire* cw = &m.wires[0];
+  const Wire* mw = scene.messenger ? &m.wires[1] : nullptr;
+  if (scene.droppers) {
+    const DropperSpec& ds = *scene.droppers;
+    for (std::size_t i = 0; i < scene.spans.size(); ++i)
+      for (double p : ds.positions[i]) {
+        const double xd = m.support_x[i] + p;
+        const int node = node_at(x, xd);
+        Dropper d;
+        d.x = xd;
+        d.contact_dof = cw->w_dof + node;
+        d.messenger_dof = mw->w_dof + node;
+        m.mass[d.contact_dof] += ds.clamp_mass_contact;
+        m.mass[d.messenger_dof] += ds.clamp_mass_messenger;
+        m.droppers.push_back(d);
+      }
+  }
+
+  // Design statics. The contact wire is held at the supports and, at every dropper, at the
+  // presag height; the reactions there are the dropper tensions. The messenger carries those
+  // tensions and the dropper weight to its supports. Dropper weight depends on the dropper length,
+  // which depends on the messenger sag: a few fixed-point passes settle it.
+  const double H = scene.contact_wire_height;
+  auto presag_at = [&](double xs) {
+    const int span = std::clamp(static_cast<int>(std::upper_bound(m.support_x.begin(), m.support_x.end(), xs) - m.support_x.begin()) - 1,
+                                0, static_cast<int>(scene.spans.size()) - 1);
+    const double s = (xs - m.support_x[span]) / scene.spans[span];
+    return scene.contact_wire.presag * 4.0 * s * (1.0 - s);
+  };
+  std::vector<double> weight_len(m.droppers.size(), scene.encumbrance);  // lengths the weights use
+  std::vector<double> dropper_len = weight_len;                          // geometric lengths
+  const double dropper_mu = scene.droppers ? scene.droppers->linear_mass : 0.0;
+  std::vector<double> cw_react, mw_react;
+  const int passes = m.droppers.empty() ? 1 : 4;
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<double> load(n);
+    for (int i = 0; i < n; ++i) load[i] = -g * m.mass[cw->w_dof + i];
+    std::vector<int> pn;
+    std::vector<double> ph;
+    for (int sn : cw->support_nodes) {
+      pn.push_back(sn);
+      ph.push_back(H);
+    }
+    for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+      const int node = m.droppers[k].contact_dof - cw->w_dof;
+      load[node] -= 0.5 * g * dropper_mu * weight_len[k];
+      pn.push_back(node);
+      ph.push_back(H - presag_at(m.droppers[k].x));
+    }
+    Wire& cwm = m.wires[0];
+    solve_wire_statics(cwm, load, pn, ph, cwm.height, cwm.slope, cw_react);
+    if (!mw) break;
+    const std::size_t ns = cw->support_nodes.size();
+    std::vector<double> mload(n);
+    for (int i = 0; i < n; ++i) mload[i] = -g * m.mass[mw->w_dof + i];
+    for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+      Dropper& d = m.droppers[k];
+      d.static_tension = cw_react[ns + k];
+      mload[d.messenger_dof - mw->w_dof] -= d.static_tension + 0.5 * g * dropper_mu * weight_len[k];
+    }
+    std::vector<int> mpn(mw->support_nodes.begin(), mw->support_nodes.end());
+    std::vector<double> mph(mpn.size(), H + scene.encumbrance);
+    Wire& mwm = m.wires[1];
+    solve_wire_statics(mwm, mload, mpn, mph, mwm.height, mwm.slope, mw_react);
+    for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+      const int node = m.droppers[k].contact_dof - cw->w_dof;
+      dropper_len[k] = mwm.height[node] - cwm.height[node];
+    }
+    if (pass + 1 < passes) weight_len = dropper_len;
+  }
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+    Dropper& d = m.droppers[k];
+    d.length = dropper_len[k];
+    if (d.length <= 0.01)
+      throw SceneError("droppers: at x = " + fmt(d.x) + " m the messenger hangs " + fmt(-d.length) +
+                       " m below the contact wire (dropper length " + fmt(d.length) +
+                       " m): raise line.encumbrance or the messenger tension, or reduce the presag");
+    if (d.static_tension <= 0.0)
+      throw SceneError("droppers: at x = " + fmt(d.x) + " m the dropper would have to push (static force " +
+                       fmt(d.static_tension) + " N): contact_wire.presag " + fmt(scene.contact_wire.presag) +
+                       " m is not reachable with tension-only droppers; reduce it");
+    d.unstretched_length = d.length / (1.0 + d.static_tension / scene.droppers->axial_stiffness);
+    d.stiffness = scene.droppers->axial_stiffness / d.unstretched_length;
+    // Half the dropper's mass on each end (the length its weight had in the statics, so that the
+    // design state is an exact equilibrium).
+    m.mass[d.contact_dof] += 0.5 * dropper_mu * weight_len[k];
+    m.mass[d.messenger_dof] += 0.5 * dropper_mu * weight_len[k];
+  }
+  // Support preloads f0 of eq. 4: the static reactions at the elastic supports.
+  for (SupportSpring& s : m.springs) s.static_force = (s.steady_arm ? cw_react : mw_react)[s.span_index];
+
+  // Constant load: gravity + support preloads - K y_design. At u = 0 it balances the static
+  // dropper tensions exactly (that is what the design statics solved for).
+  m.load = Eigen::VectorXd::Zero(dof);
+  for (const Wire& w : m.wires)
+    for (int i = 0; i < n; ++i) m.load[w.w_dof + i] -= g * m.mass[w.w_dof + i];
+  for (const SupportSpring& s : m.springs) m.load[s.dof] += s.static_force;
+  {
+    std::vector<double> scratch(n);
+    for (const Wire& w : m.wires) {
+      Wire full = w;  // with explicit rotations so that K acts on the design slopes too
+      Eigen::VectorXd yfull = Eigen::VectorXd::Zero(2 * n), ffull = Eigen::VectorXd::Zero(2 * n);
+      full.w_dof = 0;
+      full.theta_dof = n;
+      for (int i = 0; i < n; ++i) {
+        yfull[i] = w.height[i];
+        yfull[n + i] = w.slope[i];
+      }
+      wire_elastic_force(full, yfull.data(), ffull.data(), scratch.data());
+      for (int i = 0; i < n; ++i) m.load[w.w_dof + i] += ffull[i];
+    }
+  }
+  for (int i = 0; i < dof; ++i)
+    if (fixed[i]) m.load[i] = 0.0;
+
+  // Pantographs: unit-less references are set by the initial statics in the Simulation.
+  int max_nodes = 2;
+  double hmin = 1e9;
+  for (int e = 0; e + 1 < n; ++e) hmin = std::min(hmin, x[e + 1] - x[e]);
+  if (m.rub_length > 0.0) max_nodes = static_cast<int>(std::ceil(m.rub_length / hmin)) + 3;
+  m.max_contact_nodes = max_nodes;
+  for (Pantograph& p : m.pantographs)
+    for (int i = 0; i < p.masses_count(); ++i) m.mass[p.first_dof + i] = p.masses[i];
+
+  m.inv_mass = Eigen::VectorXd::Zero(dof);
+  for (int i = 0; i < dof; ++i) {
+    if (fixed[i]) continue;
+    if (!(m.mass[i] > 0.0))
+      throw SceneError("model: DOF " + std::to_string(i) + " has no mass; check linear_mass and masses");
+    m.inv_mass[i] = 1.0 / m.mass[i];
+  }
+  m.wave_speed = std::sqrt(scene.contact_wire.tension / scene.contact_wire.linear_mass);
+
+  // Train travel: by default from the rearmost collector at the line start to the foremost at
+  // the line end.
+  double lead = -1e300, rear = 1e300;
+  for (const Collector& c : m.collectors) {
+    const double off = c.offset - m.pantographs[c.pantograph].position;  // collector x - front
+    lead = std::max(lead, off);
+    rear = std::min(rear, off);
+  }
+  if (m.collectors.empty()) lead = rear = 0.0;
+  m.train_start = scene.train_start ? *scene.train_start : -rear;
+  m.train_end = scene.train_end ? *scene.train_end : m.line_length - lead;
+  if (m.train_end < m.train_start)
+    throw SceneError("train: the pass would end (front at " + fmt(m.train_end) + " m) before it starts (" +
+                     fmt(m.train_start) + " m): the pantographs are further apart than the line is long");
+
+  // Initial pantograph references (eq. 23) and the stability limit (validation.md section 5).
+  set_pantograph_references(m);
+  compute_stability_limit(m);
+  if (scene.numerics.dt) {
+    if (*scene.numerics.dt > m.dt_critical)
+      throw SceneError("numerics.dt = " + fmt(*scene.numerics.dt) + " s: above the explicit stability limit " +
+                       fmt(m.dt_critical) + " s of this model (omega_max " + fmt(m.omega_max) +
+                       " rad/s); use dt <= " + fmt(m.dt_critical) + " or dt: auto");
+    m.dt = *scene.numerics.dt;
+  } else {
+    m.dt = scene.numerics.safety_factor * m.dt_critical;
+  }
+  return m;
+}
+
+}  // namespace catenary_sim

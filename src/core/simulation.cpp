@@ -1,0 +1,95 @@
+#include "catenary_sim/core/simulation.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "catenary_sim/core/statics.hpp"
+
+namespace catenary_sim {
+
+Simulation::Simulation(const Scene& scene) : model_(build_model(scene)) {
+  initial_ = make_state(model_);
+  solve_initial_state(model_, initial_);
+  state_ = initial_;
+}
+
+std::string Simulation::status_message() const {
+  std::ostringstream s;
+  switch (state_.status) {
+    case StepStatus::kOk:
+      s << "running";
+      break;
+    case StepStatus::kFinished:
+      s << "pass finished at t = " << state_.time << " s (train front at " << state_.front << " m)";
+      break;
+    case StepStatus::kDiverged: {
+      const int d = state_.diverged_dof;
+      std::string where = "DOF " + std::to_string(d);
+      for (const Wire& w : model_.wires)
+        if (d >= w.w_dof && d < w.w_dof + w.nodes())
+          where = w.name + " at x = " + std::to_string(w.x[d - w.w_dof]) + " m";
+      for (const Pantograph& p : model_.pantographs)
+        if (!p.moving_force && d >= p.first_dof && d < p.first_dof + p.masses_count())
+          where = "pantograph " + p.name + " mass " + std::to_string(d - p.first_dof);
+      s << "diverged at t = " << state_.time << " s: displacement of " << where << " is "
+        << state_.u[d] << " m (limit " << model_.scene.numerics.divergence_limit
+        << " m); the run was stopped. Reduce numerics.dt (limit " << model_.dt_critical << " s) or check the scene";
+      break;
+    }
+  }
+  return s.str();
+}
+
+void Simulation::reset(bool keep_time) {
+  const double t = state_.time;
+  const std::int64_t n = state_.steps;
+  const double target = state_.target_speed, accel = state_.max_acceleration;
+  const std::vector<double> uplift = state_.uplift;
+  state_ = initial_;
+  state_.uplift = uplift;
+  state_.target_speed = state_.speed = target;
+  state_.max_acceleration = accel;
+  if (uplift != initial_.uplift) solve_initial_state(model_, state_);
+  if (keep_time) {
+    state_.time = t;
+    state_.steps = n;
+  }
+}
+
+bool Simulation::set_target_speed(double v, std::string* error) {
+  if (!std::isfinite(v) || v < 0.0 || v > kMaxSpeed) {
+    if (error) *error = "train speed " + std::to_string(v) + " m/s rejected: allowed 0 to " + std::to_string(kMaxSpeed) + " m/s";
+    return false;
+  }
+  state_.target_speed = v;
+  return true;
+}
+
+bool Simulation::set_max_acceleration(double a, std::string* error) {
+  if (!std::isfinite(a) || a < 0.0 || a > 20.0) {
+    if (error) *error = "max acceleration " + std::to_string(a) + " m/s^2 rejected: allowed 0 (no limit) to 20 m/s^2";
+    return false;
+  }
+  state_.max_acceleration = a;
+  return true;
+}
+
+bool Simulation::set_uplift(int p, double f, std::string* error) {
+  const int np = static_cast<int>(model_.pantographs.size());
+  if (p >= np) {
+    if (error) *error = "pantograph index " + std::to_string(p) + " rejected: the scene has " + std::to_string(np);
+    return false;
+  }
+  if (!std::isfinite(f) || f < 0.0 || f > kMaxUplift) {
+    if (error) *error = "uplift force " + std::to_string(f) + " N rejected: allowed 0 to " + std::to_string(kMaxUplift) + " N";
+    return false;
+  }
+  if (p < 0) {
+    for (double& u : state_.uplift) u = f;
+  } else {
+    state_.uplift[p] = f;
+  }
+  return true;
+}
+
+}  // namespace catenary_sim

@@ -1,0 +1,167 @@
+#include "catenary_sim/core/statistics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace catenary_sim {
+namespace {
+
+struct Biquad {
+  double b0, b1, b2, a1, a2;
+};
+
+// One pass of a biquad cascade (direct form II transposed), started in the steady state of the
+// first sample so that the ends do not ring.
+void run_cascade(const std::vector<Biquad>& cascade, std::vector<double>& x) {
+  if (x.empty()) return;
+  for (const Biquad& q : cascade) {
+    const double x0 = x.front();
+    double z2 = (q.b2 - q.a2) * x0;
+    double z1 = (q.b1 - q.a1) * x0 + z2;
+    for (double& xi : x) {
+      const double in = xi;
+      const double y = q.b0 * in + z1;
+      z1 = q.b1 * in - q.a1 * y + z2;
+      z2 = q.b2 * in - q.a2 * y;
+      xi = y;
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<double> lowpass_zero_phase(const std::vector<double>& x, double fs, double fc) {
+  const std::size_t n = x.size();
+  if (n < 3 || fc >= 0.5 * fs) return x;
+  // 4th-order Butterworth as two bilinear (pre-warped) sections with Q = 1/(2 cos(pi/8)) and
+  // 1/(2 cos(3 pi/8)).
+  std::vector<Biquad> cascade;
+  const double w0 = 2.0 * M_PI * fc / fs, cw = std::cos(w0), sw = std::sin(w0);
+  for (double q : {1.0 / (2.0 * std::cos(M_PI / 8.0)), 1.0 / (2.0 * std::cos(3.0 * M_PI / 8.0))}) {
+    const double al = sw / (2.0 * q), a0 = 1.0 + al;
+    cascade.push_back(Biquad{(1.0 - cw) / 2.0 / a0, (1.0 - cw) / a0, (1.0 - cw) / 2.0 / a0, -2.0 * cw / a0,
+                             (1.0 - al) / a0});
+  }
+  // Odd reflection about each end over a few time constants of the filter.
+  const std::size_t pad = std::min(n - 1, static_cast<std::size_t>(std::ceil(3.0 * fs / fc)));
+  std::vector<double> y;
+  y.reserve(n + 2 * pad);
+  for (std::size_t i = pad; i >= 1; --i) y.push_back(2.0 * x.front() - x[i]);
+  y.insert(y.end(), x.begin(), x.end());
+  for (std::size_t i = 1; i <= pad; ++i) y.push_back(2.0 * x.back() - x[n - 1 - i]);
+  run_cascade(cascade, y);
+  std::reverse(y.begin(), y.end());
+  run_cascade(cascade, y);
+  std::reverse(y.begin(), y.end());
+  return std::vector<double>(y.begin() + pad, y.begin() + pad + n);
+}
+
+ForceStatistics force_statistics(const std::vector<double>& x) {
+  ForceStatistics s;
+  if (x.empty()) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    s.mean = s.std_dev = s.max = s.min = s.stat_max = s.stat_min = nan;
+    return s;
+  }
+  double sum = 0.0;
+  s.max = -std::numeric_limits<double>::infinity();
+  s.min = std::numeric_limits<double>::infinity();
+  for (double v : x) {
+    sum += v;
+    s.max = std::max(s.max, v);
+    s.min = std::min(s.min, v);
+  }
+  s.mean = sum / x.size();
+  double var = 0.0;
+  for (double v : x) var += (v - s.mean) * (v - s.mean);
+  s.std_dev = std::sqrt(var / x.size());
+  s.stat_max = s.mean + 3.0 * s.std_dev;
+  s.stat_min = s.mean - 3.0 * s.std_dev;
+  return s;
+}
+
+PassRecorder::PassRecorder(const Model& m, double sample_rate_hz)
+    : sample_period_(sample_rate_hz > 0.0 ? 1.0 / sample_rate_hz : 0.0) {
+  const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
+  position_.resize(np);
+  force_.resize(np);
+  for (std::size_t k = 0; k < m.springs.size(); ++k)
+    if (m.springs[k].steady_arm) steady_arm_springs_.push_back(static_cast<int>(k));
+  max_uplift_.assign(np, std::vector<double>(steady_arm_springs_.size(), -std::numeric_limits<double>::infinity()));
+  for (const Pantograph& p : m.pantographs) {
+    columns_.push_back(p.name + "_position_m");
+    for (std::size_t c = 0; c < p.collectors.size(); ++c)
+      for (std::size_t w = 0; w < nw; ++w)
+        columns_.push_back(p.name + "_collector" + std::to_string(c) +
+                           (nw > 1 ? "_" + m.wires[m.contact_wires[w]].name + std::to_string(w) : std::string()) + "_force_N");
+    columns_.push_back(p.name + "_force_N");
+    columns_.push_back(p.name + "_head_displacement_m");
+  }
+  for (int k : steady_arm_springs_)
+    columns_.push_back("uplift_steady_arm" + std::to_string(m.springs[k].span_index) + "_m");
+}
+
+void PassRecorder::record(const Model& m, const State& s) {
+  const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
+  time_.push_back(s.observed_time);
+  for (std::size_t p = 0; p < np; ++p) {
+    const double xp = s.observed_front - m.pantographs[p].position;
+    position_[p].push_back(xp);
+    force_[p].push_back(total_contact_force(m, s, static_cast<int>(p)));
+    for (std::size_t k = 0; k < steady_arm_springs_.size(); ++k) {
+      const SupportSpring& sp = m.springs[steady_arm_springs_[k]];
+      const int span = sp.span_index;
+      const double reach = 0.5 * std::min(m.scene.spans[span - 1], m.scene.spans[span]);
+      if (std::fabs(xp - sp.x) <= reach) max_uplift_[p][k] = std::max(max_uplift_[p][k], s.u[sp.dof]);
+    }
+  }
+  if (sample_period_ > 0.0 && s.observed_time + 1e-12 < next_sample_) return;
+  next_sample_ += sample_period_;
+  Row row{s.observed_time, {}};
+  row.values.reserve(columns_.size());
+  for (std::size_t p = 0; p < np; ++p) {
+    const Pantograph& pg = m.pantographs[p];
+    row.values.push_back(position_[p].back());
+    for (int ci : pg.collectors)
+      for (std::size_t w = 0; w < nw; ++w) row.values.push_back(s.contact_force[ci * nw + w]);
+    row.values.push_back(force_[p].back());
+    row.values.push_back(pg.moving_force ? 0.0 : s.u[pg.first_dof]);
+  }
+  for (int k : steady_arm_springs_) row.values.push_back(s.u[m.springs[k].dof]);
+  rows_.push_back(std::move(row));
+}
+
+std::vector<PantographStatistics> PassRecorder::statistics(const Model& m) const {
+  std::vector<PantographStatistics> out;
+  const double x0 = m.support_x[m.scene.analysis_first()], x1 = m.support_x[m.scene.analysis_last()];
+  const double fs = 1.0 / m.dt;
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    PantographStatistics st;
+    st.name = m.pantographs[p].name;
+    const std::vector<double> filtered = lowpass_zero_phase(force_[p], fs, m.scene.output.filter_cutoff);
+    std::vector<double> f_in, raw_in;
+    std::size_t lost = 0;
+    for (std::size_t i = 0; i < force_[p].size(); ++i) {
+      const double x = position_[p][i];
+      if (x < x0 || x > x1) continue;
+      f_in.push_back(filtered[i]);
+      raw_in.push_back(force_[p][i]);
+      lost += force_[p][i] <= 0.0;
+    }
+    st.samples = raw_in.size();
+    st.filtered = force_statistics(f_in);
+    st.unfiltered = force_statistics(raw_in);
+    st.contact_loss_percent = raw_in.empty() ? std::nan("") : 100.0 * lost / raw_in.size();
+    double up = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < steady_arm_springs_.size(); ++k) {
+      const double xs = m.springs[steady_arm_springs_[k]].x;
+      if (xs >= x0 - 1e-9 && xs <= x1 + 1e-9) up = std::max(up, max_uplift_[p][k]);
+    }
+    st.max_uplift_at_support_m = std::isfinite(up) ? up : std::nan("");
+    out.push_back(st);
+  }
+  return out;
+}
+
+}  // namespace catenary_sim
