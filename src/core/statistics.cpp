@@ -122,7 +122,7 @@ void PassRecorder::record(const Model& m, const State& s) {
   row.values.reserve(columns_.size());
   for (std::size_t p = 0; p < np; ++p) {
     const Pantograph& pg = m.pantographs[p];
-    row.values.push_back(position_[p].back());
+    row.values.push_back(position_[p].back() + 0.0);  // + 0.0: no "-0" in the CSV
     for (int ci : pg.collectors)
       for (std::size_t w = 0; w < nw; ++w) row.values.push_back(s.contact_force[ci * nw + w]);
     row.values.push_back(force_[p].back());

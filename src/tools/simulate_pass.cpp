@@ -1,0 +1,211 @@
+// simulate_pass: one offline pass of a scene, no ROS master needed.
+//   simulate_pass --scene FILE [--speed KMH] [--set key=value ...] --out DIR
+// Prints a summary, writes DIR/stats.json and DIR/timeseries.csv.
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <chrono>
+#include <memory>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/simulation.hpp"
+#include "catenary_sim/core/statistics.hpp"
+
+using namespace catenary_sim;
+
+namespace {
+
+const char* kUsage =
+    "usage: simulate_pass --scene FILE [--speed KMH] [--set key=value ...] --out DIR\n"
+    "  --scene FILE     scene YAML (see README.md, e.g. config/reference_55m.yaml)\n"
+    "  --speed KMH      train speed in km/h (overrides train.speed / train.speed_kmh)\n"
+    "  --set key=value  override a scene field, e.g. --set numerics.element_length=0.125\n"
+    "  --out DIR        output directory for stats.json and timeseries.csv (created)\n"
+    "  --quiet          print only errors\n";
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream s;
+  s << std::setprecision(10) << v;
+  return s.str();
+}
+
+bool make_dirs(const std::string& path) {
+  std::string cur;
+  std::stringstream ss(path);
+  if (!path.empty() && path[0] == '/') cur = "/";
+  for (std::string part; std::getline(ss, part, '/');) {
+    if (part.empty()) continue;
+    cur += part + "/";
+    if (mkdir(cur.c_str(), 0755) != 0 && errno != EEXIST) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scene_path, out_dir;
+  std::vector<std::string> overrides;
+  double speed_kmh = std::nan("");
+  bool quiet = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&](const char* name) -> std::string {
+      if (i + 1 >= argc) {
+        std::cerr << "simulate_pass: " << name << " needs a value\n" << kUsage;
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--scene") scene_path = value("--scene");
+    else if (a == "--out") out_dir = value("--out");
+    else if (a == "--set") overrides.push_back(value("--set"));
+    else if (a == "--quiet") quiet = true;
+    else if (a == "--speed") {
+      const std::string v = value("--speed");
+      char* end = nullptr;
+      speed_kmh = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end != '\0' || !std::isfinite(speed_kmh) || speed_kmh < 0.0 || speed_kmh > 540.0) {
+        std::cerr << "simulate_pass: --speed '" << v << "': expected km/h in [0, 540]\n";
+        return 2;
+      }
+    } else if (a == "--help" || a == "-h") {
+      std::cout << kUsage;
+      return 0;
+    } else {
+      std::cerr << "simulate_pass: unknown argument '" << a << "'\n" << kUsage;
+      return 2;
+    }
+  }
+  if (scene_path.empty() || out_dir.empty()) {
+    std::cerr << "simulate_pass: --scene and --out are required\n" << kUsage;
+    return 2;
+  }
+
+  Scene scene;
+  try {
+    scene = load_scene_file(scene_path, overrides);
+    if (!std::isnan(speed_kmh)) {
+      scene.train_speed = speed_kmh / 3.6;
+      validate(scene);
+    }
+  } catch (const SceneError& e) {
+    std::cerr << "simulate_pass: " << e.what() << "\n";
+    return 2;
+  }
+
+  const auto t_build = std::chrono::steady_clock::now();
+  std::unique_ptr<Simulation> sim;
+  try {
+    sim = std::make_unique<Simulation>(scene);
+  } catch (const SceneError& e) {
+    std::cerr << "simulate_pass: " << e.what() << "\n";
+    return 2;
+  }
+  const Model& m = sim->model();
+  PassRecorder recorder(m, scene.output.sample_rate);
+  if (!quiet)
+    std::cout << "scene " << scene.name << ": " << scene.spans.size() << " spans, " << m.line_length << " m, "
+              << m.n_dof << " DOFs, dt " << m.dt * 1e3 << " ms (stability limit " << m.dt_critical * 1e3
+              << " ms), speed " << scene.train_speed * 3.6 << " km/h" << std::endl;
+  if (scene.train_speed <= 0.0 && !quiet)
+    std::cout << "note: train speed 0: the pass never ends; nothing to run\n";
+
+  const auto t0 = std::chrono::steady_clock::now();
+  StepStatus status = StepStatus::kOk;
+  if (scene.train_speed > 0.0) {
+    while ((status = sim->step()) == StepStatus::kOk) recorder.record(m, sim->state());
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double build_s = std::chrono::duration<double>(t0 - t_build).count();
+  const State& st = sim->state();
+  if (status == StepStatus::kDiverged) {
+    std::cerr << "simulate_pass: " << sim->status_message() << "\n";
+    return 3;
+  }
+
+  if (!make_dirs(out_dir)) {
+    std::cerr << "simulate_pass: cannot create output directory '" << out_dir << "'\n";
+    return 2;
+  }
+  const std::vector<PantographStatistics> stats = recorder.statistics(m);
+  const double rtf = wall > 0.0 ? st.time / wall : std::nan("");
+
+  {
+    std::ofstream j(out_dir + "/stats.json");
+    j << "{\n  \"scene\": \"" << scene.name << "\",\n"
+      << "  \"speed_kmh\": " << json_number(scene.train_speed * 3.6) << ",\n"
+      << "  \"dofs\": " << m.n_dof << ",\n  \"dt_s\": " << json_number(m.dt) << ",\n"
+      << "  \"dt_critical_s\": " << json_number(m.dt_critical) << ",\n"
+      << "  \"steps\": " << st.steps << ",\n  \"simulated_time_s\": " << json_number(st.time) << ",\n"
+      << "  \"build_time_s\": " << json_number(build_s) << ",\n"
+      << "  \"wall_time_s\": " << json_number(wall) << ",\n  \"real_time_factor\": " << json_number(rtf) << ",\n"
+      << "  \"analysis_section_m\": [" << json_number(m.support_x[scene.analysis_first()]) << ", "
+      << json_number(m.support_x[scene.analysis_last()]) << "],\n"
+      << "  \"filter_cutoff_hz\": " << json_number(scene.output.filter_cutoff) << ",\n"
+      << "  \"pantographs\": [";
+    for (std::size_t i = 0; i < stats.size(); ++i) {
+      const PantographStatistics& s = stats[i];
+      j << (i ? "," : "") << "\n    {\"name\": \"" << s.name << "\", \"samples\": " << s.samples
+        << ",\n     \"mean_force_N\": " << json_number(s.filtered.mean)
+        << ", \"std_force_N\": " << json_number(s.filtered.std_dev)
+        << ", \"max_force_N\": " << json_number(s.filtered.max) << ", \"min_force_N\": " << json_number(s.filtered.min)
+        << ",\n     \"stat_max_force_N\": " << json_number(s.filtered.stat_max)
+        << ", \"stat_min_force_N\": " << json_number(s.filtered.stat_min)
+        << ", \"contact_loss_percent\": " << json_number(s.contact_loss_percent)
+        << ", \"max_uplift_at_support_m\": " << json_number(s.max_uplift_at_support_m)
+        << ",\n     \"unfiltered\": {\"mean_force_N\": " << json_number(s.unfiltered.mean)
+        << ", \"std_force_N\": " << json_number(s.unfiltered.std_dev)
+        << ", \"max_force_N\": " << json_number(s.unfiltered.max) << ", \"min_force_N\": " << json_number(s.unfiltered.min)
+        << ", \"stat_max_force_N\": " << json_number(s.unfiltered.stat_max)
+        << ", \"stat_min_force_N\": " << json_number(s.unfiltered.stat_min) << "}}";
+    }
+    j << "\n  ]\n}\n";
+    if (!j) {
+      std::cerr << "simulate_pass: cannot write " << out_dir << "/stats.json\n";
+      return 2;
+    }
+  }
+  {
+    std::ofstream c(out_dir + "/timeseries.csv");
+    c << "time_s";
+    for (const std::string& col : recorder.columns()) c << "," << col;
+    c << "\n" << std::setprecision(9);
+    for (const auto& row : recorder.rows()) {
+      c << row.time;
+      for (double v : row.values) c << "," << v;
+      c << "\n";
+    }
+    if (!c) {
+      std::cerr << "simulate_pass: cannot write " << out_dir << "/timeseries.csv\n";
+      return 2;
+    }
+  }
+
+  if (!quiet) {
+    std::cout << std::fixed << std::setprecision(2);
+    std::cout << "pass: " << st.steps << " steps, " << st.time << " s simulated in " << wall << " s wall ("
+              << std::setprecision(1) << rtf << "x real time)\n";
+    std::cout << "statistics over " << m.support_x[scene.analysis_first()] << "-" << m.support_x[scene.analysis_last()]
+              << " m, contact force low-pass " << scene.output.filter_cutoff << " Hz:\n";
+    for (const PantographStatistics& s : stats) {
+      std::cout << std::setprecision(1) << "  " << s.name << ": mean " << s.filtered.mean << " N, std "
+                << s.filtered.std_dev << " N, max " << s.filtered.max << " N, min " << s.filtered.min
+                << " N, stat max " << s.filtered.stat_max << " N, stat min " << s.filtered.stat_min
+                << " N, contact loss " << std::setprecision(2) << s.contact_loss_percent << " %, max uplift at steady arm "
+                << std::setprecision(1) << s.max_uplift_at_support_m * 1e3 << " mm\n"
+                << "      unfiltered: max " << s.unfiltered.max << " N, min " << s.unfiltered.min << " N, std "
+                << s.unfiltered.std_dev << " N\n";
+    }
+    std::cout << "wrote " << out_dir << "/stats.json and " << out_dir << "/timeseries.csv\n";
+  }
+  return 0;
+}
