@@ -11,6 +11,46 @@
 
 namespace catenary_sim {
 
+namespace {
+
+// Contact of every collector with every contact wire under it at the state's train position:
+// the collector height is the weighted wire height (eq. 12), the force is k0 times the head's
+// penetration while compressive (eq. 22, 25), spread on the wire with the same weights.
+// Writes state.contact_force and state.collector_height; adds the forces to f unless f is null.
+void contact_forces(const Model& m, State& s, double* f) {
+  const double* u = s.u.data();
+  const double v2 = s.speed * s.speed;
+  const std::size_t nw = m.contact_wires.size();
+  for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
+    const Pantograph& p = m.pantographs[pi];
+    const double uplift = s.uplift[pi] + p.aero_coefficient * v2;
+    const double head = p.moving_force ? 0.0 : p.reference_height + u[p.first_dof];
+    const double x_ref = s.front - p.position;
+    for (int ci : p.collectors) {
+      const double xc = x_ref + m.collectors[ci].offset;
+      for (std::size_t wk = 0; wk < nw; ++wk) {
+        const Wire& w = m.wires[m.contact_wires[wk]];
+        const std::size_t idx = ci * nw + wk;
+        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
+        double yw = 0.0;
+        for (int a = 0; a < cnt; ++a) yw += s.weight[a] * (w.height[s.weight_node[a]] + u[w.w_dof + s.weight_node[a]]);
+        s.collector_height[idx] = cnt ? yw : std::nan("");
+        double fc = 0.0;
+        if (cnt) {
+          if (p.moving_force) fc = wk == 0 ? uplift / p.collectors.size() : 0.0;
+          else fc = std::max(0.0, m.contact_stiffness * (head - yw));  // eq. 22 with eq. 25
+        }
+        s.contact_force[idx] = fc;
+        if (fc == 0.0 || !f) continue;
+        if (!p.moving_force) f[p.first_dof] -= fc;
+        for (int a = 0; a < cnt; ++a) f[w.w_dof + s.weight_node[a]] += fc * s.weight[a];
+      }
+    }
+  }
+}
+
+}  // namespace
+
 State make_state(const Model& m) {
   State s;
   s.u = Eigen::VectorXd::Zero(m.n_dof);
@@ -31,6 +71,8 @@ State make_state(const Model& m) {
   s.speed = s.target_speed = m.scene.train_speed;
   return s;
 }
+
+void observe(const Model& m, State& s) { contact_forces(m, s, nullptr); }
 
 double pantograph_position(const Model& m, const State& s, int p) { return s.front - m.pantographs[p].position; }
 
@@ -88,7 +130,6 @@ StepStatus step(const Model& m, State& s) {
 
   // Pantographs: lumped chains (eq. 9), uplift on the lowest mass.
   const double v2 = s.speed * s.speed;
-  const std::size_t nw = m.contact_wires.size();
   for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
     const Pantograph& p = m.pantographs[pi];
     const double uplift = s.uplift[pi] + p.aero_coefficient * v2;
@@ -104,29 +145,8 @@ StepStatus step(const Model& m, State& s) {
       }
       f[a0 + nm - 1] += uplift;
     }
-    const double head = p.moving_force ? 0.0 : p.reference_height + u[p.first_dof];
-    const double x_ref = s.front - p.position;
-    for (int ci : p.collectors) {
-      const double xc = x_ref + m.collectors[ci].offset;
-      for (std::size_t wk = 0; wk < nw; ++wk) {
-        const Wire& w = m.wires[m.contact_wires[wk]];
-        const std::size_t idx = ci * nw + wk;
-        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
-        double yw = 0.0;
-        for (int a = 0; a < cnt; ++a) yw += s.weight[a] * (w.height[s.weight_node[a]] + u[w.w_dof + s.weight_node[a]]);
-        s.collector_height[idx] = cnt ? yw : std::nan("");
-        double fc = 0.0;
-        if (cnt) {
-          if (p.moving_force) fc = wk == 0 ? uplift / p.collectors.size() : 0.0;
-          else fc = std::max(0.0, m.contact_stiffness * (head - yw));  // eq. 22 with eq. 25
-        }
-        s.contact_force[idx] = fc;
-        if (fc == 0.0) continue;
-        if (!p.moving_force) f[p.first_dof] -= fc;
-        for (int a = 0; a < cnt; ++a) f[w.w_dof + s.weight_node[a]] += fc * s.weight[a];
-      }
-    }
   }
+  contact_forces(m, s, f);
 
   // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. Any displacement beyond
   // the divergence limit (or NaN) stops the run before it is passed on.

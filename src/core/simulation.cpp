@@ -10,6 +10,7 @@ namespace catenary_sim {
 Simulation::Simulation(const Scene& scene) : model_(build_model(scene)) {
   initial_ = make_state(model_);
   solve_initial_state(model_, initial_);
+  observe(model_, initial_);
   state_ = initial_;
 }
 
@@ -49,7 +50,10 @@ void Simulation::reset(bool keep_time) {
   state_.uplift = uplift;
   state_.target_speed = state_.speed = target;
   state_.max_acceleration = accel;
-  if (uplift != initial_.uplift) solve_initial_state(model_, state_);
+  if (uplift != initial_.uplift) {
+    solve_initial_state(model_, state_);
+    observe(model_, state_);
+  }
   if (keep_time) {
     state_.time = t;
     state_.steps = n;

@@ -53,6 +53,10 @@ State make_state(const Model& model);
 // Never reads a clock, never allocates, never logs. Returns the state's status.
 StepStatus step(const Model& model, State& state);
 
+// Fills the observations (contact forces, collector heights) for the current state without
+// advancing it, e.g. for the initial state.
+void observe(const Model& model, State& state);
+
 // Absolute height of a contact collector's pantograph head (m); NaN for a moving force.
 double head_height(const Model& model, const State& state, int pantograph);
 // Position of a pantograph's reference point along the line (m).
