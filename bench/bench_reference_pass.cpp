@@ -1,0 +1,49 @@
+// Times the reference pass (config/reference_55m.yaml, 300 km/h, h = 0.25 m, explicit) and prints
+// DOFs, dt, steps, wall time and real-time factor; the lumped-rotary-inertia (HRZ) variant runs
+// in the same process so the two can be compared as a ratio on the same machine and load.
+//   bench_reference_pass [repetitions=5] [scene=config/reference_55m.yaml]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/simulation.hpp"
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+
+using namespace catenary_sim;
+
+int main(int argc, char** argv) {
+  const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
+  const std::string path = argc > 2 ? argv[2] : CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  std::printf("%-34s %6s %9s %7s %10s %10s %8s\n", "variant", "DOFs", "dt_ms", "steps", "wall_med_s", "wall_min_s", "RTF_med");
+  for (const auto& [label, overrides] :
+       std::vector<std::pair<std::string, std::vector<std::string>>>{
+           {"condensed rotations (default)", {"train.speed_kmh=300", "numerics.element_length=0.25"}},
+           {"lumped rotary inertia (HRZ)", {"train.speed_kmh=300", "numerics.element_length=0.25", "numerics.rotary_inertia=lumped"}}}) {
+    const Scene scene = load_scene_file(path, overrides);
+    std::vector<double> walls;
+    long steps = 0;
+    double sim_time = 0.0, dt = 0.0;
+    int dofs = 0;
+    for (int r = 0; r < reps; ++r) {
+      Simulation sim(scene);  // model building and statics are not timed: only the pass
+      const auto t0 = std::chrono::steady_clock::now();
+      while (sim.step() == StepStatus::kOk) {
+      }
+      walls.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      steps = sim.state().steps;
+      sim_time = sim.state().time;
+      dt = sim.model().dt;
+      dofs = sim.model().n_dof;
+    }
+    std::sort(walls.begin(), walls.end());
+    const double med = walls[walls.size() / 2];
+    std::printf("%-34s %6d %9.4f %7ld %10.4f %10.4f %8.1f\n", label.c_str(), dofs, dt * 1e3, steps, med, walls.front(),
+                sim_time / med);
+  }
+  return 0;
+}
