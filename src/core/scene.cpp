@@ -344,7 +344,6 @@ void validate(const Scene& s) {
       }
     }
   }
-  if (s.pantographs.empty() && s.train_speed < 0.0) fail("train.speed", fmt(s.train_speed), ">= 0");
   std::set<std::string> names;
   for (std::size_t i = 0; i < s.pantographs.size(); ++i) {
     const auto& p = s.pantographs[i];

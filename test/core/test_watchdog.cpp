@@ -1,0 +1,41 @@
+// The divergence watchdog: a NaN or a displacement beyond numerics.divergence_limit stops the
+// run with a message naming where, and nothing after it is computed or passed on.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "catenary_sim/core/simulation.hpp"
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+
+using namespace catenary_sim;
+
+TEST(Watchdog, RunawayDisplacementStopsTheRun) {
+  // The static uplift under 100 N is centimetres, so a 1 mm limit must trip within the pass.
+  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", {"numerics.divergence_limit=0.001"}));
+  StepStatus st = StepStatus::kOk;
+  int n = 0;
+  while (st == StepStatus::kOk && n < 100000) {
+    st = sim.step();
+    ++n;
+  }
+  ASSERT_EQ(st, StepStatus::kDiverged);
+  const std::string msg = sim.status_message();
+  EXPECT_NE(msg.find("diverged at t = "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("limit 0.001 m"), std::string::npos) << msg;
+  const double t = sim.state().time;
+  EXPECT_EQ(sim.step(), StepStatus::kDiverged);  // refuses to go on
+  EXPECT_EQ(sim.state().time, t);
+}
+
+TEST(Watchdog, NaNIsCaughtOnTheStepItAppears) {
+  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml"));
+  State s = sim.state();
+  const Wire& cw = sim.model().wires[0];
+  s.u[cw.w_dof + cw.nodes() / 2] = std::nan("");
+  EXPECT_EQ(step(sim.model(), s), StepStatus::kDiverged);
+  EXPECT_EQ(s.time, sim.state().time);  // time did not advance past the bad step
+  EXPECT_GE(s.diverged_dof, 0);
+}
