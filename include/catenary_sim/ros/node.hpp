@@ -1,0 +1,89 @@
+// The live node: paces the core's fixed-dt steps to the wall clock, publishes contact forces,
+// pantograph states, wire shapes, markers, tf and diagnostics, and takes commands and services.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+#include <std_msgs/Float64.h>
+#include <std_msgs/Float64MultiArray.h>
+#include <std_srvs/SetBool.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include <cstdint>
+#include <memory>
+
+#include "catenary_sim/Step.h"
+#include "catenary_sim/core/simulation.hpp"
+#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/ros/params.hpp"
+
+namespace catenary_sim {
+namespace ros_layer {
+
+class SimulationNode {
+ public:
+  // Reads and validates the private parameters and loads the scene; throws ParamError.
+  SimulationNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+  // Runs the pacing loop until ros::ok() is false or the pass ends with at_end exit.
+  // Returns the process exit code (0, or 1 after a divergence with at_end exit).
+  int run();
+
+  static constexpr int kMaxStepsPerCall = 100000;  // ~step service limit
+
+ private:
+  // Steps due by the wall clock (or as many as fit in one tick at real_time_factor 0).
+  void advance(const ros::WallTime& tick_deadline);
+  // Steps up to n times (stops at the end of the pass, a divergence or the deadline when given).
+  std::int64_t do_steps(std::int64_t n, const ros::WallTime* deadline);
+  void handle_end();
+  void publish(bool force);
+  void reanchor();
+  void restart_recording();
+  void report_statistics();
+
+  void on_speed(const std_msgs::Float64::ConstPtr& msg);
+  void on_uplift(const std_msgs::Float64MultiArray::ConstPtr& msg);
+  bool on_reset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool on_set_paused(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res);
+  bool on_step(Step::Request& req, Step::Response& res);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  ros::NodeHandle nh_, pnh_;
+  NodeParams params_;
+  std::unique_ptr<Simulation> sim_;
+  std::unique_ptr<PassRecorder> recorder_;
+
+  ros::Publisher contact_pub_, pantograph_pub_, shape_pub_, marker_pub_, clock_pub_;
+  ros::Subscriber speed_sub_, uplift_sub_;
+  ros::ServiceServer reset_srv_, pause_srv_, step_srv_;
+  tf2_ros::TransformBroadcaster tf_;
+  diagnostic_updater::Updater updater_;
+
+  double stamp_offset_ = 0.0;  // s, added to the simulation time for stamps
+  bool paused_ = false;
+  bool ended_ = false;          // the end of the pass (or a divergence) has been handled
+  bool exit_requested_ = false;
+  int exit_code_ = 0;
+
+  // Pacing.
+  ros::WallTime wall_anchor_, wall_start_;
+  double sim_anchor_ = 0.0;
+  std::int64_t overruns_ = 0;
+
+  // Publishing bookkeeping.
+  double last_published_time_ = -1.0;
+  ros::WallTime last_shape_wall_, last_hold_wall_;
+
+  // Diagnostics.
+  std::int64_t loss_steps_ = 0, counted_steps_ = 0;
+  ros::WallTime last_command_wall_;
+  bool have_command_ = false;
+  ros::WallTime diag_wall_;
+  double diag_sim_ = 0.0;
+  std::int64_t diag_overruns_ = 0;
+};
+
+}  // namespace ros_layer
+}  // namespace catenary_sim

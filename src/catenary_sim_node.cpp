@@ -1,0 +1,15 @@
+// catenary_sim_node: live pantograph passes under a catenary (see README.md, launch/pass.launch).
+#include <ros/ros.h>
+
+#include "catenary_sim/ros/node.hpp"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "catenary_sim");
+  try {
+    catenary_sim::ros_layer::SimulationNode node(ros::NodeHandle(), ros::NodeHandle("~"));
+    return node.run();
+  } catch (const catenary_sim::ros_layer::ParamError& e) {
+    ROS_FATAL("catenary_sim: %s", e.what());
+    return 2;
+  }
+}

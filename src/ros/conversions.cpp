@@ -1,0 +1,337 @@
+#include "catenary_sim/ros/conversions.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace catenary_sim {
+namespace ros_layer {
+
+namespace {
+
+std_msgs::ColorRGBA color(float r, float g, float b, float a = 1.0f) {
+  std_msgs::ColorRGBA c;
+  c.r = r;
+  c.g = g;
+  c.b = b;
+  c.a = a;
+  return c;
+}
+
+geometry_msgs::Point point(double x, double y, double z) {
+  geometry_msgs::Point p;
+  p.x = x;
+  p.y = y;
+  p.z = z;
+  return p;
+}
+
+// Node indices of a wire sampled at about `resolution` m, first and last node always included.
+std::vector<int> sample_nodes(const Wire& w, double resolution) {
+  std::vector<int> idx;
+  const int n = w.nodes();
+  if (n == 0) return idx;
+  idx.push_back(0);
+  double last = w.x[0];
+  for (int i = 1; i + 1 < n; ++i) {
+    if (w.x[i] - last + 1e-9 >= resolution) {
+      idx.push_back(i);
+      last = w.x[i];
+    }
+  }
+  if (n > 1) idx.push_back(n - 1);
+  return idx;
+}
+
+visualization_msgs::Marker marker(const std_msgs::Header& h, const std::string& ns, int id, int type) {
+  visualization_msgs::Marker mk;
+  mk.header = h;
+  mk.ns = ns;
+  mk.id = id;
+  mk.type = type;
+  mk.action = visualization_msgs::Marker::ADD;
+  mk.pose.orientation.w = 1.0;
+  mk.scale.x = mk.scale.y = mk.scale.z = 1.0;
+  mk.color = color(1, 1, 1);
+  return mk;
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream s;
+  s << std::setprecision(10) << v;
+  return s.str();
+}
+
+double collector_force(const Model& m, const State& s, int ci) {
+  const std::size_t nw = m.contact_wires.size();
+  double f = 0.0;
+  for (std::size_t k = 0; k < nw; ++k) f += s.contact_force[ci * nw + k];
+  return f;
+}
+
+}  // namespace
+
+ros::Time sim_stamp(double sim_time, double offset) { return ros::Time(sim_time + offset); }
+
+ContactForceArray to_contact_force(const Model& m, const State& s, const ros::Time& stamp, const std::string& frame) {
+  ContactForceArray out;
+  out.header.stamp = stamp;
+  out.header.frame_id = frame;
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    const Pantograph& pg = m.pantographs[p];
+    ContactForce c;
+    c.header = out.header;
+    c.name = pg.name;
+    c.position = pantograph_position(m, s, static_cast<int>(p));
+    for (int ci : pg.collectors) {
+      const double f = collector_force(m, s, ci);
+      c.collector_forces.push_back(f);
+      c.in_contact.push_back(f > 0.0);
+    }
+    c.total = total_contact_force(m, s, static_cast<int>(p));
+    out.pantographs.push_back(c);
+  }
+  return out;
+}
+
+PantographStateArray to_pantograph_state(const Model& m, const State& s, const ros::Time& stamp,
+                                         const std::string& frame) {
+  PantographStateArray out;
+  out.header.stamp = stamp;
+  out.header.frame_id = frame;
+  out.step = s.steps;
+  out.sim_time = s.time;
+  out.train_front = s.front;
+  out.speed = s.speed;
+  out.target_speed = s.target_speed;
+  out.max_acceleration = s.max_acceleration;
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    const Pantograph& pg = m.pantographs[p];
+    PantographState ps;
+    ps.header = out.header;
+    ps.name = pg.name;
+    ps.position = pantograph_position(m, s, static_cast<int>(p));
+    ps.speed = s.speed;
+    ps.head_height = head_height(m, s, static_cast<int>(p));
+    if (!pg.moving_force) {
+      for (int i = 0; i < pg.masses_count(); ++i) {
+        ps.displacement.push_back(s.u[pg.first_dof + i]);
+        ps.velocity.push_back(s.v[pg.first_dof + i]);
+      }
+    }
+    ps.uplift = p < s.uplift.size() ? s.uplift[p] : 0.0;
+    ps.aero_uplift = pg.aero_coefficient * s.speed * s.speed;
+    out.pantographs.push_back(ps);
+  }
+  return out;
+}
+
+WireShapeArray to_wire_shape(const Model& m, const State& s, double resolution, const ros::Time& stamp,
+                             const std::string& frame) {
+  WireShapeArray out;
+  out.header.stamp = stamp;
+  out.header.frame_id = frame;
+  for (const Wire& w : m.wires) {
+    WireShape ws;
+    ws.header = out.header;
+    ws.name = w.name;
+    for (int i : sample_nodes(w, resolution)) {
+      ws.stations.push_back(w.x[i]);
+      ws.heights.push_back(w.height[i] + s.u[w.w_dof + i]);
+    }
+    out.wires.push_back(ws);
+  }
+  return out;
+}
+
+double wire_dof_design_height(const Model& m, int dof) {
+  for (const Wire& w : m.wires)
+    if (dof >= w.w_dof && dof < w.w_dof + w.nodes()) return w.height[dof - w.w_dof];
+  return std::nan("");
+}
+
+std::string train_frame_id() { return "train"; }
+
+std::string head_frame_id(const Model& m, int p) { return "pantograph_" + m.pantographs[p].name; }
+
+std::vector<geometry_msgs::TransformStamped> to_transforms(const Model& m, const State& s, const ros::Time& stamp,
+                                                           const std::string& line_frame) {
+  std::vector<geometry_msgs::TransformStamped> out;
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = stamp;
+  t.header.frame_id = line_frame;
+  t.child_frame_id = train_frame_id();
+  t.transform.translation.x = s.front;
+  t.transform.rotation.w = 1.0;
+  out.push_back(t);
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    const Pantograph& pg = m.pantographs[p];
+    geometry_msgs::TransformStamped h;
+    h.header.stamp = stamp;
+    h.header.frame_id = train_frame_id();
+    h.child_frame_id = head_frame_id(m, static_cast<int>(p));
+    h.transform.translation.x = -pg.position;
+    h.transform.translation.z = pg.moving_force ? m.scene.contact_wire_height : head_height(m, s, static_cast<int>(p));
+    h.transform.rotation.w = 1.0;
+    out.push_back(h);
+  }
+  return out;
+}
+
+visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const ros::Time& stamp,
+                                           const MarkerOptions& o) {
+  using visualization_msgs::Marker;
+  visualization_msgs::MarkerArray out;
+  std_msgs::Header h;
+  h.stamp = stamp;
+  h.frame_id = o.frame;
+  const double k = o.vertical_scale;
+  auto shown = [&](int dof) { return wire_dof_design_height(m, dof) + k * s.u[dof]; };
+
+  // Wires.
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    const Wire& w = m.wires[wi];
+    Marker mk = marker(h, "wires", static_cast<int>(wi), Marker::LINE_STRIP);
+    mk.scale.x = w.is_contact_wire ? 0.04 : 0.03;
+    mk.color = w.is_contact_wire ? color(0.85f, 0.55f, 0.2f) : color(0.6f, 0.6f, 0.65f);
+    for (int i : sample_nodes(w, o.shape_resolution))
+      mk.points.push_back(point(w.x[i], 0.0, w.height[i] + k * s.u[w.w_dof + i]));
+    out.markers.push_back(mk);
+  }
+
+  // Droppers: taut grey, slack red.
+  Marker taut = marker(h, "droppers", 0, Marker::LINE_LIST);
+  Marker slack = marker(h, "droppers", 1, Marker::LINE_LIST);
+  taut.scale.x = slack.scale.x = 0.015;
+  taut.color = color(0.7f, 0.7f, 0.7f);
+  slack.color = color(1.0f, 0.1f, 0.1f);
+  for (std::size_t d = 0; d < m.droppers.size(); ++d) {
+    const Dropper& dr = m.droppers[d];
+    Marker& mk = (d < s.dropper_slack.size() && s.dropper_slack[d]) ? slack : taut;
+    mk.points.push_back(point(dr.x, 0.0, shown(dr.contact_dof)));
+    mk.points.push_back(point(dr.x, 0.0, shown(dr.messenger_dof)));
+  }
+  out.markers.push_back(taut);
+  out.markers.push_back(slack);  // an empty LINE_LIST clears the previous slack droppers
+
+  if (o.include_static) {
+    // Masts 3 m beside the track with a cantilever over the wires; steady arms to the contact wire.
+    const double y_mast = 3.0;
+    const double top = m.scene.contact_wire_height + m.scene.encumbrance + 0.5;
+    Marker masts = marker(h, "masts", 0, Marker::LINE_LIST);
+    masts.scale.x = 0.15;
+    masts.color = color(0.35f, 0.35f, 0.4f);
+    for (double x : m.support_x) {
+      masts.points.push_back(point(x, y_mast, 0.0));
+      masts.points.push_back(point(x, y_mast, top));
+      masts.points.push_back(point(x, y_mast, top));
+      masts.points.push_back(point(x, 0.0, top));
+    }
+    out.markers.push_back(masts);
+    Marker arms = marker(h, "steady_arms", 0, Marker::LINE_LIST);
+    arms.scale.x = 0.03;
+    arms.color = color(0.2f, 0.5f, 0.9f);
+    for (const SupportSpring& sp : m.springs) {
+      if (!sp.steady_arm) continue;
+      const double z = shown(sp.dof);
+      arms.points.push_back(point(sp.x, y_mast, wire_dof_design_height(m, sp.dof)));
+      arms.points.push_back(point(sp.x, 0.0, z));
+    }
+    out.markers.push_back(arms);
+  }
+
+  // Pantographs: head, frame, force arrow and label.
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    const Pantograph& pg = m.pantographs[p];
+    const int id = static_cast<int>(p);
+    const double x = pantograph_position(m, s, id);
+    const double z_head = pg.moving_force ? m.scene.contact_wire_height : pg.reference_height + k * s.u[pg.first_dof];
+    const double force = total_contact_force(m, s, id);
+    const bool contact = force > 0.0;
+
+    Marker head = marker(h, "pantograph_head", id, pg.moving_force ? Marker::SPHERE : Marker::CUBE);
+    head.pose.position = point(x, 0.0, z_head - 0.03);
+    if (pg.moving_force) head.scale.x = head.scale.y = head.scale.z = 0.2;
+    else {
+      head.scale.x = 0.3;
+      head.scale.y = 1.6;
+      head.scale.z = 0.06;
+    }
+    head.color = contact ? color(0.1f, 0.1f, 0.1f) : color(1.0f, 0.1f, 0.1f);
+    out.markers.push_back(head);
+
+    Marker frame = marker(h, "pantograph_frame", id, Marker::LINE_STRIP);
+    frame.scale.x = 0.05;
+    frame.color = color(0.3f, 0.3f, 0.3f);
+    const double z_roof = std::min(4.0, z_head - 1.0);
+    frame.points.push_back(point(x - 1.2, 0.0, z_roof));
+    frame.points.push_back(point(x + 0.6, 0.0, 0.5 * (z_roof + z_head)));
+    frame.points.push_back(point(x, 0.0, z_head - 0.06));
+    out.markers.push_back(frame);
+
+    Marker arrow = marker(h, "contact_force", id, Marker::ARROW);
+    arrow.scale.x = 0.05;  // shaft diameter
+    arrow.scale.y = 0.1;   // head diameter
+    arrow.scale.z = 0.1;   // head length
+    arrow.color = contact ? color(0.1f, 0.8f, 0.2f) : color(1.0f, 0.1f, 0.1f);
+    arrow.points.push_back(point(x, 0.0, z_head));
+    arrow.points.push_back(point(x, 0.0, z_head + std::max(0.0, force) / 200.0 + 1e-3));  // 1 m per 200 N
+    out.markers.push_back(arrow);
+
+    Marker label = marker(h, "label", id, Marker::TEXT_VIEW_FACING);
+    label.pose.position = point(x, 0.0, z_head + 1.8);
+    label.scale.z = 0.3;
+    std::ostringstream t;
+    t << pg.name << ": " << std::fixed << std::setprecision(0) << force << " N" << (contact ? "" : " LOSS") << "\n"
+      << std::setprecision(1) << s.speed * 3.6 << " km/h";
+    label.text = t.str();
+    out.markers.push_back(label);
+  }
+  return out;
+}
+
+std::int64_t steps_due(double wall_elapsed, double real_time_factor, double dt, double sim_done) {
+  if (!(dt > 0.0) || !(real_time_factor > 0.0) || !(wall_elapsed > 0.0)) return 0;
+  const double n = std::floor((real_time_factor * wall_elapsed - sim_done) / dt + 1e-9);
+  return n > 0.0 ? static_cast<std::int64_t>(n) : 0;
+}
+
+std::string statistics_json(const Model& m, const State& s, const std::vector<PantographStatistics>& stats,
+                            double wall_time_s, std::int64_t overruns) {
+  const Scene& scene = m.scene;
+  std::ostringstream j;
+  j << "{\n  \"scene\": \"" << scene.name << "\",\n"
+    << "  \"speed_kmh\": " << json_number(s.speed * 3.6) << ",\n"
+    << "  \"dofs\": " << m.n_dof << ",\n  \"dt_s\": " << json_number(m.dt) << ",\n"
+    << "  \"dt_critical_s\": " << json_number(m.dt_critical) << ",\n"
+    << "  \"steps\": " << s.steps << ",\n  \"simulated_time_s\": " << json_number(s.time) << ",\n"
+    << "  \"wall_time_s\": " << json_number(wall_time_s) << ",\n"
+    << "  \"real_time_factor\": " << json_number(wall_time_s > 0.0 ? s.time / wall_time_s : std::nan("")) << ",\n"
+    << "  \"overruns\": " << overruns << ",\n"
+    << "  \"analysis_section_m\": [" << json_number(m.support_x[scene.analysis_first()]) << ", "
+    << json_number(m.support_x[scene.analysis_last()]) << "],\n"
+    << "  \"filter_cutoff_hz\": " << json_number(scene.output.filter_cutoff) << ",\n"
+    << "  \"pantographs\": [";
+  for (std::size_t i = 0; i < stats.size(); ++i) {
+    const PantographStatistics& p = stats[i];
+    j << (i ? "," : "") << "\n    {\"name\": \"" << p.name << "\", \"samples\": " << p.samples
+      << ",\n     \"mean_force_N\": " << json_number(p.filtered.mean)
+      << ", \"std_force_N\": " << json_number(p.filtered.std_dev)
+      << ", \"max_force_N\": " << json_number(p.filtered.max) << ", \"min_force_N\": " << json_number(p.filtered.min)
+      << ",\n     \"stat_max_force_N\": " << json_number(p.filtered.stat_max)
+      << ", \"stat_min_force_N\": " << json_number(p.filtered.stat_min)
+      << ", \"contact_loss_percent\": " << json_number(p.contact_loss_percent)
+      << ", \"max_uplift_at_support_m\": " << json_number(p.max_uplift_at_support_m)
+      << ",\n     \"unfiltered\": {\"mean_force_N\": " << json_number(p.unfiltered.mean)
+      << ", \"std_force_N\": " << json_number(p.unfiltered.std_dev)
+      << ", \"max_force_N\": " << json_number(p.unfiltered.max) << ", \"min_force_N\": " << json_number(p.unfiltered.min)
+      << "}}";
+  }
+  j << "\n  ]\n}\n";
+  return j.str();
+}
+
+}  // namespace ros_layer
+}  // namespace catenary_sim

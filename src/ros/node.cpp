@@ -1,0 +1,372 @@
+#include "catenary_sim/ros/node.hpp"
+
+#include <rosgraph_msgs/Clock.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <cmath>
+#include <fstream>
+#include <algorithm>
+#include <limits>
+#include <sstream>
+
+#include "catenary_sim/ContactForceArray.h"
+#include "catenary_sim/PantographStateArray.h"
+#include "catenary_sim/WireShapeArray.h"
+#include "catenary_sim/ros/conversions.hpp"
+
+namespace catenary_sim {
+namespace ros_layer {
+
+namespace {
+// Sample rate of the recorder's decimated time series (unused by the node; statistics use every step).
+constexpr double kRecorderRowRate = 10.0;
+// At real_time_factor > 0, a tick may take this many times its nominal share of steps before the
+// backlog is dropped (counted as an overrun) instead of trying to catch up.
+constexpr double kCatchUp = 2.0;
+}  // namespace
+
+SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), params_(load_params(pnh)), updater_(nh, pnh) {
+  const Scene scene = load_scene(params_);
+  try {
+    sim_ = std::make_unique<Simulation>(scene);
+  } catch (const SceneError& e) {
+    throw ParamError("parameter ~scene = '" + params_.scene + "': " + e.what());
+  }
+  std::string err;
+  if (!sim_->set_max_acceleration(params_.max_acceleration, &err)) throw ParamError("parameter ~max_acceleration: " + err);
+  restart_recording();
+
+  // Stamps start at the wall time of the start (whole seconds): never ros::Time(0) ("latest" for
+  // tf), close to now for rviz and bags at real_time_factor 1.
+  stamp_offset_ = std::floor(ros::WallTime::now().toSec());
+
+  contact_pub_ = nh_.advertise<ContactForceArray>("contact_force", 10);
+  pantograph_pub_ = nh_.advertise<PantographStateArray>("pantograph_state", 10);
+  shape_pub_ = nh_.advertise<WireShapeArray>("wire_shape", 2);
+  marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
+  if (params_.publish_clock) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  speed_sub_ = nh_.subscribe("cmd/train_speed", 10, &SimulationNode::on_speed, this);
+  uplift_sub_ = nh_.subscribe("cmd/uplift_force", 10, &SimulationNode::on_uplift, this);
+  reset_srv_ = pnh_.advertiseService("reset", &SimulationNode::on_reset, this);
+  pause_srv_ = pnh_.advertiseService("set_paused", &SimulationNode::on_set_paused, this);
+  step_srv_ = pnh_.advertiseService("step", &SimulationNode::on_step, this);
+
+  updater_.setHardwareID("catenary_sim/" + scene.name);
+  updater_.add("simulation", this, &SimulationNode::diagnose);
+
+  const Model& m = sim_->model();
+  ROS_INFO("catenary_sim: scene %s: %zu spans, %.1f m, %d DOFs, dt %.4g ms (stability limit %.4g ms), "
+           "speed %.1f km/h, real_time_factor %g, at_end %s",
+           scene.name.c_str(), scene.spans.size(), m.line_length, m.n_dof, m.dt * 1e3, m.dt_critical * 1e3,
+           scene.train_speed * 3.6, params_.real_time_factor, to_string(params_.at_end));
+}
+
+void SimulationNode::restart_recording() {
+  recorder_ = std::make_unique<PassRecorder>(sim_->model(), kRecorderRowRate);
+}
+
+void SimulationNode::reanchor() {
+  wall_anchor_ = ros::WallTime::now();
+  sim_anchor_ = sim_->state().time;
+}
+
+int SimulationNode::run() {
+  const ros::WallDuration period(1.0 / params_.publish_rate);
+  wall_start_ = ros::WallTime::now();
+  diag_wall_ = wall_start_;
+  diag_sim_ = sim_->state().time;
+  reanchor();
+  publish(true);
+  ros::WallTime next_tick = ros::WallTime::now() + period;
+  while (ros::ok() && !exit_requested_) {
+    ros::spinOnce();
+    if (exit_requested_) break;
+    advance(next_tick);
+    handle_end();
+    publish(false);
+    updater_.update();
+    const ros::WallTime now = ros::WallTime::now();
+    if (next_tick > now) {
+      (next_tick - now).sleep();
+      next_tick += period;
+    } else {
+      next_tick = now + period;  // behind: do not try to catch up on ticks
+    }
+  }
+  return exit_code_;
+}
+
+std::int64_t SimulationNode::do_steps(std::int64_t n, const ros::WallTime* deadline) {
+  const Model& m = sim_->model();
+  const std::size_t np = m.pantographs.size();
+  std::int64_t done = 0;
+  for (; done < n; ++done) {
+    if (sim_->finished()) break;
+    if (sim_->step() != StepStatus::kOk) break;
+    const State& s = sim_->state();
+    recorder_->record(m, s);
+    ++counted_steps_;
+    for (std::size_t p = 0; p < np; ++p) {
+      if (!(total_contact_force(m, s, static_cast<int>(p)) > 0.0)) {
+        ++loss_steps_;
+        break;
+      }
+    }
+    if (deadline && (done & 31) == 31 && ros::WallTime::now() >= *deadline) {
+      ++done;
+      break;
+    }
+  }
+  return done;
+}
+
+void SimulationNode::advance(const ros::WallTime& tick_deadline) {
+  if (paused_ || ended_) return;
+  if (sim_->finished() || sim_->state().status != StepStatus::kOk) return;
+  const double dt = sim_->model().dt;
+  if (params_.real_time_factor <= 0.0) {
+    // As fast as possible: step until the tick is due, then publish.
+    do_steps(std::numeric_limits<std::int64_t>::max(), &tick_deadline);
+    return;
+  }
+  const ros::WallTime now = ros::WallTime::now();
+  const std::int64_t due = steps_due((now - wall_anchor_).toSec(), params_.real_time_factor, dt,
+                                     sim_->state().time - sim_anchor_);
+  const double nominal = params_.real_time_factor / (params_.publish_rate * dt);
+  const std::int64_t limit = static_cast<std::int64_t>(std::ceil(kCatchUp * nominal)) + 1;
+  const std::int64_t want = std::min(due, limit);
+  const std::int64_t done = do_steps(want, &tick_deadline);
+  if (due > limit || (done < want && !sim_->finished() && sim_->state().status == StepStatus::kOk)) {
+    // Could not keep up: drop the backlog (dt is never stretched; the achieved factor drops).
+    ++overruns_;
+    ROS_WARN_THROTTLE(5.0, "catenary_sim: overrun: %lld steps due, %lld taken this tick (%lld overruns so far); "
+                      "real_time_factor %g is not reached",
+                      static_cast<long long>(due), static_cast<long long>(done), static_cast<long long>(overruns_),
+                      params_.real_time_factor);
+    reanchor();
+  }
+}
+
+void SimulationNode::handle_end() {
+  if (ended_) return;
+  const State& s = sim_->state();
+  if (s.status == StepStatus::kDiverged) {
+    ended_ = true;
+    ROS_ERROR("catenary_sim: %s", sim_->status_message().c_str());
+    if (params_.at_end == AtEnd::kExit) {
+      exit_code_ = 1;
+      exit_requested_ = true;
+      publish(true);
+      ros::shutdown();
+    }
+    return;
+  }
+  if (!sim_->finished()) return;
+  switch (params_.at_end) {
+    case AtEnd::kStop:
+      ended_ = true;
+      ROS_INFO("catenary_sim: %s; holding the last state (at_end stop)", sim_->status_message().c_str());
+      report_statistics();
+      break;
+    case AtEnd::kLoop:
+      ROS_INFO("catenary_sim: %s; starting again (at_end loop)", sim_->status_message().c_str());
+      report_statistics();
+      publish(true);
+      sim_->reset(true);
+      restart_recording();
+      reanchor();
+      break;
+    case AtEnd::kExit:
+      ended_ = true;
+      ROS_INFO("catenary_sim: %s; exiting (at_end exit)", sim_->status_message().c_str());
+      publish(true);
+      report_statistics();
+      exit_requested_ = true;
+      ros::shutdown();
+      break;
+  }
+}
+
+void SimulationNode::report_statistics() {
+  const Model& m = sim_->model();
+  const std::vector<PantographStatistics> stats = recorder_->statistics(m);
+  for (const PantographStatistics& s : stats) {
+    ROS_INFO("catenary_sim: %s: mean %.1f N, std %.1f N, max %.1f N, min %.1f N, stat max %.1f N, stat min %.1f N, "
+             "contact loss %.2f %%, max uplift at steady arm %.1f mm (%zu samples, filtered %.0f Hz)",
+             s.name.c_str(), s.filtered.mean, s.filtered.std_dev, s.filtered.max, s.filtered.min, s.filtered.stat_max,
+             s.filtered.stat_min, s.contact_loss_percent, s.max_uplift_at_support_m * 1e3, s.samples,
+             m.scene.output.filter_cutoff);
+  }
+  if (params_.stats_file.empty()) return;
+  const std::string json =
+      statistics_json(m, sim_->state(), stats, (ros::WallTime::now() - wall_start_).toSec(), overruns_);
+  std::ofstream f(params_.stats_file);
+  f << json;
+  if (!f) ROS_ERROR("catenary_sim: cannot write ~stats_file '%s'", params_.stats_file.c_str());
+  else ROS_INFO("catenary_sim: statistics written to %s", params_.stats_file.c_str());
+}
+
+void SimulationNode::publish(bool force) {
+  const Model& m = sim_->model();
+  const State& s = sim_->state();
+  const ros::WallTime now = ros::WallTime::now();
+  const ros::Time stamp = sim_stamp(s.time, stamp_offset_);
+  const bool advanced = s.time > last_published_time_;
+  const bool shape_due = (now - last_shape_wall_).toSec() >= 1.0 / params_.shape_rate;
+  // While the simulation holds (paused, stopped), the state topics are repeated at shape_rate with
+  // their unchanged stamp; tf and /clock are only sent for a new time.
+  if (!advanced && !force && !shape_due) return;
+
+  if (advanced || force) {
+    if (params_.publish_clock && advanced) {
+      rosgraph_msgs::Clock c;
+      c.clock = stamp;
+      clock_pub_.publish(c);
+    }
+    if (advanced) tf_.sendTransform(to_transforms(m, s, stamp, params_.line_frame));
+  }
+  contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
+  pantograph_pub_.publish(to_pantograph_state(m, s, stamp, params_.line_frame));
+  last_published_time_ = s.time;
+
+  if (shape_due || force) {
+    last_shape_wall_ = now;
+    shape_pub_.publish(to_wire_shape(m, s, params_.shape_resolution, stamp, params_.line_frame));
+    if (marker_pub_.getNumSubscribers() > 0) {
+      MarkerOptions o;
+      o.frame = params_.line_frame;
+      o.vertical_scale = params_.vertical_scale;
+      o.shape_resolution = params_.shape_resolution;
+      marker_pub_.publish(to_markers(m, s, stamp, o));
+    }
+  }
+}
+
+void SimulationNode::on_speed(const std_msgs::Float64::ConstPtr& msg) {
+  std::string err;
+  if (!sim_->set_target_speed(msg->data, &err)) {
+    ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/train_speed: %s; command ignored", err.c_str());
+    return;
+  }
+  have_command_ = true;
+  last_command_wall_ = ros::WallTime::now();
+  // A new speed after the end of a held pass does not restart it: use ~reset.
+}
+
+void SimulationNode::on_uplift(const std_msgs::Float64MultiArray::ConstPtr& msg) {
+  const std::size_t np = sim_->model().pantographs.size();
+  const std::size_t n = msg->data.size();
+  if (n != 1 && n != np) {
+    ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force: %zu values rejected: send 1 (all pantographs) or %zu "
+                       "(one per pantograph); command ignored", n, np);
+    return;
+  }
+  // Check every value first so that a rejected command leaves the state unchanged.
+  for (std::size_t i = 0; i < n; ++i) {
+    const double f = msg->data[i];
+    if (!std::isfinite(f) || f < 0.0 || f > Simulation::kMaxUplift) {
+      ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force[%zu] = %g N rejected: allowed 0 to %g N; command ignored",
+                         i, f, Simulation::kMaxUplift);
+      return;
+    }
+  }
+  std::string err;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!sim_->set_uplift(n == 1 ? -1 : static_cast<int>(i), msg->data[i], &err)) {
+      ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force: %s", err.c_str());  // not reached after the check
+      return;
+    }
+  }
+  have_command_ = true;
+  last_command_wall_ = ros::WallTime::now();
+}
+
+bool SimulationNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  sim_->reset(true);
+  restart_recording();
+  ended_ = false;
+  reanchor();
+  publish(true);
+  std::ostringstream s;
+  s << "new pass from the start at t = " << sim_->state().time << " s (time keeps running)";
+  res.success = true;
+  res.message = s.str();
+  ROS_INFO("catenary_sim: reset: %s", res.message.c_str());
+  return true;
+}
+
+bool SimulationNode::on_set_paused(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
+  if (!req.data && paused_) reanchor();
+  paused_ = req.data;
+  res.success = true;
+  res.message = paused_ ? "paused" : "running";
+  return true;
+}
+
+bool SimulationNode::on_step(Step::Request& req, Step::Response& res) {
+  res.total_steps = sim_->state().steps;
+  res.sim_time = sim_->state().time;
+  res.steps_advanced = 0;
+  if (!paused_) {
+    res.success = false;
+    res.message = "rejected: the simulation is running; call ~set_paused true first";
+    return true;
+  }
+  if (req.steps < 1 || req.steps > kMaxStepsPerCall) {
+    res.success = false;
+    res.message = "steps = " + std::to_string(req.steps) + " rejected: allowed 1 to " + std::to_string(kMaxStepsPerCall);
+    return true;
+  }
+  res.steps_advanced = do_steps(req.steps, nullptr);
+  res.total_steps = sim_->state().steps;
+  res.sim_time = sim_->state().time;
+  res.success = res.steps_advanced == req.steps;
+  res.message = res.success ? "ok" : "stopped early: " + sim_->status_message();
+  handle_end();
+  publish(true);
+  return true;
+}
+
+void SimulationNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const Model& m = sim_->model();
+  const State& s = sim_->state();
+  const ros::WallTime now = ros::WallTime::now();
+  const double wall = (now - diag_wall_).toSec();
+  const double rtf = wall > 0.0 ? (s.time - diag_sim_) / wall : 0.0;
+  const std::int64_t new_overruns = overruns_ - diag_overruns_;
+  diag_wall_ = now;
+  diag_sim_ = s.time;
+  diag_overruns_ = overruns_;
+  const double margin = m.dt / m.dt_critical;
+  bool loss_now = false;
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p)
+    if (!(total_contact_force(m, s, static_cast<int>(p)) > 0.0)) loss_now = true;
+
+  using diagnostic_msgs::DiagnosticStatus;
+  if (s.status == StepStatus::kDiverged) stat.summary(DiagnosticStatus::ERROR, sim_->status_message());
+  else if (new_overruns > 0) stat.summary(DiagnosticStatus::WARN, "overruns: real_time_factor not reached");
+  else if (margin > 1.0) stat.summary(DiagnosticStatus::WARN, "dt above the stability limit");
+  else if (loss_now) stat.summary(DiagnosticStatus::WARN, "contact loss");
+  else if (paused_) stat.summary(DiagnosticStatus::OK, "paused");
+  else if (sim_->finished()) stat.summary(DiagnosticStatus::OK, "pass finished");
+  else stat.summary(DiagnosticStatus::OK, "running");
+
+  stat.add("real_time_factor (achieved)", rtf);
+  stat.add("real_time_factor (requested, 0 = max)", params_.real_time_factor);
+  stat.add("overruns", overruns_);
+  stat.add("stability margin dt/dt_critical", margin);
+  stat.add("dt [s]", m.dt);
+  stat.add("sim time [s]", s.time);
+  stat.add("steps", s.steps);
+  stat.add("train front [m]", s.front);
+  stat.add("speed [m/s]", s.speed);
+  stat.add("contact loss now", loss_now);
+  stat.add("contact loss [% of steps]", counted_steps_ > 0 ? 100.0 * loss_steps_ / counted_steps_ : 0.0);
+  if (have_command_) stat.add("age of last command [s]", (now - last_command_wall_).toSec());
+  else stat.add("age of last command [s]", "no command yet");
+  stat.add("paused", paused_);
+}
+
+}  // namespace ros_layer
+}  // namespace catenary_sim

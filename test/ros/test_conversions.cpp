@@ -1,0 +1,222 @@
+// Conversions of the ROS layer (State/Model -> messages, markers, transforms), pacing arithmetic
+// and parameter validation: pure functions, no master needed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "catenary_sim/core/simulation.hpp"
+#include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/params.hpp"
+
+using namespace catenary_sim;
+using namespace catenary_sim::ros_layer;
+
+namespace {
+
+struct Fixture : ::testing::Test {
+  static void SetUpTestSuite() {
+    sim = new Simulation(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m.yaml"));
+    for (int i = 0; i < 2000; ++i) ASSERT_EQ(sim->step(), StepStatus::kOk);
+  }
+  static void TearDownTestSuite() { delete sim; }
+  static Simulation* sim;
+  const ros::Time stamp{1000, 500};
+};
+Simulation* Fixture::sim = nullptr;
+
+}  // namespace
+
+TEST_F(Fixture, ContactForceSumsCollectorsAndFlagsContact) {
+  const Model& m = sim->model();
+  const State& s = sim->state();
+  const ContactForceArray msg = to_contact_force(m, s, stamp, "line");
+  EXPECT_EQ(msg.header.stamp, stamp);
+  EXPECT_EQ(msg.header.frame_id, "line");
+  ASSERT_EQ(msg.pantographs.size(), m.pantographs.size());
+  for (std::size_t p = 0; p < msg.pantographs.size(); ++p) {
+    const ContactForce& c = msg.pantographs[p];
+    EXPECT_EQ(c.header.stamp, stamp);
+    EXPECT_EQ(c.name, m.pantographs[p].name);
+    EXPECT_DOUBLE_EQ(c.position, pantograph_position(m, s, p));
+    ASSERT_EQ(c.collector_forces.size(), m.pantographs[p].collectors.size());
+    ASSERT_EQ(c.in_contact.size(), c.collector_forces.size());
+    double sum = 0.0;
+    for (std::size_t k = 0; k < c.collector_forces.size(); ++k) {
+      EXPECT_GE(c.collector_forces[k], 0.0);
+      EXPECT_EQ(static_cast<bool>(c.in_contact[k]), c.collector_forces[k] > 0.0);
+      sum += c.collector_forces[k];
+    }
+    EXPECT_NEAR(c.total, sum, 1e-9);
+    EXPECT_DOUBLE_EQ(c.total, total_contact_force(m, s, p));
+    EXPECT_GT(c.total, 0.0);  // the reference pass keeps contact at the start
+  }
+}
+
+TEST_F(Fixture, PantographStateHasEveryMass) {
+  const Model& m = sim->model();
+  const State& s = sim->state();
+  const PantographStateArray msg = to_pantograph_state(m, s, stamp, "line");
+  EXPECT_EQ(msg.step, s.steps);
+  EXPECT_DOUBLE_EQ(msg.sim_time, s.time);
+  EXPECT_DOUBLE_EQ(msg.speed, s.speed);
+  EXPECT_DOUBLE_EQ(msg.train_front, s.front);
+  ASSERT_EQ(msg.pantographs.size(), m.pantographs.size());
+  const Pantograph& pg = m.pantographs[0];
+  const PantographState& ps = msg.pantographs[0];
+  ASSERT_EQ(ps.displacement.size(), static_cast<std::size_t>(pg.masses_count()));
+  ASSERT_EQ(ps.velocity.size(), ps.displacement.size());
+  for (int i = 0; i < pg.masses_count(); ++i) {
+    EXPECT_DOUBLE_EQ(ps.displacement[i], s.u[pg.first_dof + i]);
+    EXPECT_DOUBLE_EQ(ps.velocity[i], s.v[pg.first_dof + i]);
+  }
+  EXPECT_DOUBLE_EQ(ps.uplift, s.uplift[0]);
+  EXPECT_DOUBLE_EQ(ps.head_height, head_height(m, s, 0));
+  EXPECT_DOUBLE_EQ(ps.speed, s.speed);
+}
+
+TEST_F(Fixture, WireShapeSamplesAtResolutionAndKeepsEnds) {
+  const Model& m = sim->model();
+  const State& s = sim->state();
+  for (double res : {0.0, 1.0, 5.0}) {
+    const WireShapeArray msg = to_wire_shape(m, s, res, stamp, "line");
+    ASSERT_EQ(msg.wires.size(), m.wires.size());
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const Wire& w = m.wires[wi];
+      const WireShape& ws = msg.wires[wi];
+      EXPECT_EQ(ws.name, w.name);
+      ASSERT_EQ(ws.stations.size(), ws.heights.size());
+      if (res == 0.0) {
+        EXPECT_EQ(ws.stations.size(), static_cast<std::size_t>(w.nodes()));
+      }
+      EXPECT_DOUBLE_EQ(ws.stations.front(), w.x.front());
+      EXPECT_DOUBLE_EQ(ws.stations.back(), w.x.back());
+      double max_gap = 0.0;
+      for (std::size_t k = 1; k < ws.stations.size(); ++k) {
+        EXPECT_GT(ws.stations[k], ws.stations[k - 1]);
+        max_gap = std::max(max_gap, ws.stations[k] - ws.stations[k - 1]);
+      }
+      EXPECT_LE(max_gap, res + m.scene.numerics.element_length + 1e-9);
+      // Heights are design + displacement at the sampled node.
+      for (std::size_t k = 0; k < ws.stations.size(); k += 17) {
+        int node = -1;
+        for (int i = 0; i < w.nodes(); ++i)
+          if (w.x[i] == ws.stations[k]) node = i;
+        ASSERT_GE(node, 0);
+        EXPECT_DOUBLE_EQ(ws.heights[k], w.height[node] + s.u[w.w_dof + node]);
+      }
+    }
+  }
+}
+
+TEST_F(Fixture, TransformsLineTrainHead) {
+  const Model& m = sim->model();
+  const State& s = sim->state();
+  const auto tfs = to_transforms(m, s, stamp, "line");
+  ASSERT_EQ(tfs.size(), 1 + m.pantographs.size());
+  EXPECT_EQ(tfs[0].header.frame_id, "line");
+  EXPECT_EQ(tfs[0].child_frame_id, train_frame_id());
+  EXPECT_DOUBLE_EQ(tfs[0].transform.translation.x, s.front);
+  EXPECT_EQ(tfs[1].header.frame_id, train_frame_id());
+  EXPECT_EQ(tfs[1].child_frame_id, "pantograph_leading");
+  EXPECT_DOUBLE_EQ(tfs[0].transform.translation.x + tfs[1].transform.translation.x, pantograph_position(m, s, 0));
+  EXPECT_DOUBLE_EQ(tfs[1].transform.translation.z, head_height(m, s, 0));
+  for (const auto& t : tfs) {
+    EXPECT_EQ(t.header.stamp, stamp);
+    EXPECT_DOUBLE_EQ(t.transform.rotation.w, 1.0);
+  }
+}
+
+TEST_F(Fixture, MarkersCoverEveryPartAndExaggerateDisplacement) {
+  const Model& m = sim->model();
+  const State& s = sim->state();
+  MarkerOptions o;
+  o.vertical_scale = 10.0;
+  o.shape_resolution = 0.0;
+  const auto arr = to_markers(m, s, stamp, o);
+  std::set<std::string> ns;
+  for (const auto& mk : arr.markers) {
+    ns.insert(mk.ns);
+    EXPECT_EQ(mk.header.frame_id, "line");
+    EXPECT_EQ(mk.header.stamp, stamp);
+    for (const auto& p : mk.points) {
+      EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << mk.ns;
+    }
+  }
+  for (const char* n : {"wires", "droppers", "masts", "steady_arms", "pantograph_head", "pantograph_frame",
+                        "contact_force", "label"})
+    EXPECT_EQ(ns.count(n), 1u) << n;
+  // Contact wire strip: z = design + 10 u at every node.
+  const Wire& w = m.wires[0];
+  const auto& strip = arr.markers[0];
+  ASSERT_EQ(strip.points.size(), static_cast<std::size_t>(w.nodes()));
+  for (int i = 0; i < w.nodes(); i += 31) EXPECT_DOUBLE_EQ(strip.points[i].z, w.height[i] + 10.0 * s.u[w.w_dof + i]);
+  // Unique (ns, id) pairs, or rviz would overwrite markers.
+  std::set<std::pair<std::string, int>> ids;
+  for (const auto& mk : arr.markers) EXPECT_TRUE(ids.insert({mk.ns, mk.id}).second) << mk.ns << " " << mk.id;
+  EXPECT_NE(arr.markers.back().text.find("km/h"), std::string::npos);
+}
+
+TEST(Pacing, StepsDueFollowWallClockTimesFactor) {
+  EXPECT_EQ(steps_due(1.0, 1.0, 1e-3, 0.0), 1000);
+  EXPECT_EQ(steps_due(1.0, 2.0, 1e-3, 0.0), 2000);
+  EXPECT_EQ(steps_due(1.0, 1.0, 1e-3, 0.5), 500);
+  EXPECT_EQ(steps_due(1.0, 1.0, 1e-3, 2.0), 0);   // ahead: nothing due, never negative
+  EXPECT_EQ(steps_due(1.0, 0.0, 1e-3, 0.0), 0);   // factor 0 is handled by the caller
+  EXPECT_EQ(steps_due(0.0, 1.0, 1e-3, 0.0), 0);
+  EXPECT_EQ(steps_due(0.0105, 1.0, 1e-3, 0.0), 10);  // whole steps only: dt is never stretched
+}
+
+TEST(Stamps, OffsetAddsAndIsMonotonic) {
+  EXPECT_EQ(sim_stamp(1.5, 100.0), ros::Time(101.5));
+  EXPECT_LT(sim_stamp(1.0, 100.0), sim_stamp(1.0001, 100.0));
+}
+
+TEST(Params, ErrorsNameParameterValueAndRange) {
+  NodeParams p;
+  p.scene = "x.yaml";
+  EXPECT_NO_THROW(validate(p));
+  auto message = [](const NodeParams& q) {
+    try {
+      validate(q);
+    } catch (const ParamError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  NodeParams q = p;
+  q.publish_rate = -5.0;
+  std::string e = message(q);
+  EXPECT_NE(e.find("publish_rate"), std::string::npos) << e;
+  EXPECT_NE(e.find("-5"), std::string::npos) << e;
+  EXPECT_NE(e.find("10000"), std::string::npos) << e;
+  q = p;
+  q.real_time_factor = std::nan("");
+  EXPECT_NE(message(q).find("real_time_factor"), std::string::npos);
+  q = p;
+  q.speed_kmh = 600.0;
+  EXPECT_NE(message(q).find("speed_kmh = 600"), std::string::npos);
+  q = p;
+  q.max_acceleration = 25.0;
+  EXPECT_NE(message(q).find("max_acceleration"), std::string::npos);
+  q = p;
+  q.scene.clear();
+  EXPECT_NE(message(q).find("~scene is required"), std::string::npos);
+  EXPECT_THROW(parse_at_end("rewind"), ParamError);
+  EXPECT_EQ(parse_at_end("loop"), AtEnd::kLoop);
+  p.scene = "/nonexistent/scene.yaml";
+  try {
+    load_scene(p);
+    FAIL() << "no error for a missing scene file";
+  } catch (const ParamError& err) {
+    EXPECT_NE(std::string(err.what()).find("/nonexistent/scene.yaml"), std::string::npos);
+  }
+}
+
+TEST_F(Fixture, StatisticsJsonHasPantographs) {
+  PassRecorder rec(sim->model());
+  const std::string j = statistics_json(sim->model(), sim->state(), rec.statistics(sim->model()), 1.0, 3);
+  EXPECT_NE(j.find("\"pantographs\""), std::string::npos);
+  EXPECT_NE(j.find("\"overruns\": 3"), std::string::npos);
+}
