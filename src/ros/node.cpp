@@ -4,6 +4,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <algorithm>
 #include <limits>
@@ -73,6 +74,16 @@ void SimulationNode::reanchor() {
 
 int SimulationNode::run() {
   const ros::WallDuration period(1.0 / params_.publish_rate);
+  if (params_.start_delay > 0.0) {
+    ROS_INFO("catenary_sim: starting in %g s (~start_delay)", params_.start_delay);
+    const ros::WallTime start = ros::WallTime::now() + ros::WallDuration(params_.start_delay);
+    publish(true);
+    while (ros::ok() && ros::WallTime::now() < start) {
+      ros::spinOnce();
+      updater_.update();
+      ros::WallDuration(0.02).sleep();
+    }
+  }
   wall_start_ = ros::WallTime::now();
   diag_wall_ = wall_start_;
   diag_sim_ = sim_->state().time;
@@ -163,14 +174,17 @@ void SimulationNode::handle_end() {
     return;
   }
   if (!sim_->finished()) return;
+  // (finished() is true as soon as the front reaches the end, before step() marks the state)
+  char what[128];
+  std::snprintf(what, sizeof what, "pass finished at t = %.4f s (train front at %.2f m)", s.time, s.front);
   switch (params_.at_end) {
     case AtEnd::kStop:
       ended_ = true;
-      ROS_INFO("catenary_sim: %s; holding the last state (at_end stop)", sim_->status_message().c_str());
+      ROS_INFO("catenary_sim: %s; holding the last state (at_end stop)", what);
       report_statistics();
       break;
     case AtEnd::kLoop:
-      ROS_INFO("catenary_sim: %s; starting again (at_end loop)", sim_->status_message().c_str());
+      ROS_INFO("catenary_sim: %s; starting again (at_end loop)", what);
       report_statistics();
       publish(true);
       sim_->reset(true);
@@ -179,7 +193,7 @@ void SimulationNode::handle_end() {
       break;
     case AtEnd::kExit:
       ended_ = true;
-      ROS_INFO("catenary_sim: %s; exiting (at_end exit)", sim_->status_message().c_str());
+      ROS_INFO("catenary_sim: %s; exiting (at_end exit)", what);
       publish(true);
       report_statistics();
       exit_requested_ = true;

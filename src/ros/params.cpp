@@ -52,6 +52,7 @@ void validate(const NodeParams& p) {
   check_range("shape_resolution", p.shape_resolution, 0.0, 100.0, false, "m (0: every node)");
   check_range("vertical_scale", p.vertical_scale, 0.0, 10000.0, true, "");
   check_range("max_acceleration", p.max_acceleration, 0.0, 20.0, false, "m/s^2 (0: no limit)");
+  check_range("start_delay", p.start_delay, 0.0, 60.0, false, "s");
   if (p.line_frame.empty() || p.line_frame[0] == '/')
     throw ParamError("parameter ~line_frame = '" + p.line_frame + "' rejected: a non-empty frame id without a leading '/'");
 }
@@ -83,6 +84,7 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   number("shape_resolution", p.shape_resolution);
   number("vertical_scale", p.vertical_scale);
   number("max_acceleration", p.max_acceleration);
+  number("start_delay", p.start_delay);
   nh.param<std::string>("line_frame", p.line_frame, p.line_frame);
   std::string at_end = to_string(p.at_end);
   nh.param<std::string>("at_end", at_end, at_end);

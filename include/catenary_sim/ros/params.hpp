@@ -36,6 +36,8 @@ struct NodeParams {
   std::string stats_file;           // ~stats_file: JSON statistics written at the end (empty: none)
   bool publish_clock = false;       // ~publish_clock: publish rosgraph_msgs/Clock on /clock
   double max_acceleration = 1.0;    // ~max_acceleration: m/s^2 toward commanded speeds, [0, 20] (0: jump)
+  double start_delay = 0.0;         // ~start_delay: s (wall) publishing the initial state before stepping, [0, 60]
+                                    //   (lets rosbag record / rviz connect before a fast pass is over)
 };
 
 // Throws ParamError for any value out of range (message: parameter, value, allowed range).
