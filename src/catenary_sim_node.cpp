@@ -5,8 +5,11 @@
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "catenary_sim");
+  // Handles outlive the node object: destroying the last one shuts ROS (and its logging) down,
+  // which would swallow the fatal message below.
+  ros::NodeHandle nh, pnh("~");
   try {
-    catenary_sim::ros_layer::SimulationNode node(ros::NodeHandle(), ros::NodeHandle("~"));
+    catenary_sim::ros_layer::SimulationNode node(nh, pnh);
     return node.run();
   } catch (const catenary_sim::ros_layer::ParamError& e) {
     ROS_FATAL("catenary_sim: %s", e.what());
