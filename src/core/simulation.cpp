@@ -18,7 +18,10 @@ std::string Simulation::status_message() const {
   std::ostringstream s;
   switch (state_.status) {
     case StepStatus::kOk:
-      s << "running";
+      if (state_.front >= model_.train_end)
+        s << "pass finished at t = " << state_.time << " s (train front at " << state_.front << " m)";
+      else
+        s << "running";
       break;
     case StepStatus::kFinished:
       s << "pass finished at t = " << state_.time << " s (train front at " << state_.front << " m)";

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 
 namespace catenary_sim {
 namespace {
@@ -162,6 +164,54 @@ std::vector<PantographStatistics> PassRecorder::statistics(const Model& m) const
     out.push_back(st);
   }
   return out;
+}
+
+namespace {
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream s;
+  s << std::setprecision(10) << v;
+  return s.str();
+}
+
+void force_json(std::ostringstream& j, const ForceStatistics& f) {
+  j << "\"mean_force_N\": " << json_number(f.mean) << ", \"std_force_N\": " << json_number(f.std_dev)
+    << ", \"max_force_N\": " << json_number(f.max) << ", \"min_force_N\": " << json_number(f.min)
+    << ", \"stat_max_force_N\": " << json_number(f.stat_max) << ", \"stat_min_force_N\": " << json_number(f.stat_min);
+}
+
+}  // namespace
+
+std::string statistics_json(const Model& m, const State& s, const std::vector<PantographStatistics>& stats,
+                            const RunInfo& run) {
+  const Scene& scene = m.scene;
+  std::ostringstream j;
+  j << "{\n  \"scene\": \"" << scene.name << "\",\n"
+    << "  \"speed_kmh\": " << json_number(s.speed * 3.6) << ",\n"
+    << "  \"dofs\": " << m.n_dof << ",\n  \"dt_s\": " << json_number(m.dt) << ",\n"
+    << "  \"dt_critical_s\": " << json_number(m.dt_critical) << ",\n"
+    << "  \"steps\": " << s.steps << ",\n  \"simulated_time_s\": " << json_number(s.time) << ",\n";
+  if (run.build_time_s >= 0.0) j << "  \"build_time_s\": " << json_number(run.build_time_s) << ",\n";
+  j << "  \"wall_time_s\": " << json_number(run.wall_time_s) << ",\n"
+    << "  \"real_time_factor\": " << json_number(run.wall_time_s > 0.0 ? s.time / run.wall_time_s : std::nan(""))
+    << ",\n";
+  if (run.overruns >= 0) j << "  \"overruns\": " << run.overruns << ",\n";
+  j << "  \"analysis_section_m\": [" << json_number(m.support_x[scene.analysis_first()]) << ", "
+    << json_number(m.support_x[scene.analysis_last()]) << "],\n"
+    << "  \"filter_cutoff_hz\": " << json_number(scene.output.filter_cutoff) << ",\n"
+    << "  \"pantographs\": [";
+  for (std::size_t i = 0; i < stats.size(); ++i) {
+    const PantographStatistics& p = stats[i];
+    j << (i ? "," : "") << "\n    {\"name\": \"" << p.name << "\", \"samples\": " << p.samples << ",\n     ";
+    force_json(j, p.filtered);
+    j << ",\n     \"contact_loss_percent\": " << json_number(p.contact_loss_percent)
+      << ", \"max_uplift_at_support_m\": " << json_number(p.max_uplift_at_support_m) << ",\n     \"unfiltered\": {";
+    force_json(j, p.unfiltered);
+    j << "}}";
+  }
+  j << "\n  ]\n}\n";
+  return j.str();
 }
 
 }  // namespace catenary_sim

@@ -57,12 +57,6 @@ visualization_msgs::Marker marker(const std_msgs::Header& h, const std::string& 
   return mk;
 }
 
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream s;
-  s << std::setprecision(10) << v;
-  return s.str();
-}
 
 double collector_force(const Model& m, const State& s, int ci) {
   const std::size_t nw = m.contact_wires.size();
@@ -298,40 +292,6 @@ std::int64_t steps_due(double wall_elapsed, double real_time_factor, double dt, 
   return n > 0.0 ? static_cast<std::int64_t>(n) : 0;
 }
 
-std::string statistics_json(const Model& m, const State& s, const std::vector<PantographStatistics>& stats,
-                            double wall_time_s, std::int64_t overruns) {
-  const Scene& scene = m.scene;
-  std::ostringstream j;
-  j << "{\n  \"scene\": \"" << scene.name << "\",\n"
-    << "  \"speed_kmh\": " << json_number(s.speed * 3.6) << ",\n"
-    << "  \"dofs\": " << m.n_dof << ",\n  \"dt_s\": " << json_number(m.dt) << ",\n"
-    << "  \"dt_critical_s\": " << json_number(m.dt_critical) << ",\n"
-    << "  \"steps\": " << s.steps << ",\n  \"simulated_time_s\": " << json_number(s.time) << ",\n"
-    << "  \"wall_time_s\": " << json_number(wall_time_s) << ",\n"
-    << "  \"real_time_factor\": " << json_number(wall_time_s > 0.0 ? s.time / wall_time_s : std::nan("")) << ",\n"
-    << "  \"overruns\": " << overruns << ",\n"
-    << "  \"analysis_section_m\": [" << json_number(m.support_x[scene.analysis_first()]) << ", "
-    << json_number(m.support_x[scene.analysis_last()]) << "],\n"
-    << "  \"filter_cutoff_hz\": " << json_number(scene.output.filter_cutoff) << ",\n"
-    << "  \"pantographs\": [";
-  for (std::size_t i = 0; i < stats.size(); ++i) {
-    const PantographStatistics& p = stats[i];
-    j << (i ? "," : "") << "\n    {\"name\": \"" << p.name << "\", \"samples\": " << p.samples
-      << ",\n     \"mean_force_N\": " << json_number(p.filtered.mean)
-      << ", \"std_force_N\": " << json_number(p.filtered.std_dev)
-      << ", \"max_force_N\": " << json_number(p.filtered.max) << ", \"min_force_N\": " << json_number(p.filtered.min)
-      << ",\n     \"stat_max_force_N\": " << json_number(p.filtered.stat_max)
-      << ", \"stat_min_force_N\": " << json_number(p.filtered.stat_min)
-      << ", \"contact_loss_percent\": " << json_number(p.contact_loss_percent)
-      << ", \"max_uplift_at_support_m\": " << json_number(p.max_uplift_at_support_m)
-      << ",\n     \"unfiltered\": {\"mean_force_N\": " << json_number(p.unfiltered.mean)
-      << ", \"std_force_N\": " << json_number(p.unfiltered.std_dev)
-      << ", \"max_force_N\": " << json_number(p.unfiltered.max) << ", \"min_force_N\": " << json_number(p.unfiltered.min)
-      << "}}";
-  }
-  j << "\n  ]\n}\n";
-  return j.str();
-}
 
 }  // namespace ros_layer
 }  // namespace catenary_sim

@@ -214,7 +214,7 @@ void SimulationNode::report_statistics() {
   }
   if (params_.stats_file.empty()) return;
   const std::string json =
-      statistics_json(m, sim_->state(), stats, (ros::WallTime::now() - wall_start_).toSec(), overruns_);
+      statistics_json(m, sim_->state(), stats, RunInfo{(ros::WallTime::now() - wall_start_).toSec(), -1.0, overruns_});
   std::ofstream f(params_.stats_file);
   f << json;
   if (!f) ROS_ERROR("catenary_sim: cannot write ~stats_file '%s'", params_.stats_file.c_str());

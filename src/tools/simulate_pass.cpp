@@ -30,13 +30,6 @@ const char* kUsage =
     "  --out DIR        output directory for stats.json and timeseries.csv (created)\n"
     "  --quiet          print only errors\n";
 
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream s;
-  s << std::setprecision(10) << v;
-  return s.str();
-}
-
 bool make_dirs(const std::string& path) {
   std::string cur;
   std::stringstream ss(path);
@@ -141,34 +134,10 @@ int main(int argc, char** argv) {
 
   {
     std::ofstream j(out_dir + "/stats.json");
-    j << "{\n  \"scene\": \"" << scene.name << "\",\n"
-      << "  \"speed_kmh\": " << json_number(scene.train_speed * 3.6) << ",\n"
-      << "  \"dofs\": " << m.n_dof << ",\n  \"dt_s\": " << json_number(m.dt) << ",\n"
-      << "  \"dt_critical_s\": " << json_number(m.dt_critical) << ",\n"
-      << "  \"steps\": " << st.steps << ",\n  \"simulated_time_s\": " << json_number(st.time) << ",\n"
-      << "  \"build_time_s\": " << json_number(build_s) << ",\n"
-      << "  \"wall_time_s\": " << json_number(wall) << ",\n  \"real_time_factor\": " << json_number(rtf) << ",\n"
-      << "  \"analysis_section_m\": [" << json_number(m.support_x[scene.analysis_first()]) << ", "
-      << json_number(m.support_x[scene.analysis_last()]) << "],\n"
-      << "  \"filter_cutoff_hz\": " << json_number(scene.output.filter_cutoff) << ",\n"
-      << "  \"pantographs\": [";
-    for (std::size_t i = 0; i < stats.size(); ++i) {
-      const PantographStatistics& s = stats[i];
-      j << (i ? "," : "") << "\n    {\"name\": \"" << s.name << "\", \"samples\": " << s.samples
-        << ",\n     \"mean_force_N\": " << json_number(s.filtered.mean)
-        << ", \"std_force_N\": " << json_number(s.filtered.std_dev)
-        << ", \"max_force_N\": " << json_number(s.filtered.max) << ", \"min_force_N\": " << json_number(s.filtered.min)
-        << ",\n     \"stat_max_force_N\": " << json_number(s.filtered.stat_max)
-        << ", \"stat_min_force_N\": " << json_number(s.filtered.stat_min)
-        << ", \"contact_loss_percent\": " << json_number(s.contact_loss_percent)
-        << ", \"max_uplift_at_support_m\": " << json_number(s.max_uplift_at_support_m)
-        << ",\n     \"unfiltered\": {\"mean_force_N\": " << json_number(s.unfiltered.mean)
-        << ", \"std_force_N\": " << json_number(s.unfiltered.std_dev)
-        << ", \"max_force_N\": " << json_number(s.unfiltered.max) << ", \"min_force_N\": " << json_number(s.unfiltered.min)
-        << ", \"stat_max_force_N\": " << json_number(s.unfiltered.stat_max)
-        << ", \"stat_min_force_N\": " << json_number(s.unfiltered.stat_min) << "}}";
-    }
-    j << "\n  ]\n}\n";
+    RunInfo run;
+    run.wall_time_s = wall;
+    run.build_time_s = build_s;
+    j << statistics_json(m, st, stats, run);
     if (!j) {
       std::cerr << "simulate_pass: cannot write " << out_dir << "/stats.json\n";
       return 2;

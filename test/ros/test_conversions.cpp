@@ -216,7 +216,7 @@ TEST(Params, ErrorsNameParameterValueAndRange) {
 
 TEST_F(Fixture, StatisticsJsonHasPantographs) {
   PassRecorder rec(sim->model());
-  const std::string j = statistics_json(sim->model(), sim->state(), rec.statistics(sim->model()), 1.0, 3);
+  const std::string j = statistics_json(sim->model(), sim->state(), rec.statistics(sim->model()), RunInfo{1.0, -1.0, 3});
   EXPECT_NE(j.find("\"pantographs\""), std::string::npos);
   EXPECT_NE(j.find("\"overruns\": 3"), std::string::npos);
 }

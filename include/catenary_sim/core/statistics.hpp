@@ -30,6 +30,18 @@ std::vector<double> lowpass_zero_phase(const std::vector<double>& x, double fs, 
 
 ForceStatistics force_statistics(const std::vector<double>& x);
 
+// How a pass ran, for the report (NaN / negative: left out).
+struct RunInfo {
+  double wall_time_s = 0.0;
+  double build_time_s = -1.0;
+  long long overruns = -1;
+};
+
+// The pass report as JSON (stats.json of simulate_pass, ~stats_file of the node): run figures and
+// per pantograph the filtered and unfiltered force statistics.
+std::string statistics_json(const Model& model, const State& state, const std::vector<PantographStatistics>& stats,
+                            const RunInfo& run);
+
 // Records one pass at every step and reduces it to statistics and a decimated time series.
 class PassRecorder {
  public:

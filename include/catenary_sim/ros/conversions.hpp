@@ -62,9 +62,5 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
 // anchor. Never negative; dt is never stretched.
 std::int64_t steps_due(double wall_elapsed, double real_time_factor, double dt, double sim_done);
 
-// Statistics of a pass as JSON (the same keys as simulate_pass's stats.json per pantograph).
-std::string statistics_json(const Model& m, const State& s, const std::vector<PantographStatistics>& stats,
-                            double wall_time_s, std::int64_t overruns);
-
 }  // namespace ros_layer
 }  // namespace catenary_sim
