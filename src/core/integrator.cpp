@@ -105,8 +105,6 @@ StepStatus step(const Model& m, State& s) {
   const double* load = m.load.data();
   const double* mass = m.mass.data();
 
-  s.observed_time = s.time;
-  s.observed_front = s.front;
   // Stiffness-proportional damping acts through K on z = q_n + beta q_dot_{n-1/2} (eq. 5, 19).
   for (int i = 0; i < nc; ++i) {
     z[i] = u[i] + beta * v[i];
@@ -148,23 +146,28 @@ StepStatus step(const Model& m, State& s) {
   }
   contact_forces(m, s, f);
 
-  // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. Any displacement beyond
-  // the divergence limit (or NaN) stops the run before it is passed on.
+  // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. The new values go to the
+  // workspace first: a displacement beyond the divergence limit (or NaN) stops the run and the
+  // state keeps the last good step, so nothing diverged is ever passed on.
   const double* im = m.inv_mass.data();
   const double limit = m.scene.numerics.divergence_limit;
+  double* v_new = f;  // the force is no longer needed
+  double* u_new = z;
   int bad = -1;
   for (int i = 0; i < n; ++i) {
     const double vn = v[i] + dt * im[i] * f[i];
     const double un = u[i] + dt * vn;
     if (!(std::fabs(un) <= limit)) bad = i;
-    v[i] = vn;
-    u[i] = un;
+    v_new[i] = vn;
+    u_new[i] = un;
   }
   if (bad >= 0) {
     s.status = StepStatus::kDiverged;
     s.diverged_dof = bad;
     return s.status;
   }
+  s.v.swap(s.force);  // O(1): swaps the buffers, no copy, no allocation
+  s.u.swap(s.z);
 
   // Train kinematics: toward the commanded speed within the acceleration limit.
   const double dv = s.target_speed - s.speed, dvmax = s.max_acceleration * dt;
@@ -172,6 +175,8 @@ StepStatus step(const Model& m, State& s) {
   s.front += s.speed * dt;
   s.time += dt;
   ++s.steps;
+  // Observations describe the new state (t_{n+1}), so a snapshot is always consistent.
+  contact_forces(m, s, nullptr);
   return s.status;
 }
 

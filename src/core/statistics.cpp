@@ -106,9 +106,9 @@ PassRecorder::PassRecorder(const Model& m, double sample_rate_hz)
 
 void PassRecorder::record(const Model& m, const State& s) {
   const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
-  time_.push_back(s.observed_time);
+  time_.push_back(s.time);
   for (std::size_t p = 0; p < np; ++p) {
-    const double xp = s.observed_front - m.pantographs[p].position;
+    const double xp = s.front - m.pantographs[p].position;
     position_[p].push_back(xp);
     force_[p].push_back(total_contact_force(m, s, static_cast<int>(p)));
     for (std::size_t k = 0; k < steady_arm_springs_.size(); ++k) {
@@ -118,9 +118,9 @@ void PassRecorder::record(const Model& m, const State& s) {
       if (std::fabs(xp - sp.x) <= reach) max_uplift_[p][k] = std::max(max_uplift_[p][k], s.u[sp.dof]);
     }
   }
-  if (sample_period_ > 0.0 && s.observed_time + 1e-12 < next_sample_) return;
+  if (sample_period_ > 0.0 && s.time + 1e-12 < next_sample_) return;
   next_sample_ += sample_period_;
-  Row row{s.observed_time, {}};
+  Row row{s.time, {}};
   row.values.reserve(columns_.size());
   for (std::size_t p = 0; p < np; ++p) {
     const Pantograph& pg = m.pantographs[p];

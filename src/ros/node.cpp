@@ -65,6 +65,7 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
 
 void SimulationNode::restart_recording() {
   recorder_ = std::make_unique<PassRecorder>(sim_->model(), kRecorderRowRate);
+  recorder_->record(sim_->model(), sim_->state());
 }
 
 void SimulationNode::reanchor() {

@@ -114,6 +114,7 @@ int main(int argc, char** argv) {
 
   const auto t0 = std::chrono::steady_clock::now();
   StepStatus status = StepStatus::kOk;
+  recorder.record(m, sim->state());
   if (scene.train_speed > 0.0) {
     while ((status = sim->step()) == StepStatus::kOk) recorder.record(m, sim->state());
   }

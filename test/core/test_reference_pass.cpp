@@ -29,6 +29,7 @@ PassResult run_pass(double speed_kmh) {
   const Model& m = sim.model();
   const Pantograph& p = m.pantographs[0];
   PassRecorder rec(m);
+  rec.record(m, sim.state());
   // Impulse balance of the pantograph: sum_i m_i (v_i(end) - v_i(0)) = sum_n dt (F0 + C_roof - F_contact),
   // exact for the central-difference update (internal springs cancel).
   const int last = p.first_dof + p.masses_count() - 1;
@@ -37,9 +38,10 @@ PassResult run_pass(double speed_kmh) {
     const State& s = sim.state();
     const double roof = p.spring_preload.back() - p.stiffness.back() * s.u[last] - p.damping.back() * s.v[last];
     const double uplift = s.uplift[0];
+    const double contact = total_contact_force(m, s, 0);  // the force step() applies (eq. 22 at t_n)
     if (sim.step() != StepStatus::kOk) break;
-    impulse += m.dt * (uplift + roof - total_contact_force(m, sim.state(), 0));
-    contact_impulse += m.dt * total_contact_force(m, sim.state(), 0);
+    impulse += m.dt * (uplift + roof - contact);
+    contact_impulse += m.dt * contact;
     rec.record(m, sim.state());
   }
   EXPECT_EQ(sim.state().status, StepStatus::kFinished) << sim.status_message();

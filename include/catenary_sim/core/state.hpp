@@ -13,7 +13,8 @@ namespace catenary_sim {
 
 enum class StepStatus {
   kOk = 0,
-  kDiverged,   // a displacement left the divergence limit or became NaN/inf: the run is stopped
+  kDiverged,   // a displacement would leave the divergence limit or become NaN/inf: the run is
+               // stopped and the state keeps the last good step
   kFinished,   // the train front reached the end of the pass; step() does nothing more
 };
 
@@ -29,9 +30,7 @@ struct State {
   // q of eq. 21 as displacements from the design state, and q_dot_{n-1/2} (eq. 20, 26).
   Eigen::VectorXd u, v;
 
-  // Observations of the last step, at time t_n (before the update), which was observed_time with
-  // the train front at observed_front.
-  double observed_time = 0.0, observed_front = 0.0;
+  // Observations of this state (time, front, u): filled by step() and observe().
   std::vector<double> contact_force;     // N, >= 0, per collector x contact wire (eq. 22, 25)
   std::vector<double> collector_height;  // m, weighted wire height under each collector (eq. 12)
   std::vector<std::uint8_t> dropper_slack;  // 1 where the dropper carried no tension

@@ -46,7 +46,8 @@ std::string statistics_json(const Model& model, const State& state, const std::v
 class PassRecorder {
  public:
   PassRecorder(const Model& model, double sample_rate_hz = 0.0);
-  void record(const Model& model, const State& state);  // after each successful step()
+  // The initial state, then the state after each successful step().
+  void record(const Model& model, const State& state);
   std::vector<PantographStatistics> statistics(const Model& model) const;
 
   // Time series at the output sample rate (every step when 0).
