@@ -17,6 +17,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/ros/pass_bag.hpp"
 
 using namespace catenary_sim;
 
@@ -28,6 +29,8 @@ const char* kUsage =
     "  --speed KMH      train speed in km/h (overrides train.speed / train.speed_kmh)\n"
     "  --set key=value  override a scene field, e.g. --set numerics.element_length=0.125\n"
     "  --out DIR        output directory for stats.json and timeseries.csv (created)\n"
+    "  --bag FILE       also write the node's topics into a rosbag (simulation-time stamps)\n"
+    "  --bag-rate HZ    rate of /contact_force, /pantograph_state and /tf in the bag (200; 0: every step)\n"
     "  --quiet          print only errors\n";
 
 bool make_dirs(const std::string& path) {
@@ -45,7 +48,8 @@ bool make_dirs(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scene_path, out_dir;
+  std::string scene_path, out_dir, bag_path;
+  ros_layer::PassBagOptions bag_options;
   std::vector<std::string> overrides;
   double speed_kmh = std::nan("");
   bool quiet = false;
@@ -62,6 +66,17 @@ int main(int argc, char** argv) {
     else if (a == "--out") out_dir = value("--out");
     else if (a == "--set") overrides.push_back(value("--set"));
     else if (a == "--quiet") quiet = true;
+    else if (a == "--bag") bag_path = value("--bag");
+    else if (a == "--bag-rate") {
+      const std::string v = value("--bag-rate");
+      char* end = nullptr;
+      bag_options.rate = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end != '\0' || !std::isfinite(bag_options.rate) || bag_options.rate < 0.0 ||
+          bag_options.rate > 1e6) {
+        std::cerr << "simulate_pass: --bag-rate '" << v << "': expected Hz in [0, 1e6] (0: every step)\n";
+        return 2;
+      }
+    }
     else if (a == "--speed") {
       const std::string v = value("--speed");
       char* end = nullptr;
@@ -114,10 +129,28 @@ int main(int argc, char** argv) {
 
   const auto t0 = std::chrono::steady_clock::now();
   StepStatus status = StepStatus::kOk;
+  if (!make_dirs(out_dir)) {
+    std::cerr << "simulate_pass: cannot create output directory '" << out_dir << "'\n";
+    return 2;
+  }
+  std::unique_ptr<ros_layer::PassBag> bag;
+  if (!bag_path.empty()) {
+    try {
+      bag = std::make_unique<ros_layer::PassBag>(bag_path, bag_options);
+    } catch (const std::exception& e) {
+      std::cerr << "simulate_pass: --bag '" << bag_path << "': " << e.what() << "\n";
+      return 2;
+    }
+    bag->write(m, sim->state());
+  }
   recorder.record(m, sim->state());
   if (scene.train_speed > 0.0) {
-    while ((status = sim->step()) == StepStatus::kOk) recorder.record(m, sim->state());
+    while ((status = sim->step()) == StepStatus::kOk) {
+      recorder.record(m, sim->state());
+      if (bag) bag->write(m, sim->state());
+    }
   }
+  if (bag) bag->close();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double build_s = std::chrono::duration<double>(t0 - t_build).count();
   const State& st = sim->state();
@@ -126,10 +159,6 @@ int main(int argc, char** argv) {
     return 3;
   }
 
-  if (!make_dirs(out_dir)) {
-    std::cerr << "simulate_pass: cannot create output directory '" << out_dir << "'\n";
-    return 2;
-  }
   const std::vector<PantographStatistics> stats = recorder.statistics(m);
   const double rtf = wall > 0.0 ? st.time / wall : std::nan("");
 
@@ -176,6 +205,7 @@ int main(int argc, char** argv) {
                 << s.unfiltered.std_dev << " N\n";
     }
     std::cout << "wrote " << out_dir << "/stats.json and " << out_dir << "/timeseries.csv\n";
+    if (bag) std::cout << "wrote " << bag->messages() << " messages to " << bag_path << "\n";
   }
   return 0;
 }

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
+#include <std_msgs/Float64MultiArray.h>
 #include <std_srvs/SetBool.h>
+#include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -215,6 +217,77 @@ TEST(Node, PausedStepAdvancesExactlyN) {
   EXPECT_EQ(latest_state(state).step, p1.step + n) << "advanced more than N while paused";
   ASSERT_TRUE(set_paused(false));
   ASSERT_TRUE(wait_for([&] { auto v = state.take(); return !v.empty() && v.back().step > p1.step + n; }, 5.0));
+}
+
+namespace {
+void send_uplift(const std::vector<double>& values) {
+  static ros::Publisher pub = ros::NodeHandle().advertise<std_msgs::Float64MultiArray>("cmd/uplift_force", 1);
+  ASSERT_TRUE(wait_for([&] { return pub.getNumSubscribers() > 0; }, 5.0));
+  std_msgs::Float64MultiArray m;
+  m.data = values;
+  pub.publish(m);
+}
+
+bool reset_pass() {
+  std_srvs::Trigger t;
+  return ros::service::call("/catenary_sim/reset", t) && t.response.success;
+}
+
+// Mean total contact force while the pantograph is in [x0, x1] m, over the next pass from a reset.
+double mean_force_over(Recorder<ContactForceArray>& forces, double x0, double x1) {
+  EXPECT_TRUE(reset_pass());
+  forces.clear();
+  EXPECT_TRUE(wait_for([&] { auto v = forces.take(); return !v.empty() && v.back().pantographs[0].position > x1; }, 60.0));
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& m : forces.take()) {
+    const double x = m.pantographs[0].position;
+    if (x >= x0 && x <= x1) {
+      sum += m.pantographs[0].total;
+      ++n;
+    }
+  }
+  EXPECT_GT(n, 50);
+  return n ? sum / n : std::nan("");
+}
+
+}  // namespace
+
+TEST(Node, RejectedUpliftCommandsLeaveTheUpliftUnchanged) {
+  Recorder<PantographStateArray> state("pantograph_state");
+  const PantographStateArray s0 = latest_state(state);
+  send_uplift({std::numeric_limits<double>::quiet_NaN()});
+  send_uplift({-5.0});
+  send_uplift({100.0, 100.0});  // the scene has one pantograph: two values are rejected
+  ros::WallDuration(0.5).sleep();
+  const PantographStateArray s1 = latest_state(state);
+  EXPECT_GT(s1.header.stamp, s0.header.stamp);
+  EXPECT_EQ(s1.pantographs[0].uplift, s0.pantographs[0].uplift);
+}
+
+// Two passes over the same stretch from a reset, before and after an uplift command: the mean
+// contact force rises by the uplift step less what the roof spring (160 N/m) takes back as the
+// head works higher: at most 160 N/m x 100 N x 0.5 mm/N (the catenary's elasticity) = 8 N. The
+// passes are otherwise identical (same speed, same start), so 2 N more covers the rest.
+TEST(Node, UpliftCommandRaisesTheMeanContactForceAndResetStartsANewPass) {
+  Recorder<ContactForceArray> forces("contact_force");
+  Recorder<PantographStateArray> state("pantograph_state");
+  const PantographStateArray before = latest_state(state);
+  const double f100 = mean_force_over(forces, 110.0, 330.0);
+  send_uplift({200.0});
+  ASSERT_TRUE(wait_for([&] { auto v = state.take(); return !v.empty() && v.back().pantographs[0].uplift == 200.0; }, 5.0));
+  const PantographStateArray after_cmd = latest_state(state);
+  const double f200 = mean_force_over(forces, 110.0, 330.0);
+  EXPECT_LE(f200 - f100, 100.0 + 2.0);
+  EXPECT_GE(f200 - f100, 100.0 - 8.0 - 2.0);
+  // Reset: a new pass from the start while time keeps running.
+  ASSERT_TRUE(reset_pass());
+  const PantographStateArray fresh = latest_state(state);
+  EXPECT_LT(fresh.train_front, after_cmd.train_front + 1e-9);
+  EXPECT_LT(fresh.train_front, 60.0);
+  EXPECT_GT(fresh.header.stamp, before.header.stamp);
+  EXPECT_GT(fresh.sim_time, after_cmd.sim_time);
+  send_uplift({100.0});
 }
 
 int main(int argc, char** argv) {
