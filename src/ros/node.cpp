@@ -139,7 +139,7 @@ void SimulationNode::advance(const ros::WallTime& tick_deadline) {
   const double dt = sim_->model().dt;
   if (params_.real_time_factor <= 0.0) {
     // As fast as possible: step until the tick is due, then publish.
-    do_steps(std::numeric_limits<std::int64_t>::max(), &tick_deadline);
+    if (do_steps(std::numeric_limits<std::int64_t>::max(), &tick_deadline) > 0) ++chunks_;
     return;
   }
   const ros::WallTime now = ros::WallTime::now();
@@ -149,6 +149,7 @@ void SimulationNode::advance(const ros::WallTime& tick_deadline) {
   const std::int64_t limit = static_cast<std::int64_t>(std::ceil(kCatchUp * nominal)) + 1;
   const std::int64_t want = std::min(due, limit);
   const std::int64_t done = do_steps(want, &tick_deadline);
+  if (done > 0) ++chunks_;
   if (due > limit || (done < want && !sim_->finished() && sim_->state().status == StepStatus::kOk)) {
     // Could not keep up: drop the backlog (dt is never stretched; the achieved factor drops).
     ++overruns_;
@@ -176,8 +177,9 @@ void SimulationNode::handle_end() {
   }
   if (!sim_->finished()) return;
   // (finished() is true as soon as the front reaches the end, before step() marks the state)
-  char what[128];
-  std::snprintf(what, sizeof what, "pass finished at t = %.4f s (train front at %.2f m)", s.time, s.front);
+  char what[256];
+  std::snprintf(what, sizeof what, "pass finished at t = %.4f s (train front at %.2f m), %lld chunks, %lld overruns",
+                s.time, s.front, static_cast<long long>(chunks_), static_cast<long long>(overruns_));
   switch (params_.at_end) {
     case AtEnd::kStop:
       ended_ = true;
@@ -369,6 +371,7 @@ void SimulationNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
 
   stat.add("real_time_factor (achieved)", rtf);
   stat.add("real_time_factor (requested, 0 = max)", params_.real_time_factor);
+  stat.add("chunks", chunks_);
   stat.add("overruns", overruns_);
   stat.add("stability margin dt/dt_critical", margin);
   stat.add("dt [s]", m.dt);

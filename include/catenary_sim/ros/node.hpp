@@ -70,7 +70,8 @@ class SimulationNode {
   // Pacing.
   ros::WallTime wall_anchor_, wall_start_;
   double sim_anchor_ = 0.0;
-  std::int64_t overruns_ = 0;
+  std::int64_t chunks_ = 0;    // pacing ticks that stepped (at least one step)
+  std::int64_t overruns_ = 0;  // of those, ticks that could not take the steps due
 
   // Publishing bookkeeping.
   double last_published_time_ = -1.0;
