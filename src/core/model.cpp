@@ -18,24 +18,24 @@ std::string fmt(double v) {
   return s.str();
 }
 
-// Node stations: every support and dropper is a node; the segments between them are split into
-// equal elements no longer than the requested length.
-std::vector<double> mesh_stations(const Scene& s, std::vector<double>& support_x) {
+// Node stations of one tension section: every support and dropper is a node; the segments
+// between them are split into equal elements no longer than the requested length.
+std::vector<double> mesh_section(const SectionSpec& sec, double element_length, std::vector<double>& support_x) {
   std::vector<double> breaks;
-  double x0 = 0.0;
-  support_x.assign(1, 0.0);
-  for (std::size_t i = 0; i < s.spans.size(); ++i) {
+  double x0 = sec.start;
+  support_x.assign(1, x0);
+  for (std::size_t i = 0; i < sec.spans.size(); ++i) {
     breaks.push_back(x0);
-    if (s.droppers)
-      for (double p : s.droppers->positions[i]) breaks.push_back(x0 + p);
-    x0 += s.spans[i];
+    if (sec.droppers)
+      for (double p : sec.droppers->positions[i]) breaks.push_back(x0 + p);
+    x0 += sec.spans[i];
     support_x.push_back(x0);
   }
   breaks.push_back(x0);
   std::vector<double> x;
   for (std::size_t i = 0; i + 1 < breaks.size(); ++i) {
     const double len = breaks[i + 1] - breaks[i];
-    const int n = std::max(1, static_cast<int>(std::ceil(len / s.numerics.element_length - 1e-9)));
+    const int n = std::max(1, static_cast<int>(std::ceil(len / element_length - 1e-9)));
     for (int k = 0; k < n; ++k) x.push_back(breaks[i] + len * k / n);
   }
   x.push_back(x0);
@@ -215,41 +215,92 @@ void apply_stiffness(const Model& m, double front, const double* x, double* y, d
   for (int i = 0; i < m.n_dof; ++i) y[i] = -y[i];
 }
 
-Model build_model(const Scene& scene) {
+Model build_model(const Scene& scene) { return build_model(scene, BuildOptions{}); }
+
+Model build_model(const Scene& scene_in, const BuildOptions& options) {
+  Scene scene = scene_in;
+  if (scene.sections.empty()) {
+    // A Scene filled in code with the one-section fields only.
+    SectionSpec sec;
+    sec.spans = scene.spans;
+    sec.contact_wire = scene.contact_wire;
+    sec.messenger = scene.messenger;
+    sec.droppers = scene.droppers;
+    sec.steady_arms = scene.steady_arms;
+    sec.messenger_supports = scene.messenger_supports;
+    if (sec.droppers && sec.droppers->positions.size() == 1 && sec.spans.size() > 1)
+      sec.droppers->positions.assign(sec.spans.size(), sec.droppers->positions.front());
+    scene.sections.push_back(sec);
+  }
   validate(scene);
   Model m;
   m.scene = scene;
   const bool lumped_rot = scene.numerics.rotary_inertia == RotaryInertia::kLumped;
-  const std::vector<double> x = mesh_stations(scene, m.support_x);
-  const int n = static_cast<int>(x.size());
   m.line_length = scene.line_length();
   m.alpha = scene.rayleigh_alpha;
   m.beta = scene.rayleigh_beta;
   m.contact_stiffness = scene.contact.stiffness;
   m.rub_length = scene.contact.rub_length;
+  m.support_x.assign(1, scene.sections.front().start);
+  for (double l : scene.spans) m.support_x.push_back(m.support_x.back() + l);
+  auto line_support_index = [&](double xs) {
+    return static_cast<int>(std::lower_bound(m.support_x.begin(), m.support_x.end(), xs - 1e-9) - m.support_x.begin());
+  };
+
+  // Raised contact-wire supports at the transition spans (eq. 6-8): given, measured, or none yet.
+  std::vector<double> rise_first(scene.sections.size(), 0.0), rise_last(scene.sections.size(), 0.0);
+  if (options.support_rises) {
+    for (std::size_t i = 0; i < scene.sections.size(); ++i) {
+      rise_first[i] = (*options.support_rises)[2 * i];
+      rise_last[i] = (*options.support_rises)[2 * i + 1];
+    }
+  } else {
+    const std::vector<double> r = transition_support_rises(scene);
+    for (std::size_t i = 0; i < scene.sections.size(); ++i) {
+      rise_first[i] = r[2 * i];
+      rise_last[i] = r[2 * i + 1];
+    }
+  }
 
   // DOF layout: per wire the vertical displacements, then (lumped rotary inertia only) the
-  // rotations; the pantograph masses last.
+  // rotations; section by section (contact wire(s), then messenger); the pantograph masses last.
   int dof = 0;
-  auto add_wire = [&](const std::string& name, const WireSpec& spec, bool contact) {
-    Wire w;
-    w.name = name;
-    w.is_contact_wire = contact;
-    w.spec = spec;
-    w.x = x;
-    w.w_dof = dof;
-    dof += n;
-    if (lumped_rot) {
-      w.theta_dof = dof;
-      dof += n;
-    }
-    for (double sx : m.support_x) w.support_nodes.push_back(node_at(x, sx));
-    assemble_band(w);
-    m.wires.push_back(std::move(w));
-  };
-  add_wire("contact_wire", scene.contact_wire, true);
-  m.contact_wires.push_back(0);
-  if (scene.messenger) add_wire("messenger", *scene.messenger, false);
+  std::vector<std::vector<double>> section_supports(scene.sections.size());
+  for (std::size_t si = 0; si < scene.sections.size(); ++si) {
+    const SectionSpec& sec = scene.sections[si];
+    const std::vector<double> x = mesh_section(sec, scene.numerics.element_length, section_supports[si]);
+    Section info;
+    info.start = sec.start;
+    info.end = sec.end();
+    info.rise_first = rise_first[si];
+    info.rise_last = rise_last[si];
+    const std::string suffix = scene.sections.size() > 1 ? "_s" + std::to_string(si) : "";
+    auto add_wire = [&](const std::string& name, const WireSpec& spec, bool contact) {
+      Wire w;
+      w.name = name;
+      w.section = static_cast<int>(si);
+      w.is_contact_wire = contact;
+      w.spec = spec;
+      w.x = x;
+      w.w_dof = dof;
+      dof += static_cast<int>(x.size());
+      if (lumped_rot) {
+        w.theta_dof = dof;
+        dof += static_cast<int>(x.size());
+      }
+      for (double sx : section_supports[si]) w.support_nodes.push_back(node_at(x, sx));
+      assemble_band(w);
+      if (contact) m.contact_wires.push_back(static_cast<int>(m.wires.size()));
+      else info.messenger = static_cast<int>(m.wires.size());
+      info.wires.push_back(static_cast<int>(m.wires.size()));
+      m.wires.push_back(std::move(w));
+    };
+    for (int c = 0; c < sec.contact_wire_count; ++c)
+      add_wire("contact_wire" + suffix + (sec.contact_wire_count > 1 ? std::string(1, static_cast<char>('a' + c)) : ""),
+               sec.contact_wire, true);
+    if (sec.messenger) add_wire("messenger" + suffix, *sec.messenger, false);
+    m.sections.push_back(info);
+  }
   m.n_catenary_dof = dof;
 
   for (std::size_t i = 0; i < scene.pantographs.size(); ++i) {
@@ -275,13 +326,16 @@ Model build_model(const Scene& scene) {
   }
   m.n_dof = dof;
 
-  // Lumped masses (HRZ for the beams) and which DOFs are held rigidly.
+  // Lumped masses (HRZ for the beams) and which DOFs are held rigidly: the anchors at both ends
+  // of each section, and intermediate supports without a spring.
   m.mass = Eigen::VectorXd::Zero(dof);
   std::vector<bool> fixed(dof, false);
   const double g = scene.gravity;
   for (Wire& w : m.wires) {
+    const SectionSpec& sec = scene.sections[w.section];
+    const int n = w.nodes();
     for (int e = 0; e + 1 < n; ++e) {
-      const double he = x[e + 1] - x[e];
+      const double he = w.x[e + 1] - w.x[e];
       m.mass[w.w_dof + e] += beam_translational_mass(he, w.spec.linear_mass);
       m.mass[w.w_dof + e + 1] += beam_translational_mass(he, w.spec.linear_mass);
       if (lumped_rot) {
@@ -290,7 +344,7 @@ Model build_model(const Scene& scene) {
       }
     }
     const bool contact = w.is_contact_wire;
-    const std::optional<SupportSpec>& spring = contact ? scene.steady_arms : scene.messenger_supports;
+    const std::optional<SupportSpec>& spring = contact ? sec.steady_arms : sec.messenger_supports;
     const int ns = static_cast<int>(w.support_nodes.size());
     for (int k = 0; k < ns; ++k) {
       const int node = w.support_nodes[k];
@@ -299,84 +353,119 @@ Model build_model(const Scene& scene) {
         fixed[w.w_dof + node] = true;
       } else {
         m.mass[w.w_dof + node] += spring->mass;
-        m.springs.push_back(SupportSpring{w.w_dof + node, spring->stiffness, 0.0, x[node], k, contact});
+        SupportSpring sp{w.w_dof + node, spring->stiffness, 0.0, w.x[node], line_support_index(w.x[node]), contact};
+        sp.section_support = k;
+        m.springs.push_back(sp);
       }
     }
   }
 
-  // Droppers: nodes and clamp masses; lengths and tensions come from the design statics below.
-  const Wire* cw = &m.wires[0];
-  const Wire* mw = scene.messenger ? &m.wires[1] : nullptr;
-  if (scene.droppers) {
-    const DropperSpec& ds = *scene.droppers;
-    for (std::size_t i = 0; i < scene.spans.size(); ++i)
+  // Droppers: one per contact wire at each dropper station (a twin contact wire hangs both wires
+  // from the same dropper), with clamp masses; lengths and tensions come from the design statics.
+  for (std::size_t si = 0; si < scene.sections.size(); ++si) {
+    const SectionSpec& sec = scene.sections[si];
+    if (!sec.droppers) continue;
+    const Section& info = m.sections[si];
+    const Wire& mwire = m.wires[info.messenger];
+    const DropperSpec& ds = *sec.droppers;
+    for (std::size_t i = 0; i < sec.spans.size(); ++i)
       for (double p : ds.positions[i]) {
-        const double xd = m.support_x[i] + p;
-        const int node = node_at(x, xd);
-        Dropper d;
-        d.x = xd;
-        d.contact_dof = cw->w_dof + node;
-        d.messenger_dof = mw->w_dof + node;
-        m.mass[d.contact_dof] += ds.clamp_mass_contact;
-        m.mass[d.messenger_dof] += ds.clamp_mass_messenger;
-        m.droppers.push_back(d);
+        const double xd = section_supports[si][i] + p;
+        const int node = node_at(mwire.x, xd);
+        m.mass[mwire.w_dof + node] += ds.clamp_mass_messenger;
+        for (int wi : info.wires) {
+          if (wi == info.messenger) continue;
+          Dropper d;
+          d.x = xd;
+          d.section = static_cast<int>(si);
+          d.span = static_cast<int>(i);
+          d.contact_dof = m.wires[wi].w_dof + node;
+          d.messenger_dof = mwire.w_dof + node;
+          m.mass[d.contact_dof] += ds.clamp_mass_contact;
+          m.droppers.push_back(d);
+        }
       }
   }
 
-  // Design statics. The contact wire is held at the supports and, at every dropper, at the
-  // presag height; the reactions there are the dropper tensions. The messenger carries those
-  // tensions and the dropper weight to its supports. Dropper weight depends on the dropper length,
-  // which depends on the messenger sag: a few fixed-point passes settle it.
+  // Design statics, section by section. Each contact wire is held at its supports (raised by d at
+  // the outer support of a transition span) and, at every dropper, at the presag height of a
+  // current span or at the working height in a transition span (where the free wire then rises
+  // from its last dropper to the raised support, Fig. 2); the reactions there are the dropper
+  // tensions. The messenger carries those tensions and the dropper weight to its supports. The
+  // dropper weight depends on its length, which depends on the messenger sag: a few fixed-point
+  // passes settle it.
   const double H = scene.contact_wire_height;
-  auto presag_at = [&](double xs) {
-    const int span = std::clamp(static_cast<int>(std::upper_bound(m.support_x.begin(), m.support_x.end(), xs) - m.support_x.begin()) - 1,
-                                0, static_cast<int>(scene.spans.size()) - 1);
-    const double s = (xs - m.support_x[span]) / scene.spans[span];
-    return scene.contact_wire.presag * 4.0 * s * (1.0 - s);
-  };
   std::vector<double> weight_len(m.droppers.size(), scene.encumbrance);  // lengths the weights use
   std::vector<double> dropper_len = weight_len;                          // geometric lengths
-  const double dropper_mu = scene.droppers ? scene.droppers->linear_mass : 0.0;
-  std::vector<double> cw_react, mw_react;
-  const int passes = m.droppers.empty() ? 1 : 4;
-  for (int pass = 0; pass < passes; ++pass) {
-    std::vector<double> load(n);
-    for (int i = 0; i < n; ++i) load[i] = -g * m.mass[cw->w_dof + i];
-    std::vector<int> pn;
-    std::vector<double> ph;
-    for (int sn : cw->support_nodes) {
-      pn.push_back(sn);
-      ph.push_back(H);
+  std::vector<std::vector<double>> react(m.wires.size());
+  for (std::size_t si = 0; si < scene.sections.size(); ++si) {
+    const SectionSpec& sec = scene.sections[si];
+    const Section& info = m.sections[si];
+    const double mu = sec.droppers ? sec.droppers->linear_mass : 0.0;
+    const int nspan = static_cast<int>(sec.spans.size());
+    auto transition = [&](int span) {
+      return (span == 0 && sec.first_span_transition) || (span == nspan - 1 && sec.last_span_transition);
+    };
+    std::vector<std::size_t> mine;
+    for (std::size_t k = 0; k < m.droppers.size(); ++k)
+      if (m.droppers[k].section == static_cast<int>(si)) mine.push_back(k);
+    const int passes = mine.empty() ? 1 : 4;
+    for (int pass = 0; pass < passes; ++pass) {
+      for (int wi : info.wires) {
+        if (wi == info.messenger) continue;
+        Wire& w = m.wires[wi];
+        const int n = w.nodes();
+        std::vector<double> load(n);
+        for (int i = 0; i < n; ++i) load[i] = -g * m.mass[w.w_dof + i];
+        std::vector<int> pn;
+        std::vector<double> ph;
+        const int ns = static_cast<int>(w.support_nodes.size());
+        for (int k = 0; k < ns; ++k) {
+          pn.push_back(w.support_nodes[k]);
+          ph.push_back(H + (k == 0 ? info.rise_first : 0.0) + (k == ns - 1 ? info.rise_last : 0.0));
+        }
+        for (std::size_t k : mine) {
+          const Dropper& d = m.droppers[k];
+          if (d.contact_dof < w.w_dof || d.contact_dof >= w.w_dof + n) continue;
+          const int node = d.contact_dof - w.w_dof;
+          load[node] -= 0.5 * g * mu * weight_len[k];
+          const double s = (d.x - section_supports[si][d.span]) / sec.spans[d.span];
+          pn.push_back(node);
+          ph.push_back(transition(d.span) ? H : H - sec.contact_wire.presag * 4.0 * s * (1.0 - s));
+        }
+        solve_wire_statics(w, load, pn, ph, w.height, w.slope, react[wi]);
+        // Dropper tensions: the reactions at the dropper nodes, in the order they were added.
+        std::size_t r = static_cast<std::size_t>(ns);
+        for (std::size_t k : mine)
+          if (m.droppers[k].contact_dof >= w.w_dof && m.droppers[k].contact_dof < w.w_dof + n)
+            m.droppers[k].static_tension = react[wi][r++];
+      }
+      if (info.messenger < 0) break;
+      Wire& mwm = m.wires[info.messenger];
+      const int n = mwm.nodes();
+      std::vector<double> mload(n);
+      for (int i = 0; i < n; ++i) mload[i] = -g * m.mass[mwm.w_dof + i];
+      for (std::size_t k : mine) {
+        const Dropper& d = m.droppers[k];
+        mload[d.messenger_dof - mwm.w_dof] -= d.static_tension + 0.5 * g * mu * weight_len[k];
+      }
+      std::vector<int> mpn(mwm.support_nodes.begin(), mwm.support_nodes.end());
+      std::vector<double> mph(mpn.size(), H + scene.encumbrance);
+      solve_wire_statics(mwm, mload, mpn, mph, mwm.height, mwm.slope, react[info.messenger]);
+      for (std::size_t k : mine) {
+        const Dropper& d = m.droppers[k];
+        const Wire& cwire = *std::find_if(m.wires.begin(), m.wires.end(), [&](const Wire& w) {
+          return d.contact_dof >= w.w_dof && d.contact_dof < w.w_dof + w.nodes();
+        });
+        dropper_len[k] = mwm.height[d.messenger_dof - mwm.w_dof] - cwire.height[d.contact_dof - cwire.w_dof];
+      }
+      if (pass + 1 < passes)
+        for (std::size_t k : mine) weight_len[k] = dropper_len[k];
     }
-    for (std::size_t k = 0; k < m.droppers.size(); ++k) {
-      const int node = m.droppers[k].contact_dof - cw->w_dof;
-      load[node] -= 0.5 * g * dropper_mu * weight_len[k];
-      pn.push_back(node);
-      ph.push_back(H - presag_at(m.droppers[k].x));
-    }
-    Wire& cwm = m.wires[0];
-    solve_wire_statics(cwm, load, pn, ph, cwm.height, cwm.slope, cw_react);
-    if (!mw) break;
-    const std::size_t ns = cw->support_nodes.size();
-    std::vector<double> mload(n);
-    for (int i = 0; i < n; ++i) mload[i] = -g * m.mass[mw->w_dof + i];
-    for (std::size_t k = 0; k < m.droppers.size(); ++k) {
-      Dropper& d = m.droppers[k];
-      d.static_tension = cw_react[ns + k];
-      mload[d.messenger_dof - mw->w_dof] -= d.static_tension + 0.5 * g * dropper_mu * weight_len[k];
-    }
-    std::vector<int> mpn(mw->support_nodes.begin(), mw->support_nodes.end());
-    std::vector<double> mph(mpn.size(), H + scene.encumbrance);
-    Wire& mwm = m.wires[1];
-    solve_wire_statics(mwm, mload, mpn, mph, mwm.height, mwm.slope, mw_react);
-    for (std::size_t k = 0; k < m.droppers.size(); ++k) {
-      const int node = m.droppers[k].contact_dof - cw->w_dof;
-      dropper_len[k] = mwm.height[node] - cwm.height[node];
-    }
-    if (pass + 1 < passes) weight_len = dropper_len;
   }
   for (std::size_t k = 0; k < m.droppers.size(); ++k) {
     Dropper& d = m.droppers[k];
+    const SectionSpec& sec = scene.sections[d.section];
     d.length = dropper_len[k];
     if (d.length <= 0.01)
       throw SceneError("droppers: at x = " + fmt(d.x) + " m the messenger hangs " + fmt(-d.length) +
@@ -384,38 +473,41 @@ Model build_model(const Scene& scene) {
                        " m): raise line.encumbrance or the messenger tension, or reduce the presag");
     if (d.static_tension <= 0.0)
       throw SceneError("droppers: at x = " + fmt(d.x) + " m the dropper would have to push (static force " +
-                       fmt(d.static_tension) + " N): contact_wire.presag " + fmt(scene.contact_wire.presag) +
+                       fmt(d.static_tension) + " N): contact_wire.presag " + fmt(sec.contact_wire.presag) +
                        " m is not reachable with tension-only droppers; reduce it");
-    d.unstretched_length = d.length / (1.0 + d.static_tension / scene.droppers->axial_stiffness);
-    d.stiffness = scene.droppers->axial_stiffness / d.unstretched_length;
+    d.unstretched_length = d.length / (1.0 + d.static_tension / sec.droppers->axial_stiffness);
+    d.stiffness = sec.droppers->axial_stiffness / d.unstretched_length;
     // Half the dropper's mass on each end (the length its weight had in the statics, so that the
     // design state is an exact equilibrium).
-    m.mass[d.contact_dof] += 0.5 * dropper_mu * weight_len[k];
-    m.mass[d.messenger_dof] += 0.5 * dropper_mu * weight_len[k];
+    m.mass[d.contact_dof] += 0.5 * sec.droppers->linear_mass * weight_len[k];
+    m.mass[d.messenger_dof] += 0.5 * sec.droppers->linear_mass * weight_len[k];
   }
   // Support preloads f0 of eq. 4: the static reactions at the elastic supports.
-  for (SupportSpring& s : m.springs) s.static_force = (s.steady_arm ? cw_react : mw_react)[s.span_index];
+  for (SupportSpring& sp : m.springs) {
+    const auto it = std::find_if(m.wires.begin(), m.wires.end(),
+                                 [&](const Wire& w) { return sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes(); });
+    sp.static_force = react[it - m.wires.begin()][sp.section_support];
+  }
 
   // Constant load: gravity + support preloads - K y_design. At u = 0 it balances the static
   // dropper tensions exactly (that is what the design statics solved for).
   m.load = Eigen::VectorXd::Zero(dof);
   for (const Wire& w : m.wires)
-    for (int i = 0; i < n; ++i) m.load[w.w_dof + i] -= g * m.mass[w.w_dof + i];
-  for (const SupportSpring& s : m.springs) m.load[s.dof] += s.static_force;
-  {
+    for (int i = 0; i < w.nodes(); ++i) m.load[w.w_dof + i] -= g * m.mass[w.w_dof + i];
+  for (const SupportSpring& sp : m.springs) m.load[sp.dof] += sp.static_force;
+  for (const Wire& w : m.wires) {
+    const int n = w.nodes();
     std::vector<double> scratch(n);
-    for (const Wire& w : m.wires) {
-      Wire full = w;  // with explicit rotations so that K acts on the design slopes too
-      Eigen::VectorXd yfull = Eigen::VectorXd::Zero(2 * n), ffull = Eigen::VectorXd::Zero(2 * n);
-      full.w_dof = 0;
-      full.theta_dof = n;
-      for (int i = 0; i < n; ++i) {
-        yfull[i] = w.height[i];
-        yfull[n + i] = w.slope[i];
-      }
-      wire_elastic_force(full, yfull.data(), ffull.data(), scratch.data());
-      for (int i = 0; i < n; ++i) m.load[w.w_dof + i] += ffull[i];
+    Wire full = w;  // with explicit rotations so that K acts on the design slopes too
+    Eigen::VectorXd yfull = Eigen::VectorXd::Zero(2 * n), ffull = Eigen::VectorXd::Zero(2 * n);
+    full.w_dof = 0;
+    full.theta_dof = n;
+    for (int i = 0; i < n; ++i) {
+      yfull[i] = w.height[i];
+      yfull[n + i] = w.slope[i];
     }
+    wire_elastic_force(full, yfull.data(), ffull.data(), scratch.data());
+    for (int i = 0; i < n; ++i) m.load[w.w_dof + i] += ffull[i];
   }
   for (int i = 0; i < dof; ++i)
     if (fixed[i]) m.load[i] = 0.0;
@@ -423,7 +515,8 @@ Model build_model(const Scene& scene) {
   // Pantographs: unit-less references are set by the initial statics in the Simulation.
   int max_nodes = 2;
   double hmin = 1e9;
-  for (int e = 0; e + 1 < n; ++e) hmin = std::min(hmin, x[e + 1] - x[e]);
+  for (const Wire& w : m.wires)
+    for (int e = 0; e + 1 < w.nodes(); ++e) hmin = std::min(hmin, w.x[e + 1] - w.x[e]);
   if (m.rub_length > 0.0) max_nodes = static_cast<int>(std::ceil(m.rub_length / hmin)) + 3;
   m.max_contact_nodes = max_nodes;
   for (Pantograph& p : m.pantographs)
@@ -455,6 +548,10 @@ Model build_model(const Scene& scene) {
 
   // Initial pantograph references (eq. 23) and the stability limit (validation.md section 5).
   set_pantograph_references(m);
+  if (!options.stability) {
+    m.dt = m.dt_critical = scene.numerics.dt ? *scene.numerics.dt : 1e-4;
+    return m;
+  }
   compute_stability_limit(m);
   if (scene.numerics.dt) {
     if (*scene.numerics.dt > m.dt_critical)

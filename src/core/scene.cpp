@@ -62,6 +62,15 @@ class Reader {
     return out;
   }
 
+  bool boolean(const std::string& key, bool def) {
+    if (!has(key)) return def;
+    const YAML::Node n = node_[key];
+    bool v = false;
+    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
+      fail(field(key), n.IsScalar() ? "'" + n.as<std::string>() + "'" : "(not a scalar)", "true or false");
+    return v;
+  }
+
   std::string text(const std::string& key, const std::string& def) {
     if (!has(key)) return def;
     const YAML::Node n = node_[key];
@@ -172,7 +181,137 @@ PantographSpec read_pantograph(const YAML::Node& node, const std::string& path, 
   return p;
 }
 
+void read_spans(Reader& r, const std::string& path, std::vector<double>& spans) {
+  if (r.has("spans")) {
+    if (r.has("span_length") || r.has("span_count"))
+      fail(path + ".spans", "(given with span_length/span_count)", "give either spans or span_length and span_count");
+    spans = r.numbers("spans", 0.5, 500.0);
+  } else {
+    const double len = r.number("span_length", 0.5, 500.0);
+    const double count = r.number("span_count", 1.0, 10000.0);
+    if (count != std::floor(count)) fail(path + ".span_count", fmt(count), "a whole number >= 1");
+    spans.assign(static_cast<std::size_t>(count), len);
+  }
+  if (spans.empty()) fail(path + ".spans", "[]", "at least one span");
+}
+
+// The wire, dropper and support parts of a section (or the scene's defaults when defaults is null).
+void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, const SectionSpec* defaults) {
+  const std::string pre = path.empty() ? "" : path + ".";
+  if (r.has("contact_wire")) {
+    Reader w(r.child("contact_wire"), pre + "contact_wire");
+    static_cast<WireSpec&>(sec.contact_wire) = read_wire(w);
+    sec.contact_wire.presag = w.number("presag", -1.0, 1.0, 0.0);
+    w.finish();
+  } else if (!defaults) {
+    fail("contact_wire", "(missing)", "required section");
+  }
+  if (r.has("messenger")) {
+    Reader w(r.child("messenger"), pre + "messenger");
+    sec.messenger = read_wire(w);
+    w.finish();
+  }
+  if (r.has("droppers")) {
+    Reader d(r.child("droppers"), pre + "droppers");
+    DropperSpec ds;
+    const std::string f = pre + "droppers";
+    if (d.has("positions") == d.has("positions_per_span"))
+      fail(f + ".positions", "(both or neither given)", "give positions (same in every span) or positions_per_span");
+    if (d.has("positions")) {
+      ds.positions.assign(1, d.numbers("positions", 0.0, 500.0, true));  // expanded per span later
+    } else {
+      const YAML::Node per = d.child("positions_per_span");
+      if (!per.IsSequence()) fail(f + ".positions_per_span", "(not a list)", "one list of positions per span");
+      for (std::size_t i = 0; i < per.size(); ++i) {
+        std::vector<double> v;
+        const std::string fi = f + ".positions_per_span[" + std::to_string(i) + "]";
+        if (!per[i].IsSequence()) fail(fi, "(not a list)", "a list of positions in m");
+        for (std::size_t j = 0; j < per[i].size(); ++j)
+          v.push_back(Reader::parse_number(per[i][j], fi + "[" + std::to_string(j) + "]", 0.0, 500.0, true));
+        ds.positions.push_back(v);
+      }
+      ds.per_span = true;
+    }
+    if (d.has("transition_positions")) ds.transition_positions = d.numbers("transition_positions", 0.0, 500.0, true);
+    ds.axial_stiffness = d.number("axial_stiffness", 0.0, 1e10, std::nullopt, true);
+    ds.linear_mass = d.number("linear_mass", 0.0, 10.0, 0.0);
+    ds.clamp_mass_contact = d.number("clamp_mass_contact", 0.0, 100.0, 0.0);
+    ds.clamp_mass_messenger = d.number("clamp_mass_messenger", 0.0, 100.0, 0.0);
+    d.finish();
+    sec.droppers = ds;
+  }
+  if (r.has("steady_arms")) {
+    Reader a(r.child("steady_arms"), pre + "steady_arms");
+    sec.steady_arms = read_support(a);
+  }
+  if (r.has("messenger_supports")) {
+    Reader a(r.child("messenger_supports"), pre + "messenger_supports");
+    sec.messenger_supports = read_support(a);
+  }
+}
+
+// Section stations from the overlaps, dropper positions per span, and the line's spans (the union
+// of every section's supports).
+void resolve_line(Scene& s) {
+  const int k = s.overlap ? s.overlap->spans : 0;
+  std::vector<double> supports;
+  for (std::size_t i = 0; i < s.sections.size(); ++i) {
+    SectionSpec& sec = s.sections[i];
+    const std::string path = s.sections.size() > 1 ? "sections[" + std::to_string(i) + "]" : "line";
+    if (i > 0) {
+      const SectionSpec& prev = s.sections[i - 1];
+      if (static_cast<int>(prev.spans.size()) < k || static_cast<int>(sec.spans.size()) < k)
+        fail(path + ".spans", std::to_string(sec.spans.size()) + " spans",
+             "at least overlap.spans (" + std::to_string(k) + ") in every section");
+      for (int j = 0; j < k; ++j) {
+        const double a = prev.spans[prev.spans.size() - k + j], b = sec.spans[j];
+        if (std::fabs(a - b) > 1e-9)
+          fail(path + ".spans[" + std::to_string(j) + "]", fmt(b),
+               "equal to the overlapping span of the previous section (" + fmt(a) + " m)");
+      }
+      double st = prev.start;
+      for (std::size_t j = 0; j + k < prev.spans.size(); ++j) st += prev.spans[j];
+      sec.start = st;
+    }
+    if (sec.droppers) {
+      DropperSpec& d = *sec.droppers;
+      const std::size_t n = sec.spans.size();
+      if (d.per_span) {
+        if (d.positions.size() != n)
+          fail(path + ".droppers.positions_per_span", "(" + std::to_string(d.positions.size()) + " entries)",
+               "one list per span (" + std::to_string(n) + ")");
+      } else {
+        const std::vector<double> common = d.positions.empty() ? std::vector<double>{} : d.positions.front();
+        d.positions.assign(n, common);
+        if (!d.transition_positions.empty()) {
+          if (sec.last_span_transition) d.positions[n - 1] = d.transition_positions;
+          if (sec.first_span_transition) {
+            std::vector<double> mirrored;
+            for (auto it = d.transition_positions.rbegin(); it != d.transition_positions.rend(); ++it)
+              mirrored.push_back(sec.spans[0] - *it);
+            d.positions[0] = mirrored;
+          }
+        }
+      }
+    }
+    double x = sec.start;
+    supports.push_back(x);
+    for (double l : sec.spans) supports.push_back(x += l);
+  }
+  std::sort(supports.begin(), supports.end());
+  s.spans.clear();
+  for (std::size_t i = 1; i < supports.size(); ++i)
+    if (supports[i] - supports[i - 1] > 1e-9) s.spans.push_back(supports[i] - supports[i - 1]);
+  if (!s.sections.empty()) s.droppers = s.sections.front().droppers;
+}
+
 }  // namespace
+
+double SectionSpec::length() const {
+  double l = 0.0;
+  for (double x : spans) l += x;
+  return l;
+}
 
 double Scene::line_length() const {
   double s = 0.0;
@@ -199,69 +338,59 @@ Scene scene_from_yaml(const YAML::Node& root) {
 
   {
     Reader r(top.child("line"), "line");
-    if (!top.has("line")) fail("line", "(missing)", "required section with spans or span_length and span_count");
+    if (!top.has("line")) fail("line", "(missing)", "required section with spans (or span_length and span_count)");
     s.contact_wire_height = r.number("contact_wire_height", 0.0, 100.0, 5.3);
     s.encumbrance = r.number("encumbrance", 0.0, 10.0, 1.2, true);
-    if (r.has("spans")) {
-      if (r.has("span_length") || r.has("span_count"))
-        fail("line.spans", "(given with span_length/span_count)", "give either spans or span_length and span_count");
-      s.spans = r.numbers("spans", 0.5, 500.0);
+    const bool has_sections = top.has("sections");
+    if (has_sections && (r.has("spans") || r.has("span_length") || r.has("span_count")))
+      fail("line.spans", "(given with sections)", "with sections, every section gives its own spans");
+    SectionSpec defaults;
+    if (!has_sections) read_spans(r, "line", defaults.spans);
+    read_section_parts(top, "", defaults, nullptr);
+    if (!has_sections) {
+      defaults.contact_wire_count = 1;
+      s.sections.push_back(defaults);
     } else {
-      const double len = r.number("span_length", 0.5, 500.0);
-      const double count = r.number("span_count", 1.0, 10000.0);
-      if (count != std::floor(count)) fail("line.span_count", fmt(count), "a whole number >= 1");
-      s.spans.assign(static_cast<std::size_t>(count), len);
-    }
-    if (s.spans.empty()) fail("line.spans", "[]", "at least one span");
-    r.finish();
-  }
-  {
-    if (!top.has("contact_wire")) fail("contact_wire", "(missing)", "required section");
-    Reader r(top.child("contact_wire"), "contact_wire");
-    static_cast<WireSpec&>(s.contact_wire) = read_wire(r);
-    s.contact_wire.presag = r.number("presag", -1.0, 1.0, 0.0);
-    r.finish();
-  }
-  if (top.has("messenger")) {
-    Reader r(top.child("messenger"), "messenger");
-    s.messenger = read_wire(r);
-    r.finish();
-  }
-  if (top.has("droppers")) {
-    Reader r(top.child("droppers"), "droppers");
-    DropperSpec d;
-    if (r.has("positions") == r.has("positions_per_span"))
-      fail("droppers.positions", "(both or neither given)", "give positions (same in every span) or positions_per_span");
-    if (r.has("positions")) {
-      d.positions.assign(s.spans.size(), r.numbers("positions", 0.0, 500.0, true));
-    } else {
-      const YAML::Node per = r.child("positions_per_span");
-      if (!per.IsSequence() || per.size() != s.spans.size())
-        fail("droppers.positions_per_span", "(" + std::to_string(per.IsSequence() ? per.size() : 0) + " entries)",
-             "one list per span (" + std::to_string(s.spans.size()) + ")");
-      for (std::size_t i = 0; i < per.size(); ++i) {
-        std::vector<double> v;
-        if (!per[i].IsSequence()) fail("droppers.positions_per_span[" + std::to_string(i) + "]", "(not a list)", "a list of positions in m");
-        for (std::size_t j = 0; j < per[i].size(); ++j)
-          v.push_back(Reader::parse_number(per[i][j], "droppers.positions_per_span[" + std::to_string(i) + "][" + std::to_string(j) + "]", 0.0, 500.0, true));
-        d.positions.push_back(v);
+      const YAML::Node secs = top.child("sections");
+      if (!secs.IsSequence() || secs.size() == 0) fail("sections", "(not a non-empty list)", "a list of tension sections");
+      for (std::size_t i = 0; i < secs.size(); ++i) {
+        const std::string path = "sections[" + std::to_string(i) + "]";
+        Reader sr(secs[i], path);
+        SectionSpec sec = defaults;
+        read_spans(sr, path, sec.spans);
+        read_section_parts(sr, path, sec, &defaults);
+        const double count = sr.number("contact_wire_count", 1.0, 2.0, 1.0);
+        if (count != std::floor(count)) fail(sr.field("contact_wire_count"), fmt(count), "1 or 2 (twin contact wire)");
+        sec.contact_wire_count = static_cast<int>(count);
+        sec.first_span_transition = sr.boolean("first_span_transition", i > 0);
+        sec.last_span_transition = sr.boolean("last_span_transition", i + 1 < secs.size());
+        sr.finish();
+        s.sections.push_back(sec);
       }
     }
-    d.axial_stiffness = r.number("axial_stiffness", 0.0, 1e10, std::nullopt, true);
-    d.linear_mass = r.number("linear_mass", 0.0, 10.0, 0.0);
-    d.clamp_mass_contact = r.number("clamp_mass_contact", 0.0, 100.0, 0.0);
-    d.clamp_mass_messenger = r.number("clamp_mass_messenger", 0.0, 100.0, 0.0);
     r.finish();
-    s.droppers = d;
   }
-  if (top.has("steady_arms")) {
-    Reader r(top.child("steady_arms"), "steady_arms");
-    s.steady_arms = read_support(r);
+  if (top.has("overlap")) {
+    Reader r(top.child("overlap"), "overlap");
+    OverlapSpec o;
+    const double k = r.number("spans", 1.0, 10.0, 1.0);
+    if (k != std::floor(k)) fail("overlap.spans", fmt(k), "a whole number of transition spans >= 1");
+    o.spans = static_cast<int>(k);
+    if (r.has("support_rise")) o.support_rise = r.number("support_rise", 0.0, 2.0);
+    if (r.has("design_force")) o.design_force = r.number("design_force", 0.0, 2000.0, std::nullopt, true);
+    r.finish();
+    s.overlap = o;
+  } else if (s.sections.size() > 1) {
+    s.overlap = OverlapSpec{};
   }
-  if (top.has("messenger_supports")) {
-    Reader r(top.child("messenger_supports"), "messenger_supports");
-    s.messenger_supports = read_support(r);
-  }
+  // The first section's parts stay available as the scene's defaults.
+  const SectionSpec& first = s.sections.front();
+  s.contact_wire = first.contact_wire;
+  s.messenger = first.messenger;
+  s.droppers = first.droppers;
+  s.steady_arms = first.steady_arms;
+  s.messenger_supports = first.messenger_supports;
+  resolve_line(s);
   if (top.has("damping")) {
     Reader r(top.child("damping"), "damping");
     s.rayleigh_alpha = r.number("alpha", 0.0, 100.0, 0.0);
@@ -325,21 +454,26 @@ Scene scene_from_yaml(const YAML::Node& root) {
 
 void validate(const Scene& s) {
   const double line = s.line_length();
-  if (s.droppers && !s.messenger)
-    fail("droppers", "(given)", "droppers hang the contact wire from a messenger: add a messenger section or remove droppers");
-  if (s.messenger_supports && !s.messenger)
-    fail("messenger_supports", "(given)", "needs a messenger section");
-  if (s.contact_wire.presag != 0.0 && !s.droppers)
-    fail("contact_wire.presag", fmt(s.contact_wire.presag), "0 without droppers (the presag is set by the dropper lengths)");
-  if (s.droppers) {
-    if (s.droppers->positions.size() != s.spans.size())
-      fail("droppers.positions_per_span", std::to_string(s.droppers->positions.size()) + " lists", "one per span");
-    for (std::size_t i = 0; i < s.spans.size(); ++i) {
-      const auto& p = s.droppers->positions[i];
+  if (s.sections.empty()) fail("line", "(no tension section)", "at least one section of spans");
+  for (std::size_t si = 0; si < s.sections.size(); ++si) {
+    const SectionSpec& sec = s.sections[si];
+    const std::string pre = s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "";
+    if (sec.droppers && !sec.messenger)
+      fail(pre + "droppers", "(given)", "droppers hang the contact wire from a messenger: add a messenger section or remove droppers");
+    if (sec.messenger_supports && !sec.messenger) fail(pre + "messenger_supports", "(given)", "needs a messenger section");
+    if (sec.contact_wire_count == 2 && !sec.droppers)
+      fail(pre + "contact_wire_count", "2", "a twin contact wire hangs from droppers: add droppers and a messenger");
+    if (sec.contact_wire.presag != 0.0 && !sec.droppers)
+      fail(pre + "contact_wire.presag", fmt(sec.contact_wire.presag), "0 without droppers (the presag is set by the dropper lengths)");
+    if (!sec.droppers) continue;
+    if (sec.droppers->positions.size() != sec.spans.size())
+      fail(pre + "droppers.positions_per_span", std::to_string(sec.droppers->positions.size()) + " lists", "one per span");
+    for (std::size_t i = 0; i < sec.spans.size(); ++i) {
+      const auto& p = sec.droppers->positions[i];
       for (std::size_t j = 0; j < p.size(); ++j) {
-        const std::string f = "droppers.positions (span " + std::to_string(i) + ", dropper " + std::to_string(j) + ")";
-        if (p[j] <= 0.0 || p[j] >= s.spans[i])
-          fail(f, fmt(p[j]), "strictly inside the span (0, " + fmt(s.spans[i]) + ") m");
+        const std::string f = pre + "droppers.positions (span " + std::to_string(i) + ", dropper " + std::to_string(j) + ")";
+        if (p[j] <= 0.0 || p[j] >= sec.spans[i])
+          fail(f, fmt(p[j]), "strictly inside the span (0, " + fmt(sec.spans[i]) + ") m");
         if (j > 0 && p[j] <= p[j - 1]) fail(f, fmt(p[j]), "increasing along the span (previous " + fmt(p[j - 1]) + ")");
       }
     }
@@ -354,7 +488,7 @@ void validate(const Scene& s) {
   if (a0 < 0 || a1 > static_cast<int>(s.spans.size()) || a0 >= a1)
     fail("output.analysis_spans", "[" + std::to_string(a0) + ", " + std::to_string(a1) + "]",
          "0 <= first < last <= span count (" + std::to_string(s.spans.size()) + ")");
-  if (s.numerics.element_length > *std::min_element(s.spans.begin(), s.spans.end()))
+  if (s.numerics.element_length > *std::min_element(s.spans.begin(), s.spans.end()) + 1e-12)
     fail("numerics.element_length", fmt(s.numerics.element_length), "at most the shortest span");
   if (s.train_start && s.train_end && *s.train_end < *s.train_start)
     fail("train.end", fmt(*s.train_end), ">= train.start (" + fmt(*s.train_start) + ")");

@@ -4,6 +4,7 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace catenary_sim {
@@ -216,11 +217,21 @@ void set_pantograph_references(Model& m) {
     double sum = 0.0;
     int count = 0;
     for (int ci : p.collectors) {
+      // The lowest contact wire over the collector is the one the head meets first.
       const double xc = m.train_start - p.position + m.collectors[ci].offset;
-      const Wire& w = m.wires[m.contact_wires[0]];
-      const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
-      for (int a = 0; a < cnt; ++a) sum += weight[a] * w.height[node[a]];
-      count += cnt > 0;
+      double lowest = std::numeric_limits<double>::infinity();
+      for (int wi : m.contact_wires) {
+        const Wire& w = m.wires[wi];
+        const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+        if (cnt == 0) continue;
+        double y = 0.0;
+        for (int a = 0; a < cnt; ++a) y += weight[a] * w.height[node[a]];
+        lowest = std::min(lowest, y);
+      }
+      if (std::isfinite(lowest)) {
+        sum += lowest;
+        ++count;
+      }
     }
     p.reference_height = count ? sum / count : m.scene.contact_wire_height;
     p.spring_preload.assign(p.masses.size(), p.static_uplift);
@@ -235,6 +246,124 @@ void set_pantograph_references(Model& m) {
     const int last = p.masses_count() - 1;
     p.spring_preload[last] = p.stiffness[last] * st.u[p.first_dof + last];
   }
+}
+
+}  // namespace catenary_sim
+
+namespace catenary_sim {
+
+namespace {
+
+Scene probe_scene(const Scene& scene, double force) {
+  Scene s = scene;
+  PantographSpec p;
+  p.name = "probe";
+  p.masses = {1.0};
+  p.stiffness = {0.0};
+  p.damping = {0.0};
+  p.static_uplift = force;
+  p.collectors = {CollectorSpec{}};
+  s.pantographs = {p};
+  s.train_speed = 0.0;
+  s.train_start.reset();
+  s.train_end.reset();
+  s.contact.rub_length = 0.0;  // a point load: the elasticity at the station itself
+  return s;
+}
+
+}  // namespace
+
+ElasticityProbe::ElasticityProbe(const Scene& scene, double force, const std::optional<std::vector<double>>& rises) {
+  BuildOptions o;
+  o.stability = false;
+  o.support_rises = rises;
+  model_ = build_model(probe_scene(scene, force), o);
+}
+
+std::vector<double> ElasticityProbe::uplift(double x) const {
+  const Model& m = model_;
+  std::vector<double> out(m.contact_wires.size(), std::nan(""));
+  State st = make_state(m);
+  st.front = x;
+  try {
+    solve_initial_state(m, st, true);
+  } catch (const SceneError&) {
+    return out;  // nothing under the probe to press against
+  }
+  observe(m, st);
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  for (std::size_t k = 0; k < m.contact_wires.size(); ++k) {
+    if (!(st.contact_force[k] > 0.0)) continue;
+    const Wire& w = m.wires[m.contact_wires[k]];
+    const int cnt = contact_weights(w, 0.0, x, node.data(), weight.data());
+    double u = 0.0;
+    for (int a = 0; a < cnt; ++a) u += weight[a] * st.u[w.w_dof + node[a]];
+    out[k] = u;
+  }
+  return out;
+}
+
+std::vector<double> transition_support_rises(const Scene& scene) {
+  const std::size_t ns = scene.sections.size();
+  std::vector<double> rises(2 * ns, 0.0);
+  bool any = false;
+  for (const SectionSpec& sec : scene.sections) any = any || sec.first_span_transition || sec.last_span_transition;
+  if (!any) return rises;
+  if (scene.overlap && scene.overlap->support_rise) {
+    for (std::size_t i = 0; i < ns; ++i) {
+      rises[2 * i] = scene.sections[i].first_span_transition ? *scene.overlap->support_rise : 0.0;
+      rises[2 * i + 1] = scene.sections[i].last_span_transition ? *scene.overlap->support_rise : 0.0;
+    }
+    return rises;
+  }
+  // F of eq. 6: the design force, else the mean static uplift of the pantographs, else 100 N.
+  double force = 100.0;
+  if (scene.overlap && scene.overlap->design_force) {
+    force = *scene.overlap->design_force;
+  } else if (!scene.pantographs.empty()) {
+    force = 0.0;
+    for (const PantographSpec& p : scene.pantographs) force += p.static_uplift;
+    force /= scene.pantographs.size();
+  }
+  // E at mid-span of a current span, measured on the model with the supports not yet raised.
+  const ElasticityProbe probe(scene, force, std::vector<double>(2 * ns, 0.0));
+  for (std::size_t i = 0; i < ns; ++i) {
+    const SectionSpec& sec = scene.sections[i];
+    const int n = static_cast<int>(sec.spans.size());
+    int best = -1;
+    double best_dist = 1e300, x0 = sec.start;
+    std::vector<double> starts;
+    for (int j = 0; j < n; ++j) {
+      starts.push_back(x0);
+      const bool transition = (j == 0 && sec.first_span_transition) || (j == n - 1 && sec.last_span_transition);
+      const double dist = std::fabs(x0 + 0.5 * sec.spans[j] - (sec.start + 0.5 * sec.length()));
+      if (!transition && dist < best_dist) {
+        best = j;
+        best_dist = dist;
+      }
+      x0 += sec.spans[j];
+    }
+    if (best < 0) best = n / 2;  // no current span: the middle span, supports not raised
+    const std::vector<double> up = probe.uplift(starts[best] + 0.5 * sec.spans[best]);
+    double h = 0.0;
+    for (std::size_t k = 0; k < up.size(); ++k)
+      if (probe.model().wires[probe.model().contact_wires[k]].section == static_cast<int>(i) && std::isfinite(up[k]))
+        h = std::max(h, up[k]);
+    if (!(h > 0.0))
+      throw SceneError("overlap: the static uplift under " + std::to_string(force) + " N at mid-span of span " +
+                       std::to_string(best) + " of section " + std::to_string(i) +
+                       " could not be measured (eq. 6); give overlap.support_rise");
+    const double p = sec.contact_wire.linear_mass * scene.gravity, T = sec.contact_wire.tension;
+    const double b = std::sqrt(2.0 * T * h / p);  // eq. 7
+    auto rise = [&](double span) {
+      const double a = 0.5 * span;
+      return p * (a + 0.5 * b) * (a + 0.5 * b) / (2.0 * T);  // eq. 8
+    };
+    if (sec.first_span_transition) rises[2 * i] = rise(sec.spans.front());
+    if (sec.last_span_transition) rises[2 * i + 1] = rise(sec.spans.back());
+  }
+  return rises;
 }
 
 }  // namespace catenary_sim

@@ -96,7 +96,7 @@ PassRecorder::PassRecorder(const Model& m, double sample_rate_hz)
     for (std::size_t c = 0; c < p.collectors.size(); ++c)
       for (std::size_t w = 0; w < nw; ++w)
         columns_.push_back(p.name + "_collector" + std::to_string(c) +
-                           (nw > 1 ? "_" + m.wires[m.contact_wires[w]].name + std::to_string(w) : std::string()) + "_force_N");
+                           (nw > 1 ? "_" + m.wires[m.contact_wires[w]].name : std::string()) + "_force_N");
     columns_.push_back(p.name + "_force_N");
     columns_.push_back(p.name + "_head_displacement_m");
   }

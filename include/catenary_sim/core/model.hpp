@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@ namespace catenary_sim {
 // (w, theta per node): that is exactly the bandwidth of a beam, so a product costs O(nodes).
 struct Wire {
   std::string name;
+  int section = 0;               // tension section it belongs to
   bool is_contact_wire = false;
   WireSpec spec;
   std::vector<double> x;         // m, node stations along the line
@@ -29,7 +31,7 @@ struct Wire {
   std::vector<double> e_ww, e_wt, e_tw, e_tt;  // size nodes-1; e_wt = K(w_e, theta_e+1), e_tw = K(theta_e, w_e+1)
   // Condensed rotations: LDL^T factors of the tridiagonal K_theta_theta, reused every step.
   std::vector<double> tt_inv_pivot, tt_lower;
-  std::vector<int> support_nodes;  // node index of each support along this wire, in order
+  std::vector<int> support_nodes;  // node index of each support of its section, in order
 
   int nodes() const { return static_cast<int>(x.size()); }
   // Index of the element containing station xs (clamped to the wire), by bisection.
@@ -39,6 +41,7 @@ struct Wire {
 // Tension-only dropper between a contact-wire node and a messenger node.
 struct Dropper {
   int contact_dof = 0, messenger_dof = 0;
+  int section = 0, span = 0;    // tension section, span index within it
   double x = 0.0;               // m
   double stiffness = 0.0;       // N/m, EA / unstretched length
   double static_tension = 0.0;  // N, in the design state
@@ -52,8 +55,18 @@ struct SupportSpring {
   double stiffness = 0.0;     // N/m
   double static_force = 0.0;  // N, f0 of eq. 4 (balanced in the constant load vector)
   double x = 0.0;
-  int span_index = 0;         // support i is at the start of span i
+  int span_index = 0;         // index of the support along the line (Model::support_x); span i starts there
   bool steady_arm = false;
+  int section_support = 0;    // index of the support within its tension section
+};
+
+// A tension section as built: its wires and the raised contact-wire supports of its transition
+// spans (d of eq. 8, 0 where the span is a current span).
+struct Section {
+  double start = 0.0, end = 0.0;       // m
+  double rise_first = 0.0, rise_last = 0.0;  // m, at its first and last support
+  std::vector<int> wires;              // indices into Model::wires
+  int messenger = -1;                  // index into Model::wires, -1 without a messenger
 };
 
 struct Collector {
@@ -76,13 +89,14 @@ struct Pantograph {
 
 struct Model {
   Scene scene;
-  std::vector<Wire> wires;            // [0] contact wire, [1] messenger if any
+  std::vector<Section> sections;
+  std::vector<Wire> wires;            // per section: contact wire(s), then the messenger if any
   std::vector<int> contact_wires;     // indices into wires that collectors touch
   std::vector<Dropper> droppers;
   std::vector<SupportSpring> springs;
   std::vector<Pantograph> pantographs;
   std::vector<Collector> collectors;
-  std::vector<double> support_x;      // m, station of every support
+  std::vector<double> support_x;      // m, station of every support along the line (all sections)
 
   int n_dof = 0;
   int n_catenary_dof = 0;       // catenary DOFs come first, pantograph DOFs after
@@ -104,6 +118,18 @@ struct Model {
 // Builds the model, solves the design statics (dropper lengths for the presag) and the stability
 // limit. Throws SceneError for a scene that cannot be built (e.g. dt above the stability limit).
 Model build_model(const Scene& scene);
+
+struct BuildOptions {
+  bool stability = true;  // false: skip the stability limit (static probes)
+  // Raised supports per section (first, last, first, last, ...), m; empty: from the scene / eq. 6-8.
+  std::optional<std::vector<double>> support_rises;
+};
+Model build_model(const Scene& scene, const BuildOptions& options);
+
+// Heights d (m) by which each section's contact wire support is raised at its first and last
+// support (0 where the end span is a current span): overlap.support_rise, or eq. 6-8 with
+// h = E F, E measured on the model at the middle of a current span of the section.
+std::vector<double> transition_support_rises(const Scene& scene);
 
 // y = K x for the linear part of the system with every dropper and contact active (the collectors
 // at the train position `front`): used for the stability limit and by tests. x and y have n_dof

@@ -32,7 +32,11 @@ struct ContactWireSpec : WireSpec {
 };
 
 struct DropperSpec {
-  std::vector<std::vector<double>> positions;  // per span, m from the span's first support
+  std::vector<std::vector<double>> positions;  // per span of the section, m from the span's first support
+  // Transition spans (overlaps): m from the support on the section's side of the span, mirrored
+  // for a section's first span (the paper's 3.83 m and 5.83 m); empty = `positions`.
+  std::vector<double> transition_positions;
+  bool per_span = false;                       // positions were given per span (positions_per_span)
   double axial_stiffness = 0.0;                // EA, N
   double linear_mass = 0.0;                    // kg/m
   double clamp_mass_contact = 0.0;             // kg, clamp on the contact wire
@@ -68,6 +72,30 @@ struct ContactSpec {
   double rub_length = 0.0;     // l, m: length of the cosine distribution (eq. 13); 0 = point contact
 };
 
+// One tension section: its spans, wires, droppers and supports, anchored at both ends. Consecutive
+// sections overlap over `OverlapSpec::spans` transition spans (paper Figs. 1-2): in a section's
+// transition span the contact wire rises from its last dropper to a support raised by d (eq. 8).
+struct SectionSpec {
+  std::vector<double> spans;   // m
+  double start = 0.0;          // m, station of its first support (derived from the overlaps)
+  int contact_wire_count = 1;  // 2: twin contact wire (DC lines), both hanging from the same droppers
+  ContactWireSpec contact_wire;
+  std::optional<WireSpec> messenger;
+  std::optional<DropperSpec> droppers;
+  std::optional<SupportSpec> steady_arms;
+  std::optional<SupportSpec> messenger_supports;
+  bool first_span_transition = false;  // default: true where a previous section overlaps it
+  bool last_span_transition = false;   // default: true where a next section overlaps it
+  double length() const;
+  double end() const { return start + length(); }
+};
+
+struct OverlapSpec {
+  int spans = 1;                       // transition spans shared by consecutive sections
+  std::optional<double> support_rise;  // d of eq. 8, m; empty: eq. 6-8 with E measured on the model
+  std::optional<double> design_force;  // F of eq. 6, N; empty: the mean static uplift of the pantographs (else 100 N)
+};
+
 enum class RotaryInertia { kCondensed, kLumped };
 
 struct NumericsSpec {
@@ -92,7 +120,10 @@ struct Scene {
   double gravity = 9.81;               // m/s^2
   double contact_wire_height = 5.3;    // m above the rail at the supports
   double encumbrance = 1.2;            // m, messenger above contact wire at the supports
-  std::vector<double> spans;           // m, span lengths in order
+  std::vector<double> spans;           // m, the line's spans in order (overlapping spans counted once)
+  std::vector<SectionSpec> sections;   // tension sections in series; at least one
+  std::optional<OverlapSpec> overlap;  // present when there are two or more sections
+  // Section defaults (the first section's, and the only section's in a one-section scene).
   ContactWireSpec contact_wire;
   std::optional<WireSpec> messenger;
   std::optional<DropperSpec> droppers;

@@ -26,4 +26,18 @@ void solve_initial_state(const Model& model, State& state, bool roof_springs = t
 // state, the static uplift is exactly the static contact force (part of building the model).
 void set_pantograph_references(Model& model);
 
+// Static elasticity of the line: a stiff probe collector pressed up with `force` at a station
+// (eq. 23, droppers tension-only). Used for eq. 6 (h = E F) and for elasticity curves.
+class ElasticityProbe {
+ public:
+  ElasticityProbe(const Scene& scene, double force, const std::optional<std::vector<double>>& support_rises = std::nullopt);
+  // Static uplift (m) of every contact wire (Model::contact_wires order) under the probe at
+  // station x; NaN for a wire the probe does not touch there.
+  std::vector<double> uplift(double x) const;
+  const Model& model() const { return model_; }
+
+ private:
+  Model model_;
+};
+
 }  // namespace catenary_sim
