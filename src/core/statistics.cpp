@@ -88,6 +88,7 @@ PassRecorder::PassRecorder(const Model& m, double sample_rate_hz)
   const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
   position_.resize(np);
   force_.resize(np);
+  wire_force_.assign(np, std::vector<std::vector<double>>(nw));
   for (std::size_t k = 0; k < m.springs.size(); ++k)
     if (m.springs[k].steady_arm) steady_arm_springs_.push_back(static_cast<int>(k));
   max_uplift_.assign(np, std::vector<double>(steady_arm_springs_.size(), -std::numeric_limits<double>::infinity()));
@@ -111,6 +112,11 @@ void PassRecorder::record(const Model& m, const State& s) {
     const double xp = s.front - m.pantographs[p].position;
     position_[p].push_back(xp);
     force_[p].push_back(total_contact_force(m, s, static_cast<int>(p)));
+    for (std::size_t w = 0; w < nw; ++w) {
+      double f = 0.0;
+      for (int ci : m.pantographs[p].collectors) f += s.contact_force[ci * nw + w];
+      wire_force_[p][w].push_back(f);
+    }
     for (std::size_t k = 0; k < steady_arm_springs_.size(); ++k) {
       const SupportSpring& sp = m.springs[steady_arm_springs_[k]];
       const int span = sp.span_index;
@@ -161,6 +167,23 @@ std::vector<PantographStatistics> PassRecorder::statistics(const Model& m) const
       if (xs >= x0 - 1e-9 && xs <= x1 + 1e-9) up = std::max(up, max_uplift_[p][k]);
     }
     st.max_uplift_at_support_m = std::isfinite(up) ? up : std::nan("");
+    for (std::size_t w = 0; w < m.contact_wires.size(); ++w) {
+      WireContactStatistics ws;
+      ws.wire = m.wires[m.contact_wires[w]].name;
+      double sum = 0.0;
+      std::size_t n = 0, on = 0;
+      for (std::size_t i = 0; i < force_[p].size(); ++i) {
+        if (position_[p][i] < x0 || position_[p][i] > x1) continue;
+        const double f = wire_force_[p][w][i];
+        sum += f;
+        ws.max_force = std::max(ws.max_force, f);
+        on += f > 0.0;
+        ++n;
+      }
+      ws.mean_force = n ? sum / n : std::nan("");
+      ws.contact_percent = n ? 100.0 * on / n : std::nan("");
+      st.wires.push_back(ws);
+    }
     out.push_back(st);
   }
   return out;
@@ -208,7 +231,12 @@ std::string statistics_json(const Model& m, const State& s, const std::vector<Pa
     j << ",\n     \"contact_loss_percent\": " << json_number(p.contact_loss_percent)
       << ", \"max_uplift_at_support_m\": " << json_number(p.max_uplift_at_support_m) << ",\n     \"unfiltered\": {";
     force_json(j, p.unfiltered);
-    j << "}}";
+    j << "},\n     \"contact_wires\": [";
+    for (std::size_t w = 0; w < p.wires.size(); ++w)
+      j << (w ? ", " : "") << "{\"wire\": \"" << p.wires[w].wire << "\", \"mean_force_N\": " << json_number(p.wires[w].mean_force)
+        << ", \"max_force_N\": " << json_number(p.wires[w].max_force)
+        << ", \"contact_percent\": " << json_number(p.wires[w].contact_percent) << "}";
+    j << "]}";
   }
   j << "\n  ]\n}\n";
   return j.str();

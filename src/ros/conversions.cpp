@@ -85,6 +85,10 @@ ContactForceArray to_contact_force(const Model& m, const State& s, const ros::Ti
       c.in_contact.push_back(f > 0.0);
     }
     c.total = total_contact_force(m, s, static_cast<int>(p));
+    const std::size_t nw = m.contact_wires.size();
+    for (int wi : m.contact_wires) c.contact_wires.push_back(m.wires[wi].name);
+    for (int ci : pg.collectors)
+      for (std::size_t k = 0; k < nw; ++k) c.wire_forces.push_back(s.contact_force[ci * nw + k]);
     out.pantographs.push_back(c);
   }
   return out;

@@ -203,6 +203,10 @@ int main(int argc, char** argv) {
                 << std::setprecision(1) << s.max_uplift_at_support_m * 1e3 << " mm\n"
                 << "      unfiltered: max " << s.unfiltered.max << " N, min " << s.unfiltered.min << " N, std "
                 << s.unfiltered.std_dev << " N\n";
+      if (s.wires.size() > 1)
+        for (const WireContactStatistics& w : s.wires)
+          std::cout << "      on " << w.wire << ": mean " << w.mean_force << " N, max " << w.max_force << " N, in contact "
+                    << w.contact_percent << " % of the time\n";
     }
     std::cout << "wrote " << out_dir << "/stats.json and " << out_dir << "/timeseries.csv\n";
     if (bag) std::cout << "wrote " << bag->messages() << " messages to " << bag_path << "\n";

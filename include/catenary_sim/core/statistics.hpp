@@ -15,8 +15,16 @@ struct ForceStatistics {
   double stat_max = 0.0, stat_min = 0.0;                   // N, mean +- 3 std_dev
 };
 
+// The share of one contact wire in a pantograph's contact (over all its collectors).
+struct WireContactStatistics {
+  std::string wire;
+  double mean_force = 0.0, max_force = 0.0;  // N, unfiltered, over the section
+  double contact_percent = 0.0;              // share of steps with force on this wire
+};
+
 struct PantographStatistics {
   std::string name;
+  std::vector<WireContactStatistics> wires;  // per contact wire of the line
   ForceStatistics filtered;    // contact force low-pass filtered at the cutoff (zero phase)
   ForceStatistics unfiltered;  // as computed, at every step
   double contact_loss_percent = 0.0;   // share of steps in the section with zero total force
@@ -65,6 +73,7 @@ class PassRecorder {
   std::vector<Row> rows_;
   std::vector<double> time_;
   std::vector<std::vector<double>> position_, force_;  // per pantograph, every step
+  std::vector<std::vector<std::vector<double>>> wire_force_;  // per pantograph, per contact wire, every step
   std::vector<int> steady_arm_springs_;                 // indices into model.springs
   std::vector<std::vector<double>> max_uplift_;        // per pantograph, per steady arm
 };
