@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 namespace catenary_sim {
@@ -64,6 +65,63 @@ double collector_force(const Model& m, const State& s, int ci) {
   for (std::size_t k = 0; k < nw; ++k) f += s.contact_force[ci * nw + k];
   return f;
 }
+
+// Station of a collector of pantograph p now.
+double collector_x(const Model& m, const State& s, int p, int ci) {
+  return pantograph_position(m, s, p) + m.collectors[ci].offset;
+}
+
+// Under each collector of pantograph p, the contact wire with the lowest design height there (the
+// one the head meets first, as in set_pantograph_references): its design height and its displaced
+// height (weighted over the contact nodes, eq. 12), averaged over the collectors under a wire.
+// Returns false (outputs untouched) when no collector is under a contact wire.
+bool lowest_contact_wire(const Model& m, const State& s, int p, double* design, double* displaced) {
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  double sum_design = 0.0, sum_displaced = 0.0;
+  int count = 0;
+  for (int ci : m.pantographs[p].collectors) {
+    const double xc = collector_x(m, s, p, ci);
+    double best = std::numeric_limits<double>::infinity(), best_displaced = 0.0;
+    for (int wi : m.contact_wires) {
+      const Wire& w = m.wires[wi];
+      const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+      if (cnt == 0) continue;
+      double y = 0.0, u = 0.0;
+      for (int a = 0; a < cnt; ++a) {
+        y += weight[a] * w.height[node[a]];
+        u += weight[a] * s.u[w.w_dof + node[a]];
+      }
+      if (y < best) {
+        best = y;
+        best_displaced = y + u;
+      }
+    }
+    if (std::isfinite(best)) {
+      sum_design += best;
+      sum_displaced += best_displaced;
+      ++count;
+    }
+  }
+  if (count == 0) return false;
+  *design = sum_design / count;
+  *displaced = sum_displaced / count;
+  return true;
+}
+
+// Whether any collector of pantograph p is over contact wire `wi` (an index into Model::wires).
+bool under_wire(const Model& m, const State& s, int p, int wi) {
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  for (int ci : m.pantographs[p].collectors)
+    if (contact_weights(m.wires[wi], m.rub_length, collector_x(m, s, p, ci), node.data(), weight.data()) > 0)
+      return true;
+  return false;
+}
+
+constexpr double kArrowMetresPerNewton = 0.01;  // contact-force arrow: 1 m per 100 N
+constexpr double kLabelHeight = 3.0;             // m above the drawn head
+constexpr double kLabelTextSize = 0.5;           // m, height of a capital letter
 
 }  // namespace
 
@@ -150,7 +208,33 @@ double wire_dof_design_height(const Model& m, int dof) {
   return std::nan("");
 }
 
+double contact_design_height(const Model& m, const State& s, int p) {
+  double design = m.scene.contact_wire_height, displaced = 0.0;
+  lowest_contact_wire(m, s, p, &design, &displaced);
+  return design;
+}
+
+double drawn_head_height(const Model& m, const State& s, int p, double k) {
+  double d = m.scene.contact_wire_height, y = d;
+  lowest_contact_wire(m, s, p, &d, &y);
+  const double head = m.pantographs[p].moving_force ? y : head_height(m, s, p);
+  return d + k * (head - d);
+}
+
 std::string train_frame_id() { return "train"; }
+
+std::string view_frame_id() { return "train_view"; }
+
+geometry_msgs::TransformStamped to_view_transform(const State& s, const ros::Time& stamp,
+                                                  const std::string& line_frame) {
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = stamp;
+  t.header.frame_id = line_frame;
+  t.child_frame_id = view_frame_id();
+  t.transform.translation.x = s.front;
+  t.transform.rotation.w = 1.0;
+  return t;
+}
 
 std::string head_frame_id(const Model& m, int p) { return "pantograph_" + m.pantographs[p].name; }
 
@@ -240,12 +324,15 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     out.markers.push_back(arms);
   }
 
-  // Pantographs: head, frame, force arrow and label.
+  // Pantographs: head, frame, force arrow and label. The head is exaggerated about the design
+  // height of the contact wire under it, like the wires about theirs, so it is drawn on the wire
+  // it touches (see drawn_head_height).
+  const std::size_t nw = m.contact_wires.size();
   for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
     const Pantograph& pg = m.pantographs[p];
     const int id = static_cast<int>(p);
     const double x = pantograph_position(m, s, id);
-    const double z_head = pg.moving_force ? m.scene.contact_wire_height : pg.reference_height + k * s.u[pg.first_dof];
+    const double z_head = drawn_head_height(m, s, id, k);
     const double force = total_contact_force(m, s, id);
     const bool contact = force > 0.0;
 
@@ -275,15 +362,29 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     arrow.scale.z = 0.1;   // head length
     arrow.color = contact ? color(0.1f, 0.8f, 0.2f) : color(1.0f, 0.1f, 0.1f);
     arrow.points.push_back(point(x, 0.0, z_head));
-    arrow.points.push_back(point(x, 0.0, z_head + std::max(0.0, force) / 200.0 + 1e-3));  // 1 m per 200 N
+    arrow.points.push_back(point(x, 0.0, z_head + std::max(0.0, force) * kArrowMetresPerNewton + 1e-3));
     out.markers.push_back(arrow);
 
     Marker label = marker(h, "label", id, Marker::TEXT_VIEW_FACING);
-    label.pose.position = point(x, 0.0, z_head + 1.8);
-    label.scale.z = 0.3;
+    label.pose.position = point(x, 0.0, z_head + kLabelHeight);
+    label.scale.z = kLabelTextSize;
+    label.color = color(1.0f, 1.0f, 1.0f);
     std::ostringstream t;
-    t << pg.name << ": " << std::fixed << std::setprecision(0) << force << " N" << (contact ? "" : " LOSS") << "\n"
-      << std::setprecision(1) << s.speed * 3.6 << " km/h";
+    t << std::fixed << std::setprecision(0) << pg.name << ": " << force << " N";
+    if (nw > 1) {
+      // Force on each contact wire the collectors are under (two in an overlap).
+      std::string sep = " (";
+      for (std::size_t kw = 0; kw < nw; ++kw) {
+        const int wi = m.contact_wires[kw];
+        if (!under_wire(m, s, id, wi)) continue;
+        double f = 0.0;
+        for (int ci : pg.collectors) f += s.contact_force[ci * nw + kw];
+        t << sep << m.wires[wi].name << " " << f;
+        sep = " / ";
+      }
+      if (sep != " (") t << ")";
+    }
+    t << (contact ? "" : " LOSS") << "\n" << std::setprecision(1) << s.speed * 3.6 << " km/h";
     label.text = t.str();
     out.markers.push_back(label);
   }

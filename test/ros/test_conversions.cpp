@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 
@@ -156,6 +157,119 @@ TEST_F(Fixture, MarkersCoverEveryPartAndExaggerateDisplacement) {
   std::set<std::pair<std::string, int>> ids;
   for (const auto& mk : arr.markers) EXPECT_TRUE(ids.insert({mk.ns, mk.id}).second) << mk.ns << " " << mk.id;
   EXPECT_NE(arr.markers.back().text.find("km/h"), std::string::npos);
+}
+
+namespace {
+
+// Steps `sim` until its first pantograph reaches station x (m).
+void step_to(Simulation& sim, double x) {
+  while (pantograph_position(sim.model(), sim.state(), 0) < x) ASSERT_EQ(sim.step(), StepStatus::kOk);
+}
+
+const visualization_msgs::Marker* find_marker(const visualization_msgs::MarkerArray& a, const std::string& ns, int id) {
+  for (const auto& mk : a.markers)
+    if (mk.ns == ns && mk.id == id) return &mk;
+  return nullptr;
+}
+
+// Height of a drawn line strip at station x (linear between its points).
+double strip_z(const visualization_msgs::Marker& strip, double x) {
+  const auto& pts = strip.points;
+  for (std::size_t i = 1; i < pts.size(); ++i)
+    if (pts[i].x >= x) {
+      const double t = (x - pts[i - 1].x) / (pts[i].x - pts[i - 1].x);
+      return pts[i - 1].z + t * (pts[i].z - pts[i - 1].z);
+    }
+  return std::nan("");
+}
+
+}  // namespace
+
+// The head is exaggerated about the design height of the wire under it, as the wire is: at
+// mid-span (presag 55 mm) with k = 10 it is drawn on the wire it touches. Exaggerating it about
+// its reference height (the wire's height where the pass started, at a support) drew it
+// (k - 1) x 55 mm ~ 0.5 m under the wire.
+TEST(Markers, HeadIsDrawnOnTheWireItTouchesAtMidSpan) {
+  Simulation sim(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m.yaml"));
+  const Model& m = sim.model();
+  const double x_mid = m.support_x[1] + 0.5 * (m.support_x[2] - m.support_x[1]);
+  step_to(sim, x_mid);
+  const State& s = sim.state();
+  const double k = 10.0;
+  MarkerOptions o;
+  o.vertical_scale = k;
+  o.shape_resolution = 0.0;
+  const auto arr = to_markers(m, s, ros::Time(1.0), o);
+  const Pantograph& pg = m.pantographs[0];
+  const double x = pantograph_position(m, s, 0);
+  const double force = total_contact_force(m, s, 0);
+  ASSERT_GT(force, 0.0);
+  const int cw = m.contact_wires[0];
+  const auto* wire = find_marker(arr, "wires", cw);
+  const auto* head = find_marker(arr, "pantograph_head", 0);
+  const auto* arrow = find_marker(arr, "contact_force", 0);
+  ASSERT_TRUE(wire && head && arrow);
+  const double z_wire = strip_z(*wire, x);
+  const double head_top = head->pose.position.z + 0.5 * head->scale.z;
+  // In contact the head is above the wire by k x the contact spring's compression (F / k0: a few mm).
+  const double expected_gap = k * force / m.contact_stiffness;
+  EXPECT_NEAR(head_top - z_wire, expected_gap, 0.02) << "head top " << head_top << ", wire " << z_wire;
+  EXPECT_LT(std::fabs(head_top - z_wire), 0.05);
+  EXPECT_NEAR(contact_design_height(m, s, 0), m.scene.contact_wire_height - 0.055, 0.005);
+  EXPECT_NEAR(drawn_head_height(m, s, 0, 1.0), head_height(m, s, 0), 1e-12);  // k = 1: the true height
+  // The old rule (reference height + k u) is far off here, so this test tells the two apart.
+  EXPECT_GT(std::fabs(pg.reference_height + k * s.u[pg.first_dof] - z_wire), 0.3);
+  // The arrow starts on the head and is 1 m per 100 N.
+  EXPECT_DOUBLE_EQ(arrow->points[0].z, head_top);
+  EXPECT_NEAR(arrow->points[1].z - arrow->points[0].z, force / 100.0, 2e-3);
+  // The label is white, 0.5 m, above the arrow's usual length.
+  const auto* label = find_marker(arr, "label", 0);
+  ASSERT_TRUE(label);
+  EXPECT_EQ(label->color.r, 1.0f);
+  EXPECT_EQ(label->color.g, 1.0f);
+  EXPECT_EQ(label->color.b, 1.0f);
+  EXPECT_EQ(label->color.a, 1.0f);
+  EXPECT_DOUBLE_EQ(label->scale.z, 0.5);
+  EXPECT_EQ(label->text.find('('), std::string::npos) << label->text;  // one contact wire: no breakdown
+}
+
+// In the overlap of calpe_example the collectors are under both contact wires: the head is drawn
+// on the lower one and the label gives the force on each.
+TEST(Markers, OverlapLabelGivesTheForcePerContactWire) {
+  Simulation sim(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/calpe_example.yaml"));
+  const Model& m = sim.model();
+  ASSERT_EQ(m.contact_wires.size(), 2u);
+  step_to(sim, 50.0);
+  const State& s = sim.state();
+  MarkerOptions o;
+  o.shape_resolution = 0.0;
+  const auto arr = to_markers(m, s, ros::Time(1.0), o);
+  const auto* label = find_marker(arr, "label", 0);
+  const auto* head = find_marker(arr, "pantograph_head", 0);
+  ASSERT_TRUE(label && head);
+  const ContactForce c = to_contact_force(m, s, ros::Time(1.0), "line").pantographs[0];
+  ASSERT_EQ(c.contact_wires.size(), 2u);
+  for (const std::string& name : c.contact_wires) EXPECT_NE(label->text.find(name + " "), std::string::npos) << label->text;
+  EXPECT_NE(label->text.find(" / "), std::string::npos) << label->text;
+  // Drawn on the lower of the two drawn contact wires, within a few cm.
+  const double x = pantograph_position(m, s, 0);
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int wi : m.contact_wires) lowest = std::min(lowest, strip_z(*find_marker(arr, "wires", wi), x));
+  const double head_top = head->pose.position.z + 0.5 * head->scale.z;
+  EXPECT_LT(std::fabs(head_top - lowest), 0.1) << "head top " << head_top << ", lower wire " << lowest << "; "
+                                                << label->text;
+}
+
+TEST(Markers, ViewFrameFollowsTheTrainFront) {
+  State s;
+  s.front = 123.25;
+  const auto t = to_view_transform(s, ros::Time(5.0), "line");
+  EXPECT_EQ(t.header.frame_id, "line");
+  EXPECT_EQ(t.child_frame_id, "train_view");
+  EXPECT_EQ(view_frame_id(), "train_view");
+  EXPECT_EQ(t.header.stamp, ros::Time(5.0));
+  EXPECT_DOUBLE_EQ(t.transform.translation.x, 123.25);
+  EXPECT_DOUBLE_EQ(t.transform.rotation.w, 1.0);
 }
 
 TEST(Pacing, StepsDueFollowWallClockTimesFactor) {

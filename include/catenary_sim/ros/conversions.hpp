@@ -34,9 +34,28 @@ WireShapeArray to_wire_shape(const Model& m, const State& s, double resolution, 
 // Design height (m) of a wire's vertical DOF; NaN if `dof` is not a wire's vertical DOF.
 double wire_dof_design_height(const Model& m, int dof);
 
-// Frame ids of the train (x = train front) and of a pantograph head.
+// Design height (m) of the contact wire under a pantograph now: under each collector the contact
+// wire with the lowest design height there (the one the head meets first; in an overlap, the lower
+// of the two), averaged over the collectors; the scene's contact_wire_height when no collector is
+// under a contact wire.
+double contact_design_height(const Model& m, const State& s, int pantograph);
+
+// Height (m) at which the markers draw a pantograph head with displacements exaggerated k times:
+// d + k (head - d), d = contact_design_height, the same rule as for the wires (design + k u), so
+// that a head in contact is drawn on the wire it touches (k x the contact spring's compression,
+// a few cm, above it). A moving force is drawn on the displaced wire under it.
+double drawn_head_height(const Model& m, const State& s, int pantograph, double k);
+
+// Frame ids of the train (x = train front), of a pantograph head, and of the view frame the rviz
+// camera follows (train_view: also at the train front, but sent with each marker message only).
 std::string train_frame_id();
 std::string head_frame_id(const Model& m, int pantograph);
+std::string view_frame_id();
+
+// line -> train_view at the train front, for the stamp of a marker message: the camera that follows
+// it moves exactly when the markers do, not at the tf rate between two marker messages.
+geometry_msgs::TransformStamped to_view_transform(const State& s, const ros::Time& stamp,
+                                                  const std::string& line_frame);
 
 // line -> train (at the train front, on the rail) and train -> one frame per pantograph head (at
 // the head's true absolute height, not exaggerated; a moving force sits at the contact-wire
@@ -52,8 +71,10 @@ struct MarkerOptions {
 };
 
 // Wire line strips, droppers (slack in red), masts and steady arms, pantograph head and frame,
-// contact-force arrows (1 mm per N... scaled 1 m per 200 N) and a text label with speed and force.
-// Vertical displacements are exaggerated by vertical_scale about the design geometry.
+// contact-force arrows (1 m per 100 N) and a white text label (0.5 m) with the force, per contact
+// wire under the pantograph when the line has several, and the speed. Vertical displacements are
+// exaggerated by vertical_scale about the design geometry, the heads about the design height of
+// the contact wire under them (drawn_head_height).
 visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const ros::Time& stamp,
                                            const MarkerOptions& o);
 
