@@ -231,31 +231,47 @@ void SimulationNode::publish(bool force) {
   const ros::Time stamp = sim_stamp(s.time, stamp_offset_);
   const bool advanced = s.time > last_published_time_;
   const bool shape_due = (now - last_shape_wall_).toSec() >= 1.0 / params_.shape_rate;
+  // Markers: at marker_rate while the state changes, at shape_rate while it holds.
+  const bool markers_new = s.time != last_marker_time_;
+  const bool markers_due = force || (markers_new ? now >= next_marker_wall_ : shape_due);
+
   // While the simulation holds (paused, stopped), the state topics are repeated at shape_rate with
   // their unchanged stamp; tf and /clock are only sent for a new time.
-  if (!advanced && !force && !shape_due) return;
-
-  if (advanced || force) {
-    if (params_.publish_clock && advanced) {
-      rosgraph_msgs::Clock c;
-      c.clock = stamp;
-      clock_pub_.publish(c);
+  if (advanced || force || shape_due) {
+    if (advanced || force) {
+      if (params_.publish_clock && advanced) {
+        rosgraph_msgs::Clock c;
+        c.clock = stamp;
+        clock_pub_.publish(c);
+      }
+      if (advanced) tf_.sendTransform(to_transforms(m, s, stamp, params_.line_frame));
     }
-    if (advanced) tf_.sendTransform(to_transforms(m, s, stamp, params_.line_frame));
+    contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
+    pantograph_pub_.publish(to_pantograph_state(m, s, stamp, params_.line_frame));
+    last_published_time_ = s.time;
+    if (shape_due || force) {
+      last_shape_wall_ = now;
+      shape_pub_.publish(to_wire_shape(m, s, params_.shape_resolution, stamp, params_.line_frame));
+    }
   }
-  contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
-  pantograph_pub_.publish(to_pantograph_state(m, s, stamp, params_.line_frame));
-  last_published_time_ = s.time;
 
-  if (shape_due || force) {
-    last_shape_wall_ = now;
-    shape_pub_.publish(to_wire_shape(m, s, params_.shape_resolution, stamp, params_.line_frame));
+  if (markers_due) {
+    // Fixed schedule (no drift from the tick quantisation); after a stall, restart from now.
+    const ros::WallDuration period(1.0 / params_.marker_rate);
+    next_marker_wall_ = (now - next_marker_wall_ > period) ? now + period : next_marker_wall_ + period;
     if (marker_pub_.getNumSubscribers() > 0) {
       MarkerOptions o;
       o.frame = params_.line_frame;
       o.vertical_scale = params_.vertical_scale;
       o.shape_resolution = params_.shape_resolution;
       marker_pub_.publish(to_markers(m, s, stamp, o));
+      // The camera's frame moves with the markers, same stamp. A repeated stamp (holding) is not
+      // sent again: tf2 would warn TF_REPEATED_DATA, and the last transform stays in effect.
+      if (stamp != last_view_stamp_) {
+        tf_.sendTransform(to_view_transform(s, stamp, params_.line_frame));
+        last_view_stamp_ = stamp;
+      }
+      last_marker_time_ = s.time;
     }
   }
 }

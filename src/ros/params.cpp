@@ -49,6 +49,7 @@ void validate(const NodeParams& p) {
   check_range("real_time_factor", p.real_time_factor, 0.0, 1000.0, false, "(0: as fast as possible)");
   check_range("publish_rate", p.publish_rate, 0.0, 10000.0, true, "Hz");
   check_range("shape_rate", p.shape_rate, 0.0, 1000.0, true, "Hz");
+  check_range("marker_rate", p.marker_rate, 0.0, 1000.0, true, "Hz");
   check_range("shape_resolution", p.shape_resolution, 0.0, 100.0, false, "m (0: every node)");
   check_range("vertical_scale", p.vertical_scale, 0.0, 10000.0, true, "");
   check_range("max_acceleration", p.max_acceleration, 0.0, 20.0, false, "m/s^2 (0: no limit)");
@@ -81,6 +82,7 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   number("real_time_factor", p.real_time_factor);
   number("publish_rate", p.publish_rate);
   number("shape_rate", p.shape_rate);
+  number("marker_rate", p.marker_rate);
   number("shape_resolution", p.shape_resolution);
   number("vertical_scale", p.vertical_scale);
   number("max_acceleration", p.max_acceleration);

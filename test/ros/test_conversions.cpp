@@ -312,6 +312,12 @@ TEST(Params, ErrorsNameParameterValueAndRange) {
   q.speed_kmh = 600.0;
   EXPECT_NE(message(q).find("speed_kmh = 600"), std::string::npos);
   q = p;
+  q.marker_rate = 0.0;
+  e = message(q);
+  EXPECT_NE(e.find("marker_rate = 0"), std::string::npos) << e;
+  EXPECT_NE(e.find("(0, 1000] Hz"), std::string::npos) << e;
+  EXPECT_EQ(NodeParams().marker_rate, 30.0);
+  q = p;
   q.max_acceleration = 25.0;
   EXPECT_NE(message(q).find("max_acceleration"), std::string::npos);
   q = p;

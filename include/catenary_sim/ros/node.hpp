@@ -76,6 +76,9 @@ class SimulationNode {
   // Publishing bookkeeping.
   double last_published_time_ = -1.0;
   ros::WallTime last_shape_wall_, last_hold_wall_;
+  ros::WallTime next_marker_wall_;   // markers are due at or after this wall time (marker_rate)
+  double last_marker_time_ = -1.0;   // sim time of the last marker message
+  ros::Time last_view_stamp_;        // stamp of the last train_view transform
 
   // Diagnostics.
   std::int64_t loss_steps_ = 0, counted_steps_ = 0;

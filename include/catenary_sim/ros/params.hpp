@@ -28,7 +28,9 @@ struct NodeParams {
   std::optional<double> speed_kmh;  // ~speed_kmh: overrides the scene's train speed, [0, 540] km/h
   double real_time_factor = 1.0;    // ~real_time_factor: [0, 1000]; 0 = as fast as possible
   double publish_rate = 200.0;      // ~publish_rate: Hz (wall clock), (0, 10000]
-  double shape_rate = 10.0;         // ~shape_rate: Hz (wall clock) for wire_shape and markers, (0, 1000]
+  double shape_rate = 10.0;         // ~shape_rate: Hz (wall clock) for wire_shape, (0, 1000]
+  double marker_rate = 30.0;        // ~marker_rate: Hz (wall clock) for markers + the train_view tf, (0, 1000]
+                                    //   (at most one per pacing tick: publish_rate bounds it)
   double shape_resolution = 1.0;    // ~shape_resolution: m between wire-shape samples, [0, 100] (0: every node)
   double vertical_scale = 10.0;     // ~vertical_scale: exaggeration of displacements in the markers, (0, 10000]
   std::string line_frame = "line";  // ~line_frame: fixed frame, x along the track, z up
