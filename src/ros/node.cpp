@@ -277,8 +277,16 @@ void SimulationNode::publish(bool force) {
 }
 
 void SimulationNode::on_speed(const std_msgs::Float64::ConstPtr& msg) {
+  // The range is checked here too, for a message with %g numbers (the core's has std::to_string's
+  // "200.000000"); the core's check stays the authority.
+  const double v = msg->data;
+  if (!std::isfinite(v) || v < 0.0 || v > Simulation::kMaxSpeed) {
+    ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/train_speed = %g m/s rejected: allowed 0 to %g m/s (%g km/h); "
+                       "command ignored", v, Simulation::kMaxSpeed, Simulation::kMaxSpeed * 3.6);
+    return;
+  }
   std::string err;
-  if (!sim_->set_target_speed(msg->data, &err)) {
+  if (!sim_->set_target_speed(v, &err)) {
     ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/train_speed: %s; command ignored", err.c_str());
     return;
   }
@@ -291,8 +299,12 @@ void SimulationNode::on_uplift(const std_msgs::Float64MultiArray::ConstPtr& msg)
   const std::size_t np = sim_->model().pantographs.size();
   const std::size_t n = msg->data.size();
   if (n != 1 && n != np) {
-    ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force: %zu values rejected: send 1 (all pantographs) or %zu "
-                       "(one per pantograph); command ignored", n, np);
+    if (np == 1)
+      ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force: %zu values rejected: the scene has one pantograph, "
+                         "send 1 value; command ignored", n);
+    else
+      ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force: %zu values rejected: send 1 (all pantographs) or %zu "
+                         "(one per pantograph); command ignored", n, np);
     return;
   }
   // Check every value first so that a rejected command leaves the state unchanged.
