@@ -120,8 +120,17 @@ bool under_wire(const Model& m, const State& s, int p, int wi) {
 }
 
 constexpr double kArrowMetresPerNewton = 0.01;  // contact-force arrow: 1 m per 100 N
-constexpr double kLabelHeight = 3.0;             // m above the drawn head
 constexpr double kLabelTextSize = 0.5;           // m, height of a capital letter
+constexpr double kLabelLineHeight = 0.6;         // m per line of text at that size (rviz's spacing)
+constexpr double kLabelClearance = 2.0;          // m between the drawn head and the label's last line
+                                                 // (clear of the arrow up to 200 N)
+
+// Contact wire name as the label shows it: "contact_wire..." shortened to "cw..." so that the
+// forces of two wires fit on one line ("cw_s0 47 / cw_s1 62 N").
+std::string label_wire_name(const std::string& name) {
+  static const std::string prefix = "contact_wire";
+  return name.compare(0, prefix.size(), prefix) == 0 ? "cw" + name.substr(prefix.size()) : name;
+}
 
 }  // namespace
 
@@ -366,25 +375,30 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     out.markers.push_back(arrow);
 
     Marker label = marker(h, "label", id, Marker::TEXT_VIEW_FACING);
-    label.pose.position = point(x, 0.0, z_head + kLabelHeight);
     label.scale.z = kLabelTextSize;
     label.color = color(1.0f, 1.0f, 1.0f);
     std::ostringstream t;
-    t << std::fixed << std::setprecision(0) << pg.name << ": " << force << " N";
+    t << std::fixed << std::setprecision(0) << pg.name << ": " << force << " N" << (contact ? "" : " LOSS") << "\n";
+    int lines = 2;
     if (nw > 1) {
-      // Force on each contact wire the collectors are under (two in an overlap).
-      std::string sep = " (";
+      // Force on each contact wire the collectors are under (two in an overlap), on a line of its own.
+      const char* sep = "";
       for (std::size_t kw = 0; kw < nw; ++kw) {
         const int wi = m.contact_wires[kw];
         if (!under_wire(m, s, id, wi)) continue;
         double f = 0.0;
         for (int ci : pg.collectors) f += s.contact_force[ci * nw + kw];
-        t << sep << m.wires[wi].name << " " << f;
+        t << sep << label_wire_name(m.wires[wi].name) << " " << f;
         sep = " / ";
       }
-      if (sep != " (") t << ")";
+      if (*sep) {
+        t << " N\n";
+        ++lines;
+      }
     }
-    t << (contact ? "" : " LOSS") << "\n" << std::setprecision(1) << s.speed * 3.6 << " km/h";
+    t << std::setprecision(1) << s.speed * 3.6 << " km/h";
+    // Text is centred on its position: keep its lowest line kLabelClearance above the head.
+    label.pose.position = point(x, 0.0, z_head + kLabelClearance + 0.5 * lines * kLabelLineHeight);
     label.text = t.str();
     out.markers.push_back(label);
   }

@@ -2,7 +2,9 @@
 // and parameter validation: pure functions, no master needed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <set>
 #include <string>
@@ -230,7 +232,10 @@ TEST(Markers, HeadIsDrawnOnTheWireItTouchesAtMidSpan) {
   EXPECT_EQ(label->color.b, 1.0f);
   EXPECT_EQ(label->color.a, 1.0f);
   EXPECT_DOUBLE_EQ(label->scale.z, 0.5);
-  EXPECT_EQ(label->text.find('('), std::string::npos) << label->text;  // one contact wire: no breakdown
+  // One contact wire: "leading: 101 N" and the speed, no line per contact wire.
+  EXPECT_EQ(std::count(label->text.begin(), label->text.end(), '\n'), 1) << label->text;
+  EXPECT_EQ(label->text.rfind(pg.name + ": ", 0), 0u) << label->text;
+  EXPECT_GT(label->pose.position.z, arrow->points[1].z) << "label over the arrow";
 }
 
 // In the overlap of calpe_example the collectors are under both contact wires: the head is drawn
@@ -249,8 +254,18 @@ TEST(Markers, OverlapLabelGivesTheForcePerContactWire) {
   ASSERT_TRUE(label && head);
   const ContactForce c = to_contact_force(m, s, ros::Time(1.0), "line").pantographs[0];
   ASSERT_EQ(c.contact_wires.size(), 2u);
-  for (const std::string& name : c.contact_wires) EXPECT_NE(label->text.find(name + " "), std::string::npos) << label->text;
-  EXPECT_NE(label->text.find(" / "), std::string::npos) << label->text;
+  // A line with the force on each wire, "contact_wire" shortened to "cw": "cw_s0 47 / cw_s1 62 N".
+  ASSERT_EQ(c.contact_wires[0], "contact_wire_s0");
+  ASSERT_EQ(c.contact_wires[1], "contact_wire_s1");
+  const std::size_t nl = label->text.find('\n');
+  ASSERT_NE(nl, std::string::npos) << label->text;
+  const std::string line = label->text.substr(nl + 1, label->text.find('\n', nl + 1) - nl - 1);
+  char expected[128];
+  std::snprintf(expected, sizeof expected, "cw_s0 %.0f / cw_s1 %.0f N", c.wire_forces[0], c.wire_forces[1]);
+  EXPECT_EQ(line, expected) << label->text;
+  EXPECT_GT(c.wire_forces[0], 0.0);  // touching both wires at 50 m
+  EXPECT_GT(c.wire_forces[1], 0.0);
+  EXPECT_EQ(std::count(label->text.begin(), label->text.end(), '\n'), 2) << label->text;
   // Drawn on the lower of the two drawn contact wires, within a few cm.
   const double x = pantograph_position(m, s, 0);
   double lowest = std::numeric_limits<double>::infinity();
