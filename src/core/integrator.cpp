@@ -6,6 +6,7 @@
 // spring k0 carries the contact force (eq. 22) while that force is compressive (eq. 25).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "catenary_sim/core/state.hpp"
 
@@ -28,20 +29,34 @@ void contact_forces(const Model& m, State& s, double* f) {
     const double x_ref = s.front - p.position;
     for (int ci : p.collectors) {
       const double xc = x_ref + m.collectors[ci].offset;
+      // Collector heights on every contact wire under it (eq. 12).
+      double lowest = std::numeric_limits<double>::infinity();
       for (std::size_t wk = 0; wk < nw; ++wk) {
         const Wire& w = m.wires[m.contact_wires[wk]];
-        const std::size_t idx = ci * nw + wk;
         const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
         double yw = 0.0;
         for (int a = 0; a < cnt; ++a) yw += s.weight[a] * (w.height[s.weight_node[a]] + u[w.w_dof + s.weight_node[a]]);
-        s.collector_height[idx] = cnt ? yw : std::nan("");
+        s.collector_height[ci * nw + wk] = cnt ? yw : std::nan("");
+        if (cnt) lowest = std::min(lowest, yw);
+      }
+      // A force-driven collector (moving force, external rig) pushes the lowest wire(s) under it,
+      // shared equally among wires within 1 mm of the lowest (a twin contact wire).
+      int sharing = 0;
+      if (p.moving_force)
+        for (std::size_t wk = 0; wk < nw; ++wk) sharing += s.collector_height[ci * nw + wk] <= lowest + 1e-3;
+      const double given = (p.external ? s.external_force[pi] : uplift) / p.collectors.size();
+      for (std::size_t wk = 0; wk < nw; ++wk) {
+        const std::size_t idx = ci * nw + wk;
+        const double yw = s.collector_height[idx];
         double fc = 0.0;
-        if (cnt) {
-          if (p.moving_force) fc = wk == 0 ? uplift / p.collectors.size() : 0.0;
+        if (!std::isnan(yw)) {
+          if (p.moving_force) fc = yw <= lowest + 1e-3 ? given / sharing : 0.0;
           else fc = std::max(0.0, m.contact_stiffness * (head - yw));  // eq. 22 with eq. 25
         }
         s.contact_force[idx] = fc;
         if (fc == 0.0 || !f) continue;
+        const Wire& w = m.wires[m.contact_wires[wk]];
+        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
         if (!p.moving_force) f[p.first_dof] -= fc;
         for (int a = 0; a < cnt; ++a) f[w.w_dof + s.weight_node[a]] += fc * s.weight[a];
       }
@@ -56,6 +71,7 @@ State make_state(const Model& m) {
   s.u = Eigen::VectorXd::Zero(m.n_dof);
   s.v = Eigen::VectorXd::Zero(m.n_dof);
   s.force = Eigen::VectorXd::Zero(m.n_dof);
+  s.accel = Eigen::VectorXd::Zero(m.n_dof);
   s.z = Eigen::VectorXd::Zero(m.n_dof);
   int max_nodes = 1;
   for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
@@ -67,12 +83,51 @@ State make_state(const Model& m) {
   s.dropper_slack.assign(m.droppers.size(), 0);
   s.uplift.resize(m.pantographs.size());
   for (std::size_t i = 0; i < m.pantographs.size(); ++i) s.uplift[i] = m.pantographs[i].static_uplift;
+  s.external_force = s.uplift;
   s.front = m.train_start;
   s.speed = s.target_speed = m.scene.train_speed;
   return s;
 }
 
 void observe(const Model& m, State& s) { contact_forces(m, s, nullptr); }
+
+void contact_point_motion(const Model& m, const State& s, int pantograph, std::vector<ContactPointMotion>& out) {
+  out.clear();
+  const Pantograph& p = m.pantographs[pantograph];
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  for (int ci : p.collectors) {
+    const double xc = s.front - p.position + m.collectors[ci].offset;
+    for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+      const Wire& w = m.wires[m.contact_wires[wk]];
+      ContactPointMotion c;
+      c.collector = ci;
+      c.wire = static_cast<int>(wk);
+      c.force = s.contact_force[ci * m.contact_wires.size() + wk];
+      const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+      c.on_wire = cnt > 0;
+      if (c.on_wire) {
+        c.height = c.velocity = c.acceleration = 0.0;
+        for (int a = 0; a < cnt; ++a) {
+          const int d = w.w_dof + node[a];
+          c.height += weight[a] * (w.height[node[a]] + s.u[d]);
+          c.velocity += weight[a] * (s.v[d] + 0.5 * m.dt * s.accel[d]);  // v_{n+1/2} + dt/2 a_n ~ v(t_{n+1})
+          c.acceleration += weight[a] * s.accel[d];
+        }
+        // Slope of the wire (eq. 12 height) at the collector: the height the moving pantograph
+        // meets changes by speed x slope on top of the wire's own motion.
+        const double dx = 1e-3;
+        double yp = 0.0, ym = 0.0;
+        const int np = contact_weights(w, m.rub_length, xc + dx, node.data(), weight.data());
+        for (int a = 0; a < np; ++a) yp += weight[a] * (w.height[node[a]] + s.u[w.w_dof + node[a]]);
+        const int nm = contact_weights(w, m.rub_length, xc - dx, node.data(), weight.data());
+        for (int a = 0; a < nm; ++a) ym += weight[a] * (w.height[node[a]] + s.u[w.w_dof + node[a]]);
+        c.path_velocity = (np && nm) ? c.velocity + s.speed * (yp - ym) / (2 * dx) : c.velocity;
+      }
+      out.push_back(c);
+    }
+  }
+}
 
 double pantograph_position(const Model& m, const State& s, int p) { return s.front - m.pantographs[p].position; }
 
@@ -154,8 +209,10 @@ StepStatus step(const Model& m, State& s) {
   double* v_new = f;  // the force is no longer needed
   double* u_new = z;
   int bad = -1;
+  double* acc = s.accel.data();
   for (int i = 0; i < n; ++i) {
-    const double vn = v[i] + dt * im[i] * f[i];
+    acc[i] = im[i] * f[i];  // q'' at t_n (eq. 20)
+    const double vn = v[i] + dt * acc[i];
     const double un = u[i] + dt * vn;
     if (!(std::fabs(un) <= limit)) bad = i;
     v_new[i] = vn;

@@ -308,7 +308,8 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
     Pantograph p;
     p.name = ps.name;
     p.position = ps.position;
-    p.moving_force = ps.moving_force;
+    p.moving_force = ps.moving_force || ps.external;
+    p.external = ps.external;
     p.masses = ps.masses;
     p.stiffness = ps.stiffness;
     p.damping = ps.damping;

@@ -140,8 +140,11 @@ PantographSpec read_pantograph(const YAML::Node& node, const std::string& path, 
     p.moving_force = false;
   } else if (type == "moving_force") {
     p.moving_force = true;
+  } else if (type == "external") {
+    p.moving_force = true;
+    p.external = true;
   } else {
-    fail(r.field("type"), "'" + type + "'", "one of: lumped, moving_force");
+    fail(r.field("type"), "'" + type + "'", "one of: lumped, moving_force, external (hardware in the loop)");
   }
   p.static_uplift = r.number("static_uplift", 0.0, 2000.0);
   p.aero_coefficient = r.number("aero_coefficient", -1.0, 1.0, 0.0);
@@ -162,7 +165,7 @@ PantographSpec read_pantograph(const YAML::Node& node, const std::string& path, 
              "must be > 0 between two masses (only the last, to the roof, may be 0)");
   } else {
     for (const char* k : {"masses", "stiffness", "damping"})
-      if (r.has(k)) fail(r.field(k), "(given)", "not allowed for type moving_force (it has no masses)");
+      if (r.has(k)) fail(r.field(k), "(given)", "not allowed for type " + type + " (it has no masses)");
   }
   if (r.has("collectors")) {
     const YAML::Node cs = r.child("collectors");

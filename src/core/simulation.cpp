@@ -1,5 +1,6 @@
 #include "catenary_sim/core/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -48,12 +49,13 @@ void Simulation::reset(bool keep_time) {
   const double t = state_.time;
   const std::int64_t n = state_.steps;
   const double target = state_.target_speed, accel = state_.max_acceleration;
-  const std::vector<double> uplift = state_.uplift;
+  const std::vector<double> uplift = state_.uplift, external = state_.external_force;
   state_ = initial_;
   state_.uplift = uplift;
+  state_.external_force = external;  // the rig's latest measurement stays in effect
   state_.target_speed = state_.speed = target;
   state_.max_acceleration = accel;
-  if (uplift != initial_.uplift) {
+  if (uplift != initial_.uplift || external != initial_.external_force) {
     solve_initial_state(model_, state_);
     observe(model_, state_);
   }
@@ -96,6 +98,23 @@ bool Simulation::set_uplift(int p, double f, std::string* error) {
   } else {
     state_.uplift[p] = f;
   }
+  return true;
+}
+
+bool Simulation::set_external_force(int p, double f, std::string* error) {
+  const int np = static_cast<int>(model_.pantographs.size());
+  if (p < 0 || p >= np || !model_.pantographs[p].external) {
+    if (error) *error = "pantograph index " + std::to_string(p) + " rejected: not an external (hardware-in-the-loop) pantograph";
+    return false;
+  }
+  if (!std::isfinite(f) || f < kMinExternalForce || f > kMaxExternalForce) {
+    std::ostringstream s;
+    s << "external contact force " << f << " N rejected: allowed " << kMinExternalForce << " to " << kMaxExternalForce
+      << " N (negative readings are taken as 0)";
+    if (error) *error = s.str();
+    return false;
+  }
+  state_.external_force[p] = std::max(0.0, f);
   return true;
 }
 

@@ -131,14 +131,33 @@ void solve_initial_state(const Model& m, State& st, bool roof_springs) {
       for (std::size_t cj = 0; cj < p.collectors.size(); ++cj) {
         const int ci = p.collectors[cj];
         const double xc = st.front - p.position + m.collectors[ci].offset;
+        if (p.moving_force) {
+          // As in step(): the given force acts on the lowest wire(s) under the collector.
+          std::vector<double> yd(m.contact_wires.size(), std::numeric_limits<double>::infinity());
+          double lowest = std::numeric_limits<double>::infinity();
+          for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+            const Wire& w = m.wires[m.contact_wires[wk]];
+            const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+            if (cnt == 0) continue;
+            yd[wk] = 0.0;
+            for (int a = 0; a < cnt; ++a) yd[wk] += weight[a] * w.height[node[a]];
+            lowest = std::min(lowest, yd[wk]);
+          }
+          int sharing = 0;
+          for (double y : yd) sharing += y <= lowest + 1e-3;
+          const double given = (p.external ? st.external_force[pi] : uplift) / p.collectors.size();
+          for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+            if (!(yd[wk] <= lowest + 1e-3)) continue;
+            const Wire& w = m.wires[m.contact_wires[wk]];
+            const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+            for (int a = 0; a < cnt; ++a) r[w.w_dof + node[a]] += given / sharing * weight[a];
+          }
+          continue;
+        }
         for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
           const Wire& w = m.wires[m.contact_wires[wk]];
           const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
           if (cnt == 0) continue;
-          if (p.moving_force) {
-            for (int a = 0; a < cnt; ++a) r[w.w_dof + node[a]] += uplift / p.collectors.size() * weight[a];
-            break;  // a moving force acts on the first contact wire under it
-          }
           if (!contact_on[ci * m.contact_wires.size() + wk]) continue;
           double yd = 0.0;
           for (int a = 0; a < cnt; ++a) yd += weight[a] * w.height[node[a]];

@@ -77,7 +77,8 @@ struct Collector {
 struct Pantograph {
   std::string name;
   double position = 0.0;  // m behind the train front
-  bool moving_force = false;
+  bool moving_force = false;  // no masses: the force is given (uplift, or the rig's for external)
+  bool external = false;      // hardware-in-the-loop: the force comes from a real pantograph
   int first_dof = -1;     // head DOF; masses follow down the chain
   std::vector<double> masses, stiffness, damping;
   double static_uplift = 0.0, aero_coefficient = 0.0;

@@ -57,6 +57,8 @@ struct PantographSpec {
   std::string name;
   double position = 0.0;  // m behind the train's front
   bool moving_force = false;  // true: a plain moving force, no masses
+  bool external = false;      // true: hardware in the loop, the force is measured on a real pantograph
+                              // (a moving force set by Simulation::set_external_force)
   // Lumped-mass chain, head first (paper Fig. 3 / eq. 9): masses[i] is joined to masses[i+1]
   // (the last to the roof) by stiffness[i] and damping[i].
   std::vector<double> masses;     // kg

@@ -34,6 +34,14 @@ class Simulation {
   // pantograph < 0: all pantographs.
   bool set_uplift(int pantograph, double force_n, std::string* error);
 
+  // Force measured on the real pantograph of an external (hardware-in-the-loop) pantograph.
+  // Readings down to kMinExternalForce are taken as 0 (load-cell noise without contact: a
+  // collector cannot pull); NaN, inf and values outside [kMinExternalForce, kMaxExternalForce] are
+  // rejected and leave the state unchanged.
+  bool set_external_force(int pantograph, double force_n, std::string* error);
+
+  static constexpr double kMinExternalForce = -50.0;  // N
+  static constexpr double kMaxExternalForce = 2000.0; // N
   static constexpr double kMaxSpeed = 150.0;   // m/s (540 km/h)
   static constexpr double kMaxUplift = 1000.0;  // N
 

@@ -26,9 +26,11 @@ struct State {
   double target_speed = 0.0;      // m/s, commanded speed the train accelerates toward
   double max_acceleration = 0.0;  // m/s^2, |dv/dt| limit toward target_speed (0: jump)
   std::vector<double> uplift;     // N, static uplift in effect per pantograph (eq. 9 thrust F)
+  std::vector<double> external_force;  // N, force of an external (hardware-in-the-loop) pantograph
 
   // q of eq. 21 as displacements from the design state, and q_dot_{n-1/2} (eq. 20, 26).
   Eigen::VectorXd u, v;
+  Eigen::VectorXd accel;  // q'' of the last step (at its start, t_n), for observers
 
   // Observations of this state (time, front, u): filled by step() and observe().
   std::vector<double> contact_force;     // N, >= 0, per collector x contact wire (eq. 22, 25)
@@ -55,6 +57,21 @@ StepStatus step(const Model& model, State& state);
 // Fills the observations (contact forces, collector heights) for the current state without
 // advancing it, e.g. for the initial state.
 void observe(const Model& model, State& state);
+
+// Motion of the contact wire under one pantograph's collectors, per collector and contact wire:
+// what a hardware-in-the-loop rig must impose on a real pantograph (eq. 12 weights).
+struct ContactPointMotion {
+  int collector = 0, wire = 0;   // indices into Model::collectors and Model::contact_wires
+  bool on_wire = false;          // false: the collector is not under this wire
+  double height = 0.0;           // m, absolute
+  double velocity = 0.0;         // m/s, of the wire point under the collector, at the state's time
+                                 // (half-step velocity + dt/2 acceleration)
+  double acceleration = 0.0;     // m/s^2, of the wire point under the collector (last step)
+  double path_velocity = 0.0;    // m/s, rate of change of `height` seen by the moving pantograph:
+                                 // velocity + train speed x wire slope
+  double force = 0.0;            // N, contact force on this wire
+};
+void contact_point_motion(const Model& model, const State& state, int pantograph, std::vector<ContactPointMotion>& out);
 
 // Absolute height of a contact collector's pantograph head (m); NaN for a moving force.
 double head_height(const Model& model, const State& state, int pantograph);
