@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "catenary_sim/core/implicit.hpp"
 #include "catenary_sim/core/state.hpp"
 
 namespace catenary_sim {
@@ -18,8 +19,7 @@ namespace {
 // the collector height is the weighted wire height (eq. 12), the force is k0 times the head's
 // penetration while compressive (eq. 22, 25), spread on the wire with the same weights.
 // Writes state.contact_force and state.collector_height; adds the forces to f unless f is null.
-void contact_forces(const Model& m, State& s, double* f) {
-  const double* u = s.u.data();
+void contact_forces(const Model& m, State& s, const double* u, double* f) {
   const double v2 = s.speed * s.speed;
   const std::size_t nw = m.contact_wires.size();
   for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
@@ -72,6 +72,17 @@ State make_state(const Model& m) {
   s.v = Eigen::VectorXd::Zero(m.n_dof);
   s.force = Eigen::VectorXd::Zero(m.n_dof);
   s.accel = Eigen::VectorXd::Zero(m.n_dof);
+  if (m.implicit) {
+    s.u_pred = Eigen::VectorXd::Zero(m.n_dof);
+    s.v_pred = Eigen::VectorXd::Zero(m.n_dof);
+    s.solve_tmp = Eigen::VectorXd::Zero(m.n_dof);
+    const std::size_t contacts = m.collectors.size() * m.contact_wires.size();
+    s.contact_solve.assign(contacts * m.n_dof, 0.0);
+    s.contact_g_index.assign(contacts * (m.max_contact_nodes + 1), 0);
+    s.contact_g_value.assign(contacts * (m.max_contact_nodes + 1), 0.0);
+    s.contact_g_count.assign(contacts, 0);
+    s.contact_small.assign(contacts * contacts + contacts, 0.0);
+  }
   s.z = Eigen::VectorXd::Zero(m.n_dof);
   int max_nodes = 1;
   for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
@@ -89,7 +100,7 @@ State make_state(const Model& m) {
   return s;
 }
 
-void observe(const Model& m, State& s) { contact_forces(m, s, nullptr); }
+void observe(const Model& m, State& s) { contact_forces(m, s, s.u.data(), nullptr); }
 
 void contact_point_motion(const Model& m, const State& s, int pantograph, std::vector<ContactPointMotion>& out) {
   out.clear();
@@ -111,7 +122,8 @@ void contact_point_motion(const Model& m, const State& s, int pantograph, std::v
         for (int a = 0; a < cnt; ++a) {
           const int d = w.w_dof + node[a];
           c.height += weight[a] * (w.height[node[a]] + s.u[d]);
-          c.velocity += weight[a] * (s.v[d] + 0.5 * m.dt * s.accel[d]);  // v_{n+1/2} + dt/2 a_n ~ v(t_{n+1})
+          // explicit: v_{n+1/2} + dt/2 a_n ~ v(t_{n+1}); Newmark: v is already at t_{n+1}
+          c.velocity += weight[a] * (m.implicit ? s.v[d] : s.v[d] + 0.5 * m.dt * s.accel[d]);
           c.acceleration += weight[a] * s.accel[d];
         }
         // Slope of the wire (eq. 12 height) at the collector: the height the moving pantograph
@@ -145,22 +157,22 @@ double total_contact_force(const Model& m, const State& s, int p) {
   return f;
 }
 
-StepStatus step(const Model& m, State& s) {
-  if (s.status != StepStatus::kOk) return s.status;
-  if (s.front >= m.train_end) {
-    s.status = StepStatus::kFinished;
-    return s.status;
-  }
+namespace {
+
+// Train kinematics: toward the commanded speed within the acceleration limit.
+double next_speed(const State& s, double dt) {
+  const double dv = s.target_speed - s.speed, dvmax = s.max_acceleration * dt;
+  return (s.max_acceleration <= 0.0 || std::fabs(dv) <= dvmax) ? s.target_speed : s.speed + std::copysign(dvmax, dv);
+}
+
+// Total force on every DOF at displacements u and velocities v (eq. 1 right-hand side minus the
+// internal and damping forces): constant load, beams, supports, tension-only droppers, Rayleigh
+// damping (eq. 5) through z = u + beta v, pantograph chains with their uplift, and the contact.
+void assemble_force(const Model& m, State& s, const double* u, const double* v, double* z, double* f) {
   const int n = m.n_dof, nc = m.n_catenary_dof;
-  const double dt = m.dt, beta = m.beta, alpha = m.alpha;
-  double* u = s.u.data();
-  double* v = s.v.data();
-  double* f = s.force.data();
-  double* z = s.z.data();
+  const double beta = m.beta, alpha = m.alpha;
   const double* load = m.load.data();
   const double* mass = m.mass.data();
-
-  // Stiffness-proportional damping acts through K on z = q_n + beta q_dot_{n-1/2} (eq. 5, 19).
   for (int i = 0; i < nc; ++i) {
     z[i] = u[i] + beta * v[i];
     f[i] = load[i] - alpha * mass[i] * v[i];
@@ -199,24 +211,146 @@ StepStatus step(const Model& m, State& s) {
       f[a0 + nm - 1] += uplift;
     }
   }
-  contact_forces(m, s, f);
+  contact_forces(m, s, u, f);
+}
 
-  // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. The new values go to the
-  // workspace first: a displacement beyond the divergence limit (or NaN) stops the run and the
-  // state keeps the last good step, so nothing diverged is ever passed on.
-  const double* im = m.inv_mass.data();
-  const double limit = m.scene.numerics.divergence_limit;
-  double* v_new = f;  // the force is no longer needed
-  double* u_new = z;
-  int bad = -1;
+}  // namespace
+
+StepStatus step(const Model& m, State& s) {
+  if (s.status != StepStatus::kOk) return s.status;
+  if (s.front >= m.train_end) {
+    s.status = StepStatus::kFinished;
+    return s.status;
+  }
+  const int n = m.n_dof;
+  const double dt = m.dt;
+  double* u = s.u.data();
+  double* v = s.v.data();
+  double* f = s.force.data();
+  double* z = s.z.data();
   double* acc = s.accel.data();
-  for (int i = 0; i < n; ++i) {
-    acc[i] = im[i] * f[i];  // q'' at t_n (eq. 20)
-    const double vn = v[i] + dt * acc[i];
-    const double un = u[i] + dt * vn;
-    if (!(std::fabs(un) <= limit)) bad = i;
-    v_new[i] = vn;
-    u_new[i] = un;
+  const double limit = m.scene.numerics.divergence_limit;
+  int bad = -1;
+  if (!m.implicit) {
+    assemble_force(m, s, u, v, z, f);
+    // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. The new values go to the
+    // workspace first: a displacement beyond the divergence limit (or NaN) stops the run and the
+    // state keeps the last good step, so nothing diverged is ever passed on.
+    const double* im = m.inv_mass.data();
+    double* v_new = f;  // the force is no longer needed
+    double* u_new = z;
+    for (int i = 0; i < n; ++i) {
+      acc[i] = im[i] * f[i];  // q'' at t_n (eq. 20)
+      const double vn = v[i] + dt * acc[i];
+      const double un = u[i] + dt * vn;
+      if (!(std::fabs(un) <= limit)) bad = i;
+      v_new[i] = vn;
+      u_new[i] = un;
+    }
+  } else {
+    // Newmark average acceleration (beta 1/4, gamma 1/2): predict, then solve
+    // (M + dt/2 C + dt^2/4 K0) a_{n+1} = F(u~, v~) with the matrix factorised once. K0 holds the
+    // beams, supports and pantograph springs; the tension-only droppers enter F at the prediction
+    // (explicit, stable at these steps: checked when the model is built). Every contact active
+    // at the prediction is implicit: its penalty k0 g g^T joins the matrix as a rank-1 update
+    // (Woodbury), g = e_head - sum_a w_a e_a (eq. 12).
+    const double b = 0.25, g = 0.5;
+    // The equation is written at t_{n+1}: the contact sits where the train is then (evaluating it
+    // a step behind would shift it along the wire's slope under the head: a bias of order
+    // k0 V dt F / (2T), several newtons at 300 km/h and 1 ms).
+    const double front_n = s.front;
+    s.front = front_n + next_speed(s, dt) * dt;
+    double* up = s.u_pred.data();
+    double* vp = s.v_pred.data();
+    for (int i = 0; i < n; ++i) {
+      up[i] = u[i] + dt * v[i] + dt * dt * (0.5 - b) * acc[i];
+      vp[i] = v[i] + dt * (1.0 - g) * acc[i];
+    }
+    assemble_force(m, s, up, vp, z, f);
+    const double* im = m.inv_mass.data();
+    for (int i = 0; i < n; ++i)
+      if (im[i] == 0.0) f[i] = 0.0;  // rigid supports (every other DOF has mass: rotations are lumped)
+    double* tmp = s.solve_tmp.data();
+    newmark_solve_checked(*m.implicit, f, tmp);
+    // Active contacts at the prediction and their g vectors (sparse: head + wire nodes).
+    const std::size_t nw = m.contact_wires.size();
+    int active = 0;
+    for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
+      const Pantograph& p = m.pantographs[pi];
+      if (p.moving_force) continue;
+      for (int ci : p.collectors)
+        for (std::size_t wk = 0; wk < nw; ++wk) {
+          if (!(s.contact_force[ci * nw + wk] > 0.0)) continue;
+          const Wire& w = m.wires[m.contact_wires[wk]];
+          const double xc = s.front - p.position + m.collectors[ci].offset;
+          const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
+          double* y = s.contact_solve.data() + static_cast<std::size_t>(active) * n;
+          std::fill(y, y + n, 0.0);
+          int* gi = s.contact_g_index.data() + active * (m.max_contact_nodes + 1);
+          double* gv = s.contact_g_value.data() + active * (m.max_contact_nodes + 1);
+          gi[0] = p.first_dof;
+          gv[0] = 1.0;
+          for (int a = 0; a < cnt; ++a) {
+            gi[a + 1] = w.w_dof + s.weight_node[a];
+            gv[a + 1] = -s.weight[a];
+          }
+          s.contact_g_count[active] = cnt + 1;
+          for (int a = 0; a <= cnt; ++a)
+            if (im[gi[a]] != 0.0) y[gi[a]] += gv[a];
+          newmark_solve_checked(*m.implicit, y, tmp);  // y = A^-1 g
+          ++active;
+        }
+    }
+    if (active > 0) {
+      // Woodbury: a = x0 - Y (I / c + G^T Y)^-1 G^T x0, c = dt^2/4 k0; S is active x active.
+      const double c = b * dt * dt * m.contact_stiffness;
+      const int na = active, stride = m.max_contact_nodes + 1;
+      double* sm = s.contact_small.data();
+      double* rhs = sm + na * na;
+      for (int i = 0; i < na; ++i) {
+        const int* gi = s.contact_g_index.data() + i * stride;
+        const double* gv = s.contact_g_value.data() + i * stride;
+        double gx = 0.0;
+        for (int a = 0; a < s.contact_g_count[i]; ++a) gx += gv[a] * f[gi[a]];
+        rhs[i] = gx;
+        for (int j = 0; j < na; ++j) {
+          const double* y = s.contact_solve.data() + static_cast<std::size_t>(j) * n;
+          double gy = 0.0;
+          for (int a = 0; a < s.contact_g_count[i]; ++a) gy += gv[a] * y[gi[a]];
+          sm[i * na + j] = gy + (i == j ? 1.0 / c : 0.0);
+        }
+      }
+      // Small dense solve (Gaussian elimination without pivoting: S is symmetric positive definite).
+      for (int k = 0; k < na; ++k)
+        for (int i = k + 1; i < na; ++i) {
+          const double l = sm[i * na + k] / sm[k * na + k];
+          for (int j = k; j < na; ++j) sm[i * na + j] -= l * sm[k * na + j];
+          rhs[i] -= l * rhs[k];
+        }
+      for (int i = na - 1; i >= 0; --i) {
+        double r = rhs[i];
+        for (int j = i + 1; j < na; ++j) r -= sm[i * na + j] * rhs[j];
+        rhs[i] = r / sm[i * na + i];
+      }
+      for (int j = 0; j < na; ++j) {
+        const double* y = s.contact_solve.data() + static_cast<std::size_t>(j) * n;
+        const double cj = rhs[j];
+        for (int i = 0; i < n; ++i) f[i] -= y[i] * cj;
+      }
+    }
+    double* u_new = z;
+    double* v_new = s.solve_tmp.data();
+    for (int i = 0; i < n; ++i) {
+      const double un = up[i] + b * dt * dt * f[i];
+      if (!(std::fabs(un) <= limit)) bad = i;
+      u_new[i] = un;
+      v_new[i] = vp[i] + g * dt * f[i];
+    }
+    if (bad < 0) {
+      for (int i = 0; i < n; ++i) acc[i] = f[i];
+      std::copy(v_new, v_new + n, f);  // f becomes the new velocity, swapped in below
+    }
+    s.front = front_n;  // the kinematics below advance it once
   }
   if (bad >= 0) {
     s.status = StepStatus::kDiverged;
@@ -226,14 +360,12 @@ StepStatus step(const Model& m, State& s) {
   s.v.swap(s.force);  // O(1): swaps the buffers, no copy, no allocation
   s.u.swap(s.z);
 
-  // Train kinematics: toward the commanded speed within the acceleration limit.
-  const double dv = s.target_speed - s.speed, dvmax = s.max_acceleration * dt;
-  s.speed = (s.max_acceleration <= 0.0 || std::fabs(dv) <= dvmax) ? s.target_speed : s.speed + std::copysign(dvmax, dv);
+  s.speed = next_speed(s, dt);
   s.front += s.speed * dt;
   s.time += dt;
   ++s.steps;
   // Observations describe the new state (t_{n+1}), so a snapshot is always consistent.
-  contact_forces(m, s, nullptr);
+  contact_forces(m, s, s.u.data(), nullptr);
   return s.status;
 }
 

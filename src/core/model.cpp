@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "catenary_sim/core/beam.hpp"
+#include "catenary_sim/core/implicit.hpp"
 #include "catenary_sim/core/stability.hpp"
 #include "catenary_sim/core/statics.hpp"
 
@@ -551,6 +552,24 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
   set_pantograph_references(m);
   if (!options.stability) {
     m.dt = m.dt_critical = scene.numerics.dt ? *scene.numerics.dt : 1e-4;
+    return m;
+  }
+  if (scene.numerics.integrator == Integrator::kImplicit) {
+    // Newmark average acceleration is unconditionally stable for the linear part; what it takes
+    // explicitly (slack-dropper corrections, contacts) bounds the step.
+    m.omega_explicit_parts = explicit_parts_frequency(m);
+    m.omega_max = m.omega_explicit_parts;
+    m.dt_critical = critical_time_step(m.omega_explicit_parts, 0.0, 0.0);
+    if (scene.numerics.dt) {
+      if (*scene.numerics.dt > m.dt_critical)
+        throw SceneError("numerics.dt = " + fmt(*scene.numerics.dt) + " s: above the limit " + fmt(m.dt_critical) +
+                         " s of the implicit integrator's explicit part (the tension-only droppers: " +
+                         fmt(m.omega_explicit_parts) + " rad/s); use dt <= " + fmt(m.dt_critical));
+      m.dt = *scene.numerics.dt;
+    } else {
+      m.dt = std::min(1e-3, scene.numerics.safety_factor * m.dt_critical);
+    }
+    m.implicit = newmark_matrix(m, m.dt);
     return m;
   }
   compute_stability_limit(m);

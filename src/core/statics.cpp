@@ -1,5 +1,7 @@
 #include "catenary_sim/core/statics.hpp"
 
+#include "assembly.hpp"
+
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
@@ -8,9 +10,6 @@
 #include <sstream>
 
 namespace catenary_sim {
-namespace {
-
-using Triplets = std::vector<Eigen::Triplet<double>>;
 
 // The wire's band in a sparse matrix, w of node i at w0 + i and theta at t0 + i.
 void add_wire_band(Triplets& t, const Wire& w, int w0, int t0) {
@@ -44,6 +43,8 @@ void add_spring(Triplets& t, Eigen::VectorXd& r, int a, int b, double k, double 
     r[b] -= preload;
   }
 }
+
+namespace {
 
 Eigen::VectorXd solve_spd(const Eigen::SparseMatrix<double>& k, const Eigen::VectorXd& r, const char* what) {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);

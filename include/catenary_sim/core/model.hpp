@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -88,6 +89,15 @@ struct Pantograph {
   int masses_count() const { return static_cast<int>(masses.size()); }
 };
 
+// The Newmark matrix M + dt/2 C + dt^2/4 K0, factorised once: L D L^T of P A P^T with L unit
+// lower triangular (strict part in compressed columns).
+struct ImplicitMatrix {
+  std::vector<int> perm;           // P as indices: (P b)[perm[i]] = b[i]
+  std::vector<int> col, row;       // CSC of the strict lower part of L
+  std::vector<double> val;
+  std::vector<double> inv_diag;    // 1 / D
+};
+
 struct Model {
   Scene scene;
   std::vector<Section> sections;
@@ -111,6 +121,8 @@ struct Model {
   double omega_max = 0.0;       // rad/s, highest eigenfrequency of the assembled system
   double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction
   double dt = 0.0;              // s, the step in use
+  std::shared_ptr<const ImplicitMatrix> implicit;  // set when the integrator is implicit
+  double omega_explicit_parts = 0.0;  // rad/s, highest frequency of what the implicit scheme treats explicitly
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
   double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire

@@ -99,9 +99,14 @@ struct OverlapSpec {
 };
 
 enum class RotaryInertia { kCondensed, kLumped };
+enum class Integrator { kExplicit, kImplicit };
 
 struct NumericsSpec {
+  std::string preset;            // "", fast, balanced, accurate, reference: defaults for the fields below
   double element_length = 0.25;  // m, target; segments between supports and droppers are split evenly
+  // explicit: the paper's central differences (eq. 19-21); implicit: Newmark average acceleration
+  // with a matrix factorised once (rotations are then always DOFs with HRZ rotary inertia).
+  Integrator integrator = Integrator::kExplicit;
   std::optional<double> dt;      // s; empty = automatic (safety_factor times the stability limit)
   double safety_factor = 0.9;    // for automatic dt
   RotaryInertia rotary_inertia = RotaryInertia::kCondensed;

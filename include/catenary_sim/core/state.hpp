@@ -28,7 +28,8 @@ struct State {
   std::vector<double> uplift;     // N, static uplift in effect per pantograph (eq. 9 thrust F)
   std::vector<double> external_force;  // N, force of an external (hardware-in-the-loop) pantograph
 
-  // q of eq. 21 as displacements from the design state, and q_dot_{n-1/2} (eq. 20, 26).
+  // q of eq. 21 as displacements from the design state, and q_dot_{n-1/2} (eq. 20, 26); with the
+  // implicit integrator v is the velocity at the state's time.
   Eigen::VectorXd u, v;
   Eigen::VectorXd accel;  // q'' of the last step (at its start, t_n), for observers
 
@@ -42,6 +43,10 @@ struct State {
 
   // Workspace, sized once by make_state().
   Eigen::VectorXd force, z;
+  Eigen::VectorXd u_pred, v_pred, solve_tmp;  // implicit integrator only
+  std::vector<double> contact_solve;           // implicit: A^-1 g per active contact
+  std::vector<int> contact_g_index, contact_g_count;
+  std::vector<double> contact_g_value, contact_small;
   std::vector<double> theta;
   std::vector<int> weight_node;
   std::vector<double> weight;
