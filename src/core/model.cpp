@@ -218,6 +218,16 @@ void apply_stiffness(const Model& m, double front, const double* x, double* y, d
 
 Model build_model(const Scene& scene) { return build_model(scene, BuildOptions{}); }
 
+std::string speed_warning(const Model& m, double speed) {
+  if (!(speed > 0.7 * m.wave_speed)) return "";
+  std::ostringstream s;
+  s.precision(3);
+  s << "train speed " << speed * 3.6 << " km/h is " << speed / m.wave_speed << " of the contact wire's wave speed c = "
+    << m.wave_speed * 3.6 << " km/h: above 0.7 c is outside design practice (the wave ahead of the pantograph steepens "
+    << "and contact is lost as the speed nears c)";
+  return s.str();
+}
+
 Model build_model(const Scene& scene_in, const BuildOptions& options) {
   Scene scene = scene_in;
   if (scene.sections.empty()) {
@@ -531,7 +541,10 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
       throw SceneError("model: DOF " + std::to_string(i) + " has no mass; check linear_mass and masses");
     m.inv_mass[i] = 1.0 / m.mass[i];
   }
-  m.wave_speed = std::sqrt(scene.contact_wire.tension / scene.contact_wire.linear_mass);
+  m.wave_speed = 1e300;
+  for (int wi : m.contact_wires)
+    m.wave_speed = std::min(m.wave_speed, std::sqrt(m.wires[wi].spec.tension / m.wires[wi].spec.linear_mass));
+  if (const std::string w = speed_warning(m, scene.train_speed); !w.empty()) m.warnings.push_back(w);
 
   // Train travel: by default from the rearmost collector at the line start to the foremost at
   // the line end.

@@ -425,21 +425,17 @@ Scene scene_from_yaml(const YAML::Node& root) {
     Reader r(top.child("numerics"), "numerics");
     // A preset sets the defaults of the fidelity ladder; every field can still be set on its own.
     const std::string preset = r.text("preset", "");
-    double h = 0.25, auto_safety = 0.9;
-    std::string integrator = "explicit", rot = "condensed";
-    std::optional<double> dt;
+    double h = 0.25;
+    // Element lengths measured in bench/speed_accuracy (BENCHMARKS.md): all explicit, because on
+    // these lines the condensed explicit scheme is the fastest at every accuracy level.
     if (preset == "fast") {
       h = 1.0;
-    } else if (preset == "balanced" || preset.empty()) {
+    } else if (preset == "balanced") {
+      h = 0.5;
+    } else if (preset == "accurate" || preset.empty()) {
       h = 0.25;
-    } else if (preset == "accurate") {
-      h = 0.125;
-      integrator = "implicit";
-      rot = "lumped";
-      dt = 2.5e-4;
     } else if (preset == "reference") {
       h = 0.0625;
-      auto_safety = 0.9;
     } else {
       fail("numerics.preset", "'" + preset + "'", "one of: fast, balanced, accurate, reference");
     }
@@ -449,15 +445,13 @@ Scene scene_from_yaml(const YAML::Node& root) {
       const YAML::Node n = r.child("dt");
       if (!(n.IsScalar() && n.as<std::string>() == "auto"))
         s.numerics.dt = Reader::parse_number(n, "numerics.dt", 0.0, 0.1, true);
-    } else {
-      s.numerics.dt = dt;
     }
-    s.numerics.safety_factor = r.number("safety_factor", 0.0, 1.0, auto_safety, true);
-    const std::string integ = r.text("integrator", integrator);
+    s.numerics.safety_factor = r.number("safety_factor", 0.0, 1.0, 0.9, true);
+    const std::string integ = r.text("integrator", "explicit");
     if (integ == "explicit") s.numerics.integrator = Integrator::kExplicit;
     else if (integ == "implicit") s.numerics.integrator = Integrator::kImplicit;
     else fail("numerics.integrator", "'" + integ + "'", "one of: explicit (central differences, eq. 19-21), implicit (Newmark average acceleration)");
-    const std::string rt = r.text("rotary_inertia", s.numerics.integrator == Integrator::kImplicit ? "lumped" : rot);
+    const std::string rt = r.text("rotary_inertia", s.numerics.integrator == Integrator::kImplicit ? "lumped" : "condensed");
     if (rt == "condensed") s.numerics.rotary_inertia = RotaryInertia::kCondensed;
     else if (rt == "lumped") s.numerics.rotary_inertia = RotaryInertia::kLumped;
     else fail("numerics.rotary_inertia", "'" + rt + "'", "one of: condensed (massless rotations, statically condensed), lumped (HRZ rotary inertia)");

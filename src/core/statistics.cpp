@@ -141,13 +141,17 @@ void PassRecorder::record(const Model& m, const State& s) {
 }
 
 std::vector<PantographStatistics> PassRecorder::statistics(const Model& m) const {
+  return statistics(m, m.scene.output.filter_cutoff);
+}
+
+std::vector<PantographStatistics> PassRecorder::statistics(const Model& m, double cutoff_hz) const {
   std::vector<PantographStatistics> out;
   const double x0 = m.support_x[m.scene.analysis_first()], x1 = m.support_x[m.scene.analysis_last()];
   const double fs = 1.0 / m.dt;
   for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
     PantographStatistics st;
     st.name = m.pantographs[p].name;
-    const std::vector<double> filtered = lowpass_zero_phase(force_[p], fs, m.scene.output.filter_cutoff);
+    const std::vector<double> filtered = lowpass_zero_phase(force_[p], fs, cutoff_hz);
     std::vector<double> f_in, raw_in;
     std::size_t lost = 0;
     for (std::size_t i = 0; i < force_[p].size(); ++i) {

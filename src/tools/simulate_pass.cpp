@@ -124,6 +124,7 @@ int main(int argc, char** argv) {
     std::cout << "scene " << scene.name << ": " << scene.spans.size() << " spans, " << m.line_length << " m, "
               << m.n_dof << " DOFs, dt " << m.dt * 1e3 << " ms (stability limit " << m.dt_critical * 1e3
               << " ms), speed " << scene.train_speed * 3.6 << " km/h" << std::endl;
+  for (const std::string& w : m.warnings) std::cerr << "simulate_pass: warning: " << w << "\n";
   if (scene.train_speed <= 0.0 && !quiet)
     std::cout << "note: train speed 0: the pass never ends; nothing to run\n";
 

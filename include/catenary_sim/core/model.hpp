@@ -125,7 +125,8 @@ struct Model {
   double omega_explicit_parts = 0.0;  // rad/s, highest frequency of what the implicit scheme treats explicitly
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
-  double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire
+  double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)
+  std::vector<std::string> warnings;  // what the scene asks that is outside design practice
 };
 
 // Builds the model, solves the design statics (dropper lengths for the presag) and the stability
@@ -138,6 +139,9 @@ struct BuildOptions {
   std::optional<std::vector<double>> support_rises;
 };
 Model build_model(const Scene& scene, const BuildOptions& options);
+
+// A warning (empty if none) for a train speed above 0.7 of the contact wire's wave speed.
+std::string speed_warning(const Model& model, double speed_mps);
 
 // Heights d (m) by which each section's contact wire support is raised at its first and last
 // support (0 where the end span is a current span): overlap.support_rise, or eq. 6-8 with

@@ -57,6 +57,8 @@ class PassRecorder {
   // The initial state, then the state after each successful step().
   void record(const Model& model, const State& state);
   std::vector<PantographStatistics> statistics(const Model& model) const;
+  // The same with another low-pass cutoff (Hz), e.g. 200 Hz for the extremes of EN 50317.
+  std::vector<PantographStatistics> statistics(const Model& model, double cutoff_hz) const;
 
   // Time series at the output sample rate (every step when 0).
   struct Row {

@@ -1,0 +1,120 @@
+// Numerical stability at the extremes: train speeds from 0 to 0.95 c, contact stiffness from
+// 1e3 to 1e7 N/m, element lengths from 0.05 to 2 m, uplift from 0 to 400 N, sudden speed and
+// uplift steps. Nothing may go NaN; what is physically extreme is warned about or refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/simulation.hpp"
+#include "catenary_sim/core/statistics.hpp"
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+
+using namespace catenary_sim;
+
+namespace {
+
+const std::string kScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+
+// Steps up to `max_steps` (or to the end of the pass) and checks every state stays finite.
+int run_finite(Simulation& sim, int max_steps) {
+  int n = 0;
+  for (; n < max_steps; ++n) {
+    const StepStatus st = sim.step();
+    if (st == StepStatus::kFinished) break;
+    EXPECT_EQ(st, StepStatus::kOk) << sim.status_message();
+    if (st != StepStatus::kOk) break;
+  }
+  EXPECT_TRUE(sim.state().u.allFinite());
+  EXPECT_TRUE(sim.state().v.allFinite());
+  for (double f : sim.state().contact_force) EXPECT_TRUE(std::isfinite(f) && f >= 0.0);
+  return n;
+}
+
+}  // namespace
+
+TEST(Extremes, TrainAtRestAndCreeping) {
+  // At 0 km/h the pantograph stays on its static state (eq. 23): the force stays the uplift.
+  Simulation rest(load_scene_file(kScene, {"train.speed_kmh=0", "train.start=302.5"}));
+  run_finite(rest, 3000);
+  EXPECT_NEAR(total_contact_force(rest.model(), rest.state(), 0), 100.0, 0.5);  // damped residual only
+  EXPECT_FALSE(rest.finished());
+  Simulation creep(load_scene_file(kScene, {"train.speed_kmh=1"}));
+  run_finite(creep, 3000);
+  EXPECT_TRUE(creep.model().warnings.empty());
+}
+
+TEST(Extremes, NearTheWaveSpeedWarnsAndStaysFinite) {
+  const double c_kmh = std::sqrt(22000.0 / 1.35) * 3.6;  // 460 km/h
+  Simulation fast(load_scene_file(kScene, {"train.speed_kmh=" + std::to_string(0.95 * c_kmh)}));
+  ASSERT_EQ(fast.model().warnings.size(), 1u);
+  EXPECT_NE(fast.model().warnings[0].find("above 0.7 c"), std::string::npos) << fast.model().warnings[0];
+  run_finite(fast, 1000000);
+  EXPECT_TRUE(fast.finished());
+  Simulation below(load_scene_file(kScene, {"train.speed_kmh=" + std::to_string(0.65 * c_kmh)}));
+  EXPECT_TRUE(below.model().warnings.empty());
+}
+
+TEST(Extremes, ContactStiffnessFrom1e3To1e7) {
+  for (double k : {1e3, 1e4, 1e5, 1e6, 1e7}) {
+    Simulation sim(load_scene_file(kScene, {"contact.stiffness=" + std::to_string(k)}));
+    SCOPED_TRACE("k0 = " + std::to_string(k) + ", dt = " + std::to_string(sim.model().dt));
+    // The automatic step follows the stiffest contact: dt shrinks for 1e7 N/m.
+    EXPECT_LE(sim.model().dt, sim.model().dt_critical);
+    run_finite(sim, 4000);
+  }
+  // The implicit integrator takes the contact implicitly: 1e7 N/m at 1 ms.
+  Simulation implicit(load_scene_file(kScene, {"contact.stiffness=1e7", "numerics.integrator=implicit", "numerics.dt=0.001"}));
+  run_finite(implicit, 2000);
+}
+
+TEST(Extremes, ElementLengthsFrom5cmTo2m) {
+  for (double h : {0.05, 0.5, 2.0}) {
+    Simulation sim(load_scene_file(kScene, {"numerics.element_length=" + std::to_string(h)}));
+    SCOPED_TRACE("h = " + std::to_string(h));
+    run_finite(sim, h < 0.1 ? 300 : 3000);
+  }
+}
+
+TEST(Extremes, UpliftZeroAndFourHundredNewtons) {
+  {
+    // No uplift: only the roof spring (160 N/m, relaxed at the start's working height) keeps the
+    // head up, so where the wire sags (presag 55 mm) the head presses at most about
+    // 160 N/m x 0.055 m = 8.8 N on average; the contact is mostly lost; nothing goes NaN.
+    Simulation sim(load_scene_file(kScene, {"pantographs.0.static_uplift=0"}));
+    PassRecorder rec(sim.model());
+    rec.record(sim.model(), sim.state());
+    while (sim.step() == StepStatus::kOk) rec.record(sim.model(), sim.state());
+    EXPECT_EQ(sim.state().status, StepStatus::kFinished) << sim.status_message();
+    const PantographStatistics st = rec.statistics(sim.model())[0];
+    EXPECT_LT(st.unfiltered.mean, 160.0 * 0.055 + 1.0);
+    EXPECT_GT(st.contact_loss_percent, 50.0);
+  }
+  {
+    Simulation sim(load_scene_file(kScene, {"pantographs.0.static_uplift=400"}));
+    PassRecorder rec(sim.model());
+    rec.record(sim.model(), sim.state());
+    while (sim.step() == StepStatus::kOk) rec.record(sim.model(), sim.state());
+    EXPECT_EQ(sim.state().status, StepStatus::kFinished) << sim.status_message();
+    // Mean = uplift within the roof-spring bound (160 N/m x 0.2 m of working-height change at 400 N).
+    EXPECT_NEAR(rec.statistics(sim.model())[0].filtered.mean, 400.0, 32.0);
+  }
+}
+
+TEST(Extremes, SuddenSpeedAndUpliftSteps) {
+  Simulation sim(load_scene_file(kScene));
+  std::string err;
+  run_finite(sim, 1500);
+  ASSERT_TRUE(sim.set_max_acceleration(0.0, &err));  // no limit: the speed jumps
+  ASSERT_TRUE(sim.set_target_speed(100.0 / 3.6, &err));
+  ASSERT_TRUE(sim.set_uplift(-1, 300.0, &err));
+  run_finite(sim, 1500);
+  EXPECT_DOUBLE_EQ(sim.state().speed, 100.0 / 3.6);
+  ASSERT_TRUE(sim.set_target_speed(400.0 / 3.6, &err));
+  ASSERT_TRUE(sim.set_uplift(-1, 0.0, &err));
+  run_finite(sim, 1500);
+}
