@@ -1,5 +1,6 @@
 #include "catenary_sim/core/stability.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -50,6 +51,19 @@ void compute_stability_limit(Model& m) {
   // iteration has not converged (measured: 3e-4 after 400 iterations on the HRZ variant), so the
   // refusal of a user dt is on the safe side.
   m.omega_max = 1.002 * highest_eigenfrequency(m);
+  // The contacts move along the wire: where one meets a light node its frequency is highest, and
+  // the power iteration sees it only where the train starts. Add every contact's worst case as a
+  // bound (Weyl: lambda_max(A + B) <= lambda_max(A) + lambda_max(B)), with the contact as a
+  // rank-1 spring k0 g g^T, g^T M^-1 g <= 1/m_head + max 1/m over the contact-wire nodes.
+  double lightest = 0.0;
+  for (int wi : m.contact_wires)
+    for (int i = 0; i < m.wires[wi].nodes(); ++i) lightest = std::max(lightest, m.inv_mass[m.wires[wi].w_dof + i]);
+  double contact = 0.0;
+  for (const Collector& c : m.collectors) {
+    const Pantograph& p = m.pantographs[c.pantograph];
+    if (!p.moving_force) contact += m.contact_stiffness * (m.inv_mass[p.first_dof] + lightest) * m.contact_wires.size();
+  }
+  m.omega_max = std::sqrt(m.omega_max * m.omega_max + contact);
   m.dt_critical = critical_time_step(m.omega_max, m.alpha, m.beta);
 }
 

@@ -60,6 +60,12 @@ TEST(Extremes, NearTheWaveSpeedWarnsAndStaysFinite) {
 }
 
 TEST(Extremes, ContactStiffnessFrom1e3To1e7) {
+  // The explicit limit must follow the contact: k0 = 1e7 N/m on a 0.5 kg wire node is a
+  // 4500 rad/s mode (dt < 0.45 ms), stiffer than the wire's highest (about 1800 rad/s).
+  const double dt_soft = build_model(load_scene_file(kScene, {"contact.stiffness=5e4"})).dt;
+  const double dt_stiff = build_model(load_scene_file(kScene, {"contact.stiffness=1e7"})).dt;
+  EXPECT_LT(dt_stiff, 0.5 * dt_soft);
+  EXPECT_LT(dt_stiff, 2.0 / std::sqrt(1e7 / 0.5));
   for (double k : {1e3, 1e4, 1e5, 1e6, 1e7}) {
     Simulation sim(load_scene_file(kScene, {"contact.stiffness=" + std::to_string(k)}));
     SCOPED_TRACE("k0 = " + std::to_string(k) + ", dt = " + std::to_string(sim.model().dt));

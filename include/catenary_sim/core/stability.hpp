@@ -13,7 +13,8 @@ double highest_eigenfrequency(const Model& model, int iterations = 3000);
 // dt_crit = (2 / w_max) (sqrt(1 + xi^2) - xi), xi = alpha / (2 w_max) + beta w_max / 2.
 double critical_time_step(double omega_max, double alpha, double beta);
 
-// Sets model.omega_max (the estimate with a 0.2 % safety margin) and model.dt_critical.
+// Sets model.omega_max (the estimate with a 0.2 % safety margin, plus a bound for the contacts
+// wherever they are along the line) and model.dt_critical.
 void compute_stability_limit(Model& model);
 
 }  // namespace catenary_sim
