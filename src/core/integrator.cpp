@@ -10,6 +10,7 @@
 
 #include "catenary_sim/core/implicit.hpp"
 #include "catenary_sim/core/state.hpp"
+#include "window.hpp"
 
 namespace catenary_sim {
 
@@ -92,6 +93,13 @@ State make_state(const Model& m) {
   s.contact_force.assign(m.collectors.size() * m.contact_wires.size(), 0.0);
   s.collector_height.assign(m.collectors.size() * m.contact_wires.size(), 0.0);
   s.dropper_slack.assign(m.droppers.size(), 0);
+  s.window.resize(m.wires.size());
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    s.window[wi].tt_lower.assign(m.wires[wi].nodes(), 0.0);
+    s.window[wi].tt_inv_pivot.assign(m.wires[wi].nodes(), 0.0);
+  }
+  s.window_droppers.assign(m.droppers.size(), 0);
+  s.window_springs.assign(m.springs.size(), 0);
   s.uplift.resize(m.pantographs.size());
   for (std::size_t i = 0; i < m.pantographs.size(); ++i) s.uplift[i] = m.pantographs[i].static_uplift;
   s.external_force = s.uplift;
@@ -165,6 +173,16 @@ double next_speed(const State& s, double dt) {
   return (s.max_acceleration <= 0.0 || std::fabs(dv) <= dvmax) ? s.target_speed : s.speed + std::copysign(dvmax, dv);
 }
 
+// The end of every step: the train moves, the clock advances, and the observations are taken on
+// the new state (t_{n+1}), so a snapshot is always consistent.
+void advance_train(const Model& m, State& s, double dt) {
+  s.speed = next_speed(s, dt);
+  s.front += s.speed * dt;
+  s.time += dt;
+  ++s.steps;
+  contact_forces(m, s, s.u.data(), nullptr);
+}
+
 // Total force on every DOF at displacements u and velocities v (eq. 1 right-hand side minus the
 // internal and damping forces): constant load, beams, supports, tension-only droppers, Rayleigh
 // damping (eq. 5) through z = u + beta v, pantograph chains with their uplift, and the contact.
@@ -173,24 +191,50 @@ void assemble_force(const Model& m, State& s, const double* u, const double* v, 
   const double beta = m.beta, alpha = m.alpha;
   const double* load = m.load.data();
   const double* mass = m.mass.data();
-  for (int i = 0; i < nc; ++i) {
-    z[i] = u[i] + beta * v[i];
-    f[i] = load[i] - alpha * mass[i] * v[i];
-  }
-  for (int i = nc; i < n; ++i) f[i] = 0.0;
-  for (const Wire& w : m.wires) wire_elastic_force(w, z, f, s.theta.data());
-  for (const SupportSpring& sp : m.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
-
-  // Droppers work only in tension; the switch is decided on the elastic stretch.
-  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+  auto init = [&](int i0, int i1) {
+    for (int i = i0; i < i1; ++i) {
+      z[i] = u[i] + beta * v[i];
+      f[i] = load[i] - alpha * mass[i] * v[i];
+    }
+  };
+  auto dropper = [&](std::size_t k) {
+    // Droppers work only in tension; the switch is decided on the elastic stretch.
     const Dropper& d = m.droppers[k];
     const double stretch = u[d.messenger_dof] - u[d.contact_dof];
     const bool taut = d.static_tension + d.stiffness * stretch > 0.0;
     s.dropper_slack[k] = !taut;
-    if (!taut) continue;
+    if (!taut) return;
     const double t = std::max(0.0, d.static_tension + d.stiffness * (z[d.messenger_dof] - z[d.contact_dof]));
     f[d.contact_dof] += t;
     f[d.messenger_dof] -= t;
+  };
+  for (int i = nc; i < n; ++i) f[i] = 0.0;
+  if (m.scene.numerics.window_ahead > 0.0) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const WireWindow& ww = s.window[wi];
+      const Wire& w = m.wires[wi];
+      init(w.w_dof + ww.lo, w.w_dof + ww.hi + 1);
+    }
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const WireWindow& ww = s.window[wi];
+      const Wire& w = m.wires[wi];
+      wire_elastic_force_window(w, ww, z, f, s.theta.data());
+      // Where the window cuts the wire, a dashpot of the wire's impedance sqrt(T rhoA) lets
+      // outgoing waves leave (the exact condition for a taut string).
+      const double c = std::sqrt(w.spec.tension * w.spec.linear_mass);
+      if (ww.hi >= ww.lo && ww.cut_lo) f[w.w_dof + ww.lo] -= c * v[w.w_dof + ww.lo];
+      if (ww.hi >= ww.lo && ww.cut_hi) f[w.w_dof + ww.hi] -= c * v[w.w_dof + ww.hi];
+    }
+    for (int j = 0; j < s.window_spring_count; ++j) {
+      const SupportSpring& sp = m.springs[s.window_springs[j]];
+      f[sp.dof] -= sp.stiffness * z[sp.dof];
+    }
+    for (int j = 0; j < s.window_dropper_count; ++j) dropper(static_cast<std::size_t>(s.window_droppers[j]));
+  } else {
+    init(0, nc);
+    for (const Wire& w : m.wires) wire_elastic_force(w, z, f, s.theta.data());
+    for (const SupportSpring& sp : m.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
+    for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(k);
   }
 
   // Pantographs: lumped chains (eq. 9), uplift on the lowest mass.
@@ -232,6 +276,8 @@ StepStatus step(const Model& m, State& s) {
   const double limit = m.scene.numerics.divergence_limit;
   int bad = -1;
   if (!m.implicit) {
+    const bool windowed = m.scene.numerics.window_ahead > 0.0;
+    if (windowed) update_window(m, s);
     assemble_force(m, s, u, v, z, f);
     // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. The new values go to the
     // workspace first: a displacement beyond the divergence limit (or NaN) stops the run and the
@@ -239,13 +285,44 @@ StepStatus step(const Model& m, State& s) {
     const double* im = m.inv_mass.data();
     double* v_new = f;  // the force is no longer needed
     double* u_new = z;
-    for (int i = 0; i < n; ++i) {
-      acc[i] = im[i] * f[i];  // q'' at t_n (eq. 20)
-      const double vn = v[i] + dt * acc[i];
-      const double un = u[i] + dt * vn;
-      if (!(std::fabs(un) <= limit)) bad = i;
-      v_new[i] = vn;
-      u_new[i] = un;
+    auto update = [&](int i0, int i1) {
+      for (int i = i0; i < i1; ++i) {
+        acc[i] = im[i] * f[i];  // q'' at t_n (eq. 20)
+        const double vn = v[i] + dt * acc[i];
+        const double un = u[i] + dt * vn;
+        if (!(std::fabs(un) <= limit)) bad = i;
+        v_new[i] = vn;
+        u_new[i] = un;
+      }
+    };
+    if (windowed) {
+      // Only the window moves: new values for its DOFs go to the workspace, and are copied back
+      // (not swapped: outside the window the buffers hold nothing current) once all are good.
+      for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+        const WireWindow& ww = s.window[wi];
+        update(m.wires[wi].w_dof + ww.lo, m.wires[wi].w_dof + ww.hi + 1);
+      }
+      update(m.n_catenary_dof, n);
+      if (bad >= 0) {
+        s.status = StepStatus::kDiverged;
+        s.diverged_dof = bad;
+        return s.status;
+      }
+      auto commit = [&](int i0, int i1) {
+        for (int i = i0; i < i1; ++i) {
+          v[i] = v_new[i];
+          u[i] = u_new[i];
+        }
+      };
+      for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+        const WireWindow& ww = s.window[wi];
+        commit(m.wires[wi].w_dof + ww.lo, m.wires[wi].w_dof + ww.hi + 1);
+      }
+      commit(m.n_catenary_dof, n);
+      advance_train(m, s, dt);
+      return s.status;
+    } else {
+      update(0, n);
     }
   } else {
     // Newmark average acceleration (beta 1/4, gamma 1/2): predict, then solve
@@ -360,12 +437,7 @@ StepStatus step(const Model& m, State& s) {
   s.v.swap(s.force);  // O(1): swaps the buffers, no copy, no allocation
   s.u.swap(s.z);
 
-  s.speed = next_speed(s, dt);
-  s.front += s.speed * dt;
-  s.time += dt;
-  ++s.steps;
-  // Observations describe the new state (t_{n+1}), so a snapshot is always consistent.
-  contact_forces(m, s, s.u.data(), nullptr);
+  advance_train(m, s, dt);
   return s.status;
 }
 

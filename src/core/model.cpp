@@ -567,6 +567,10 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
     m.dt = m.dt_critical = scene.numerics.dt ? *scene.numerics.dt : 1e-4;
     return m;
   }
+  if (scene.numerics.window_ahead > 0.0 &&
+      (scene.numerics.integrator != Integrator::kExplicit || scene.numerics.rotary_inertia != RotaryInertia::kCondensed))
+    throw SceneError("numerics.window: needs numerics.integrator explicit with rotary_inertia condensed (the window "
+                     "integrates node ranges of the condensed band)");
   if (scene.numerics.integrator == Integrator::kImplicit) {
     // Newmark average acceleration is unconditionally stable for the linear part; what it takes
     // explicitly (slack-dropper corrections, contacts) bounds the step.

@@ -62,7 +62,7 @@ TEST(Allocation, StepNeverAllocates) {
   // code paths.
   for (const std::vector<std::string>& ov :
        {std::vector<std::string>{}, std::vector<std::string>{"numerics.rotary_inertia=lumped"},
-        std::vector<std::string>{"numerics.integrator=implicit"},
+        std::vector<std::string>{"numerics.integrator=implicit"}, std::vector<std::string>{"numerics.window=auto"},
         std::vector<std::string>{"pantographs.0.type=moving_force", "pantographs.0.masses=null",
                                  "pantographs.0.stiffness=null", "pantographs.0.damping=null"}}) {
     Simulation sim(load_scene_file(kReference, ov));

@@ -111,6 +111,10 @@ struct NumericsSpec {
   double safety_factor = 0.9;    // for automatic dt
   RotaryInertia rotary_inertia = RotaryInertia::kCondensed;
   double divergence_limit = 5.0;  // m: any displacement beyond this stops the run as diverged
+  // Moving window: only the spans from `window_behind` m behind the rearmost pantograph to
+  // `window_ahead` m ahead of the foremost are integrated (snapped outward to supports); the rest
+  // of the line stays at its static state. Off when window_ahead is 0.
+  double window_ahead = 0.0, window_behind = 0.0;
 };
 
 struct OutputSpec {

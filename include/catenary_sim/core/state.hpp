@@ -18,6 +18,16 @@ enum class StepStatus {
   kFinished,   // the train front reached the end of the pass; step() does nothing more
 };
 
+// The part of one wire a moving window integrates: nodes lo..hi (empty when hi < lo). Where the
+// window cuts the wire (not at its anchors) the element outside is left out and a dashpot of the
+// wire's impedance sqrt(T rhoA) absorbs the waves that leave.
+struct WireWindow {
+  int lo = 0, hi = -1;
+  bool cut_lo = false, cut_hi = false;
+  double lo_ww = 0, lo_wt = 0, lo_tt = 0, hi_ww = 0, hi_wt = 0, hi_tt = 0;  // outside element's share of the end blocks
+  std::vector<double> tt_lower, tt_inv_pivot;  // LDL^T of the window's K_theta_theta
+};
+
 struct State {
   double time = 0.0;       // s, simulation time since the pass started
   std::int64_t steps = 0;
@@ -40,6 +50,12 @@ struct State {
 
   StepStatus status = StepStatus::kOk;
   int diverged_dof = -1;
+
+  // Moving window (numerics.window): the supports it spans and what it integrates.
+  int window_first_support = -1, window_last_support = -1;
+  std::vector<WireWindow> window;
+  std::vector<int> window_droppers, window_springs;  // the first *_count entries are in the window
+  int window_dropper_count = 0, window_spring_count = 0;
 
   // Workspace, sized once by make_state().
   Eigen::VectorXd force, z;

@@ -1,0 +1,134 @@
+// The moving window (numerics.window): only the spans around the pantographs are integrated.
+// Ahead of it the line is at its static state, which is u = 0 (the dynamics run on displacements
+// from the design state), so spans join it at static equilibrium for free; behind it they leave
+// and return to that state. The window moves a whole span at a time (its ends on supports), so
+// the band and the condensation factors of the window change only then.
+#include "window.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "catenary_sim/core/beam.hpp"
+
+namespace catenary_sim {
+
+void update_window(const Model& m, State& s) {
+  double x_min = 1e300, x_max = -1e300;
+  for (const Pantograph& p : m.pantographs) {
+    const double x = s.front - p.position;
+    x_min = std::min(x_min, x);
+    x_max = std::max(x_max, x);
+  }
+  if (m.pantographs.empty()) x_min = x_max = s.front;
+  const std::vector<double>& sx = m.support_x;
+  const double lo_x = x_min - m.scene.numerics.window_behind, hi_x = x_max + m.scene.numerics.window_ahead;
+  // Snap outward to supports.
+  int first = static_cast<int>(std::upper_bound(sx.begin(), sx.end(), lo_x) - sx.begin()) - 1;
+  int last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x) - sx.begin());
+  first = std::clamp(first, 0, static_cast<int>(sx.size()) - 1);
+  last = std::clamp(last, 0, static_cast<int>(sx.size()) - 1);
+  if (first == s.window_first_support && last == s.window_last_support) return;
+  const double a = sx[first], b = sx[last];
+  s.window_first_support = first;
+  s.window_last_support = last;
+
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    const Wire& w = m.wires[wi];
+    WireWindow& ww = s.window[wi];
+    const int old_lo = ww.lo, old_hi = ww.hi;
+    const int n = w.nodes();
+    ww.lo = static_cast<int>(std::lower_bound(w.x.begin(), w.x.end(), a - 1e-9) - w.x.begin());
+    ww.hi = static_cast<int>(std::upper_bound(w.x.begin(), w.x.end(), b + 1e-9) - w.x.begin()) - 1;
+    // Nodes that left the window return to the static state.
+    for (int i = old_lo; i <= old_hi; ++i)
+      if (i < ww.lo || i > ww.hi) {
+        s.u[w.w_dof + i] = 0.0;
+        s.v[w.w_dof + i] = 0.0;
+      }
+    if (ww.hi < ww.lo) continue;
+    ww.cut_lo = ww.lo > 0;
+    ww.cut_hi = ww.hi < n - 1;
+    ww.lo_ww = ww.lo_wt = ww.lo_tt = ww.hi_ww = ww.hi_wt = ww.hi_tt = 0.0;
+    if (ww.cut_lo) {
+      const Matrix4 k = beam_stiffness(w.x[ww.lo] - w.x[ww.lo - 1], w.spec.bending_stiffness, w.spec.tension);
+      ww.lo_ww = k[2][2];
+      ww.lo_wt = k[2][3];
+      ww.lo_tt = k[3][3];
+    }
+    if (ww.cut_hi) {
+      const Matrix4 k = beam_stiffness(w.x[ww.hi + 1] - w.x[ww.hi], w.spec.bending_stiffness, w.spec.tension);
+      ww.hi_ww = k[0][0];
+      ww.hi_wt = k[0][1];
+      ww.hi_tt = k[1][1];
+    }
+    // LDL^T of the window's tridiagonal K_theta_theta (free rotations at the cut ends).
+    double d = 0.0;
+    for (int i = ww.lo; i <= ww.hi; ++i) {
+      double diag = w.d_tt[i];
+      if (i == ww.lo) diag -= ww.lo_tt;
+      if (i == ww.hi) diag -= ww.hi_tt;
+      if (i == ww.lo) {
+        d = diag;
+        ww.tt_lower[i] = 0.0;
+      } else {
+        const double l = w.e_tt[i - 1] / d;
+        d = diag - l * w.e_tt[i - 1];
+        ww.tt_lower[i] = l;
+      }
+      ww.tt_inv_pivot[i] = 1.0 / d;
+    }
+  }
+  auto inside = [&](int dof) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const Wire& w = m.wires[wi];
+      if (dof >= w.w_dof && dof < w.w_dof + w.nodes()) {
+        const int i = dof - w.w_dof;
+        return i >= s.window[wi].lo && i <= s.window[wi].hi;
+      }
+    }
+    return false;
+  };
+  // Index lists sized once in make_state (a copied State keeps their size): no allocation.
+  s.window_dropper_count = 0;
+  for (std::size_t k = 0; k < m.droppers.size(); ++k)
+    if (inside(m.droppers[k].contact_dof) && inside(m.droppers[k].messenger_dof))
+      s.window_droppers[s.window_dropper_count++] = static_cast<int>(k);
+  s.window_spring_count = 0;
+  for (std::size_t k = 0; k < m.springs.size(); ++k)
+    if (inside(m.springs[k].dof)) s.window_springs[s.window_spring_count++] = static_cast<int>(k);
+}
+
+void wire_elastic_force_window(const Wire& wire, const WireWindow& ww, const double* z, double* f, double* theta) {
+  const int lo = ww.lo, hi = ww.hi;
+  if (hi < lo) return;
+  const double* w = z + wire.w_dof;
+  double* fw = f + wire.w_dof;
+  const double* dww = wire.d_ww.data();
+  const double* dwt = wire.d_wt.data();
+  const double* eww = wire.e_ww.data();
+  const double* ewt = wire.e_wt.data();
+  const double* etw = wire.e_tw.data();
+  const double* lower = ww.tt_lower.data();
+  const double* ip = ww.tt_inv_pivot.data();
+  auto dwt_at = [&](int i) { return dwt[i] - (i == lo ? ww.lo_wt : 0.0) - (i == hi ? ww.hi_wt : 0.0); };
+  auto dww_at = [&](int i) { return dww[i] - (i == lo ? ww.lo_ww : 0.0) - (i == hi ? ww.hi_ww : 0.0); };
+  // Condensed rotations over the window: K_tt theta = -K_tw w.
+  double prev = 0.0;
+  for (int i = lo; i <= hi; ++i) {
+    double r = -dwt_at(i) * w[i];
+    if (i < hi) r -= etw[i] * w[i + 1];
+    if (i > lo) r -= ewt[i - 1] * w[i - 1];
+    prev = r - (i > lo ? lower[i] * prev : 0.0);
+    theta[i] = prev;
+  }
+  theta[hi] *= ip[hi];
+  for (int i = hi - 1; i >= lo; --i) theta[i] = theta[i] * ip[i] - lower[i + 1] * theta[i + 1];
+  fw[lo] -= dww_at(lo) * w[lo] + dwt_at(lo) * theta[lo];
+  for (int i = lo + 1; i <= hi; ++i) {
+    const int e = i - 1;
+    fw[i] -= dww_at(i) * w[i] + dwt_at(i) * theta[i] + eww[e] * w[e] + etw[e] * theta[e];
+    fw[e] -= eww[e] * w[i] + ewt[e] * theta[i];
+  }
+}
+
+}  // namespace catenary_sim
