@@ -1,5 +1,5 @@
-// The fidelity ladder measured: the reference scene at 250 and 300 km/h for every preset (and the
-// implicit integrator as a knob), with DOFs, dt, wall time, real-time factor, and the error
+// The fidelity ladder measured: the reference scene at 250 and 300 km/h for every preset, with the
+// moving window off and on (and the implicit integrator as a knob), with DOFs, dt, wall time, real-time factor, and the error
 // against `reference` in the 0-20 Hz statistics (mean, std, max, min) and in the 0-200 Hz max.
 //   bench_speed_accuracy [scene=config/reference_55m.yaml] [csv=speed_accuracy.csv]
 // Errors are relative to the reference value (for the min: relative to the reference mean,
@@ -69,8 +69,11 @@ int main(int argc, char** argv) {
     const Result ref = run(path, "reference", {"numerics.preset=reference"}, kmh, 1);
     const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {
         {"fast", {"numerics.preset=fast"}},
+        {"fast + window", {"numerics.preset=fast", "numerics.window=auto"}},
         {"balanced", {"numerics.preset=balanced"}},
+        {"balanced + window", {"numerics.preset=balanced", "numerics.window=auto"}},
         {"accurate", {"numerics.preset=accurate"}},
+        {"accurate + window", {"numerics.preset=accurate", "numerics.window=auto"}},
         {"implicit h=0.25 dt=1ms", {"numerics.integrator=implicit", "numerics.dt=0.001"}},
         {"implicit h=0.125 dt=1ms", {"numerics.integrator=implicit", "numerics.element_length=0.125", "numerics.dt=0.001"}},
     };
