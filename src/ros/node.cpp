@@ -61,6 +61,7 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
            "speed %.1f km/h, real_time_factor %g, at_end %s",
            scene.name.c_str(), scene.spans.size(), m.line_length, m.n_dof, m.dt * 1e3, m.dt_critical * 1e3,
            scene.train_speed * 3.6, params_.real_time_factor, to_string(params_.at_end));
+  for (const std::string& w : m.warnings) ROS_WARN("catenary_sim: %s", w.c_str());
 }
 
 void SimulationNode::restart_recording() {
@@ -290,6 +291,7 @@ void SimulationNode::on_speed(const std_msgs::Float64::ConstPtr& msg) {
     ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/train_speed: %s; command ignored", err.c_str());
     return;
   }
+  if (const std::string w = speed_warning(sim_->model(), v); !w.empty()) ROS_WARN_THROTTLE(5.0, "catenary_sim: %s", w.c_str());
   have_command_ = true;
   last_command_wall_ = ros::WallTime::now();
   // A new speed after the end of a held pass does not restart it: use ~reset.
