@@ -129,6 +129,29 @@ TEST(Node, EveryTopicPublishesWithIncreasingStamps) {
   EXPECT_TRUE(found) << "no diagnostics status named ...simulation";
 }
 
+TEST(Node, TopicsPublishAtTheirDeclaredRates) {
+  // node.test declares publish_rate 100 Hz and shape_rate 10 Hz; markers go at the default
+  // marker_rate of 30 Hz while someone listens. Counted over 3 s of wall time; the lower bound
+  // leaves room for a loaded CI machine (the node drops ticks rather than stretching dt), the
+  // upper one catches a rate parameter that is ignored.
+  Recorder<ContactForceArray> force("contact_force");
+  Recorder<WireShapeArray> shape("wire_shape");
+  Recorder<visualization_msgs::MarkerArray> markers("markers");
+  ASSERT_TRUE(wait_for([&] { return markers.size() > 0 && shape.size() > 0; }, 10.0));
+  force.clear();
+  shape.clear();
+  markers.clear();
+  const double window = 3.0;
+  ros::WallDuration(window).sleep();
+  const double f = force.size() / window, w = shape.size() / window, k = markers.size() / window;
+  EXPECT_GT(f, 0.6 * 100.0) << f;
+  EXPECT_LT(f, 1.2 * 100.0) << f;
+  EXPECT_GT(w, 0.6 * 10.0) << w;
+  EXPECT_LT(w, 1.2 * 10.0 + 1.0) << w;
+  EXPECT_GT(k, 0.6 * 30.0) << k;
+  EXPECT_LT(k, 1.2 * 30.0) << k;
+}
+
 TEST(Node, TfLineToPantographHead) {
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
