@@ -1,0 +1,105 @@
+// Parameters of catenary_sim_hil_node: read once, validated; errors name the parameter, the value
+// and the allowed range.
+#include <ros/node_handle.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/ros/hil.hpp"
+
+namespace catenary_sim {
+namespace ros_layer {
+
+namespace {
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+void check(const char* name, double v, double lo, double hi, bool lo_open, const char* unit) {
+  const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi;
+  if (!ok)
+    throw ParamError(std::string("parameter ~") + name + " = " + fmt(v) + " rejected: allowed " +
+                     (lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + "] " + unit);
+}
+
+}  // namespace
+
+void validate_hil_params(const HilParams& p) {
+  if (p.scene.empty())
+    throw ParamError("parameter ~scene is required: path of a scene YAML file with a `type: external` pantograph");
+  if (p.speed_kmh) check("speed_kmh", *p.speed_kmh, 0.0, 540.0, false, "km/h");
+  check("hil/rate", p.rate, 1000.0, 10000.0, false, "Hz");
+  const double period = 1.0 / p.rate;
+  if (!std::isfinite(p.timeout) || p.timeout < 2.0 * period || p.timeout > 10.0)
+    throw ParamError("parameter ~hil/timeout = " + fmt(p.timeout) + " s rejected: allowed [" + fmt(2.0 * period) +
+                     ", 10] s (at least two loop periods of ~hil/rate = " + fmt(p.rate) + " Hz)");
+  check("hil/hold_ramp", p.hold_ramp, 0.0, 60.0, false, "s (0: at once)");
+  check("hil/hold_deceleration", p.hold_deceleration, 0.0, 50.0, false, "m/s^2 (0: at once)");
+  check("publish_rate", p.publish_rate, 0.0, 1000.0, true, "Hz");
+  check("marker_rate", p.marker_rate, 0.0, 100.0, true, "Hz");
+  check("start_delay", p.start_delay, 0.0, 60.0, false, "s");
+  if (p.line_frame.empty() || p.line_frame[0] == '/')
+    throw ParamError("parameter ~line_frame = '" + p.line_frame + "' rejected: a non-empty frame id without a leading '/'");
+}
+
+HilParams load_hil_params(const ros::NodeHandle& nh) {
+  HilParams p;
+  nh.param<std::string>("scene", p.scene, "");
+  auto number = [&](const char* name, double& out) {
+    if (!nh.hasParam(name)) return false;
+    double d;
+    int i;
+    std::string s;
+    if (nh.getParam(name, d)) out = d;
+    else if (nh.getParam(name, i)) out = i;
+    else if (nh.getParam(name, s) && s.empty()) return false;  // an empty launch argument: not given
+    else throw ParamError(std::string("parameter ~") + name + " must be a number");
+    return true;
+  };
+  double speed = 0.0;
+  if (number("speed_kmh", speed)) p.speed_kmh = speed;
+  number("hil/rate", p.rate);
+  number("hil/timeout", p.timeout);
+  number("hil/hold_ramp", p.hold_ramp);
+  number("hil/hold_deceleration", p.hold_deceleration);
+  number("publish_rate", p.publish_rate);
+  number("marker_rate", p.marker_rate);
+  number("start_delay", p.start_delay);
+  if (nh.hasParam("hil/extrapolate") && !nh.getParam("hil/extrapolate", p.extrapolate))
+    throw ParamError("parameter ~hil/extrapolate must be true or false");
+  nh.param<std::string>("hil/report_file", p.report_file, "");
+  nh.param<std::string>("stats_file", p.stats_file, "");
+  nh.param<std::string>("line_frame", p.line_frame, p.line_frame);
+  std::string at_end = to_string(p.at_end);
+  nh.param<std::string>("at_end", at_end, at_end);
+  p.at_end = parse_at_end(at_end);
+  validate_hil_params(p);
+  return p;
+}
+
+Scene load_hil_scene(const HilParams& p) {
+  Scene scene;
+  try {
+    scene = load_scene_file(p.scene);
+    if (p.speed_kmh) {
+      scene.train_speed = *p.speed_kmh / 3.6;
+      validate(scene);
+    }
+  } catch (const SceneError& e) {
+    throw ParamError("parameter ~scene = '" + p.scene + "': " + e.what());
+  }
+  bool external = false;
+  for (const PantographSpec& ps : scene.pantographs) external = external || ps.external;
+  if (!external)
+    throw ParamError("parameter ~scene = '" + p.scene +
+                     "': no pantograph of `type: external`; the hardware-in-the-loop node needs one (e.g. "
+                     "config/reference_55m_hil.yaml)");
+  return scene;
+}
+
+}  // namespace ros_layer
+}  // namespace catenary_sim
