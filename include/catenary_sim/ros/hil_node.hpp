@@ -1,0 +1,145 @@
+// catenary_sim_hil_node: the catenary of a scene against real pantographs (hardware in the loop).
+//
+// Force in, motion out. Once per loop period (~hil/rate, 1 to 10 kHz, a whole number of core
+// steps) the node applies the newest measured contact force of every external pantograph
+// (hil/contact_force), steps the core through the period and publishes the motion of the wire
+// under each pantograph (hil/contact_point). The loop is paced on the wall clock: each period
+// has a window one period wide; a fresh measurement that arrives inside it starts the steps at
+// once (so the output follows the input by the computation time only), else the steps start at
+// the window's end with the held measurement. The windows lock slowly (at most 0.1 % of a period
+// per period) onto the arrivals of a rig that sends at the same rate. Input older than
+// ~hil/timeout puts the line into the safe hold (README "Hardware in the loop").
+//
+// Slow publications (contact_force, tf, markers, diagnostics, pass statistics) run on a second
+// thread from snapshots of the state, so that the loop's period holds only the steps and the
+// contact point.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/callback_queue.h>
+#include <ros/ros.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "catenary_sim/ContactPointArray.h"
+#include "catenary_sim/MeasuredContactForce.h"
+#include "catenary_sim/core/simulation.hpp"
+#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/ros/hil.hpp"
+
+namespace catenary_sim {
+namespace ros_layer {
+
+class HilNode {
+ public:
+  // Reads and validates the parameters, loads the scene and chooses dt; throws ParamError.
+  HilNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  ~HilNode();
+  // Runs the loop until shutdown (or the end of the pass with at_end exit). Returns the exit code.
+  int run();
+
+  // Loop figures, also written to ~hil/report_file.
+  struct Counters {
+    std::int64_t batches = 0;        // loop periods that stepped
+    std::int64_t triggered = 0;      // of those, started by a fresh measurement
+    std::int64_t held = 0;           // running without a fresh measurement in the window (held input)
+    std::int64_t hold_batches = 0;   // in the safe hold
+    std::int64_t overruns = 0;       // the loop fell behind: a window closed before its steps began
+    std::int64_t accepted = 0, rejected = 0;
+    std::int64_t superseded = 0;     // replaced by a newer one before any period used them
+    std::int64_t late = 0;           // answered an older contact point than the last published
+    std::int64_t holds = 0;          // times the safe hold was entered
+    std::int64_t relocks = 0;        // the windows were centred on an arrival again (after an overrun)
+    double max_age_running = 0.0;    // s, oldest measurement used while running
+  };
+
+ private:
+  enum class Mode { kWaiting, kRunning, kHold, kEnded };
+
+  void on_measurement(const MeasuredContactForce::ConstPtr& msg);
+  void batch(double t, bool triggered);
+  void publish_point();
+  void handle_end();
+  void enter_hold(double t, double age);
+  void leave_hold();
+  void snapshot(double t);
+  void worker();
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void write_report() const;
+  static std::uint8_t mode_code(Mode m);
+
+  ros::NodeHandle nh_, pnh_;
+  HilParams params_;
+  HilTiming timing_;
+  std::unique_ptr<Simulation> sim_;
+  std::vector<int> external_;
+  double commanded_speed_ = 0.0;  // m/s, the scene's (or ~speed_kmh)
+
+  // Loop state (loop thread only).
+  ros::CallbackQueue hil_queue_;
+  ros::Subscriber force_sub_;
+  ros::Publisher point_pub_;
+  Mode mode_ = Mode::kWaiting;
+  MeasurementHold hold_;
+  bool fresh_ = false;             // a valid measurement that may start a period (answers the last contact point)
+  bool unused_ = false;            // the newest valid measurement has not been used by a period yet
+  std::uint64_t published_step_ = 0;  // step of the last contact point published
+  bool owed_ = false;              // the last period ran at its deadline without a measurement
+  std::vector<double> accept_buf_;
+  double age_in_effect_ = -1.0;    // s, age of the measurement used by the last batch
+  std::uint64_t step_in_effect_ = 0;
+  double hold_start_time_ = 0.0;   // s, simulation time when the safe hold began
+  std::vector<double> hold_from_;  // N, per pantograph, force when it began
+  bool diverged_ = false;
+  bool exit_requested_ = false;
+  int exit_code_ = 0;
+  std::uint32_t pass_count_ = 0;
+  double stamp_offset_ = 0.0;
+  double started_ = 0.0;           // s (steady), first measurement
+  std::vector<ContactPointMotion> scratch_;
+  std::unique_ptr<PassRecorder> recorder_;
+  Counters c_;
+  LatencyHistogram latency_;       // measurement arrival -> its contact point published
+  LatencyHistogram transport_;     // rig stamp -> arrival (same machine clocks)
+  LatencyHistogram compute_;       // batch start -> contact point published
+  LatencyHistogram wait_;          // measurement arrival -> the steps that use it start
+  double next_snapshot_ = 0.0, next_quantiles_ = 0.0;
+  double q_latency_[3] = {0, 0, 0};  // p50, p99, max for the diagnostics
+
+  // Snapshot for the worker thread (slow publications).
+  struct Snapshot {
+    State state;
+    Mode mode = Mode::kWaiting;
+    Counters counters;
+    double age = -1.0, age_in_effect = -1.0;
+    double latency[3] = {0, 0, 0};
+    bool diverged = false;
+    std::uint32_t pass_count = 0;
+  };
+  std::mutex snap_mu_;
+  std::condition_variable snap_cv_;
+  Snapshot snap_;
+  bool snap_new_ = false, stop_worker_ = false;
+  std::unique_ptr<PassRecorder> finished_recorder_;  // a pass to report (under snap_mu_)
+  State finished_state_;
+  std::thread worker_;
+
+  // Worker thread only.
+  Snapshot wsnap_;
+  ros::Publisher contact_pub_, marker_pub_;
+  tf2_ros::TransformBroadcaster tf_;
+  diagnostic_updater::Updater updater_;
+  double last_tf_time_ = -1.0;
+  ros::Time last_view_stamp_;
+  double next_marker_wall_ = 0.0;
+};
+
+}  // namespace ros_layer
+}  // namespace catenary_sim

@@ -1,0 +1,534 @@
+#include "catenary_sim/ros/hil_node.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "catenary_sim/ContactForceArray.h"
+#include "catenary_sim/ros/conversions.hpp"
+
+namespace catenary_sim {
+namespace ros_layer {
+
+namespace {
+
+// Steady (monotonic) clock in seconds: every loop time is on it.
+double steady_now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Phase lock of the loop's windows onto the arrivals of a rig sending at the same rate: a gain
+// per period on the offset of a triggering arrival from the window's centre, at most this share
+// of a period per period: the rate stays within 0.2 % of ~hil/rate (a rig's crystal drifts far
+// less), and a lost phase is found again within 250 periods.
+constexpr double kLockGain = 0.05;
+constexpr double kLockMax = 2e-3;
+constexpr int kRelockPeriods = 16;
+constexpr double kRecorderRowRate = 10.0;  // Hz, decimated rows of the pass recorder (unused here)
+constexpr double kQuantilePeriod = 1.0;    // s (wall) between latency quantiles for the diagnostics
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char b[64];
+  std::snprintf(b, sizeof b, "%.9g", v);
+  return b;
+}
+
+}  // namespace
+
+std::uint8_t HilNode::mode_code(Mode m) {
+  switch (m) {
+    case Mode::kWaiting: return ContactPointArray::WAITING;
+    case Mode::kRunning: return ContactPointArray::RUNNING;
+    case Mode::kHold: return ContactPointArray::SAFE_HOLD;
+    case Mode::kEnded: return ContactPointArray::ENDED;
+  }
+  return ContactPointArray::ENDED;
+}
+
+HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), params_(load_hil_params(pnh)), updater_(nh, pnh) {
+  Scene scene = load_hil_scene(params_);
+  try {
+    // The automatic dt of this scene decides how many steps a period holds (hil_timing).
+    double auto_dt = 0.0;
+    if (!scene.numerics.dt) auto_dt = build_model(scene).dt;
+    timing_ = hil_timing(params_.rate, scene.numerics.dt, auto_dt);
+    scene.numerics.dt = timing_.dt;
+    sim_ = std::make_unique<Simulation>(scene);
+  } catch (const SceneError& e) {
+    throw ParamError("parameter ~scene = '" + params_.scene + "': " + e.what());
+  }
+  const Model& m = sim_->model();
+  external_ = external_pantographs(m);
+  commanded_speed_ = scene.train_speed;
+  std::string err;
+  if (!sim_->set_max_acceleration(params_.hold_deceleration, &err)) throw ParamError("parameter ~hil/hold_deceleration: " + err);
+  hold_ = MeasurementHold(external_.size());
+  accept_buf_.assign(external_.size(), 0.0);
+  hold_from_.assign(m.pantographs.size(), 0.0);
+  recorder_ = std::make_unique<PassRecorder>(m, kRecorderRowRate);
+  recorder_->record(m, sim_->state());
+  stamp_offset_ = std::floor(ros::WallTime::now().toSec());
+
+  point_pub_ = nh_.advertise<ContactPointArray>("hil/contact_point", 10);
+  contact_pub_ = nh_.advertise<ContactForceArray>("contact_force", 10);
+  marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
+  // The rig's measurements on a queue of their own, waited on by the loop; TCP_NODELAY: no
+  // Nagle delay on the small messages (the hint is also applied to the rig's end of the socket).
+  ros::SubscribeOptions so = ros::SubscribeOptions::create<MeasuredContactForce>(
+      "hil/contact_force", 100, [this](const MeasuredContactForce::ConstPtr& msg) { on_measurement(msg); },
+      ros::VoidPtr(), &hil_queue_);
+  so.transport_hints = ros::TransportHints().tcpNoDelay();
+  force_sub_ = nh_.subscribe(so);
+
+  updater_.setHardwareID("catenary_sim_hil/" + scene.name);
+  updater_.add("hardware in the loop", this, &HilNode::diagnose);
+
+  std::string names;
+  for (int p : external_) names += (names.empty() ? "" : ", ") + m.pantographs[p].name;
+  ROS_INFO("catenary_sim_hil: scene %s: %d DOFs, external pantograph(s) %s; loop %g Hz (period %g ms) = %d step(s) "
+           "of dt %.6g ms (stability limit %.4g ms); speed %.1f km/h; timeout %g s; %s; at_end %s",
+           scene.name.c_str(), m.n_dof, names.c_str(), params_.rate, timing_.period * 1e3, timing_.steps_per_period,
+           m.dt * 1e3, m.dt_critical * 1e3, scene.train_speed * 3.6, params_.timeout,
+           params_.extrapolate ? "linear extrapolation" : "newest measurement held", to_string(params_.at_end));
+  ROS_INFO("catenary_sim_hil: waiting for the first measurement on %s (the line holds its static state)",
+           force_sub_.getTopic().c_str());
+  worker_ = std::thread([this] { worker(); });
+}
+
+HilNode::~HilNode() {
+  {
+    std::lock_guard<std::mutex> l(snap_mu_);
+    stop_worker_ = true;
+  }
+  snap_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void HilNode::on_measurement(const MeasuredContactForce::ConstPtr& msg) {
+  const double arrival = steady_now();
+  const std::size_t n = external_.size();
+  if (msg->force.size() != n) {
+    ++c_.rejected;
+    ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil: hil/contact_force with %zu values rejected: the scene has %zu external "
+                       "pantograph(s), send one total force (N) each in scene order; measurement ignored",
+                       msg->force.size(), n);
+    return;
+  }
+  // The core checks each value (NaN, inf, range); a rejected message changes nothing.
+  std::string err;
+  for (std::size_t i = 0; i < n; ++i) accept_buf_[i] = sim_->state().external_force[external_[i]];
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!sim_->set_external_force(external_[i], msg->force[i], &err)) {
+      for (std::size_t j = 0; j < i; ++j) sim_->set_external_force(external_[j], accept_buf_[j], nullptr);
+      ++c_.rejected;
+      ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil: hil/contact_force.force[%zu]: %s; measurement ignored, the previous "
+                         "one stays in effect (%lld rejected so far)", i, err.c_str(), static_cast<long long>(c_.rejected));
+      return;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) accept_buf_[i] = sim_->state().external_force[external_[i]];
+  const double stamp = msg->header.stamp.toSec();
+  if (stamp > 0.0) {
+    const double transport = ros::WallTime::now().toSec() - stamp;
+    if (transport >= 0.0 && transport < 1.0) transport_.add(transport);
+  }
+  if (unused_) ++c_.superseded;
+  hold_.accept(accept_buf_, arrival, stamp, msg->step);
+  unused_ = true;
+  ++c_.accepted;
+  // Which period it starts. An answer to the last contact point published starts the next period
+  // (a rig that sends no step is taken as answering the last one). An answer to an older one is
+  // late: if the last period ran at its deadline without a measurement, this is the answer that
+  // period lacked, so it is held but starts nothing (else it would take the next period and push
+  // every later answer a period back); otherwise the rig is a period behind (its round trip is
+  // longer than a period) and it starts the next period like any other.
+  if (msg->step == 0 || msg->step >= published_step_) {
+    fresh_ = true;
+    owed_ = false;
+  } else {
+    ++c_.late;
+    if (owed_) owed_ = false;
+    else fresh_ = true;
+  }
+}
+
+int HilNode::run() {
+  const double period = timing_.period, half = 0.5 * period;
+  publish_point();
+  double w = steady_now() + period;  // centre of the next period's window
+  const double start_wait_end = steady_now() + params_.start_delay;
+  if (params_.start_delay > 0.0) ROS_INFO("catenary_sim_hil: measurements ignored for %g s (~start_delay)", params_.start_delay);
+  next_snapshot_ = next_quantiles_ = steady_now();
+  // (ros::ok() stays true while a shutdown closes the connections: without the second test the
+  // rig's measurements would seem to stop and the loop enter the safe hold on its way out)
+  auto running = [] { return ros::ok() && !ros::isShuttingDown(); };
+  bool relock = false;  // centre the windows on the next arrival
+  int off_centre = 0;   // triggering arrivals in a row more than a quarter period off the centre
+  while (running() && !exit_requested_) {
+    // Wait for a fresh measurement inside the window, or for the window's end.
+    double t = steady_now();
+    while (running()) {
+      if (fresh_ && t >= w - half) break;
+      if (t >= w + half) break;
+      const double until = fresh_ ? w - half : w + half;
+      hil_queue_.callAvailable(ros::WallDuration(std::max(0.0, until - t)));
+      t = steady_now();
+    }
+    if (!running()) break;
+    if (mode_ == Mode::kWaiting && t < start_wait_end) fresh_ = false;  // (~start_delay)
+    const bool triggered = fresh_;
+    if (mode_ == Mode::kWaiting && triggered) {
+      w = t;  // the schedule starts on the rig's first measurement
+      started_ = t;
+      relock = false;
+      ROS_INFO("catenary_sim_hil: first measurement received: running");
+    } else if (triggered && relock) {
+      w = std::max(t, w - half);  // centre the windows on this arrival (never earlier than this window)
+      relock = false;
+      ++c_.relocks;
+    }
+    batch(t, triggered);
+    // Phase lock on the arrival of the measurement (not on the start of the steps, which waits for
+    // the window of an early one). Arrivals far off the centre for many periods in a row (the
+    // rig's phase changed) make the next one the centre at once.
+    if (triggered) {
+      const double offset = hold_.arrival() - w;
+      off_centre = std::fabs(offset) > 0.25 * period ? off_centre + 1 : 0;
+      if (off_centre >= kRelockPeriods) {
+        relock = true;
+        off_centre = 0;
+      }
+      w += period + std::clamp(kLockGain * offset, -kLockMax * period, kLockMax * period);
+    } else {
+      w += period;
+    }
+    const double done = steady_now();
+    if (done >= next_snapshot_) snapshot(done);
+    if (done > w + half) {
+      // The next window closed before its steps could begin: the loop fell behind. Drop the
+      // missed periods (dt is never stretched; simulation time falls behind the wall clock) but
+      // keep the windows' phase, which is locked onto the rig.
+      ++c_.overruns;
+      const double missed = std::ceil((done - (w + half)) / period);
+      ROS_WARN_THROTTLE(5.0, "catenary_sim_hil: overrun: the loop is %.3f ms behind its %g Hz schedule (%lld overruns "
+                        "so far); %g period(s) dropped", (done - w) * 1e3, params_.rate,
+                        static_cast<long long>(c_.overruns), missed);
+      w += missed * period;
+      relock = true;  // the windows' phase relative to the rig is lost: the next arrival sets it
+    }
+  }
+  write_report();
+  return exit_code_;
+}
+
+void HilNode::enter_hold(double t, double age) {
+  mode_ = Mode::kHold;
+  ++c_.holds;
+  hold_start_time_ = sim_->state().time;
+  for (int p : external_) hold_from_[p] = sim_->state().external_force[p];
+  std::string err;
+  sim_->set_target_speed(0.0, &err);
+  ROS_ERROR("catenary_sim_hil: no valid hil/contact_force for %.3f s (> ~hil/timeout = %g s): safe hold: the train "
+            "stops (%g m/s^2) and the applied force ramps to the static uplift over %g s",
+            std::isfinite(age) ? age : (t - started_), params_.timeout, params_.hold_deceleration, params_.hold_ramp);
+}
+
+void HilNode::leave_hold() {
+  mode_ = Mode::kRunning;
+  std::string err;
+  sim_->set_target_speed(commanded_speed_, &err);
+  ROS_WARN("catenary_sim_hil: fresh hil/contact_force: safe hold ended after %.3f s of simulation; the train "
+           "accelerates back to %.1f km/h", sim_->state().time - hold_start_time_, commanded_speed_ * 3.6);
+}
+
+void HilNode::batch(double t, bool triggered) {
+  if (mode_ == Mode::kEnded || (mode_ == Mode::kWaiting && !triggered)) {
+    fresh_ = unused_ = false;  // (a measurement while waiting starts the run; after the end it changes nothing)
+    publish_point();
+    return;
+  }
+  if (mode_ == Mode::kWaiting) mode_ = Mode::kRunning;
+  const double age = hold_.age(t);
+  if (mode_ == Mode::kRunning && age > params_.timeout) enter_hold(t, age);
+  else if (mode_ == Mode::kHold && triggered) leave_hold();
+  ++c_.batches;
+  if (triggered) ++c_.triggered;
+  if (mode_ == Mode::kHold) ++c_.hold_batches;
+  else if (!triggered) ++c_.held;
+  if (mode_ == Mode::kRunning) c_.max_age_running = std::max(c_.max_age_running, age);
+  age_in_effect_ = std::isfinite(age) ? age : -1.0;
+  step_in_effect_ = mode_ == Mode::kRunning ? hold_.step() : 0;
+
+  const Model& m = sim_->model();
+  std::string err;
+  for (int j = 0; j < timing_.steps_per_period; ++j) {
+    const State& s = sim_->state();
+    for (std::size_t i = 0; i < external_.size(); ++i) {
+      const int p = external_[i];
+      double f;
+      if (mode_ == Mode::kHold) {
+        const double static_force = s.uplift[p] + m.pantographs[p].aero_coefficient * s.speed * s.speed;
+        f = hold_ramp_force(hold_from_[p], static_force, s.time - hold_start_time_, params_.hold_ramp);
+      } else {
+        f = hold_.value(i, t + j * timing_.dt, params_.extrapolate, params_.timeout);
+      }
+      f = std::clamp(f, 0.0, Simulation::kMaxExternalForce);
+      sim_->set_external_force(p, f, &err);  // (finite and in range: cannot fail)
+    }
+    if (sim_->finished() || sim_->step() != StepStatus::kOk) break;
+    recorder_->record(m, sim_->state());
+  }
+  publish_point();
+  const double published = steady_now();
+  compute_.add(published - t);
+  if (published - t > timing_.period)
+    ROS_WARN_THROTTLE(5.0, "catenary_sim_hil: a period's steps and contact point took %.3f ms (period %g ms) at t = "
+                      "%.4f s", (published - t) * 1e3, timing_.period * 1e3, sim_->state().time);
+  if (unused_) latency_.add(published - hold_.arrival());  // the first output computed with it
+  unused_ = false;
+  owed_ = !triggered && mode_ == Mode::kRunning;  // ran at the deadline: its measurement may still come
+  if (triggered) {
+    wait_.add(t - hold_.arrival());
+  }
+  fresh_ = false;
+  if (published >= next_quantiles_) {
+    next_quantiles_ = published + kQuantilePeriod;
+    q_latency_[0] = latency_.quantile(0.5);
+    q_latency_[1] = latency_.quantile(0.99);
+    q_latency_[2] = latency_.max();
+  }
+  handle_end();
+}
+
+void HilNode::publish_point() {
+  const Model& m = sim_->model();
+  const State& s = sim_->state();
+  ContactPointArray msg =
+      to_contact_points(m, s, sim_stamp(s.time, stamp_offset_), params_.line_frame, timing_.steps_per_period, scratch_);
+  msg.mode = mode_code(mode_);
+  msg.pass_count = pass_count_;
+  msg.measurement_step = step_in_effect_;
+  for (ContactPoint& c : msg.pantographs) c.measurement_age = age_in_effect_;
+  if (!all_finite(msg)) {
+    ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil: a contact point with a non-finite value was not published (t = %g s)", s.time);
+    return;
+  }
+  point_pub_.publish(msg);
+  published_step_ = msg.step;
+}
+
+void HilNode::handle_end() {
+  const State& s = sim_->state();
+  if (mode_ == Mode::kEnded) return;
+  const bool diverged = s.status == StepStatus::kDiverged;
+  if (!diverged && !sim_->finished()) return;
+  // The pass is over: its statistics go to the worker thread (filtering takes milliseconds).
+  {
+    std::lock_guard<std::mutex> l(snap_mu_);
+    finished_recorder_ = std::move(recorder_);
+    finished_state_ = s;
+  }
+  snap_cv_.notify_all();
+  recorder_ = std::make_unique<PassRecorder>(sim_->model(), kRecorderRowRate);
+  if (diverged) {
+    diverged_ = true;
+    ROS_ERROR("catenary_sim_hil: %s", sim_->status_message().c_str());
+  } else {
+    ROS_INFO("catenary_sim_hil: pass %u finished at t = %.4f s (train front at %.2f m): %lld periods, %lld overruns",
+             pass_count_, s.time, s.front, static_cast<long long>(c_.batches), static_cast<long long>(c_.overruns));
+  }
+  if (!diverged && params_.at_end == AtEnd::kLoop) {
+    // A new pass from the initial static state with the static force (no new static solve), the
+    // clock running on; pass_count tells the rig to re-initialise.
+    for (int p : external_) sim_->set_external_force(p, sim_->state().uplift[p], nullptr);
+    sim_->reset(true);
+    ++pass_count_;
+    recorder_->record(sim_->model(), sim_->state());
+    return;
+  }
+  mode_ = Mode::kEnded;
+  if (params_.at_end == AtEnd::kExit) {
+    exit_requested_ = true;
+    exit_code_ = diverged ? 1 : 0;
+  }
+}
+
+void HilNode::snapshot(double t) {
+  next_snapshot_ = t + 1.0 / params_.publish_rate;
+  std::unique_lock<std::mutex> l(snap_mu_, std::try_to_lock);
+  if (!l.owns_lock()) return;  // the worker is busy: next time
+  snap_.state = sim_->state();
+  snap_.mode = mode_;
+  snap_.counters = c_;
+  snap_.age = hold_.has_value() ? hold_.age(t) : -1.0;
+  snap_.age_in_effect = age_in_effect_;
+  std::copy(q_latency_, q_latency_ + 3, snap_.latency);
+  snap_.diverged = diverged_;
+  snap_.pass_count = pass_count_;
+  snap_new_ = true;
+  l.unlock();
+  snap_cv_.notify_all();
+}
+
+void HilNode::worker() {
+  // Slow work at normal priority even when the loop thread was made real-time.
+  sched_param sp{};
+  pthread_setschedparam(pthread_self(), SCHED_OTHER, &sp);
+  const Model& m = sim_->model();
+  while (true) {
+    std::unique_ptr<PassRecorder> finished;
+    State finished_state;
+    bool have = false;
+    {
+      std::unique_lock<std::mutex> l(snap_mu_);
+      snap_cv_.wait_for(l, std::chrono::milliseconds(100),
+                        [this] { return snap_new_ || stop_worker_ || finished_recorder_ != nullptr; });
+      if (stop_worker_) return;
+      if (snap_new_) {
+        std::swap(wsnap_, snap_);
+        snap_new_ = false;
+        have = true;
+      }
+      if (finished_recorder_) {
+        finished = std::move(finished_recorder_);
+        finished_state = finished_state_;
+      }
+    }
+    if (have) {
+      const State& s = wsnap_.state;
+      const ros::Time stamp = sim_stamp(s.time, stamp_offset_);
+      contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
+      if (s.time > last_tf_time_) {
+        tf_.sendTransform(to_transforms(m, s, stamp, params_.line_frame));
+        last_tf_time_ = s.time;
+      }
+      const double now = steady_now();
+      if (now >= next_marker_wall_ && marker_pub_.getNumSubscribers() > 0) {
+        next_marker_wall_ = now + 1.0 / params_.marker_rate;
+        MarkerOptions o;
+        o.frame = params_.line_frame;
+        marker_pub_.publish(to_markers(m, s, stamp, o));
+        if (stamp != last_view_stamp_) {
+          tf_.sendTransform(to_view_transform(s, stamp, params_.line_frame));
+          last_view_stamp_ = stamp;
+        }
+      }
+    }
+    if (finished) {
+      const std::vector<PantographStatistics> stats = finished->statistics(m);
+      for (const PantographStatistics& st : stats) {
+        ROS_INFO("catenary_sim_hil: %s: mean %.1f N, std %.1f N, max %.1f N, min %.1f N, contact loss %.2f %% "
+                 "(%zu samples, filtered %.0f Hz)", st.name.c_str(), st.filtered.mean, st.filtered.std_dev,
+                 st.filtered.max, st.filtered.min, st.contact_loss_percent, st.samples, m.scene.output.filter_cutoff);
+      }
+      if (!params_.stats_file.empty()) {
+        std::ofstream f(params_.stats_file);
+        f << statistics_json(m, finished_state, stats, RunInfo{-1.0, -1.0, wsnap_.counters.overruns});
+        if (!f) ROS_ERROR("catenary_sim_hil: cannot write ~stats_file '%s'", params_.stats_file.c_str());
+      }
+    }
+    updater_.update();
+  }
+}
+
+void HilNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const Snapshot& s = wsnap_;
+  const Counters& c = s.counters;
+  using diagnostic_msgs::DiagnosticStatus;
+  char what[256];
+  switch (s.mode) {
+    case Mode::kWaiting:
+      stat.summary(DiagnosticStatus::WARN, "waiting for the first measurement on hil/contact_force");
+      break;
+    case Mode::kRunning:
+      if (s.state.speed < commanded_speed_ - 1e-9)
+        stat.summary(DiagnosticStatus::WARN, "running: the train accelerates back after a safe hold");
+      else
+        stat.summary(DiagnosticStatus::OK, "running");
+      break;
+    case Mode::kHold:
+      std::snprintf(what, sizeof what,
+                    "SAFE HOLD: no valid hil/contact_force for %.3f s (> ~hil/timeout = %g s); train stopping, force "
+                    "ramped to the static uplift", s.age, params_.timeout);
+      stat.summary(DiagnosticStatus::ERROR, what);
+      break;
+    case Mode::kEnded:
+      if (s.diverged) stat.summary(DiagnosticStatus::ERROR, "diverged: the loop is stopped");
+      else stat.summary(DiagnosticStatus::OK, "pass finished");
+      break;
+  }
+  stat.add("mode", s.mode == Mode::kWaiting ? "waiting" : s.mode == Mode::kRunning ? "running"
+                   : s.mode == Mode::kHold ? "safe hold" : "ended");
+  stat.add("measurement age [s]", s.age);
+  stat.add("age of the measurement in effect [s]", s.age_in_effect);
+  stat.add("max measurement age while running [s]", c.max_age_running);
+  stat.add("timeout [s]", params_.timeout);
+  stat.add("rate [Hz]", params_.rate);
+  stat.add("dt [s]", sim_->model().dt);
+  stat.add("steps per period", timing_.steps_per_period);
+  stat.add("periods", c.batches);
+  stat.add("periods started by a measurement", c.triggered);
+  stat.add("periods with the held measurement", c.held);
+  stat.add("periods in safe hold", c.hold_batches);
+  stat.add("safe holds", c.holds);
+  stat.add("overruns", c.overruns);
+  stat.add("measurements accepted", c.accepted);
+  stat.add("measurements rejected", c.rejected);
+  stat.add("measurements superseded", c.superseded);
+  stat.add("measurements late (answering an older contact point)", c.late);
+  stat.add("latency p50 [s]", s.latency[0]);
+  stat.add("latency p99 [s]", s.latency[1]);
+  stat.add("latency max [s]", s.latency[2]);
+  stat.add("sim time [s]", s.state.time);
+  stat.add("steps", s.state.steps);
+  stat.add("train front [m]", s.state.front);
+  stat.add("speed [m/s]", s.state.speed);
+  stat.add("pass", s.pass_count);
+}
+
+void HilNode::write_report() const {
+  const double wall = started_ > 0.0 ? steady_now() - started_ : 0.0;
+  // (printf: after a shutdown rosconsole no longer prints)
+  std::printf("catenary_sim_hil: %lld periods in %.1f s, %lld overruns, %lld safe holds; latency (measurement arrival "
+              "-> contact point published) p50 %.1f us, p99 %.1f us, max %.1f us over %llu measurements\n",
+              static_cast<long long>(c_.batches), wall, static_cast<long long>(c_.overruns),
+              static_cast<long long>(c_.holds), latency_.quantile(0.5) * 1e6, latency_.quantile(0.99) * 1e6,
+              latency_.max() * 1e6, static_cast<unsigned long long>(latency_.count()));
+  std::fflush(stdout);
+  if (params_.report_file.empty()) return;
+  auto hist = [](const LatencyHistogram& h) {
+    std::ostringstream j;
+    j << "{\"count\": " << h.count() << ", \"mean_s\": " << json_number(h.mean())
+      << ", \"p50_s\": " << json_number(h.quantile(0.5)) << ", \"p90_s\": " << json_number(h.quantile(0.9))
+      << ", \"p99_s\": " << json_number(h.quantile(0.99)) << ", \"p999_s\": " << json_number(h.quantile(0.999))
+      << ", \"max_s\": " << json_number(h.max()) << "}";
+    return j.str();
+  };
+  std::ofstream f(params_.report_file);
+  f << "{\n  \"rate_hz\": " << json_number(params_.rate) << ",\n  \"period_s\": " << json_number(timing_.period)
+    << ",\n  \"dt_s\": " << json_number(sim_->model().dt) << ",\n  \"steps_per_period\": " << timing_.steps_per_period
+    << ",\n  \"dofs\": " << sim_->model().n_dof << ",\n  \"wall_s\": " << json_number(wall)
+    << ",\n  \"sim_time_s\": " << json_number(sim_->state().time) << ",\n  \"passes\": " << pass_count_ + 1
+    << ",\n  \"periods\": " << c_.batches << ",\n  \"periods_triggered\": " << c_.triggered
+    << ",\n  \"periods_held\": " << c_.held << ",\n  \"periods_safe_hold\": " << c_.hold_batches
+    << ",\n  \"safe_holds\": " << c_.holds << ",\n  \"overruns\": " << c_.overruns
+    << ",\n  \"relocks\": " << c_.relocks
+    << ",\n  \"measurements_accepted\": " << c_.accepted << ",\n  \"measurements_rejected\": " << c_.rejected
+    << ",\n  \"measurements_superseded\": " << c_.superseded << ",\n  \"measurements_late\": " << c_.late
+    << ",\n  \"max_age_running_s\": " << json_number(c_.max_age_running)
+    << ",\n  \"latency\": " << hist(latency_) << ",\n  \"compute\": " << hist(compute_) << ",\n  \"wait\": " << hist(wait_)
+    << ",\n  \"transport\": " << hist(transport_) << "\n}\n";
+  if (!f) ROS_ERROR("catenary_sim_hil: cannot write ~hil/report_file '%s'", params_.report_file.c_str());
+}
+
+}  // namespace ros_layer
+}  // namespace catenary_sim
