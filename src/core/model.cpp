@@ -92,8 +92,8 @@ int Wire::element_at(double xs) const {
   return std::clamp(e, 0, n - 2);
 }
 
-void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta) {
-  const int n = wire.nodes();
+void condensed_band_force(const Wire& wire, int lo, int hi, const double end_correction[4], const double* lower,
+                          const double* inv_pivot, const double* z, double* f, double* theta) {
   const double* w = z + wire.w_dof;
   double* fw = f + wire.w_dof;
   const double* dww = wire.d_ww.data();
@@ -101,34 +101,53 @@ void wire_elastic_force(const Wire& wire, const double* z, double* f, double* th
   const double* eww = wire.e_ww.data();
   const double* ewt = wire.e_wt.data();
   const double* etw = wire.e_tw.data();
-  const double* t;
-  if (wire.theta_dof < 0) {
-    // Massless rotations, condensed exactly: K_tt theta = -K_tw w (tridiagonal, LDL^T reused).
-    const double* lo = wire.tt_lower.data();
-    const double* ip = wire.tt_inv_pivot.data();
-    double prev = 0.0;
-    for (int i = 0; i < n; ++i) {
-      double r = -dwt[i] * w[i];
-      if (i + 1 < n) r -= etw[i] * w[i + 1];
-      if (i > 0) r -= ewt[i - 1] * w[i - 1];
-      prev = r - lo[i] * prev;
-      theta[i] = prev;
-    }
-    theta[n - 1] *= ip[n - 1];
-    for (int i = n - 2; i >= 0; --i) theta[i] = theta[i] * ip[i] - lo[i + 1] * theta[i + 1];
-    t = theta;
-  } else {
-    t = z + wire.theta_dof;
-    double* ft = f + wire.theta_dof;
-    const double* dtt = wire.d_tt.data();
-    const double* ett = wire.e_tt.data();
-    for (int i = 0; i < n; ++i) ft[i] -= dwt[i] * w[i] + dtt[i] * t[i];
-    for (int e = 0; e + 1 < n; ++e) {
-      ft[e] -= etw[e] * w[e + 1] + ett[e] * t[e + 1];
-      ft[e + 1] -= ewt[e] * w[e] + ett[e] * t[e];
-    }
-    std::copy(t, t + n, theta);
+  // Diagonal blocks less the share of elements left out at the ends (a window's cut).
+  auto dww_at = [&](int i) { return dww[i] - (i == lo ? end_correction[0] : 0.0) - (i == hi ? end_correction[2] : 0.0); };
+  auto dwt_at = [&](int i) { return dwt[i] - (i == lo ? end_correction[1] : 0.0) - (i == hi ? end_correction[3] : 0.0); };
+  // Massless rotations, condensed exactly: K_tt theta = -K_tw w (tridiagonal, LDL^T given).
+  double prev = 0.0;
+  for (int i = lo; i <= hi; ++i) {
+    double r = -dwt_at(i) * w[i];
+    if (i < hi) r -= etw[i] * w[i + 1];
+    if (i > lo) r -= ewt[i - 1] * w[i - 1];
+    prev = r - (i > lo ? lower[i] * prev : 0.0);
+    theta[i] = prev;
   }
+  theta[hi] *= inv_pivot[hi];
+  for (int i = hi - 1; i >= lo; --i) theta[i] = theta[i] * inv_pivot[i] - lower[i + 1] * theta[i + 1];
+  fw[lo] -= dww_at(lo) * w[lo] + dwt_at(lo) * theta[lo];
+  for (int i = lo + 1; i <= hi; ++i) {
+    const int e = i - 1;
+    fw[i] -= dww_at(i) * w[i] + dwt_at(i) * theta[i] + eww[e] * w[e] + etw[e] * theta[e];
+    fw[e] -= eww[e] * w[i] + ewt[e] * theta[i];
+  }
+}
+
+void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta) {
+  const int n = wire.nodes();
+  if (wire.theta_dof < 0) {
+    static constexpr double kNone[4] = {0.0, 0.0, 0.0, 0.0};
+    condensed_band_force(wire, 0, n - 1, kNone, wire.tt_lower.data(), wire.tt_inv_pivot.data(), z, f, theta);
+    return;
+  }
+  const double* w = z + wire.w_dof;
+  double* fw = f + wire.w_dof;
+  const double* dww = wire.d_ww.data();
+  const double* dwt = wire.d_wt.data();
+  const double* eww = wire.e_ww.data();
+  const double* ewt = wire.e_wt.data();
+  const double* etw = wire.e_tw.data();
+  // Rotations as DOFs (HRZ rotary inertia): the full band.
+  const double* t = z + wire.theta_dof;
+  double* ft = f + wire.theta_dof;
+  const double* dtt = wire.d_tt.data();
+  const double* ett = wire.e_tt.data();
+  for (int i = 0; i < n; ++i) ft[i] -= dwt[i] * w[i] + dtt[i] * t[i];
+  for (int e = 0; e + 1 < n; ++e) {
+    ft[e] -= etw[e] * w[e + 1] + ett[e] * t[e + 1];
+    ft[e + 1] -= ewt[e] * w[e] + ett[e] * t[e];
+  }
+  std::copy(t, t + n, theta);
   fw[0] -= dww[0] * w[0] + dwt[0] * t[0];
   for (int i = 1; i < n; ++i) {
     const int e = i - 1;

@@ -99,36 +99,9 @@ void update_window(const Model& m, State& s) {
 }
 
 void wire_elastic_force_window(const Wire& wire, const WireWindow& ww, const double* z, double* f, double* theta) {
-  const int lo = ww.lo, hi = ww.hi;
-  if (hi < lo) return;
-  const double* w = z + wire.w_dof;
-  double* fw = f + wire.w_dof;
-  const double* dww = wire.d_ww.data();
-  const double* dwt = wire.d_wt.data();
-  const double* eww = wire.e_ww.data();
-  const double* ewt = wire.e_wt.data();
-  const double* etw = wire.e_tw.data();
-  const double* lower = ww.tt_lower.data();
-  const double* ip = ww.tt_inv_pivot.data();
-  auto dwt_at = [&](int i) { return dwt[i] - (i == lo ? ww.lo_wt : 0.0) - (i == hi ? ww.hi_wt : 0.0); };
-  auto dww_at = [&](int i) { return dww[i] - (i == lo ? ww.lo_ww : 0.0) - (i == hi ? ww.hi_ww : 0.0); };
-  // Condensed rotations over the window: K_tt theta = -K_tw w.
-  double prev = 0.0;
-  for (int i = lo; i <= hi; ++i) {
-    double r = -dwt_at(i) * w[i];
-    if (i < hi) r -= etw[i] * w[i + 1];
-    if (i > lo) r -= ewt[i - 1] * w[i - 1];
-    prev = r - (i > lo ? lower[i] * prev : 0.0);
-    theta[i] = prev;
-  }
-  theta[hi] *= ip[hi];
-  for (int i = hi - 1; i >= lo; --i) theta[i] = theta[i] * ip[i] - lower[i + 1] * theta[i + 1];
-  fw[lo] -= dww_at(lo) * w[lo] + dwt_at(lo) * theta[lo];
-  for (int i = lo + 1; i <= hi; ++i) {
-    const int e = i - 1;
-    fw[i] -= dww_at(i) * w[i] + dwt_at(i) * theta[i] + eww[e] * w[e] + etw[e] * theta[e];
-    fw[e] -= eww[e] * w[i] + ewt[e] * theta[i];
-  }
+  if (ww.hi < ww.lo) return;
+  const double ends[4] = {ww.lo_ww, ww.lo_wt, ww.hi_ww, ww.hi_wt};
+  condensed_band_force(wire, ww.lo, ww.hi, ends, ww.tt_lower.data(), ww.tt_inv_pivot.data(), z, f, theta);
 }
 
 }  // namespace catenary_sim

@@ -157,6 +157,12 @@ void apply_stiffness(const Model& model, double front, const double* x, double* 
 // condensed or taken from z). `theta` is scratch (nodes entries) and returns the rotations used.
 void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta);
 
+// The condensed band's force on nodes lo..hi of a wire (f -= K z), given the LDL^T factors of
+// K_theta_theta over that range and the diagonal shares (ww, wt at lo, then at hi) of elements
+// left out at the ends. Shared by the whole wire and the moving window.
+void condensed_band_force(const Wire& wire, int lo, int hi, const double end_correction[4], const double* lower,
+                          const double* inv_pivot, const double* z, double* f, double* theta);
+
 // Weights of the contact wire's nodes for a distributed contact centred at xc (eq. 10-13): the
 // collector height is sum w_i y_i (eq. 12) and its force is spread as F w_i. Returns the count,
 // at most model.max_contact_nodes; 0 if xc is off the wire.
