@@ -6,8 +6,9 @@
 // under each pantograph (hil/contact_point). The loop is paced on the wall clock: each period
 // has a window one period wide; a fresh measurement that arrives inside it starts the steps at
 // once (so the output follows the input by the computation time only), else the steps start at
-// the window's end with the held measurement. The windows lock slowly (at most 0.1 % of a period
-// per period) onto the arrivals of a rig that sends at the same rate. Input older than
+// the window's end with the held measurement. The windows lock onto the arrivals of a rig that
+// sends on its own clock at the same rate (at most 0.2 % of a period per period); a late answer
+// that belongs to a period already run at its deadline starts nothing. Input older than
 // ~hil/timeout puts the line into the safe hold (README "Hardware in the loop").
 //
 // Slow publications (contact_force, tf, markers, diagnostics, pass statistics) run on a second
