@@ -1,4 +1,5 @@
 #include "catenary_sim/ros/hil.hpp"
+#include "catenary_sim/ros/params.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,11 +10,6 @@ namespace ros_layer {
 
 namespace {
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 
 constexpr double kBinWidth = 1e-6;   // s
 constexpr std::size_t kBins = 10000;  // up to 10 ms
@@ -22,7 +18,7 @@ constexpr std::size_t kBins = 10000;  // up to 10 ms
 
 HilTiming hil_timing(double rate, std::optional<double> scene_dt, double auto_dt) {
   if (!std::isfinite(rate) || rate < 1000.0 || rate > 10000.0)
-    throw ParamError("parameter ~hil/rate = " + fmt(rate) + " rejected: allowed [1000, 10000] Hz");
+    throw ParamError("parameter ~hil/rate = " + format_number(rate) + " rejected: allowed [1000, 10000] Hz");
   HilTiming t;
   t.period = 1.0 / rate;
   if (scene_dt) {
@@ -30,14 +26,14 @@ HilTiming hil_timing(double rate, std::optional<double> scene_dt, double auto_dt
     const double kr = std::round(k);
     if (kr < 1.0 || std::fabs(k - kr) > 1e-6 * kr) {
       const int k_auto = static_cast<int>(std::ceil(t.period / *scene_dt - 1e-9));
-      throw ParamError("numerics.dt = " + fmt(*scene_dt) + " s of ~scene does not divide the loop period " +
-                       fmt(t.period) + " s of ~hil/rate = " + fmt(rate) +
+      throw ParamError("numerics.dt = " + format_number(*scene_dt) + " s of ~scene does not divide the loop period " +
+                       format_number(t.period) + " s of ~hil/rate = " + format_number(rate) +
                        " Hz: the period must be a whole number of core steps; use numerics.dt = period / k, e.g. " +
-                       fmt(t.period / std::max(1, k_auto)) + " s, or numerics.dt: auto (the node then chooses it)");
+                       format_number(t.period / std::max(1, k_auto)) + " s, or numerics.dt: auto (the node then chooses it)");
     }
     t.steps_per_period = static_cast<int>(kr);
   } else {
-    if (!(auto_dt > 0.0)) throw ParamError("~scene: the automatic dt is " + fmt(auto_dt) + " s");
+    if (!(auto_dt > 0.0)) throw ParamError("~scene: the automatic dt is " + format_number(auto_dt) + " s");
     t.steps_per_period = static_cast<int>(std::ceil(t.period / auto_dt - 1e-9));
   }
   t.dt = t.period / t.steps_per_period;

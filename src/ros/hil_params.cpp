@@ -7,41 +7,25 @@
 
 #include "catenary_sim/core/scene.hpp"
 #include "catenary_sim/ros/hil.hpp"
+#include "catenary_sim/ros/params.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
 
-namespace {
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-void check(const char* name, double v, double lo, double hi, bool lo_open, const char* unit) {
-  const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi;
-  if (!ok)
-    throw ParamError(std::string("parameter ~") + name + " = " + fmt(v) + " rejected: allowed " +
-                     (lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + "] " + unit);
-}
-
-}  // namespace
-
 void validate_hil_params(const HilParams& p) {
   if (p.scene.empty())
     throw ParamError("parameter ~scene is required: path of a scene YAML file with a `type: external` pantograph");
-  if (p.speed_kmh) check("speed_kmh", *p.speed_kmh, 0.0, 540.0, false, "km/h");
-  check("hil/rate", p.rate, 1000.0, 10000.0, false, "Hz");
+  if (p.speed_kmh) check_range("speed_kmh", *p.speed_kmh, 0.0, 540.0, false, "km/h");
+  check_range("hil/rate", p.rate, 1000.0, 10000.0, false, "Hz");
   const double period = 1.0 / p.rate;
   if (!std::isfinite(p.timeout) || p.timeout < 2.0 * period || p.timeout > 10.0)
-    throw ParamError("parameter ~hil/timeout = " + fmt(p.timeout) + " s rejected: allowed [" + fmt(2.0 * period) +
-                     ", 10] s (at least two loop periods of ~hil/rate = " + fmt(p.rate) + " Hz)");
-  check("hil/hold_ramp", p.hold_ramp, 0.0, 60.0, false, "s (0: at once)");
-  check("hil/hold_deceleration", p.hold_deceleration, 0.0, 50.0, false, "m/s^2 (0: at once)");
-  check("publish_rate", p.publish_rate, 0.0, 1000.0, true, "Hz");
-  check("marker_rate", p.marker_rate, 0.0, 100.0, true, "Hz");
-  check("start_delay", p.start_delay, 0.0, 60.0, false, "s");
+    throw ParamError("parameter ~hil/timeout = " + format_number(p.timeout) + " s rejected: allowed [" + format_number(2.0 * period) +
+                     ", 10] s (at least two loop periods of ~hil/rate = " + format_number(p.rate) + " Hz)");
+  check_range("hil/hold_ramp", p.hold_ramp, 0.0, 60.0, false, "s (0: at once)");
+  check_range("hil/hold_deceleration", p.hold_deceleration, 0.0, 50.0, false, "m/s^2 (0: at once)");
+  check_range("publish_rate", p.publish_rate, 0.0, 1000.0, true, "Hz");
+  check_range("marker_rate", p.marker_rate, 0.0, 100.0, true, "Hz");
+  check_range("start_delay", p.start_delay, 0.0, 60.0, false, "s");
   if (p.line_frame.empty() || p.line_frame[0] == '/')
     throw ParamError("parameter ~line_frame = '" + p.line_frame + "' rejected: a non-empty frame id without a leading '/'");
 }

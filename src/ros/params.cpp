@@ -10,9 +10,8 @@
 namespace catenary_sim {
 namespace ros_layer {
 
-namespace {
 
-std::string fmt(double v) {
+std::string format_number(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
@@ -21,11 +20,10 @@ std::string fmt(double v) {
 void check_range(const char* name, double v, double lo, double hi, bool lo_open, const char* unit) {
   const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi;
   if (!ok)
-    throw ParamError(std::string("parameter ~") + name + " = " + fmt(v) + " rejected: allowed " +
-                     (lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + "] " + unit);
+    throw ParamError(std::string("parameter ~") + name + " = " + format_number(v) + " rejected: allowed " +
+                     (lo_open ? "(" : "[") + format_number(lo) + ", " + format_number(hi) + "] " + unit);
 }
 
-}  // namespace
 
 AtEnd parse_at_end(const std::string& s) {
   if (s == "stop") return AtEnd::kStop;
