@@ -40,16 +40,6 @@ double mono_now() {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-std::vector<WirePoint> points_of(const ContactPoint& c) {
-  std::vector<WirePoint> p(c.on_wire.size());
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    p[i].on_wire = c.on_wire[i];
-    p[i].height = c.wire_height[i];
-    p[i].path_velocity = c.wire_path_velocity[i];
-  }
-  return p;
-}
-
 class VirtualRig {
  public:
   VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
@@ -133,7 +123,7 @@ class VirtualRig {
           return;
         }
         rigs_.emplace_back(*spec, scene_.contact.stiffness);
-        points_.push_back(points_of(c));
+        points_.push_back(wire_points(c));
         rigs_.back().reset(points_.back(), msg->speed);
       }
       if (have_) ROS_INFO("virtual_rig: pass %u: pantograph(s) reset at the static state", msg->pass_count);
@@ -144,7 +134,7 @@ class VirtualRig {
           const double ahead = extrapolate_ ? static_cast<double>(s - step_) * dt_ : 0.0;
           rigs_[i].step(dt_, rigs_[i].contact_force(points_[i], ahead), speed_);
         }
-        points_[i] = points_of(msg->pantographs[i]);
+        points_[i] = wire_points(msg->pantographs[i]);
       }
     }
     have_ = true;

@@ -7,6 +7,16 @@
 namespace catenary_sim {
 namespace ros_layer {
 
+std::vector<WirePoint> wire_points(const ContactPoint& c) {
+  std::vector<WirePoint> p(c.on_wire.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p[i].on_wire = c.on_wire[i];
+    p[i].height = c.wire_height[i];
+    p[i].path_velocity = c.wire_path_velocity[i];
+  }
+  return p;
+}
+
 RigPantograph::RigPantograph(const PantographSpec& spec, double k0) : spec_(spec), k0_(k0) {
   if (spec.moving_force || spec.external || spec.masses.empty())
     throw std::invalid_argument("virtual rig: pantograph '" + spec.name +

@@ -48,16 +48,6 @@ Scene external_of(Scene s) {
   return s;
 }
 
-std::vector<WirePoint> points_of(const ContactPoint& c) {
-  std::vector<WirePoint> p(c.on_wire.size());
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    p[i].on_wire = c.on_wire[i];
-    p[i].height = c.wire_height[i];
-    p[i].path_velocity = c.wire_path_velocity[i];
-  }
-  return p;
-}
-
 // The contact force sampled once per loop period (k steps), with the position, as the rostest
 // collects it from hil/contact_point.
 struct Series {
@@ -99,7 +89,7 @@ Series hil_pass(const Scene& lumped, int k, int delay, Simulation* keep = nullpt
   RigPantograph rig(lumped.pantographs[0], lumped.contact.stiffness);
   std::vector<ContactPointMotion> scratch;
   ContactPointArray msg = to_contact_points(m, sim.state(), ros::Time(1), "line", k, scratch);
-  std::vector<WirePoint> points = points_of(msg.pantographs[0]);
+  std::vector<WirePoint> points = wire_points(msg.pantographs[0]);
   rig.reset(points, msg.speed);
   std::deque<double> answers{rig.contact_force(points)};
   std::uint64_t rig_step = msg.step;
@@ -117,7 +107,7 @@ Series hil_pass(const Scene& lumped, int k, int delay, Simulation* keep = nullpt
     for (std::uint64_t s = rig_step; s < msg.step; ++s)
       rig.step(m.dt, rig.contact_force(points, static_cast<double>(s - rig_step) * m.dt), msg.speed);
     rig_step = msg.step;
-    points = points_of(msg.pantographs[0]);
+    points = wire_points(msg.pantographs[0]);
     answers.push_back(rig.contact_force(points));
   }
   return out;

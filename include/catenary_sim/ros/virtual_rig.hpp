@@ -9,6 +9,7 @@
 
 #include <vector>
 
+#include "catenary_sim/ContactPoint.h"
 #include "catenary_sim/core/scene.hpp"
 
 namespace catenary_sim {
@@ -20,6 +21,9 @@ struct WirePoint {
   double height = 0.0;         // m, absolute
   double path_velocity = 0.0;  // m/s, rate of change of `height` seen by the moving pantograph
 };
+
+// The wire points of one pantograph's hil/contact_point entry.
+std::vector<WirePoint> wire_points(const ContactPoint& c);
 
 class RigPantograph {
  public:
