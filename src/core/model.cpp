@@ -92,17 +92,37 @@ int Wire::element_at(double xs) const {
   return std::clamp(e, 0, n - 2);
 }
 
-void condensed_band_force(const Wire& wire, int lo, int hi, const double end_correction[4], const double* lower,
-                          const double* inv_pivot, const double* z, double* f, double* theta) {
-  const double* w = z + wire.w_dof;
-  double* fw = f + wire.w_dof;
+namespace {
+
+// The vertical-displacement rows of the band product, f_w -= K_ww w + K_wt theta, over nodes
+// lo..hi, less the diagonal shares of elements left out at the ends (ww, wt at lo, then at hi).
+void band_w_rows(const Wire& wire, int lo, int hi, const double end_correction[4], const double* w,
+                 const double* theta, double* fw) {
   const double* dww = wire.d_ww.data();
   const double* dwt = wire.d_wt.data();
   const double* eww = wire.e_ww.data();
   const double* ewt = wire.e_wt.data();
   const double* etw = wire.e_tw.data();
-  // Diagonal blocks less the share of elements left out at the ends (a window's cut).
   auto dww_at = [&](int i) { return dww[i] - (i == lo ? end_correction[0] : 0.0) - (i == hi ? end_correction[2] : 0.0); };
+  auto dwt_at = [&](int i) { return dwt[i] - (i == lo ? end_correction[1] : 0.0) - (i == hi ? end_correction[3] : 0.0); };
+  fw[lo] -= dww_at(lo) * w[lo] + dwt_at(lo) * theta[lo];
+  for (int i = lo + 1; i <= hi; ++i) {
+    const int e = i - 1;
+    fw[i] -= dww_at(i) * w[i] + dwt_at(i) * theta[i] + eww[e] * w[e] + etw[e] * theta[e];
+    fw[e] -= eww[e] * w[i] + ewt[e] * theta[i];
+  }
+}
+
+}  // namespace
+
+void condensed_band_force(const Wire& wire, int lo, int hi, const double end_correction[4], const double* lower,
+                          const double* inv_pivot, const double* z, double* f, double* theta) {
+  const double* w = z + wire.w_dof;
+  double* fw = f + wire.w_dof;
+  const double* dwt = wire.d_wt.data();
+  const double* ewt = wire.e_wt.data();
+  const double* etw = wire.e_tw.data();
+  // Diagonal blocks less the share of elements left out at the ends (a window's cut).
   auto dwt_at = [&](int i) { return dwt[i] - (i == lo ? end_correction[1] : 0.0) - (i == hi ? end_correction[3] : 0.0); };
   // Massless rotations, condensed exactly: K_tt theta = -K_tw w (tridiagonal, LDL^T given).
   double prev = 0.0;
@@ -115,12 +135,7 @@ void condensed_band_force(const Wire& wire, int lo, int hi, const double end_cor
   }
   theta[hi] *= inv_pivot[hi];
   for (int i = hi - 1; i >= lo; --i) theta[i] = theta[i] * inv_pivot[i] - lower[i + 1] * theta[i + 1];
-  fw[lo] -= dww_at(lo) * w[lo] + dwt_at(lo) * theta[lo];
-  for (int i = lo + 1; i <= hi; ++i) {
-    const int e = i - 1;
-    fw[i] -= dww_at(i) * w[i] + dwt_at(i) * theta[i] + eww[e] * w[e] + etw[e] * theta[e];
-    fw[e] -= eww[e] * w[i] + ewt[e] * theta[i];
-  }
+  band_w_rows(wire, lo, hi, end_correction, w, theta, fw);
 }
 
 void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta) {
@@ -132,9 +147,7 @@ void wire_elastic_force(const Wire& wire, const double* z, double* f, double* th
   }
   const double* w = z + wire.w_dof;
   double* fw = f + wire.w_dof;
-  const double* dww = wire.d_ww.data();
   const double* dwt = wire.d_wt.data();
-  const double* eww = wire.e_ww.data();
   const double* ewt = wire.e_wt.data();
   const double* etw = wire.e_tw.data();
   // Rotations as DOFs (HRZ rotary inertia): the full band.
@@ -148,12 +161,8 @@ void wire_elastic_force(const Wire& wire, const double* z, double* f, double* th
     ft[e + 1] -= ewt[e] * w[e] + ett[e] * t[e];
   }
   std::copy(t, t + n, theta);
-  fw[0] -= dww[0] * w[0] + dwt[0] * t[0];
-  for (int i = 1; i < n; ++i) {
-    const int e = i - 1;
-    fw[i] -= dww[i] * w[i] + dwt[i] * t[i] + eww[e] * w[e] + etw[e] * t[e];
-    fw[e] -= eww[e] * w[i] + ewt[e] * t[i];
-  }
+  static constexpr double kNone[4] = {0.0, 0.0, 0.0, 0.0};
+  band_w_rows(wire, 0, n - 1, kNone, w, t, fw);
 }
 
 int contact_weights(const Wire& wire, double rub_length, double xc, int* node, double* weight) {
