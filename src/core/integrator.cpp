@@ -113,8 +113,13 @@ void observe(const Model& m, State& s) { contact_forces(m, s, s.u.data(), nullpt
 void contact_point_motion(const Model& m, const State& s, int pantograph, std::vector<ContactPointMotion>& out) {
   out.clear();
   const Pantograph& p = m.pantographs[pantograph];
-  std::vector<int> node(m.max_contact_nodes);
-  std::vector<double> weight(m.max_contact_nodes);
+  // Called every loop period by the HIL node: scratch kept per thread, allocated once.
+  thread_local std::vector<int> node;
+  thread_local std::vector<double> weight;
+  if (node.size() < static_cast<std::size_t>(m.max_contact_nodes)) {
+    node.resize(m.max_contact_nodes);
+    weight.resize(m.max_contact_nodes);
+  }
   for (int ci : p.collectors) {
     const double xc = s.front - p.position + m.collectors[ci].offset;
     for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
@@ -348,7 +353,7 @@ StepStatus step(const Model& m, State& s) {
     for (int i = 0; i < n; ++i)
       if (im[i] == 0.0) f[i] = 0.0;  // rigid supports (every other DOF has mass: rotations are lumped)
     double* tmp = s.solve_tmp.data();
-    newmark_solve_checked(*m.implicit, f, tmp);
+    newmark_solve(*m.implicit, f, tmp);
     // Active contacts at the prediction and their g vectors (sparse: head + wire nodes).
     const std::size_t nw = m.contact_wires.size();
     int active = 0;
@@ -374,7 +379,7 @@ StepStatus step(const Model& m, State& s) {
           s.contact_g_count[active] = cnt + 1;
           for (int a = 0; a <= cnt; ++a)
             if (im[gi[a]] != 0.0) y[gi[a]] += gv[a];
-          newmark_solve_checked(*m.implicit, y, tmp);  // y = A^-1 g
+          newmark_solve(*m.implicit, y, tmp);  // y = A^-1 g
           ++active;
         }
     }

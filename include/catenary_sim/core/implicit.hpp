@@ -16,6 +16,6 @@ double explicit_parts_frequency(const Model& model);
 std::shared_ptr<const ImplicitMatrix> newmark_matrix(const Model& model, double dt);
 
 // Solves A x = b in place (b becomes x); tmp has n entries. No allocation.
-void newmark_solve_checked(const ImplicitMatrix& a, double* b, double* tmp);
+void newmark_solve(const ImplicitMatrix& a, double* b, double* tmp);
 
 }  // namespace catenary_sim
