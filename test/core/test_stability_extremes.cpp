@@ -69,8 +69,6 @@ TEST(Extremes, ContactStiffnessFrom1e3To1e7) {
   for (double k : {1e3, 1e4, 1e5, 1e6, 1e7}) {
     Simulation sim(load_scene_file(kScene, {"contact.stiffness=" + std::to_string(k)}));
     SCOPED_TRACE("k0 = " + std::to_string(k) + ", dt = " + std::to_string(sim.model().dt));
-    // The automatic step follows the stiffest contact: dt shrinks for 1e7 N/m.
-    EXPECT_LE(sim.model().dt, sim.model().dt_critical);
     run_finite(sim, 4000);
   }
   // The implicit integrator takes the contact implicitly: 1e7 N/m at 1 ms.
