@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "catenary_sim/core/beam.hpp"
@@ -205,6 +206,24 @@ int contact_weights(const Wire& wire, double rub_length, double xc, int* node, d
   // Renormalise where the rub zone hangs over the end of the wire, so that eq. 11 holds.
   for (int k = 0; k < count; ++k) weight[k] /= total;
   return count;
+}
+
+double lowest_design_height(const Model& m, double xc, int* wire) {
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  double lowest = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < m.contact_wires.size(); ++k) {
+    const Wire& w = m.wires[m.contact_wires[k]];
+    const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+    if (cnt == 0) continue;
+    double y = 0.0;
+    for (int a = 0; a < cnt; ++a) y += weight[a] * w.height[node[a]];
+    if (y < lowest) {
+      lowest = y;
+      if (wire) *wire = static_cast<int>(k);
+    }
+  }
+  return lowest;
 }
 
 void apply_stiffness(const Model& m, double front, const double* x, double* y, double* scratch) {

@@ -231,23 +231,12 @@ void set_pantograph_references(Model& m) {
   // the static state every mass is displaced as much as the head. The roof spring is relaxed at
   // the initial static state: the static uplift is then exactly the static contact force, and the
   // roof spring models how that force changes with working height.
-  std::vector<int> node(m.max_contact_nodes);
-  std::vector<double> weight(m.max_contact_nodes);
   for (Pantograph& p : m.pantographs) {
     double sum = 0.0;
     int count = 0;
     for (int ci : p.collectors) {
       // The lowest contact wire over the collector is the one the head meets first.
-      const double xc = m.train_start - p.position + m.collectors[ci].offset;
-      double lowest = std::numeric_limits<double>::infinity();
-      for (int wi : m.contact_wires) {
-        const Wire& w = m.wires[wi];
-        const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
-        if (cnt == 0) continue;
-        double y = 0.0;
-        for (int a = 0; a < cnt; ++a) y += weight[a] * w.height[node[a]];
-        lowest = std::min(lowest, y);
-      }
+      const double lowest = lowest_design_height(m, m.train_start - p.position + m.collectors[ci].offset);
       if (std::isfinite(lowest)) {
         sum += lowest;
         ++count;

@@ -82,26 +82,16 @@ bool lowest_contact_wire(const Model& m, const State& s, int p, double* design, 
   int count = 0;
   for (int ci : m.pantographs[p].collectors) {
     const double xc = collector_x(m, s, p, ci);
-    double best = std::numeric_limits<double>::infinity(), best_displaced = 0.0;
-    for (int wi : m.contact_wires) {
-      const Wire& w = m.wires[wi];
-      const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
-      if (cnt == 0) continue;
-      double y = 0.0, u = 0.0;
-      for (int a = 0; a < cnt; ++a) {
-        y += weight[a] * w.height[node[a]];
-        u += weight[a] * s.u[w.w_dof + node[a]];
-      }
-      if (y < best) {
-        best = y;
-        best_displaced = y + u;
-      }
-    }
-    if (std::isfinite(best)) {
-      sum_design += best;
-      sum_displaced += best_displaced;
-      ++count;
-    }
+    int k = -1;
+    const double best = lowest_design_height(m, xc, &k);
+    if (!std::isfinite(best)) continue;
+    const Wire& w = m.wires[m.contact_wires[k]];
+    const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+    double u = 0.0;
+    for (int a = 0; a < cnt; ++a) u += weight[a] * s.u[w.w_dof + node[a]];
+    sum_design += best;
+    sum_displaced += best + u;
+    ++count;
   }
   if (count == 0) return false;
   *design = sum_design / count;
