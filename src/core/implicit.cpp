@@ -9,26 +9,17 @@
 
 namespace catenary_sim {
 
-double explicit_parts_frequency(const Model& m) {
-  // What the implicit scheme evaluates at the prediction: the droppers (tension only).
-  double w2 = 0.0;
-  for (const Dropper& d : m.droppers) {
-    const double ic = m.inv_mass[d.contact_dof], im = m.inv_mass[d.messenger_dof];
-    w2 = std::max(w2, d.stiffness * (ic + im));
-  }
-  return std::sqrt(w2);
-}
-
 std::shared_ptr<const ImplicitMatrix> newmark_matrix(const Model& m, double dt) {
   const int n = m.n_dof;
   const double gdt = 0.5 * dt, bdt2 = 0.25 * dt * dt;
   Triplets k, c;
   Eigen::VectorXd unused = Eigen::VectorXd::Zero(n);
-  // Catenary stiffness K0: beams and supports. The droppers stay out: they switch between taut
-  // and slack every few steps near the pantograph, and a taut dropper kept in the matrix would
-  // resist the correction of a slack one; they are evaluated at the prediction instead.
+  // Catenary stiffness K0: beams, supports and every dropper taut. A dropper that slackens is
+  // taken out again in step() by a rank-1 correction (an active set), so the matrix is never
+  // refactorised.
   for (const Wire& w : m.wires) add_wire_band(k, w, w.w_dof, w.theta_dof);
   for (const SupportSpring& sp : m.springs) k.emplace_back(sp.dof, sp.dof, sp.stiffness);
+  for (const Dropper& d : m.droppers) add_spring(k, unused, d.messenger_dof, d.contact_dof, d.stiffness, 0.0);
   // Rayleigh damping of the catenary (eq. 5) is beta K0 + alpha M.
   for (const auto& e : k) c.emplace_back(e.row(), e.col(), m.beta * e.value());
   for (int i = 0; i < m.n_catenary_dof; ++i) c.emplace_back(i, i, m.alpha * m.mass[i]);

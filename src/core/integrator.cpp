@@ -78,11 +78,19 @@ State make_state(const Model& m) {
     s.v_pred = Eigen::VectorXd::Zero(m.n_dof);
     s.solve_tmp = Eigen::VectorXd::Zero(m.n_dof);
     const std::size_t contacts = m.collectors.size() * m.contact_wires.size();
+    const std::size_t slots = std::min<std::size_t>(m.droppers.size(), kSlackDropperCapacity);
+    const std::size_t corrections = contacts + slots, stride = m.max_contact_nodes + 1;
     s.contact_solve.assign(contacts * m.n_dof, 0.0);
-    s.contact_g_index.assign(contacts * (m.max_contact_nodes + 1), 0);
-    s.contact_g_value.assign(contacts * (m.max_contact_nodes + 1), 0.0);
-    s.contact_g_count.assign(contacts, 0);
-    s.contact_small.assign(contacts * contacts + contacts, 0.0);
+    s.dropper_solve.assign(slots * m.n_dof, 0.0);
+    s.dropper_slot.assign(m.droppers.size(), -1);
+    s.slot_dropper.assign(slots, -1);
+    s.slot_used.assign(slots, -1);
+    s.correction_g_index.assign(corrections * stride, 0);
+    s.correction_g_value.assign(corrections * stride, 0.0);
+    s.correction_g_count.assign(corrections, 0);
+    s.correction_factor.assign(corrections, 0.0);
+    s.correction_solve.assign(corrections, nullptr);
+    s.correction_small.assign(corrections * corrections + corrections, 0.0);
   }
   s.z = Eigen::VectorXd::Zero(m.n_dof);
   int max_nodes = 1;
@@ -191,7 +199,11 @@ void advance_train(const Model& m, State& s, double dt) {
 // Total force on every DOF at displacements u and velocities v (eq. 1 right-hand side minus the
 // internal and damping forces): constant load, beams, supports, tension-only droppers, Rayleigh
 // damping (eq. 5) through z = u + beta v, pantograph chains with their uplift, and the contact.
-void assemble_force(const Model& m, State& s, const double* u, const double* v, double* z, double* f) {
+// With `given_slack` (the implicit scheme) the droppers are not switched here: those marked slack in
+// state.dropper_slack carry nothing and the others the linear force of the matrix, so that the
+// force and the corrected matrix describe the same active set.
+void assemble_force(const Model& m, State& s, const double* u, const double* v, double* z, double* f,
+                    bool given_slack = false) {
   const int n = m.n_dof, nc = m.n_catenary_dof;
   const double beta = m.beta, alpha = m.alpha;
   const double* load = m.load.data();
@@ -205,6 +217,13 @@ void assemble_force(const Model& m, State& s, const double* u, const double* v, 
   auto dropper = [&](std::size_t k) {
     // Droppers work only in tension; the switch is decided on the elastic stretch.
     const Dropper& d = m.droppers[k];
+    if (given_slack) {
+      if (s.dropper_slack[k]) return;
+      const double t = d.static_tension + d.stiffness * (z[d.messenger_dof] - z[d.contact_dof]);
+      f[d.contact_dof] += t;
+      f[d.messenger_dof] -= t;
+      return;
+    }
     const double stretch = u[d.messenger_dof] - u[d.contact_dof];
     const bool taut = d.static_tension + d.stiffness * stretch > 0.0;
     s.dropper_slack[k] = !taut;
@@ -261,6 +280,129 @@ void assemble_force(const Model& m, State& s, const double* u, const double* v, 
     }
   }
   contact_forces(m, s, u, f);
+}
+
+
+// Columns for the contacts in touch at the prediction (state.contact_force > 0): their sparse
+// g = e_head - sum_a w_a e_a (eq. 12), the factor dt^2/4 k0, and A^-1 g. Returns their count;
+// they are corrections 0..count-1.
+int contact_corrections(const Model& m, State& s) {
+  const int n = m.n_dof, stride = m.max_contact_nodes + 1;
+  const std::size_t nw = m.contact_wires.size();
+  const double* im = m.inv_mass.data();
+  int active = 0;
+  for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
+    const Pantograph& p = m.pantographs[pi];
+    if (p.moving_force) continue;
+    for (int ci : p.collectors)
+      for (std::size_t wk = 0; wk < nw; ++wk) {
+        if (!(s.contact_force[ci * nw + wk] > 0.0)) continue;
+        const Wire& w = m.wires[m.contact_wires[wk]];
+        const double xc = s.front - p.position + m.collectors[ci].offset;
+        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
+        double* y = s.contact_solve.data() + static_cast<std::size_t>(active) * n;
+        std::fill(y, y + n, 0.0);
+        int* gi = s.correction_g_index.data() + active * stride;
+        double* gv = s.correction_g_value.data() + active * stride;
+        gi[0] = p.first_dof;
+        gv[0] = 1.0;
+        for (int a = 0; a < cnt; ++a) {
+          gi[a + 1] = w.w_dof + s.weight_node[a];
+          gv[a + 1] = -s.weight[a];
+        }
+        s.correction_g_count[active] = cnt + 1;
+        s.correction_factor[active] = 0.25 * m.dt * m.dt * m.contact_stiffness;
+        for (int a = 0; a <= cnt; ++a)
+          if (im[gi[a]] != 0.0) y[gi[a]] += gv[a];
+        newmark_solve(*m.implicit, y, s.solve_tmp.data());  // y = A^-1 g
+        s.correction_solve[active] = y;
+        ++active;
+      }
+  }
+  return active;
+}
+
+// Correction `index` for slack dropper k: g = e_m - e_c, factor -(dt^2/4 + dt/2 beta) k (its share
+// of A taken out), A^-1 g from the cache (solved once when the dropper first slackens; the least
+// recently used slot not used in this step is reused). False if every slot is in use this step.
+bool slack_dropper_correction(const Model& m, State& s, int k, int index) {
+  const int n = m.n_dof, stride = m.max_contact_nodes + 1;
+  const Dropper& d = m.droppers[k];
+  int slot = s.dropper_slot[k];
+  if (slot < 0) {
+    for (std::size_t j = 0; j < s.slot_dropper.size(); ++j)
+      if (s.slot_used[j] < s.steps && (slot < 0 || s.slot_used[j] < s.slot_used[slot])) slot = static_cast<int>(j);
+    if (slot < 0) return false;
+    if (s.slot_dropper[slot] >= 0) s.dropper_slot[s.slot_dropper[slot]] = -1;
+    s.slot_dropper[slot] = k;
+    s.dropper_slot[k] = slot;
+    double* y = s.dropper_solve.data() + static_cast<std::size_t>(slot) * n;
+    std::fill(y, y + n, 0.0);
+    if (m.inv_mass[d.messenger_dof] != 0.0) y[d.messenger_dof] = 1.0;
+    if (m.inv_mass[d.contact_dof] != 0.0) y[d.contact_dof] = -1.0;
+    newmark_solve(*m.implicit, y, s.solve_tmp.data());
+  }
+  s.slot_used[slot] = s.steps;
+  int* gi = s.correction_g_index.data() + index * stride;
+  double* gv = s.correction_g_value.data() + index * stride;
+  int cnt = 0;
+  if (m.inv_mass[d.messenger_dof] != 0.0) {
+    gi[cnt] = d.messenger_dof;
+    gv[cnt++] = 1.0;
+  }
+  if (m.inv_mass[d.contact_dof] != 0.0) {
+    gi[cnt] = d.contact_dof;
+    gv[cnt++] = -1.0;
+  }
+  s.correction_g_count[index] = cnt;
+  s.correction_factor[index] = -(0.25 * m.dt * m.dt + 0.5 * m.dt * m.beta) * d.stiffness;
+  s.correction_solve[index] = s.dropper_solve.data() + static_cast<std::size_t>(slot) * n;
+  return true;
+}
+
+// x = (A + sum_i c_i g_i g_i^T)^-1 b given x = A^-1 b (Woodbury):
+//   x -= Y (C^-1 + G^T Y)^-1 G^T x, Y = A^-1 G.
+// The small matrix is symmetric but indefinite when droppers are taken out: partial pivoting.
+void woodbury(State& s, int count, int n, double* x) {
+  if (count == 0) return;
+  const int stride = static_cast<int>(s.correction_g_value.size() / s.correction_g_count.size());
+  double* sm = s.correction_small.data();
+  double* rhs = sm + count * count;
+  auto g_dot = [&](int i, const double* y) {
+    const int* gi = s.correction_g_index.data() + i * stride;
+    const double* gv = s.correction_g_value.data() + i * stride;
+    double r = 0.0;
+    for (int a = 0; a < s.correction_g_count[i]; ++a) r += gv[a] * y[gi[a]];
+    return r;
+  };
+  for (int i = 0; i < count; ++i) {
+    rhs[i] = g_dot(i, x);
+    for (int j = 0; j < count; ++j) sm[i * count + j] = g_dot(i, s.correction_solve[j]) + (i == j ? 1.0 / s.correction_factor[i] : 0.0);
+  }
+  for (int k = 0; k < count; ++k) {
+    int p = k;
+    for (int i = k + 1; i < count; ++i)
+      if (std::fabs(sm[i * count + k]) > std::fabs(sm[p * count + k])) p = i;
+    if (p != k) {
+      for (int j = 0; j < count; ++j) std::swap(sm[k * count + j], sm[p * count + j]);
+      std::swap(rhs[k], rhs[p]);
+    }
+    for (int i = k + 1; i < count; ++i) {
+      const double l = sm[i * count + k] / sm[k * count + k];
+      for (int j = k; j < count; ++j) sm[i * count + j] -= l * sm[k * count + j];
+      rhs[i] -= l * rhs[k];
+    }
+  }
+  for (int i = count - 1; i >= 0; --i) {
+    double r = rhs[i];
+    for (int j = i + 1; j < count; ++j) r -= sm[i * count + j] * rhs[j];
+    rhs[i] = r / sm[i * count + i];
+  }
+  for (int j = 0; j < count; ++j) {
+    const double* y = s.correction_solve[j];
+    const double cj = rhs[j];
+    for (int i = 0; i < n; ++i) x[i] -= y[i] * cj;
+  }
 }
 
 }  // namespace
@@ -331,11 +473,14 @@ StepStatus step(const Model& m, State& s) {
     }
   } else {
     // Newmark average acceleration (beta 1/4, gamma 1/2): predict, then solve
-    // (M + dt/2 C + dt^2/4 K0) a_{n+1} = F(u~, v~) with the matrix factorised once. K0 holds the
-    // beams, supports and pantograph springs; the tension-only droppers enter F at the prediction
-    // (explicit, stable at these steps: checked when the model is built). Every contact active
-    // at the prediction is implicit: its penalty k0 g g^T joins the matrix as a rank-1 update
-    // (Woodbury), g = e_head - sum_a w_a e_a (eq. 12).
+    // (M + dt/2 C + dt^2/4 K) a_{n+1} = F(u~, v~) with A = M + dt/2 C0 + dt^2/4 K0 factorised
+    // once (every dropper taut, no contact). What switches enters as rank-1 corrections of A
+    // (Woodbury), so A is never refactorised:
+    //  - every contact in touch at the prediction adds dt^2/4 k0 g g^T, g = e_head - sum_a w_a e_a
+    //    (eq. 12);
+    //  - every slack dropper takes its (dt^2/4 + dt/2 beta) k g g^T out again, g = e_m - e_c;
+    //    which droppers are slack is an active set: start from the last step's, solve, switch the
+    //    droppers whose tension at t_{n+1} disagrees, and solve again (rarely more than once).
     const double b = 0.25, g = 0.5;
     // The equation is written at t_{n+1}: the contact sits where the train is then (evaluating it
     // a step behind would shift it along the wire's slope under the head: a bias of order
@@ -348,77 +493,43 @@ StepStatus step(const Model& m, State& s) {
       up[i] = u[i] + dt * v[i] + dt * dt * (0.5 - b) * acc[i];
       vp[i] = v[i] + dt * (1.0 - g) * acc[i];
     }
-    assemble_force(m, s, up, vp, z, f);
     const double* im = m.inv_mass.data();
-    for (int i = 0; i < n; ++i)
-      if (im[i] == 0.0) f[i] = 0.0;  // rigid supports (every other DOF has mass: rotations are lumped)
     double* tmp = s.solve_tmp.data();
-    newmark_solve(*m.implicit, f, tmp);
-    // Active contacts at the prediction and their g vectors (sparse: head + wire nodes).
-    const std::size_t nw = m.contact_wires.size();
-    int active = 0;
-    for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
-      const Pantograph& p = m.pantographs[pi];
-      if (p.moving_force) continue;
-      for (int ci : p.collectors)
-        for (std::size_t wk = 0; wk < nw; ++wk) {
-          if (!(s.contact_force[ci * nw + wk] > 0.0)) continue;
-          const Wire& w = m.wires[m.contact_wires[wk]];
-          const double xc = s.front - p.position + m.collectors[ci].offset;
-          const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
-          double* y = s.contact_solve.data() + static_cast<std::size_t>(active) * n;
-          std::fill(y, y + n, 0.0);
-          int* gi = s.contact_g_index.data() + active * (m.max_contact_nodes + 1);
-          double* gv = s.contact_g_value.data() + active * (m.max_contact_nodes + 1);
-          gi[0] = p.first_dof;
-          gv[0] = 1.0;
-          for (int a = 0; a < cnt; ++a) {
-            gi[a + 1] = w.w_dof + s.weight_node[a];
-            gv[a + 1] = -s.weight[a];
-          }
-          s.contact_g_count[active] = cnt + 1;
-          for (int a = 0; a <= cnt; ++a)
-            if (im[gi[a]] != 0.0) y[gi[a]] += gv[a];
-          newmark_solve(*m.implicit, y, tmp);  // y = A^-1 g
-          ++active;
+    const double bdt2 = b * dt * dt;
+    int contacts = 0;
+    for (int iteration = 0;; ++iteration) {
+      assemble_force(m, s, up, vp, z, f, true);
+      for (int i = 0; i < n; ++i)
+        if (im[i] == 0.0) f[i] = 0.0;  // rigid supports (every other DOF has mass: rotations are lumped)
+      newmark_solve(*m.implicit, f, tmp);
+      if (iteration == 0) contacts = contact_corrections(m, s);  // the same set in every iteration
+      int count = contacts;
+      for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+        if (!s.dropper_slack[k]) continue;
+        if (!slack_dropper_correction(m, s, static_cast<int>(k), count)) {
+          s.front = front_n;
+          s.active_set_full = true;
+          s.status = StepStatus::kDiverged;
+          s.diverged_dof = -1;
+          return s.status;
         }
-    }
-    if (active > 0) {
-      // Woodbury: a = x0 - Y (I / c + G^T Y)^-1 G^T x0, c = dt^2/4 k0; S is active x active.
-      const double c = b * dt * dt * m.contact_stiffness;
-      const int na = active, stride = m.max_contact_nodes + 1;
-      double* sm = s.contact_small.data();
-      double* rhs = sm + na * na;
-      for (int i = 0; i < na; ++i) {
-        const int* gi = s.contact_g_index.data() + i * stride;
-        const double* gv = s.contact_g_value.data() + i * stride;
-        double gx = 0.0;
-        for (int a = 0; a < s.contact_g_count[i]; ++a) gx += gv[a] * f[gi[a]];
-        rhs[i] = gx;
-        for (int j = 0; j < na; ++j) {
-          const double* y = s.contact_solve.data() + static_cast<std::size_t>(j) * n;
-          double gy = 0.0;
-          for (int a = 0; a < s.contact_g_count[i]; ++a) gy += gv[a] * y[gi[a]];
-          sm[i * na + j] = gy + (i == j ? 1.0 / c : 0.0);
+        ++count;
+      }
+      woodbury(s, count, n, f);
+      // The droppers' elastic tension at t_{n+1} decides the set (as in the explicit scheme).
+      bool changed = false;
+      for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+        const Dropper& d = m.droppers[k];
+        const double stretch = up[d.messenger_dof] + bdt2 * f[d.messenger_dof] - up[d.contact_dof] - bdt2 * f[d.contact_dof];
+        const std::uint8_t slack = !(d.static_tension + d.stiffness * stretch > 0.0);
+        if (slack != s.dropper_slack[k]) {
+          s.dropper_slack[k] = slack;
+          changed = true;
         }
       }
-      // Small dense solve (Gaussian elimination without pivoting: S is symmetric positive definite).
-      for (int k = 0; k < na; ++k)
-        for (int i = k + 1; i < na; ++i) {
-          const double l = sm[i * na + k] / sm[k * na + k];
-          for (int j = k; j < na; ++j) sm[i * na + j] -= l * sm[k * na + j];
-          rhs[i] -= l * rhs[k];
-        }
-      for (int i = na - 1; i >= 0; --i) {
-        double r = rhs[i];
-        for (int j = i + 1; j < na; ++j) r -= sm[i * na + j] * rhs[j];
-        rhs[i] = r / sm[i * na + i];
-      }
-      for (int j = 0; j < na; ++j) {
-        const double* y = s.contact_solve.data() + static_cast<std::size_t>(j) * n;
-        const double cj = rhs[j];
-        for (int i = 0; i < n; ++i) f[i] -= y[i] * cj;
-      }
+      // A dropper at the switching point can alternate; after a few passes the last solve stands
+      // (its set differs from the exact one by droppers carrying next to no tension).
+      if (!changed || iteration == kMaxActiveSetPasses - 1) break;
     }
     double* u_new = z;
     double* v_new = s.solve_tmp.data();

@@ -28,6 +28,12 @@ std::string Simulation::status_message() const {
       s << "pass finished at t = " << state_.time << " s (train front at " << state_.front << " m)";
       break;
     case StepStatus::kDiverged: {
+      if (state_.active_set_full) {
+        s << "stopped at t = " << state_.time << " s: more than " << kSlackDropperCapacity
+          << " droppers slack at once, beyond what the implicit integrator takes out of its matrix; "
+             "use numerics.integrator explicit for this scene";
+        break;
+      }
       const int d = state_.diverged_dof;
       std::string where = "DOF " + std::to_string(d);
       for (const Wire& w : model_.wires)

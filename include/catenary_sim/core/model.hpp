@@ -119,10 +119,9 @@ struct Model {
   int max_contact_nodes = 2;    // nodes a distributed contact can touch (sizes the workspace)
 
   double omega_max = 0.0;       // rad/s, highest eigenfrequency of the assembled system
-  double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction
+  double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction (inf: implicit)
   double dt = 0.0;              // s, the step in use
   std::shared_ptr<const ImplicitMatrix> implicit;  // set when the integrator is implicit
-  double omega_explicit_parts = 0.0;  // rad/s, highest frequency of what the implicit scheme treats explicitly
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
   double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)

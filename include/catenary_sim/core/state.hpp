@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -27,6 +28,11 @@ struct WireWindow {
   double lo_ww = 0, lo_wt = 0, lo_tt = 0, hi_ww = 0, hi_wt = 0, hi_tt = 0;  // outside element's share of the end blocks
   std::vector<double> tt_lower, tt_inv_pivot;  // LDL^T of the window's K_theta_theta
 };
+
+// Implicit integrator: slack droppers it can take out of its matrix at once (each keeps a column
+// of n values); more stops the run with a message. Active-set passes per step at most.
+constexpr std::size_t kSlackDropperCapacity = 64;
+constexpr int kMaxActiveSetPasses = 4;
 
 struct State {
   double time = 0.0;       // s, simulation time since the pass started
@@ -59,10 +65,19 @@ struct State {
 
   // Workspace, sized once by make_state().
   Eigen::VectorXd force, z;
-  Eigen::VectorXd u_pred, v_pred, solve_tmp;  // implicit integrator only
-  std::vector<double> contact_solve;           // implicit: A^-1 g per active contact
-  std::vector<int> contact_g_index, contact_g_count;
-  std::vector<double> contact_g_value, contact_small;
+  // Implicit integrator only: the prediction, and the rank-1 corrections of the factorised
+  // matrix A (contacts in touch add k0 g g^T, slack droppers take their stiffness out again),
+  // each with its sparse g, its stiffness factor and its column A^-1 g.
+  Eigen::VectorXd u_pred, v_pred, solve_tmp;
+  std::vector<double> contact_solve;           // A^-1 g per contact in touch (they move: every step)
+  std::vector<double> dropper_solve;           // A^-1 g per cache slot (A never changes: kept)
+  std::vector<int> dropper_slot;               // per dropper: its cache slot, -1 if none
+  std::vector<int> slot_dropper;               // per slot: its dropper, -1 if free
+  std::vector<std::int64_t> slot_used;         // per slot: the step that last used it
+  std::vector<int> correction_g_index, correction_g_count;
+  std::vector<double> correction_g_value, correction_factor, correction_small;
+  std::vector<const double*> correction_solve;
+  bool active_set_full = false;  // more droppers slack at once than the cache holds: run stopped
   std::vector<double> theta;
   std::vector<int> weight_node;
   std::vector<double> weight;
