@@ -233,7 +233,7 @@ void assemble_force(const Model& m, State& s, const double* u, const double* v, 
     f[d.messenger_dof] -= t;
   };
   for (int i = nc; i < n; ++i) f[i] = 0.0;
-  if (m.scene.numerics.window_ahead > 0.0) {
+  if (m.scene.numerics.windowed()) {
     for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
       const WireWindow& ww = s.window[wi];
       const Wire& w = m.wires[wi];
@@ -423,7 +423,7 @@ StepStatus step(const Model& m, State& s) {
   const double limit = m.scene.numerics.divergence_limit;
   int bad = -1;
   if (!m.implicit) {
-    const bool windowed = m.scene.numerics.window_ahead > 0.0;
+    const bool windowed = m.scene.numerics.windowed();
     if (windowed) update_window(m, s);
     assemble_force(m, s, u, v, z, f);
     // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. The new values go to the

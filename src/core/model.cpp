@@ -592,6 +592,8 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
   for (int wi : m.contact_wires)
     m.wave_speed = std::min(m.wave_speed, std::sqrt(m.wires[wi].spec.tension / m.wires[wi].spec.linear_mass));
   if (const std::string w = speed_warning(m, scene.train_speed); !w.empty()) m.warnings.push_back(w);
+  for (std::size_t i = 1; i < m.support_x.size(); ++i)
+    m.longest_span = std::max(m.longest_span, m.support_x[i] - m.support_x[i - 1]);
 
   // Train travel: by default from the rearmost collector at the line start to the foremost at
   // the line end.
@@ -614,7 +616,7 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
     m.dt = m.dt_critical = scene.numerics.dt ? *scene.numerics.dt : 1e-4;
     return m;
   }
-  if (scene.numerics.window_ahead > 0.0 &&
+  if (scene.numerics.windowed() &&
       (scene.numerics.integrator != Integrator::kExplicit || scene.numerics.rotary_inertia != RotaryInertia::kCondensed))
     throw SceneError("numerics.window: needs numerics.integrator explicit with rotary_inertia condensed (the window "
                      "integrates node ranges of the condensed band)");

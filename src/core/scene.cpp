@@ -460,15 +460,8 @@ Scene scene_from_yaml(const YAML::Node& root) {
     s.numerics.divergence_limit = r.number("divergence_limit", 0.0, 1000.0, 5.0, true);
     if (r.has("window")) {
       const YAML::Node wn = r.child("window");
-      double longest = 0.0;
-      for (const SectionSpec& sec : s.sections)
-        for (double l : sec.spans) longest = std::max(longest, l);
       if (wn.IsScalar() && wn.as<std::string>() == "auto") {
-        // A span and a half ahead and four behind (then snapped outward to supports): waves
-        // run ahead of the train only at c - V, while behind it the wake reflected by droppers
-        // and supports comes back to the pantograph; measured in bench_window.
-        s.numerics.window_ahead = 1.5 * longest;
-        s.numerics.window_behind = 4.0 * longest;
+        s.numerics.window_auto = true;  // lengths from speed and wave speed: window_lengths()
       } else if (wn.IsScalar() && wn.as<std::string>() == "off") {
       } else {
         Reader w(wn, "numerics.window");

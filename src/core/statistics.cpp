@@ -91,6 +91,12 @@ PassRecorder::PassRecorder(const Model& m, double sample_rate_hz)
   wire_force_.assign(np, std::vector<std::vector<double>>(nw));
   for (std::size_t k = 0; k < m.springs.size(); ++k)
     if (m.springs[k].steady_arm) steady_arm_springs_.push_back(static_cast<int>(k));
+  // In line order, so that record() looks only at the steady arms near each pantograph (its cost
+  // per step must not grow with the line).
+  std::stable_sort(steady_arm_springs_.begin(), steady_arm_springs_.end(),
+                   [&](int a, int b) { return m.springs[a].x < m.springs[b].x; });
+  for (int k : steady_arm_springs_) steady_arm_x_.push_back(m.springs[k].x);
+  for (double l : m.scene.spans) longest_span_ = std::max(longest_span_, l);
   max_uplift_.assign(np, std::vector<double>(steady_arm_springs_.size(), -std::numeric_limits<double>::infinity()));
   for (const Pantograph& p : m.pantographs) {
     columns_.push_back(p.name + "_position_m");
@@ -117,7 +123,8 @@ void PassRecorder::record(const Model& m, const State& s) {
       for (int ci : m.pantographs[p].collectors) f += s.contact_force[ci * nw + w];
       wire_force_[p][w].push_back(f);
     }
-    for (std::size_t k = 0; k < steady_arm_springs_.size(); ++k) {
+    const auto first = std::lower_bound(steady_arm_x_.begin(), steady_arm_x_.end(), xp - longest_span_);
+    for (std::size_t k = first - steady_arm_x_.begin(); k < steady_arm_x_.size() && steady_arm_x_[k] <= xp + longest_span_; ++k) {
       const SupportSpring& sp = m.springs[steady_arm_springs_[k]];
       const int span = sp.span_index;
       const double reach = 0.5 * std::min(m.scene.spans[span - 1], m.scene.spans[span]);

@@ -12,6 +12,29 @@
 
 namespace catenary_sim {
 
+namespace {
+// window: auto. A wave the pantograph sends ahead meets a reflector D ahead of it and its echo is
+// back at the pantograph after 2 D / (c + V); one sent behind comes back from D behind after
+// 2 D / (c - V). The window holds the reflectors whose echoes return within a memory time:
+// D = (c +- V) T / 2. T measured in bench_window_lengths (BENCHMARKS.md: statistics within a few
+// tenths of a percent of a generous window at 150-350 km/h): the echoes from behind are Doppler
+// stretched to low frequencies, which the damping barely touches, so they are remembered longer.
+constexpr double kMemoryAhead = 2.0, kMemoryBehind = 4.0;  // s
+constexpr double kWindowMinSpans = 2.0;  // the droppers around the head and the joining span
+}  // namespace
+
+void window_lengths(const Model& m, double speed, double* ahead, double* behind) {
+  const NumericsSpec& n = m.scene.numerics;
+  if (!n.window_auto) {
+    *ahead = n.window_ahead;
+    *behind = n.window_behind;
+    return;
+  }
+  const double c = m.wave_speed, v = std::fabs(speed);
+  *ahead = std::max(kWindowMinSpans * m.longest_span, 0.5 * (c + v) * kMemoryAhead);
+  *behind = std::max(kWindowMinSpans * m.longest_span, 0.5 * std::max(0.0, c - v) * kMemoryBehind);
+}
+
 void update_window(const Model& m, State& s) {
   double x_min = 1e300, x_max = -1e300;
   for (const Pantograph& p : m.pantographs) {
@@ -21,7 +44,9 @@ void update_window(const Model& m, State& s) {
   }
   if (m.pantographs.empty()) x_min = x_max = s.front;
   const std::vector<double>& sx = m.support_x;
-  const double lo_x = x_min - m.scene.numerics.window_behind, hi_x = x_max + m.scene.numerics.window_ahead;
+  double ahead = 0.0, behind = 0.0;
+  window_lengths(m, s.speed, &ahead, &behind);
+  const double lo_x = x_min - behind, hi_x = x_max + ahead;
   // Snap outward to supports.
   int first = static_cast<int>(std::upper_bound(sx.begin(), sx.end(), lo_x) - sx.begin()) - 1;
   int last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x) - sx.begin());

@@ -40,7 +40,7 @@ double wire_energy(const Model& m, const State& s) {
 }  // namespace
 
 TEST(Window, StatisticsMatchTheFullLine) {
-  // 20 spans at 300 km/h, balanced preset: the window (1.5 spans ahead, 4 behind) against the
+  // 20 spans at 300 km/h, balanced preset: the window (auto: 3.8 spans ahead, 2 behind) against the
   // full line, over spans 4-15: the window stands for a line that goes on, so the statistics are
   // taken where the full line's anchors are out of reach (near them the full line's reflections
   // are real and the window's are not). The budget is 1 %: mean, std and max relative;
@@ -52,6 +52,31 @@ TEST(Window, StatisticsMatchTheFullLine) {
   EXPECT_NEAR(win.filtered.std_dev, full.filtered.std_dev, 0.01 * full.filtered.std_dev);
   EXPECT_NEAR(win.filtered.max, full.filtered.max, 0.01 * full.filtered.max);
   EXPECT_NEAR(win.filtered.min, full.filtered.min, 0.01 * full.filtered.mean);
+}
+
+TEST(Window, AutoLengthsFollowTheSpeed) {
+  // At 350 km/h the waves' echoes from ahead return sooner (2 D / (c + V)), so the window must
+  // reach further ahead than at 300 km/h; a window sized by spans alone (1.5 ahead, 4 behind)
+  // changes the std by 5 % there (bench_window_lengths). The auto window against a generous one
+  // (5 spans ahead, 14 behind) on a 42-span line, statistics over spans 16-35 (the generous
+  // window stands for the line that goes on; a finite full line would add its anchors' echoes):
+  // within the 1 %, the min relative to the mean as above.
+  const std::vector<std::string> base = {"line.span_count=42", "numerics.preset=balanced", "output.analysis_spans=[16,36]",
+                                         "train.speed_kmh=350"};
+  std::vector<std::string> generous = base, automatic = base;
+  generous.push_back("numerics.window={ahead: 275, behind: 770}");
+  automatic.push_back("numerics.window=auto");
+  const PantographStatistics ref = pass(generous), win = pass(automatic);
+  Simulation probe(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", automatic));
+  double ahead_350 = 0, behind_350 = 0, ahead_150 = 0, behind_150 = 0;
+  window_lengths(probe.model(), 350 / 3.6, &ahead_350, &behind_350);
+  window_lengths(probe.model(), 150 / 3.6, &ahead_150, &behind_150);
+  EXPECT_GT(ahead_350, ahead_150);
+  EXPECT_LT(behind_350, behind_150);
+  EXPECT_NEAR(win.filtered.mean, ref.filtered.mean, 0.01 * ref.filtered.mean);
+  EXPECT_NEAR(win.filtered.std_dev, ref.filtered.std_dev, 0.01 * ref.filtered.std_dev);
+  EXPECT_NEAR(win.filtered.max, ref.filtered.max, 0.01 * ref.filtered.max);
+  EXPECT_NEAR(win.filtered.min, ref.filtered.min, 0.01 * ref.filtered.mean);
 }
 
 TEST(Window, EndsLetAPulseOut) {

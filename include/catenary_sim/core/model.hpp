@@ -125,6 +125,7 @@ struct Model {
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
   double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)
+  double longest_span = 0.0;    // m
   std::vector<std::string> warnings;  // what the scene asks that is outside design practice
 };
 
@@ -138,6 +139,11 @@ struct BuildOptions {
   std::optional<std::vector<double>> support_rises;
 };
 Model build_model(const Scene& scene, const BuildOptions& options);
+
+// Lengths (m) the moving window integrates ahead of the foremost and behind the rearmost
+// pantograph at a train speed (m/s): the scene's, or for `window: auto` the distances the
+// contact wire's waves run from the pantograph in the time they take to fade (window.cpp).
+void window_lengths(const Model& model, double speed_mps, double* ahead, double* behind);
 
 // A warning (empty if none) for a train speed above 0.7 of the contact wire's wave speed.
 std::string speed_warning(const Model& model, double speed_mps);

@@ -113,8 +113,11 @@ struct NumericsSpec {
   double divergence_limit = 5.0;  // m: any displacement beyond this stops the run as diverged
   // Moving window: only the spans from `window_behind` m behind the rearmost pantograph to
   // `window_ahead` m ahead of the foremost are integrated (snapped outward to supports); the rest
-  // of the line stays at its static state. Off when window_ahead is 0.
+  // of the line stays at its static state. Off when window_ahead is 0 and window_auto is false.
+  // window_auto: the lengths follow the train speed and the wave speed (window_lengths()).
   double window_ahead = 0.0, window_behind = 0.0;
+  bool window_auto = false;
+  bool windowed() const { return window_auto || window_ahead > 0.0; }
 };
 
 struct OutputSpec {

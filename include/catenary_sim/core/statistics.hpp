@@ -76,7 +76,9 @@ class PassRecorder {
   std::vector<double> time_;
   std::vector<std::vector<double>> position_, force_;  // per pantograph, every step
   std::vector<std::vector<std::vector<double>>> wire_force_;  // per pantograph, per contact wire, every step
-  std::vector<int> steady_arm_springs_;                 // indices into model.springs
+  std::vector<int> steady_arm_springs_;                 // indices into model.springs, in line order
+  std::vector<double> steady_arm_x_;                    // m, their stations
+  double longest_span_ = 0.0;                           // m
   std::vector<std::vector<double>> max_uplift_;        // per pantograph, per steady arm
 };
 
