@@ -1,6 +1,7 @@
 // The moving window on a long line: the reference catenary on 100 spans (5.5 km) at 300 km/h,
 // balanced preset, full line against numerics.window=auto, and the window's cost per simulated
-// second against the 10-span line's (it must not grow with the line).
+// second against the 10-span line's (it must not grow with the line); then the endless line
+// (config/reference_55m_endless.yaml) run over the same 100 spans and over ten times as many.
 //   bench_window [spans=100]
 #include <chrono>
 #include <cmath>
@@ -25,8 +26,8 @@ struct Run {
   PantographStatistics st;
 };
 
-Run run(std::vector<std::string> ov) {
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", ov));
+Run run(std::vector<std::string> ov, const char* scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml") {
+  Simulation sim(load_scene_file(scene, ov));
   const Model& m = sim.model();
   PassRecorder rec(m);
   rec.record(m, sim.state());
@@ -66,5 +67,22 @@ int main(int argc, char** argv) {
               100 * std::fabs(win.st.filtered.min - full.st.filtered.min) / full.st.filtered.mean);
   std::printf("cost per simulated second with the window: %.3f ms (%d spans) against %.3f ms (10 spans)\n",
               1e3 * win.wall / win.sim_time, spans, 1e3 * short_win.wall / short_win.sim_time);
+
+  // The endless line over the same pass (front from 0 to the line's end) and ten times longer;
+  // statistics over the same spans as above.
+  const char* endless_scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml";
+  const double length = 55.0 * spans;
+  const Run endless = run({"numerics.preset=balanced", "train.end=" + std::to_string(length), section}, endless_scene);
+  const Run endless_long = run({"numerics.preset=balanced", "train.end=" + std::to_string(10 * length), section}, endless_scene);
+  std::printf("\n");
+  row(("endless, " + std::to_string(spans) + " spans run").c_str(), endless);
+  row(("endless, " + std::to_string(10 * spans) + " spans run").c_str(), endless_long);
+  std::printf("endless against the window on the %d-span line: mean %.2f %%, std %.2f %%, max %.2f %%, min %.2f %% of the mean\n",
+              spans, 100 * std::fabs(endless.st.filtered.mean / win.st.filtered.mean - 1),
+              100 * std::fabs(endless.st.filtered.std_dev / win.st.filtered.std_dev - 1),
+              100 * std::fabs(endless.st.filtered.max / win.st.filtered.max - 1),
+              100 * std::fabs(endless.st.filtered.min - win.st.filtered.min) / win.st.filtered.mean);
+  std::printf("cost per simulated second on the endless line: %.3f ms (%d spans run) against %.3f ms (%d spans run)\n",
+              1e3 * endless.wall / endless.sim_time, spans, 1e3 * endless_long.wall / endless_long.sim_time, 10 * spans);
   return 0;
 }

@@ -112,6 +112,7 @@ State make_state(const Model& m) {
   for (std::size_t i = 0; i < m.pantographs.size(); ++i) s.uplift[i] = m.pantographs[i].static_uplift;
   s.external_force = s.uplift;
   s.front = m.train_start;
+  s.line_offset = m.initial_line_offset;
   s.speed = s.target_speed = m.scene.train_speed;
   return s;
 }
@@ -162,7 +163,9 @@ void contact_point_motion(const Model& m, const State& s, int pantograph, std::v
   }
 }
 
-double pantograph_position(const Model& m, const State& s, int p) { return s.front - m.pantographs[p].position; }
+double pantograph_position(const Model& m, const State& s, int p) {
+  return s.front + s.line_offset - m.pantographs[p].position;
+}
 
 double head_height(const Model& m, const State& s, int p) {
   const Pantograph& pg = m.pantographs[p];
@@ -409,7 +412,7 @@ void woodbury(State& s, int count, int n, double* x) {
 
 StepStatus step(const Model& m, State& s) {
   if (s.status != StepStatus::kOk) return s.status;
-  if (s.front >= m.train_end) {
+  if (s.front + s.line_offset >= m.train_end) {
     s.status = StepStatus::kFinished;
     return s.status;
   }
@@ -424,6 +427,7 @@ StepStatus step(const Model& m, State& s) {
   int bad = -1;
   if (!m.implicit) {
     const bool windowed = m.scene.numerics.windowed();
+    if (m.endless) shift_endless_block(m, s);
     if (windowed) update_window(m, s);
     assemble_force(m, s, u, v, z, f);
     // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. The new values go to the

@@ -8,7 +8,9 @@
 #include "catenary_sim/core/beam.hpp"
 #include "catenary_sim/core/implicit.hpp"
 #include "catenary_sim/core/stability.hpp"
+#include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statics.hpp"
+#include "window.hpp"
 
 namespace catenary_sim {
 namespace {
@@ -263,6 +265,77 @@ void apply_stiffness(const Model& m, double front, const double* x, double* y, d
   for (int i = 0; i < m.n_dof; ++i) y[i] = -y[i];
 }
 
+namespace {
+
+// Spans at each end of an endless line's block that the window never reaches: the anchors'
+// effect on the design statics (messenger heights, dropper lengths) falls by about a thousand
+// per span, so from the third span on the spans are identical to well under a micrometre.
+constexpr int kEndlessMargin = 3;
+
+// An endless line moves its state back a span at a time, which is exact only if the block's
+// spans are identical where the window goes: same nodes, stations relative to the span, design
+// heights (to 1 um, against wire motions of millimetres) and masses; same droppers. Sets
+// Model::span_nodes.
+void check_endless_block(Model& m) {
+  const double span = m.endless_span;
+  const int count = static_cast<int>(m.scene.spans.size());
+  auto fail = [&](const std::string& what) {
+    throw SceneError("line.endless: the model's spans are not identical (" + what +
+                     "); the state cannot be moved back a span. Report this with the scene");
+  };
+  for (const Wire& w : m.wires) {
+    if (static_cast<int>(w.support_nodes.size()) != count + 1) fail(w.name + ": supports");
+    const int first = kEndlessMargin - 1, last = count - kEndlessMargin;  // spans compared with the next
+    const int ns = w.support_nodes[first + 1] - w.support_nodes[first];
+    for (int k = first; k < last; ++k) {
+      if (w.support_nodes[k + 1] - w.support_nodes[k] != ns || w.support_nodes[k + 2] - w.support_nodes[k + 1] != ns)
+        fail(w.name + ": nodes per span");
+      for (int i = w.support_nodes[k]; i < w.support_nodes[k + 1]; ++i) {
+        const int j = i + ns;
+        if (std::fabs(w.x[j] - w.x[i] - span) > 1e-9 * span || std::fabs(w.height[j] - w.height[i]) > 1e-6 ||
+            std::fabs(m.mass[w.w_dof + j] - m.mass[w.w_dof + i]) > 1e-6 * m.mass[w.w_dof + i])
+          fail(w.name + " at x = " + fmt(w.x[i]) + " m");
+      }
+    }
+    m.span_nodes.push_back(ns);
+  }
+  const double tol = 1e-6;
+  for (std::size_t k = 0; k < m.droppers.size(); ++k)
+    for (std::size_t j = k + 1; j < m.droppers.size(); ++j) {
+      const Dropper& a = m.droppers[k];
+      const Dropper& b = m.droppers[j];
+      if (a.span < kEndlessMargin - 1 || a.span >= count - kEndlessMargin || b.span != a.span + 1 || std::fabs(b.x - a.x - span) > 1e-9 * span) continue;
+      if (std::fabs(b.static_tension - a.static_tension) > tol * std::fabs(a.static_tension) + 1e-9 ||
+          std::fabs(b.stiffness - a.stiffness) > tol * a.stiffness)
+        fail("dropper at x = " + fmt(a.x) + " m");
+    }
+}
+
+}  // namespace
+
+void analysis_section(const Model& m, double* x0, double* x1) {
+  const OutputSpec& o = m.scene.output;
+  if (!m.endless) {
+    *x0 = m.support_x[m.scene.analysis_first()];
+    *x1 = m.support_x[m.scene.analysis_last()];
+    return;
+  }
+  const double span = m.endless_span;
+  if (o.analysis_first_span && o.analysis_last_span) {
+    *x0 = *o.analysis_first_span * span;
+    *x1 = *o.analysis_last_span * span;
+    return;
+  }
+  // The pass's spans but two at each end, as on a finite line.
+  const double start = m.train_start + m.initial_line_offset + m.rear_collector_offset;
+  *x0 = (std::ceil(start / span - 1e-9) + 2) * span;
+  *x1 = (std::floor(m.train_end / span + 1e-9) - 2) * span;
+  if (*x1 <= *x0) {
+    *x0 = start;
+    *x1 = m.train_end;
+  }
+}
+
 Model build_model(const Scene& scene) { return build_model(scene, BuildOptions{}); }
 
 std::string speed_warning(const Model& m, double speed) {
@@ -290,8 +363,53 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
       sec.droppers->positions.assign(sec.spans.size(), sec.droppers->positions.front());
     scene.sections.push_back(sec);
   }
-  validate(scene);
+  validate(scene);  // as given (an endless line's block and stations are made below)
   Model m;
+  double endless_front = 0.0;  // train front at the start, station along the endless line
+  if (scene.endless) {
+    // A block of equal spans: `margin` spans at each end keep the anchors out of the window's
+    // reach (kEndlessMargin); the rearmost collector stays within [home, home + span) (step() moves the state back
+    // a span when it leaves), so the block must hold the window behind it (B spans, one more for
+    // snapping to supports), the train (S) and the window ahead (A) at any speed a command allows.
+    const double span = scene.spans.front();
+    const double c = std::sqrt(scene.contact_wire.tension / scene.contact_wire.linear_mass);
+    double ahead_slow = 0, behind_slow = 0, ahead_fast = 0, behind_fast = 0;
+    window_lengths_for(scene.numerics, c, span, 0.0, &ahead_slow, &behind_slow);
+    window_lengths_for(scene.numerics, c, span, std::max(scene.train_speed, Simulation::kMaxSpeed), &ahead_fast, &behind_fast);
+    double lead = 0.0, rear = 0.0;
+    bool first = true;
+    for (const PantographSpec& p : scene.pantographs) {
+      std::vector<CollectorSpec> cs = p.collectors;
+      if (cs.empty()) cs.emplace_back();
+      for (const CollectorSpec& cl : cs) {
+        const double off = cl.offset - p.position;
+        lead = first ? off : std::max(lead, off);
+        rear = first ? off : std::min(rear, off);
+        first = false;
+      }
+    }
+    auto spans_for = [&](double length) { return static_cast<int>(std::ceil(length / span - 1e-9)); };
+    const int margin = kEndlessMargin, behind = spans_for(std::max(behind_slow, behind_fast)) + 1;
+    const int ahead = spans_for(std::max(ahead_slow, ahead_fast)) + 1, train = spans_for(lead - rear);
+    const int home = margin + behind, count = home + 1 + train + ahead + margin;
+    scene.spans.assign(count, span);
+    scene.sections.front().spans = scene.spans;
+    if (scene.sections.front().droppers) {
+      auto& pos = scene.sections.front().droppers->positions;
+      pos.assign(count, pos.front());
+      scene.droppers = scene.sections.front().droppers;
+    }
+    m.endless = true;
+    m.endless_span = span;
+    m.endless_home = home * span;
+    m.rear_collector_offset = rear;
+    // The block starts a whole number of spans behind, so that the line's supports stay at
+    // multiples of the span.
+    endless_front = scene.train_start ? *scene.train_start : -rear;
+    const double shift = std::floor((endless_front + rear) / span) - home;
+    m.initial_line_offset = shift * span;
+    scene.train_start = endless_front - m.initial_line_offset;
+  }
   m.scene = scene;
   const bool lumped_rot = scene.numerics.rotary_inertia == RotaryInertia::kLumped;
   m.line_length = scene.line_length();
@@ -606,7 +724,12 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
   if (m.collectors.empty()) lead = rear = 0.0;
   m.train_start = scene.train_start ? *scene.train_start : -rear;
   m.train_end = scene.train_end ? *scene.train_end : m.line_length - lead;
-  if (m.train_end < m.train_start)
+  if (m.endless) {
+    check_endless_block(m);
+    if (m.train_end < endless_front)
+      throw SceneError("train.end: " + fmt(m.train_end) + " m is behind the start of the pass (train front at " +
+                       fmt(endless_front + 0.0) + " m)");
+  } else if (m.train_end < m.train_start)
     throw SceneError("train: the pass would end (front at " + fmt(m.train_end) + " m) before it starts (" +
                      fmt(m.train_start) + " m): the pantographs are further apart than the line is long");
 

@@ -348,7 +348,16 @@ Scene scene_from_yaml(const YAML::Node& root) {
     if (has_sections && (r.has("spans") || r.has("span_length") || r.has("span_count")))
       fail("line.spans", "(given with sections)", "with sections, every section gives its own spans");
     SectionSpec defaults;
-    if (!has_sections) read_spans(r, "line", defaults.spans);
+    s.endless = r.boolean("endless", false);
+    if (s.endless) {
+      if (has_sections) fail("line.endless", "true", "a single tension section (remove the sections list)");
+      if (r.has("spans") || r.has("span_count"))
+        fail(r.has("spans") ? "line.spans" : "line.span_count", "(given with endless: true)",
+             "an endless line repeats one span: give span_length only");
+      defaults.spans.assign(1, r.number("span_length", 0.5, 500.0));
+    } else if (!has_sections) {
+      read_spans(r, "line", defaults.spans);
+    }
     read_section_parts(top, "", defaults, nullptr);
     if (!has_sections) {
       defaults.contact_wire_count = 1;
@@ -521,6 +530,22 @@ void validate(const Scene& s) {
     const auto& p = s.pantographs[i];
     if (!names.insert(p.name).second)
       fail("pantographs[" + std::to_string(i) + "].name", "'" + p.name + "'", "unique among pantographs");
+  }
+  if (s.endless) {
+    if (!s.numerics.windowed())
+      fail("numerics.window", "off", "auto or {ahead, behind} on an endless line (only the window around the train is modelled)");
+    if (!s.train_end) fail("train.end", "(missing)", "required on an endless line: the train front's station where the pass ends, m");
+    if (s.droppers && s.droppers->per_span)
+      fail("droppers.positions_per_span", "(given)", "an endless line repeats one span: give droppers.positions");
+    if (s.output.analysis_first_span && s.output.analysis_last_span &&
+        !(0 <= *s.output.analysis_first_span && *s.output.analysis_first_span < *s.output.analysis_last_span))
+      fail("output.analysis_spans", "[" + std::to_string(*s.output.analysis_first_span) + ", " + std::to_string(*s.output.analysis_last_span) + "]",
+           "0 <= first < last (span indices along the endless line)");
+    if (s.train_start && *s.train_end < *s.train_start)
+      fail("train.end", fmt(*s.train_end), ">= train.start (" + fmt(*s.train_start) + ")");
+    if (s.numerics.element_length > s.spans.front() + 1e-12)
+      fail("numerics.element_length", fmt(s.numerics.element_length), "at most the span length");
+    return;
   }
   const int a0 = s.analysis_first(), a1 = s.analysis_last();
   if (a0 < 0 || a1 > static_cast<int>(s.spans.size()) || a0 >= a1)

@@ -19,13 +19,13 @@ std::string Simulation::status_message() const {
   std::ostringstream s;
   switch (state_.status) {
     case StepStatus::kOk:
-      if (state_.front >= model_.train_end)
-        s << "pass finished at t = " << state_.time << " s (train front at " << state_.front << " m)";
+      if (finished())
+        s << "pass finished at t = " << state_.time << " s (train front at " << state_.front + state_.line_offset << " m)";
       else
         s << "running";
       break;
     case StepStatus::kFinished:
-      s << "pass finished at t = " << state_.time << " s (train front at " << state_.front << " m)";
+      s << "pass finished at t = " << state_.time << " s (train front at " << state_.front + state_.line_offset << " m)";
       break;
     case StepStatus::kDiverged: {
       if (state_.active_set_full) {
@@ -38,7 +38,7 @@ std::string Simulation::status_message() const {
       std::string where = "DOF " + std::to_string(d);
       for (const Wire& w : model_.wires)
         if (d >= w.w_dof && d < w.w_dof + w.nodes())
-          where = w.name + " at x = " + std::to_string(w.x[d - w.w_dof]) + " m";
+          where = w.name + " at x = " + std::to_string(w.x[d - w.w_dof] + state_.line_offset) + " m";
       for (const Pantograph& p : model_.pantographs)
         if (!p.moving_force && d >= p.first_dof && d < p.first_dof + p.masses_count())
           where = "pantograph " + p.name + " mass " + std::to_string(d - p.first_dof);

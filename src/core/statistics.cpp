@@ -97,7 +97,7 @@ PassRecorder::PassRecorder(const Model& m, double sample_rate_hz)
                    [&](int a, int b) { return m.springs[a].x < m.springs[b].x; });
   for (int k : steady_arm_springs_) steady_arm_x_.push_back(m.springs[k].x);
   for (double l : m.scene.spans) longest_span_ = std::max(longest_span_, l);
-  max_uplift_.assign(np, std::vector<double>(steady_arm_springs_.size(), -std::numeric_limits<double>::infinity()));
+  max_uplift_.resize(np);
   for (const Pantograph& p : m.pantographs) {
     columns_.push_back(p.name + "_position_m");
     for (std::size_t c = 0; c < p.collectors.size(); ++c)
@@ -107,16 +107,18 @@ PassRecorder::PassRecorder(const Model& m, double sample_rate_hz)
     columns_.push_back(p.name + "_force_N");
     columns_.push_back(p.name + "_head_displacement_m");
   }
-  for (int k : steady_arm_springs_)
-    columns_.push_back("uplift_steady_arm" + std::to_string(m.springs[k].span_index) + "_m");
+  // Per steady arm (not on an endless line, whose model moves along under the train).
+  if (!m.endless)
+    for (int k : steady_arm_springs_)
+      columns_.push_back("uplift_steady_arm" + std::to_string(m.springs[k].span_index) + "_m");
 }
 
 void PassRecorder::record(const Model& m, const State& s) {
   const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
   time_.push_back(s.time);
   for (std::size_t p = 0; p < np; ++p) {
-    const double xp = s.front - m.pantographs[p].position;
-    position_[p].push_back(xp);
+    const double xp = s.front - m.pantographs[p].position;  // model station
+    position_[p].push_back(xp + s.line_offset);
     force_[p].push_back(total_contact_force(m, s, static_cast<int>(p)));
     for (std::size_t w = 0; w < nw; ++w) {
       double f = 0.0;
@@ -128,7 +130,13 @@ void PassRecorder::record(const Model& m, const State& s) {
       const SupportSpring& sp = m.springs[steady_arm_springs_[k]];
       const int span = sp.span_index;
       const double reach = 0.5 * std::min(m.scene.spans[span - 1], m.scene.spans[span]);
-      if (std::fabs(xp - sp.x) <= reach) max_uplift_[p][k] = std::max(max_uplift_[p][k], s.u[sp.dof]);
+      if (std::fabs(xp - sp.x) > reach) continue;
+      // Keyed by the steady arm's station along the line (mm), which on an endless line is not
+      // the same spring from one span to the next.
+      const long long key = std::llround(1e3 * (sp.x + s.line_offset));
+      const auto it = max_uplift_[p].find(key);
+      if (it == max_uplift_[p].end()) max_uplift_[p].emplace(key, s.u[sp.dof]);
+      else it->second = std::max(it->second, s.u[sp.dof]);
     }
   }
   if (sample_period_ > 0.0 && s.time + 1e-12 < next_sample_) return;
@@ -143,7 +151,8 @@ void PassRecorder::record(const Model& m, const State& s) {
     row.values.push_back(force_[p].back());
     row.values.push_back(pg.moving_force ? 0.0 : s.u[pg.first_dof]);
   }
-  for (int k : steady_arm_springs_) row.values.push_back(s.u[m.springs[k].dof]);
+  if (!m.endless)
+    for (int k : steady_arm_springs_) row.values.push_back(s.u[m.springs[k].dof]);
   rows_.push_back(std::move(row));
 }
 
@@ -153,7 +162,8 @@ std::vector<PantographStatistics> PassRecorder::statistics(const Model& m) const
 
 std::vector<PantographStatistics> PassRecorder::statistics(const Model& m, double cutoff_hz) const {
   std::vector<PantographStatistics> out;
-  const double x0 = m.support_x[m.scene.analysis_first()], x1 = m.support_x[m.scene.analysis_last()];
+  double x0 = 0.0, x1 = 0.0;
+  analysis_section(m, &x0, &x1);
   const double fs = 1.0 / m.dt;
   for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
     PantographStatistics st;
@@ -173,9 +183,9 @@ std::vector<PantographStatistics> PassRecorder::statistics(const Model& m, doubl
     st.unfiltered = force_statistics(raw_in);
     st.contact_loss_percent = raw_in.empty() ? std::nan("") : 100.0 * lost / raw_in.size();
     double up = -std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < steady_arm_springs_.size(); ++k) {
-      const double xs = m.springs[steady_arm_springs_[k]].x;
-      if (xs >= x0 - 1e-9 && xs <= x1 + 1e-9) up = std::max(up, max_uplift_[p][k]);
+    for (const auto& [key, uplift] : max_uplift_[p]) {
+      const double xs = 1e-3 * key;
+      if (xs >= x0 - 1e-6 && xs <= x1 + 1e-6) up = std::max(up, uplift);
     }
     st.max_uplift_at_support_m = std::isfinite(up) ? up : std::nan("");
     for (std::size_t w = 0; w < m.contact_wires.size(); ++w) {
@@ -231,8 +241,9 @@ std::string statistics_json(const Model& m, const State& s, const std::vector<Pa
     << "  \"real_time_factor\": " << json_number(run.wall_time_s > 0.0 ? s.time / run.wall_time_s : std::nan(""))
     << ",\n";
   if (run.overruns >= 0) j << "  \"overruns\": " << run.overruns << ",\n";
-  j << "  \"analysis_section_m\": [" << json_number(m.support_x[scene.analysis_first()]) << ", "
-    << json_number(m.support_x[scene.analysis_last()]) << "],\n"
+  double x0 = 0.0, x1 = 0.0;
+  analysis_section(m, &x0, &x1);
+  j << "  \"analysis_section_m\": [" << json_number(x0) << ", " << json_number(x1) << "],\n"
     << "  \"filter_cutoff_hz\": " << json_number(scene.output.filter_cutoff) << ",\n"
     << "  \"pantographs\": [";
   for (std::size_t i = 0; i < stats.size(); ++i) {

@@ -23,16 +23,45 @@ constexpr double kMemoryAhead = 2.0, kMemoryBehind = 4.0;  // s
 constexpr double kWindowMinSpans = 2.0;  // the droppers around the head and the joining span
 }  // namespace
 
-void window_lengths(const Model& m, double speed, double* ahead, double* behind) {
-  const NumericsSpec& n = m.scene.numerics;
+void window_lengths_for(const NumericsSpec& n, double c, double span, double speed, double* ahead, double* behind) {
   if (!n.window_auto) {
     *ahead = n.window_ahead;
     *behind = n.window_behind;
     return;
   }
-  const double c = m.wave_speed, v = std::fabs(speed);
-  *ahead = std::max(kWindowMinSpans * m.longest_span, 0.5 * (c + v) * kMemoryAhead);
-  *behind = std::max(kWindowMinSpans * m.longest_span, 0.5 * std::max(0.0, c - v) * kMemoryBehind);
+  const double v = std::fabs(speed);
+  *ahead = std::max(kWindowMinSpans * span, 0.5 * (c + v) * kMemoryAhead);
+  *behind = std::max(kWindowMinSpans * span, 0.5 * std::max(0.0, c - v) * kMemoryBehind);
+}
+
+void window_lengths(const Model& m, double speed, double* ahead, double* behind) {
+  window_lengths_for(m.scene.numerics, m.wave_speed, m.longest_span, speed, ahead, behind);
+}
+
+void shift_endless_block(const Model& m, State& s) {
+  const double span = m.endless_span;
+  if (!(s.front + m.rear_collector_offset >= m.endless_home + span)) return;
+  double* u = s.u.data();
+  double* v = s.v.data();
+  double* a = s.accel.data();
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    WireWindow& ww = s.window[wi];
+    if (ww.hi < ww.lo) continue;
+    const int ns = m.span_nodes[wi], w0 = m.wires[wi].w_dof;
+    for (int i = ww.lo; i <= ww.hi; ++i) {  // upward: the destination is always below the source
+      u[w0 + i - ns] = u[w0 + i];
+      v[w0 + i - ns] = v[w0 + i];
+      a[w0 + i - ns] = a[w0 + i];
+    }
+    for (int i = std::max(ww.lo, ww.hi - ns + 1); i <= ww.hi; ++i) u[w0 + i] = v[w0 + i] = a[w0 + i] = 0.0;
+    ww.lo -= ns;
+    ww.hi -= ns;
+  }
+  s.front -= span;
+  s.line_offset += span;
+  // The window now spans one support less on both ends; update_window() rebuilds its factors and
+  // lists there (the node ranges already match, so nothing is reset).
+  s.window_first_support = s.window_last_support = -1;
 }
 
 void update_window(const Model& m, State& s) {

@@ -6,8 +6,18 @@
 
 namespace catenary_sim {
 
+// The window's lengths (m) ahead and behind at a train speed (m/s), for a contact wire of wave
+// speed c (m/s) and spans of `span` m: the scene's, or the auto rule.
+void window_lengths_for(const NumericsSpec& numerics, double wave_speed, double span, double speed, double* ahead,
+                        double* behind);
+
 // Moves the window to the pantographs if they crossed into another span; no allocation.
 void update_window(const Model& model, State& state);
+
+// Endless line: once the rearmost collector has run a span past Model::endless_home, moves the
+// window's displacements, velocities and accelerations back one span (the block is periodic, so
+// this is exact), the train with them, and adds the span to State::line_offset. No allocation.
+void shift_endless_block(const Model& model, State& state);
 
 // -K z over the window's nodes of one wire (condensed rotations, cut ends left free).
 void wire_elastic_force_window(const Wire& wire, const WireWindow& window, const double* z, double* f, double* theta);

@@ -66,9 +66,10 @@ double collector_force(const Model& m, const State& s, int ci) {
   return f;
 }
 
-// Station of a collector of pantograph p now.
+// Station of a collector of pantograph p now, in the model's stations (the wires' x; on an
+// endless line the line's station is this plus State::line_offset).
 double collector_x(const Model& m, const State& s, int p, int ci) {
-  return pantograph_position(m, s, p) + m.collectors[ci].offset;
+  return s.front - m.pantographs[p].position + m.collectors[ci].offset;
 }
 
 // Under each collector of pantograph p, the contact wire with the lowest design height there (the
@@ -158,7 +159,7 @@ PantographStateArray to_pantograph_state(const Model& m, const State& s, const r
   out.header.frame_id = frame;
   out.step = s.steps;
   out.sim_time = s.time;
-  out.train_front = s.front;
+  out.train_front = s.front + s.line_offset;
   out.speed = s.speed;
   out.target_speed = s.target_speed;
   out.max_acceleration = s.max_acceleration;
@@ -193,7 +194,7 @@ WireShapeArray to_wire_shape(const Model& m, const State& s, double resolution, 
     ws.header = out.header;
     ws.name = w.name;
     for (int i : sample_nodes(w, resolution)) {
-      ws.stations.push_back(w.x[i]);
+      ws.stations.push_back(w.x[i] + s.line_offset);
       ws.heights.push_back(w.height[i] + s.u[w.w_dof + i]);
     }
     out.wires.push_back(ws);
@@ -230,7 +231,7 @@ geometry_msgs::TransformStamped to_view_transform(const State& s, const ros::Tim
   t.header.stamp = stamp;
   t.header.frame_id = line_frame;
   t.child_frame_id = view_frame_id();
-  t.transform.translation.x = s.front;
+  t.transform.translation.x = s.front + s.line_offset;
   t.transform.rotation.w = 1.0;
   return t;
 }
@@ -244,7 +245,7 @@ std::vector<geometry_msgs::TransformStamped> to_transforms(const Model& m, const
   t.header.stamp = stamp;
   t.header.frame_id = line_frame;
   t.child_frame_id = train_frame_id();
-  t.transform.translation.x = s.front;
+  t.transform.translation.x = s.front + s.line_offset;
   t.transform.rotation.w = 1.0;
   out.push_back(t);
   for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
@@ -278,7 +279,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     mk.scale.x = w.is_contact_wire ? 0.04 : 0.03;
     mk.color = w.is_contact_wire ? color(0.85f, 0.55f, 0.2f) : color(0.6f, 0.6f, 0.65f);
     for (int i : sample_nodes(w, o.shape_resolution))
-      mk.points.push_back(point(w.x[i], 0.0, w.height[i] + k * s.u[w.w_dof + i]));
+      mk.points.push_back(point(w.x[i] + s.line_offset, 0.0, w.height[i] + k * s.u[w.w_dof + i]));
     out.markers.push_back(mk);
   }
 
@@ -291,8 +292,8 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
   for (std::size_t d = 0; d < m.droppers.size(); ++d) {
     const Dropper& dr = m.droppers[d];
     Marker& mk = (d < s.dropper_slack.size() && s.dropper_slack[d]) ? slack : taut;
-    mk.points.push_back(point(dr.x, 0.0, shown(dr.contact_dof)));
-    mk.points.push_back(point(dr.x, 0.0, shown(dr.messenger_dof)));
+    mk.points.push_back(point(dr.x + s.line_offset, 0.0, shown(dr.contact_dof)));
+    mk.points.push_back(point(dr.x + s.line_offset, 0.0, shown(dr.messenger_dof)));
   }
   out.markers.push_back(taut);
   out.markers.push_back(slack);  // an empty LINE_LIST clears the previous slack droppers
@@ -304,7 +305,8 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     Marker masts = marker(h, "masts", 0, Marker::LINE_LIST);
     masts.scale.x = 0.15;
     masts.color = color(0.35f, 0.35f, 0.4f);
-    for (double x : m.support_x) {
+    for (double xs : m.support_x) {
+      const double x = xs + s.line_offset;
       masts.points.push_back(point(x, y_mast, 0.0));
       masts.points.push_back(point(x, y_mast, top));
       masts.points.push_back(point(x, y_mast, top));
@@ -317,8 +319,8 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     for (const SupportSpring& sp : m.springs) {
       if (!sp.steady_arm) continue;
       const double z = shown(sp.dof);
-      arms.points.push_back(point(sp.x, y_mast, wire_dof_design_height(m, sp.dof)));
-      arms.points.push_back(point(sp.x, 0.0, z));
+      arms.points.push_back(point(sp.x + s.line_offset, y_mast, wire_dof_design_height(m, sp.dof)));
+      arms.points.push_back(point(sp.x + s.line_offset, 0.0, z));
     }
     out.markers.push_back(arms);
   }

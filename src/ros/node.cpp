@@ -180,7 +180,7 @@ void SimulationNode::handle_end() {
   // (finished() is true as soon as the front reaches the end, before step() marks the state)
   char what[256];
   std::snprintf(what, sizeof what, "pass finished at t = %.4f s (train front at %.2f m), %lld chunks, %lld overruns",
-                s.time, s.front, static_cast<long long>(chunks_), static_cast<long long>(overruns_));
+                s.time, s.front + s.line_offset, static_cast<long long>(chunks_), static_cast<long long>(overruns_));
   switch (params_.at_end) {
     case AtEnd::kStop:
       ended_ = true;
@@ -407,7 +407,7 @@ void SimulationNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("dt [s]", m.dt);
   stat.add("sim time [s]", s.time);
   stat.add("steps", s.steps);
-  stat.add("train front [m]", s.front);
+  stat.add("train front [m]", s.front + s.line_offset);
   stat.add("speed [m/s]", s.speed);
   stat.add("contact loss now", loss_now);
   stat.add("contact loss [% of steps]", counted_steps_ > 0 ? 100.0 * loss_steps_ / counted_steps_ : 0.0);

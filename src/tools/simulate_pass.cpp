@@ -120,10 +120,15 @@ int main(int argc, char** argv) {
   }
   const Model& m = sim->model();
   PassRecorder recorder(m, scene.output.sample_rate);
-  if (!quiet)
-    std::cout << "scene " << scene.name << ": " << scene.spans.size() << " spans, " << m.line_length << " m, "
-              << m.n_dof << " DOFs, dt " << m.dt * 1e3 << " ms (stability limit " << m.dt_critical * 1e3
+  if (!quiet) {
+    if (m.endless)
+      std::cout << "scene " << scene.name << ": endless line of " << m.endless_span << " m spans (a block of "
+                << m.scene.spans.size() << " moves along under the train), ";
+    else
+      std::cout << "scene " << scene.name << ": " << scene.spans.size() << " spans, " << m.line_length << " m, ";
+    std::cout << m.n_dof << " DOFs, dt " << m.dt * 1e3 << " ms (stability limit " << m.dt_critical * 1e3
               << " ms), speed " << scene.train_speed * 3.6 << " km/h" << std::endl;
+  }
   for (const std::string& w : m.warnings) std::cerr << "simulate_pass: warning: " << w << "\n";
   if (scene.train_speed <= 0.0 && !quiet)
     std::cout << "note: train speed 0: the pass never ends; nothing to run\n";
@@ -194,8 +199,9 @@ int main(int argc, char** argv) {
     std::cout << std::fixed << std::setprecision(2);
     std::cout << "pass: " << st.steps << " steps, " << st.time << " s simulated in " << wall << " s wall ("
               << std::setprecision(1) << rtf << "x real time)\n";
-    std::cout << "statistics over " << m.support_x[scene.analysis_first()] << "-" << m.support_x[scene.analysis_last()]
-              << " m, contact force low-pass " << scene.output.filter_cutoff << " Hz:\n";
+    double x0 = 0.0, x1 = 0.0;
+    analysis_section(m, &x0, &x1);
+    std::cout << "statistics over " << x0 << "-" << x1 << " m, contact force low-pass " << scene.output.filter_cutoff << " Hz:\n";
     for (const PantographStatistics& s : stats) {
       std::cout << std::setprecision(1) << "  " << s.name << ": mean " << s.filtered.mean << " N, std "
                 << s.filtered.std_dev << " N, max " << s.filtered.max << " N, min " << s.filtered.min

@@ -74,4 +74,14 @@ TEST(Allocation, StepNeverAllocates) {
     EXPECT_EQ(g_allocations.load(), 0) << "step() allocated with overrides of size " << ov.size();
     EXPECT_EQ(sim.state().status, StepStatus::kOk);
   }
+  // The endless line: 2000 steps run 145 m, so the block is moved back at least twice.
+  Simulation endless(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml"));
+  const double offset0 = endless.state().line_offset;
+  endless.step();
+  g_allocations = 0;
+  g_counting = true;
+  for (int i = 0; i < 2000; ++i) endless.step();
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0) << "step() allocated on the endless line";
+  EXPECT_GE(endless.state().line_offset - offset0, 2 * 55.0);
 }

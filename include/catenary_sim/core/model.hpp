@@ -125,6 +125,15 @@ struct Model {
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
   double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)
+  // Endless line (Scene::endless): the wires are a block of equal spans starting at station 0;
+  // whenever the rearmost collector runs a span past endless_home, step() moves the state back a
+  // span and adds it to State::line_offset (a station along the line = block station + offset).
+  // train_start is then in block stations, train_end along the line.
+  bool endless = false;
+  double endless_span = 0.0, endless_home = 0.0;  // m
+  double initial_line_offset = 0.0;               // m, a whole number of spans
+  double rear_collector_offset = 0.0;             // m, rearmost collector station - train front
+  std::vector<int> span_nodes;                    // per wire: nodes per span (endless)
   double longest_span = 0.0;    // m
   std::vector<std::string> warnings;  // what the scene asks that is outside design practice
 };
@@ -144,6 +153,10 @@ Model build_model(const Scene& scene, const BuildOptions& options);
 // pantograph at a train speed (m/s): the scene's, or for `window: auto` the distances the
 // contact wire's waves run from the pantograph in the time they take to fade (window.cpp).
 void window_lengths(const Model& model, double speed_mps, double* ahead, double* behind);
+
+// The statistics section along the line (m): output.analysis_spans, or by default all spans but
+// two at each end of the line (of the pass on an endless line).
+void analysis_section(const Model& model, double* x0, double* x1);
 
 // A warning (empty if none) for a train speed above 0.7 of the contact wire's wave speed.
 std::string speed_warning(const Model& model, double speed_mps);

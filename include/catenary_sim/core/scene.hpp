@@ -135,6 +135,11 @@ struct Scene {
   double contact_wire_height = 5.3;    // m above the rail at the supports
   double encumbrance = 1.2;            // m, messenger above contact wire at the supports
   std::vector<double> spans;           // m, the line's spans in order (overlapping spans counted once)
+  // line.endless: one tension section of equal spans that goes on for ever (no anchors in reach).
+  // `spans` holds one span here; build_model makes a block of them long enough for the moving
+  // window (which it requires) and moves the state back a span at a time as the train runs on.
+  // Stations along the line are then unbounded; train.end says where the pass ends.
+  bool endless = false;
   std::vector<SectionSpec> sections;   // tension sections in series; at least one
   std::optional<OverlapSpec> overlap;  // present when there are two or more sections
   // Section defaults (the first section's, and the only section's in a one-section scene).

@@ -19,7 +19,7 @@ class Simulation {
   const State& state() const { return state_; }
 
   StepStatus step() { return catenary_sim::step(model_, state_); }
-  bool finished() const { return state_.status == StepStatus::kFinished || state_.front >= model_.train_end; }
+  bool finished() const { return state_.status == StepStatus::kFinished || state_.front + state_.line_offset >= model_.train_end; }
   // Human-readable status, naming the DOF and time of a divergence.
   std::string status_message() const;
 

@@ -37,7 +37,8 @@ constexpr int kMaxActiveSetPasses = 4;
 struct State {
   double time = 0.0;       // s, simulation time since the pass started
   std::int64_t steps = 0;
-  double front = 0.0;      // m, train front position along the line
+  double front = 0.0;      // m, train front position (a block station on an endless line)
+  double line_offset = 0.0;  // m, station along the line of the model's station 0 (endless line)
   double speed = 0.0;      // m/s, train speed now
   double target_speed = 0.0;      // m/s, commanded speed the train accelerates toward
   double max_acceleration = 0.0;  // m/s^2, |dv/dt| limit toward target_speed (0: jump)

@@ -2,6 +2,7 @@
 // over an analysis section, per pantograph.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -79,7 +80,7 @@ class PassRecorder {
   std::vector<int> steady_arm_springs_;                 // indices into model.springs, in line order
   std::vector<double> steady_arm_x_;                    // m, their stations
   double longest_span_ = 0.0;                           // m
-  std::vector<std::vector<double>> max_uplift_;        // per pantograph, per steady arm
+  std::vector<std::map<long long, double>> max_uplift_;  // per pantograph: steady arm station (mm) -> max uplift (m)
 };
 
 }  // namespace catenary_sim
