@@ -49,7 +49,7 @@ def loadavg():
         return " ".join(f.read().split()[:3])
 
 
-def run_rate(rate, duration, env, tmp, chrt):
+def run_rate(rate, duration, env, tmp, chrt, spin_wait):
     label = f"{int(rate)}hz"
     node_report = os.path.join(tmp, f"node_{label}.json")
     rig_report = os.path.join(tmp, f"rig_{label}.json")
@@ -58,6 +58,8 @@ def run_rate(rate, duration, env, tmp, chrt):
                          f"_scene:={os.path.join(ROOT, 'config', 'reference_55m_hil.yaml')}",
                          f"_hil/rate:={float(rate)}", "_hil/timeout:=0.05", "_at_end:=loop",
                          f"_hil/report_file:={node_report}"]
+    if spin_wait is not None:
+        node_cmd.append(f"_hil/spin_wait:={float(spin_wait)}")
     rig_cmd = prefix + [os.path.join(LIB, "virtual_rig"), f"__name:=rig_{label}",
                         f"_pantograph_scene:={os.path.join(ROOT, 'config', 'reference_55m.yaml')}",
                         f"_report_file:={rig_report}"]
@@ -107,6 +109,8 @@ def main():
     ap.add_argument("--rates", default="1000,2000,5000", help="Hz, comma separated")
     ap.add_argument("--durations", default="60,60,60", help="s of wall clock per rate, comma separated")
     ap.add_argument("--chrt", type=int, default=0, help="SCHED_FIFO priority for node and rig (0: normal)")
+    ap.add_argument("--spin-wait", type=float, default=None,
+                    help="s, the node's ~hil/spin_wait (default: the node's default)")
     args = ap.parse_args()
     rates = [float(r) for r in args.rates.split(",")]
     durations = [float(d) for d in args.durations.split(",")]
@@ -130,7 +134,7 @@ def main():
     results = []
     for rate, duration in zip(rates, durations):
         bn.log(f"{rate:g} Hz for {duration:g} s ...")
-        r = run_rate(rate, duration, env, bn._tmp, args.chrt)
+        r = run_rate(rate, duration, env, bn._tmp, args.chrt, args.spin_wait)
         results.append(r)
         n = r["node"]
         bn.log(f"  {n['periods']} periods, {n['overruns']} overruns, latency p99 {us(n['latency']['p99_s'])} us")
