@@ -20,7 +20,8 @@ Targets (at 1 kHz): latency p99 < 0.5 ms and no overruns; the script exits with 
 missed. --chrt N runs both processes under `chrt -f N` (SCHED_FIFO, needs the right to).
 --inprocess runs both as nodelets (catenary_sim/HilNodelet, catenary_sim/VirtualRigNodelet) in
 one nodelet manager: the messages pass as shared pointers, no serialisation, no socket.
---spin-wait S sets the node's ~hil/spin_wait.
+--spin-wait S sets the node's ~hil/spin_wait. --watch-outputs subscribes to pantograph_state and
+wire_shape (rostopic hz) during the run: what publishing them costs the loop.
 
 Runs against a private roscore on a free loopback port (reusing bench_node.py's helpers);
 everything started here is stopped on exit. Build first: SKIP_SETUP=1 scripts/build
@@ -55,7 +56,7 @@ def loadavg():
 NODELET = "/usr/lib/nodelet/nodelet"  # Debian's libnodeletlib-tools (rosrun nodelet nodelet)
 
 
-def run_rate(rate, duration, env, tmp, chrt, spin_wait, inprocess):
+def run_rate(rate, duration, env, tmp, chrt, spin_wait, inprocess, watch):
     label = f"{int(rate)}hz"
     node_report = os.path.join(tmp, f"node_{label}.json")
     rig_report = os.path.join(tmp, f"rig_{label}.json")
@@ -82,6 +83,9 @@ def run_rate(rate, duration, env, tmp, chrt, spin_wait, inprocess):
     else:
         cmds = [prefix + node_cmd, prefix + rig_cmd]
         names = ("node", "rig")
+    if watch:  # a subscriber to the decimated outputs (its own CPU time is part of the load)
+        cmds.append(["/usr/bin/rostopic", "hz", "pantograph_state", "wire_shape"])
+        names += ("watch",)
     logs = [open(os.path.join(tmp, f"{n}_{label}.log"), "w") for n in names]
     procs = []
     load0 = loadavg()
@@ -132,6 +136,8 @@ def main():
     ap.add_argument("--chrt", type=int, default=0, help="SCHED_FIFO priority for node and rig (0: normal)")
     ap.add_argument("--inprocess", action="store_true",
                     help="node and rig as nodelets in one manager (shared pointers, no sockets)")
+    ap.add_argument("--watch-outputs", action="store_true",
+                    help="subscribe to pantograph_state and wire_shape (rostopic hz) during the run")
     ap.add_argument("--spin-wait", type=float, default=None,
                     help="s, the node's ~hil/spin_wait (default: the node's default)")
     args = ap.parse_args()
@@ -157,7 +163,7 @@ def main():
     results = []
     for rate, duration in zip(rates, durations):
         bn.log(f"{rate:g} Hz for {duration:g} s ...")
-        r = run_rate(rate, duration, env, bn._tmp, args.chrt, args.spin_wait, args.inprocess)
+        r = run_rate(rate, duration, env, bn._tmp, args.chrt, args.spin_wait, args.inprocess, args.watch_outputs)
         results.append(r)
         n = r["node"]
         bn.log(f"  {n['periods']} periods, {n['overruns']} overruns, latency p99 {us(n['latency']['p99_s'])} us")
