@@ -18,6 +18,10 @@ given wall-clock duration; then both get SIGINT and write their reports:
 
 Targets (at 1 kHz): latency p99 < 0.5 ms and no overruns; the script exits with status 1 if
 missed. --chrt N runs both processes under `chrt -f N` (SCHED_FIFO, needs the right to).
+--inprocess runs both as nodelets (catenary_sim/HilNodelet, catenary_sim/VirtualRigNodelet) in
+one nodelet manager: the messages pass as shared pointers, no serialisation, no socket.
+--spin-wait S sets the node's ~hil/spin_wait. --watch-outputs subscribes to pantograph_state and
+wire_shape (rostopic hz) during the run: what publishing them costs the loop.
 
 Runs against a private roscore on a free loopback port (reusing bench_node.py's helpers);
 everything started here is stopped on exit. Build first: SKIP_SETUP=1 scripts/build
@@ -49,23 +53,44 @@ def loadavg():
         return " ".join(f.read().split()[:3])
 
 
-def run_rate(rate, duration, env, tmp, chrt):
+NODELET = "/usr/lib/nodelet/nodelet"  # Debian's libnodeletlib-tools (rosrun nodelet nodelet)
+
+
+def run_rate(rate, duration, env, tmp, chrt, spin_wait, inprocess, watch):
     label = f"{int(rate)}hz"
     node_report = os.path.join(tmp, f"node_{label}.json")
     rig_report = os.path.join(tmp, f"rig_{label}.json")
     prefix = ["chrt", "-f", str(chrt)] if chrt > 0 else []
-    node_cmd = prefix + [os.path.join(LIB, "catenary_sim_hil_node"), f"__name:=hil_{label}",
-                         f"_scene:={os.path.join(ROOT, 'config', 'reference_55m_hil.yaml')}",
-                         f"_hil/rate:={float(rate)}", "_hil/timeout:=0.05", "_at_end:=loop",
-                         f"_hil/report_file:={node_report}"]
-    rig_cmd = prefix + [os.path.join(LIB, "virtual_rig"), f"__name:=rig_{label}",
-                        f"_pantograph_scene:={os.path.join(ROOT, 'config', 'reference_55m.yaml')}",
-                        f"_report_file:={rig_report}"]
-    logs = [open(os.path.join(tmp, f"{n}_{label}.log"), "w") for n in ("node", "rig")]
+    manager = f"hil_manager_{label}"
+    # In-process: a nodelet manager, and the node and the rig loaded into it by two loader processes
+    # (named as the node and the rig, whose private parameters they carry).
+    node_exe = [NODELET, "load", "catenary_sim/HilNodelet", manager] if inprocess else \
+        [os.path.join(LIB, "catenary_sim_hil_node")]
+    rig_exe = [NODELET, "load", "catenary_sim/VirtualRigNodelet", manager] if inprocess else \
+        [os.path.join(LIB, "virtual_rig")]
+    node_cmd = node_exe + [f"__name:=hil_{label}",
+                           f"_scene:={os.path.join(ROOT, 'config', 'reference_55m_hil.yaml')}",
+                           f"_hil/rate:={float(rate)}", "_hil/timeout:=0.05", "_at_end:=loop",
+                           f"_hil/report_file:={node_report}"]
+    if spin_wait is not None:
+        node_cmd.append(f"_hil/spin_wait:={float(spin_wait)}")
+    rig_cmd = rig_exe + [f"__name:=rig_{label}",
+                         f"_pantograph_scene:={os.path.join(ROOT, 'config', 'reference_55m.yaml')}",
+                         f"_report_file:={rig_report}"]
+    if inprocess:  # the manager first, at the priority asked for; the loaders are plain clients
+        cmds = [prefix + [NODELET, "manager", f"__name:={manager}"], node_cmd, rig_cmd]
+        names = ("manager", "node", "rig")
+    else:
+        cmds = [prefix + node_cmd, prefix + rig_cmd]
+        names = ("node", "rig")
+    if watch:  # a subscriber to the decimated outputs (its own CPU time is part of the load)
+        cmds.append(["/usr/bin/rostopic", "hz", "pantograph_state", "wire_shape"])
+        names += ("watch",)
+    logs = [open(os.path.join(tmp, f"{n}_{label}.log"), "w") for n in names]
     procs = []
     load0 = loadavg()
     try:
-        for cmd, log in zip((node_cmd, rig_cmd), logs):
+        for cmd, log in zip(cmds, logs):
             p = subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                                  start_new_session=True)
             bn._started.append(p)
@@ -74,12 +99,14 @@ def run_rate(rate, duration, env, tmp, chrt):
         while time.monotonic() < deadline:
             for p in procs:
                 if p.poll() is not None:
-                    raise RuntimeError(f"{os.path.basename(p.args[len(prefix)])} exited with {p.returncode}; "
+                    raise RuntimeError(f"{' '.join(p.args[:4])} exited with {p.returncode}; "
                                        f"see {tmp}")
             time.sleep(0.5)
         load1 = loadavg()
     finally:
-        for p in procs:  # the node first: a rig stopping first would put it into the safe hold
+        # The node first: a rig stopping first would put it into the safe hold (in-process: the
+        # manager, which ends both loops and writes both reports, then the loaders).
+        for p in procs:
             if p.poll() is None:
                 p.send_signal(signal.SIGINT)
             try:
@@ -107,6 +134,12 @@ def main():
     ap.add_argument("--rates", default="1000,2000,5000", help="Hz, comma separated")
     ap.add_argument("--durations", default="60,60,60", help="s of wall clock per rate, comma separated")
     ap.add_argument("--chrt", type=int, default=0, help="SCHED_FIFO priority for node and rig (0: normal)")
+    ap.add_argument("--inprocess", action="store_true",
+                    help="node and rig as nodelets in one manager (shared pointers, no sockets)")
+    ap.add_argument("--watch-outputs", action="store_true",
+                    help="subscribe to pantograph_state and wire_shape (rostopic hz) during the run")
+    ap.add_argument("--spin-wait", type=float, default=None,
+                    help="s, the node's ~hil/spin_wait (default: the node's default)")
     args = ap.parse_args()
     rates = [float(r) for r in args.rates.split(",")]
     durations = [float(d) for d in args.durations.split(",")]
@@ -114,8 +147,8 @@ def main():
         durations *= len(rates)
     if len(durations) != len(rates):
         ap.error("--durations needs one value, or one per rate")
-    for exe in ("catenary_sim_hil_node", "virtual_rig"):
-        if not os.access(os.path.join(LIB, exe), os.X_OK):
+    for exe in ("catenary_sim_hil_node", "virtual_rig") + (("../libcatenary_sim_nodelets.so",) if args.inprocess else ()):
+        if not os.access(os.path.join(LIB, exe), os.R_OK):
             sys.exit(f"bench_hil_latency: {LIB}/{exe} missing: run SKIP_SETUP=1 scripts/build first")
 
     atexit.register(bn.cleanup)
@@ -130,7 +163,7 @@ def main():
     results = []
     for rate, duration in zip(rates, durations):
         bn.log(f"{rate:g} Hz for {duration:g} s ...")
-        r = run_rate(rate, duration, env, bn._tmp, args.chrt)
+        r = run_rate(rate, duration, env, bn._tmp, args.chrt, args.spin_wait, args.inprocess, args.watch_outputs)
         results.append(r)
         n = r["node"]
         bn.log(f"  {n['periods']} periods, {n['overruns']} overruns, latency p99 {us(n['latency']['p99_s'])} us")

@@ -2,12 +2,16 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -42,6 +46,21 @@ std::string json_number(double v) {
 }
 
 }  // namespace
+
+void prepare_loop_thread(int priority, const char* who) {
+  // Wake-ups within ~1 us of the requested time instead of the default 50 us timer slack (threads
+  // started from this one inherit it).
+  prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);
+  if (priority <= 0) return;
+  sched_param sp{};
+  sp.sched_priority = priority;
+  if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) != 0)
+    ROS_WARN("%s: ~hil/realtime_priority %d: SCHED_FIFO not granted; running with normal scheduling", who, priority);
+  else if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+    ROS_WARN("%s: mlockall failed (%s)", who, std::strerror(errno));
+  else
+    ROS_INFO("%s: loop thread at SCHED_FIFO priority %d, memory locked", who, priority);
+}
 
 std::uint8_t HilNode::mode_code(Mode m) {
   switch (m) {
@@ -80,6 +99,8 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
 
   point_pub_ = nh_.advertise<ContactPointArray>("hil/contact_point", 10);
   contact_pub_ = nh_.advertise<ContactForceArray>("contact_force", 10);
+  pantograph_pub_ = nh_.advertise<PantographStateArray>("pantograph_state", 10);
+  shape_pub_ = nh_.advertise<WireShapeArray>("wire_shape", 2);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
   // The rig's measurements on a queue of their own, waited on by the loop; TCP_NODELAY: no
   // Nagle delay on the small messages (the hint is also applied to the rig's end of the socket).
@@ -88,6 +109,12 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
       ros::VoidPtr(), &hil_queue_);
   so.transport_hints = ros::TransportHints().tcpNoDelay();
   force_sub_ = nh_.subscribe(so);
+  // The same measurement as a wrench (a load cell's usual message), on the same queue.
+  ros::SubscribeOptions wo = ros::SubscribeOptions::create<geometry_msgs::WrenchStamped>(
+      "hil/contact_wrench", 100, [this](const geometry_msgs::WrenchStamped::ConstPtr& msg) { on_wrench(msg); },
+      ros::VoidPtr(), &hil_queue_);
+  wo.transport_hints = ros::TransportHints().tcpNoDelay();
+  wrench_sub_ = nh_.subscribe(wo);
 
   updater_.setHardwareID("catenary_sim_hil/" + scene.name);
   updater_.add("hardware in the loop", this, &HilNode::diagnose);
@@ -99,8 +126,9 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
            scene.name.c_str(), m.n_dof, names.c_str(), params_.rate, timing_.period * 1e3, timing_.steps_per_period,
            m.dt * 1e3, m.dt_critical * 1e3, scene.train_speed * 3.6, params_.timeout,
            params_.extrapolate ? "linear extrapolation" : "newest measurement held", to_string(params_.at_end));
-  ROS_INFO("catenary_sim_hil: waiting for the first measurement on %s (the line holds its static state)",
-           force_sub_.getTopic().c_str());
+  ROS_INFO("catenary_sim_hil: waiting for the first measurement on %s%s (the line holds its static state)",
+           force_sub_.getTopic().c_str(),
+           external_.size() == 1 ? (" or " + wrench_sub_.getTopic()).c_str() : "");
   worker_ = std::thread([this] { worker(); });
 }
 
@@ -113,36 +141,66 @@ HilNode::~HilNode() {
   if (worker_.joinable()) worker_.join();
 }
 
+void HilNode::reject(const std::string& what) {
+  ++c_.rejected;
+  ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil: %s; measurement ignored, the previous one stays in effect (%lld rejected so "
+                     "far)", what.c_str(), static_cast<long long>(c_.rejected));
+}
+
 void HilNode::on_measurement(const MeasuredContactForce::ConstPtr& msg) {
   const double arrival = steady_now();
   const std::size_t n = external_.size();
   if (msg->force.size() != n) {
-    ++c_.rejected;
-    ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil: hil/contact_force with %zu values rejected: the scene has %zu external "
-                       "pantograph(s), send one total force (N) each in scene order; measurement ignored",
-                       msg->force.size(), n);
+    reject("hil/contact_force with " + std::to_string(msg->force.size()) + " values rejected: the scene has " +
+           std::to_string(n) + " external pantograph(s), send one total force (N) each in scene order");
     return;
   }
+  accept(msg->force.data(), arrival, msg->header.stamp, msg->step, "hil/contact_force.force", true);
+}
+
+void HilNode::on_wrench(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
+  const double arrival = steady_now();
+  if (external_.size() != 1) {
+    reject("hil/contact_wrench rejected: it carries one force (wrench.force.z) and the scene has " +
+           std::to_string(external_.size()) + " external pantographs; send hil/contact_force with one total force each");
+    return;
+  }
+  // Only force.z is used; a non-finite value anywhere is a broken reading.
+  const geometry_msgs::Wrench& w = msg->wrench;
+  const std::pair<const char*, double> others[] = {{"force.x", w.force.x},   {"force.y", w.force.y},
+                                                   {"torque.x", w.torque.x}, {"torque.y", w.torque.y},
+                                                   {"torque.z", w.torque.z}};
+  for (const auto& o : others)
+    if (!std::isfinite(o.second)) {
+      reject(std::string("hil/contact_wrench.wrench.") + o.first + " = " + format_number(o.second) +
+             " rejected: allowed a finite value (only force.z is used; the other components must be finite)");
+      return;
+    }
+  const double f = w.force.z;
+  accept(&f, arrival, msg->header.stamp, 0, "hil/contact_wrench.wrench.force.z", false);
+}
+
+bool HilNode::accept(const double* force, double arrival, const ros::Time& stamp_time, std::uint64_t step,
+                     const char* field, bool indexed) {
+  const std::size_t n = external_.size();
   // The core checks each value (NaN, inf, range); a rejected message changes nothing.
   std::string err;
   for (std::size_t i = 0; i < n; ++i) accept_buf_[i] = sim_->state().external_force[external_[i]];
   for (std::size_t i = 0; i < n; ++i) {
-    if (!sim_->set_external_force(external_[i], msg->force[i], &err)) {
+    if (!sim_->set_external_force(external_[i], force[i], &err)) {
       for (std::size_t j = 0; j < i; ++j) sim_->set_external_force(external_[j], accept_buf_[j], nullptr);
-      ++c_.rejected;
-      ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil: hil/contact_force.force[%zu]: %s; measurement ignored, the previous "
-                         "one stays in effect (%lld rejected so far)", i, err.c_str(), static_cast<long long>(c_.rejected));
-      return;
+      reject(std::string(field) + (indexed ? "[" + std::to_string(i) + "]" : std::string()) + ": " + err);
+      return false;
     }
   }
   for (std::size_t i = 0; i < n; ++i) accept_buf_[i] = sim_->state().external_force[external_[i]];
-  const double stamp = msg->header.stamp.toSec();
+  const double stamp = stamp_time.toSec();
   if (stamp > 0.0) {
     const double transport = ros::WallTime::now().toSec() - stamp;
     if (transport >= 0.0 && transport < 1.0) transport_.add(transport);
   }
   if (unused_) ++c_.superseded;
-  hold_.accept(accept_buf_, arrival, stamp, msg->step);
+  hold_.accept(accept_buf_, arrival, stamp, step);
   unused_ = true;
   ++c_.accepted;
   // Which period it starts. An answer to the last contact point published starts the next period
@@ -151,7 +209,7 @@ void HilNode::on_measurement(const MeasuredContactForce::ConstPtr& msg) {
   // period lacked, so it is held but starts nothing (else it would take the next period and push
   // every later answer a period back); otherwise the rig is a period behind (its round trip is
   // longer than a period) and it starts the next period like any other.
-  if (msg->step == 0 || msg->step >= published_step_) {
+  if (step == 0 || step >= published_step_) {
     fresh_ = true;
     owed_ = false;
   } else {
@@ -159,9 +217,36 @@ void HilNode::on_measurement(const MeasuredContactForce::ConstPtr& msg) {
     if (owed_) owed_ = false;
     else fresh_ = true;
   }
+  return true;
+}
+
+void HilNode::wait_for_period(double w, double half, double& t) {
+  // Wait for a fresh measurement inside the window [w - half, w + half], or for the window's end.
+  // Blocking on the queue costs a wake-up (the thread that queued the measurement signals this
+  // one); with ~hil/spin_wait the loop blocks only until that long before a due time (the start
+  // of the window for an early measurement, else the expected arrival, the window's centre, on
+  // which the windows are locked) and then polls the queue on the steady clock until it is (or,
+  // for the arrival, until that long after it).
+  const double spin = params_.spin_wait;
+  auto running = [this] { return ros::ok() && !ros::isShuttingDown() && !stop_; };
+  while (running()) {
+    if (fresh_ && t >= w - half) break;
+    if (t >= w + half) break;
+    const double until = fresh_ ? w - half : w + half;
+    double block_until = until;
+    if (spin > 0.0) {
+      const double due = fresh_ ? w - half : w;
+      const double spin_end = fresh_ ? until : std::min(until, w + spin);
+      if (t < due - spin) block_until = due - spin;
+      else if (t < spin_end) block_until = t;  // poll
+    }
+    hil_queue_.callAvailable(ros::WallDuration(std::max(0.0, block_until - t)));
+    t = steady_now();
+  }
 }
 
 int HilNode::run() {
+  prepare_loop_thread(params_.realtime_priority, "catenary_sim_hil");
   const double period = timing_.period, half = 0.5 * period;
   publish_point();
   double w = steady_now() + period;  // centre of the next period's window
@@ -170,19 +255,12 @@ int HilNode::run() {
   next_snapshot_ = next_quantiles_ = steady_now();
   // (ros::ok() stays true while a shutdown closes the connections: without the second test the
   // rig's measurements would seem to stop and the loop enter the safe hold on its way out)
-  auto running = [] { return ros::ok() && !ros::isShuttingDown(); };
+  auto running = [this] { return ros::ok() && !ros::isShuttingDown() && !stop_; };
   bool relock = false;  // centre the windows on the next arrival
   int off_centre = 0;   // triggering arrivals in a row more than a quarter period off the centre
   while (running() && !exit_requested_) {
-    // Wait for a fresh measurement inside the window, or for the window's end.
     double t = steady_now();
-    while (running()) {
-      if (fresh_ && t >= w - half) break;
-      if (t >= w + half) break;
-      const double until = fresh_ ? w - half : w + half;
-      hil_queue_.callAvailable(ros::WallDuration(std::max(0.0, until - t)));
-      t = steady_now();
-    }
+    wait_for_period(w, half, t);
     if (!running()) break;
     if (mode_ == Mode::kWaiting && t < start_wait_end) fresh_ = false;  // (~start_delay)
     const bool triggered = fresh_;
@@ -314,18 +392,19 @@ void HilNode::batch(double t, bool triggered) {
 void HilNode::publish_point() {
   const Model& m = sim_->model();
   const State& s = sim_->state();
-  ContactPointArray msg =
-      to_contact_points(m, s, sim_stamp(s.time, stamp_offset_), params_.line_frame, timing_.steps_per_period, scratch_);
-  msg.mode = mode_code(mode_);
-  msg.pass_count = pass_count_;
-  msg.measurement_step = step_in_effect_;
-  for (ContactPoint& c : msg.pantographs) c.measurement_age = age_in_effect_;
-  if (!all_finite(msg)) {
+  // (a shared pointer: a subscriber in the same process, e.g. VirtualRigNodelet, gets it without a copy)
+  const boost::shared_ptr<ContactPointArray> msg = boost::make_shared<ContactPointArray>(
+      to_contact_points(m, s, sim_stamp(s.time, stamp_offset_), params_.line_frame, timing_.steps_per_period, scratch_));
+  msg->mode = mode_code(mode_);
+  msg->pass_count = pass_count_;
+  msg->measurement_step = step_in_effect_;
+  for (ContactPoint& c : msg->pantographs) c.measurement_age = age_in_effect_;
+  if (!all_finite(*msg)) {
     ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil: a contact point with a non-finite value was not published (t = %g s)", s.time);
     return;
   }
+  published_step_ = msg->step;
   point_pub_.publish(msg);
-  published_step_ = msg.step;
 }
 
 void HilNode::handle_end() {
@@ -409,11 +488,16 @@ void HilNode::worker() {
       const State& s = wsnap_.state;
       const ros::Time stamp = sim_stamp(s.time, stamp_offset_);
       contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
+      if (pantograph_pub_.getNumSubscribers() > 0) publish_pantograph_state(m, s, stamp);
       if (s.time > last_tf_time_) {
         tf_.sendTransform(to_transforms(m, s, stamp, params_.line_frame));
         last_tf_time_ = s.time;
       }
       const double now = steady_now();
+      if (now >= next_shape_wall_ && shape_pub_.getNumSubscribers() > 0) {
+        next_shape_wall_ = now + 1.0 / params_.shape_rate;
+        shape_pub_.publish(to_wire_shape(m, s, params_.shape_resolution, stamp, params_.line_frame));
+      }
       if (now >= next_marker_wall_ && marker_pub_.getNumSubscribers() > 0) {
         next_marker_wall_ = now + 1.0 / params_.marker_rate;
         MarkerOptions o;
@@ -440,6 +524,18 @@ void HilNode::worker() {
     }
     updater_.update();
   }
+}
+
+void HilNode::publish_pantograph_state(const Model& m, const State& s, const ros::Time& stamp) {
+  PantographStateArray msg = to_pantograph_state(m, s, stamp, params_.line_frame);
+  // An external pantograph has no masses here (its head is the real one on the rig): its head
+  // height is the height the rig is told to impose, that of the contact point (never the NaN of a
+  // simulated moving force).
+  const ContactPointArray points = to_contact_points(m, s, stamp, params_.line_frame, timing_.steps_per_period,
+                                                     worker_scratch_);
+  for (std::size_t i = 0; i < external_.size() && i < points.pantographs.size(); ++i)
+    msg.pantographs[external_[i]].head_height = points.pantographs[i].height;
+  pantograph_pub_.publish(msg);
 }
 
 void HilNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
@@ -523,7 +619,7 @@ void HilNode::write_report() const {
     << ",\n  \"periods\": " << c_.batches << ",\n  \"periods_triggered\": " << c_.triggered
     << ",\n  \"periods_held\": " << c_.held << ",\n  \"periods_safe_hold\": " << c_.hold_batches
     << ",\n  \"safe_holds\": " << c_.holds << ",\n  \"overruns\": " << c_.overruns
-    << ",\n  \"relocks\": " << c_.relocks
+    << ",\n  \"relocks\": " << c_.relocks << ",\n  \"spin_wait_s\": " << json_number(params_.spin_wait)
     << ",\n  \"measurements_accepted\": " << c_.accepted << ",\n  \"measurements_rejected\": " << c_.rejected
     << ",\n  \"measurements_superseded\": " << c_.superseded << ",\n  \"measurements_late\": " << c_.late
     << ",\n  \"max_age_running_s\": " << json_number(c_.max_age_running)

@@ -26,6 +26,15 @@ void validate_hil_params(const HilParams& p) {
   check_range("publish_rate", p.publish_rate, 0.0, 1000.0, true, "Hz");
   check_range("marker_rate", p.marker_rate, 0.0, 100.0, true, "Hz");
   check_range("start_delay", p.start_delay, 0.0, 60.0, false, "s");
+  check_range("shape_rate", p.shape_rate, 0.0, 100.0, true, "Hz");
+  check_range("shape_resolution", p.shape_resolution, 0.0, 100.0, false, "m (0: every node)");
+  if (!std::isfinite(p.spin_wait) || p.spin_wait < 0.0 || p.spin_wait > 0.5 * period)
+    throw ParamError("parameter ~hil/spin_wait = " + format_number(p.spin_wait) + " s rejected: allowed [0, " +
+                     format_number(0.5 * period) + "] s (at most half a loop period of ~hil/rate = " +
+                     format_number(p.rate) + " Hz; 0: no spinning)");
+  if (p.realtime_priority < 0 || p.realtime_priority > 99)
+    throw ParamError("parameter ~hil/realtime_priority = " + std::to_string(p.realtime_priority) +
+                     " rejected: allowed 0 (normal scheduling) to 99 (SCHED_FIFO priority)");
   if (p.line_frame.empty() || p.line_frame[0] == '/')
     throw ParamError("parameter ~line_frame = '" + p.line_frame + "' rejected: a non-empty frame id without a leading '/'");
 }
@@ -53,6 +62,11 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
   number("publish_rate", p.publish_rate);
   number("marker_rate", p.marker_rate);
   number("start_delay", p.start_delay);
+  number("shape_rate", p.shape_rate);
+  number("shape_resolution", p.shape_resolution);
+  number("hil/spin_wait", p.spin_wait);
+  if (nh.hasParam("hil/realtime_priority") && !nh.getParam("hil/realtime_priority", p.realtime_priority))
+    throw ParamError("parameter ~hil/realtime_priority must be an integer in [0, 99]");
   if (nh.hasParam("hil/extrapolate") && !nh.getParam("hil/extrapolate", p.extrapolate))
     throw ParamError("parameter ~hil/extrapolate must be true or false");
   nh.param<std::string>("hil/report_file", p.report_file, "");

@@ -157,6 +157,49 @@ TEST(HilTiming, ExplicitDtMustDivideThePeriod) {
   for (double rate : {999.0, 10001.0, std::nan("")}) EXPECT_THROW(hil_timing(rate, std::nullopt, 1e-3), ParamError);
 }
 
+// The parameters added for the loop's scheduling and the decimated outputs: out of range names the
+// parameter, the value and what is allowed.
+TEST(HilParams, SpinWaitPriorityAndShapeParametersAreChecked) {
+  HilParams p;
+  p.scene = "x.yaml";
+  EXPECT_NO_THROW(validate_hil_params(p));
+  p.spin_wait = 0.0005;  // half the period at 1 kHz: the most allowed
+  EXPECT_NO_THROW(validate_hil_params(p));
+  auto message = [](const HilParams& q) {
+    try {
+      validate_hil_params(q);
+    } catch (const ParamError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  for (double bad : {0.0006, -1e-6, std::nan("")}) {
+    HilParams q = p;
+    q.spin_wait = bad;
+    const std::string msg = message(q);
+    EXPECT_NE(msg.find("~hil/spin_wait"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("allowed [0, 0.0005] s"), std::string::npos) << msg;
+  }
+  HilParams q = p;
+  q.rate = 5000.0;
+  q.timeout = 0.01;
+  q.spin_wait = 0.0002;  // more than half of 0.2 ms
+  EXPECT_NE(message(q).find("allowed [0, 0.0001] s"), std::string::npos) << message(q);
+  for (int bad : {-1, 100}) {
+    q = p;
+    q.realtime_priority = bad;
+    const std::string msg = message(q);
+    EXPECT_NE(msg.find("~hil/realtime_priority = " + std::to_string(bad)), std::string::npos) << msg;
+    EXPECT_NE(msg.find("0 (normal scheduling) to 99"), std::string::npos) << msg;
+  }
+  q = p;
+  q.shape_rate = 0.0;
+  EXPECT_NE(message(q).find("~shape_rate = 0 rejected: allowed (0, 100] Hz"), std::string::npos) << message(q);
+  q = p;
+  q.shape_resolution = -1.0;
+  EXPECT_NE(message(q).find("~shape_resolution = -1 rejected"), std::string::npos) << message(q);
+}
+
 TEST(HilScene, ReferenceHilIsTheReferenceSceneWithAnExternalPantograph) {
   YAML::Node hil = YAML::LoadFile(kDir + "/config/reference_55m_hil.yaml");
   YAML::Node ref = YAML::LoadFile(kDir + "/config/reference_55m.yaml");

@@ -47,6 +47,13 @@ struct HilParams {
   double marker_rate = 10.0;        // ~marker_rate: Hz for markers (only with a subscriber), (0, 100]
   double start_delay = 0.0;         // ~start_delay: s (wall) in which measurements are ignored and the
                                     //   initial state is published (lets recorders connect), [0, 60]
+  double shape_rate = 10.0;         // ~shape_rate: Hz for wire_shape (only with a subscriber), (0, 100]
+  double shape_resolution = 1.0;    // ~shape_resolution: m between wire_shape samples, [0, 100] (0: every node)
+  double spin_wait = 0.0;           // ~hil/spin_wait: s; the loop blocks until this long before a due
+                                    //   time (an expected arrival, the start of a window) and then polls
+                                    //   its queue on the steady clock, [0, half a loop period]
+  int realtime_priority = 0;        // ~hil/realtime_priority: > 0: SCHED_FIFO priority of the loop
+                                    //   thread (and memory locked), [0, 99]
 };
 
 // Throws ParamError naming the parameter, the value and the allowed range.

@@ -11,12 +11,21 @@
 // that belongs to a period already run at its deadline starts nothing. Input older than
 // ~hil/timeout puts the line into the safe hold (README "Hardware in the loop").
 //
-// Slow publications (contact_force, tf, markers, diagnostics, pass statistics) run on a second
-// thread from snapshots of the state, so that the loop's period holds only the steps and the
-// contact point.
+// Slow publications (contact_force, pantograph_state, wire_shape, tf, markers, diagnostics, pass
+// statistics) run on a second thread from snapshots of the state, so that the loop's period holds
+// only the steps and the contact point.
+//
+// The rig's measurement comes as hil/contact_force (MeasuredContactForce, one total force per
+// external pantograph) or, for a scene with one external pantograph, as hil/contact_wrench
+// (geometry_msgs/WrenchStamped: force.z, z up, is the force the pantograph exerts on the wire).
+//
+// The node runs as a process (catenary_sim_hil_node: run() on the main thread) or as a nodelet
+// (catenary_sim/HilNodelet: run() on a thread of its own, stop() ends it), e.g. with
+// catenary_sim/VirtualRigNodelet in the same manager: the messages then pass as shared pointers.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/WrenchStamped.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -43,8 +52,11 @@ class HilNode {
   // Reads and validates the parameters, loads the scene and chooses dt; throws ParamError.
   HilNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
   ~HilNode();
-  // Runs the loop until shutdown (or the end of the pass with at_end exit). Returns the exit code.
+  // Runs the loop until shutdown, stop() or the end of the pass with at_end exit. Returns the exit
+  // code. The calling thread is the loop thread: with ~hil/realtime_priority it is made SCHED_FIFO.
   int run();
+  // Ends run() within a loop period (from any thread).
+  void stop() { stop_ = true; }
 
   // Loop figures, also written to ~hil/report_file.
   struct Counters {
@@ -65,6 +77,13 @@ class HilNode {
   enum class Mode { kWaiting, kRunning, kHold, kEnded };
 
   void on_measurement(const MeasuredContactForce::ConstPtr& msg);
+  void on_wrench(const geometry_msgs::WrenchStamped::ConstPtr& msg);
+  // A measurement of `force` (one value per external pantograph, named `field`[i] in errors, or
+  // `field` alone for a single value): validated whole, then held. False when rejected.
+  bool accept(const double* force, double arrival, const ros::Time& stamp, std::uint64_t step, const char* field,
+              bool indexed);
+  void reject(const std::string& what);
+  void wait_for_period(double w, double half, double& t);
   void batch(double t, bool triggered);
   void publish_point();
   void handle_end();
@@ -72,6 +91,7 @@ class HilNode {
   void leave_hold();
   void snapshot(double t);
   void worker();
+  void publish_pantograph_state(const Model& m, const State& s, const ros::Time& stamp);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void write_report() const;
   static std::uint8_t mode_code(Mode m);
@@ -85,7 +105,8 @@ class HilNode {
 
   // Loop state (loop thread only).
   ros::CallbackQueue hil_queue_;
-  ros::Subscriber force_sub_;
+  ros::Subscriber force_sub_, wrench_sub_;
+  std::atomic<bool> stop_{false};
   ros::Publisher point_pub_;
   Mode mode_ = Mode::kWaiting;
   MeasurementHold hold_;
@@ -134,13 +155,20 @@ class HilNode {
 
   // Worker thread only.
   Snapshot wsnap_;
-  ros::Publisher contact_pub_, marker_pub_;
+  ros::Publisher contact_pub_, pantograph_pub_, shape_pub_, marker_pub_;
+  std::vector<ContactPointMotion> worker_scratch_;
+  double next_shape_wall_ = 0.0;
   tf2_ros::TransformBroadcaster tf_;
   diagnostic_updater::Updater updater_;
   double last_tf_time_ = -1.0;
   ros::Time last_view_stamp_;
   double next_marker_wall_ = 0.0;
 };
+
+// Loop-thread set-up: timer slack of 1 us (wake-ups on time), and with `realtime_priority` > 0
+// SCHED_FIFO at that priority for the calling thread and all memory locked (needs CAP_SYS_NICE or
+// an rtprio limit; refused: a warning, normal scheduling). `who` prefixes the log lines.
+void prepare_loop_thread(int realtime_priority, const char* who);
 
 }  // namespace ros_layer
 }  // namespace catenary_sim

@@ -1,0 +1,68 @@
+// virtual_rig's loop: a simulated hardware-in-the-loop rig, so that catenary_sim_hil_node can run
+// (and be tested) without hardware. It holds the lumped pantograph(s) of a scene (RigPantograph),
+// imposes on each the wire motion it receives on hil/contact_point, and sends the contact force on
+// hil/contact_force, paced on its own wall clock as a rig's controller would be. Runs as a process
+// (virtual_rig: run() on the main thread) or as a nodelet (catenary_sim/VirtualRigNodelet: run()
+// on a thread of its own, stop() ends it).
+//
+//   ~pantograph_scene  scene whose lumped pantographs have the names of the external ones (required)
+//   ~rate              Hz, the rig's loop (0: the node's loop rate, from hil/contact_point)
+//   ~extrapolate       true: between two contact points the wire height follows its path velocity
+//                      (an actuator tracking the trajectory); false: held
+//   ~report_file       JSON with the round trip (measurement sent -> the contact point that used it
+//                      received) at exit
+#pragma once
+
+#include <ros/callback_queue.h>
+#include <ros/ros.h>
+
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/ContactPointArray.h"
+#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/ros/hil.hpp"
+#include "catenary_sim/ros/virtual_rig.hpp"
+
+namespace catenary_sim {
+namespace ros_layer {
+
+class VirtualRig {
+ public:
+  // Reads the parameters and loads the scene; throws std::runtime_error naming the parameter.
+  VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh);
+  // Runs the rig's loop until shutdown or stop(); prints (and writes) the report. Returns 0.
+  int run();
+  void stop() { stop_ = true; }
+
+ private:
+  void on_point(const ContactPointArray::ConstPtr& msg);
+  void send();
+  bool running() const { return ros::ok() && !stop_; }
+
+  ros::NodeHandle nh_;
+  ros::CallbackQueue queue_;
+  ros::Subscriber sub_;
+  ros::Publisher pub_;
+  Scene scene_;
+  double rate_ = 0.0;
+  bool extrapolate_ = true;
+  std::string report_file_;
+  std::vector<RigPantograph> rigs_;
+  std::vector<std::vector<WirePoint>> points_;
+  bool have_ = false;
+  std::uint32_t pass_ = 0;
+  std::uint64_t step_ = 0;
+  double dt_ = 0.0, speed_ = 0.0;
+  std::uint32_t steps_per_period_ = 1;
+  std::uint64_t sent_ = 0, missed_ = 0;
+  std::map<std::uint64_t, double> sent_at_;
+  LatencyHistogram round_trip_;
+  std::atomic<bool> stop_{false};
+};
+
+}  // namespace ros_layer
+}  // namespace catenary_sim

@@ -1,0 +1,150 @@
+#include "catenary_sim/ros/virtual_rig_loop.hpp"
+
+#include <sys/prctl.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+#include "catenary_sim/MeasuredContactForce.h"
+
+namespace catenary_sim {
+namespace ros_layer {
+
+namespace {
+
+double mono_now() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+}  // namespace
+
+VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
+  std::string scene_file;
+  if (!pnh.getParam("pantograph_scene", scene_file) || scene_file.empty())
+    throw std::runtime_error("parameter ~pantograph_scene is required: a scene whose lumped pantographs have the "
+                             "names of the external ones (e.g. config/reference_55m.yaml)");
+  try {
+    scene_ = load_scene_file(scene_file);
+  } catch (const SceneError& e) {
+    throw std::runtime_error("parameter ~pantograph_scene = '" + scene_file + "': " + e.what());
+  }
+  pnh.param("rate", rate_, 0.0);
+  if (!std::isfinite(rate_) || rate_ < 0.0 || rate_ > 20000.0)
+    throw std::runtime_error("parameter ~rate rejected: allowed 0 (the node's loop rate) to 20000 Hz");
+  pnh.param("extrapolate", extrapolate_, true);
+  pnh.param<std::string>("report_file", report_file_, "");
+  ros::SubscribeOptions so = ros::SubscribeOptions::create<ContactPointArray>(
+      "hil/contact_point", 100, [this](const ContactPointArray::ConstPtr& m) { on_point(m); }, ros::VoidPtr(),
+      &queue_);
+  so.transport_hints = ros::TransportHints().tcpNoDelay();
+  sub_ = nh_.subscribe(so);
+  pub_ = nh_.advertise<MeasuredContactForce>("hil/contact_force", 10);
+  ROS_INFO("virtual_rig: pantographs from %s (k0 %g N/m), waiting for %s", scene_file.c_str(),
+           scene_.contact.stiffness, sub_.getTopic().c_str());
+}
+
+int VirtualRig::run() {
+  prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);  // wake-ups on time (this thread)
+  while (running() && !have_) queue_.callAvailable(ros::WallDuration(0.1));
+  if (!running()) return 0;
+  const double period = rate_ > 0.0 ? 1.0 / rate_ : dt_ * steps_per_period_;
+  ROS_INFO("virtual_rig: %zu pantograph(s), loop %g Hz, dt %g ms, %s wire between contact points", rigs_.size(),
+           1.0 / period, dt_ * 1e3, extrapolate_ ? "extrapolated" : "held");
+  double next = mono_now() + 0.25 * period;
+  const double start = mono_now();
+  while (running()) {
+    // Take contact points as they come (stepping the pantograph up to each at once) until the
+    // tick, then send the contact force: the measurement, as a rig samples its load cell.
+    for (double now = mono_now(); now < next && running(); now = mono_now())
+      queue_.callAvailable(ros::WallDuration(next - now));
+    queue_.callAvailable(ros::WallDuration(0.0));
+    send();
+    next += period;
+    const double now = mono_now();
+    if (now > next) {  // late by more than a period: skip the missed ticks
+      ++missed_;
+      next += std::ceil((now - next) / period) * period;
+    }
+  }
+  const double wall = mono_now() - start;
+  std::printf("virtual_rig: %llu measurements in %.1f s, %llu missed ticks; round trip (sent -> contact point "
+              "using it received) p50 %.1f us, p99 %.1f us, max %.1f us over %llu\n",
+              static_cast<unsigned long long>(sent_), wall, static_cast<unsigned long long>(missed_),
+              round_trip_.quantile(0.5) * 1e6, round_trip_.quantile(0.99) * 1e6, round_trip_.max() * 1e6,
+              static_cast<unsigned long long>(round_trip_.count()));
+  std::fflush(stdout);
+  if (!report_file_.empty()) {
+    std::ofstream f(report_file_);
+    f << "{\"measurements\": " << sent_ << ", \"missed_ticks\": " << missed_ << ", \"wall_s\": " << wall
+      << ", \"round_trip\": {\"count\": " << round_trip_.count() << ", \"p50_s\": " << round_trip_.quantile(0.5)
+      << ", \"p99_s\": " << round_trip_.quantile(0.99) << ", \"max_s\": " << round_trip_.max() << "}}\n";
+  }
+  return 0;
+}
+
+void VirtualRig::on_point(const ContactPointArray::ConstPtr& msg) {
+  if (msg->dt <= 0.0 || msg->steps_per_period == 0) return;
+  const bool restart = !have_ || msg->pass_count != pass_ || msg->step < step_ ||
+                       msg->pantographs.size() != rigs_.size() || msg->step - step_ > 1000000;
+  if (restart) {
+    rigs_.clear();
+    points_.clear();
+    for (const ContactPoint& c : msg->pantographs) {
+      const PantographSpec* spec = nullptr;
+      for (const PantographSpec& ps : scene_.pantographs)
+        if (ps.name == c.name) spec = &ps;
+      if (!spec) {
+        ROS_ERROR_THROTTLE(5.0, "virtual_rig: no pantograph named '%s' in ~pantograph_scene", c.name.c_str());
+        have_ = false;
+        return;
+      }
+      rigs_.emplace_back(*spec, scene_.contact.stiffness);
+      points_.push_back(wire_points(c));
+      rigs_.back().reset(points_.back(), msg->speed);
+    }
+    if (have_) ROS_INFO("virtual_rig: pass %u: pantograph(s) reset at the static state", msg->pass_count);
+  } else {
+    // Step up to the new state, against the wire of the previous contact point.
+    for (std::size_t i = 0; i < rigs_.size(); ++i) {
+      for (std::uint64_t s = step_; s < msg->step; ++s) {
+        const double ahead = extrapolate_ ? static_cast<double>(s - step_) * dt_ : 0.0;
+        rigs_[i].step(dt_, rigs_[i].contact_force(points_[i], ahead), speed_);
+      }
+      points_[i] = wire_points(msg->pantographs[i]);
+    }
+  }
+  have_ = true;
+  pass_ = msg->pass_count;
+  step_ = msg->step;
+  dt_ = msg->dt;
+  steps_per_period_ = msg->steps_per_period;
+  speed_ = msg->speed;
+  // Round trip of the measurement this contact point used.
+  const auto it = sent_at_.find(msg->measurement_step);
+  if (msg->measurement_step > 0 && it != sent_at_.end()) {
+    round_trip_.add(mono_now() - it->second);
+    sent_at_.erase(it);
+  }
+}
+
+void VirtualRig::send() {
+  if (!have_) return;
+  // (a shared pointer: the node in the same process, HilNodelet, gets it without a copy)
+  const boost::shared_ptr<MeasuredContactForce> m = boost::make_shared<MeasuredContactForce>();
+  m->header.stamp = ros::Time::now();
+  m->step = step_;
+  for (std::size_t i = 0; i < rigs_.size(); ++i) m->force.push_back(rigs_[i].contact_force(points_[i]));
+  pub_.publish(m);
+  ++sent_;
+  sent_at_.emplace(step_, mono_now());  // (a repeated step keeps its first time)
+  while (sent_at_.size() > 256) sent_at_.erase(sent_at_.begin());
+}
+
+}  // namespace ros_layer
+}  // namespace catenary_sim
