@@ -425,7 +425,7 @@ void HilNode::handle_end() {
     ROS_ERROR("catenary_sim_hil: %s", sim_->status_message().c_str());
   } else {
     ROS_INFO("catenary_sim_hil: pass %u finished at t = %.4f s (train front at %.2f m): %lld periods, %lld overruns",
-             pass_count_, s.time, s.front, static_cast<long long>(c_.batches), static_cast<long long>(c_.overruns));
+             pass_count_, s.time, s.front + s.line_offset, static_cast<long long>(c_.batches), static_cast<long long>(c_.overruns));
   }
   if (!diverged && params_.at_end == AtEnd::kLoop) {
     // A new pass from the initial static state with the static force (no new static solve), the
@@ -588,7 +588,7 @@ void HilNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("latency max [s]", s.latency[2]);
   stat.add("sim time [s]", s.state.time);
   stat.add("steps", s.state.steps);
-  stat.add("train front [m]", s.state.front);
+  stat.add("train front [m]", s.state.front + s.state.line_offset);
   stat.add("speed [m/s]", s.state.speed);
   stat.add("pass", s.pass_count);
 }
