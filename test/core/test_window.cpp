@@ -56,8 +56,8 @@ TEST(Window, StatisticsMatchTheFullLine) {
 
 TEST(Window, AutoLengthsFollowTheSpeed) {
   // At 350 km/h the waves' echoes from ahead return sooner (2 D / (c + V)), so the window must
-  // reach further ahead than at 300 km/h; a window sized by spans alone (1.5 ahead, 4 behind)
-  // changes the std by 5 % there (bench_window_lengths). The auto window against a generous one
+  // reach further ahead than at 300 km/h; a window sized by spans alone (it had 1.5 spans ahead)
+  // moves the std by 3.9 % there (bench_window_lengths). The auto window against a generous one
   // (5 spans ahead, 14 behind) on a 42-span line, statistics over spans 16-35 (the generous
   // window stands for the line that goes on; a finite full line would add its anchors' echoes):
   // within the 1 %, the min relative to the mean as above.
