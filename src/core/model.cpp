@@ -712,6 +712,14 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
   if (const std::string w = speed_warning(m, scene.train_speed); !w.empty()) m.warnings.push_back(w);
   for (std::size_t i = 1; i < m.support_x.size(); ++i)
     m.longest_span = std::max(m.longest_span, m.support_x[i] - m.support_x[i - 1]);
+  // Droppers and supports in line order, for the moving window to find its own by bisection.
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) m.dropper_order.push_back(static_cast<int>(k));
+  std::stable_sort(m.dropper_order.begin(), m.dropper_order.end(),
+                   [&](int a, int b) { return m.droppers[a].x < m.droppers[b].x; });
+  for (int k : m.dropper_order) m.dropper_order_x.push_back(m.droppers[k].x);
+  for (std::size_t k = 0; k < m.springs.size(); ++k) m.spring_order.push_back(static_cast<int>(k));
+  std::stable_sort(m.spring_order.begin(), m.spring_order.end(), [&](int a, int b) { return m.springs[a].x < m.springs[b].x; });
+  for (int k : m.spring_order) m.spring_order_x.push_back(m.springs[k].x);
 
   // Train travel: by default from the rearmost collector at the line start to the foremost at
   // the line end.

@@ -142,14 +142,20 @@ void update_window(const Model& m, State& s) {
     }
     return false;
   };
-  // Index lists sized once in make_state (a copied State keeps their size): no allocation.
+  // Index lists sized once in make_state (a copied State keeps their size): no allocation. Only
+  // the droppers and supports between the window's ends are looked at (bisection on the line
+  // order), so moving the window costs what the window holds, not the line.
+  const auto from = [&](const std::vector<double>& xs) {
+    return static_cast<std::size_t>(std::lower_bound(xs.begin(), xs.end(), a - 1e-6) - xs.begin());
+  };
   s.window_dropper_count = 0;
-  for (std::size_t k = 0; k < m.droppers.size(); ++k)
-    if (inside(m.droppers[k].contact_dof) && inside(m.droppers[k].messenger_dof))
-      s.window_droppers[s.window_dropper_count++] = static_cast<int>(k);
+  for (std::size_t j = from(m.dropper_order_x); j < m.dropper_order.size() && m.dropper_order_x[j] <= b + 1e-6; ++j) {
+    const Dropper& d = m.droppers[m.dropper_order[j]];
+    if (inside(d.contact_dof) && inside(d.messenger_dof)) s.window_droppers[s.window_dropper_count++] = m.dropper_order[j];
+  }
   s.window_spring_count = 0;
-  for (std::size_t k = 0; k < m.springs.size(); ++k)
-    if (inside(m.springs[k].dof)) s.window_springs[s.window_spring_count++] = static_cast<int>(k);
+  for (std::size_t j = from(m.spring_order_x); j < m.spring_order.size() && m.spring_order_x[j] <= b + 1e-6; ++j)
+    if (inside(m.springs[m.spring_order[j]].dof)) s.window_springs[s.window_spring_count++] = m.spring_order[j];
 }
 
 void wire_elastic_force_window(const Wire& wire, const WireWindow& ww, const double* z, double* f, double* theta) {

@@ -135,6 +135,8 @@ struct Model {
   double rear_collector_offset = 0.0;             // m, rearmost collector station - train front
   std::vector<int> span_nodes;                    // per wire: nodes per span (endless)
   double longest_span = 0.0;    // m
+  std::vector<int> dropper_order, spring_order;       // indices in line order (stable)
+  std::vector<double> dropper_order_x, spring_order_x;  // m, their stations
   std::vector<std::string> warnings;  // what the scene asks that is outside design practice
 };
 
