@@ -366,9 +366,9 @@ bool slack_dropper_correction(const Model& m, State& s, int k, int index) {
 // x = (A + sum_i c_i g_i g_i^T)^-1 b given x = A^-1 b (Woodbury):
 //   x -= Y (C^-1 + G^T Y)^-1 G^T x, Y = A^-1 G.
 // The small matrix is symmetric but indefinite when droppers are taken out: partial pivoting.
-void woodbury(State& s, int count, int n, double* x) {
+// `stride`: entries reserved per correction's g (Model::max_contact_nodes + 1).
+void woodbury(State& s, int count, int n, int stride, double* x) {
   if (count == 0) return;
-  const int stride = static_cast<int>(s.correction_g_value.size() / s.correction_g_count.size());
   double* sm = s.correction_small.data();
   double* rhs = sm + count * count;
   auto g_dot = [&](int i, const double* y) {
@@ -519,7 +519,7 @@ StepStatus step(const Model& m, State& s) {
         }
         ++count;
       }
-      woodbury(s, count, n, f);
+      woodbury(s, count, n, m.max_contact_nodes + 1, f);
       // The droppers' elastic tension at t_{n+1} decides the set (as in the explicit scheme).
       bool changed = false;
       for (std::size_t k = 0; k < m.droppers.size(); ++k) {

@@ -267,6 +267,20 @@ void apply_stiffness(const Model& m, double front, const double* x, double* y, d
 
 namespace {
 
+// Offsets from the train front (m) of the foremost and rearmost collectors of all pantographs
+// (collector station - front); both 0 without collectors.
+void collector_extent(const Scene& scene, double* lead, double* rear) {
+  bool first = true;
+  *lead = *rear = 0.0;
+  for (const PantographSpec& p : scene.pantographs)
+    for (const CollectorSpec& c : p.collectors) {
+      const double off = c.offset - p.position;
+      *lead = first ? off : std::max(*lead, off);
+      *rear = first ? off : std::min(*rear, off);
+      first = false;
+    }
+}
+
 // Spans at each end of an endless line's block that the window never reaches: the anchors'
 // effect on the design statics (messenger heights, dropper lengths) falls by about a thousand
 // per span, so from the third span on the spans are identical to well under a micrometre.
@@ -377,17 +391,7 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
     window_lengths_for(scene.numerics, c, span, 0.0, &ahead_slow, &behind_slow);
     window_lengths_for(scene.numerics, c, span, std::max(scene.train_speed, Simulation::kMaxSpeed), &ahead_fast, &behind_fast);
     double lead = 0.0, rear = 0.0;
-    bool first = true;
-    for (const PantographSpec& p : scene.pantographs) {
-      std::vector<CollectorSpec> cs = p.collectors;
-      if (cs.empty()) cs.emplace_back();
-      for (const CollectorSpec& cl : cs) {
-        const double off = cl.offset - p.position;
-        lead = first ? off : std::max(lead, off);
-        rear = first ? off : std::min(rear, off);
-        first = false;
-      }
-    }
+    collector_extent(scene, &lead, &rear);
     auto spans_for = [&](double length) { return static_cast<int>(std::ceil(length / span - 1e-9)); };
     const int margin = kEndlessMargin, behind = spans_for(std::max(behind_slow, behind_fast)) + 1;
     const int ahead = spans_for(std::max(ahead_slow, ahead_fast)) + 1, train = spans_for(lead - rear);
@@ -723,13 +727,8 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
 
   // Train travel: by default from the rearmost collector at the line start to the foremost at
   // the line end.
-  double lead = -1e300, rear = 1e300;
-  for (const Collector& c : m.collectors) {
-    const double off = c.offset - m.pantographs[c.pantograph].position;  // collector x - front
-    lead = std::max(lead, off);
-    rear = std::min(rear, off);
-  }
-  if (m.collectors.empty()) lead = rear = 0.0;
+  double lead = 0.0, rear = 0.0;
+  collector_extent(scene, &lead, &rear);
   m.train_start = scene.train_start ? *scene.train_start : -rear;
   m.train_end = scene.train_end ? *scene.train_end : m.line_length - lead;
   if (m.endless) {

@@ -35,8 +35,7 @@ void validate_hil_params(const HilParams& p) {
   if (p.realtime_priority < 0 || p.realtime_priority > 99)
     throw ParamError("parameter ~hil/realtime_priority = " + std::to_string(p.realtime_priority) +
                      " rejected: allowed 0 (normal scheduling) to 99 (SCHED_FIFO priority)");
-  if (p.line_frame.empty() || p.line_frame[0] == '/')
-    throw ParamError("parameter ~line_frame = '" + p.line_frame + "' rejected: a non-empty frame id without a leading '/'");
+  check_frame_id("line_frame", p.line_frame);
 }
 
 HilParams load_hil_params(const ros::NodeHandle& nh) {

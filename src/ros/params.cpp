@@ -24,6 +24,12 @@ void check_range(const char* name, double v, double lo, double hi, bool lo_open,
                      (lo_open ? "(" : "[") + format_number(lo) + ", " + format_number(hi) + "] " + unit);
 }
 
+void check_frame_id(const char* name, const std::string& frame) {
+  if (frame.empty() || frame[0] == '/')
+    throw ParamError(std::string("parameter ~") + name + " = '" + frame +
+                     "' rejected: a non-empty frame id without a leading '/'");
+}
+
 
 AtEnd parse_at_end(const std::string& s) {
   if (s == "stop") return AtEnd::kStop;
@@ -52,8 +58,7 @@ void validate(const NodeParams& p) {
   check_range("vertical_scale", p.vertical_scale, 0.0, 10000.0, true, "");
   check_range("max_acceleration", p.max_acceleration, 0.0, 20.0, false, "m/s^2 (0: no limit)");
   check_range("start_delay", p.start_delay, 0.0, 60.0, false, "s");
-  if (p.line_frame.empty() || p.line_frame[0] == '/')
-    throw ParamError("parameter ~line_frame = '" + p.line_frame + "' rejected: a non-empty frame id without a leading '/'");
+  check_frame_id("line_frame", p.line_frame);
 }
 
 NodeParams load_params(const ros::NodeHandle& nh) {

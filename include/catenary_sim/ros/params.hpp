@@ -26,6 +26,8 @@ std::string format_number(double v);
 // Throws ParamError naming the parameter ~name, the value and the allowed range unless v is
 // finite and in [lo, hi] (or (lo, hi] when lo_open).
 void check_range(const char* name, double v, double lo, double hi, bool lo_open, const char* unit);
+// Throws ParamError unless `frame` is a usable tf2 frame id (non-empty, no leading '/').
+void check_frame_id(const char* name, const std::string& frame);
 
 enum class AtEnd { kStop, kLoop, kExit };
 
