@@ -1,0 +1,62 @@
+// Output files written whole or not at all. A reader (or a second run) never sees half a file:
+// everything is written to a temporary file in the same directory and renamed into place, which
+// POSIX makes atomic. A failed write (full disk, no permission) is an OutputError naming the file
+// and the system's reason, never a silent success.
+#pragma once
+
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace catenary_sim {
+
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Writes `content` to `path` atomically (temporary file, flush, fsync, rename). Throws OutputError.
+void write_file_atomically(const std::string& path, const std::string& content);
+
+// Checks at start-up that `path` can be written later: the directory exists and accepts a new file
+// (created and removed again), and `path` itself is not a directory. Throws OutputError naming the
+// path and the reason. Leaves nothing behind.
+void check_writable(const std::string& path);
+
+// Creates `dir` and its parents (mkdir -p). Throws OutputError.
+void make_directories(const std::string& dir);
+
+// A file being written: text goes to DIR/.NAME.tmp.XXXXXX; commit() flushes, fsyncs and renames it
+// to `path`. Destroyed without commit() (an error, an exception) it removes the temporary file.
+class AtomicFile {
+ public:
+  explicit AtomicFile(const std::string& path);  // throws OutputError
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  std::FILE* file() { return file_; }
+  void write(const std::string& text);  // throws OutputError on a failed write
+  void commit();                        // throws OutputError; the file is then in place
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_, tmp_;
+  std::FILE* file_ = nullptr;
+};
+
+// An exclusive advisory lock (flock) on DIR/.catenary_sim.lock, held while the object lives, so two
+// runs never write into one output directory at once. Throws OutputError if another process holds
+// it. The lock file stays (empty); the lock itself dies with the process.
+class DirectoryLock {
+ public:
+  explicit DirectoryLock(const std::string& dir);
+  ~DirectoryLock();
+  DirectoryLock(const DirectoryLock&) = delete;
+  DirectoryLock& operator=(const DirectoryLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace catenary_sim
