@@ -1,6 +1,10 @@
 #include "catenary_sim/core/scene.hpp"
 
+#include <sys/stat.h>
 #include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <algorithm>
 #include <cmath>
@@ -114,6 +118,43 @@ class Reader {
   std::set<std::string> used_;
 };
 
+const char* kind_of(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Sequence: return "a list";
+    case YAML::NodeType::Map: return "a map";
+    case YAML::NodeType::Null: return "empty";
+    default: return "a value";
+  }
+}
+
+std::string where(const YAML::Node& n) {
+  const YAML::Mark m = n.Mark();
+  if (m.line < 0) return "";
+  return " (line " + std::to_string(m.line + 1) + ", column " + std::to_string(m.column + 1) + ")";
+}
+
+// The whole document before any field is read: every key a plain name given once, no empty value.
+// yaml-cpp keeps the first of two equal keys and throws on a non-scalar key only when it is read,
+// so both would otherwise be a silent wrong value or an abort.
+void check_document(const YAML::Node& n, const std::string& path) {
+  if (n.IsMap()) {
+    std::set<std::string> seen;
+    for (const auto& kv : n) {
+      if (!kv.first.IsScalar())
+        throw SceneError("scene: a key" + where(kv.first) + (path.empty() ? "" : " in '" + path + "'") + " is " +
+                         kind_of(kv.first) + "; keys are plain field names");
+      const std::string key = kv.first.Scalar();
+      const std::string f = path.empty() ? key : path + "." + key;
+      if (!seen.insert(key).second) fail(f, "(given twice" + where(kv.first) + ")", "each field once");
+      if (kv.second.IsNull())
+        fail(f, "(empty" + where(kv.first) + ")", "a value; remove the field to use its default");
+      check_document(kv.second, f);
+    }
+  } else if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i) check_document(n[i], path + "[" + std::to_string(i) + "]");
+  }
+}
+
 WireSpec read_wire(Reader& r) {
   WireSpec w;
   w.linear_mass = r.number("linear_mass", 0.0, 100.0, std::nullopt, true);
@@ -222,6 +263,8 @@ void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, co
       fail(f + ".positions", "(both or neither given)", "give positions (same in every span) or positions_per_span");
     if (d.has("positions")) {
       ds.positions.assign(1, d.numbers("positions", 0.0, 500.0, true));  // expanded per span later
+      if (ds.positions.front().empty())
+        fail(f + ".positions", "[]", "at least one dropper position in m from the span start (or remove the droppers section)");
     } else {
       const YAML::Node per = d.child("positions_per_span");
       if (!per.IsSequence()) fail(f + ".positions_per_span", "(not a list)", "one list of positions per span");
@@ -234,6 +277,10 @@ void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, co
         ds.positions.push_back(v);
       }
       ds.per_span = true;
+      std::size_t count = 0;
+      for (const auto& v : ds.positions) count += v.size();
+      if (count == 0)
+        fail(f + ".positions_per_span", "(no dropper in any span)", "at least one dropper position (or remove the droppers section)");
     }
     if (d.has("transition_positions")) ds.transition_positions = d.numbers("transition_positions", 0.0, 500.0, true);
     ds.axial_stiffness = d.number("axial_stiffness", 0.0, 1e10, std::nullopt, true);
@@ -528,8 +575,15 @@ void validate(const Scene& s) {
   std::set<std::string> names;
   for (std::size_t i = 0; i < s.pantographs.size(); ++i) {
     const auto& p = s.pantographs[i];
-    if (!names.insert(p.name).second)
-      fail("pantographs[" + std::to_string(i) + "].name", "'" + p.name + "'", "unique among pantographs");
+    const std::string pre = "pantographs[" + std::to_string(i) + "].";
+    if (!names.insert(p.name).second) fail(pre + "name", "'" + p.name + "'", "unique among pantographs");
+    // The uplift F0 + a v^2 pushes the head up against the wire; a net downward push is not a
+    // pantograph (it would pull the head off the wire and the roof spring alone cannot hold it).
+    const double v = s.train_speed, uplift = p.static_uplift + p.aero_coefficient * v * v;
+    if (!p.moving_force && uplift < 0.0)
+      fail(pre + "aero_coefficient", fmt(p.aero_coefficient),
+           "at least " + fmt(-p.static_uplift / (v * v)) + " N s^2/m^2 at " + fmt(v * 3.6) +
+               " km/h: the uplift static_uplift + aero_coefficient v^2 = " + fmt(uplift) + " N must not be negative");
   }
   if (s.endless) {
     if (!s.numerics.windowed())
@@ -561,53 +615,81 @@ void validate(const Scene& s) {
 
 namespace {
 
-YAML::Node apply_override(YAML::Node root, const std::string& assignment) {
+// A part of a dotted key that indexes a list: digits only, small enough to be an index.
+bool index_of(const std::string& part, std::size_t* idx) {
+  if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos) return false;
+  *idx = part.size() > 9 ? std::numeric_limits<std::size_t>::max() : std::stoul(part);
+  return true;
+}
+
+// Applies "a.b.0.c=value" to the tree. A value of null removes the field (back to its default).
+void apply_override(YAML::Node root, const std::string& assignment) {
   const auto eq = assignment.find('=');
-  if (eq == std::string::npos || eq == 0)
-    throw SceneError("override '" + assignment + "': expected key.path=value, e.g. numerics.element_length=0.125");
+  auto bad = [&](const std::string& why) -> SceneError {
+    return SceneError("override '" + assignment + "': " + why);
+  };
+  if (eq == std::string::npos || eq == 0) throw bad("expected key.path=value, e.g. numerics.element_length=0.125");
   const std::string key = assignment.substr(0, eq);
   YAML::Node value;
   try {
     value = YAML::Load(assignment.substr(eq + 1));
   } catch (const YAML::Exception& e) {
-    throw SceneError("override '" + assignment + "': value is not valid YAML (" + e.what() + ")");
+    throw bad(std::string("value is not valid YAML (") + e.what() + ")");
   }
   std::vector<std::string> parts;
   std::stringstream ss(key);
   for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
-  // Walk down, creating maps as needed; numeric parts index sequences.
-  std::vector<YAML::Node> chain{root};
-  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
-    YAML::Node cur = chain.back();
-    const bool is_index = !parts[i].empty() && parts[i].find_first_not_of("0123456789") == std::string::npos;
-    if (cur.IsSequence() && is_index) {
-      const std::size_t idx = std::stoul(parts[i]);
+  if (key.back() == '.') parts.push_back("");
+  for (const std::string& p : parts)
+    if (p.empty()) throw bad("empty part in the key '" + key + "' (fields are joined by single dots)");
+  // Walk down, creating maps as needed; numeric parts index lists.
+  YAML::Node cur = root;
+  std::string walked;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const std::string& part = parts[i];
+    const bool leaf = i + 1 == parts.size();
+    const std::string here = walked.empty() ? "the scene" : "'" + walked + "'";
+    std::size_t idx = 0;
+    if (cur.IsSequence()) {
+      if (!index_of(part, &idx)) throw bad(here + " is a list: expected " + (cur.size() ? "an index 0.." + std::to_string(cur.size() - 1) : std::string("no index (it is empty)")) + ", not '" + part + "'");
       if (idx >= cur.size())
-        throw SceneError("override '" + assignment + "': index " + parts[i] + " out of range (" + std::to_string(cur.size()) + " entries)");
-      chain.push_back(cur[idx]);
+        throw bad("index " + part + " out of range: " + here + " has " + std::to_string(cur.size()) + " entries");
+      if (leaf) {
+        if (value.IsNull()) throw bad("a list entry cannot be removed with null");
+        cur[idx] = value;
+        return;
+      }
+      cur.reset(cur[idx]);
+    } else if (cur.IsMap() || cur.IsNull() || !cur.IsDefined()) {
+      if (leaf) {
+        if (value.IsNull()) {
+          if (cur.IsMap()) cur.remove(part);
+        } else {
+          cur[part] = value;
+        }
+        return;
+      }
+      if (!cur[part] || cur[part].IsNull()) cur[part] = YAML::Node(YAML::NodeType::Map);
+      cur.reset(cur[part]);
     } else {
-      if (!cur[parts[i]]) cur[parts[i]] = YAML::Node(YAML::NodeType::Map);
-      chain.push_back(cur[parts[i]]);
+      throw bad(here + " is a value ('" + cur.Scalar() + "'), it has no field '" + part + "'");
     }
+    walked += (walked.empty() ? "" : ".") + part;
   }
-  YAML::Node last = chain.back();
-  const std::string& leaf = parts.back();
-  const bool is_index = !leaf.empty() && leaf.find_first_not_of("0123456789") == std::string::npos;
-  if (last.IsSequence() && is_index) {
-    const std::size_t idx = std::stoul(leaf);
-    if (idx >= last.size())
-      throw SceneError("override '" + assignment + "': index " + leaf + " out of range");
-    last[idx] = value;
-  } else {
-    last[leaf] = value;
-  }
-  return root;
 }
 
 Scene load_from_node(YAML::Node root, const std::vector<std::string>& overrides) {
   if (!root || !root.IsMap()) throw SceneError("scene: the document must be a YAML map of sections (line, contact_wire, ...)");
-  for (const auto& o : overrides) root = apply_override(root, o);
-  return scene_from_yaml(root);
+  try {
+    for (const auto& o : overrides) apply_override(root, o);
+    check_document(root, "");
+    return scene_from_yaml(root);
+  } catch (const YAML::Exception& e) {
+    // Not expected after check_document; a field is still better named by the reader, but never abort.
+    throw SceneError(std::string("scene: ") + e.what());
+  } catch (const std::logic_error& e) {
+    throw SceneError(std::string("scene: ") + e.what());
+  }
 }
 
 }  // namespace
@@ -622,13 +704,24 @@ Scene load_scene_string(const std::string& yaml, const std::vector<std::string>&
   return load_from_node(root, overrides);
 }
 
+
 Scene load_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path);
-  if (!in) throw SceneError("scene file '" + path + "': cannot be opened");
-  std::stringstream buf;
-  buf << in.rdbuf();
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0)
+    throw SceneError("scene file '" + path + "': cannot be opened (" + std::strerror(errno) + ")");
+  if (S_ISDIR(st.st_mode)) throw SceneError("scene file '" + path + "': is a directory, expected a YAML file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError("scene file '" + path + "': cannot be opened (" + std::strerror(errno) + ")");
+  // Read at most the cap and one byte more: /dev/zero or a huge file must not fill the memory.
+  std::string text(kMaxSceneFileBytes + 1, '\0');
+  in.read(&text[0], static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxSceneFileBytes)
+    throw SceneError("scene file '" + path + "': larger than " + std::to_string(kMaxSceneFileBytes >> 20) +
+                     " MiB, the limit for a scene (scenes are a few kB of YAML)");
+  if (in.bad()) throw SceneError("scene file '" + path + "': read error (" + std::strerror(errno) + ")");
   try {
-    return load_scene_string(buf.str(), overrides);
+    return load_scene_string(text, overrides);
   } catch (const SceneError& e) {
     throw SceneError(path + ": " + e.what());
   }

@@ -3,6 +3,7 @@
 // optional, so a scene may be a single tensioned wire between two supports under a moving force.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -163,6 +164,9 @@ struct Scene {
   int analysis_first() const;
   int analysis_last() const;
 };
+
+// A scene is a few kB of YAML: a file above this is refused before it is read whole.
+constexpr std::size_t kMaxSceneFileBytes = std::size_t{16} << 20;
 
 // Loads and validates; throws SceneError. `overrides` are "dotted.key=value" pairs applied to the
 // YAML tree before validation (the same keys as the file, e.g. "numerics.element_length=0.125").
