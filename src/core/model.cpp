@@ -1,5 +1,7 @@
 #include "catenary_sim/core/model.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -362,7 +364,9 @@ std::string speed_warning(const Model& m, double speed) {
   return s.str();
 }
 
-Model build_model(const Scene& scene_in, const BuildOptions& options) {
+namespace {
+
+Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) {
   Scene scene = scene_in;
   if (scene.sections.empty()) {
     // A Scene filled in code with the one-section fields only.
@@ -414,6 +418,7 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
     m.initial_line_offset = shift * span;
     scene.train_start = endless_front - m.initial_line_offset;
   }
+  check_model_memory(scene);
   m.scene = scene;
   const bool lumped_rot = scene.numerics.rotary_inertia == RotaryInertia::kLumped;
   m.line_length = scene.line_length();
@@ -736,9 +741,36 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
     if (m.train_end < endless_front)
       throw SceneError("train.end: " + fmt(m.train_end) + " m is behind the start of the pass (train front at " +
                        fmt(endless_front + 0.0) + " m)");
-  } else if (m.train_end < m.train_start)
-    throw SceneError("train: the pass would end (front at " + fmt(m.train_end) + " m) before it starts (" +
-                     fmt(m.train_start) + " m): the pantographs are further apart than the line is long");
+  } else {
+    // Every collector starts and ends on the line: the statics (eq. 23) need each pantograph
+    // pressed against a wire or held by its own springs at a design height under the wire.
+    const double lo = 0.0 - rear, hi = m.line_length - lead;
+    if (lo > hi + 1e-9)
+      throw SceneError("pantographs: the collectors span " + fmt(lead - rear) + " m from the foremost to the rearmost, more than the line (" +
+                       fmt(m.line_length) + " m); allowed: pantograph positions within the line length");
+    if (scene.train_start && (m.train_start < lo - 1e-9 || m.train_start > hi + 1e-9))
+      throw SceneError("scene field 'train.start' = " + fmt(m.train_start) + ": allowed [" + fmt(lo) + ", " + fmt(hi) +
+                       "] m (the train front where every collector is on the line, 0-" + fmt(m.line_length) + " m)");
+    if (scene.train_end && m.train_end > hi + 1e-9)
+      throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": allowed at most " + fmt(hi) +
+                       " m (the foremost collector, " + fmt(lead) + " m ahead of the front, stays on the line)");
+    if (m.train_end < m.train_start)
+      throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": allowed >= train.start (" + fmt(m.train_start) + " m)");
+    // Every pantograph passes through some of the analysis section, or its statistics are empty.
+    double x0 = 0.0, x1 = 0.0;
+      x0 = m.support_x[scene.analysis_first()];
+    x1 = m.support_x[scene.analysis_last()];
+    for (const PantographSpec& p : scene.pantographs) {
+      if (m.train_end - p.position < x0)
+        throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": pantograph '" + p.name +
+                         "' would stop before the analysis section " + fmt(x0) + "-" + fmt(x1) +
+                         " m (output.analysis_spans); allowed >= " + fmt(x0 + p.position) + " m");
+      if (m.train_start - p.position > x1)
+        throw SceneError("scene field 'train.start' = " + fmt(m.train_start) + ": pantograph '" + p.name +
+                         "' would start after the analysis section " + fmt(x0) + "-" + fmt(x1) +
+                         " m (output.analysis_spans); allowed <= " + fmt(x1 + p.position) + " m");
+    }
+  }
 
   // Initial pantograph references (eq. 23) and the stability limit (validation.md section 5).
   set_pantograph_references(m);
@@ -771,6 +803,60 @@ Model build_model(const Scene& scene_in, const BuildOptions& options) {
     m.dt = scene.numerics.safety_factor * m.dt_critical;
   }
   return m;
+}
+
+}  // namespace
+
+Model build_model(const Scene& scene, const BuildOptions& options) {
+  Model m = build_model_unchecked(scene, options);
+  if (!options.stability) return m;
+  // The statistics filter runs at the step rate: a cutoff at or above its Nyquist frequency would
+  // be no filter at all (lowpass_zero_phase returns the input unchanged).
+  const double nyquist = 0.5 / m.dt;
+  if (!(scene.output.filter_cutoff < nyquist))
+    throw SceneError("scene field 'output.filter_cutoff' = " + fmt(scene.output.filter_cutoff) + ": allowed below " +
+                     fmt(nyquist) + " Hz, the Nyquist frequency of the time step (dt " + fmt(m.dt) + " s)");
+  return m;
+}
+
+double model_memory_limit_bytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0) return 8.0 * (1ull << 30);  // unknown: assume a small 16 GiB machine
+  return 0.5 * static_cast<double>(pages) * static_cast<double>(page);
+}
+
+double estimate_model_bytes(const Scene& scene) {
+  double nodes = 0.0;
+  const double h = scene.numerics.element_length;
+  for (const SectionSpec& sec : scene.sections) {
+    double droppers = 0.0;
+    if (sec.droppers)
+      for (const auto& span : sec.droppers->positions) droppers += static_cast<double>(span.size());
+    const double per_wire = std::ceil(sec.length() / h) + droppers + static_cast<double>(sec.spans.size()) + 1.0;
+    const double wires = sec.contact_wire_count + (sec.messenger ? 1 : 0);
+    nodes += wires * per_wire;
+  }
+  return kModelBytesPerNode * nodes;
+}
+
+void check_model_memory(const Scene& scene) {
+  const double need = estimate_model_bytes(scene), limit = model_memory_limit_bytes();
+  if (need > limit) {
+    std::ostringstream s;
+    s.precision(3);
+    s << "scene: the model would need about " << need / (1ull << 30) << " GiB (" << scene.line_length() / 1000.0
+      << " km of line in " << scene.numerics.element_length << " m elements), more than the limit of "
+      << limit / (1ull << 30) << " GiB (half of this machine's memory); use a longer numerics.element_length, fewer "
+      << "or shorter spans (line.span_count, line.span_length), or line.endless with numerics.window";
+    throw SceneError(s.str());
+  }
+}
+
+double pass_step_count(const Model& m) {
+  const double distance = m.train_end - m.train_start - (m.endless ? m.initial_line_offset : 0.0);
+  const double v = m.scene.train_speed;
+  if (!(v > 0.0)) return std::numeric_limits<double>::infinity();
+  return std::max(0.0, distance) / v / m.dt;
 }
 
 }  // namespace catenary_sim

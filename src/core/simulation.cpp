@@ -44,7 +44,13 @@ std::string Simulation::status_message() const {
           where = "pantograph " + p.name + " mass " + std::to_string(d - p.first_dof);
       s << "diverged at t = " << state_.time << " s: displacement of " << where << " is "
         << state_.u[d] << " m (limit " << model_.scene.numerics.divergence_limit
-        << " m); the run was stopped. Reduce numerics.dt (limit " << model_.dt_critical << " s) or check the scene";
+        << " m); the run was stopped. ";
+      if (model_.scene.numerics.dt)
+        s << "Reduce numerics.dt (" << model_.dt << " s; the stability estimate is " << model_.dt_critical
+          << " s) or check the scene";
+      else
+        s << "The automatic dt (" << model_.dt << " s) was below the stability estimate, so the scene is outside "
+          << "what the estimate covers: check its masses, stiffnesses and dampers, or use numerics.integrator implicit";
       break;
     }
   }

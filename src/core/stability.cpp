@@ -65,6 +65,23 @@ void compute_stability_limit(Model& m) {
   }
   m.omega_max = std::sqrt(m.omega_max * m.omega_max + contact);
   m.dt_critical = critical_time_step(m.omega_max, m.alpha, m.beta);
+  // The pantographs' dampers are not Rayleigh damping: the half-step velocity of eq. 19-21 takes
+  // them explicitly, and a damper c on a light mass m needs dt < 2 m / c even without a spring.
+  // Each mass with its own springs and dampers as one DOF (w^2 = k/m, mass-proportional damping
+  // c/m in the formula of validation.md section 5): far from binding on real pantographs (the
+  // reference's lower frame: 33 ms), binding on absurdly light ones, which then get a dt that holds.
+  for (const Pantograph& p : m.pantographs) {
+    if (p.moving_force) continue;
+    for (int i = 0; i < p.masses_count(); ++i) {
+      double k = p.stiffness[i], c = p.damping[i];
+      if (i > 0) k += p.stiffness[i - 1], c += p.damping[i - 1];
+      if (i == 0) k += m.contact_stiffness * static_cast<double>(p.collectors.size() * m.contact_wires.size());
+      if (!(c > 0.0)) continue;
+      const double w = std::sqrt(k / p.masses[i]);
+      const double dt = w > 0.0 ? critical_time_step(w, c / p.masses[i], 0.0) : 2.0 * p.masses[i] / c;
+      m.dt_critical = std::min(m.dt_critical, dt);
+    }
+  }
 }
 
 }  // namespace catenary_sim

@@ -249,7 +249,25 @@ void set_pantograph_references(Model& m) {
   if (m.pantographs.empty()) return;
   State st = make_state(m);
   st.front = m.train_start;
-  solve_initial_state(m, st, false);
+  try {
+    solve_initial_state(m, st, false);
+  } catch (const SceneError&) {
+    // Without roof springs (relaxed at the working height, eq. 23) only the contact holds a
+    // lumped pantograph: with no uplift it may not press on the wire, and nothing holds it.
+    for (std::size_t i = 0; i < m.pantographs.size(); ++i) {
+      const Pantograph& p = m.pantographs[i];
+      const double v = m.scene.train_speed, uplift = p.static_uplift + p.aero_coefficient * v * v;
+      if (!p.moving_force && !(uplift > 0.0)) {
+        std::ostringstream s;
+        s << "scene field 'pantographs[" << i << "].static_uplift' = " << p.static_uplift
+          << ": allowed > 0 N in this scene: the initial statics (eq. 23) hold pantograph '" << p.name
+          << "' at its working height by its contact alone (the roof spring is relaxed there), and with an uplift of "
+          << uplift << " N it does not press on the wire at the start";
+        throw SceneError(s.str());
+      }
+    }
+    throw;
+  }
   for (Pantograph& p : m.pantographs) {
     if (p.moving_force) continue;
     const int last = p.masses_count() - 1;
