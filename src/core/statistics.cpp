@@ -1,5 +1,7 @@
 #include "catenary_sim/core/statistics.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -212,17 +214,14 @@ std::vector<PantographStatistics> PassRecorder::statistics(const Model& m, doubl
 
 namespace {
 
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream s;
-  s << std::setprecision(10) << v;
-  return s.str();
-}
+using Json = nlohmann::ordered_json;  // keeps the fields in the order a reader expects
 
-void force_json(std::ostringstream& j, const ForceStatistics& f) {
-  j << "\"mean_force_N\": " << json_number(f.mean) << ", \"std_force_N\": " << json_number(f.std_dev)
-    << ", \"max_force_N\": " << json_number(f.max) << ", \"min_force_N\": " << json_number(f.min)
-    << ", \"stat_max_force_N\": " << json_number(f.stat_max) << ", \"stat_min_force_N\": " << json_number(f.stat_min);
+// NaN and inf become null (what nlohmann writes for non-finite numbers): "no value", e.g. no
+// steady arm in the section.
+Json force_json(const ForceStatistics& f) {
+  return Json{{"mean_force_N", f.mean},         {"std_force_N", f.std_dev},
+              {"max_force_N", f.max},           {"min_force_N", f.min},
+              {"stat_max_force_N", f.stat_max}, {"stat_min_force_N", f.stat_min}};
 }
 
 }  // namespace
@@ -230,38 +229,41 @@ void force_json(std::ostringstream& j, const ForceStatistics& f) {
 std::string statistics_json(const Model& m, const State& s, const std::vector<PantographStatistics>& stats,
                             const RunInfo& run) {
   const Scene& scene = m.scene;
-  std::ostringstream j;
-  j << "{\n  \"scene\": \"" << scene.name << "\",\n"
-    << "  \"speed_kmh\": " << json_number(s.speed * 3.6) << ",\n"
-    << "  \"dofs\": " << m.n_dof << ",\n  \"dt_s\": " << json_number(m.dt) << ",\n"
-    << "  \"dt_critical_s\": " << json_number(m.dt_critical) << ",\n"
-    << "  \"steps\": " << s.steps << ",\n  \"simulated_time_s\": " << json_number(s.time) << ",\n";
-  if (run.build_time_s >= 0.0) j << "  \"build_time_s\": " << json_number(run.build_time_s) << ",\n";
-  j << "  \"wall_time_s\": " << json_number(run.wall_time_s) << ",\n"
-    << "  \"real_time_factor\": " << json_number(run.wall_time_s > 0.0 ? s.time / run.wall_time_s : std::nan(""))
-    << ",\n";
-  if (run.overruns >= 0) j << "  \"overruns\": " << run.overruns << ",\n";
+  Json j;
+  j["scene"] = scene.name;
+  j["speed_kmh"] = s.speed * 3.6;
+  j["dofs"] = m.n_dof;
+  j["dt_s"] = m.dt;
+  j["dt_critical_s"] = m.dt_critical;
+  j["steps"] = s.steps;
+  j["simulated_time_s"] = s.time;
+  if (run.build_time_s >= 0.0) j["build_time_s"] = run.build_time_s;
+  j["wall_time_s"] = run.wall_time_s;
+  j["real_time_factor"] = run.wall_time_s > 0.0 ? s.time / run.wall_time_s : std::nan("");
+  if (run.overruns >= 0) j["overruns"] = run.overruns;
   double x0 = 0.0, x1 = 0.0;
   analysis_section(m, &x0, &x1);
-  j << "  \"analysis_section_m\": [" << json_number(x0) << ", " << json_number(x1) << "],\n"
-    << "  \"filter_cutoff_hz\": " << json_number(scene.output.filter_cutoff) << ",\n"
-    << "  \"pantographs\": [";
-  for (std::size_t i = 0; i < stats.size(); ++i) {
-    const PantographStatistics& p = stats[i];
-    j << (i ? "," : "") << "\n    {\"name\": \"" << p.name << "\", \"samples\": " << p.samples << ",\n     ";
-    force_json(j, p.filtered);
-    j << ",\n     \"contact_loss_percent\": " << json_number(p.contact_loss_percent)
-      << ", \"max_uplift_at_support_m\": " << json_number(p.max_uplift_at_support_m) << ",\n     \"unfiltered\": {";
-    force_json(j, p.unfiltered);
-    j << "},\n     \"contact_wires\": [";
-    for (std::size_t w = 0; w < p.wires.size(); ++w)
-      j << (w ? ", " : "") << "{\"wire\": \"" << p.wires[w].wire << "\", \"mean_force_N\": " << json_number(p.wires[w].mean_force)
-        << ", \"max_force_N\": " << json_number(p.wires[w].max_force)
-        << ", \"contact_percent\": " << json_number(p.wires[w].contact_percent) << "}";
-    j << "]}";
+  j["analysis_section_m"] = {x0, x1};
+  j["filter_cutoff_hz"] = scene.output.filter_cutoff;
+  Json pantographs = Json::array();
+  for (const PantographStatistics& p : stats) {
+    Json pj;
+    pj["name"] = p.name;
+    pj["samples"] = p.samples;
+    pj.update(force_json(p.filtered));
+    pj["contact_loss_percent"] = p.contact_loss_percent;
+    pj["max_uplift_at_support_m"] = p.max_uplift_at_support_m;
+    pj["unfiltered"] = force_json(p.unfiltered);
+    Json wires = Json::array();
+    for (const WireContactStatistics& w : p.wires)
+      wires.push_back(Json{{"wire", w.wire}, {"mean_force_N", w.mean_force}, {"max_force_N", w.max_force},
+                           {"contact_percent", w.contact_percent}});
+    pj["contact_wires"] = wires;
+    pantographs.push_back(pj);
   }
-  j << "\n  ]\n}\n";
-  return j.str();
+  j["pantographs"] = pantographs;
+  // Replace invalid UTF-8 in names rather than throw: a scene name is the user's text.
+  return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace catenary_sim
