@@ -64,15 +64,19 @@ void AtomicFile::write(const std::string& text) {
     throw OutputError("cannot write '" + path_ + "': " + reason());
 }
 
-void AtomicFile::commit() {
+void AtomicFile::flush() {
   if (!file_) throw OutputError("cannot write '" + path_ + "': already closed");
+  // fflush and fsync report what a full disk or a quota refuses.
+  if (std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0 || std::ferror(file_))
+    throw OutputError("cannot write '" + path_ + "': " + reason());
+}
+
+void AtomicFile::commit() {
+  flush();
   std::FILE* f = file_;
   file_ = nullptr;
-  // fflush and fsync report what a full disk or a quota refuses; fclose can report it too.
-  const bool ok = std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0 && !std::ferror(f);
-  const std::string why = ok ? "" : reason();
-  if (std::fclose(f) != 0 || !ok) {
-    const std::string r = why.empty() ? reason() : why;
+  if (std::fclose(f) != 0) {
+    const std::string r = reason();
     ::unlink(tmp_.c_str());
     throw OutputError("cannot write '" + path_ + "': " + r);
   }

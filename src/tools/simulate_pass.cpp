@@ -1,20 +1,22 @@
 // simulate_pass: one offline pass of a scene, no ROS master needed.
 //   simulate_pass --scene FILE [--speed KMH] [--set key=value ...] --out DIR
-// Prints a summary, writes DIR/stats.json and DIR/timeseries.csv.
-#include <sys/stat.h>
+// Prints a summary, writes DIR/stats.json and DIR/timeseries.csv, each whole or not at all
+// (temporary file + rename), with DIR locked against a second run writing into it.
+#include <unistd.h>
 
-#include <cerrno>
+#include <CLI/CLI.hpp>
 #include <chrono>
-#include <memory>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <memory>
+#include <new>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
 #include "catenary_sim/ros/pass_bag.hpp"
@@ -23,102 +25,154 @@ using namespace catenary_sim;
 
 namespace {
 
-const char* kUsage =
-    "usage: simulate_pass --scene FILE [--speed KMH] [--set key=value ...] --out DIR\n"
-    "  --scene FILE     scene YAML (see README.md, e.g. config/reference_55m.yaml)\n"
-    "  --speed KMH      train speed in km/h (overrides train.speed / train.speed_kmh)\n"
-    "  --set key=value  override a scene field, e.g. --set numerics.element_length=0.125\n"
-    "  --out DIR        output directory for stats.json and timeseries.csv (created)\n"
-    "  --bag FILE       also write the node's topics into a rosbag (simulation-time stamps)\n"
-    "  --bag-rate HZ    rate of /contact_force, /pantograph_state and /tf in the bag (200; 0: every step)\n"
-    "  --quiet          print only errors\n";
+// Exit codes: 0 done, 2 bad input or failed write, 3 diverged; a bad command line exits with
+// CLI11's own non-zero codes (and --help with 0).
+constexpr int kBadInput = 2, kDiverged = 3;
 
-bool make_dirs(const std::string& path) {
-  std::string cur;
-  std::stringstream ss(path);
-  if (!path.empty() && path[0] == '/') cur = "/";
-  for (std::string part; std::getline(ss, part, '/');) {
-    if (part.empty()) continue;
-    cur += part + "/";
-    if (mkdir(cur.c_str(), 0755) != 0 && errno != EEXIST) return false;
+// A pass of more steps is refused unless --max-steps raises the bound: at the accurate preset's
+// ~0.1 ms per step of the 4405-DOF reference scene (BENCHMARKS.md) 2e7 steps are about half an
+// hour; a speed of 0.001 km/h would need billions and never end.
+constexpr double kDefaultMaxSteps = 2e7;
+
+// RFC 4180: a field with a comma, a quote or a line break is quoted, its quotes doubled.
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+// A progress line on a terminal (stderr), redrawn at most twice a second: share done, simulated
+// time, the real-time factor so far and the estimated end. Silent when stderr is not a terminal.
+class Progress {
+ public:
+  Progress(double total_steps, bool enabled)
+      : total_(total_steps), enabled_(enabled && ::isatty(STDERR_FILENO)), start_(Clock::now()), last_(start_) {}
+  void update(std::int64_t steps, double sim_time) {
+    if (!enabled_ || (steps & 255) != 0) return;
+    const auto now = Clock::now();
+    if (std::chrono::duration<double>(now - last_).count() < 0.5) return;
+    last_ = now;
+    const double wall = std::chrono::duration<double>(now - start_).count();
+    const double share = std::min(1.0, steps / total_);
+    const double left = share > 0.0 ? wall * (1.0 - share) / share : 0.0;
+    const int width = 30, filled = static_cast<int>(share * width);
+    std::fprintf(stderr, "\r[%s%s] %5.1f %%  t = %.2f s  %.1fx real time  about %.0f s left   ",
+                 std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), 100.0 * share, sim_time,
+                 wall > 0.0 ? sim_time / wall : 0.0, left);
+    drawn_ = true;
   }
+  void done() {
+    if (drawn_) std::fprintf(stderr, "\r%s\r", std::string(100, ' ').c_str());
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  double total_;
+  bool enabled_, drawn_ = false;
+  Clock::time_point start_, last_;
+};
+
+bool all_finite(const std::vector<PantographStatistics>& stats) {
+  for (const PantographStatistics& s : stats)
+    for (double v : {s.filtered.mean, s.filtered.std_dev, s.filtered.max, s.filtered.min, s.unfiltered.mean})
+      if (!std::isfinite(v)) return false;
   return true;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  CLI::App app{"One offline pantograph pass over a scene (no ROS master needed). Writes DIR/stats.json and "
+               "DIR/timeseries.csv, each whole or not at all.",
+               "simulate_pass"};
   std::string scene_path, out_dir, bag_path;
-  ros_layer::PassBagOptions bag_options;
   std::vector<std::string> overrides;
   double speed_kmh = std::nan("");
-  bool quiet = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* name) -> std::string {
-      if (i + 1 >= argc) {
-        std::cerr << "simulate_pass: " << name << " needs a value\n" << kUsage;
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--scene") scene_path = value("--scene");
-    else if (a == "--out") out_dir = value("--out");
-    else if (a == "--set") overrides.push_back(value("--set"));
-    else if (a == "--quiet") quiet = true;
-    else if (a == "--bag") bag_path = value("--bag");
-    else if (a == "--bag-rate") {
-      const std::string v = value("--bag-rate");
-      char* end = nullptr;
-      bag_options.rate = std::strtod(v.c_str(), &end);
-      if (end == v.c_str() || *end != '\0' || !std::isfinite(bag_options.rate) || bag_options.rate < 0.0 ||
-          bag_options.rate > 1e6) {
-        std::cerr << "simulate_pass: --bag-rate '" << v << "': expected Hz in [0, 1e6] (0: every step)\n";
-        return 2;
-      }
-    }
-    else if (a == "--speed") {
-      const std::string v = value("--speed");
-      char* end = nullptr;
-      speed_kmh = std::strtod(v.c_str(), &end);
-      if (end == v.c_str() || *end != '\0' || !std::isfinite(speed_kmh) || speed_kmh < 0.0 || speed_kmh > 540.0) {
-        std::cerr << "simulate_pass: --speed '" << v << "': expected km/h in [0, 540]\n";
-        return 2;
-      }
-    } else if (a == "--help" || a == "-h") {
-      std::cout << kUsage;
-      return 0;
-    } else {
-      std::cerr << "simulate_pass: unknown argument '" << a << "'\n" << kUsage;
-      return 2;
-    }
-  }
-  if (scene_path.empty() || out_dir.empty()) {
-    std::cerr << "simulate_pass: --scene and --out are required\n" << kUsage;
-    return 2;
+  double max_steps = kDefaultMaxSteps;
+  bool quiet = false, no_progress = false;
+  ros_layer::PassBagOptions bag_options;
+  app.add_option("--scene", scene_path, "scene YAML (README.md, e.g. config/reference_55m.yaml)")
+      ->required()
+      ->type_name("FILE");
+  app.add_option("--out", out_dir, "output directory for stats.json and timeseries.csv (created)")
+      ->required()
+      ->type_name("DIR");
+  app.add_option("--speed", speed_kmh, "train speed in km/h, overrides train.speed / train.speed_kmh")
+      ->check(CLI::Range(0.0, 540.0))
+      ->type_name("KMH");
+  app.add_option("--set", overrides, "override a scene field, e.g. --set numerics.element_length=0.125 (null removes it)")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false)
+      ->take_all();
+  app.add_option("--bag", bag_path, "also write the node's topics into a rosbag (simulation-time stamps)")
+      ->type_name("FILE");
+  app.add_option("--bag-rate", bag_options.rate,
+                 "rate of /contact_force, /pantograph_state and /tf in the bag (Hz; 0: every step)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str()
+      ->type_name("HZ");
+  app.add_option("--max-steps", max_steps, "refuse a pass of more steps than this (a bound against runs that never end)")
+      ->check(CLI::Range(1.0, 1e12))
+      ->capture_default_str()
+      ->type_name("N");
+  app.add_flag("--quiet", quiet, "print only errors");
+  app.add_flag("--no-progress", no_progress, "no progress line (it is drawn only on a terminal anyway)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);  // --help: 0; bad flags and values: CLI11's message and a non-zero code
   }
 
   Scene scene;
+  std::unique_ptr<Simulation> sim;
+  const auto t_build = std::chrono::steady_clock::now();
   try {
     scene = load_scene_file(scene_path, overrides);
     if (!std::isnan(speed_kmh)) {
       scene.train_speed = speed_kmh / 3.6;
       validate(scene);
     }
-  } catch (const SceneError& e) {
-    std::cerr << "simulate_pass: " << e.what() << "\n";
-    return 2;
-  }
-
-  const auto t_build = std::chrono::steady_clock::now();
-  std::unique_ptr<Simulation> sim;
-  try {
+    if (!(scene.train_speed > 0.0))
+      throw SceneError("scene field 'train.speed_kmh' = 0: an offline pass needs a train speed > 0 (give "
+                       "train.speed_kmh in the scene or --speed; the live node accepts 0 and waits for a speed command)");
     sim = std::make_unique<Simulation>(scene);
   } catch (const SceneError& e) {
     std::cerr << "simulate_pass: " << e.what() << "\n";
-    return 2;
+    return kBadInput;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "simulate_pass: out of memory while building the model of '" << scene_path
+              << "'; use a longer numerics.element_length or fewer spans\n";
+    return kBadInput;
   }
   const Model& m = sim->model();
+  const double steps_needed = pass_step_count(m);
+  if (!(steps_needed <= max_steps)) {
+    std::ostringstream s;
+    s.precision(3);
+    s << "simulate_pass: the pass would take " << steps_needed << " steps (" << (m.train_end - m.train_start)
+      << " m at " << scene.train_speed * 3.6 << " km/h with dt " << m.dt << " s), more than --max-steps "
+      << max_steps << "; raise --max-steps if that is meant, or check train.speed_kmh, the line length and "
+      << "the masses that set dt";
+    std::cerr << s.str() << "\n";
+    return kBadInput;
+  }
+
+  // The output directory: created, locked against a second run, and checked writable before the
+  // pass (a full or read-only target is found now, not after the pass).
+  std::unique_ptr<DirectoryLock> lock;
+  const std::string stats_path = out_dir + "/stats.json", csv_path = out_dir + "/timeseries.csv";
+  try {
+    make_directories(out_dir);
+    lock = std::make_unique<DirectoryLock>(out_dir);
+    check_writable(stats_path);
+    check_writable(csv_path);
+    if (!bag_path.empty()) check_writable(bag_path);
+  } catch (const OutputError& e) {
+    std::cerr << "simulate_pass: " << e.what() << "\n";
+    return kBadInput;
+  }
+
   PassRecorder recorder(m, scene.output.sample_rate);
   if (!quiet) {
     if (m.endless)
@@ -130,69 +184,89 @@ int main(int argc, char** argv) {
               << " ms), speed " << scene.train_speed * 3.6 << " km/h" << std::endl;
   }
   for (const std::string& w : m.warnings) std::cerr << "simulate_pass: warning: " << w << "\n";
-  if (scene.train_speed <= 0.0 && !quiet)
-    std::cout << "note: train speed 0: the pass never ends; nothing to run\n";
 
   const auto t0 = std::chrono::steady_clock::now();
   StepStatus status = StepStatus::kOk;
-  if (!make_dirs(out_dir)) {
-    std::cerr << "simulate_pass: cannot create output directory '" << out_dir << "'\n";
-    return 2;
-  }
   std::unique_ptr<ros_layer::PassBag> bag;
-  if (!bag_path.empty()) {
-    try {
-      bag = std::make_unique<ros_layer::PassBag>(bag_path, bag_options);
-    } catch (const std::exception& e) {
-      std::cerr << "simulate_pass: --bag '" << bag_path << "': " << e.what() << "\n";
-      return 2;
+  // The bag is written under a temporary name and renamed when complete (rosbag writes its index
+  // at close), so a failed pass never leaves a half bag under the asked name.
+  const std::string bag_tmp = bag_path.empty() ? "" : bag_path + ".partial";
+  try {
+    if (!bag_path.empty()) {
+      bag = std::make_unique<ros_layer::PassBag>(bag_tmp, bag_options);
+      bag->write(m, sim->state());
     }
-    bag->write(m, sim->state());
-  }
-  recorder.record(m, sim->state());
-  if (scene.train_speed > 0.0) {
+    Progress progress(steps_needed, !quiet && !no_progress);
+    recorder.record(m, sim->state());
     while ((status = sim->step()) == StepStatus::kOk) {
       recorder.record(m, sim->state());
       if (bag) bag->write(m, sim->state());
+      progress.update(sim->state().steps, sim->state().time);
     }
+    progress.done();
+    if (bag) bag->close();
+  } catch (const std::exception& e) {
+    std::cerr << "simulate_pass: " << (bag ? "--bag '" + bag_path + "': " : "") << e.what() << "\n";
+    if (!bag_tmp.empty()) std::remove(bag_tmp.c_str());
+    return kBadInput;
   }
-  if (bag) bag->close();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double build_s = std::chrono::duration<double>(t0 - t_build).count();
   const State& st = sim->state();
   if (status == StepStatus::kDiverged) {
     std::cerr << "simulate_pass: " << sim->status_message() << "\n";
-    return 3;
+    if (!bag_tmp.empty()) std::remove(bag_tmp.c_str());
+    return kDiverged;
   }
 
   const std::vector<PantographStatistics> stats = recorder.statistics(m);
+  if (!all_finite(stats)) {
+    // Guarded by the scene checks (every pantograph crosses the analysis section); never written as null.
+    std::cerr << "simulate_pass: the pass gave no statistics over the analysis section (output.analysis_spans); "
+                 "nothing written\n";
+    if (!bag_tmp.empty()) std::remove(bag_tmp.c_str());
+    return kBadInput;
+  }
   const double rtf = wall > 0.0 ? st.time / wall : std::nan("");
 
-  {
-    std::ofstream j(out_dir + "/stats.json");
+  try {
     RunInfo run;
     run.wall_time_s = wall;
     run.build_time_s = build_s;
-    j << statistics_json(m, st, stats, run);
-    if (!j) {
-      std::cerr << "simulate_pass: cannot write " << out_dir << "/stats.json\n";
-      return 2;
+    AtomicFile csv(csv_path);
+    {
+      std::ostringstream c;
+      c << "time_s";
+      for (const std::string& col : recorder.columns()) c << "," << csv_field(col);
+      c << "\n";
+      csv.write(c.str());
     }
-  }
-  {
-    std::ofstream c(out_dir + "/timeseries.csv");
-    c << "time_s";
-    for (const std::string& col : recorder.columns()) c << "," << col;
-    c << "\n" << std::setprecision(9);
+    std::ostringstream c;
+    c << std::setprecision(9);
     for (const auto& row : recorder.rows()) {
       c << row.time;
       for (double v : row.values) c << "," << v;
       c << "\n";
+      if (c.tellp() > (1 << 20)) {  // in pieces of about 1 MiB
+        csv.write(c.str());
+        c.str("");
+      }
     }
-    if (!c) {
-      std::cerr << "simulate_pass: cannot write " << out_dir << "/timeseries.csv\n";
-      return 2;
-    }
+    csv.write(c.str());
+    AtomicFile json(stats_path);
+    json.write(statistics_json(m, st, stats, run));
+    // Both on the disk before either is renamed into place: a full disk leaves the old pair (or
+    // none), never a new CSV beside an old stats.json.
+    csv.flush();
+    json.flush();
+    csv.commit();
+    json.commit();
+    if (!bag_tmp.empty() && std::rename(bag_tmp.c_str(), bag_path.c_str()) != 0)
+      throw OutputError("cannot write '" + bag_path + "': rename failed");
+  } catch (const OutputError& e) {
+    std::cerr << "simulate_pass: " << e.what() << "\n";
+    if (!bag_tmp.empty()) std::remove(bag_tmp.c_str());
+    return kBadInput;
   }
 
   if (!quiet) {
@@ -215,7 +289,7 @@ int main(int argc, char** argv) {
           std::cout << "      on " << w.wire << ": mean " << w.mean_force << " N, max " << w.max_force << " N, in contact "
                     << w.contact_percent << " % of the time\n";
     }
-    std::cout << "wrote " << out_dir << "/stats.json and " << out_dir << "/timeseries.csv\n";
+    std::cout << "wrote " << stats_path << " and " << csv_path << "\n";
     if (bag) std::cout << "wrote " << bag->messages() << " messages to " << bag_path << "\n";
   }
   return 0;

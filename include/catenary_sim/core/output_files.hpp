@@ -37,7 +37,8 @@ class AtomicFile {
   AtomicFile& operator=(const AtomicFile&) = delete;
   std::FILE* file() { return file_; }
   void write(const std::string& text);  // throws OutputError on a failed write
-  void commit();                        // throws OutputError; the file is then in place
+  void flush();                         // writes everything to the disk; throws OutputError
+  void commit();                        // flush() and rename into place; throws OutputError
   const std::string& path() const { return path_; }
 
  private:
