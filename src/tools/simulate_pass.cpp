@@ -20,6 +20,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
 #include "catenary_sim/ros/pass_bag.hpp"
+#include "cli_checks.hpp"
 
 using namespace catenary_sim;
 
@@ -99,7 +100,7 @@ int main(int argc, char** argv) {
       ->required()
       ->type_name("DIR");
   app.add_option("--speed", speed_kmh, "train speed in km/h, overrides train.speed / train.speed_kmh")
-      ->check(CLI::Range(0.0, 540.0))
+      ->check(kFinite & CLI::Range(0.0, 540.0))
       ->type_name("KMH");
   app.add_option("--set", overrides, "override a scene field, e.g. --set numerics.element_length=0.125 (null removes it)")
       ->type_name("KEY=VALUE")
@@ -109,11 +110,11 @@ int main(int argc, char** argv) {
       ->type_name("FILE");
   app.add_option("--bag-rate", bag_options.rate,
                  "rate of /contact_force, /pantograph_state and /tf in the bag (Hz; 0: every step)")
-      ->check(CLI::Range(0.0, 1e6))
+      ->check(kFinite & CLI::Range(0.0, 1e6))
       ->capture_default_str()
       ->type_name("HZ");
   app.add_option("--max-steps", max_steps, "refuse a pass of more steps than this (a bound against runs that never end)")
-      ->check(CLI::Range(1.0, 1e12))
+      ->check(kFinite & CLI::Range(1.0, 1e12))
       ->capture_default_str()
       ->type_name("N");
   app.add_flag("--quiet", quiet, "print only errors");

@@ -1,0 +1,296 @@
+// Fuzz of bad input to the offline tools (issue 10): generated bad scenes, --set overrides and
+// command lines, each run as a child process of simulate_pass (and elasticity_curve). For each:
+// a non-zero exit, no signal, no hang (10 s), no output file written (so nothing half-written and
+// no NaN), and a message naming the field (or flag, or file) that is wrong.
+//
+// The inputs are generated from the reference scene itself: every numeric field it holds gets
+// values no range allows (NaN, inf, 1e300, text, lists, maps), every map gets an unknown field
+// and a scalar in its place, and the YAML text is corrupted in the ways the issue's fuzz found.
+// Deterministic (fixed seed): a failure is reproducible, never by chance.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+#ifndef CATENARY_SIM_DEVEL_LIB
+#define CATENARY_SIM_DEVEL_LIB "."
+#endif
+
+extern char** environ;
+
+namespace {
+
+const std::string kReference = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+const std::string kSimulatePass = CATENARY_SIM_DEVEL_LIB "/simulate_pass";
+const std::string kElasticity = CATENARY_SIM_DEVEL_LIB "/elasticity_curve";
+
+struct ChildRun {
+  int exit_code = -1;
+  int signal = 0;
+  bool hung = false;
+  std::string err;
+};
+
+std::string temp_dir() {
+  char t[] = "/tmp/catenary_sim_fuzz_XXXXXX";
+  return mkdtemp(t);
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// Runs argv with stdout and stderr to files; kills it after `limit` seconds.
+ChildRun run(const std::vector<std::string>& args, const std::string& dir, double limit = 10.0) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&fa, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = 0;
+  ChildRun r;
+  if (posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ) != 0) {
+    r.err = "spawn failed";
+    return r;
+  }
+  posix_spawn_file_actions_destroy(&fa);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      r.hung = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
+  r.err = slurp(err) + slurp(out);
+  return r;
+}
+
+bool exists(const std::string& p) {
+  struct stat st {};
+  return stat(p.c_str(), &st) == 0;
+}
+
+// One bad input: the run must fail cleanly and name `field` (any of the alternatives).
+struct Case {
+  std::string what;                   // for the failure message
+  std::vector<std::string> args;      // after the program
+  std::vector<std::string> names;     // the message must contain one of these
+};
+
+void expect_rejected(const std::string& program, const Case& c, const std::string& dir, int* count) {
+  const std::string out = dir + "/out";
+  std::vector<std::string> args{program};
+  for (const std::string& a : c.args) args.push_back(a == "@OUT" ? out : a);
+  const ChildRun r = run(args, dir);
+  ++*count;
+  SCOPED_TRACE(c.what + "\n  message: " + r.err);
+  EXPECT_FALSE(r.hung) << "hung (killed after 10 s)";
+  EXPECT_EQ(r.signal, 0) << "killed by signal " << r.signal;
+  EXPECT_NE(r.exit_code, 0) << "accepted";
+  EXPECT_NE(r.exit_code, -1);
+  bool named = false;
+  for (const std::string& n : c.names) named = named || r.err.find(n) != std::string::npos;
+  EXPECT_TRUE(named) << "the message names none of: " << ::testing::PrintToString(c.names);
+  // Nothing written: a refused pass leaves no stats.json or CSV (so none half-written or NaN).
+  EXPECT_FALSE(exists(out + "/stats.json")) << "stats.json written";
+  EXPECT_FALSE(exists(out + "/timeseries.csv")) << "timeseries.csv written";
+  if (exists(out)) std::system(("rm -rf '" + out + "'").c_str());
+}
+
+// The reference scene's fields as dotted --set keys and as the messages name them.
+struct Field {
+  std::string key;      // pantographs.0.masses.1
+  std::string message;  // pantographs[0].masses[1]
+  bool in_list = false;
+};
+
+void collect(const YAML::Node& n, const std::string& key, const std::string& msg, std::vector<Field>* numeric,
+             std::vector<Field>* maps) {
+  if (n.IsMap()) {
+    if (!key.empty()) maps->push_back({key, msg});
+    for (const auto& kv : n) {
+      const std::string k = kv.first.Scalar();
+      collect(kv.second, key.empty() ? k : key + "." + k, msg.empty() ? k : msg + "." + k, numeric, maps);
+    }
+  } else if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i)
+      collect(n[i], key + "." + std::to_string(i), msg + "[" + std::to_string(i) + "]", numeric, maps);
+  } else if (n.IsScalar()) {
+    double d = 0.0;
+    if (YAML::convert<double>::decode(n, d)) numeric->push_back({key, msg, msg.back() == ']'});
+  }
+}
+
+}  // namespace
+
+TEST(FuzzBadInput, SetOverridesOfEveryField) {
+  const std::string dir = temp_dir();
+  const YAML::Node root = YAML::LoadFile(kReference);
+  std::vector<Field> numeric, maps;
+  collect(root, "", "", &numeric, &maps);
+  ASSERT_GT(numeric.size(), 30u);
+  int count = 0;
+  // No range of any numeric field allows these (the widest, train.start/end, are finite).
+  const std::vector<std::string> bad_numbers = {".nan", ".inf", "-.inf", "1e300", "-1e300", "abc", "[1, 2]", "{a: 1}"};
+  for (const Field& f : numeric)
+    for (const std::string& v : bad_numbers) {
+      // A list entry is named as list[i] by the scene, or by the list when its shape is wrong.
+      std::vector<std::string> names{f.message};
+      if (f.in_list) names.push_back(f.message.substr(0, f.message.rfind('[')));
+      expect_rejected(kSimulatePass, {"--set " + f.key + "=" + v, {"--scene", kReference, "--out", "@OUT", "--set", f.key + "=" + v}, names},
+                      dir, &count);
+    }
+  for (const Field& f : maps) {
+    expect_rejected(kSimulatePass, {"unknown field in " + f.key, {"--scene", kReference, "--out", "@OUT", "--set", f.key + ".spam=1"},
+                     {f.message + ".spam"}}, dir, &count);
+    expect_rejected(kSimulatePass, {"scalar in place of " + f.key, {"--scene", kReference, "--out", "@OUT", "--set", f.key + "=5"},
+                     {f.message}}, dir, &count);
+  }
+  RecordProperty("cases", count);
+}
+
+TEST(FuzzBadInput, OverridePathsAndValues) {
+  const std::string dir = temp_dir();
+  int count = 0;
+  std::vector<Case> cases = {
+      {"through a value", {"--set", "name.foo=1"}, {"name"}},
+      {"through a number", {"--set", "contact_wire.tension.x=1"}, {"contact_wire.tension"}},
+      {"huge index", {"--set", "pantographs.99999999999999999999999.static_uplift=1"}, {"index 99999999999999999999999"}},
+      {"index past the end", {"--set", "pantographs.1.static_uplift=1"}, {"index 1"}},
+      {"name as index", {"--set", "pantographs.lead.static_uplift=1"}, {"pantographs"}},
+      {"empty key part", {"--set", "numerics..dt=1"}, {"numerics..dt"}},
+      {"no '='", {"--set", "numerics.dt"}, {"numerics.dt"}},
+      {"invalid YAML value", {"--set", "numerics.dt=[1,"}, {"numerics.dt"}},
+      {"empty dropper list", {"--set", "droppers.positions=[]"}, {"droppers.positions"}},
+      {"dropper outside the span", {"--set", "droppers.positions=[4.5, 60]"}, {"droppers.positions"}},
+      {"filter above Nyquist", {"--set", "output.filter_cutoff=5000"}, {"output.filter_cutoff"}},
+      {"pass ends before the analysis section", {"--set", "train.end=10"}, {"train.end"}},
+      {"train starts off the line", {"--set", "train.start=-1"}, {"train.start"}},
+      {"train starts beyond the line", {"--set", "train.start=1000"}, {"train.start"}},
+      {"speed removed (0)", {"--set", "train.speed_kmh=null"}, {"train.speed_kmh"}},
+      {"negative net uplift", {"--set", "pantographs.0.aero_coefficient=-1"}, {"pantographs[0].aero_coefficient"}},
+      {"unknown preset", {"--set", "numerics.preset=ultra"}, {"numerics.preset"}},
+      {"unknown pantograph type", {"--set", "pantographs.0.type=rigid"}, {"pantographs[0].type"}},
+      {"two equal pantograph names",
+       {"--set", "pantographs=[{name: a, type: moving_force, static_uplift: 100}, {name: a, type: moving_force, static_uplift: 100}]"},
+       {"pantographs[1].name"}},
+      {"dt above the stability limit", {"--set", "numerics.dt=0.01"}, {"numerics.dt"}},
+      {"more memory than the machine", {"--set", "line.span_count=10000", "--set", "line.span_length=500", "--set", "numerics.element_length=0.01"},
+       {"memory", "GiB"}},
+      {"a pass that never ends (speed)", {"--speed", "1e-300"}, {"--max-steps"}},
+      {"a pass of billions of steps (0.001 km/h)", {"--speed", "0.001"}, {"--max-steps"}},
+      {"pantograph masses of 1e-12 kg", {"--set", "pantographs.0.masses=[1e-12, 1e-12, 1e-12]"}, {"--max-steps", "masses"}},
+      {"speed out of range", {"--speed", "600"}, {"--speed"}},
+      {"speed not a number", {"--speed", "fast"}, {"--speed"}},
+      {"bag rate NaN", {"--bag-rate", "nan"}, {"--bag-rate"}},
+      {"unknown flag", {"--sped", "300"}, {"--sped"}},
+      {"--set without a value", {"--set"}, {"--set"}},
+  };
+  for (Case c : cases) {
+    std::vector<std::string> args{"--scene", kReference, "--out", "@OUT"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    c.args = args;
+    expect_rejected(kSimulatePass, c, dir, &count);
+  }
+  // Outputs that cannot be written, found before the pass.
+  expect_rejected(kSimulatePass, {"--out is a file", {"--scene", kReference, "--out", kReference}, {kReference}}, dir, &count);
+  expect_rejected(kSimulatePass, {"--out under /proc", {"--scene", kReference, "--out", "/proc/catenary_sim_out"}, {"/proc/catenary_sim_out"}},
+                  dir, &count);
+  expect_rejected(kSimulatePass, {"--bag into a missing directory", {"--scene", kReference, "--out", "@OUT", "--bag", "/nonexistent/x.bag"},
+                   {"/nonexistent/x.bag"}}, dir, &count);
+  // elasticity_curve shares the loader; its own flags are checked too.
+  expect_rejected(kElasticity, {"elasticity: bad --set", {"--scene", kReference, "--set", "name.foo=1"}, {"name"}}, dir, &count);
+  expect_rejected(kElasticity, {"elasticity: --step 0", {"--scene", kReference, "--step", "0"}, {"--step"}}, dir, &count);
+  expect_rejected(kElasticity, {"elasticity: unknown flag", {"--scene", kReference, "--stepp", "1"}, {"--stepp"}}, dir, &count);
+  RecordProperty("cases", count);
+}
+
+TEST(FuzzBadInput, CorruptedSceneFiles) {
+  const std::string dir = temp_dir();
+  const std::string text = slurp(kReference);
+  std::mt19937 rng(20261123);  // fixed: the same files every run
+  int count = 0;
+  auto scene_case = [&](const std::string& what, const std::string& body, std::vector<std::string> names) {
+    const std::string path = dir + "/scene.yaml";
+    std::ofstream(path) << body;
+    names.push_back(path);  // failures to parse at all name the file
+    expect_rejected(kSimulatePass, {what, {"--scene", path, "--out", "@OUT"}, names}, dir, &count);
+  };
+  scene_case("non-scalar key", text + "? [a, b]\n: 1\n", {"key"});
+  scene_case("map key", text + "? {a: 1}\n: 1\n", {"key"});
+  scene_case("duplicate top-level key", "name: other\n" + text, {"name"});
+  {
+    std::string t = text;
+    t.replace(t.find("train:\n"), 7, "train:\n  speed_kmh: 250.0\n");
+    scene_case("duplicate nested key", t, {"train.speed_kmh"});
+  }
+  scene_case("empty value", text.substr(0, text.find("train:")) + "train:\n  speed_kmh:\n" +
+                                text.substr(text.find("numerics:")), {"train.speed_kmh"});
+  scene_case("unclosed list", text + "extra: [1, 2\n", {"not valid YAML"});
+  scene_case("tab indentation", text + "train2:\n\tspeed: 1\n", {"not valid YAML", "train2"});
+  scene_case("not a map", "- a\n- b\n", {"map"});
+  scene_case("empty file", "", {"map"});
+  // Random bytes overwrite a random stretch of the text: whatever it parses to, it must be
+  // refused cleanly, or (a comment hit, a value changed within its range) run as a valid pass.
+  for (int i = 0; i < 40; ++i) {
+    std::string t = text;
+    std::uniform_int_distribution<std::size_t> at(0, t.size() - 1);
+    std::uniform_int_distribution<int> byte(0, 255), len(1, 4);
+    const std::size_t p = at(rng);
+    const int n = len(rng);
+    for (int k = 0; k < n && p + k < t.size(); ++k) t[p + k] = static_cast<char>(byte(rng));
+    const std::string path = dir + "/scene.yaml";
+    std::ofstream(path) << t;
+    const ChildRun r = run({kSimulatePass, "--scene", path, "--out", dir + "/out"}, dir);
+    SCOPED_TRACE("random bytes at " + std::to_string(p) + ": " + r.err);
+    EXPECT_FALSE(r.hung);
+    EXPECT_EQ(r.signal, 0);
+    if (r.exit_code == 0) {
+      // The corruption hit a comment or changed a value within its range: a valid pass, whose
+      // outputs must then be whole and finite.
+      const std::string stats = slurp(dir + "/out/stats.json");
+      EXPECT_EQ(stats.find("nan"), std::string::npos);
+      EXPECT_NE(stats.find("\"pantographs\""), std::string::npos);
+    } else {
+      EXPECT_EQ(r.exit_code, 2);
+      EXPECT_NE(r.err.find("scene"), std::string::npos) << "an error not about the scene";
+    }
+    std::system(("rm -rf '" + dir + "/out'").c_str());
+    ++count;
+  }
+  // Files that are not scene files.
+  expect_rejected(kSimulatePass, {"a directory", {"--scene", CATENARY_SIM_SOURCE_DIR "/config", "--out", "@OUT"}, {"directory"}}, dir, &count);
+  expect_rejected(kSimulatePass, {"/dev/zero", {"--scene", "/dev/zero", "--out", "@OUT"}, {"/dev/zero", "MiB"}}, dir, &count);
+  expect_rejected(kSimulatePass, {"missing file", {"--scene", dir + "/none.yaml", "--out", "@OUT"}, {"none.yaml"}}, dir, &count);
+  RecordProperty("cases", count);
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
