@@ -86,7 +86,7 @@ class Reader {
     if (!node_ || !node_.IsMap()) return;
     for (const auto& kv : node_) {
       const std::string key = kv.first.as<std::string>();
-      if (!used_.count(key)) fail(field(key), "(unknown field)", "not a field of '" + (path_.empty() ? "scene" : path_) + "'; check the spelling against README.md");
+      if (!used_.count(key)) fail(field(key), "(unknown field)", "not a field of '" + (path_.empty() ? "scene" : path_) + "'; check the spelling against docs/scene_reference.md");
     }
   }
 

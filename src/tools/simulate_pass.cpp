@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
   double max_steps = kDefaultMaxSteps;
   bool quiet = false, no_progress = false;
   ros_layer::PassBagOptions bag_options;
-  app.add_option("--scene", scene_path, "scene YAML (README.md, e.g. config/reference_55m.yaml)")
+  app.add_option("--scene", scene_path, "scene YAML (docs/scene_reference.md, e.g. config/reference_55m.yaml)")
       ->required()
       ->type_name("FILE");
   app.add_option("--out", out_dir, "output directory for stats.json and timeseries.csv (created)")
