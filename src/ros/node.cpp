@@ -1,6 +1,7 @@
 #include "catenary_sim/ros/node.hpp"
 
 #include <rosgraph_msgs/Clock.h>
+#include <std_msgs/String.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 
 #include "catenary_sim/ContactForceArray.h"
 #include "catenary_sim/PantographStateArray.h"
+#include "catenary_sim/PassEvent.h"
 #include "catenary_sim/WireShapeArray.h"
 #include "catenary_sim/ros/conversions.hpp"
 
@@ -38,15 +40,15 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   if (!sim_->set_max_acceleration(params_.max_acceleration, &err)) throw ParamError("parameter ~max_acceleration: " + err);
   restart_recording();
 
-  // Stamps start at the wall time of the start (whole seconds): never ros::Time(0) ("latest" for
-  // tf), close to now for rviz and bags at real_time_factor 1.
-  stamp_offset_ = std::floor(ros::WallTime::now().toSec());
+  paused_ = params_.paused;
 
   contact_pub_ = nh_.advertise<ContactForceArray>("contact_force", 10);
   pantograph_pub_ = nh_.advertise<PantographStateArray>("pantograph_state", 10);
   shape_pub_ = nh_.advertise<WireShapeArray>("wire_shape", 2);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
   if (params_.publish_clock) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  status_pub_ = nh_.advertise<std_msgs::String>("pass_status", 1, true);
+  events_pub_ = nh_.advertise<PassEvent>("events", 100);
   speed_sub_ = nh_.subscribe("cmd/train_speed", 10, &SimulationNode::on_speed, this);
   uplift_sub_ = nh_.subscribe("cmd/uplift_force", 10, &SimulationNode::on_uplift, this);
   reset_srv_ = pnh_.advertiseService("reset", &SimulationNode::on_reset, this);
@@ -55,6 +57,10 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
 
   updater_.setHardwareID("catenary_sim/" + scene.name);
   updater_.add("simulation", this, &SimulationNode::diagnose);
+  // After the parameters: the server starts from the values on the parameter server (validated
+  // above) and calls on_reconfigure once with them.
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<NodeConfig>>(pnh_);
+  reconfigure_->setCallback([this](NodeConfig& c, uint32_t level) { on_reconfigure(c, level); });
 
   const Model& m = sim_->model();
   ROS_INFO("catenary_sim: scene %s: %zu spans, %.1f m, %d DOFs, dt %.4g ms (stability limit %.4g ms), "
@@ -65,6 +71,8 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 void SimulationNode::restart_recording() {
+  loss_since_.assign(sim_->model().pantographs.size(), std::nan(""));
+  loss_station_ = loss_since_;
   recorder_ = std::make_unique<PassRecorder>(sim_->model(), kRecorderRowRate);
   recorder_->record(sim_->model(), sim_->state());
 }
@@ -75,57 +83,141 @@ void SimulationNode::reanchor() {
 }
 
 int SimulationNode::run() {
-  const ros::WallDuration period(1.0 / params_.publish_rate);
-  if (params_.start_delay > 0.0) {
+  waiting_ = true;
+  publish_status();
+  publish(true);
+  wait_for_viewer();
+  if (params_.start_delay > 0.0 && ros::ok()) {
     ROS_INFO("catenary_sim: starting in %g s (~start_delay)", params_.start_delay);
     const ros::WallTime start = ros::WallTime::now() + ros::WallDuration(params_.start_delay);
-    publish(true);
     while (ros::ok() && ros::WallTime::now() < start) {
       ros::spinOnce();
-      updater_.update();
+      publish(false);
       ros::WallDuration(0.02).sleep();
     }
   }
+  waiting_ = false;
+  if (paused_) ROS_INFO("catenary_sim: paused (~paused); start with: rosservice call %s false",
+                        pnh_.resolveName("set_paused").c_str());
   wall_start_ = ros::WallTime::now();
   diag_wall_ = wall_start_;
   diag_sim_ = sim_->state().time;
   reanchor();
   publish(true);
-  ros::WallTime next_tick = ros::WallTime::now() + period;
+  ros::WallTime next_tick = ros::WallTime::now();
   while (ros::ok() && !exit_requested_) {
     ros::spinOnce();
     if (exit_requested_) break;
-    advance(next_tick);
+    advance(next_tick + ros::WallDuration(1.0 / params_.publish_rate));
+    if (sim_->finished() || ended_) track_contact_loss();  // closes a loss still open at the end
     handle_end();
     publish(false);
-    updater_.update();
+    publish_status();
+    // Health on the wall clock: with simulated time the updater's own timer would stop while paused.
     const ros::WallTime now = ros::WallTime::now();
+    if (now >= next_diagnostics_wall_) {
+      updater_.force_update();
+      next_diagnostics_wall_ = now + ros::WallDuration(1.0);
+    }
+    const ros::WallDuration period(1.0 / params_.publish_rate);  // may change (dynamic_reconfigure)
+    next_tick += period;
     if (next_tick > now) {
       (next_tick - now).sleep();
-      next_tick += period;
     } else {
-      next_tick = now + period;  // behind: do not try to catch up on ticks
+      next_tick = now;  // behind: do not try to catch up on ticks
     }
   }
   return exit_code_;
 }
 
+void SimulationNode::wait_for_viewer() {
+  if (!(params_.wait_for_viewer > 0.0)) return;
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(params_.wait_for_viewer);
+  if (marker_pub_.getNumSubscribers() == 0)
+    ROS_INFO("catenary_sim: waiting up to %g s for a viewer (rviz) to subscribe to %s (~wait_for_viewer)",
+             params_.wait_for_viewer, marker_pub_.getTopic().c_str());
+  while (ros::ok() && marker_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < give_up) {
+    ros::spinOnce();
+    publish(false);
+    ros::WallDuration(0.05).sleep();
+  }
+  if (marker_pub_.getNumSubscribers() == 0)
+    ROS_WARN("catenary_sim: no viewer subscribed within %g s; starting anyway", params_.wait_for_viewer);
+  else  // rviz subscribes before its displays have drawn the first frame: give it a moment
+    for (int i = 0; i < 20 && ros::ok(); ++i) {
+      ros::spinOnce();
+      publish(true);
+      ros::WallDuration(0.05).sleep();
+    }
+}
+
+void SimulationNode::publish_status() {
+  const State& s = sim_->state();
+  std::string now = "running";
+  if (s.status == StepStatus::kDiverged) now = "diverged";
+  else if (ended_) now = "ended";
+  else if (waiting_) now = "waiting";
+  else if (paused_) now = "paused";
+  if (now == status_) return;
+  status_ = now;
+  std_msgs::String m;
+  m.data = now;
+  status_pub_.publish(m);
+}
+
+void SimulationNode::track_contact_loss() {
+  const Model& m = sim_->model();
+  const State& s = sim_->state();
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    if (m.pantographs[p].external) continue;
+    const bool lost = !(total_contact_force(m, s, static_cast<int>(p)) > 0.0);
+    const double station = s.front - m.pantographs[p].position + s.line_offset;
+    const bool in_loss = !std::isnan(loss_since_[p]);
+    if (lost && !in_loss) {
+      loss_since_[p] = s.time;
+      loss_station_[p] = station;
+    } else if (in_loss && (!lost || sim_->finished() || ended_)) {
+      PassEvent e;
+      e.header.stamp = ros::Time(loss_since_[p]);
+      e.header.frame_id = params_.line_frame;
+      e.kind = PassEvent::CONTACT_LOSS;
+      e.pantograph = m.pantographs[p].name;
+      e.station = loss_station_[p];
+      e.simulation_time = loss_since_[p];
+      e.duration = s.time - loss_since_[p];
+      e.length = station - loss_station_[p];
+      events_pub_.publish(e);
+      loss_since_[p] = std::nan("");
+    }
+  }
+}
+
+void SimulationNode::on_reconfigure(NodeConfig& c, uint32_t) {
+  // The ranges of the .cfg are those of the parameters; dynamic_reconfigure clamps to them.
+  if (c.real_time_factor != params_.real_time_factor) reanchor();
+  params_.real_time_factor = c.real_time_factor;
+  params_.vertical_scale = c.vertical_scale;
+  params_.publish_rate = c.publish_rate;
+  params_.shape_rate = c.shape_rate;
+  params_.marker_rate = c.marker_rate;
+  std::string err;
+  if (sim_->set_max_acceleration(c.max_acceleration, &err)) {
+    params_.max_acceleration = c.max_acceleration;
+  } else {
+    ROS_ERROR("catenary_sim: max_acceleration = %g rejected: %s", c.max_acceleration, err.c_str());
+    c.max_acceleration = params_.max_acceleration;  // the server publishes the value in effect
+  }
+}
+
 std::int64_t SimulationNode::do_steps(std::int64_t n, const ros::WallTime* deadline) {
   const Model& m = sim_->model();
-  const std::size_t np = m.pantographs.size();
   std::int64_t done = 0;
   for (; done < n; ++done) {
     if (sim_->finished()) break;
     if (sim_->step() != StepStatus::kOk) break;
     const State& s = sim_->state();
     recorder_->record(m, s);
-    ++counted_steps_;
-    for (std::size_t p = 0; p < np; ++p) {
-      if (!(total_contact_force(m, s, static_cast<int>(p)) > 0.0)) {
-        ++loss_steps_;
-        break;
-      }
-    }
+    track_contact_loss();  // every step: the events resolve dt, not the publishing tick
     if (deadline && (done & 31) == 31 && ros::WallTime::now() >= *deadline) {
       ++done;
       break;
@@ -229,7 +321,7 @@ void SimulationNode::publish(bool force) {
   const Model& m = sim_->model();
   const State& s = sim_->state();
   const ros::WallTime now = ros::WallTime::now();
-  const ros::Time stamp = sim_stamp(s.time, stamp_offset_);
+  const ros::Time stamp = sim_stamp(s.time, 0.0);
   const bool advanced = s.time > last_published_time_;
   const bool shape_due = (now - last_shape_wall_).toSec() >= 1.0 / params_.shape_rate;
   // Markers: at marker_rate while the state changes, at shape_rate while it holds.
@@ -239,12 +331,14 @@ void SimulationNode::publish(bool force) {
   // While the simulation holds (paused, stopped), the state topics are repeated at shape_rate with
   // their unchanged stamp; tf and /clock are only sent for a new time.
   if (advanced || force || shape_due) {
+    // /clock for every new time and, while holding, again at shape_rate: a node started with
+    // /use_sim_time during a pause gets its time at once (gazebo_ros does the same).
+    if (params_.publish_clock) {
+      rosgraph_msgs::Clock c;
+      c.clock = stamp;
+      clock_pub_.publish(c);
+    }
     if (advanced || force) {
-      if (params_.publish_clock && advanced) {
-        rosgraph_msgs::Clock c;
-        c.clock = stamp;
-        clock_pub_.publish(c);
-      }
       if (advanced) tf_.sendTransform(to_transforms(m, s, stamp, params_.line_frame));
     }
     contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
@@ -386,20 +480,21 @@ void SimulationNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   diag_sim_ = s.time;
   diag_overruns_ = overruns_;
   const double margin = m.dt / m.dt_critical;
-  bool loss_now = false;
-  for (std::size_t p = 0; p < m.pantographs.size(); ++p)
-    if (!(total_contact_force(m, s, static_cast<int>(p)) > 0.0)) loss_now = true;
 
+  // Health only: is the simulation computing, in time, within its stability limit. What the
+  // physics does (contact loss, slack droppers, uplift) is a result: on `events` and the topics.
   using diagnostic_msgs::DiagnosticStatus;
+  const bool holding = paused_ || ended_ || waiting_ || sim_->finished();
   if (s.status == StepStatus::kDiverged) stat.summary(DiagnosticStatus::ERROR, sim_->status_message());
   else if (new_overruns > 0) stat.summary(DiagnosticStatus::WARN, "overruns: real_time_factor not reached");
   else if (margin > 1.0) stat.summary(DiagnosticStatus::WARN, "dt above the stability limit");
-  else if (loss_now) stat.summary(DiagnosticStatus::WARN, "contact loss");
+  else if (waiting_) stat.summary(DiagnosticStatus::OK, "waiting to start");
   else if (paused_) stat.summary(DiagnosticStatus::OK, "paused");
-  else if (sim_->finished()) stat.summary(DiagnosticStatus::OK, "pass finished");
+  else if (ended_ || sim_->finished()) stat.summary(DiagnosticStatus::OK, "pass finished");
   else stat.summary(DiagnosticStatus::OK, "running");
 
-  stat.add("real_time_factor (achieved)", rtf);
+  if (holding) stat.add("real_time_factor (achieved)", "not stepping (" + status_ + ")");
+  else stat.add("real_time_factor (achieved)", rtf);
   stat.add("real_time_factor (requested, 0 = max)", params_.real_time_factor);
   stat.add("chunks", chunks_);
   stat.add("overruns", overruns_);
@@ -407,10 +502,6 @@ void SimulationNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("dt [s]", m.dt);
   stat.add("sim time [s]", s.time);
   stat.add("steps", s.steps);
-  stat.add("train front [m]", s.front + s.line_offset);
-  stat.add("speed [m/s]", s.speed);
-  stat.add("contact loss now", loss_now);
-  stat.add("contact loss [% of steps]", counted_steps_ > 0 ? 100.0 * loss_steps_ / counted_steps_ : 0.0);
   if (have_command_) stat.add("age of last command [s]", (now - last_command_wall_).toSec());
   else stat.add("age of last command [s]", "no command yet");
   stat.add("paused", paused_);

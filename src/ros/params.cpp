@@ -58,6 +58,7 @@ void validate(const NodeParams& p) {
   check_range("vertical_scale", p.vertical_scale, 0.0, 10000.0, true, "");
   check_range("max_acceleration", p.max_acceleration, 0.0, 20.0, false, "m/s^2 (0: no limit)");
   check_range("start_delay", p.start_delay, 0.0, 60.0, false, "s");
+  check_range("wait_for_viewer", p.wait_for_viewer, 0.0, 600.0, false, "s (0: no wait)");
   check_frame_id("line_frame", p.line_frame);
 }
 
@@ -90,12 +91,14 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   number("vertical_scale", p.vertical_scale);
   number("max_acceleration", p.max_acceleration);
   number("start_delay", p.start_delay);
+  number("wait_for_viewer", p.wait_for_viewer);
   nh.param<std::string>("line_frame", p.line_frame, p.line_frame);
   std::string at_end = to_string(p.at_end);
   nh.param<std::string>("at_end", at_end, at_end);
   p.at_end = parse_at_end(at_end);
   nh.param<std::string>("stats_file", p.stats_file, "");
-  nh.param<bool>("publish_clock", p.publish_clock, false);
+  nh.param<bool>("publish_clock", p.publish_clock, p.publish_clock);
+  nh.param<bool>("paused", p.paused, p.paused);
   validate(p);
   return p;
 }

@@ -1,5 +1,7 @@
 // rostest companion of node.test: the live node with the reference scene at real time.
 #include <diagnostic_msgs/DiagnosticArray.h>
+#include <dynamic_reconfigure/Reconfigure.h>
+#include <rosgraph_msgs/Clock.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
@@ -311,6 +313,73 @@ TEST(Node, UpliftCommandRaisesTheMeanContactForceAndResetStartsANewPass) {
   EXPECT_GT(fresh.header.stamp, before.header.stamp);
   EXPECT_GT(fresh.sim_time, after_cmd.sim_time);
   send_uplift({100.0});
+}
+
+// gazebo_ros behaviour: /clock keeps coming while paused (at shape_rate, 10 Hz here) with the
+// paused time, so that a /use_sim_time node started during a pause gets its time at once.
+TEST(Node, ClockIsPublishedWhilePausedAtThePausedTime) {
+  Recorder<rosgraph_msgs::Clock> clock("/clock");
+  Recorder<PantographStateArray> state("pantograph_state");
+  ASSERT_TRUE(wait_for([&] { return clock.size() > 10; }, 5.0)) << "no /clock while running";
+  ASSERT_TRUE(set_paused(true));
+  const PantographStateArray paused = latest_state(state);
+  ros::WallDuration(0.3).sleep();  // anything sent before the pause has arrived
+  clock.clear();
+  ros::WallDuration(1.5).sleep();
+  const std::vector<rosgraph_msgs::Clock> during = clock.take();
+  // 10 Hz for 1.5 s: 15 expected; 3 leaves room for a loaded machine, and 0 is the defect.
+  EXPECT_GE(during.size(), 3u) << "/clock fell silent while paused";
+  for (const auto& c : during) EXPECT_EQ(c.clock, paused.header.stamp) << "the clock moved while paused";
+  // Stamps are simulated time (no wall-clock offset): the stamp is the pantograph state's sim time.
+  EXPECT_NEAR(paused.header.stamp.toSec(), paused.sim_time, 1e-6);
+  ASSERT_TRUE(set_paused(false));
+  ASSERT_TRUE(wait_for([&] { auto v = clock.take(); return !v.empty() && v.back().clock > paused.header.stamp; }, 5.0));
+}
+
+namespace {
+bool reconfigure(const std::string& name, double value) {
+  dynamic_reconfigure::Reconfigure r;
+  dynamic_reconfigure::DoubleParameter p;
+  p.name = name;
+  p.value = value;
+  r.request.config.doubles.push_back(p);
+  if (!ros::service::call("/catenary_sim/set_parameters", r)) return false;
+  for (const auto& d : r.response.config.doubles)
+    if (d.name == name) return d.value == value;
+  return false;
+}
+}  // namespace
+
+// dynamic_reconfigure: real_time_factor 0.25 makes simulated time advance at a quarter of the wall
+// clock. Pacing never runs ahead of the factor (steps_due), so the rate is at most 0.25 plus one
+// tick of 10 ms over the 2 s measured; on a loaded machine it can only fall behind, and below half
+// of it would take a second of stalls (then overruns, which the diagnostics report).
+TEST(Node, DynamicReconfigureChangesTheRealTimeFactorLive) {
+  Recorder<PantographStateArray> state("pantograph_state");
+  ASSERT_TRUE(reconfigure("real_time_factor", 0.25));
+  ros::WallDuration(0.3).sleep();
+  const PantographStateArray a = latest_state(state);
+  const ros::WallTime wa = ros::WallTime::now();
+  ros::WallDuration(2.0).sleep();
+  const PantographStateArray b = latest_state(state);
+  const double wall = (ros::WallTime::now() - wa).toSec();
+  const double rate = (b.sim_time - a.sim_time) / wall;
+  EXPECT_LE(rate, 0.25 * (2.0 + 0.01 + 0.1) / 2.0) << "faster than the factor";  // +0.1 s: latest_state's latency
+  EXPECT_GE(rate, 0.125) << "far slower than the factor";
+  ASSERT_TRUE(reconfigure("real_time_factor", 1.0));
+  // Out of range: dynamic_reconfigure clamps to the .cfg's range, which is the parameter's.
+  dynamic_reconfigure::Reconfigure r;
+  dynamic_reconfigure::DoubleParameter p;
+  p.name = "max_acceleration";
+  p.value = 1e9;
+  r.request.config.doubles.push_back(p);
+  ASSERT_TRUE(ros::service::call("/catenary_sim/set_parameters", r));
+  for (const auto& d : r.response.config.doubles) {
+    if (d.name == "max_acceleration") {
+      EXPECT_LE(d.value, 20.0);
+    }
+  }
+  ASSERT_TRUE(reconfigure("max_acceleration", 5.0));
 }
 
 int main(int argc, char** argv) {

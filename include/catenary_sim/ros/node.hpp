@@ -3,6 +3,7 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
 #include <std_msgs/Float64MultiArray.h>
@@ -12,7 +13,10 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <vector>
 
+#include "catenary_sim/NodeConfig.h"
 #include "catenary_sim/Step.h"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
@@ -49,19 +53,33 @@ class SimulationNode {
   bool on_set_paused(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res);
   bool on_step(Step::Request& req, Step::Response& res);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void on_reconfigure(NodeConfig& config, uint32_t level);
+  // Waits (wall clock) for a subscriber of `markers` up to ~wait_for_viewer, publishing the initial
+  // state and /clock meanwhile.
+  void wait_for_viewer();
+  // Publishes `pass_status` (latched) when it changes: waiting, running, paused, ended, diverged.
+  void publish_status();
+  // Contact-loss events per pantograph (a physics result, on `events`, not on /diagnostics).
+  void track_contact_loss();
 
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
   std::unique_ptr<Simulation> sim_;
   std::unique_ptr<PassRecorder> recorder_;
 
-  ros::Publisher contact_pub_, pantograph_pub_, shape_pub_, marker_pub_, clock_pub_;
+  ros::Publisher contact_pub_, pantograph_pub_, shape_pub_, marker_pub_, clock_pub_, status_pub_, events_pub_;
   ros::Subscriber speed_sub_, uplift_sub_;
   ros::ServiceServer reset_srv_, pause_srv_, step_srv_;
   tf2_ros::TransformBroadcaster tf_;
   diagnostic_updater::Updater updater_;
+  std::unique_ptr<dynamic_reconfigure::Server<NodeConfig>> reconfigure_;
+  ros::WallTime next_diagnostics_wall_;  // diagnostics on the wall clock (health, also while paused)
+  std::string status_;                  // last published pass_status
+  bool waiting_ = false;                // waiting for a viewer or ~start_delay
+  // Per pantograph: in a contact loss since this simulated time and station (NaN: in contact).
+  std::vector<double> loss_since_, loss_station_;
 
-  double stamp_offset_ = 0.0;  // s, added to the simulation time for stamps
+  // Stamps are simulated time, as gazebo_ros does (docs/user_guide.md, "Time"): no offset.
   bool paused_ = false;
   bool ended_ = false;          // the end of the pass (or a divergence) has been handled
   bool exit_requested_ = false;
@@ -81,7 +99,6 @@ class SimulationNode {
   ros::Time last_view_stamp_;        // stamp of the last train_view transform
 
   // Diagnostics.
-  std::int64_t loss_steps_ = 0, counted_steps_ = 0;
   ros::WallTime last_command_wall_;
   bool have_command_ = false;
   ros::WallTime diag_wall_;

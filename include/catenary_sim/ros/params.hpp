@@ -44,7 +44,11 @@ struct NodeParams {
   std::string line_frame = "line";  // ~line_frame: fixed frame, x along the track, z up
   AtEnd at_end = AtEnd::kStop;      // ~at_end: stop | loop | exit
   std::string stats_file;           // ~stats_file: JSON statistics written at the end (empty: none)
-  bool publish_clock = false;       // ~publish_clock: publish rosgraph_msgs/Clock on /clock
+  bool publish_clock = true;        // ~publish_clock: publish rosgraph_msgs/Clock on /clock (simulated time,
+                                    //   from 0, also while paused; pass.launch sets /use_sim_time with it)
+  bool paused = false;              // ~paused: start paused (like gazebo's paused:=true); ~set_paused false starts
+  double wait_for_viewer = 0.0;     // ~wait_for_viewer: s (wall) to wait for a subscriber of `markers` (rviz)
+                                    //   before the pass starts, [0, 600]; 0: no wait
   double max_acceleration = 1.0;    // ~max_acceleration: m/s^2 toward commanded speeds, [0, 20] (0: jump)
   double start_delay = 0.0;         // ~start_delay: s (wall) publishing the initial state before stepping, [0, 60]
                                     //   (lets rosbag record / rviz connect before a fast pass is over)
