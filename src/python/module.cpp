@@ -1,0 +1,188 @@
+// catenary_sim._core: the core for Python (pybind11), a thin skin over Simulation like the ROS
+// layer is: no physics here. The Python package (python/catenary_sim/__init__.py) adds scenes from
+// dicts and the SceneError exception with the field, the value and what is allowed.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/simulation.hpp"
+#include "catenary_sim/core/statistics.hpp"
+
+namespace py = pybind11;
+using namespace catenary_sim;
+
+namespace {
+
+// A read-only numpy view of a state vector, alive as long as the simulation object.
+py::array_t<double> view(const double* data, std::size_t n, py::handle owner) {
+  py::array_t<double> a({n}, {sizeof(double)}, data, owner);
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return a;
+}
+
+// A pass of a scene with its recorder: the object Python steps.
+class PySimulation {
+ public:
+  // sample_rate < 0: the scene's output.sample_rate.
+  PySimulation(const Scene& scene, double sample_rate)
+      : sim_(scene), recorder_(sim_.model(), sample_rate < 0.0 ? scene.output.sample_rate : sample_rate) {
+    recorder_.record(sim_.model(), sim_.state());
+  }
+
+  // Steps up to n times; stops at the end of the pass or a divergence. Returns the steps taken.
+  long long step(long long n) {
+    if (n < 0) throw py::value_error("step(n): n = " + std::to_string(n) + ": allowed n >= 0");
+    long long done = 0;
+    for (; done < n && !sim_.finished(); ++done) {
+      if (sim_.step() != StepStatus::kOk) break;
+      recorder_.record(sim_.model(), sim_.state());
+    }
+    if (sim_.state().status == StepStatus::kDiverged) throw std::runtime_error(sim_.status_message());
+    return done;
+  }
+
+  // To the end of the pass, refused when it would not end within max_steps (speed 0, a crawl).
+  long long run(double max_steps) {
+    const State& st = sim_.state();
+    const double left = st.speed > 0.0 ? (sim_.model().train_end - st.front - st.line_offset) / st.speed / sim_.model().dt
+                                       : std::numeric_limits<double>::infinity();
+    if (!(left <= max_steps))
+      throw py::value_error("run(): the rest of the pass would take " + std::to_string(left) + " steps at " +
+                            std::to_string(st.speed) + " m/s, more than max_steps = " + std::to_string(max_steps) +
+                            "; set a speed, or step(n) yourself");
+    return step(std::numeric_limits<long long>::max());
+  }
+
+  std::string statistics_json(double wall_s) const {
+    return catenary_sim::statistics_json(sim_.model(), sim_.state(), recorder_.statistics(sim_.model()),
+                                         RunInfo{wall_s, -1.0, -1});
+  }
+
+  py::dict series() const {
+    py::dict out;
+    const auto& rows = recorder_.rows();
+    const std::vector<std::string> cols = recorder_.columns();
+    py::array_t<double> t(rows.size());
+    auto tm = t.mutable_unchecked<1>();
+    for (std::size_t i = 0; i < rows.size(); ++i) tm(i) = rows[i].time;
+    out["time_s"] = t;
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      py::array_t<double> a(rows.size());
+      auto am = a.mutable_unchecked<1>();
+      for (std::size_t i = 0; i < rows.size(); ++i) am(i) = rows[i].values[c];
+      out[py::str(cols[c])] = a;
+    }
+    return out;
+  }
+
+  void command(bool ok, const std::string& err) {
+    if (!ok) throw py::value_error(err);  // the state is as it was (Simulation's guarantee)
+  }
+
+  Simulation sim_;
+  PassRecorder recorder_;
+};
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "catenary_sim core (pybind11): scenes, passes, stepping; see catenary_sim.__doc__";
+  py::register_exception<SceneError>(m, "_SceneError", PyExc_ValueError);
+
+  m.def("_check_scene_string", [](const std::string& yaml, const std::vector<std::string>& overrides) {
+    load_scene_string(yaml, overrides);
+  });
+
+  py::class_<PySimulation>(m, "_Simulation")
+      .def(py::init([](const std::string& yaml, const std::vector<std::string>& overrides, double sample_rate) {
+             if (!std::isfinite(sample_rate) || sample_rate < -1.0 || (sample_rate < 0.0 && sample_rate != -1.0))
+               throw py::value_error("sample_rate = " + std::to_string(sample_rate) + ": allowed >= 0 Hz (0: every step)");
+             return std::make_unique<PySimulation>(load_scene_string(yaml, overrides), sample_rate);
+           }),
+           py::arg("yaml"), py::arg("overrides"), py::arg("sample_rate"))
+      .def_static("from_file", [](const std::string& path, const std::vector<std::string>& overrides, double sample_rate) {
+             if (!std::isfinite(sample_rate) || sample_rate < -1.0 || (sample_rate < 0.0 && sample_rate != -1.0))
+               throw py::value_error("sample_rate = " + std::to_string(sample_rate) + ": allowed >= 0 Hz (0: every step)");
+             return std::make_unique<PySimulation>(load_scene_file(path, overrides), sample_rate);
+           },
+           py::arg("path"), py::arg("overrides"), py::arg("sample_rate"))
+      .def("step", &PySimulation::step, py::arg("n") = 1, py::call_guard<py::gil_scoped_release>())
+      .def("run", &PySimulation::run, py::arg("max_steps") = 2e7)
+      .def("statistics_json", &PySimulation::statistics_json, py::arg("wall_s") = 0.0)
+      .def("series", &PySimulation::series)
+      .def("finished", [](const PySimulation& s) { return s.sim_.finished(); })
+      .def("reset", [](PySimulation& s) {
+        s.sim_.reset(true);
+        s.recorder_ = PassRecorder(s.sim_.model(), 0.0);
+        s.recorder_.record(s.sim_.model(), s.sim_.state());
+      })
+      .def_property_readonly("time", [](const PySimulation& s) { return s.sim_.state().time; })
+      .def_property_readonly("steps", [](const PySimulation& s) { return static_cast<long long>(s.sim_.state().steps); })
+      .def_property_readonly("dt", [](const PySimulation& s) { return s.sim_.model().dt; })
+      .def_property_readonly("dofs", [](const PySimulation& s) { return s.sim_.model().n_dof; })
+      .def_property_readonly("speed", [](const PySimulation& s) { return s.sim_.state().speed; })
+      .def_property_readonly("front", [](const PySimulation& s) { return s.sim_.state().front + s.sim_.state().line_offset; })
+      .def_property_readonly("status", [](const PySimulation& s) { return s.sim_.status_message(); })
+      .def_property_readonly("pantograph_names", [](const PySimulation& s) {
+        std::vector<std::string> n;
+        for (const Pantograph& p : s.sim_.model().pantographs) n.push_back(p.name);
+        return n;
+      })
+      .def_property_readonly("contact_wire_names", [](const PySimulation& s) {
+        std::vector<std::string> n;
+        for (int w : s.sim_.model().contact_wires) n.push_back(s.sim_.model().wires[w].name);
+        return n;
+      })
+      // Views (read-only, no copy) of the state: they change as the simulation steps.
+      .def_property_readonly("displacements", [](py::object self) {
+        const PySimulation& s = self.cast<const PySimulation&>();
+        return view(s.sim_.state().u.data(), static_cast<std::size_t>(s.sim_.state().u.size()), self);
+      })
+      .def_property_readonly("velocities", [](py::object self) {
+        const PySimulation& s = self.cast<const PySimulation&>();
+        return view(s.sim_.state().v.data(), static_cast<std::size_t>(s.sim_.state().v.size()), self);
+      })
+      .def_property_readonly("contact_forces", [](py::object self) {
+        const PySimulation& s = self.cast<const PySimulation&>();
+        const auto& f = s.sim_.state().contact_force;
+        py::array_t<double> a = view(f.data(), f.size(), self);
+        const std::size_t nw = s.sim_.model().contact_wires.size();
+        return a.reshape({static_cast<py::ssize_t>(f.size() / nw), static_cast<py::ssize_t>(nw)});
+      })
+      .def("pantograph_state", [](const PySimulation& s, int i) {
+        const Model& m = s.sim_.model();
+        if (i < 0 || i >= static_cast<int>(m.pantographs.size()))
+          throw py::index_error("pantograph " + std::to_string(i) + ": allowed 0.." + std::to_string(m.pantographs.size() - 1));
+        const State& st = s.sim_.state();
+        py::dict d;
+        d["name"] = m.pantographs[i].name;
+        d["position_m"] = pantograph_position(m, st, i);
+        d["contact_force_N"] = total_contact_force(m, st, i);
+        d["head_height_m"] = head_height(m, st, i);
+        d["uplift_N"] = st.uplift[i];
+        return d;
+      }, py::arg("index") = 0)
+      .def("set_speed", [](PySimulation& s, double v) {
+        std::string e;
+        s.command(s.sim_.set_target_speed(v, &e), e);
+      }, py::arg("speed_mps"))
+      .def("set_max_acceleration", [](PySimulation& s, double a) {
+        std::string e;
+        s.command(s.sim_.set_max_acceleration(a, &e), e);
+      }, py::arg("accel_mps2"))
+      .def("set_uplift", [](PySimulation& s, double f, int i) {
+        std::string e;
+        s.command(s.sim_.set_uplift(i, f, &e), e);
+      }, py::arg("force_n"), py::arg("pantograph") = -1)
+      .def("set_external_force", [](PySimulation& s, double f, int i) {
+        std::string e;
+        s.command(s.sim_.set_external_force(i, f, &e), e);
+      }, py::arg("force_n"), py::arg("pantograph") = 0);
+}

@@ -1,0 +1,127 @@
+"""`import catenary_sim` (pybind11 module): physics through the skin, errors, views, commands.
+
+Run by scripts/run_tests with Debian's pytest after sourcing the workspace."""
+import json
+import math
+import os
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+import yaml
+
+import catenary_sim as cs
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+REFERENCE = os.path.join(ROOT, "config", "reference_55m.yaml")
+
+
+def single_wire(span=50.0, tension=20000.0, linear_mass=1.35, h=0.25, force=100.0):
+    """One tensioned wire between two rigid supports and a force pressing it up at mid-span,
+    standing still (a moving force at speed 0)."""
+    return {
+        "name": "single_wire",
+        "line": {"span_length": span, "span_count": 1},
+        "contact_wire": {"linear_mass": linear_mass, "bending_stiffness": 0.0, "tension": tension},
+        "pantographs": [{"name": "force", "type": "moving_force", "static_uplift": force}],
+        "train": {"speed": 0.0, "start": span / 2.0},
+        "numerics": {"element_length": h},
+        "output": {"analysis_spans": [0, 1]},
+    }
+
+
+def test_static_deflection_under_a_point_force_converges_to_the_tensioned_beam():
+    # A simply supported beam in tension T with bending stiffness EI under a point force F at
+    # mid-span rises F / (2 k T) (u - tanh u) there, k = sqrt(T / EI), u = k L / 2 (Timoshenko's
+    # beam-column in tension). Hermite elements converge to it at about the fourth order in h
+    # (measured: 2.6e-6 at 0.1 m, 1.8e-7 at 0.05 m): the error must fall below 1e-6 at 0.05 m and by
+    # more than 8x when h halves (16x for the fourth order, with room for round-off).
+    span, tension, force, ei = 50.0, 20000.0, 100.0, 195.0
+    k = math.sqrt(tension / ei)
+    u = k * span / 2.0
+    exact = force / (2.0 * k * tension) * (u - math.tanh(u))
+    errors = []
+    for h in (0.1, 0.05):
+        scene = single_wire(span, tension, force=force, h=h)
+        scene["contact_wire"]["bending_stiffness"] = ei
+        sim = cs.Simulation(scene)
+        errors.append(abs(np.max(sim.displacements) - exact) / exact)
+    assert errors[1] < 1e-6
+    assert errors[0] / errors[1] > 8.0
+
+
+def test_errors_name_the_field_the_value_and_what_is_allowed():
+    with pytest.raises(cs.SceneError) as e:
+        cs.Simulation(REFERENCE, overrides={"pantographs.0.static_uplift": -1})
+    assert e.value.field == "pantographs[0].static_uplift"
+    assert e.value.value == "-1"
+    assert "[0, 2000]" in e.value.allowed
+    with pytest.raises(cs.SceneError) as e:
+        cs.Simulation(REFERENCE, overrides=["contact_wire.tensoin=1"])
+    assert e.value.field == "contact_wire.tensoin"
+    with pytest.raises(cs.SceneError) as e:
+        cs.Simulation(REFERENCE, overrides=["name.foo=1"])
+    assert e.value.field == "name.foo"
+    with pytest.raises(cs.SceneError):
+        cs.Simulation({"line": "not a map"})
+    with pytest.raises(cs.SceneError):
+        cs.Simulation(42)
+    with pytest.raises(cs.SceneError):
+        cs.Simulation(REFERENCE, sample_rate=float("nan"))
+    with pytest.raises(ValueError, match="max_steps"):
+        cs.Simulation(single_wire()).run()  # speed 0: would never end
+
+
+def test_a_rejected_command_leaves_the_state_as_it_was():
+    sim = cs.Simulation(REFERENCE)
+    sim.step(10)
+    speed, uplift = sim.speed, sim.pantograph_state()["uplift_N"]
+    for bad in (-1.0, float("nan"), 1e9):
+        with pytest.raises(ValueError):
+            sim.set_speed(bad)
+        with pytest.raises(ValueError):
+            sim.set_uplift(bad)
+    sim.step(10)
+    assert sim.speed == speed
+    assert sim.pantograph_state()["uplift_N"] == uplift
+
+
+def test_views_follow_the_state_without_copies_and_are_read_only():
+    sim = cs.Simulation(REFERENCE)
+    u = sim.displacements
+    assert u.shape == (sim.dofs,)
+    assert not u.flags.writeable
+    before = u.copy()
+    sim.step(50)
+    assert sim.steps == 50 and sim.time == pytest.approx(50 * sim.dt, rel=1e-12)
+    assert not np.array_equal(u, before)  # the same view shows the new state
+    f = sim.contact_forces
+    assert f.shape == (1, 1) and f[0, 0] > 0.0
+    assert sim.pantograph_state()["contact_force_N"] == pytest.approx(f.sum(), rel=1e-12)
+
+
+def test_a_pass_from_python_equals_simulate_pass():
+    # The module adds no physics: the same scene gives the same statistics, bit for bit, as the
+    # offline runner (the same core and the same fixed dt; only the skin differs).
+    stats, series = cs.run_pass(REFERENCE, overrides={"train.speed_kmh": 250})
+    with tempfile.TemporaryDirectory() as d:
+        binary = os.path.join(os.environ.get("CATENARY_SIM_DEVEL_LIB", os.path.join(ROOT, ".ws/devel/lib/catenary_sim")),
+                              "simulate_pass")
+        subprocess.run([binary, "--scene", REFERENCE, "--out", d, "--speed", "250", "--quiet"], check=True)
+        with open(os.path.join(d, "stats.json")) as f:
+            tool = json.load(f)
+    for key in ("mean_force_N", "std_force_N", "max_force_N", "min_force_N", "contact_loss_percent"):
+        assert stats["pantographs"][0][key] == tool["pantographs"][0][key], key
+    assert stats["steps"] == tool["steps"]
+    # The series at the scene's output.sample_rate (1000 Hz): one row per ms of the 7.9 s pass.
+    assert series["time_s"].shape[0] == pytest.approx(stats["simulated_time_s"] * 1000.0, abs=2)
+    assert np.all(np.isfinite(series["leading_force_N"]))
+
+
+def test_a_dict_scene_equals_its_file():
+    with open(REFERENCE) as f:
+        scene = yaml.safe_load(f)
+    a, _ = cs.run_pass(scene, sample_rate=0)
+    b, _ = cs.run_pass(REFERENCE, sample_rate=0)
+    assert a["pantographs"][0]["std_force_N"] == b["pantographs"][0]["std_force_N"]
