@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <sstream>
 
 #include "catenary_sim/core/beam.hpp"
@@ -366,6 +367,80 @@ std::string speed_warning(const Model& m, double speed) {
 
 namespace {
 
+// Normal errors from one generator, reproducible everywhere: mt19937_64 is fully specified by the
+// standard, and Box-Muller is written out (std::normal_distribution differs between libraries).
+class NormalErrors {
+ public:
+  explicit NormalErrors(std::uint64_t seed) : gen_(seed) {}
+  double next(double std_dev) {
+    const double u1 = (static_cast<double>(gen_() >> 11) + 0.5) * 0x1.0p-53;  // (0, 1)
+    const double u2 = (static_cast<double>(gen_() >> 11) + 0.5) * 0x1.0p-53;
+    return std_dev * std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+  }
+
+ private:
+  std::mt19937_64 gen_;
+};
+
+// The line as built: the design statics set the dropper lengths and support heights; the errors
+// act on the built line through the constant load (at u = 0 it no longer balances, and the eq. 23
+// statics find where the built line hangs). A dropper longer by e carries k e less at the design
+// geometry; a steady arm assembled e higher pushes k_A e more (eq. 4 with y0 + e); a point mass
+// adds its mass and weight to the nearest contact-wire node.
+void apply_imperfections(const Scene& scene, Model& m, const std::vector<bool>& fixed) {
+  const ImperfectionSpec& im = scene.imperfections;
+  if (!im.any()) return;
+  NormalErrors shared(im.seed);
+  NormalErrors own_droppers(im.dropper_length_seed.value_or(0)), own_arms(im.support_height_seed.value_or(0));
+  NormalErrors& dropper_normal = im.dropper_length_seed ? own_droppers : shared;
+  NormalErrors& arm_normal = im.support_height_seed ? own_arms : shared;
+  std::vector<int> order(m.droppers.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return m.droppers[a].x < m.droppers[b].x; });
+  if (!im.dropper_length_errors.empty() && im.dropper_length_errors.size() != order.size())
+    throw SceneError("scene field 'imperfections.dropper_length_errors' = (" + std::to_string(im.dropper_length_errors.size()) +
+                     " values): one per dropper in line order (" + std::to_string(order.size()) + ")");
+  if ((im.dropper_length_std > 0.0 || !im.dropper_length_errors.empty()) && order.empty())
+    throw SceneError("scene field 'imperfections.dropper_length_std': the scene has no droppers");
+  for (std::size_t j = 0; j < order.size(); ++j) {
+    const double e = !im.dropper_length_errors.empty() ? im.dropper_length_errors[j]
+                     : im.dropper_length_std > 0.0     ? dropper_normal.next(im.dropper_length_std)
+                                                       : 0.0;
+    Dropper& d = m.droppers[order[j]];
+    if (e >= d.unstretched_length)
+      throw SceneError("scene field 'imperfections.dropper_length_errors' (dropper at " + fmt(d.x) + " m) = " + fmt(e) +
+                       ": allowed below the dropper's length " + fmt(d.unstretched_length) + " m");
+    d.static_tension -= d.stiffness * e;  // may go negative: a dropper too long hangs slack
+  }
+  std::vector<int> arms;
+  for (std::size_t k = 0; k < m.springs.size(); ++k)
+    if (m.springs[k].steady_arm) arms.push_back(static_cast<int>(k));
+  std::stable_sort(arms.begin(), arms.end(), [&](int a, int b) { return m.springs[a].x < m.springs[b].x; });
+  if (!im.support_height_errors.empty() && im.support_height_errors.size() != arms.size())
+    throw SceneError("scene field 'imperfections.support_height_errors' = (" + std::to_string(im.support_height_errors.size()) +
+                     " values): one per steady arm in line order (" + std::to_string(arms.size()) + ")");
+  if ((im.support_height_std > 0.0 || !im.support_height_errors.empty()) && arms.empty())
+    throw SceneError("scene field 'imperfections.support_height_std': the scene has no steady arms (elastic contact-wire "
+                     "supports; rigid supports cannot be displaced)");
+  for (std::size_t j = 0; j < arms.size(); ++j) {
+    const double e = !im.support_height_errors.empty() ? im.support_height_errors[j]
+                     : im.support_height_std > 0.0     ? arm_normal.next(im.support_height_std)
+                                                       : 0.0;
+    m.load[m.springs[arms[j]].dof] += m.springs[arms[j]].stiffness * e;
+  }
+  const double g = scene.gravity;
+  for (const PointMassSpec& pm : im.point_masses) {
+    const Wire& w = m.wires[m.contact_wires.front()];
+    const auto it = std::lower_bound(w.x.begin(), w.x.end(), pm.station);
+    int node = static_cast<int>(it - w.x.begin());
+    if (node == w.nodes() || (node > 0 && pm.station - w.x[node - 1] < w.x[node] - pm.station)) --node;
+    const int dof = w.w_dof + node;
+    if (fixed[dof]) continue;  // on a rigid support: held, no dynamic effect
+    m.mass[dof] += pm.mass;
+    m.load[dof] -= g * pm.mass;
+  }
+}
+
 Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) {
   Scene scene = scene_in;
   if (scene.sections.empty()) {
@@ -697,6 +772,7 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
   }
   for (int i = 0; i < dof; ++i)
     if (fixed[i]) m.load[i] = 0.0;
+  apply_imperfections(scene, m, fixed);
 
   // Pantographs: unit-less references are set by the initial statics in the Simulation.
   int max_nodes = 2;

@@ -528,6 +528,40 @@ Scene scene_from_yaml(const YAML::Node& root) {
     }
     r.finish();
   }
+  if (top.has("imperfections")) {
+    Reader r(top.child("imperfections"), "imperfections");
+    ImperfectionSpec& im = s.imperfections;
+    const double seed = r.number("seed", 0.0, 9007199254740992.0, 0.0);
+    if (seed != std::floor(seed)) fail("imperfections.seed", fmt(seed), "a whole number >= 0");
+    im.seed = static_cast<std::uint64_t>(seed);
+    for (const char* k : {"dropper_length_seed", "support_height_seed"}) {
+      if (!r.has(k)) continue;
+      const double v = r.number(k, 0.0, 9007199254740992.0);
+      if (v != std::floor(v)) fail(std::string("imperfections.") + k, fmt(v), "a whole number >= 0");
+      (std::string(k) == "dropper_length_seed" ? im.dropper_length_seed : im.support_height_seed) = static_cast<std::uint64_t>(v);
+    }
+    im.dropper_length_std = r.number("dropper_length_std", 0.0, 0.1, 0.0);
+    if (r.has("dropper_length_errors")) im.dropper_length_errors = r.numbers("dropper_length_errors", -0.5, 0.5);
+    if (im.dropper_length_std > 0.0 && !im.dropper_length_errors.empty())
+      fail("imperfections.dropper_length_errors", "(given with dropper_length_std)", "give either errors or a std");
+    im.support_height_std = r.number("support_height_std", 0.0, 0.2, 0.0);
+    if (r.has("support_height_errors")) im.support_height_errors = r.numbers("support_height_errors", -0.5, 0.5);
+    if (im.support_height_std > 0.0 && !im.support_height_errors.empty())
+      fail("imperfections.support_height_errors", "(given with support_height_std)", "give either errors or a std");
+    if (r.has("point_masses")) {
+      const YAML::Node pm = r.child("point_masses");
+      if (!pm.IsSequence()) fail("imperfections.point_masses", "(not a list)", "a list of {station: m, mass: kg}");
+      for (std::size_t i = 0; i < pm.size(); ++i) {
+        Reader q(pm[i], "imperfections.point_masses[" + std::to_string(i) + "]");
+        PointMassSpec p;
+        p.station = q.number("station", 0.0, 1e7);
+        p.mass = q.number("mass", 0.0, 1000.0, std::nullopt, true);
+        q.finish();
+        im.point_masses.push_back(p);
+      }
+    }
+    r.finish();
+  }
   if (top.has("output")) {
     Reader r(top.child("output"), "output");
     if (r.has("analysis_spans")) {
@@ -584,6 +618,14 @@ void validate(const Scene& s) {
       fail(pre + "aero_coefficient", fmt(p.aero_coefficient),
            "at least " + fmt(-p.static_uplift / (v * v)) + " N s^2/m^2 at " + fmt(v * 3.6) +
                " km/h: the uplift static_uplift + aero_coefficient v^2 = " + fmt(uplift) + " N must not be negative");
+  }
+  if (s.imperfections.any()) {
+    if (s.endless)
+      fail("imperfections", "(given)", "a finite line: an endless line repeats one perfect span");
+    for (std::size_t i = 0; i < s.imperfections.point_masses.size(); ++i)
+      if (s.imperfections.point_masses[i].station > line + 1e-9)
+        fail("imperfections.point_masses[" + std::to_string(i) + "].station", fmt(s.imperfections.point_masses[i].station),
+             "on the line, [0, " + fmt(line) + "] m");
   }
   if (s.endless) {
     if (!s.numerics.windowed())

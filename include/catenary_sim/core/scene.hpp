@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -130,6 +131,29 @@ struct OutputSpec {
   double sample_rate = 0.0;     // Hz for the CSV time series; 0 = every step
 };
 
+// A line as built rather than as designed (design statics first, then these errors, as on a real
+// line). Random errors are normal, drawn from one seeded generator in line order (reproducible on
+// every machine: mt19937_64 and Box-Muller, no library-defined distribution).
+struct PointMassSpec {
+  double station = 0.0;  // m along the line
+  double mass = 0.0;     // kg on the contact wire (a section insulator, a splice, a clamp: a hard spot)
+};
+struct ImperfectionSpec {
+  std::uint64_t seed = 0;
+  // Per class (a study can vary one class's realisation alone, e.g. for grouped Sobol indices);
+  // unset: each class draws from `seed` in the order droppers, then steady arms.
+  std::optional<std::uint64_t> dropper_length_seed, support_height_seed;
+  double dropper_length_std = 0.0;            // m: each dropper longer by a normal error (+: the wire hangs lower)
+  std::vector<double> dropper_length_errors;  // m per dropper in line order (instead of the std)
+  double support_height_std = 0.0;            // m: each steady arm's assembly height y0 of eq. 4 raised by a normal error
+  std::vector<double> support_height_errors;  // m per steady arm in line order (instead of the std)
+  std::vector<PointMassSpec> point_masses;
+  bool any() const {
+    return dropper_length_std > 0.0 || !dropper_length_errors.empty() || support_height_std > 0.0 ||
+           !support_height_errors.empty() || !point_masses.empty();
+  }
+};
+
 struct Scene {
   std::string name;
   double gravity = 9.81;               // m/s^2
@@ -158,6 +182,7 @@ struct Scene {
   std::optional<double> train_end;        // m, the pass ends when the train front reaches it
   NumericsSpec numerics;
   OutputSpec output;
+  ImperfectionSpec imperfections;
 
   double line_length() const;
   // Span index [first, last) of the statistics section, resolved against the defaults.
