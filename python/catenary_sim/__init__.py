@@ -18,10 +18,16 @@ the simulation as it was. Statistics are the same JSON as simulate_pass's stats.
 import json
 import re
 import time
+from pkgutil import extend_path
 
 import yaml
 
-from . import _core
+# The package lives in two places: these sources and the build's devel space (the pybind11
+# extension _core, the generated message modules). A process that meets the sources first on
+# sys.path (a Dask worker spawned from a sourced shell) must still find the rest.
+__path__ = extend_path(__path__, __name__)
+
+from . import _core  # noqa: E402
 
 __all__ = ["SceneError", "Simulation", "run_pass", "check_scene"]
 

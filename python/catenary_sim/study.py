@@ -1,0 +1,394 @@
+"""Studies: many passes of one scene with parameters varied, run on Dask distributed.
+
+    catenary_sim_study STUDY.yaml --out DIR [--workers 2 | --scheduler tcp://host:8786]
+    from catenary_sim.study import run_study; table = run_study("STUDY.yaml", "DIR")
+
+A study file (YAML; paths relative to it):
+
+    name: uplift_and_speed
+    scene: ../config/reference_55m.yaml
+    overrides: {numerics.preset: balanced}          # applied to every case
+    sampling: grid                                  # grid | random | lhs | sobol | saltelli
+    samples: 64                                     # random, lhs, sobol, saltelli (base samples N)
+    seed: 1
+    parameters:
+      - key: pantographs.0.static_uplift            # any scene field, as simulate_pass --set
+        values: [80, 100, 120]                      # grid
+      - key: train.speed_kmh
+        distribution: {type: uniform, low: 200, high: 300}      # random, lhs, sobol, saltelli
+        # {type: normal, mean: 0, std: 0.01}, {type: truncated_normal, mean, std, low, high},
+        # {type: integers, low: 0, high: 1000000} (e.g. the seed of a random line)
+    outputs: [pantographs.0.std_force_N, pantographs.0.max_force_N]   # paths into stats.json
+    bootstrap: 200                                  # saltelli: resamples for the confidence intervals
+
+Each case is written atomically to DIR/cases/NNNNNN.json when it finishes; a study started again
+on the same DIR resumes where it stopped (the plan must be the same); a failed case is recorded
+with its message and the others go on. The table DIR/results.csv (pandas.read_csv) has one row per
+case: its parameters, the outputs, status and message. Plots: DIR/*.png. With sampling: saltelli,
+DIR/sensitivity.json holds first-order and total Sobol indices with bootstrap intervals.
+A thin skin: the passes are the core's (catenary_sim.run_pass); no physics here.
+"""
+import fcntl
+import itertools
+import json
+import math
+import os
+import tempfile
+import time
+
+import numpy as np
+import yaml
+
+from . import SceneError
+
+SAMPLINGS = ("grid", "random", "lhs", "sobol", "saltelli")
+DISTRIBUTIONS = ("uniform", "normal", "truncated_normal", "integers")
+
+
+class StudyError(ValueError):
+    """A study file that cannot be run: names the field, the value and what is allowed."""
+
+
+def _fail(field, value, allowed):
+    raise StudyError(f"study field '{field}' = {value!r}: {allowed}")
+
+
+# --------------------------------------------------------------------------------------------
+# The study file
+# --------------------------------------------------------------------------------------------
+def load_study(path):
+    """Reads and checks a study file; returns a dict with absolute paths. Raises StudyError."""
+    with open(path, "rb") as f:
+        raw = f.read(1 << 20)
+    try:
+        doc = yaml.safe_load(raw)
+    except yaml.YAMLError as e:
+        raise StudyError(f"study file '{path}': not valid YAML: {e}") from None
+    if not isinstance(doc, dict):
+        raise StudyError(f"study file '{path}': expected a map of fields (name, scene, parameters, ...)")
+    known = {"name", "scene", "overrides", "sampling", "samples", "seed", "parameters", "outputs", "bootstrap"}
+    for k in doc:
+        if k not in known:
+            _fail(k, doc[k], f"unknown field; allowed: {', '.join(sorted(known))}")
+    base = os.path.dirname(os.path.abspath(path))
+    s = {"name": str(doc.get("name", os.path.splitext(os.path.basename(path))[0]))}
+    scene = doc.get("scene")
+    if not isinstance(scene, str):
+        _fail("scene", scene, "required: the scene file, relative to the study file")
+    s["scene"] = scene if os.path.isabs(scene) else os.path.normpath(os.path.join(base, scene))
+    if not os.path.isfile(s["scene"]):
+        _fail("scene", scene, f"a scene file; '{s['scene']}' does not exist")
+    ov = doc.get("overrides", {}) or {}
+    if not isinstance(ov, dict):
+        _fail("overrides", ov, "a map {dotted.key: value}")
+    s["overrides"] = ov
+    s["sampling"] = doc.get("sampling", "grid")
+    if s["sampling"] not in SAMPLINGS:
+        _fail("sampling", s["sampling"], f"one of {', '.join(SAMPLINGS)}")
+    params = doc.get("parameters")
+    if not isinstance(params, list) or not params:
+        _fail("parameters", params, "a non-empty list of {key, values} or {key, distribution}")
+    s["parameters"] = []
+    seen = set()
+    for i, p in enumerate(params):
+        f = f"parameters[{i}]"
+        if not isinstance(p, dict) or not isinstance(p.get("key"), str) or not p["key"]:
+            _fail(f + ".key", p, "a scene field as a dotted key, e.g. pantographs.0.static_uplift")
+        for k in p:
+            if k not in ("key", "values", "distribution"):
+                _fail(f"{f}.{k}", p[k], "unknown field; allowed: key, values, distribution")
+        if p["key"] in seen:
+            _fail(f + ".key", p["key"], "each parameter once")
+        seen.add(p["key"])
+        if s["sampling"] == "grid":
+            v = p.get("values")
+            if not isinstance(v, list) or not v:
+                _fail(f + ".values", v, "a non-empty list of values (sampling: grid)")
+            s["parameters"].append({"key": p["key"], "values": v})
+        else:
+            s["parameters"].append({"key": p["key"], "distribution": _check_distribution(p.get("distribution"), f)})
+    if s["sampling"] != "grid":
+        n = doc.get("samples")
+        if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 1_000_000:
+            _fail("samples", n, "a whole number of samples in [1, 1000000]")
+        s["samples"] = n
+    seed = doc.get("seed", 0)
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        _fail("seed", seed, "a whole number >= 0")
+    s["seed"] = seed
+    outs = doc.get("outputs")
+    if not isinstance(outs, list) or not outs or not all(isinstance(o, str) and o for o in outs):
+        _fail("outputs", outs, "a non-empty list of paths into stats.json, e.g. pantographs.0.std_force_N")
+    s["outputs"] = outs
+    b = doc.get("bootstrap", 200)
+    if not isinstance(b, int) or isinstance(b, bool) or not 0 <= b <= 100_000:
+        _fail("bootstrap", b, "a whole number of resamples in [0, 100000]")
+    s["bootstrap"] = b
+    return s
+
+
+def _check_distribution(d, f):
+    f = f + ".distribution"
+    if not isinstance(d, dict) or d.get("type") not in DISTRIBUTIONS:
+        _fail(f + ".type", (d or {}).get("type") if isinstance(d, dict) else d, f"one of {', '.join(DISTRIBUTIONS)}")
+    need = {"uniform": ("low", "high"), "normal": ("mean", "std"), "truncated_normal": ("mean", "std", "low", "high"),
+            "integers": ("low", "high")}[d["type"]]
+    for k in d:
+        if k != "type" and k not in need:
+            _fail(f"{f}.{k}", d[k], f"not a field of a {d['type']} distribution ({', '.join(need)})")
+    out = {"type": d["type"]}
+    for k in need:
+        v = d.get(k)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            _fail(f"{f}.{k}", v, "a finite number")
+        out[k] = float(v)
+    if "std" in out and not out["std"] > 0:
+        _fail(f + ".std", out["std"], "> 0")
+    if "low" in out and not out["low"] < out["high"]:
+        _fail(f + ".high", out["high"], f"> low ({out['low']})")
+    return out
+
+
+def _ppf(dist, u):
+    """Maps uniform samples u in (0, 1) to the distribution (inverse CDF)."""
+    from scipy import stats
+    u = np.clip(np.asarray(u, dtype=float), 1e-12, 1 - 1e-12)
+    if dist["type"] == "uniform":
+        return dist["low"] + u * (dist["high"] - dist["low"])
+    if dist["type"] == "integers":  # whole numbers low..high-1, equally likely (e.g. seeds of random lines)
+        return np.floor(dist["low"] + u * (dist["high"] - dist["low"]))
+    if dist["type"] == "normal":
+        return stats.norm.ppf(u, loc=dist["mean"], scale=dist["std"])
+    a = (dist["low"] - dist["mean"]) / dist["std"]
+    b = (dist["high"] - dist["mean"]) / dist["std"]
+    return stats.truncnorm.ppf(u, a, b, loc=dist["mean"], scale=dist["std"])
+
+
+# --------------------------------------------------------------------------------------------
+# The plan: one override dict per case
+# --------------------------------------------------------------------------------------------
+def make_cases(study):
+    """The cases of a study, in order: a list of {key: value} (plain floats or grid values)."""
+    params = study["parameters"]
+    keys = [p["key"] for p in params]
+    kind = study["sampling"]
+    if kind == "grid":
+        return [dict(zip(keys, combo)) for combo in itertools.product(*[p["values"] for p in params])]
+    from scipy.stats import qmc
+    d, n, seed = len(params), study["samples"], study["seed"]
+    if kind == "random":
+        u = np.random.default_rng(seed).random((n, d))
+    elif kind == "lhs":
+        u = qmc.LatinHypercube(d=d, seed=seed).random(n)
+    elif kind == "sobol":
+        u = qmc.Sobol(d=d, scramble=True, seed=seed).random(n)
+    else:  # saltelli: A, B from one 2d-dimensional Sobol sequence, then AB_i (Saltelli 2010)
+        ab = qmc.Sobol(d=2 * d, scramble=True, seed=seed).random(n)
+        a, b = ab[:, :d], ab[:, d:]
+        blocks = [a, b] + [np.where(np.arange(d) == i, b, a) for i in range(d)]
+        u = np.vstack(blocks)
+    values = np.column_stack([_ppf(p["distribution"], u[:, j]) for j, p in enumerate(params)])
+    ints = [p["distribution"]["type"] == "integers" for p in params]
+    return [{k: (int(values[i, j]) if ints[j] else float(values[i, j])) for j, k in enumerate(keys)}
+            for i in range(values.shape[0])]
+
+
+def _output(stats, path):
+    node = stats
+    for part in path.split("."):
+        if isinstance(node, list):
+            if not part.isdigit() or int(part) >= len(node):
+                raise KeyError(f"output '{path}': '{part}' is not an index of a list of {len(node)}")
+            node = node[int(part)]
+        elif isinstance(node, dict) and part in node:
+            node = node[part]
+        else:
+            raise KeyError(f"output '{path}': no field '{part}' in stats.json")
+    if node is None:
+        return float("nan")
+    if isinstance(node, bool) or not isinstance(node, (int, float)):
+        raise KeyError(f"output '{path}': not a number ({node!r})")
+    return float(node)
+
+
+def run_case(scene, overrides, case, outputs):
+    """One pass (runs on a Dask worker). Returns the case's record; never raises."""
+    import catenary_sim as cs
+    start = time.perf_counter()
+    record = {"parameters": case, "status": "ok", "message": "", "outputs": {}}
+    try:
+        stats, _ = cs.run_pass(scene, overrides={**overrides, **case}, sample_rate=0)
+        record["outputs"] = {o: _output(stats, o) for o in outputs}
+    except (SceneError, ValueError, RuntimeError, KeyError) as e:
+        record["status"] = "failed"
+        record["message"] = str(e).strip("'\"")
+        record["outputs"] = {o: float("nan") for o in outputs}
+    record["wall_time_s"] = time.perf_counter() - start
+    return record
+
+
+# --------------------------------------------------------------------------------------------
+# Files: whole or not at all
+# --------------------------------------------------------------------------------------------
+def _write_atomically(path, text):
+    d = os.path.dirname(path) or "."
+    fd, tmp = tempfile.mkstemp(dir=d, prefix="." + os.path.basename(path) + ".")
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _case_path(out, i):
+    return os.path.join(out, "cases", f"{i:06d}.json")
+
+
+# --------------------------------------------------------------------------------------------
+# Running
+# --------------------------------------------------------------------------------------------
+def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=True):
+    """Runs (or resumes) a study into `out`; returns the results table (pandas.DataFrame)."""
+    import pandas as pd
+    from dask.distributed import Client, LocalCluster, as_completed
+    from tqdm import tqdm
+
+    study = load_study(study_path)
+    if not isinstance(workers, int) or not 1 <= workers <= 1024:
+        raise StudyError(f"workers = {workers!r}: allowed 1 to 1024")
+    os.makedirs(os.path.join(out, "cases"), exist_ok=True)
+    lock = open(os.path.join(out, ".catenary_sim.lock"), "w")
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise StudyError(f"output directory '{out}' is being written by another study run") from None
+    cases = make_cases(study)
+    plan = {"study": study, "cases": cases}
+    plan_path = os.path.join(out, "plan.json")
+    if os.path.exists(plan_path):
+        with open(plan_path) as f:
+            if json.load(f) != json.loads(json.dumps(plan)):
+                raise StudyError(f"'{out}' holds another study's cases (plan.json differs); use a new --out to start afresh")
+    else:
+        _write_atomically(plan_path, json.dumps(plan, indent=1))
+    todo = [i for i in range(len(cases)) if not os.path.exists(_case_path(out, i))]
+
+    if todo:
+        own = None
+        if scheduler:
+            client = Client(scheduler)
+        else:
+            own = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+            client = Client(own)
+        try:
+            futures = {client.submit(run_case, study["scene"], study["overrides"], cases[i], study["outputs"],
+                                     key=f"case-{study['name']}-{i}", pure=False): i for i in todo}
+            bar = tqdm(total=len(cases), initial=len(cases) - len(todo), unit="case", disable=not progress,
+                       desc=study["name"])
+            for fut in as_completed(futures):
+                i = futures[fut]
+                record = fut.result()
+                record["case"] = i
+                _write_atomically(_case_path(out, i), json.dumps(record))
+                bar.update(1)
+            bar.close()
+        finally:
+            client.close()
+            if own is not None:
+                own.close()
+
+    rows = []
+    for i in range(len(cases)):
+        with open(_case_path(out, i)) as f:
+            r = json.load(f)
+        rows.append({"case": i, **r["parameters"], **r["outputs"], "status": r["status"],
+                     "message": r["message"], "wall_time_s": r["wall_time_s"]})
+    table = pd.DataFrame(rows)
+    _write_atomically(os.path.join(out, "results.csv"), table.to_csv(index=False))
+    if study["sampling"] == "saltelli":
+        sens = sobol_indices_from_table(table, study)
+        _write_atomically(os.path.join(out, "sensitivity.json"), json.dumps(sens, indent=1))
+    if plots:
+        from . import study_plots
+        study_plots.plot_study(study, table, out)
+    lock.close()
+    return table
+
+
+# --------------------------------------------------------------------------------------------
+# Sensitivity: Saltelli's scheme, first-order (Saltelli 2010) and total (Jansen 1999) indices
+# --------------------------------------------------------------------------------------------
+def sobol_indices(f_a, f_b, f_ab, bootstrap=200, seed=0, confidence=0.95):
+    """First-order and total Sobol indices from f(A), f(B) (N,) and f(AB_i) (k, N).
+
+    S_i = mean(f_B (f_ABi - f_A)) / V, ST_i = mean((f_A - f_ABi)^2) / (2 V), V the variance of
+    f(A) and f(B) together, f centred on their mean (Saltelli et al. 2010, "Variance based sensitivity analysis of model
+    output", Comput. Phys. Commun. 181). Confidence intervals by bootstrap over the N rows."""
+    f_a, f_b, f_ab = np.asarray(f_a, float), np.asarray(f_b, float), np.asarray(f_ab, float)
+
+    def estimate(idx):
+        a, b, ab = f_a[idx], f_b[idx], f_ab[:, idx]
+        # Centred first: the S_i estimator's terms are products with f_B, whose mean adds variance
+        # (not bias) to it; an output with a large mean and a small spread (a force std of 40 N
+        # varying by 1 N between lines) would drown in it. S_T is shift-invariant.
+        mu = np.mean(np.concatenate([a, b]))
+        a, b, ab = a - mu, b - mu, ab - mu
+        var = np.var(np.concatenate([a, b]))
+        if not var > 0:
+            nan = np.full(ab.shape[0], np.nan)
+            return nan, nan
+        s1 = np.mean(b * (ab - a), axis=1) / var
+        st = 0.5 * np.mean((a - ab) ** 2, axis=1) / var
+        return s1, st
+
+    n = f_a.shape[0]
+    s1, st = estimate(np.arange(n))
+    out = {"S1": s1.tolist(), "ST": st.tolist()}
+    if bootstrap > 0:
+        rng = np.random.default_rng(seed)
+        draws = [estimate(rng.integers(0, n, n)) for _ in range(bootstrap)]
+        lo, hi = (1 - confidence) / 2 * 100, (1 + confidence) / 2 * 100
+        for name, j in (("S1", 0), ("ST", 1)):
+            vals = np.array([d[j] for d in draws])
+            out[name + "_conf"] = [np.nanpercentile(vals, lo, axis=0).tolist(), np.nanpercentile(vals, hi, axis=0).tolist()]
+    return out
+
+
+def sobol_indices_from_table(table, study):
+    k = len(study["parameters"])
+    n = study["samples"]
+    result = {"parameters": [p["key"] for p in study["parameters"]], "samples": n, "outputs": {}}
+    for o in study["outputs"]:
+        y = table[o].to_numpy(dtype=float)
+        blocks = y.reshape(k + 2, n)
+        if not np.all(np.isfinite(blocks)):
+            result["outputs"][o] = {"error": "failed cases: the estimator needs every case"}
+            continue
+        result["outputs"][o] = sobol_indices(blocks[0], blocks[1], blocks[2:], study["bootstrap"], study["seed"])
+    return result
+
+
+def main(argv=None):
+    import argparse
+    ap = argparse.ArgumentParser(prog="catenary_sim_study", description="Run (or resume) a study of many passes on Dask.")
+    ap.add_argument("study", help="study YAML (see catenary_sim.study)")
+    ap.add_argument("--out", required=True, help="output directory (cases/, results.csv, plots)")
+    ap.add_argument("--workers", type=int, default=2, help="local Dask workers (default 2; ignored with --scheduler)")
+    ap.add_argument("--scheduler", help="address of a running dask-scheduler, e.g. tcp://host:8786")
+    ap.add_argument("--no-progress", action="store_true", help="no progress bar")
+    ap.add_argument("--no-plots", action="store_true", help="no PNG plots")
+    a = ap.parse_args(argv)
+    try:
+        table = run_study(a.study, a.out, a.scheduler, a.workers, not a.no_progress, not a.no_plots)
+    except (StudyError, SceneError, OSError) as e:
+        print(f"catenary_sim_study: {e}", flush=True)
+        return 2
+    failed = int((table["status"] != "ok").sum())
+    print(f"catenary_sim_study: {len(table)} cases, {failed} failed; {os.path.join(a.out, 'results.csv')}")
+    return 0
