@@ -139,8 +139,9 @@ class ReplayMarkers {
       return;
     }
     options_.frame = shape.header.frame_id.empty() ? "line" : shape.header.frame_id;
-    pub_.publish(to_markers(*model_, state_, t, options_));
+    // The transform first, so that rviz may know the line frame before the markers arrive.
     if (view_) tf_.sendTransform(to_view_transform(state_, t, options_.frame));
+    pub_.publish(to_markers(*model_, state_, t, options_));
   }
 
   std::unique_ptr<Model> model_;
