@@ -156,6 +156,10 @@ class Simulation:
     status = property(lambda self: self._sim.status)
     pantograph_names = property(lambda self: self._sim.pantograph_names)
     contact_wire_names = property(lambda self: self._sim.contact_wire_names)
+    steady_arms = property(lambda self: self._sim.steady_arms,
+                           doc="list of dicts per steady arm: wire, station_m (model stations; on an endless line "
+                               "add the line offset, a wire_shape's stations[0] - wire_start_m), design_height_m, "
+                               "wire_start_m")
 
     # Commands (checked; a rejected one raises ValueError and changes nothing) -------------------
     def set_speed(self, speed_mps):

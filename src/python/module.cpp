@@ -135,6 +135,26 @@ PYBIND11_MODULE(_core, m) {
         for (const Pantograph& p : s.sim_.model().pantographs) n.push_back(p.name);
         return n;
       })
+      // Steady arms (constant geometry, for plots of their uplift from a recorded wire_shape): the
+      // contact wire, the station in the model's stations (on an endless line add the line offset:
+      // a wire_shape's stations[0] minus wire_start_m), the design height and the wire's first station.
+      .def_property_readonly("steady_arms", [](const PySimulation& s) {
+        const Model& m = s.sim_.model();
+        py::list out;
+        for (const SupportSpring& sp : m.springs) {
+          if (!sp.steady_arm) continue;
+          for (const Wire& w : m.wires) {
+            if (sp.dof < w.w_dof || sp.dof >= w.w_dof + w.nodes()) continue;
+            py::dict d;
+            d["wire"] = w.name;
+            d["station_m"] = sp.x;
+            d["design_height_m"] = w.height[sp.dof - w.w_dof];
+            d["wire_start_m"] = w.x.front();
+            out.append(d);
+          }
+        }
+        return out;
+      })
       .def_property_readonly("contact_wire_names", [](const PySimulation& s) {
         std::vector<std::string> n;
         for (int w : s.sim_.model().contact_wires) n.push_back(s.sim_.model().wires[w].name);

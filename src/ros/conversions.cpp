@@ -131,6 +131,7 @@ ContactForceArray to_contact_force(const Model& m, const State& s, const ros::Ti
   ContactForceArray out;
   out.header.stamp = stamp;
   out.header.frame_id = frame;
+  out.sim_time = s.time;
   for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
     const Pantograph& pg = m.pantographs[p];
     ContactForce c;
@@ -189,6 +190,7 @@ WireShapeArray to_wire_shape(const Model& m, const State& s, double resolution, 
   WireShapeArray out;
   out.header.stamp = stamp;
   out.header.frame_id = frame;
+  out.sim_time = s.time;
   for (const Wire& w : m.wires) {
     WireShape ws;
     ws.header = out.header;

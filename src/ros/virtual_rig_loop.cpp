@@ -120,6 +120,7 @@ void VirtualRig::on_point(const ContactPointArray::ConstPtr& msg) {
     }
   }
   have_ = true;
+  frame_ = msg->header.frame_id;
   pass_ = msg->pass_count;
   step_ = msg->step;
   dt_ = msg->dt;
@@ -138,6 +139,7 @@ void VirtualRig::send() {
   // (a shared pointer: the node in the same process, HilNodelet, gets it without a copy)
   const boost::shared_ptr<MeasuredContactForce> m = boost::make_shared<MeasuredContactForce>();
   m->header.stamp = ros::Time::now();
+  m->header.frame_id = frame_;  // the frame of the contact point answered (the line frame)
   m->step = step_;
   for (std::size_t i = 0; i < rigs_.size(); ++i) m->force.push_back(rigs_[i].contact_force(points_[i]));
   pub_.publish(m);

@@ -125,3 +125,19 @@ def test_a_dict_scene_equals_its_file():
     a, _ = cs.run_pass(scene, sample_rate=0)
     b, _ = cs.run_pass(REFERENCE, sample_rate=0)
     assert a["pantographs"][0]["std_force_N"] == b["pantographs"][0]["std_force_N"]
+
+
+def test_steady_arms_sit_at_the_supports_at_the_contact_wire_height():
+    # The scene holds the contact wire at line.contact_wire_height at every support of a single
+    # tension section (presag is at mid-span), one span_length apart: what plot_contact_force needs
+    # to turn a recorded wire_shape into steady-arm uplift.
+    with open(REFERENCE) as f:
+        line = yaml.safe_load(f)["line"]
+    arms = cs.Simulation(REFERENCE).steady_arms
+    assert 1 <= len(arms) <= line["span_count"] + 1
+    for a in arms:
+        assert a["wire"] == "contact_wire"
+        spans = a["station_m"] / line["span_length"]
+        assert abs(spans - round(spans)) < 1e-9 and 0 <= round(spans) <= line["span_count"]
+        assert a["design_height_m"] == pytest.approx(line["contact_wire_height"], abs=1e-9)
+        assert a["wire_start_m"] == 0.0

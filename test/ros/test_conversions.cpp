@@ -36,6 +36,9 @@ TEST_F(Fixture, ContactForceSumsCollectorsAndFlagsContact) {
   const State& s = sim->state();
   const ContactForceArray msg = to_contact_force(m, s, stamp, "line");
   EXPECT_EQ(msg.header.stamp, stamp);
+  // Simulated time without the stamp's offset (stamp here is 1000.5 s, the pass time 2000 dt).
+  EXPECT_EQ(msg.sim_time, s.time);
+  EXPECT_GT(msg.sim_time, 0.0);
   EXPECT_EQ(msg.header.frame_id, "line");
   ASSERT_EQ(msg.pantographs.size(), m.pantographs.size());
   for (std::size_t p = 0; p < msg.pantographs.size(); ++p) {
@@ -84,6 +87,7 @@ TEST_F(Fixture, WireShapeSamplesAtResolutionAndKeepsEnds) {
   const State& s = sim->state();
   for (double res : {0.0, 1.0, 5.0}) {
     const WireShapeArray msg = to_wire_shape(m, s, res, stamp, "line");
+    EXPECT_EQ(msg.sim_time, s.time);
     ASSERT_EQ(msg.wires.size(), m.wires.size());
     for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
       const Wire& w = m.wires[wi];

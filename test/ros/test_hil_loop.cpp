@@ -13,9 +13,11 @@
 #include <cstdio>
 #include <mutex>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "catenary_sim/ContactPointArray.h"
+#include "catenary_sim/MeasuredContactForce.h"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
 #include "catenary_sim/ros/hil.hpp"
@@ -31,11 +33,17 @@ namespace {
 std::mutex mu;
 std::vector<ContactPointArray> points;
 bool ended = false;
+std::vector<std::string> measurement_frames;  // header.frame_id of every hil/contact_force from the rig
 
 void on_point(const ContactPointArray::ConstPtr& m) {
   std::lock_guard<std::mutex> l(mu);
   points.push_back(*m);
   if (m->mode == ContactPointArray::ENDED) ended = true;
+}
+
+void on_measurement(const MeasuredContactForce::ConstPtr& m) {
+  std::lock_guard<std::mutex> l(mu);
+  measurement_frames.push_back(m->header.frame_id);
 }
 
 }  // namespace
@@ -53,9 +61,11 @@ TEST(HilLoop, ClosedLoopStatisticsMatchTheInternalPantograph) {
     ros::WallDuration(0.05).sleep();
   }
   std::vector<ContactPointArray> msgs;
+  std::vector<std::string> frames;
   {
     std::lock_guard<std::mutex> l(mu);
     msgs = points;
+    frames = measurement_frames;
     ASSERT_TRUE(ended) << "the pass did not end within 90 s (" << points.size() << " contact points)";
   }
   // Every contact point finite; the running ones one period apart, in order, with increasing stamps.
@@ -67,6 +77,10 @@ TEST(HilLoop, ClosedLoopStatisticsMatchTheInternalPantograph) {
       run.push_back(&m);
   }
   ASSERT_GT(run.size(), 100u);
+  // The rig answers in the frame of the contact points (the line frame), never an empty frame_id.
+  ASSERT_FALSE(frames.empty());
+  for (const std::string& f : frames) ASSERT_EQ(f, msgs[0].header.frame_id);
+  EXPECT_FALSE(msgs[0].header.frame_id.empty());
   const int k = static_cast<int>(run[0]->steps_per_period);
   const double dt = run[0]->dt;
   EXPECT_NEAR(k * dt, 1.0 / rate, 1e-12);
@@ -125,6 +139,7 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh;
   ros::Subscriber sub =
       nh.subscribe("hil/contact_point", 100000, &on_point, ros::TransportHints().tcpNoDelay());
+  ros::Subscriber msub = nh.subscribe("hil/contact_force", 100000, &on_measurement);
   ros::AsyncSpinner spinner(1);
   spinner.start();
   const int rc = RUN_ALL_TESTS();

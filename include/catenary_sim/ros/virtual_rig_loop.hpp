@@ -51,6 +51,7 @@ class VirtualRig {
   double rate_ = 0.0;
   bool extrapolate_ = true;
   std::string report_file_;
+  std::string frame_;  // frame_id of the last contact point, sent back with the measurements
   std::vector<RigPantograph> rigs_;
   std::vector<std::vector<WirePoint>> points_;
   bool have_ = false;

@@ -1,0 +1,120 @@
+#include "catenary_sim/ros/replay.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace catenary_sim {
+namespace ros_layer {
+
+namespace {
+
+std::string num(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+const char* const kOtherScene = " (is ~scene the scene of the recording?)";
+
+// Height of the recorded samples at station x: linear between samples, the end sample beyond.
+double interpolate(const std::vector<double>& xs, const std::vector<double>& ys, double x) {
+  if (x <= xs.front()) return ys.front();
+  if (x >= xs.back()) return ys.back();
+  const std::size_t k = std::upper_bound(xs.begin(), xs.end(), x) - xs.begin();  // xs[k-1] <= x < xs[k]
+  const double t = (x - xs[k - 1]) / (xs[k] - xs[k - 1]);
+  return ys[k - 1] + t * (ys[k] - ys[k - 1]);
+}
+
+}  // namespace
+
+std::string state_from_messages(const Model& m, const WireShapeArray& shape, const PantographStateArray& state,
+                                const ContactForceArray& force, State* s) {
+  // Wires: same names in the same order, each sampled over the stations of the scene's wire.
+  if (shape.wires.size() != m.wires.size())
+    return "wire_shape has " + num(shape.wires.size()) + " wires, the scene " + num(m.wires.size()) + kOtherScene;
+  double offset = 0.0;
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    const Wire& w = m.wires[wi];
+    const WireShape& ws = shape.wires[wi];
+    const std::string field = "wire_shape.wires[" + num(wi) + "]";
+    if (ws.name != w.name) return field + ".name = '" + ws.name + "': expected '" + w.name + "'" + kOtherScene;
+    if (ws.stations.empty() || ws.stations.size() != ws.heights.size())
+      return field + ": " + num(ws.stations.size()) + " stations and " + num(ws.heights.size()) +
+             " heights: expected as many of each, at least one";
+    for (std::size_t k = 0; k < ws.stations.size(); ++k)
+      if (!std::isfinite(ws.stations[k]) || !std::isfinite(ws.heights[k]) || (k > 0 && !(ws.stations[k] > ws.stations[k - 1])))
+        return field + ".stations/heights[" + num(k) + "] = " + num(ws.stations[k]) + " / " + num(ws.heights[k]) +
+               ": expected finite values at increasing stations";
+    // Stations along the line are the model's plus the line offset (endless line), the same for every wire.
+    const double o = ws.stations.front() - w.x.front();
+    const double length = ws.stations.back() - ws.stations.front(), expected = w.x.back() - w.x.front();
+    if (std::fabs(length - expected) > 1e-6)
+      return field + " ('" + w.name + "') spans " + num(length) + " m: the scene's wire spans " + num(expected) + " m" +
+             kOtherScene;
+    if (wi == 0) offset = o;
+    else if (std::fabs(o - offset) > 1e-6)
+      return field + ".stations[0] = " + num(ws.stations.front()) + ": expected " + num(w.x.front() + offset) +
+             " (the line offset of the first wire)" + kOtherScene;
+    for (int i = 0; i < w.nodes(); ++i)
+      s->u[w.w_dof + i] = interpolate(ws.stations, ws.heights, w.x[i] + o) - w.height[i];
+  }
+  s->line_offset = offset;
+
+  // Train and pantographs.
+  if (state.pantographs.size() != m.pantographs.size())
+    return "pantograph_state has " + num(state.pantographs.size()) + " pantographs, the scene " +
+           num(m.pantographs.size()) + kOtherScene;
+  if (force.pantographs.size() != m.pantographs.size())
+    return "contact_force has " + num(force.pantographs.size()) + " pantographs, the scene " +
+           num(m.pantographs.size()) + kOtherScene;
+  s->time = state.sim_time;
+  s->steps = state.step;
+  s->front = state.train_front - offset;
+  s->speed = state.speed;
+  s->target_speed = state.target_speed;
+  s->max_acceleration = state.max_acceleration;
+  const std::size_t nw = m.contact_wires.size();
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    const Pantograph& pg = m.pantographs[p];
+    const PantographState& ps = state.pantographs[p];
+    const ContactForce& c = force.pantographs[p];
+    const std::string field = "pantograph_state.pantographs[" + num(p) + "]";
+    if (ps.name != pg.name) return field + ".name = '" + ps.name + "': expected '" + pg.name + "'" + kOtherScene;
+    if (c.name != pg.name)
+      return "contact_force.pantographs[" + num(p) + "].name = '" + c.name + "': expected '" + pg.name + "'" + kOtherScene;
+    const std::size_t masses = pg.moving_force ? 0 : static_cast<std::size_t>(pg.masses_count());
+    if (ps.displacement.size() != masses || ps.velocity.size() != masses)
+      return field + ": " + num(ps.displacement.size()) + " displacements and " + num(ps.velocity.size()) +
+             " velocities: expected " + num(masses) + " of each (the masses of '" + pg.name + "')" + kOtherScene;
+    for (std::size_t i = 0; i < masses; ++i) {
+      s->u[pg.first_dof + i] = ps.displacement[i];
+      s->v[pg.first_dof + i] = ps.velocity[i];
+    }
+    s->uplift[p] = ps.uplift;
+    if (c.contact_wires.size() != nw)
+      return "contact_force.pantographs[" + num(p) + "].contact_wires has " + num(c.contact_wires.size()) +
+             " names, the scene " + num(nw) + " contact wires" + kOtherScene;
+    for (std::size_t k = 0; k < nw; ++k)
+      if (c.contact_wires[k] != m.wires[m.contact_wires[k]].name)
+        return "contact_force.pantographs[" + num(p) + "].contact_wires[" + num(k) + "] = '" + c.contact_wires[k] +
+               "': expected '" + m.wires[m.contact_wires[k]].name + "'" + kOtherScene;
+    if (c.wire_forces.size() != pg.collectors.size() * nw)
+      return "contact_force.pantographs[" + num(p) + "].wire_forces has " + num(c.wire_forces.size()) +
+             " values: expected " + num(pg.collectors.size() * nw) + " (collectors x contact wires)" + kOtherScene;
+    for (std::size_t j = 0; j < pg.collectors.size(); ++j)
+      for (std::size_t k = 0; k < nw; ++k)
+        s->contact_force[pg.collectors[j] * nw + k] = c.wire_forces[j * nw + k];
+  }
+
+  // Droppers: slack where the core's criterion says so (no tension at the elastic stretch).
+  for (std::size_t d = 0; d < m.droppers.size(); ++d) {
+    const Dropper& dr = m.droppers[d];
+    const double stretch = s->u[dr.messenger_dof] - s->u[dr.contact_dof];
+    s->dropper_slack[d] = !(dr.static_tension + dr.stiffness * stretch > 0.0);
+  }
+  return "";
+}
+
+}  // namespace ros_layer
+}  // namespace catenary_sim

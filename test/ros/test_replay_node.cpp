@@ -1,0 +1,157 @@
+// rostest companion of replay.test: a pass written to a bag by simulate_pass --bag (the node's
+// topics, no markers) is played back with rosbag play --clock; replay_markers must draw it: one
+// marker array per recorded wire_shape, every part of the scene in it, the pantograph head at the
+// recorded position of the same instant. plot_contact_force, started on the same playback, must
+// write its PNG when the pass ends.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <std_msgs/String.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/PantographStateArray.h"
+#include "catenary_sim/WireShapeArray.h"
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+#ifndef CATENARY_SIM_DEVEL_LIB
+#define CATENARY_SIM_DEVEL_LIB "."
+#endif
+
+namespace {
+
+std::mutex mu;
+std::vector<visualization_msgs::MarkerArray> received;
+
+void on_markers(const visualization_msgs::MarkerArray::ConstPtr& m) {
+  std::lock_guard<std::mutex> l(mu);
+  received.push_back(*m);
+}
+
+bool wait_for(const std::function<bool()>& cond, double seconds) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    if (cond()) return true;
+    ros::WallDuration(0.1).sleep();
+  }
+  return cond();
+}
+
+std::string sh(const std::string& cmd) { return "bash -c '" + cmd + "'"; }
+
+}  // namespace
+
+TEST(Replay, RecordedPassIsDrawnAndPlotted) {
+  char dir_template[] = "/tmp/catenary_sim_replay_XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  const std::string scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string bag = dir + "/pass.bag", png = dir + "/plot.png";
+  // The whole reference pass (550 m, 6.6 s at 300 km/h): state topics at 200 Hz, wire_shape at 10 Hz.
+  ASSERT_EQ(std::system((std::string(CATENARY_SIM_DEVEL_LIB) + "/simulate_pass --scene " + scene + " --quiet --out " +
+                         dir + "/offline --bag " + bag + " > " + dir + "/simulate_pass.log 2>&1").c_str()),
+            0)
+      << "see " << dir << "/simulate_pass.log";
+
+  // What the bag holds: the pantograph position at every stamp, the stamps of the wire shapes.
+  std::map<ros::Time, double> position;
+  std::set<ros::Time> shape_stamps;
+  {
+    rosbag::Bag b(bag, rosbag::bagmode::Read);
+    for (const rosbag::MessageInstance& mi : rosbag::View(b)) {
+      if (const auto s = mi.instantiate<catenary_sim::PantographStateArray>())
+        position[s->header.stamp] = s->pantographs.at(0).position;
+      if (const auto w = mi.instantiate<catenary_sim::WireShapeArray>()) shape_stamps.insert(w->header.stamp);
+    }
+  }
+  ASSERT_GT(shape_stamps.size(), 50u);
+
+  ros::NodeHandle nh;
+  ros::Publisher status = nh.advertise<std_msgs::String>("pass_status", 1, true);
+  ros::Subscriber sub = nh.subscribe("markers", 1000, &on_markers);
+  // plot_contact_force, headless, on the same playback (started here: the PNG goes to this test's directory).
+  ASSERT_EQ(std::system(sh(std::string(CATENARY_SIM_DEVEL_LIB) + "/plot_contact_force _scene:=" + scene + " _output_png:=" + png +
+                           " _headless:=true > " + dir + "/plot.log 2>&1 & echo $! > " + dir + "/plot.pid")
+                            .c_str()),
+            0);
+  ASSERT_TRUE(wait_for([&] { return sub.getNumPublishers() > 0; }, 60.0)) << "replay_markers did not start";
+  ASSERT_TRUE(wait_for([&] { return status.getNumSubscribers() > 0; }, 60.0))
+      << "plot_contact_force did not start; see " << dir << "/plot.log";
+  ros::WallDuration(1.0).sleep();  // its other subscriptions connect
+
+  ASSERT_EQ(std::system(sh("rosbag play -q --clock -r 2 -d 1 " + bag + " > " + dir + "/play.log 2>&1").c_str()), 0)
+      << "see " << dir << "/play.log";
+  ros::WallDuration(2.0).sleep();  // the last messages reach the nodes
+
+  std::vector<visualization_msgs::MarkerArray> got;
+  {
+    std::lock_guard<std::mutex> l(mu);
+    got = received;
+  }
+  // One marker array per wire_shape; the first ones may go while the connections are made.
+  EXPECT_GE(got.size(), shape_stamps.size() * 8 / 10) << "of " << shape_stamps.size() << " wire shapes";
+  EXPECT_LE(got.size(), shape_stamps.size());
+  ASSERT_FALSE(got.empty());
+  double first_x = 1e300, last_x = -1e300;
+  for (const auto& arr : got) {
+    std::map<std::string, std::size_t> points;  // per namespace
+    ros::Time stamp;
+    const visualization_msgs::Marker* head = nullptr;
+    for (const auto& mk : arr.markers) {
+      points[mk.ns] += mk.points.size();
+      stamp = mk.header.stamp;
+      EXPECT_EQ(mk.header.frame_id, "line");
+      if (mk.ns == "pantograph_head") head = &mk;
+    }
+    for (const char* ns : {"wires", "droppers", "masts", "steady_arms", "pantograph_frame", "contact_force"})
+      EXPECT_GT(points[ns], 0u) << ns << " at " << stamp;
+    ASSERT_TRUE(shape_stamps.count(stamp)) << "marker stamp " << stamp << " is no wire_shape's";
+    ASSERT_TRUE(head);
+    // Drawn at the recorded position of that instant (same arithmetic up to rounding: 1e-9 m).
+    ASSERT_TRUE(position.count(stamp));
+    EXPECT_NEAR(head->pose.position.x, position[stamp], 1e-9) << "at " << stamp;
+    first_x = std::min(first_x, head->pose.position.x);
+    last_x = std::max(last_x, head->pose.position.x);
+  }
+  // The whole pass was drawn, not only its start.
+  EXPECT_GT(last_x - first_x, 400.0);
+
+  // The pass ends (the offline bag has no pass_status: sent here as the node would): the plot is written.
+  std_msgs::String ended;
+  ended.data = "ended";
+  status.publish(ended);
+  const bool written = wait_for([&] { return std::ifstream(png).good(); }, 30.0);
+  (void)!std::system(sh("kill -INT $(cat " + dir + "/plot.pid) 2>/dev/null; sleep 1").c_str());
+  ASSERT_TRUE(written) << png << " not written; see " << dir << "/plot.log";
+  std::ifstream f(png, std::ios::binary);
+  unsigned char head[24] = {};
+  f.read(reinterpret_cast<char*>(head), sizeof head);
+  ASSERT_EQ(std::string(reinterpret_cast<char*>(head + 1), 3), "PNG");
+  // IHDR: width and height, big-endian, of the 11 x 6.5 in figure at 100 dpi.
+  const unsigned w = head[16] << 24 | head[17] << 16 | head[18] << 8 | head[19];
+  const unsigned h = head[20] << 24 | head[21] << 16 | head[22] << 8 | head[23];
+  EXPECT_EQ(w, 1100u);
+  EXPECT_EQ(h, 650u);
+  if (!HasFailure()) (void)!std::system(("rm -rf " + dir).c_str());  // kept for a look when it failed
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_replay_node");
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}
