@@ -2,6 +2,8 @@
 // hil/contact_force (or hil/contact_wrench) in, hil/contact_point out (see README "Hardware in the
 // loop", launch/hil.launch). The same node runs in a nodelet manager as catenary_sim/HilNodelet.
 #include <ros/ros.h>
+
+#include <exception>
 #include <sys/prctl.h>
 
 #include "catenary_sim/ros/hil_node.hpp"
@@ -18,5 +20,8 @@ int main(int argc, char** argv) {
   } catch (const catenary_sim::ros_layer::ParamError& e) {
     ROS_FATAL("catenary_sim_hil: %s", e.what());
     return 2;
+  } catch (const std::exception& e) {  // (none expected: never an abort)
+    ROS_FATAL("catenary_sim_hil: %s", e.what());
+    return 1;
   }
 }

@@ -1,6 +1,8 @@
 // catenary_sim_node: live pantograph passes under a catenary (see README.md, launch/pass.launch).
 #include <ros/ros.h>
 
+#include <exception>
+
 #include "catenary_sim/ros/node.hpp"
 
 int main(int argc, char** argv) {
@@ -14,5 +16,8 @@ int main(int argc, char** argv) {
   } catch (const catenary_sim::ros_layer::ParamError& e) {
     ROS_FATAL("catenary_sim: %s", e.what());
     return 2;
+  } catch (const std::exception& e) {  // (none expected: never an abort)
+    ROS_FATAL("catenary_sim: %s", e.what());
+    return 1;
   }
 }

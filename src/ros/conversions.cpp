@@ -402,7 +402,8 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
 std::int64_t steps_due(double wall_elapsed, double real_time_factor, double dt, double sim_done) {
   if (!(dt > 0.0) || !(real_time_factor > 0.0) || !(wall_elapsed > 0.0)) return 0;
   const double n = std::floor((real_time_factor * wall_elapsed - sim_done) / dt + 1e-9);
-  return n > 0.0 ? static_cast<std::int64_t>(n) : 0;
+  // (at most 1e15: a tiny dt would give a double beyond int64, whose conversion is undefined)
+  return n > 0.0 ? static_cast<std::int64_t>(std::min(n, 1e15)) : 0;
 }
 
 

@@ -12,10 +12,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "catenary_sim/ContactForceArray.h"
+#include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 
 namespace catenary_sim {
@@ -38,11 +39,10 @@ constexpr int kRelockPeriods = 16;
 constexpr double kRecorderRowRate = 10.0;  // Hz, decimated rows of the pass recorder (unused here)
 constexpr double kQuantilePeriod = 1.0;    // s (wall) between latency quantiles for the diagnostics
 
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";
-  char b[64];
-  std::snprintf(b, sizeof b, "%.9g", v);
-  return b;
+// An error at the end of the run: after a shutdown rosconsole no longer prints, so then on stderr.
+void end_error(const std::string& what) {
+  if (ros::ok() && !ros::isShuttingDown()) ROS_ERROR("%s", what.c_str());
+  else std::fprintf(stderr, "[ERROR] %s\n", what.c_str());
 }
 
 }  // namespace
@@ -132,7 +132,9 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   worker_ = std::thread([this] { worker(); });
 }
 
-HilNode::~HilNode() {
+HilNode::~HilNode() { stop_worker(); }
+
+void HilNode::stop_worker() {
   {
     std::lock_guard<std::mutex> l(snap_mu_);
     stop_worker_ = true;
@@ -304,7 +306,10 @@ int HilNode::run() {
       relock = true;  // the windows' phase relative to the rig is lost: the next arrival sets it
     }
   }
-  write_report();
+  // The statistics of a pass that has just ended are written before the exit code is decided.
+  stop_worker();
+  const bool report_ok = write_report();
+  if ((!report_ok || stats_failed_) && exit_code_ == 0) exit_code_ = 1;
   return exit_code_;
 }
 
@@ -473,8 +478,9 @@ void HilNode::worker() {
       std::unique_lock<std::mutex> l(snap_mu_);
       snap_cv_.wait_for(l, std::chrono::milliseconds(100),
                         [this] { return snap_new_ || stop_worker_ || finished_recorder_ != nullptr; });
-      if (stop_worker_) return;
-      if (snap_new_) {
+      // (stopping: only the statistics of a pass that has ended are still written)
+      if (stop_worker_ && !finished_recorder_) return;
+      if (snap_new_ && !stop_worker_) {
         std::swap(wsnap_, snap_);
         snap_new_ = false;
         have = true;
@@ -517,9 +523,14 @@ void HilNode::worker() {
                  st.filtered.max, st.filtered.min, st.contact_loss_percent, st.samples, m.scene.output.filter_cutoff);
       }
       if (!params_.stats_file.empty()) {
-        std::ofstream f(params_.stats_file);
-        f << statistics_json(m, finished_state, stats, RunInfo{-1.0, -1.0, wsnap_.counters.overruns});
-        if (!f) ROS_ERROR("catenary_sim_hil: cannot write ~stats_file '%s'", params_.stats_file.c_str());
+        // Whole or not at all (checked writable at start-up; a full disk is still possible).
+        try {
+          write_file_atomically(params_.stats_file,
+                                statistics_json(m, finished_state, stats, RunInfo{-1.0, -1.0, wsnap_.counters.overruns}));
+        } catch (const OutputError& e) {
+          end_error(std::string("catenary_sim_hil: ~stats_file: ") + e.what());
+          stats_failed_ = true;
+        }
       }
     }
     updater_.update();
@@ -593,7 +604,7 @@ void HilNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("pass", s.pass_count);
 }
 
-void HilNode::write_report() const {
+bool HilNode::write_report() const {
   const double wall = started_ > 0.0 ? steady_now() - started_ : 0.0;
   // (printf: after a shutdown rosconsole no longer prints)
   std::printf("catenary_sim_hil: %lld periods in %.1f s, %lld overruns, %lld safe holds; latency (measurement arrival "
@@ -602,30 +613,52 @@ void HilNode::write_report() const {
               static_cast<long long>(c_.holds), latency_.quantile(0.5) * 1e6, latency_.quantile(0.99) * 1e6,
               latency_.max() * 1e6, static_cast<unsigned long long>(latency_.count()));
   std::fflush(stdout);
-  if (params_.report_file.empty()) return;
+  if (params_.report_file.empty()) return true;
+  // nlohmann::json writes a non-finite number as null.
   auto hist = [](const LatencyHistogram& h) {
-    std::ostringstream j;
-    j << "{\"count\": " << h.count() << ", \"mean_s\": " << json_number(h.mean())
-      << ", \"p50_s\": " << json_number(h.quantile(0.5)) << ", \"p90_s\": " << json_number(h.quantile(0.9))
-      << ", \"p99_s\": " << json_number(h.quantile(0.99)) << ", \"p999_s\": " << json_number(h.quantile(0.999))
-      << ", \"max_s\": " << json_number(h.max()) << "}";
-    return j.str();
+    nlohmann::ordered_json j;
+    j["count"] = h.count();
+    j["mean_s"] = h.mean();
+    j["p50_s"] = h.quantile(0.5);
+    j["p90_s"] = h.quantile(0.9);
+    j["p99_s"] = h.quantile(0.99);
+    j["p999_s"] = h.quantile(0.999);
+    j["max_s"] = h.max();
+    return j;
   };
-  std::ofstream f(params_.report_file);
-  f << "{\n  \"rate_hz\": " << json_number(params_.rate) << ",\n  \"period_s\": " << json_number(timing_.period)
-    << ",\n  \"dt_s\": " << json_number(sim_->model().dt) << ",\n  \"steps_per_period\": " << timing_.steps_per_period
-    << ",\n  \"dofs\": " << sim_->model().n_dof << ",\n  \"wall_s\": " << json_number(wall)
-    << ",\n  \"sim_time_s\": " << json_number(sim_->state().time) << ",\n  \"passes\": " << pass_count_ + 1
-    << ",\n  \"periods\": " << c_.batches << ",\n  \"periods_triggered\": " << c_.triggered
-    << ",\n  \"periods_held\": " << c_.held << ",\n  \"periods_safe_hold\": " << c_.hold_batches
-    << ",\n  \"safe_holds\": " << c_.holds << ",\n  \"overruns\": " << c_.overruns
-    << ",\n  \"relocks\": " << c_.relocks << ",\n  \"spin_wait_s\": " << json_number(params_.spin_wait)
-    << ",\n  \"measurements_accepted\": " << c_.accepted << ",\n  \"measurements_rejected\": " << c_.rejected
-    << ",\n  \"measurements_superseded\": " << c_.superseded << ",\n  \"measurements_late\": " << c_.late
-    << ",\n  \"max_age_running_s\": " << json_number(c_.max_age_running)
-    << ",\n  \"latency\": " << hist(latency_) << ",\n  \"compute\": " << hist(compute_) << ",\n  \"wait\": " << hist(wait_)
-    << ",\n  \"transport\": " << hist(transport_) << "\n}\n";
-  if (!f) ROS_ERROR("catenary_sim_hil: cannot write ~hil/report_file '%s'", params_.report_file.c_str());
+  nlohmann::ordered_json j;
+  j["rate_hz"] = params_.rate;
+  j["period_s"] = timing_.period;
+  j["dt_s"] = sim_->model().dt;
+  j["steps_per_period"] = timing_.steps_per_period;
+  j["dofs"] = sim_->model().n_dof;
+  j["wall_s"] = wall;
+  j["sim_time_s"] = sim_->state().time;
+  j["passes"] = pass_count_ + 1;
+  j["periods"] = c_.batches;
+  j["periods_triggered"] = c_.triggered;
+  j["periods_held"] = c_.held;
+  j["periods_safe_hold"] = c_.hold_batches;
+  j["safe_holds"] = c_.holds;
+  j["overruns"] = c_.overruns;
+  j["relocks"] = c_.relocks;
+  j["spin_wait_s"] = params_.spin_wait;
+  j["measurements_accepted"] = c_.accepted;
+  j["measurements_rejected"] = c_.rejected;
+  j["measurements_superseded"] = c_.superseded;
+  j["measurements_late"] = c_.late;
+  j["max_age_running_s"] = c_.max_age_running;
+  j["latency"] = hist(latency_);
+  j["compute"] = hist(compute_);
+  j["wait"] = hist(wait_);
+  j["transport"] = hist(transport_);
+  try {
+    write_file_atomically(params_.report_file, j.dump(2) + "\n");
+  } catch (const OutputError& e) {
+    end_error(std::string("catenary_sim_hil: ~hil/report_file: ") + e.what());
+    return false;
+  }
+  return true;
 }
 
 }  // namespace ros_layer

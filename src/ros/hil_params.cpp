@@ -23,10 +23,11 @@ void validate_hil_params(const HilParams& p) {
                      ", 10] s (at least two loop periods of ~hil/rate = " + format_number(p.rate) + " Hz)");
   check_range("hil/hold_ramp", p.hold_ramp, 0.0, 60.0, false, "s (0: at once)");
   check_range("hil/hold_deceleration", p.hold_deceleration, 0.0, 50.0, false, "m/s^2 (0: at once)");
-  check_range("publish_rate", p.publish_rate, 0.0, 1000.0, true, "Hz");
-  check_range("marker_rate", p.marker_rate, 0.0, 100.0, true, "Hz");
+  // (lower bounds as catenary_sim_node's: params.hpp)
+  check_range("publish_rate", p.publish_rate, kMinPublishRate, 1000.0, false, "Hz");
+  check_range("marker_rate", p.marker_rate, kMinMarkerRate, 100.0, false, "Hz");
   check_range("start_delay", p.start_delay, 0.0, 60.0, false, "s");
-  check_range("shape_rate", p.shape_rate, 0.0, 100.0, true, "Hz");
+  check_range("shape_rate", p.shape_rate, kMinShapeRate, 100.0, false, "Hz");
   check_range("shape_resolution", p.shape_resolution, 0.0, 100.0, false, "m (0: every node)");
   if (!std::isfinite(p.spin_wait) || p.spin_wait < 0.0 || p.spin_wait > 0.5 * period)
     throw ParamError("parameter ~hil/spin_wait = " + format_number(p.spin_wait) + " s rejected: allowed [0, " +
@@ -39,42 +40,37 @@ void validate_hil_params(const HilParams& p) {
 }
 
 HilParams load_hil_params(const ros::NodeHandle& nh) {
+  ParamReader r(nh, "catenary_sim_hil",
+                {"scene", "speed_kmh", "hil/rate", "hil/timeout", "hil/extrapolate", "hil/hold_ramp",
+                 "hil/hold_deceleration", "hil/report_file", "hil/realtime_priority", "hil/spin_wait", "at_end",
+                 "stats_file", "line_frame", "publish_rate", "marker_rate", "start_delay", "shape_rate",
+                 "shape_resolution", "diagnostic_period"});  // (the last read by diagnostic_updater)
   HilParams p;
-  nh.param<std::string>("scene", p.scene, "");
-  auto number = [&](const char* name, double& out) {
-    if (!nh.hasParam(name)) return false;
-    double d;
-    int i;
-    std::string s;
-    if (nh.getParam(name, d)) out = d;
-    else if (nh.getParam(name, i)) out = i;
-    else if (nh.getParam(name, s) && s.empty()) return false;  // an empty launch argument: not given
-    else throw ParamError(std::string("parameter ~") + name + " must be a number");
-    return true;
-  };
-  double speed = 0.0;
-  if (number("speed_kmh", speed)) p.speed_kmh = speed;
-  number("hil/rate", p.rate);
-  number("hil/timeout", p.timeout);
-  number("hil/hold_ramp", p.hold_ramp);
-  number("hil/hold_deceleration", p.hold_deceleration);
-  number("publish_rate", p.publish_rate);
-  number("marker_rate", p.marker_rate);
-  number("start_delay", p.start_delay);
-  number("shape_rate", p.shape_rate);
-  number("shape_resolution", p.shape_resolution);
-  number("hil/spin_wait", p.spin_wait);
-  if (nh.hasParam("hil/realtime_priority") && !nh.getParam("hil/realtime_priority", p.realtime_priority))
-    throw ParamError("parameter ~hil/realtime_priority must be an integer in [0, 99]");
-  if (nh.hasParam("hil/extrapolate") && !nh.getParam("hil/extrapolate", p.extrapolate))
-    throw ParamError("parameter ~hil/extrapolate must be true or false");
-  nh.param<std::string>("hil/report_file", p.report_file, "");
-  nh.param<std::string>("stats_file", p.stats_file, "");
-  nh.param<std::string>("line_frame", p.line_frame, p.line_frame);
+  // (the ranges are checked by validate_hil_params; the type errors name them too)
+  r.text("scene", p.scene, "the path of a scene YAML file");
+  read_speed_kmh(r, nh, p.speed_kmh, "a number in [0, 540] km/h");
+  r.number("hil/rate", p.rate, "a number in [1000, 10000] Hz");
+  r.number("hil/timeout", p.timeout, "a number of seconds in [2 loop periods, 10]");
+  r.number("hil/hold_ramp", p.hold_ramp, "a number in [0, 60] s");
+  r.number("hil/hold_deceleration", p.hold_deceleration, "a number in [0, 50] m/s^2");
+  r.number("publish_rate", p.publish_rate, "a number in " + range_text(kMinPublishRate, 1000.0, false, "Hz"));
+  r.number("marker_rate", p.marker_rate, "a number in " + range_text(kMinMarkerRate, 100.0, false, "Hz"));
+  r.number("start_delay", p.start_delay, "a number in [0, 60] s");
+  r.number("shape_rate", p.shape_rate, "a number in " + range_text(kMinShapeRate, 100.0, false, "Hz"));
+  r.number("shape_resolution", p.shape_resolution, "a number in [0, 100] m (0: every node)");
+  r.number("hil/spin_wait", p.spin_wait, "a number of seconds in [0, half a loop period]");
+  r.integer("hil/realtime_priority", p.realtime_priority, "an integer in [0, 99]");
+  r.boolean("hil/extrapolate", p.extrapolate);
+  r.text("hil/report_file", p.report_file, "a file path (empty: none)");
+  r.text("stats_file", p.stats_file, "a file path (empty: none)");
+  r.text("line_frame", p.line_frame, "a frame id");
   std::string at_end = to_string(p.at_end);
-  nh.param<std::string>("at_end", at_end, at_end);
+  r.text("at_end", at_end, "stop, loop or exit");
   p.at_end = parse_at_end(at_end);
   validate_hil_params(p);
+  // Before the loop starts: a file that cannot be written is known now, not after the run.
+  check_output_param("stats_file", p.stats_file);
+  check_output_param("hil/report_file", p.report_file);
   return p;
 }
 

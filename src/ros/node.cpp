@@ -6,7 +6,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <algorithm>
 #include <limits>
 #include <sstream>
@@ -15,6 +14,7 @@
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/PassEvent.h"
 #include "catenary_sim/WireShapeArray.h"
+#include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 
 namespace catenary_sim {
@@ -239,7 +239,8 @@ void SimulationNode::advance(const ros::WallTime& tick_deadline) {
   const std::int64_t due = steps_due((now - wall_anchor_).toSec(), params_.real_time_factor, dt,
                                      sim_->state().time - sim_anchor_);
   const double nominal = params_.real_time_factor / (params_.publish_rate * dt);
-  const std::int64_t limit = static_cast<std::int64_t>(std::ceil(kCatchUp * nominal)) + 1;
+  // (at most 1e15 steps: the conversion of a larger double, from a tiny dt, is undefined)
+  const std::int64_t limit = static_cast<std::int64_t>(std::min(std::ceil(kCatchUp * nominal), 1e15)) + 1;
   const std::int64_t want = std::min(due, limit);
   const std::int64_t done = do_steps(want, &tick_deadline);
   if (done > 0) ++chunks_;
@@ -311,10 +312,15 @@ void SimulationNode::report_statistics() {
   if (params_.stats_file.empty()) return;
   const std::string json =
       statistics_json(m, sim_->state(), stats, RunInfo{(ros::WallTime::now() - wall_start_).toSec(), -1.0, overruns_});
-  std::ofstream f(params_.stats_file);
-  f << json;
-  if (!f) ROS_ERROR("catenary_sim: cannot write ~stats_file '%s'", params_.stats_file.c_str());
-  else ROS_INFO("catenary_sim: statistics written to %s", params_.stats_file.c_str());
+  // Whole or not at all (checked writable at start-up; a full disk is still possible): a failure
+  // is an error and the node's exit code becomes 1, whenever it exits.
+  try {
+    write_file_atomically(params_.stats_file, json);
+    ROS_INFO("catenary_sim: statistics written to %s", params_.stats_file.c_str());
+  } catch (const OutputError& e) {
+    ROS_ERROR("catenary_sim: ~stats_file: %s", e.what());
+    exit_code_ = 1;
+  }
 }
 
 void SimulationNode::publish(bool force) {

@@ -1,10 +1,13 @@
 #include "catenary_sim/ros/params.hpp"
 
 #include <ros/node_handle.h>
+#include <xmlrpcpp/XmlRpcValue.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
+#include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/core/scene.hpp"
 
 namespace catenary_sim {
@@ -17,11 +20,17 @@ std::string format_number(double v) {
   return s.str();
 }
 
+std::string range_text(double lo, double hi, bool lo_open, const char* unit) {
+  std::string s = (lo_open ? "(" : "[") + format_number(lo) + ", " + format_number(hi) + "]";
+  if (unit && *unit) s += std::string(" ") + unit;
+  return s;
+}
+
 void check_range(const char* name, double v, double lo, double hi, bool lo_open, const char* unit) {
   const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi;
   if (!ok)
     throw ParamError(std::string("parameter ~") + name + " = " + format_number(v) + " rejected: allowed " +
-                     (lo_open ? "(" : "[") + format_number(lo) + ", " + format_number(hi) + "] " + unit);
+                     range_text(lo, hi, lo_open, unit));
 }
 
 void check_frame_id(const char* name, const std::string& frame) {
@@ -30,6 +39,158 @@ void check_frame_id(const char* name, const std::string& frame) {
                      "' rejected: a non-empty frame id without a leading '/'");
 }
 
+
+// ---------------------------------------------------------------------------------------------
+// Typed reading
+
+std::string describe_value(const XmlRpc::XmlRpcValue& v) {
+  using XmlRpc::XmlRpcValue;
+  switch (v.getType()) {
+    case XmlRpcValue::TypeBoolean: return std::string(static_cast<const bool&>(v) ? "true" : "false") + " (a boolean)";
+    case XmlRpcValue::TypeInt: return std::to_string(static_cast<const int&>(v)) + " (an integer)";
+    case XmlRpcValue::TypeDouble: return format_number(static_cast<const double&>(v)) + " (a number)";
+    case XmlRpcValue::TypeString: return "'" + static_cast<const std::string&>(v) + "' (a string)";
+    case XmlRpcValue::TypeArray: return "a list";
+    case XmlRpcValue::TypeStruct: return "a map";
+    case XmlRpcValue::TypeDateTime: return "a date";
+    case XmlRpcValue::TypeBase64: return "binary data";
+    case XmlRpcValue::TypeInvalid: break;
+  }
+  return "an invalid value";
+}
+
+namespace {
+[[noreturn]] void wrong_type(const std::string& name, const XmlRpc::XmlRpcValue& v, const std::string& expected) {
+  throw ParamError("parameter ~" + name + " = " + describe_value(v) + " rejected: expected " + expected);
+}
+}  // namespace
+
+double param_number(const std::string& name, const XmlRpc::XmlRpcValue& v, const std::string& expected) {
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) return static_cast<const double&>(v);
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) return static_cast<const int&>(v);
+  wrong_type(name, v, expected);
+}
+
+int param_integer(const std::string& name, const XmlRpc::XmlRpcValue& v, const std::string& expected) {
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) return static_cast<const int&>(v);
+  wrong_type(name, v, expected);
+}
+
+bool param_bool(const std::string& name, const XmlRpc::XmlRpcValue& v) {
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeBoolean) return static_cast<const bool&>(v);
+  wrong_type(name, v, "true or false");
+}
+
+std::string param_string(const std::string& name, const XmlRpc::XmlRpcValue& v, const std::string& expected) {
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeString) return static_cast<const std::string&>(v);
+  wrong_type(name, v, expected + " (a string; a name of digits: type=\"str\" in a launch file)");
+}
+
+std::vector<std::string> unknown_parameters(const std::vector<std::string>& all, const std::string& ns,
+                                            const std::vector<std::string>& known) {
+  std::string prefix = ns;
+  if (prefix.empty() || prefix.back() != '/') prefix += '/';
+  std::vector<std::string> out;
+  for (const std::string& full : all) {
+    if (full.size() <= prefix.size() || full.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string name = full.substr(prefix.size());
+    if (std::find(known.begin(), known.end(), name) == known.end() &&
+        std::find(out.begin(), out.end(), name) == out.end())
+      out.push_back(name);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+namespace {
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+}  // namespace
+
+std::string unknown_parameter_warning(const std::string& name, const std::vector<std::string>& known) {
+  std::string best;
+  std::size_t best_d = std::string::npos;
+  for (const std::string& k : known) {
+    const auto slash = k.find_last_of('/');
+    std::size_t d = edit_distance(name, k);
+    if (slash != std::string::npos) d = std::min(d, edit_distance(name, k.substr(slash + 1)));
+    if (d < best_d) {
+      best_d = d;
+      best = k;
+    }
+  }
+  std::string s = "unknown parameter ~" + name + " (ignored); ";
+  // Close: a typo or two, more in a long name.
+  if (!best.empty() && best_d <= std::max<std::size_t>(2, name.size() / 3)) return s + "did you mean ~" + best + "?";
+  s += "known parameters:";
+  for (std::size_t i = 0; i < known.size(); ++i) s += (i ? ", ~" : " ~") + known[i];
+  return s;
+}
+
+ParamReader::ParamReader(const ros::NodeHandle& nh, const char* who, std::vector<std::string> known)
+    : nh_(nh), known_(std::move(known)) {
+  std::vector<std::string> all;
+  if (!nh_.getParamNames(all)) return;  // (no answer from the master: nothing to check)
+  for (const std::string& name : unknown_parameters(all, nh_.getNamespace(), known_))
+    ROS_WARN("%s: %s", who, unknown_parameter_warning(name, known_).c_str());
+}
+
+bool ParamReader::get(const std::string& name, XmlRpc::XmlRpcValue& v) const {
+  if (std::find(known_.begin(), known_.end(), name) == known_.end())
+    throw std::logic_error("ParamReader: parameter ~" + name + " is read but not in the list of known parameters");
+  return nh_.hasParam(name) && nh_.getParam(name, v);
+}
+
+bool ParamReader::number(const std::string& name, double& out, const std::string& expected) {
+  XmlRpc::XmlRpcValue v;
+  if (!get(name, v)) return false;
+  out = param_number(name, v, expected);
+  return true;
+}
+
+bool ParamReader::integer(const std::string& name, int& out, const std::string& expected) {
+  XmlRpc::XmlRpcValue v;
+  if (!get(name, v)) return false;
+  out = param_integer(name, v, expected);
+  return true;
+}
+
+bool ParamReader::boolean(const std::string& name, bool& out) {
+  XmlRpc::XmlRpcValue v;
+  if (!get(name, v)) return false;
+  out = param_bool(name, v);
+  return true;
+}
+
+bool ParamReader::text(const std::string& name, std::string& out, const std::string& expected) {
+  XmlRpc::XmlRpcValue v;
+  if (!get(name, v)) return false;
+  out = param_string(name, v, expected);
+  return true;
+}
+
+void check_output_param(const char* name, const std::string& path) {
+  if (path.empty()) return;
+  try {
+    check_writable(path);
+  } catch (const OutputError& e) {
+    throw ParamError(std::string("parameter ~") + name + " = '" + path + "' rejected: " + e.what());
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 
 AtEnd parse_at_end(const std::string& s) {
   if (s == "stop") return AtEnd::kStop;
@@ -47,59 +208,81 @@ const char* to_string(AtEnd a) {
   return "?";
 }
 
+namespace {
+// The node's ranges, for validate() and the type errors of load_params().
+struct Range {
+  double lo, hi;
+  bool lo_open;
+  const char* unit;
+  std::string text() const { return "a number in " + range_text(lo, hi, lo_open, unit); }
+};
+const Range kSpeed{0.0, 540.0, false, "km/h"};
+const Range kRealTimeFactor{0.0, 1000.0, false, "(0: as fast as possible)"};
+const Range kPublishRate{kMinPublishRate, 10000.0, false, "Hz"};
+const Range kShapeRate{kMinShapeRate, 1000.0, false, "Hz"};
+const Range kMarkerRate{kMinMarkerRate, 1000.0, false, "Hz"};
+const Range kShapeResolution{0.0, 100.0, false, "m (0: every node)"};
+const Range kVerticalScale{kMinVerticalScale, 10000.0, false, ""};
+const Range kMaxAcceleration{0.0, 20.0, false, "m/s^2 (0: no limit)"};
+const Range kStartDelay{0.0, 60.0, false, "s"};
+const Range kWaitForViewer{0.0, 600.0, false, "s (0: no wait)"};
+
+void check(const char* name, double v, const Range& r) { check_range(name, v, r.lo, r.hi, r.lo_open, r.unit); }
+}  // namespace
+
 void validate(const NodeParams& p) {
   if (p.scene.empty()) throw ParamError("parameter ~scene is required: path of a scene YAML file");
-  if (p.speed_kmh) check_range("speed_kmh", *p.speed_kmh, 0.0, 540.0, false, "km/h");
-  check_range("real_time_factor", p.real_time_factor, 0.0, 1000.0, false, "(0: as fast as possible)");
-  check_range("publish_rate", p.publish_rate, 0.0, 10000.0, true, "Hz");
-  check_range("shape_rate", p.shape_rate, 0.0, 1000.0, true, "Hz");
-  check_range("marker_rate", p.marker_rate, 0.0, 1000.0, true, "Hz");
-  check_range("shape_resolution", p.shape_resolution, 0.0, 100.0, false, "m (0: every node)");
-  check_range("vertical_scale", p.vertical_scale, 0.0, 10000.0, true, "");
-  check_range("max_acceleration", p.max_acceleration, 0.0, 20.0, false, "m/s^2 (0: no limit)");
-  check_range("start_delay", p.start_delay, 0.0, 60.0, false, "s");
-  check_range("wait_for_viewer", p.wait_for_viewer, 0.0, 600.0, false, "s (0: no wait)");
+  if (p.speed_kmh) check("speed_kmh", *p.speed_kmh, kSpeed);
+  check("real_time_factor", p.real_time_factor, kRealTimeFactor);
+  check("publish_rate", p.publish_rate, kPublishRate);
+  check("shape_rate", p.shape_rate, kShapeRate);
+  check("marker_rate", p.marker_rate, kMarkerRate);
+  check("shape_resolution", p.shape_resolution, kShapeResolution);
+  check("vertical_scale", p.vertical_scale, kVerticalScale);
+  check("max_acceleration", p.max_acceleration, kMaxAcceleration);
+  check("start_delay", p.start_delay, kStartDelay);
+  check("wait_for_viewer", p.wait_for_viewer, kWaitForViewer);
   check_frame_id("line_frame", p.line_frame);
 }
 
+bool read_speed_kmh(ParamReader& r, const ros::NodeHandle& nh, std::optional<double>& out, const std::string& expected) {
+  // An empty string (an empty launch argument, speed_kmh:="") means "not given"; any other
+  // string is a type error.
+  std::string s;
+  if (nh.hasParam("speed_kmh") && nh.getParam("speed_kmh", s) && s.empty()) return false;
+  double v = 0.0;
+  if (!r.number("speed_kmh", v, expected + "; empty: the scene's speed")) return false;
+  out = v;
+  return true;
+}
+
 NodeParams load_params(const ros::NodeHandle& nh) {
+  ParamReader r(nh, "catenary_sim",
+                {"scene", "speed_kmh", "real_time_factor", "publish_rate", "shape_rate", "marker_rate",
+                 "shape_resolution", "vertical_scale", "line_frame", "at_end", "stats_file", "publish_clock",
+                 "paused", "wait_for_viewer", "max_acceleration", "start_delay",
+                 "diagnostic_period"});  // (the last read by diagnostic_updater)
   NodeParams p;
-  nh.param<std::string>("scene", p.scene, "");
-  double speed = 0.0;
-  if (nh.getParam("speed_kmh", speed)) {
-    p.speed_kmh = speed;
-  } else if (nh.hasParam("speed_kmh")) {
-    // Present but not a number (e.g. an empty launch argument): treat "" as "not given".
-    std::string s;
-    if (!(nh.getParam("speed_kmh", s) && s.empty()))
-      throw ParamError("parameter ~speed_kmh must be a number in [0, 540] km/h");
-  }
-  // Integers are accepted for the double parameters (rosparam stores "1" as int).
-  auto number = [&](const char* name, double& out) {
-    if (!nh.hasParam(name)) return;
-    double d;
-    int i;
-    if (nh.getParam(name, d)) out = d;
-    else if (nh.getParam(name, i)) out = i;
-    else throw ParamError(std::string("parameter ~") + name + " must be a number");
-  };
-  number("real_time_factor", p.real_time_factor);
-  number("publish_rate", p.publish_rate);
-  number("shape_rate", p.shape_rate);
-  number("marker_rate", p.marker_rate);
-  number("shape_resolution", p.shape_resolution);
-  number("vertical_scale", p.vertical_scale);
-  number("max_acceleration", p.max_acceleration);
-  number("start_delay", p.start_delay);
-  number("wait_for_viewer", p.wait_for_viewer);
-  nh.param<std::string>("line_frame", p.line_frame, p.line_frame);
+  r.text("scene", p.scene, "the path of a scene YAML file");
+  read_speed_kmh(r, nh, p.speed_kmh, kSpeed.text());
+  r.number("real_time_factor", p.real_time_factor, kRealTimeFactor.text());
+  r.number("publish_rate", p.publish_rate, kPublishRate.text());
+  r.number("shape_rate", p.shape_rate, kShapeRate.text());
+  r.number("marker_rate", p.marker_rate, kMarkerRate.text());
+  r.number("shape_resolution", p.shape_resolution, kShapeResolution.text());
+  r.number("vertical_scale", p.vertical_scale, kVerticalScale.text());
+  r.number("max_acceleration", p.max_acceleration, kMaxAcceleration.text());
+  r.number("start_delay", p.start_delay, kStartDelay.text());
+  r.number("wait_for_viewer", p.wait_for_viewer, kWaitForViewer.text());
+  r.text("line_frame", p.line_frame, "a frame id");
   std::string at_end = to_string(p.at_end);
-  nh.param<std::string>("at_end", at_end, at_end);
+  r.text("at_end", at_end, "stop, loop or exit");
   p.at_end = parse_at_end(at_end);
-  nh.param<std::string>("stats_file", p.stats_file, "");
-  nh.param<bool>("publish_clock", p.publish_clock, p.publish_clock);
-  nh.param<bool>("paused", p.paused, p.paused);
+  r.text("stats_file", p.stats_file, "a file path (empty: none)");
+  r.boolean("publish_clock", p.publish_clock);
+  r.boolean("paused", p.paused);
   validate(p);
+  check_output_param("stats_file", p.stats_file);
   return p;
 }
 

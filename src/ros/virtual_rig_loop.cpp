@@ -6,10 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
 #include "catenary_sim/MeasuredContactForce.h"
+#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/ros/params.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
@@ -25,20 +28,25 @@ double mono_now() {
 }  // namespace
 
 VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
+  ParamReader r(pnh, "virtual_rig", {"pantograph_scene", "rate", "extrapolate", "report_file"});
   std::string scene_file;
-  if (!pnh.getParam("pantograph_scene", scene_file) || scene_file.empty())
-    throw std::runtime_error("parameter ~pantograph_scene is required: a scene whose lumped pantographs have the "
-                             "names of the external ones (e.g. config/reference_55m.yaml)");
+  r.text("pantograph_scene", scene_file, "the path of a scene YAML file");
+  if (scene_file.empty())
+    throw ParamError("parameter ~pantograph_scene is required: a scene whose lumped pantographs have the "
+                     "names of the external ones (e.g. config/reference_55m.yaml)");
+  r.number("rate", rate_, "a number in [0, 20000] Hz (0: the node's loop rate)");
+  // (a rate below 1 Hz would leave the loop asleep for seconds between measurements: no rig runs so)
+  if (!std::isfinite(rate_) || !(rate_ == 0.0 || (rate_ >= 1.0 && rate_ <= 20000.0)))
+    throw ParamError("parameter ~rate = " + format_number(rate_) +
+                     " rejected: allowed 0 (the node's loop rate) or [1, 20000] Hz");
+  r.boolean("extrapolate", extrapolate_);
+  r.text("report_file", report_file_, "a file path (empty: none)");
+  check_output_param("report_file", report_file_);
   try {
     scene_ = load_scene_file(scene_file);
   } catch (const SceneError& e) {
-    throw std::runtime_error("parameter ~pantograph_scene = '" + scene_file + "': " + e.what());
+    throw ParamError("parameter ~pantograph_scene = '" + scene_file + "': " + e.what());
   }
-  pnh.param("rate", rate_, 0.0);
-  if (!std::isfinite(rate_) || rate_ < 0.0 || rate_ > 20000.0)
-    throw std::runtime_error("parameter ~rate rejected: allowed 0 (the node's loop rate) to 20000 Hz");
-  pnh.param("extrapolate", extrapolate_, true);
-  pnh.param<std::string>("report_file", report_file_, "");
   ros::SubscribeOptions so = ros::SubscribeOptions::create<ContactPointArray>(
       "hil/contact_point", 100, [this](const ContactPointArray::ConstPtr& m) { on_point(m); }, ros::VoidPtr(),
       &queue_);
@@ -80,16 +88,27 @@ int VirtualRig::run() {
               static_cast<unsigned long long>(round_trip_.count()));
   std::fflush(stdout);
   if (!report_file_.empty()) {
-    std::ofstream f(report_file_);
-    f << "{\"measurements\": " << sent_ << ", \"missed_ticks\": " << missed_ << ", \"wall_s\": " << wall
-      << ", \"round_trip\": {\"count\": " << round_trip_.count() << ", \"p50_s\": " << round_trip_.quantile(0.5)
-      << ", \"p99_s\": " << round_trip_.quantile(0.99) << ", \"max_s\": " << round_trip_.max() << "}}\n";
+    nlohmann::ordered_json j;  // (a non-finite number is written as null)
+    j["measurements"] = sent_;
+    j["missed_ticks"] = missed_;
+    j["wall_s"] = wall;
+    j["round_trip"] = {{"count", round_trip_.count()},
+                       {"p50_s", round_trip_.quantile(0.5)},
+                       {"p99_s", round_trip_.quantile(0.99)},
+                       {"max_s", round_trip_.max()}};
+    try {
+      write_file_atomically(report_file_, j.dump() + "\n");
+    } catch (const OutputError& e) {
+      // (after a shutdown rosconsole no longer prints)
+      std::fprintf(stderr, "[ERROR] virtual_rig: ~report_file: %s\n", e.what());
+      return 1;
+    }
   }
   return 0;
 }
 
 void VirtualRig::on_point(const ContactPointArray::ConstPtr& msg) {
-  if (msg->dt <= 0.0 || msg->steps_per_period == 0) return;
+  if (!(msg->dt > 0.0 && msg->dt < 1.0) || msg->steps_per_period == 0) return;  // (also NaN)
   const bool restart = !have_ || msg->pass_count != pass_ || msg->step < step_ ||
                        msg->pantographs.size() != rigs_.size() || msg->step - step_ > 1000000;
   if (restart) {

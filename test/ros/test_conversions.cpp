@@ -13,6 +13,8 @@
 #include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/ros/params.hpp"
 
+#include <xmlrpcpp/XmlRpcValue.h>
+
 using namespace catenary_sim;
 using namespace catenary_sim::ros_layer;
 
@@ -334,7 +336,7 @@ TEST(Params, ErrorsNameParameterValueAndRange) {
   q.marker_rate = 0.0;
   e = message(q);
   EXPECT_NE(e.find("marker_rate = 0"), std::string::npos) << e;
-  EXPECT_NE(e.find("(0, 1000] Hz"), std::string::npos) << e;
+  EXPECT_NE(e.find("[0.1, 1000] Hz"), std::string::npos) << e;
   EXPECT_EQ(NodeParams().marker_rate, 30.0);
   q = p;
   q.max_acceleration = 25.0;
@@ -351,6 +353,102 @@ TEST(Params, ErrorsNameParameterValueAndRange) {
   } catch (const ParamError& err) {
     EXPECT_NE(std::string(err.what()).find("/nonexistent/scene.yaml"), std::string::npos);
   }
+}
+
+// The lower bounds of the rates keep every period within ros::WallDuration (int32 seconds): the
+// issue's 1e-10 and 1e-300 are refused with the parameter named, and the smallest value allowed
+// gives a period that a WallDuration holds (constructing it throws past 2^31 s).
+TEST(Params, AbsurdRatesAreRejectedAndTheSmallestAllowedHasAPeriod) {
+  NodeParams p;
+  p.scene = "x.yaml";
+  struct Rate {
+    const char* name;
+    double NodeParams::*field;
+    double min;
+  };
+  for (const Rate& r : {Rate{"publish_rate", &NodeParams::publish_rate, kMinPublishRate},
+                        Rate{"shape_rate", &NodeParams::shape_rate, kMinShapeRate},
+                        Rate{"marker_rate", &NodeParams::marker_rate, kMinMarkerRate}}) {
+    for (double bad : {1e-10, 1e-300, 0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+      NodeParams q = p;
+      q.*r.field = bad;
+      try {
+        validate(q);
+        ADD_FAILURE() << r.name << " = " << bad << " accepted";
+      } catch (const ParamError& e) {
+        EXPECT_NE(std::string(e.what()).find(std::string("~") + r.name + " = "), std::string::npos) << e.what();
+      }
+    }
+    NodeParams q = p;
+    q.*r.field = r.min;
+    EXPECT_NO_THROW(validate(q)) << r.name;
+    EXPECT_NO_THROW(ros::WallDuration(1.0 / r.min)) << r.name;
+  }
+  EXPECT_ANY_THROW(ros::WallDuration(1.0 / 1e-10));  // what aborted the node before
+}
+
+// Wrong types are errors naming the parameter, the value as given and what was expected; an
+// integer is a number (rosparam stores 1 as an integer), but a number is never a string or a
+// boolean and a string never a number.
+TEST(Params, WrongTypesNameParameterValueAndExpectedType) {
+  using XmlRpc::XmlRpcValue;
+  auto error = [](auto f) {
+    try {
+      f();
+    } catch (const ParamError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(param_number("publish_rate", XmlRpcValue(100), "a number"), 100.0);
+  EXPECT_EQ(param_number("publish_rate", XmlRpcValue(2.5), "a number"), 2.5);
+  EXPECT_EQ(param_bool("paused", XmlRpcValue(true)), true);
+  EXPECT_EQ(param_string("line_frame", XmlRpcValue(std::string("map")), "a frame id"), "map");
+  EXPECT_EQ(param_integer("hil/realtime_priority", XmlRpcValue(5), "an integer"), 5);
+
+  std::string e = error([] { param_number("publish_rate", XmlRpcValue(std::string("fast")), "a number in [1, 10000] Hz"); });
+  EXPECT_NE(e.find("~publish_rate = 'fast' (a string)"), std::string::npos) << e;
+  EXPECT_NE(e.find("expected a number in [1, 10000] Hz"), std::string::npos) << e;
+  e = error([] { param_number("publish_rate", XmlRpcValue(true), "a number"); });
+  EXPECT_NE(e.find("~publish_rate = true (a boolean)"), std::string::npos) << e;
+  e = error([] { param_string("line_frame", XmlRpcValue(5), "a frame id"); });  // _line_frame:=5
+  EXPECT_NE(e.find("~line_frame = 5 (an integer)"), std::string::npos) << e;
+  EXPECT_NE(e.find("expected a frame id"), std::string::npos) << e;
+  e = error([] { param_string("at_end", XmlRpcValue(1), "stop, loop or exit"); });  // _at_end:=1
+  EXPECT_NE(e.find("~at_end = 1 (an integer)"), std::string::npos) << e;
+  EXPECT_NE(e.find("stop, loop or exit"), std::string::npos) << e;
+  e = error([] { param_bool("paused", XmlRpcValue(1)); });
+  EXPECT_NE(e.find("~paused = 1 (an integer) rejected: expected true or false"), std::string::npos) << e;
+  e = error([] { param_bool("paused", XmlRpcValue(std::string("yes"))); });
+  EXPECT_NE(e.find("~paused = 'yes' (a string)"), std::string::npos) << e;
+  e = error([] { param_integer("hil/realtime_priority", XmlRpcValue(5.5), "an integer in [0, 99]"); });
+  EXPECT_NE(e.find("~hil/realtime_priority = 5.5 (a number)"), std::string::npos) << e;
+  XmlRpcValue list;
+  list.setSize(1);
+  list[0] = 1;
+  e = error([&] { param_number("vertical_scale", list, "a number"); });
+  EXPECT_NE(e.find("~vertical_scale = a list"), std::string::npos) << e;
+}
+
+TEST(Params, UnknownParametersAreFoundAndTheClosestKnownNameSuggested) {
+  const std::vector<std::string> known{"scene", "vertical_scale", "real_time_factor", "hil/rate", "publish_rate"};
+  const std::vector<std::string> all{"/catenary_sim/scene",          "/catenary_sim/vertical_scal",
+                                     "/catenary_sim/real_time_facter", "/catenary_sim/rate",
+                                     "/catenary_sim/zzz",            "/catenary_sim_hil/foo",
+                                     "/catenary_sim2/bar",           "/use_sim_time",
+                                     "/catenary_sim/hil/rate"};
+  const std::vector<std::string> unknown = unknown_parameters(all, "/catenary_sim", known);
+  EXPECT_EQ(unknown, (std::vector<std::string>{"rate", "real_time_facter", "vertical_scal", "zzz"}));
+  EXPECT_EQ(unknown_parameter_warning("vertical_scal", known),
+            "unknown parameter ~vertical_scal (ignored); did you mean ~vertical_scale?");
+  EXPECT_EQ(unknown_parameter_warning("real_time_facter", known),
+            "unknown parameter ~real_time_facter (ignored); did you mean ~real_time_factor?");
+  // A name without its group: the group's parameter.
+  EXPECT_EQ(unknown_parameter_warning("rate", known), "unknown parameter ~rate (ignored); did you mean ~hil/rate?");
+  // Nothing close: the known names are listed.
+  const std::string w = unknown_parameter_warning("zzz", known);
+  EXPECT_NE(w.find("unknown parameter ~zzz (ignored); known parameters: ~scene, ~vertical_scale"), std::string::npos) << w;
+  EXPECT_EQ(w.find("did you mean"), std::string::npos) << w;
 }
 
 TEST_F(Fixture, StatisticsJsonHasPantographs) {

@@ -194,7 +194,7 @@ TEST(HilParams, SpinWaitPriorityAndShapeParametersAreChecked) {
   }
   q = p;
   q.shape_rate = 0.0;
-  EXPECT_NE(message(q).find("~shape_rate = 0 rejected: allowed (0, 100] Hz"), std::string::npos) << message(q);
+  EXPECT_NE(message(q).find("~shape_rate = 0 rejected: allowed [0.1, 100] Hz"), std::string::npos) << message(q);
   q = p;
   q.shape_resolution = -1.0;
   EXPECT_NE(message(q).find("~shape_resolution = -1 rejected"), std::string::npos) << message(q);

@@ -43,11 +43,11 @@ struct HilParams {
   AtEnd at_end = AtEnd::kStop;      // ~at_end: stop | loop | exit
   std::string stats_file;           // ~stats_file: pass statistics JSON at the end of each pass
   std::string line_frame = "line";  // ~line_frame
-  double publish_rate = 100.0;      // ~publish_rate: Hz for contact_force and tf, (0, 1000]
-  double marker_rate = 10.0;        // ~marker_rate: Hz for markers (only with a subscriber), (0, 100]
+  double publish_rate = 100.0;      // ~publish_rate: Hz for contact_force and tf, [1, 1000]
+  double marker_rate = 10.0;        // ~marker_rate: Hz for markers (only with a subscriber), [0.1, 100]
   double start_delay = 0.0;         // ~start_delay: s (wall) in which measurements are ignored and the
                                     //   initial state is published (lets recorders connect), [0, 60]
-  double shape_rate = 10.0;         // ~shape_rate: Hz for wire_shape (only with a subscriber), (0, 100]
+  double shape_rate = 10.0;         // ~shape_rate: Hz for wire_shape (only with a subscriber), [0.1, 100]
   double shape_resolution = 1.0;    // ~shape_resolution: m between wire_shape samples, [0, 100] (0: every node)
   double spin_wait = 0.0;           // ~hil/spin_wait: s; the loop blocks until this long before a due
                                     //   time (an expected arrival, the start of a window) and then polls
@@ -58,6 +58,8 @@ struct HilParams {
 
 // Throws ParamError naming the parameter, the value and the allowed range.
 void validate_hil_params(const HilParams& p);
+// Reads (ParamReader: typed, unknown names warned about), validates, and checks that ~stats_file
+// and ~hil/report_file can be written. Throws ParamError.
 HilParams load_hil_params(const ros::NodeHandle& private_nh);
 
 // Loads the scene, applies ~speed_kmh and checks that it has an external pantograph. Throws

@@ -93,7 +93,8 @@ class HilNode {
   void worker();
   void publish_pantograph_state(const Model& m, const State& s, const ros::Time& stamp);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
-  void write_report() const;
+  bool write_report() const;  // false: ~hil/report_file could not be written (said on stderr)
+  void stop_worker();         // after it has written the statistics of a pass that has ended
   static std::uint8_t mode_code(Mode m);
 
   ros::NodeHandle nh_, pnh_;
@@ -152,6 +153,7 @@ class HilNode {
   std::unique_ptr<PassRecorder> finished_recorder_;  // a pass to report (under snap_mu_)
   State finished_state_;
   std::thread worker_;
+  std::atomic<bool> stats_failed_{false};  // a ~stats_file write failed: the exit code becomes 1
 
   // Worker thread only.
   Snapshot wsnap_;

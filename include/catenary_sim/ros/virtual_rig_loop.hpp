@@ -6,11 +6,12 @@
 // on a thread of its own, stop() ends it).
 //
 //   ~pantograph_scene  scene whose lumped pantographs have the names of the external ones (required)
-//   ~rate              Hz, the rig's loop (0: the node's loop rate, from hil/contact_point)
+//   ~rate              Hz, the rig's loop, [1, 20000] (0: the node's loop rate, from hil/contact_point)
 //   ~extrapolate       true: between two contact points the wire height follows its path velocity
 //                      (an actuator tracking the trajectory); false: held
 //   ~report_file       JSON with the round trip (measurement sent -> the contact point that used it
-//                      received) at exit
+//                      received) at exit; checked writable at start-up
+// Typed and checked as the nodes' parameters (params.hpp: ParamReader); unknown ones are warned about.
 #pragma once
 
 #include <ros/callback_queue.h>
@@ -32,9 +33,10 @@ namespace ros_layer {
 
 class VirtualRig {
  public:
-  // Reads the parameters and loads the scene; throws std::runtime_error naming the parameter.
+  // Reads the parameters and loads the scene; throws ParamError naming the parameter.
   VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh);
-  // Runs the rig's loop until shutdown or stop(); prints (and writes) the report. Returns 0.
+  // Runs the rig's loop until shutdown or stop(); prints (and writes) the report. Returns 0, or 1
+  // when ~report_file could not be written.
   int run();
   void stop() { stop_ = true; }
 

@@ -1,0 +1,412 @@
+// Fuzz of bad node parameters (issue 10): catenary_sim_node, catenary_sim_hil_node and virtual_rig
+// run as child processes against a master of this test's own, each with one private parameter
+// set to a value its type or range does not allow (`_name:=value` on the command line, as a user
+// would). For each: a non-zero exit, no signal, no hang (20 s), no output file written, and a
+// message naming the parameter. Also: the issue's cases by name (_publish_rate:=1e-10,
+// _marker_rate:=1e-300, _at_end:=1, _line_frame:=5), unknown parameters warned about by name with
+// the closest known one, unwritable output files refused at start-up, and a ~stats_file that
+// becomes unwritable during the pass failing the node's exit code.
+//
+// The values are generated per parameter from its type (deterministic: a failure is reproducible).
+// Every run gets a node name of its own: `_name:=value` stays on the master after the run.
+#include <gtest/gtest.h>
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+#ifndef CATENARY_SIM_DEVEL_LIB
+#define CATENARY_SIM_DEVEL_LIB "."
+#endif
+
+extern char** environ;
+
+namespace {
+
+const std::string kNode = CATENARY_SIM_DEVEL_LIB "/catenary_sim_node";
+const std::string kHilNode = CATENARY_SIM_DEVEL_LIB "/catenary_sim_hil_node";
+const std::string kRig = CATENARY_SIM_DEVEL_LIB "/virtual_rig";
+const std::string kScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+const std::string kHilScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_hil.yaml";
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+bool exists(const std::string& p) {
+  struct stat st {};
+  return stat(p.c_str(), &st) == 0;
+}
+
+int free_port() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof a;
+  int port = 0;
+  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 && getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0)
+    port = ntohs(a.sin_port);
+  close(fd);
+  return port;
+}
+
+bool port_open(int port) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = htons(port);
+  const bool ok = connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  close(fd);
+  return ok;
+}
+
+struct ChildRun {
+  int exit_code = -1;
+  int signal = 0;
+  bool hung = false;
+  std::string out;  // stdout and stderr
+};
+
+class Child {
+ public:
+  // Starts args[0] with stdout and stderr to `log` and the environment `env` added.
+  Child(const std::vector<std::string>& args, const std::vector<std::string>& env, const std::string& log) : log_(log) {
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    std::vector<std::string> envs = env;
+    for (char** e = environ; *e; ++e) envs.push_back(*e);  // (the first of a name wins in getenv)
+    std::vector<char*> envp;
+    for (std::string& e : envs) envp.push_back(&e[0]);
+    envp.push_back(nullptr);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), envp.data()) != 0) pid_ = -1;
+    posix_spawn_file_actions_destroy(&fa);
+  }
+  bool started() const { return pid_ > 0; }
+  pid_t pid() const { return pid_; }
+  // Waits up to `limit` s, then kills it (SIGKILL) and reports it as hung.
+  ChildRun wait(double limit) {
+    ChildRun r;
+    if (pid_ <= 0) return r;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
+    int status = 0;
+    while (waitpid(pid_, &status, WNOHANG) == 0) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        kill(pid_, SIGKILL);
+        waitpid(pid_, &status, 0);
+        r.hung = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    pid_ = -1;
+    if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
+    if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
+    r.out = slurp(log_);
+    return r;
+  }
+  ~Child() {
+    if (pid_ > 0) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+
+ private:
+  std::string log_;
+  pid_t pid_ = -1;
+};
+
+// A master of the test's own on a free loopback port, and a scratch directory.
+class NodeParamsFuzz : public ::testing::Test {
+ public:
+  static void SetUpTestSuite() {
+    char t[] = "/tmp/catenary_sim_params_XXXXXX";
+    dir_ = mkdtemp(t);
+    port_ = free_port();
+    env_ = {"ROS_MASTER_URI=http://localhost:" + std::to_string(port_), "ROS_HOME=" + dir_,
+            "ROS_LOG_DIR=" + dir_ + "/log", "ROSCONSOLE_FORMAT=[${severity}] ${message}",
+            // (the tests below wait for a line of the node's: stdout to a file is else block-buffered)
+            "ROSCONSOLE_STDOUT_LINE_BUFFERED=1"};
+    master_ = new Child({"/usr/bin/rosmaster", "--core", "-p", std::to_string(port_)}, env_, dir_ + "/master.log");
+    for (int i = 0; i < 400 && !port_open(port_); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  static void TearDownTestSuite() {
+    if (master_ && master_->started()) kill(master_->pid(), SIGTERM);
+    if (master_) master_->wait(10.0);
+    delete master_;
+    master_ = nullptr;
+  }
+  void SetUp() override { ASSERT_TRUE(port_open(port_)) << "rosmaster did not start; see " << dir_ << "/master.log"; }
+
+  // Runs `program` as a node of a name of its own with the `_name:=value` arguments.
+  ChildRun run(const std::string& program, const std::vector<std::string>& params, double limit = 20.0) {
+    std::vector<std::string> args{program, "__name:=fuzz" + std::to_string(++runs_)};
+    for (const std::string& p : params) args.push_back(p);
+    Child c(args, env_, dir_ + "/run.log");
+    return c.wait(limit);
+  }
+
+  static std::string dir_;
+  static int port_;
+  static std::vector<std::string> env_;
+  static Child* master_;
+  static int runs_;
+};
+std::string NodeParamsFuzz::dir_;
+int NodeParamsFuzz::port_ = 0;
+std::vector<std::string> NodeParamsFuzz::env_;
+Child* NodeParamsFuzz::master_ = nullptr;
+int NodeParamsFuzz::runs_ = 0;
+
+enum class Kind { kNumber, kRate, kRigRate, kInteger, kBool, kString, kPath, kFrame, kAtEnd, kScene };
+
+struct Param {
+  std::string name;
+  Kind kind;
+};
+
+// Values no parameter of the kind allows. Every one reaches the node with a type of its own:
+// roscpp stores `_x:=5` as an integer, `_x:=1.5` (and nan, inf) as a double, true/false as a
+// boolean, anything else as a string. The reading and the range checks are shared by all
+// parameters, so each parameter gets one value of every class (wrong type, not finite, out of
+// range), the class's values taken in turn over the parameters (`i`: the parameter's index);
+// the rates get every tiny value (the issue's crashes) and every parameter the empty string.
+std::vector<std::string> bad_values(Kind k, std::size_t i) {
+  auto pick = [i](const std::vector<std::string>& v) { return v[i % v.size()]; };
+  const std::string wrong_type = pick({"abc", "true", "[1]", "{a: 1}"});
+  const std::string not_finite = pick({"nan", "inf", "-inf"});
+  const std::string out_of_range = pick({"-1", "1e300"});
+  switch (k) {
+    case Kind::kNumber: return {wrong_type, not_finite, out_of_range, ""};
+    case Kind::kRate: return {wrong_type, not_finite, out_of_range, "", "0", "1e-10", "1e-300"};
+    case Kind::kRigRate: return {wrong_type, not_finite, out_of_range, "", "1e-10", "1e-300"};  // (0: allowed)
+    case Kind::kInteger: return {"1.5", "-1", "100", "abc", "true", "nan", ""};
+    case Kind::kBool: return {"1", "0", "yes", "1.5", ""};
+    case Kind::kString: return {"5", "1.5", "true"};
+    case Kind::kPath: return {"5", "true", "/nonexistent_catenary_sim_dir/x.json", "/tmp"};
+    case Kind::kFrame: return {"5", "true", "", "/line"};
+    case Kind::kAtEnd: return {"1", "true", "", "rewind"};
+    case Kind::kScene: return {"5", "", "/nonexistent_catenary_sim_dir/s.yaml"};
+  }
+  return {};
+}
+
+void expect_rejected(const ChildRun& r, const std::string& what, const std::string& name) {
+  SCOPED_TRACE(what + "\n  output: " + r.out);
+  EXPECT_FALSE(r.hung) << "hung (killed)";
+  EXPECT_EQ(r.signal, 0) << "killed by signal " << r.signal;
+  EXPECT_NE(r.exit_code, 0) << "accepted";
+  EXPECT_NE(r.exit_code, -1);
+  EXPECT_NE(r.out.find("~" + name), std::string::npos) << "the message does not name ~" << name;
+}
+
+// `base`: valid parameters (the scene) that the fuzzed one replaces. The runs go kParallel at a
+// time (each waits on the master most of its time).
+constexpr int kParallel = 4;
+void fuzz(NodeParamsFuzz* t, const std::string& program, const std::vector<Param>& params,
+          const std::vector<std::pair<std::string, std::string>>& base, const std::string& stats_dir, int* count) {
+  struct Job {
+    std::string what, name;
+    std::vector<std::string> args;
+  };
+  std::vector<Job> jobs;
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const Param& p = params[i];
+    for (const std::string& v : bad_values(p.kind, i)) {
+      if (p.name == "speed_kmh" && v.empty()) continue;  // "" is "not given" (an empty launch argument)
+      Job j{program + " _" + p.name + ":=" + v, p.name, {program, "__name:=fuzz" + std::to_string(++t->runs_)}};
+      for (const auto& [n, bv] : base)
+        if (n != p.name) j.args.push_back("_" + n + ":=" + bv);
+      j.args.push_back("_" + p.name + ":=" + v);
+      jobs.push_back(j);
+    }
+  }
+  for (std::size_t first = 0; first < jobs.size(); first += kParallel) {
+    std::vector<std::unique_ptr<Child>> children;
+    for (std::size_t k = first; k < jobs.size() && k < first + kParallel; ++k)
+      children.push_back(std::make_unique<Child>(jobs[k].args, t->env_, t->dir_ + "/run" + std::to_string(k - first) + ".log"));
+    for (std::size_t k = 0; k < children.size(); ++k) {
+      const ChildRun r = children[k]->wait(20.0);
+      expect_rejected(r, jobs[first + k].what, jobs[first + k].name);
+      ++*count;
+    }
+  }
+  // Refused at start-up: nothing written (so nothing half-written and no NaN in a file).
+  for (const char* f : {"/stats.json", "/report.json"}) EXPECT_FALSE(exists(stats_dir + f)) << stats_dir << f;
+}
+
+}  // namespace
+
+TEST_F(NodeParamsFuzz, NodeRejectsEveryBadValueNamingTheParameter) {
+  const std::string out = dir_ + "/node";
+  mkdir(out.c_str(), 0755);
+  const std::vector<Param> params{
+      {"scene", Kind::kScene},           {"speed_kmh", Kind::kNumber},       {"real_time_factor", Kind::kNumber},
+      {"publish_rate", Kind::kRate},     {"shape_rate", Kind::kRate},        {"marker_rate", Kind::kRate},
+      {"shape_resolution", Kind::kNumber}, {"vertical_scale", Kind::kRate},  {"line_frame", Kind::kFrame},
+      {"at_end", Kind::kAtEnd},          {"stats_file", Kind::kPath},        {"publish_clock", Kind::kBool},
+      {"paused", Kind::kBool},           {"wait_for_viewer", Kind::kNumber}, {"max_acceleration", Kind::kNumber},
+      {"start_delay", Kind::kNumber}};
+  int count = 0;
+  fuzz(this, kNode, params, {{"scene", kScene}, {"stats_file", out + "/stats.json"}}, out, &count);
+  EXPECT_GT(count, 60);
+}
+
+TEST_F(NodeParamsFuzz, HilNodeRejectsEveryBadValueNamingTheParameter) {
+  const std::string out = dir_ + "/hil";
+  mkdir(out.c_str(), 0755);
+  const std::vector<Param> params{
+      {"scene", Kind::kScene},           {"speed_kmh", Kind::kNumber},       {"hil/rate", Kind::kRate},
+      {"hil/timeout", Kind::kNumber},    {"hil/extrapolate", Kind::kBool},   {"hil/hold_ramp", Kind::kNumber},
+      {"hil/hold_deceleration", Kind::kNumber}, {"hil/report_file", Kind::kPath},
+      {"hil/realtime_priority", Kind::kInteger}, {"hil/spin_wait", Kind::kNumber}, {"at_end", Kind::kAtEnd},
+      {"stats_file", Kind::kPath},       {"line_frame", Kind::kFrame},       {"publish_rate", Kind::kRate},
+      {"marker_rate", Kind::kRate},      {"start_delay", Kind::kNumber},     {"shape_rate", Kind::kRate},
+      {"shape_resolution", Kind::kNumber}};
+  int count = 0;
+  fuzz(this, kHilNode, params,
+       {{"scene", kHilScene}, {"stats_file", out + "/stats.json"}, {"hil/report_file", out + "/report.json"}}, out,
+       &count);
+  EXPECT_GT(count, 60);
+}
+
+TEST_F(NodeParamsFuzz, VirtualRigRejectsEveryBadValueNamingTheParameter) {
+  const std::string out = dir_ + "/rig";
+  mkdir(out.c_str(), 0755);
+  const std::vector<Param> params{{"pantograph_scene", Kind::kScene}, {"rate", Kind::kRigRate},
+                                  {"extrapolate", Kind::kBool}, {"report_file", Kind::kPath}};
+  int count = 0;
+  fuzz(this, kRig, params, {{"pantograph_scene", kScene}, {"report_file", out + "/report.json"}}, out, &count);
+  EXPECT_GT(count, 15);
+}
+
+// The issue's cases, by name: the messages say the value as given and what is allowed.
+TEST_F(NodeParamsFuzz, IssueCasesSayValueAndWhatIsAllowed) {
+  struct Case {
+    std::string arg, says;
+  };
+  for (const Case& c : {Case{"_publish_rate:=1e-10", "~publish_rate = 1e-10 rejected: allowed [1, 10000] Hz"},
+                        Case{"_marker_rate:=1e-300", "~marker_rate = 1e-300 rejected: allowed [0.1, 1000] Hz"},
+                        Case{"_at_end:=1", "~at_end = 1 (an integer) rejected: expected stop, loop or exit"},
+                        Case{"_line_frame:=5", "~line_frame = 5 (an integer) rejected: expected a frame id"},
+                        Case{"_stats_file:=/nonexistent_catenary_sim_dir/s.json",
+                             "~stats_file = '/nonexistent_catenary_sim_dir/s.json' rejected: cannot write"}}) {
+    const ChildRun r = run(kNode, {"_scene:=" + kScene, c.arg});
+    SCOPED_TRACE(c.arg + "\n  output: " + r.out);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.out.find(c.says), std::string::npos);
+  }
+}
+
+// Misspelt parameters are ignored with a warning naming them and the closest known name, for
+// every node; the warning comes before any error (so a typo that leaves a required parameter
+// unset is explained).
+TEST_F(NodeParamsFuzz, UnknownParametersAreWarnedAboutByName) {
+  ChildRun r = run(kNode, {"_vertical_scal:=5", "_real_time_facter:=0.5"});  // ~scene missing too
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("unknown parameter ~vertical_scal (ignored); did you mean ~vertical_scale?"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("unknown parameter ~real_time_facter (ignored); did you mean ~real_time_factor?"),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("~scene is required"), std::string::npos) << r.out;
+  r = run(kHilNode, {"_scene:=" + kHilScene, "_rate:=2000", "_hil/rate:=1"});
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("unknown parameter ~rate (ignored); did you mean ~hil/rate?"), std::string::npos) << r.out;
+  r = run(kRig, {"_pantograph_scen:=x", "_rate:=-1"});
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("unknown parameter ~pantograph_scen (ignored); did you mean ~pantograph_scene?"),
+            std::string::npos) << r.out;
+
+  // Only a warning: a pass with a misspelt parameter runs (and its statistics hold no NaN).
+  const std::string stats = dir_ + "/unknown_stats.json";
+  r = run(kNode, {"_scene:=" + kScene, "_speed_kmh:=250", "_real_time_factor:=0", "_at_end:=exit",
+                  "_publish_clock:=false", "_stats_file:=" + stats, "_vertical_scal:=5"},
+          60.0);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("unknown parameter ~vertical_scal (ignored)"), std::string::npos) << r.out;
+  const std::string json = slurp(stats);
+  EXPECT_NE(json.find("\"pantographs\""), std::string::npos) << json;
+  nlohmann::json parsed;
+  EXPECT_NO_THROW(parsed = nlohmann::json::parse(json)) << json;  // (a NaN or inf written would not parse)
+}
+
+// ~stats_file checked at start-up, but the directory removed during the pass: the end-of-pass
+// write fails, the node says so and exits 1 (not 0), and nothing is left behind.
+TEST_F(NodeParamsFuzz, StatsFileThatFailsAtTheEndFailsTheExitCode) {
+  const std::string out = dir_ + "/vanishing";
+  mkdir(out.c_str(), 0755);
+  const std::string log = dir_ + "/vanishing.log";
+  Child c({kNode, "__name:=vanishing", "_scene:=" + kScene, "_speed_kmh:=250", "_real_time_factor:=0",
+           "_at_end:=exit", "_publish_clock:=false", "_start_delay:=3", "_stats_file:=" + out + "/stats.json"},
+          env_, log);
+  ASSERT_TRUE(c.started());
+  // The start-up check has passed once the start delay is announced.
+  bool announced = false;
+  for (int i = 0; i < 600 && !announced; ++i) {
+    announced = slurp(log).find("(~start_delay)") != std::string::npos;
+    if (!announced) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_TRUE(announced) << slurp(log);
+  ASSERT_EQ(rmdir(out.c_str()), 0) << std::strerror(errno);
+  const ChildRun r = c.wait(60.0);
+  EXPECT_FALSE(r.hung);
+  EXPECT_EQ(r.signal, 0);
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("~stats_file: cannot write '" + out + "/stats.json'"), std::string::npos) << r.out;
+  EXPECT_FALSE(exists(out));
+}
+
+// The same for the HIL node's ~hil/report_file, written when the node is stopped (SIGINT).
+TEST_F(NodeParamsFuzz, HilReportFileThatFailsAtExitFailsTheExitCode) {
+  const std::string out = dir_ + "/vanishing_hil";
+  mkdir(out.c_str(), 0755);
+  const std::string log = dir_ + "/vanishing_hil.log";
+  Child c({kHilNode, "__name:=vanishing_hil", "_scene:=" + kHilScene, "_hil/report_file:=" + out + "/report.json"},
+          env_, log);
+  ASSERT_TRUE(c.started());
+  bool waiting = false;
+  for (int i = 0; i < 600 && !waiting; ++i) {
+    waiting = slurp(log).find("waiting for the first measurement") != std::string::npos;
+    if (!waiting) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_TRUE(waiting) << slurp(log);
+  ASSERT_EQ(rmdir(out.c_str()), 0) << std::strerror(errno);
+  kill(c.pid(), SIGINT);
+  const ChildRun r = c.wait(30.0);
+  EXPECT_FALSE(r.hung);
+  EXPECT_EQ(r.signal, 0);
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("~hil/report_file: cannot write '" + out + "/report.json'"), std::string::npos) << r.out;
+}
