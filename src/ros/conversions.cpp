@@ -264,6 +264,19 @@ std::vector<geometry_msgs::TransformStamped> to_transforms(const Model& m, const
   return out;
 }
 
+namespace {
+// rviz marks a whole display as Error for a list marker (LINE_LIST, LINE_STRIP, POINTS, ...) sent
+// with no points ("Points should not be empty"). An empty one is sent as DELETE of its id instead,
+// which also clears what it drew before (no slack dropper now, no steady arm in the scene).
+void add_list(visualization_msgs::MarkerArray& out, visualization_msgs::Marker mk) {
+  if (mk.points.empty()) {
+    mk.action = visualization_msgs::Marker::DELETE;
+    mk.colors.clear();
+  }
+  out.markers.push_back(mk);
+}
+}  // namespace
+
 visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const ros::Time& stamp,
                                            const MarkerOptions& o) {
   using visualization_msgs::Marker;
@@ -282,7 +295,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     mk.color = w.is_contact_wire ? color(0.85f, 0.55f, 0.2f) : color(0.6f, 0.6f, 0.65f);
     for (int i : sample_nodes(w, o.shape_resolution))
       mk.points.push_back(point(w.x[i] + s.line_offset, 0.0, w.height[i] + k * s.u[w.w_dof + i]));
-    out.markers.push_back(mk);
+    add_list(out, mk);
   }
 
   // Droppers: taut grey, slack red.
@@ -297,8 +310,8 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     mk.points.push_back(point(dr.x + s.line_offset, 0.0, shown(dr.contact_dof)));
     mk.points.push_back(point(dr.x + s.line_offset, 0.0, shown(dr.messenger_dof)));
   }
-  out.markers.push_back(taut);
-  out.markers.push_back(slack);  // an empty LINE_LIST clears the previous slack droppers
+  add_list(out, taut);
+  add_list(out, slack);
 
   if (o.include_static) {
     // Masts 3 m beside the track with a cantilever over the wires; steady arms to the contact wire.
@@ -314,7 +327,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
       masts.points.push_back(point(x, y_mast, top));
       masts.points.push_back(point(x, 0.0, top));
     }
-    out.markers.push_back(masts);
+    add_list(out, masts);
     Marker arms = marker(h, "steady_arms", 0, Marker::LINE_LIST);
     arms.scale.x = 0.03;
     arms.color = color(0.2f, 0.5f, 0.9f);
@@ -324,7 +337,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
       arms.points.push_back(point(sp.x + s.line_offset, y_mast, wire_dof_design_height(m, sp.dof)));
       arms.points.push_back(point(sp.x + s.line_offset, 0.0, z));
     }
-    out.markers.push_back(arms);
+    add_list(out, arms);
   }
 
   // Pantographs: head, frame, force arrow and label. The head is exaggerated about the design
@@ -357,7 +370,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     frame.points.push_back(point(x - 1.2, 0.0, z_roof));
     frame.points.push_back(point(x + 0.6, 0.0, 0.5 * (z_roof + z_head)));
     frame.points.push_back(point(x, 0.0, z_head - 0.06));
-    out.markers.push_back(frame);
+    add_list(out, frame);
 
     Marker arrow = marker(h, "contact_force", id, Marker::ARROW);
     arrow.scale.x = 0.05;  // shaft diameter

@@ -457,3 +457,42 @@ TEST_F(Fixture, StatisticsJsonHasPantographs) {
   EXPECT_NE(j.find("\"pantographs\""), std::string::npos);
   EXPECT_NE(j.find("\"overruns\": 3"), std::string::npos);
 }
+
+// rviz turns the whole display to Error for a list marker sent with no points ("Points should not
+// be empty"): no ADD of a LINE_LIST, LINE_STRIP, POINTS, CUBE_LIST, SPHERE_LIST or TRIANGLE_LIST
+// may be empty, in any state: no dropper slack (the usual case), every dropper slack, an overlap,
+// a moving force, a scene without droppers or steady arms, an external (HIL) pantograph.
+TEST(Markers, NoListMarkerIsEverSentEmpty) {
+  using visualization_msgs::Marker;
+  auto check = [](const visualization_msgs::MarkerArray& arr, const std::string& what) {
+    for (const Marker& mk : arr.markers) {
+      const bool list = mk.type == Marker::LINE_LIST || mk.type == Marker::LINE_STRIP || mk.type == Marker::POINTS ||
+                        mk.type == Marker::CUBE_LIST || mk.type == Marker::SPHERE_LIST || mk.type == Marker::TRIANGLE_LIST;
+      if (list && mk.action == Marker::ADD) {
+        EXPECT_FALSE(mk.points.empty()) << what << ": " << mk.ns << "/" << mk.id;
+      }
+    }
+  };
+  const std::string dir = std::string(CATENARY_SIM_SOURCE_DIR) + "/config/";
+  for (const char* scene : {"reference_55m.yaml", "calpe_example.yaml", "reference_55m_hil.yaml", "reference_55m_two_sections.yaml"}) {
+    Simulation sim(load_scene_file(dir + scene));
+    MarkerOptions o;
+    const auto idle = to_markers(sim.model(), sim.state(), ros::Time(1.0), o);
+    check(idle, std::string(scene) + " at the start");
+    // The slack droppers' marker is there, as a DELETE, when none is slack: it clears the last ones.
+    bool slack_deleted = sim.model().droppers.empty();
+    for (const Marker& mk : idle.markers)
+      if (mk.ns == "droppers" && mk.id == 1) slack_deleted = mk.action == Marker::DELETE;
+    EXPECT_TRUE(slack_deleted) << scene;
+    State s = sim.state();
+    std::fill(s.dropper_slack.begin(), s.dropper_slack.end(), 1);
+    check(to_markers(sim.model(), s, ros::Time(1.0), o), std::string(scene) + " all droppers slack");
+    for (int i = 0; i < 2000 && sim.step() == StepStatus::kOk; ++i) {
+    }
+    check(to_markers(sim.model(), sim.state(), ros::Time(2.0), o), std::string(scene) + " during the pass");
+  }
+  Simulation wire(load_scene_string(
+      "line: {span_length: 50.0, span_count: 2}\ncontact_wire: {linear_mass: 1.35, tension: 20000.0}\n"
+      "pantographs: [{name: f, type: moving_force, static_uplift: 100}]\ntrain: {speed: 50.0}\n"));
+  check(to_markers(wire.model(), wire.state(), ros::Time(1.0), MarkerOptions{}), "a single wire (no droppers, no arms)");
+}

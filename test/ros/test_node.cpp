@@ -315,6 +315,24 @@ TEST(Node, UpliftCommandRaisesTheMeanContactForceAndResetStartsANewPass) {
   send_uplift({100.0});
 }
 
+// The live marker array never holds an empty list marker (rviz would mark the display Error):
+// over two seconds of a pass, every LINE_LIST / LINE_STRIP / POINTS added has points.
+TEST(Node, LiveMarkersHaveNoEmptyListMarker) {
+  using visualization_msgs::Marker;
+  Recorder<visualization_msgs::MarkerArray> markers("markers");
+  ASSERT_TRUE(wait_for([&] { return markers.size() >= 20; }, 10.0)) << markers.size();
+  std::size_t lists = 0;
+  for (const auto& arr : markers.take())
+    for (const Marker& mk : arr.markers) {
+      const bool list = mk.type == Marker::LINE_LIST || mk.type == Marker::LINE_STRIP || mk.type == Marker::POINTS;
+      if (list && mk.action == Marker::ADD) {
+        ++lists;
+        EXPECT_FALSE(mk.points.empty()) << mk.ns << "/" << mk.id;
+      }
+    }
+  EXPECT_GT(lists, 20u);
+}
+
 // gazebo_ros behaviour: /clock keeps coming while paused (at shape_rate, 10 Hz here) with the
 // paused time, so that a /use_sim_time node started during a pause gets its time at once.
 TEST(Node, ClockIsPublishedWhilePausedAtThePausedTime) {

@@ -176,6 +176,7 @@ TEST(FuzzBadInput, SetOverridesOfEveryField) {
                      {f.message}}, dir, &count);
   }
   RecordProperty("cases", count);
+  std::system(("rm -rf '" + dir + "'").c_str());
 }
 
 TEST(FuzzBadInput, OverridePathsAndValues) {
@@ -232,6 +233,7 @@ TEST(FuzzBadInput, OverridePathsAndValues) {
   expect_rejected(kElasticity, {"elasticity: --step 0", {"--scene", kReference, "--step", "0"}, {"--step"}}, dir, &count);
   expect_rejected(kElasticity, {"elasticity: unknown flag", {"--scene", kReference, "--stepp", "1"}, {"--stepp"}}, dir, &count);
   RecordProperty("cases", count);
+  std::system(("rm -rf '" + dir + "'").c_str());
 }
 
 TEST(FuzzBadInput, CorruptedSceneFiles) {
