@@ -116,6 +116,8 @@ constexpr double kLabelLineHeight = 0.6;         // m per line of text at that s
 constexpr double kLabelClearance = 2.0;          // m between the drawn head and the label's last line
                                                  // (clear of the arrow up to 200 N)
 
+}  // namespace
+
 // Contact wire name as the label shows it: "contact_wire..." shortened to "cw..." so that the
 // forces of two wires fit on one line ("cw_s0 47 / cw_s1 62 N").
 std::string label_wire_name(const std::string& name) {
@@ -123,7 +125,6 @@ std::string label_wire_name(const std::string& name) {
   return name.compare(0, prefix.size(), prefix) == 0 ? "cw" + name.substr(prefix.size()) : name;
 }
 
-}  // namespace
 
 ros::Time sim_stamp(double sim_time, double offset) { return ros::Time(sim_time + offset); }
 
@@ -352,16 +353,44 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     const double force = total_contact_force(m, s, id);
     const bool contact = force > 0.0;
 
-    Marker head = marker(h, "pantograph_head", id, pg.moving_force ? Marker::SPHERE : Marker::CUBE);
-    head.pose.position = point(x, 0.0, z_head - 0.03);
-    if (pg.moving_force) head.scale.x = head.scale.y = head.scale.z = 0.2;
+    // A plain moving force is a point; a pantograph (lumped, or a real one on a rig) has a head:
+    // its collector strips across the track (carbon, 1.2 m working width) on a frame, and horns
+    // curving down at both ends.
+    const bool point_force = pg.moving_force && !pg.external;
+    Marker head = marker(h, "pantograph_head", id, point_force ? Marker::SPHERE : Marker::CUBE);
+    head.pose.position = point(x, 0.0, z_head - 0.05);
+    if (point_force) head.scale.x = head.scale.y = head.scale.z = 0.2;
     else {
-      head.scale.x = 0.3;
-      head.scale.y = 1.6;
-      head.scale.z = 0.06;
+      head.scale.x = 0.1;
+      head.scale.y = 1.2;
+      head.scale.z = 0.04;
     }
-    head.color = contact ? color(0.1f, 0.1f, 0.1f) : color(1.0f, 0.1f, 0.1f);
+    head.color = contact ? color(0.25f, 0.25f, 0.28f) : color(1.0f, 0.1f, 0.1f);
     out.markers.push_back(head);
+    if (!point_force) {
+      Marker strips = marker(h, "pantograph_strips", id, Marker::CUBE_LIST);
+      strips.scale.x = 0.035;  // strip width along the track
+      strips.scale.y = 1.2;    // working width
+      strips.scale.z = 0.03;
+      strips.color = contact ? color(0.05f, 0.05f, 0.05f) : color(1.0f, 0.1f, 0.1f);
+      for (int ci : pg.collectors) strips.points.push_back(point(x + m.collectors[ci].offset, 0.0, z_head - 0.015));
+      add_list(out, strips);
+      Marker horns = marker(h, "pantograph_horns", id, Marker::LINE_LIST);
+      horns.scale.x = 0.03;
+      horns.color = color(0.3f, 0.3f, 0.32f);
+      for (double side : {-1.0, 1.0}) {  // from the strip's end out and down: a quarter arc in 4 pieces
+        double py = side * 0.6, pz = z_head - 0.03;
+        for (int i = 1; i <= 4; ++i) {
+          const double a = 0.5 * M_PI * i / 4.0;
+          const double ny = side * (0.6 + 0.25 * std::sin(a)), nz = z_head - 0.03 - 0.25 * (1.0 - std::cos(a));
+          horns.points.push_back(point(x, py, pz));
+          horns.points.push_back(point(x, ny, nz));
+          py = ny;
+          pz = nz;
+        }
+      }
+      add_list(out, horns);
+    }
 
     Marker frame = marker(h, "pantograph_frame", id, Marker::LINE_STRIP);
     frame.scale.x = 0.05;
@@ -409,6 +438,85 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     label.text = t.str();
     out.markers.push_back(label);
   }
+  return out;
+}
+
+visualization_msgs::MarkerArray to_strip_chart(const ChartData& d, const ros::Time& stamp, const ChartOptions& o) {
+  using visualization_msgs::Marker;
+  visualization_msgs::MarkerArray out;
+  std_msgs::Header h;
+  h.stamp = stamp;
+  h.frame_id = o.frame;
+  const double t1 = d.time.empty() ? 0.0 : d.time.back(), t0 = t1 - o.window;
+  double fmax = o.force_max;
+  for (const ChartSeries& s : d.series)
+    for (double f : s.force)
+      if (std::isfinite(f)) fmax = std::max(fmax, 100.0 * std::ceil(f / 100.0));
+  // A point of the panel: u along the time axis (m from the left edge), z height.
+  auto at = [&](double u, double z) { return point(o.origin_x + u * o.dir_x, o.origin_y + u * o.dir_y, z); };
+  auto pu = [&](double t) { return o.width * (t - t0) / o.window; };
+  auto pz = [&](double f) { return o.z_bottom + o.height * std::clamp(f, 0.0, fmax) / fmax; };
+  auto text = [&](const char* ns, int id, double u, double z, const std::string& str, std_msgs::ColorRGBA c) {
+    Marker t = marker(h, ns, id, Marker::TEXT_VIEW_FACING);
+    t.scale.z = o.text;
+    t.color = c;
+    t.pose.position = at(u, z);
+    t.text = str;
+    out.markers.push_back(t);
+  };
+  const std_msgs::ColorRGBA light = color(0.92f, 0.92f, 0.92f);
+
+  Marker axes = marker(h, "chart_axes", 0, Marker::LINE_LIST);
+  axes.scale.x = 0.03;
+  axes.color = light;
+  Marker grid = marker(h, "chart_axes", 1, Marker::LINE_LIST);
+  grid.scale.x = 0.015;
+  grid.color = color(0.92f, 0.92f, 0.92f, 0.3f);
+  auto seg = [&](Marker& m, double u0, double z0, double u1, double z1) {
+    m.points.push_back(at(u0, z0));
+    m.points.push_back(at(u1, z1));
+  };
+  seg(axes, 0.0, o.z_bottom, o.width, o.z_bottom);          // time axis
+  seg(axes, 0.0, o.z_bottom, 0.0, o.z_bottom + o.height);   // force axis
+  int id = 0;
+  for (double f = 0.0; f <= fmax + 1e-9; f += 100.0) {
+    if (f > 0.0) seg(grid, 0.0, pz(f), o.width, pz(f));
+    std::ostringstream t;
+    t << static_cast<int>(f) << (f + 100.0 > fmax + 1e-9 ? " N" : "");
+    text("chart_ticks", id++, -0.7, pz(f), t.str(), light);
+  }
+  for (int k = 0; k <= static_cast<int>(o.window); ++k) {  // a tick a second, from now back
+    const double u = pu(t1 - k);
+    if (u >= 0.0) seg(axes, u, o.z_bottom, u, o.z_bottom - 0.15);
+  }
+  std::ostringstream tl;
+  tl << "contact force, last " << o.window << " s (a tick a second)";
+  text("chart_ticks", id++, 0.5 * o.width, o.z_bottom - 0.5, tl.str(), light);
+  add_list(out, axes);
+  add_list(out, grid);
+
+  // One strip per series, colours that differ on rviz's dark background.
+  static const float palette[][3] = {{0.2f, 0.9f, 0.3f}, {1.0f, 0.75f, 0.2f}, {0.4f, 0.7f, 1.0f}, {1.0f, 0.4f, 0.8f},
+                                     {0.9f, 0.9f, 0.3f}, {0.6f, 1.0f, 0.9f}};
+  for (std::size_t k = 0; k < d.series.size(); ++k) {
+    const float* c = palette[k % 6];
+    Marker strip = marker(h, "chart_series", static_cast<int>(k), Marker::LINE_STRIP);
+    strip.scale.x = 0.05;
+    strip.color = color(c[0], c[1], c[2]);
+    const ChartSeries& s = d.series[k];
+    for (std::size_t i = 0; i < d.time.size() && i < s.force.size(); ++i)
+      if (d.time[i] >= t0 && std::isfinite(s.force[i])) strip.points.push_back(at(pu(d.time[i]), pz(s.force[i])));
+    if (strip.points.size() == 1) strip.points.push_back(strip.points.front());  // a strip needs two
+    add_list(out, strip);
+    // The legend under the time axis's label, one line a series.
+    text("chart_legend", static_cast<int>(k), 0.5 * o.width, o.z_bottom - 1.0 - 0.45 * static_cast<double>(k), s.name,
+         strip.color);
+  }
+  std::ostringstream it;
+  it << d.heading;
+  for (const std::string& line : d.stats) it << "\n" << line;
+  const double lines = 1.0 + static_cast<double>(d.stats.size());
+  text("chart_info", 0, 0.5 * o.width, o.z_bottom + o.height + 0.3 + 0.6 * lines * o.text, it.str(), color(1.0f, 1.0f, 1.0f));
   return out;
 }
 

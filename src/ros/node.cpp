@@ -5,6 +5,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cmath>
+#include <iomanip>
 #include <cstdio>
 #include <algorithm>
 #include <limits>
@@ -12,6 +13,7 @@
 
 #include "catenary_sim/ContactForceArray.h"
 #include "catenary_sim/PantographStateArray.h"
+#include "catenary_sim/LineState.h"
 #include "catenary_sim/PassEvent.h"
 #include "catenary_sim/WireShapeArray.h"
 #include "catenary_sim/core/output_files.hpp"
@@ -21,6 +23,14 @@ namespace catenary_sim {
 namespace ros_layer {
 
 namespace {
+// Span of the train front along the line, counted from 0 (an endless line's spans go on).
+long span_along_line(const Model& m, const State& s) {
+  if (m.endless) return static_cast<long>(std::floor((s.front + s.line_offset) / m.endless_span));
+  const auto it = std::upper_bound(m.support_x.begin(), m.support_x.end(), s.front);
+  const long i = static_cast<long>(it - m.support_x.begin()) - 1;
+  return std::clamp<long>(i, 0, static_cast<long>(m.support_x.size()) - 2);
+}
+
 // Sample rate of the recorder's decimated time series (unused by the node; statistics use every step).
 constexpr double kRecorderRowRate = 10.0;
 // At real_time_factor > 0, a tick may take this many times its nominal share of steps before the
@@ -49,6 +59,7 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   if (params_.publish_clock) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   status_pub_ = nh_.advertise<std_msgs::String>("pass_status", 1, true);
   events_pub_ = nh_.advertise<PassEvent>("events", 100);
+  line_state_pub_ = nh_.advertise<LineState>("line_state", 10);
   speed_sub_ = nh_.subscribe("cmd/train_speed", 10, &SimulationNode::on_speed, this);
   uplift_sub_ = nh_.subscribe("cmd/uplift_force", 10, &SimulationNode::on_uplift, this);
   reset_srv_ = pnh_.advertiseService("reset", &SimulationNode::on_reset, this);
@@ -75,6 +86,76 @@ void SimulationNode::restart_recording() {
   loss_station_ = loss_since_;
   recorder_ = std::make_unique<PassRecorder>(sim_->model(), kRecorderRowRate);
   recorder_->record(sim_->model(), sim_->state());
+  running_.assign(sim_->model().pantographs.size(), Running{});
+  arm_max_uplift_.assign(sim_->model().springs.size(), 0.0);
+  chart_ = ChartData{};
+  last_chart_time_ = -1.0;
+}
+
+void SimulationNode::sample_chart() {
+  const Model& m = sim_->model();
+  const State& s = sim_->state();
+  if (s.time == last_chart_time_) return;
+  last_chart_time_ = s.time;
+  const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
+  if (chart_.series.empty()) {
+    for (std::size_t p = 0; p < np; ++p) {
+      chart_.series.push_back({m.pantographs[p].name, {}});
+      if (nw > 1)
+        for (std::size_t k = 0; k < nw; ++k)
+          chart_.series.push_back({m.pantographs[p].name + " on " + label_wire_name(m.wires[m.contact_wires[k]].name), {}});
+    }
+  }
+  chart_.time.push_back(s.time);
+  std::size_t j = 0;
+  for (std::size_t p = 0; p < np; ++p) {
+    const double f = total_contact_force(m, s, static_cast<int>(p));
+    chart_.series[j++].force.push_back(f);
+    Running& r = running_[p];
+    r.n += 1;
+    r.sum += f;
+    r.sum2 += f * f;
+    r.max = std::max(r.max, f);
+    r.min = std::min(r.min, f);
+    if (nw > 1)
+      for (std::size_t k = 0; k < nw; ++k) {
+        double fk = 0.0;
+        for (int ci : m.pantographs[p].collectors) fk += s.contact_force[ci * nw + k];
+        chart_.series[j++].force.push_back(fk);
+      }
+  }
+  // Keep the window (and a sample before it, so the strip starts at the panel's edge).
+  std::size_t drop = 0;
+  while (drop + 1 < chart_.time.size() && chart_.time[drop + 1] < s.time - params_.chart_window) ++drop;
+  if (drop > 0) {
+    chart_.time.erase(chart_.time.begin(), chart_.time.begin() + drop);
+    for (ChartSeries& c : chart_.series) c.force.erase(c.force.begin(), c.force.begin() + drop);
+  }
+  for (std::size_t k = 0; k < m.springs.size(); ++k)
+    if (m.springs[k].steady_arm) arm_max_uplift_[k] = std::max(arm_max_uplift_[k], s.u[m.springs[k].dof]);
+}
+
+void SimulationNode::publish_line_state(const ros::Time& stamp) {
+  const Model& m = sim_->model();
+  const State& s = sim_->state();
+  LineState ls;
+  ls.header.stamp = stamp;
+  ls.header.frame_id = params_.line_frame;
+  ls.sim_time = s.time;
+  for (std::uint8_t d : s.dropper_slack) ls.slack_droppers += d;
+  const double reach = m.longest_span;
+  for (std::size_t k = 0; k < m.springs.size(); ++k) {
+    const SupportSpring& sp = m.springs[k];
+    if (!sp.steady_arm) continue;
+    bool near = false;
+    for (std::size_t p = 0; p < m.pantographs.size(); ++p)
+      near = near || std::fabs(sp.x - (s.front - m.pantographs[p].position)) <= reach;
+    if (!near) continue;
+    ls.steady_arm_station.push_back(sp.x + s.line_offset);
+    ls.steady_arm_uplift.push_back(s.u[sp.dof]);
+    ls.steady_arm_max_uplift.push_back(arm_max_uplift_[k]);
+  }
+  line_state_pub_.publish(ls);
 }
 
 void SimulationNode::reanchor() {
@@ -218,6 +299,8 @@ std::int64_t SimulationNode::do_steps(std::int64_t n, const ros::WallTime* deadl
     const State& s = sim_->state();
     recorder_->record(m, s);
     track_contact_loss();  // every step: the events resolve dt, not the publishing tick
+    // The chart's samples on simulated time (a thousand per window), also when ~step jumps ahead.
+    if (params_.strip_chart && s.time - last_chart_time_ >= 1e-3 * params_.chart_window) sample_chart();
     if (deadline && (done & 31) == 31 && ros::WallTime::now() >= *deadline) {
       ++done;
       break;
@@ -326,6 +409,7 @@ void SimulationNode::report_statistics() {
 void SimulationNode::publish(bool force) {
   const Model& m = sim_->model();
   const State& s = sim_->state();
+  if (params_.strip_chart && last_chart_time_ < 0.0) sample_chart();  // the initial state
   const ros::WallTime now = ros::WallTime::now();
   const ros::Time stamp = sim_stamp(s.time, 0.0);
   const bool advanced = s.time > last_published_time_;
@@ -353,6 +437,7 @@ void SimulationNode::publish(bool force) {
     if (shape_due || force) {
       last_shape_wall_ = now;
       shape_pub_.publish(to_wire_shape(m, s, params_.shape_resolution, stamp, params_.line_frame));
+      publish_line_state(stamp);
     }
   }
 
@@ -365,7 +450,34 @@ void SimulationNode::publish(bool force) {
       o.frame = params_.line_frame;
       o.vertical_scale = params_.vertical_scale;
       o.shape_resolution = params_.shape_resolution;
-      marker_pub_.publish(to_markers(m, s, stamp, o));
+      visualization_msgs::MarkerArray arr = to_markers(m, s, stamp, o);
+      if (params_.strip_chart) {
+        // The heads-up line and the statistics so far (unfiltered: the filtered ones need the
+        // whole pass, zero-phase), in the chart's panel, which follows the train.
+        std::ostringstream head;
+        head << std::fixed << std::setprecision(1) << "x " << s.front + s.line_offset << " m  span "
+             << span_along_line(m, s) + 1 << "  t " << std::setprecision(2) << s.time << " s  "
+             << std::setprecision(2);
+        if (paused_ || waiting_ || ended_ || sim_->finished()) head << (paused_ ? "paused" : ended_ || sim_->finished() ? "ended" : "waiting");
+        else head << achieved_rtf_ << "x real time";
+        head << "  vertical x" << std::setprecision(0) << params_.vertical_scale;
+        chart_.heading = head.str();
+        chart_.stats.clear();
+        for (std::size_t p = 0; p < running_.size(); ++p) {
+          const Running& r = running_[p];
+          if (r.n < 1) continue;
+          const double mean = r.sum / r.n, sd = std::sqrt(std::max(0.0, r.sum2 / r.n - mean * mean));
+          std::ostringstream t;
+          t << std::fixed << std::setprecision(0) << m.pantographs[p].name << ": mean " << mean << ", std " << sd
+            << ", max " << r.max << ", min " << r.min << " N (so far, unfiltered)";
+          chart_.stats.push_back(t.str());
+        }
+        ChartOptions co;
+        co.window = params_.chart_window;
+        const visualization_msgs::MarkerArray chart = to_strip_chart(chart_, stamp, co);
+        arr.markers.insert(arr.markers.end(), chart.markers.begin(), chart.markers.end());
+      }
+      marker_pub_.publish(arr);
       // The camera's frame moves with the markers, same stamp. A repeated stamp (holding) is not
       // sent again: tf2 would warn TF_REPEATED_DATA, and the last transform stays in effect.
       if (stamp != last_view_stamp_) {
@@ -499,6 +611,7 @@ void SimulationNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   else if (ended_ || sim_->finished()) stat.summary(DiagnosticStatus::OK, "pass finished");
   else stat.summary(DiagnosticStatus::OK, "running");
 
+  achieved_rtf_ = holding ? 0.0 : rtf;
   if (holding) stat.add("real_time_factor (achieved)", "not stepping (" + status_ + ")");
   else stat.add("real_time_factor (achieved)", rtf);
   stat.add("real_time_factor (requested, 0 = max)", params_.real_time_factor);

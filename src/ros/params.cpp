@@ -226,6 +226,7 @@ const Range kVerticalScale{kMinVerticalScale, 10000.0, false, ""};
 const Range kMaxAcceleration{0.0, 20.0, false, "m/s^2 (0: no limit)"};
 const Range kStartDelay{0.0, 60.0, false, "s"};
 const Range kWaitForViewer{0.0, 600.0, false, "s (0: no wait)"};
+const Range kChartWindow{0.5, 60.0, false, "s"};
 
 void check(const char* name, double v, const Range& r) { check_range(name, v, r.lo, r.hi, r.lo_open, r.unit); }
 }  // namespace
@@ -242,6 +243,7 @@ void validate(const NodeParams& p) {
   check("max_acceleration", p.max_acceleration, kMaxAcceleration);
   check("start_delay", p.start_delay, kStartDelay);
   check("wait_for_viewer", p.wait_for_viewer, kWaitForViewer);
+  check("chart_window", p.chart_window, kChartWindow);
   check_frame_id("line_frame", p.line_frame);
 }
 
@@ -260,7 +262,7 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   ParamReader r(nh, "catenary_sim",
                 {"scene", "speed_kmh", "real_time_factor", "publish_rate", "shape_rate", "marker_rate",
                  "shape_resolution", "vertical_scale", "line_frame", "at_end", "stats_file", "publish_clock",
-                 "paused", "wait_for_viewer", "max_acceleration", "start_delay",
+                 "paused", "wait_for_viewer", "max_acceleration", "start_delay", "strip_chart", "chart_window",
                  "diagnostic_period"});  // (the last read by diagnostic_updater)
   NodeParams p;
   r.text("scene", p.scene, "the path of a scene YAML file");
@@ -281,6 +283,8 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   r.text("stats_file", p.stats_file, "a file path (empty: none)");
   r.boolean("publish_clock", p.publish_clock);
   r.boolean("paused", p.paused);
+  r.boolean("strip_chart", p.strip_chart);
+  r.number("chart_window", p.chart_window, kChartWindow.text());
   validate(p);
   check_output_param("stats_file", p.stats_file);
   return p;

@@ -70,6 +70,37 @@ struct MarkerOptions {
   bool include_static = true;     // masts and steady arms (constant parts)
 };
 
+// The contact-force strip chart drawn in rviz beside the line (issue: "see the force"): the last
+// `window` seconds of one or more series (per pantograph, and per contact wire in overlaps), in a
+// panel in the train-following frame, with a force axis (ticks every 100 N), a time axis, a legend,
+// the statistics so far and a heads-up line (station, span, time, real-time factor, scale).
+// A contact wire's name shortened for labels: "contact_wire_s1" -> "cw_s1".
+std::string label_wire_name(const std::string& name);
+
+struct ChartSeries {
+  std::string name;
+  std::vector<double> force;  // N, one per sample of ChartData::time
+};
+struct ChartData {
+  std::vector<double> time;          // s, simulated, increasing
+  std::vector<ChartSeries> series;
+  std::vector<std::string> stats;    // one line per pantograph: "leading: mean 99 N, std 41 N, ..."
+  std::string heading;               // the heads-up line
+};
+struct ChartOptions {
+  std::string frame = "train_view";  // follows the train (to_view_transform)
+  double window = 5.0;               // s shown
+  // The panel faces the default view of config/catenary_sim.rviz (an orbit 16 m from (-5, 0, 6) in
+  // train_view at yaw -0.45): its time axis runs along (dir_x, dir_y), the camera's right, and it
+  // sits in the upper left of that view, clear of the line and the head.
+  double origin_x = -8.6, origin_y = -7.2, z_bottom = 7.7;  // m: the bottom-left corner
+  double dir_x = 0.442, dir_y = 0.897;                       // unit, horizontal
+  double width = 8.0, height = 2.6;                          // m
+  double text = 0.36;                                        // m, text height
+  double force_max = 300.0;          // N at the top (grows to the next 100 N above the data)
+};
+visualization_msgs::MarkerArray to_strip_chart(const ChartData& d, const ros::Time& stamp, const ChartOptions& o);
+
 // Wire line strips, droppers (slack in red), masts and steady arms, pantograph head and frame,
 // contact-force arrows (1 m per 100 N) and a white text label (0.5 m) with the force, per contact
 // wire under the pantograph when the line has several, and the speed. Vertical displacements are

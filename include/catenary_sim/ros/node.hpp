@@ -20,6 +20,7 @@
 #include "catenary_sim/Step.h"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/ros/params.hpp"
 
 namespace catenary_sim {
@@ -59,6 +60,9 @@ class SimulationNode {
   void wait_for_viewer();
   // Publishes `pass_status` (latched) when it changes: waiting, running, paused, ended, diverged.
   void publish_status();
+  // The strip chart's samples (one per publishing tick) and running statistics, and LineState.
+  void sample_chart();
+  void publish_line_state(const ros::Time& stamp);
   // Contact-loss events per pantograph (a physics result, on `events`, not on /diagnostics).
   void track_contact_loss();
 
@@ -67,7 +71,8 @@ class SimulationNode {
   std::unique_ptr<Simulation> sim_;
   std::unique_ptr<PassRecorder> recorder_;
 
-  ros::Publisher contact_pub_, pantograph_pub_, shape_pub_, marker_pub_, clock_pub_, status_pub_, events_pub_;
+  ros::Publisher contact_pub_, pantograph_pub_, shape_pub_, marker_pub_, clock_pub_, status_pub_, events_pub_,
+      line_state_pub_;
   ros::Subscriber speed_sub_, uplift_sub_;
   ros::ServiceServer reset_srv_, pause_srv_, step_srv_;
   tf2_ros::TransformBroadcaster tf_;
@@ -78,6 +83,14 @@ class SimulationNode {
   bool waiting_ = false;                // waiting for a viewer or ~start_delay
   // Per pantograph: in a contact loss since this simulated time and station (NaN: in contact).
   std::vector<double> loss_since_, loss_station_;
+  ChartData chart_;                       // samples within the chart window
+  struct Running {                        // unfiltered contact force so far in this pass
+    double n = 0, sum = 0, sum2 = 0, max = -1e300, min = 1e300;
+  };
+  std::vector<Running> running_;          // per pantograph
+  double last_chart_time_ = -1.0;
+  double achieved_rtf_ = 0.0;             // over the last diagnostics period (0 while holding)
+  std::vector<double> arm_max_uplift_;    // per steady arm (model spring index order), this pass
 
   // Stamps are simulated time, as gazebo_ros does (docs/user_guide.md, "Time"): no offset.
   bool paused_ = false;

@@ -118,6 +118,8 @@ struct NodeParams {
   double max_acceleration = 1.0;    // ~max_acceleration: m/s^2 toward commanded speeds, [0, 20] (0: jump)
   double start_delay = 0.0;         // ~start_delay: s (wall) publishing the initial state before stepping, [0, 60]
                                     //   (lets rosbag record / rviz connect before a fast pass is over)
+  bool strip_chart = true;          // ~strip_chart: draw the contact-force strip chart with the markers
+  double chart_window = 5.0;        // ~chart_window: s of simulated time the strip chart shows, [0.5, 60]
 };
 
 // Throws ParamError for any value out of range (message: parameter, value, allowed range).
