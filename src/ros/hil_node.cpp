@@ -248,6 +248,12 @@ void HilNode::poll_control() {
     const bool holding = mode_ == Mode::kHold || (mode_ == Mode::kPaused && paused_from_ == Mode::kHold);
     std::string err;
     if (!holding) sim_->set_target_speed(commanded_speed_, &err);  // (checked: cannot fail)
+    if (mode_ == Mode::kWaiting) {
+      // Not started: the pass starts at the commanded speed (the line is at its initial static
+      // state; reset() with the static force needs no new static solve and changes nothing else).
+      for (int p : external_) sim_->set_external_force(p, sim_->state().uplift[p], nullptr);
+      sim_->reset(true);
+    }
   }
   if (!ctrl_posted_) return;
   std::unique_lock<std::mutex> l(ctrl_mu_, std::try_to_lock);

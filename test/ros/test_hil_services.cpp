@@ -36,7 +36,6 @@ using namespace catenary_sim;
 namespace {
 
 constexpr double kForce = 120.0;     // N, what the rig measures (static uplift 100 N)
-constexpr double kSpeed = 100.0 / 3.6;  // m/s, ~speed_kmh
 
 std::mutex mu;
 ContactPointArray last;               // newest contact point
@@ -140,6 +139,15 @@ TEST(HilServices, ArmPauseSpeedResetStopAndArmAgain) {
   expect_refused(trigger("reset"), p, true, "reset while waiting");
   expect_refused(trigger("stop"), p, true, "stop while waiting");
 
+  // A speed commanded before the start is the speed the pass starts at (not ~speed_kmh's).
+  EXPECT_NEAR(first.speed, 100.0 / 3.6, 1e-9);
+  std_msgs::Float64 v;
+  v.data = 15.0;
+  speed_pub.publish(v);
+  ASSERT_TRUE(wait_for([] { return point().speed == 15.0; }, 10.0)) << point().speed;
+  EXPECT_EQ(name(point().mode), "WAITING");
+  EXPECT_EQ(point().step, first.step);
+
   // 2. ~arm: the pass starts with the rig's measurements; a second ~arm is refused.
   std_srvs::Trigger::Response r = trigger("arm");
   EXPECT_TRUE(r.success) << r.message;
@@ -147,7 +155,7 @@ TEST(HilServices, ArmPauseSpeedResetStopAndArmAgain) {
   ASSERT_TRUE(wait_for([] { return point().step > 1000; }, 20.0)) << point().step;
   p = point();
   EXPECT_DOUBLE_EQ(p.pantographs.at(0).applied_force, kForce);
-  EXPECT_DOUBLE_EQ(p.speed, kSpeed);
+  EXPECT_DOUBLE_EQ(p.speed, 15.0);
   r = trigger("arm");
   EXPECT_FALSE(r.success) << r.message;
   EXPECT_NE(r.message.find("running"), std::string::npos) << r.message;  // says why
@@ -163,9 +171,8 @@ TEST(HilServices, ArmPauseSpeedResetStopAndArmAgain) {
     EXPECT_NEAR(last.simulation_time, static_cast<double>(last.step) * last.dt, 1e-6);
   }
 
-  // 4. cmd/train_speed: the train slows to 10 m/s at 20 m/s^2; 200 m/s is rejected with the pass
+  // 4. cmd/train_speed while running: the train slows to 10 m/s at 20 m/s^2; 200 m/s is rejected with the pass
   // node's message and changes nothing.
-  std_msgs::Float64 v;
   v.data = 10.0;
   speed_pub.publish(v);
   ASSERT_TRUE(wait_for([] { return point().speed == 10.0; }, 20.0)) << point().speed;
