@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <limits>
 #include <sstream>
+
+#include "catenary_sim/core/simulation.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
@@ -125,6 +128,14 @@ std::string label_wire_name(const std::string& name) {
   return name.compare(0, prefix.size(), prefix) == 0 ? "cw" + name.substr(prefix.size()) : name;
 }
 
+
+std::string speed_command_error(double v) {
+  if (std::isfinite(v) && v >= 0.0 && v <= Simulation::kMaxSpeed) return "";
+  char what[160];
+  std::snprintf(what, sizeof what, "cmd/train_speed = %g m/s rejected: allowed 0 to %g m/s (%g km/h)", v,
+                Simulation::kMaxSpeed, Simulation::kMaxSpeed * 3.6);
+  return what;
+}
 
 ros::Time sim_stamp(double sim_time, double offset) { return ros::Time(sim_time + offset); }
 

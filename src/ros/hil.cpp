@@ -112,6 +112,7 @@ ContactPointArray to_contact_points(const Model& m, const State& s, const ros::T
   ContactPointArray out;
   out.header.stamp = stamp;
   out.header.frame_id = frame;
+  out.simulation_time = s.time;
   out.step = static_cast<std::uint64_t>(s.steps);
   out.dt = m.dt;
   out.steps_per_period = static_cast<std::uint32_t>(steps_per_period);
@@ -168,7 +169,7 @@ ContactPointArray to_contact_points(const Model& m, const State& s, const ros::T
 
 bool all_finite(const ContactPointArray& msg) {
   auto ok = [](double x) { return std::isfinite(x); };
-  if (!ok(msg.dt) || !ok(msg.speed) || !ok(msg.header.stamp.toSec())) return false;
+  if (!ok(msg.dt) || !ok(msg.speed) || !ok(msg.simulation_time) || !ok(msg.header.stamp.toSec())) return false;
   for (const ContactPoint& c : msg.pantographs) {
     for (double x : {c.position, c.height, c.velocity, c.acceleration, c.path_velocity, c.applied_force,
                      c.measurement_age})

@@ -7,6 +7,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
+#include <tuple>
 #include <chrono>
 #include <cerrno>
 #include <cmath>
@@ -38,6 +39,14 @@ constexpr double kLockMax = 2e-3;
 constexpr int kRelockPeriods = 16;
 constexpr double kRecorderRowRate = 10.0;  // Hz, decimated rows of the pass recorder (unused here)
 constexpr double kQuantilePeriod = 1.0;    // s (wall) between latency quantiles for the diagnostics
+// ~stop: the safe hold ends the pass once the train stands, the force ramp is over and the wire
+// under every pantograph moves slower than this (the actuator is then held where it is, a step in
+// velocity below what a load cell's noise makes), or at the latest this long after the ramp.
+constexpr double kSettledMotion = 2e-3;    // m/s
+constexpr double kSettleMax = 5.0;         // s (simulation)
+// How long a service waits for the loop to take its request: a period is at most 1 ms, but on a
+// loaded machine the loop can fall far behind; a request not taken in time is withdrawn.
+constexpr double kControlWait = 5.0;       // s (wall)
 
 // An error at the end of the run: after a shutdown rosconsole no longer prints, so then on stderr.
 void end_error(const std::string& what) {
@@ -67,9 +76,21 @@ std::uint8_t HilNode::mode_code(Mode m) {
     case Mode::kWaiting: return ContactPointArray::WAITING;
     case Mode::kRunning: return ContactPointArray::RUNNING;
     case Mode::kHold: return ContactPointArray::SAFE_HOLD;
+    case Mode::kPaused: return ContactPointArray::PAUSED;
     case Mode::kEnded: return ContactPointArray::ENDED;
   }
   return ContactPointArray::ENDED;
+}
+
+const char* HilNode::mode_name(Mode m) {
+  switch (m) {
+    case Mode::kWaiting: return "waiting";
+    case Mode::kRunning: return "running";
+    case Mode::kHold: return "safe hold";
+    case Mode::kPaused: return "paused";
+    case Mode::kEnded: return "ended";
+  }
+  return "ended";
 }
 
 HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
@@ -115,6 +136,27 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
       ros::VoidPtr(), &hil_queue_);
   wo.transport_hints = ros::TransportHints().tcpNoDelay();
   wrench_sub_ = nh_.subscribe(wo);
+  armed_ = params_.auto_start;
+  // Control on a queue and a thread of its own: the loop never serves it (see the header).
+  auto trigger = [this](const char* name, bool (HilNode::*f)(std_srvs::Trigger::Request&, std_srvs::Trigger::Response&)) {
+    ros::AdvertiseServiceOptions o = ros::AdvertiseServiceOptions::create<std_srvs::Trigger>(
+        name, [this, f](std_srvs::Trigger::Request& q, std_srvs::Trigger::Response& r) { return (this->*f)(q, r); },
+        ros::VoidConstPtr(), &ctrl_queue_);
+    return pnh_.advertiseService(o);
+  };
+  arm_srv_ = trigger("arm", &HilNode::on_arm);
+  reset_srv_ = trigger("reset", &HilNode::on_reset);
+  stop_srv_ = trigger("stop", &HilNode::on_stop);
+  ros::AdvertiseServiceOptions po = ros::AdvertiseServiceOptions::create<std_srvs::SetBool>(
+      "set_paused", [this](std_srvs::SetBool::Request& q, std_srvs::SetBool::Response& r) { return on_set_paused(q, r); },
+      ros::VoidConstPtr(), &ctrl_queue_);
+  pause_srv_ = pnh_.advertiseService(po);
+  ros::SubscribeOptions vo = ros::SubscribeOptions::create<std_msgs::Float64>(
+      "cmd/train_speed", 10, [this](const std_msgs::Float64::ConstPtr& msg) { on_speed(msg); }, ros::VoidPtr(),
+      &ctrl_queue_);
+  speed_sub_ = nh_.subscribe(vo);
+  ctrl_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &ctrl_queue_);
+  ctrl_spinner_->start();
 
   updater_.setHardwareID("catenary_sim_hil/" + scene.name);
   updater_.add("hardware in the loop", this, &HilNode::diagnose);
@@ -126,13 +168,210 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
            scene.name.c_str(), m.n_dof, names.c_str(), params_.rate, timing_.period * 1e3, timing_.steps_per_period,
            m.dt * 1e3, m.dt_critical * 1e3, scene.train_speed * 3.6, params_.timeout,
            params_.extrapolate ? "linear extrapolation" : "newest measurement held", to_string(params_.at_end));
-  ROS_INFO("catenary_sim_hil: waiting for the first measurement on %s%s (the line holds its static state)",
-           force_sub_.getTopic().c_str(),
-           external_.size() == 1 ? (" or " + wrench_sub_.getTopic()).c_str() : "");
+  if (armed_)
+    ROS_INFO("catenary_sim_hil: waiting for the first measurement on %s%s (the line holds its static state)",
+             force_sub_.getTopic().c_str(),
+             external_.size() == 1 ? (" or " + wrench_sub_.getTopic()).c_str() : "");
+  else
+    ROS_INFO("catenary_sim_hil: ~hil/auto_start false: the line holds its static state until `rosservice call %s`; "
+             "the pass then starts with the first measurement", arm_srv_.getService().c_str());
   worker_ = std::thread([this] { worker(); });
 }
 
-HilNode::~HilNode() { stop_worker(); }
+HilNode::~HilNode() {
+  {
+    std::lock_guard<std::mutex> l(ctrl_mu_);
+    loop_running_ = false;
+  }
+  ctrl_cv_.notify_all();
+  if (ctrl_spinner_) ctrl_spinner_->stop();  // (before the services and their queue go)
+  stop_worker();
+}
+
+// ---- Control: services and commands (control thread) ----
+
+void HilNode::on_speed(const std_msgs::Float64::ConstPtr& msg) {
+  const double v = msg->data;
+  if (const std::string e = speed_command_error(v); !e.empty()) {
+    ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil: %s; command ignored", e.c_str());
+    return;
+  }
+  if (const std::string w = speed_warning(sim_->model(), v); !w.empty())  // (the model is never changed)
+    ROS_WARN_THROTTLE(5.0, "catenary_sim_hil: %s", w.c_str());
+  speed_command_ = v;
+  speed_posted_ = true;  // (the loop takes the newest at its next period)
+}
+
+std::pair<bool, std::string> HilNode::ask_loop(Request r, const char* service) {
+  std::unique_lock<std::mutex> l(ctrl_mu_);
+  if (!loop_running_) return {false, "refused: the loop is not running (starting up or shutting down); nothing changed"};
+  ctrl_request_ = r;
+  ctrl_done_ = false;
+  ctrl_posted_ = true;
+  ctrl_cv_.wait_for(l, std::chrono::duration<double>(kControlWait), [this] { return ctrl_done_ || !loop_running_; });
+  if (!ctrl_done_) {
+    ctrl_posted_ = false;  // withdrawn: the loop has not taken it (it takes it under ctrl_mu_)
+    return {false, "refused: the loop did not take the request within " + format_number(kControlWait) +
+                       " s (far behind its schedule, or stopping); nothing changed"};
+  }
+  if (ctrl_ok_) ROS_INFO("catenary_sim_hil: ~%s: %s", service, ctrl_reply_.c_str());
+  else ROS_WARN("catenary_sim_hil: ~%s: %s", service, ctrl_reply_.c_str());
+  return {ctrl_ok_, ctrl_reply_};
+}
+
+bool HilNode::on_arm(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::tie(res.success, res.message) = ask_loop(Request::kArm, "arm");
+  return true;
+}
+
+bool HilNode::on_set_paused(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
+  std::tie(res.success, res.message) = ask_loop(req.data ? Request::kPause : Request::kResume, "set_paused");
+  return true;
+}
+
+bool HilNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::tie(res.success, res.message) = ask_loop(Request::kReset, "reset");
+  return true;
+}
+
+bool HilNode::on_stop(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::tie(res.success, res.message) = ask_loop(Request::kStop, "stop");
+  return true;
+}
+
+// ---- Control (loop thread) ----
+
+void HilNode::poll_control() {
+  if (speed_posted_.exchange(false)) {
+    commanded_speed_ = speed_command_;
+    // (in the safe hold the train keeps stopping: leave_hold applies the commanded speed)
+    const bool holding = mode_ == Mode::kHold || (mode_ == Mode::kPaused && paused_from_ == Mode::kHold);
+    std::string err;
+    if (!holding) sim_->set_target_speed(commanded_speed_, &err);  // (checked: cannot fail)
+    if (mode_ == Mode::kWaiting) {
+      // Not started: the pass starts at the commanded speed (the line is at its initial static
+      // state; reset() with the static force needs no new static solve and changes nothing else).
+      for (int p : external_) sim_->set_external_force(p, sim_->state().uplift[p], nullptr);
+      sim_->reset(true);
+    }
+  }
+  if (!ctrl_posted_) return;
+  std::unique_lock<std::mutex> l(ctrl_mu_, std::try_to_lock);
+  if (!l.owns_lock() || !ctrl_posted_) return;  // (the control thread holds it for a moment: next period)
+  ctrl_ok_ = execute(ctrl_request_, ctrl_reply_);
+  ctrl_done_ = true;
+  ctrl_posted_ = false;
+  l.unlock();
+  ctrl_cv_.notify_all();
+}
+
+bool HilNode::execute(Request r, std::string& msg) {
+  const std::string now = stopping_ ? "stopping (~stop)" : mode_ == Mode::kPaused
+      ? std::string(paused_from_ == Mode::kHold ? "paused (in the safe hold)" : "paused")
+      : mode_ == Mode::kWaiting ? (armed_ ? "waiting for the first measurement" : "waiting for ~arm")
+      : mode_ == Mode::kEnded ? (diverged_ ? "ended (diverged)" : "ended") : mode_name(mode_);
+  auto refuse = [&](const std::string& why) {
+    msg = "refused: the pass is " + now + "; " + why;
+    return false;
+  };
+  char t[64];
+  std::snprintf(t, sizeof t, "t = %.4f s", sim_->state().time);
+  switch (r) {
+    case Request::kArm:
+      if (mode_ == Mode::kWaiting) {
+        if (armed_) return refuse("already armed: it starts with the first valid measurement");
+        armed_ = true;
+        msg = "armed: the pass starts with the first valid measurement";
+        return true;
+      }
+      if (mode_ == Mode::kEnded) {
+        new_pass();
+        mode_ = Mode::kWaiting;
+        armed_ = true;
+        hold_ = MeasurementHold(external_.size());  // (the last pass's measurements start nothing)
+        fresh_ = unused_ = owed_ = false;
+        age_in_effect_ = -1.0;
+        step_in_effect_ = 0;
+        msg = "pass " + std::to_string(pass_count_) + " armed: the line is at its initial static state at " + t +
+              " (time keeps running); it starts with the first valid measurement";
+        return true;
+      }
+      return refuse("~arm starts a pass that has not started or has ended (~stop ends it, ~reset restarts it)");
+    case Request::kPause:
+      if (stopping_) return refuse("it ends by itself");
+      if (mode_ == Mode::kRunning || mode_ == Mode::kHold) {
+        paused_from_ = mode_;
+        mode_ = Mode::kPaused;
+        msg = std::string("paused at ") + t + ": the line is held, the contact point repeats (velocities 0); "
+              "~set_paused false resumes";
+        return true;
+      }
+      if (mode_ == Mode::kPaused) return refuse("already paused");
+      return refuse(mode_ == Mode::kEnded ? "nothing to pause (~arm for a new pass)" : "nothing to pause yet");
+    case Request::kResume:
+      if (mode_ != Mode::kPaused) return refuse("not paused");
+      mode_ = paused_from_;
+      msg = std::string("resumed at ") + t + (mode_ == Mode::kHold ? " in the safe hold" : "");
+      return true;
+    case Request::kReset:
+      if (stopping_) return refuse("~arm after its end starts a new pass");
+      if (mode_ == Mode::kRunning || mode_ == Mode::kHold || mode_ == Mode::kPaused) {
+        new_pass();
+        msg = "new pass " + std::to_string(pass_count_) + " from the start at " + t + " (time keeps running)" +
+              (mode_ == Mode::kPaused ? "; still paused" : "");
+        return true;
+      }
+      return refuse(mode_ == Mode::kEnded ? "~arm starts a new pass" : "nothing to reset (it has not started)");
+    case Request::kStop:
+      if (stopping_) return refuse("already stopping");
+      if (mode_ == Mode::kRunning || mode_ == Mode::kHold || mode_ == Mode::kPaused) {
+        begin_stop();
+        msg = std::string("stopping at ") + t + ": safe hold (the train stops at " +
+              format_number(params_.hold_deceleration) + " m/s^2, the force ramps to the static uplift over " +
+              format_number(params_.hold_ramp) + " s), then ENDED with the statistics written once the line has settled";
+        return true;
+      }
+      return refuse(mode_ == Mode::kEnded ? "already ended" : "nothing to stop (it has not started)");
+  }
+  return false;
+}
+
+void HilNode::begin_stop() {
+  if (mode_ == Mode::kPaused) mode_ = paused_from_;
+  stopping_ = true;
+  recovering_ = false;
+  if (mode_ == Mode::kHold) return;  // a safe hold already: it goes on, and then ends the pass
+  mode_ = Mode::kHold;
+  hold_start_time_ = sim_->state().time;
+  for (int p : external_) hold_from_[p] = sim_->state().external_force[p];
+  std::string err;
+  sim_->set_target_speed(0.0, &err);
+}
+
+bool HilNode::stop_settled() const {
+  const State& s = sim_->state();
+  const double elapsed = s.time - hold_start_time_;
+  if (s.speed > 0.0 || elapsed < params_.hold_ramp) return false;
+  return point_motion_ < kSettledMotion || elapsed >= params_.hold_ramp + kSettleMax;
+}
+
+void HilNode::new_pass() {
+  // As at_end loop: the static force first (no new static solve in reset), the clock running on.
+  for (int p : external_) sim_->set_external_force(p, sim_->state().uplift[p], nullptr);
+  const bool holding = mode_ == Mode::kHold || (mode_ == Mode::kPaused && paused_from_ == Mode::kHold);
+  std::string err;
+  sim_->set_target_speed(holding ? 0.0 : commanded_speed_, &err);  // (reset starts at the target speed)
+  sim_->reset(true);
+  ++pass_count_;
+  recorder_ = std::make_unique<PassRecorder>(sim_->model(), kRecorderRowRate);
+  recorder_->record(sim_->model(), sim_->state());
+  if (holding) {  // the hold goes on from the new static state: nothing left to ramp
+    hold_start_time_ = sim_->state().time;
+    for (int p : external_) hold_from_[p] = sim_->state().uplift[p];
+  }
+  diverged_ = false;
+  recovering_ = false;
+}
 
 void HilNode::stop_worker() {
   {
@@ -249,6 +488,7 @@ void HilNode::wait_for_period(double w, double half, double& t) {
 
 int HilNode::run() {
   prepare_loop_thread(params_.realtime_priority, "catenary_sim_hil");
+  loop_running_ = true;
   const double period = timing_.period, half = 0.5 * period;
   publish_point();
   double w = steady_now() + period;  // centre of the next period's window
@@ -264,13 +504,14 @@ int HilNode::run() {
     double t = steady_now();
     wait_for_period(w, half, t);
     if (!running()) break;
-    if (mode_ == Mode::kWaiting && t < start_wait_end) fresh_ = false;  // (~start_delay)
+    poll_control();
+    if (mode_ == Mode::kWaiting && (t < start_wait_end || !armed_)) fresh_ = false;  // (~start_delay, ~arm)
     const bool triggered = fresh_;
     if (mode_ == Mode::kWaiting && triggered) {
       w = t;  // the schedule starts on the rig's first measurement
-      started_ = t;
+      if (started_ == 0.0) started_ = t;
       relock = false;
-      ROS_INFO("catenary_sim_hil: first measurement received: running");
+      ROS_INFO("catenary_sim_hil: pass %u: first measurement received: running", pass_count_);
     } else if (triggered && relock) {
       w = std::max(t, w - half);  // centre the windows on this arrival (never earlier than this window)
       relock = false;
@@ -306,6 +547,11 @@ int HilNode::run() {
       relock = true;  // the windows' phase relative to the rig is lost: the next arrival sets it
     }
   }
+  {
+    std::lock_guard<std::mutex> l(ctrl_mu_);
+    loop_running_ = false;  // (a waiting service answers at once)
+  }
+  ctrl_cv_.notify_all();
   // The statistics of a pass that has just ended are written before the exit code is decided.
   stop_worker();
   const bool report_ok = write_report();
@@ -327,6 +573,7 @@ void HilNode::enter_hold(double t, double age) {
 
 void HilNode::leave_hold() {
   mode_ = Mode::kRunning;
+  recovering_ = true;
   std::string err;
   sim_->set_target_speed(commanded_speed_, &err);
   ROS_WARN("catenary_sim_hil: fresh hil/contact_force: safe hold ended after %.3f s of simulation; the train "
@@ -334,15 +581,17 @@ void HilNode::leave_hold() {
 }
 
 void HilNode::batch(double t, bool triggered) {
-  if (mode_ == Mode::kEnded || (mode_ == Mode::kWaiting && !triggered)) {
-    fresh_ = unused_ = false;  // (a measurement while waiting starts the run; after the end it changes nothing)
+  if (mode_ == Mode::kEnded || mode_ == Mode::kPaused || (mode_ == Mode::kWaiting && !triggered)) {
+    // (a measurement while waiting starts the run; paused or after the end it changes nothing, but
+    // it is held: a pass resumed with the rig still sending is not in the safe hold)
+    fresh_ = unused_ = false;
     publish_point();
     return;
   }
   if (mode_ == Mode::kWaiting) mode_ = Mode::kRunning;
   const double age = hold_.age(t);
   if (mode_ == Mode::kRunning && age > params_.timeout) enter_hold(t, age);
-  else if (mode_ == Mode::kHold && triggered) leave_hold();
+  else if (mode_ == Mode::kHold && triggered && !stopping_) leave_hold();
   ++c_.batches;
   if (triggered) ++c_.triggered;
   if (mode_ == Mode::kHold) ++c_.hold_batches;
@@ -372,6 +621,7 @@ void HilNode::batch(double t, bool triggered) {
     // grow for as long as the hold lasts)
     if (mode_ != Mode::kHold) recorder_->record(m, sim_->state());
   }
+  if (recovering_ && sim_->state().speed >= sim_->state().target_speed - 1e-9) recovering_ = false;
   publish_point();
   const double published = steady_now();
   compute_.add(published - t);
@@ -398,8 +648,23 @@ void HilNode::publish_point() {
   const Model& m = sim_->model();
   const State& s = sim_->state();
   // (a shared pointer: a subscriber in the same process, e.g. VirtualRigNodelet, gets it without a copy)
-  const boost::shared_ptr<ContactPointArray> msg = boost::make_shared<ContactPointArray>(
-      to_contact_points(m, s, sim_stamp(s.time, stamp_offset_), params_.line_frame, timing_.steps_per_period, scratch_));
+  // Stamped in wall time, as the rig stamps its measurements (the loop runs on the wall clock);
+  // the simulation time is in simulation_time (docs/hil.md, "Stamps").
+  const ros::WallTime wall = ros::WallTime::now();
+  const boost::shared_ptr<ContactPointArray> msg = boost::make_shared<ContactPointArray>(to_contact_points(
+      m, s, ros::Time(wall.sec, wall.nsec), params_.line_frame, timing_.steps_per_period, scratch_));
+  if (mode_ == Mode::kPaused) {
+    // The line is held: the point does not move (an actuator following path_velocity stays put).
+    for (ContactPoint& c : msg->pantographs) {
+      c.velocity = c.acceleration = c.path_velocity = 0.0;
+      for (auto* v : {&c.wire_velocity, &c.wire_acceleration, &c.wire_path_velocity}) std::fill(v->begin(), v->end(), 0.0);
+    }
+  }
+  if (stopping_) {
+    point_motion_ = 0.0;
+    for (const ContactPoint& c : msg->pantographs)
+      point_motion_ = std::max({point_motion_, std::fabs(c.velocity), std::fabs(c.path_velocity)});
+  }
   msg->mode = mode_code(mode_);
   msg->pass_count = pass_count_;
   msg->measurement_step = step_in_effect_;
@@ -416,7 +681,8 @@ void HilNode::handle_end() {
   const State& s = sim_->state();
   if (mode_ == Mode::kEnded) return;
   const bool diverged = s.status == StepStatus::kDiverged;
-  if (!diverged && !sim_->finished()) return;
+  const bool stopped = stopping_ && stop_settled();
+  if (!diverged && !stopped && !sim_->finished()) return;
   // The pass is over: its statistics go to the worker thread (filtering takes milliseconds).
   {
     std::lock_guard<std::mutex> l(snap_mu_);
@@ -428,11 +694,15 @@ void HilNode::handle_end() {
   if (diverged) {
     diverged_ = true;
     ROS_ERROR("catenary_sim_hil: %s", sim_->status_message().c_str());
+  } else if (stopping_) {
+    ROS_INFO("catenary_sim_hil: pass %u stopped (~stop) at t = %.4f s (train front at %.2f m), the line settled: "
+             "ended; %lld periods, %lld overruns", pass_count_, s.time, s.front + s.line_offset,
+             static_cast<long long>(c_.batches), static_cast<long long>(c_.overruns));
   } else {
     ROS_INFO("catenary_sim_hil: pass %u finished at t = %.4f s (train front at %.2f m): %lld periods, %lld overruns",
              pass_count_, s.time, s.front + s.line_offset, static_cast<long long>(c_.batches), static_cast<long long>(c_.overruns));
   }
-  if (!diverged && params_.at_end == AtEnd::kLoop) {
+  if (!diverged && !stopping_ && params_.at_end == AtEnd::kLoop) {
     // A new pass from the initial static state with the static force (no new static solve), the
     // clock running on; pass_count tells the rig to re-initialise.
     for (int p : external_) sim_->set_external_force(p, sim_->state().uplift[p], nullptr);
@@ -442,6 +712,7 @@ void HilNode::handle_end() {
     return;
   }
   mode_ = Mode::kEnded;
+  stopping_ = false;
   if (params_.at_end == AtEnd::kExit) {
     exit_requested_ = true;
     exit_code_ = diverged ? 1 : 0;
@@ -460,6 +731,10 @@ void HilNode::snapshot(double t) {
   std::copy(q_latency_, q_latency_ + 3, snap_.latency);
   snap_.diverged = diverged_;
   snap_.pass_count = pass_count_;
+  snap_.armed = armed_;
+  snap_.stopping = stopping_;
+  snap_.recovering = recovering_;
+  snap_.commanded_speed = commanded_speed_;
   snap_new_ = true;
   l.unlock();
   snap_cv_.notify_all();
@@ -556,15 +831,23 @@ void HilNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   char what[256];
   switch (s.mode) {
     case Mode::kWaiting:
-      stat.summary(DiagnosticStatus::WARN, "waiting for the first measurement on hil/contact_force");
+      stat.summary(DiagnosticStatus::WARN, s.armed ? "waiting for the first measurement on hil/contact_force"
+                                                   : "waiting for ~arm (~hil/auto_start false)");
       break;
     case Mode::kRunning:
-      if (s.state.speed < commanded_speed_ - 1e-9)
+      if (s.recovering)
         stat.summary(DiagnosticStatus::WARN, "running: the train accelerates back after a safe hold");
       else
         stat.summary(DiagnosticStatus::OK, "running");
       break;
+    case Mode::kPaused:
+      stat.summary(DiagnosticStatus::OK, "paused (~set_paused): the line is held");
+      break;
     case Mode::kHold:
+      if (s.stopping) {
+        stat.summary(DiagnosticStatus::WARN, "stopping (~stop): safe hold, then ended once the line has settled");
+        break;
+      }
       std::snprintf(what, sizeof what,
                     "SAFE HOLD: no valid hil/contact_force for %.3f s (> ~hil/timeout = %g s); train stopping, force "
                     "ramped to the static uplift", s.age, params_.timeout);
@@ -575,8 +858,7 @@ void HilNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
       else stat.summary(DiagnosticStatus::OK, "pass finished");
       break;
   }
-  stat.add("mode", s.mode == Mode::kWaiting ? "waiting" : s.mode == Mode::kRunning ? "running"
-                   : s.mode == Mode::kHold ? "safe hold" : "ended");
+  stat.add("mode", mode_name(s.mode));
   stat.add("measurement age [s]", s.age);
   stat.add("age of the measurement in effect [s]", s.age_in_effect);
   stat.add("max measurement age while running [s]", c.max_age_running);
@@ -601,6 +883,7 @@ void HilNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("steps", s.state.steps);
   stat.add("train front [m]", s.state.front + s.state.line_offset);
   stat.add("speed [m/s]", s.state.speed);
+  stat.add("commanded speed [m/s]", s.commanded_speed);
   stat.add("pass", s.pass_count);
 }
 

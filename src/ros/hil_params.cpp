@@ -42,7 +42,7 @@ void validate_hil_params(const HilParams& p) {
 HilParams load_hil_params(const ros::NodeHandle& nh) {
   ParamReader r(nh, "catenary_sim_hil",
                 {"scene", "speed_kmh", "hil/rate", "hil/timeout", "hil/extrapolate", "hil/hold_ramp",
-                 "hil/hold_deceleration", "hil/report_file", "hil/realtime_priority", "hil/spin_wait", "at_end",
+                 "hil/hold_deceleration", "hil/report_file", "hil/realtime_priority", "hil/spin_wait", "hil/auto_start", "at_end",
                  "stats_file", "line_frame", "publish_rate", "marker_rate", "start_delay", "shape_rate",
                  "shape_resolution", "diagnostic_period"});  // (the last read by diagnostic_updater)
   HilParams p;
@@ -61,6 +61,7 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
   r.number("hil/spin_wait", p.spin_wait, "a number of seconds in [0, half a loop period]");
   r.integer("hil/realtime_priority", p.realtime_priority, "an integer in [0, 99]");
   r.boolean("hil/extrapolate", p.extrapolate);
+  r.boolean("hil/auto_start", p.auto_start);
   r.text("hil/report_file", p.report_file, "a file path (empty: none)");
   r.text("stats_file", p.stats_file, "a file path (empty: none)");
   r.text("line_frame", p.line_frame, "a frame id");

@@ -493,9 +493,8 @@ void SimulationNode::on_speed(const std_msgs::Float64::ConstPtr& msg) {
   // The range is checked here too, for a message with %g numbers (the core's has std::to_string's
   // "200.000000"); the core's check stays the authority.
   const double v = msg->data;
-  if (!std::isfinite(v) || v < 0.0 || v > Simulation::kMaxSpeed) {
-    ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/train_speed = %g m/s rejected: allowed 0 to %g m/s (%g km/h); "
-                       "command ignored", v, Simulation::kMaxSpeed, Simulation::kMaxSpeed * 3.6);
+  if (const std::string e = speed_command_error(v); !e.empty()) {
+    ROS_ERROR_THROTTLE(1.0, "catenary_sim: %s; command ignored", e.c_str());
     return;
   }
   std::string err;

@@ -303,6 +303,21 @@ TEST(Pacing, StepsDueFollowWallClockTimesFactor) {
   EXPECT_EQ(steps_due(0.0105, 1.0, 1e-3, 0.0), 10);  // whole steps only: dt is never stretched
 }
 
+// The pass node and the HIL node reject cmd/train_speed with this message (the same range as the
+// core's set_target_speed, which stays the authority).
+TEST(Commands, SpeedCommandErrorNamesTopicValueAndRange) {
+  EXPECT_EQ(speed_command_error(0.0), "");
+  EXPECT_EQ(speed_command_error(Simulation::kMaxSpeed), "");
+  EXPECT_EQ(speed_command_error(200.0), "cmd/train_speed = 200 m/s rejected: allowed 0 to 150 m/s (540 km/h)");
+  EXPECT_NE(speed_command_error(-0.5).find("= -0.5 m/s rejected"), std::string::npos);
+  EXPECT_NE(speed_command_error(std::nan("")).find("= nan m/s rejected"), std::string::npos);
+  EXPECT_NE(speed_command_error(std::numeric_limits<double>::infinity()), "");
+  // Whatever it accepts the core accepts, and the other way round.
+  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml"));
+  for (double v : {-1e-9, 0.0, 75.0, 150.0, 150.0000001, std::nan("")})
+    EXPECT_EQ(speed_command_error(v).empty(), sim.set_target_speed(v, nullptr)) << v;
+}
+
 TEST(Stamps, OffsetAddsAndIsMonotonic) {
   EXPECT_EQ(sim_stamp(1.5, 100.0), ros::Time(101.5));
   EXPECT_LT(sim_stamp(1.0, 100.0), sim_stamp(1.0001, 100.0));

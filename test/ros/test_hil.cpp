@@ -299,6 +299,7 @@ TEST(ContactPoints, TheMotionUnderTheExternalPantographAndNeverNaN) {
   EXPECT_EQ(msg.steps_per_period, 2u);
   EXPECT_DOUBLE_EQ(msg.dt, m.dt);
   EXPECT_EQ(msg.header.stamp, ros::Time(12.5));
+  EXPECT_DOUBLE_EQ(msg.simulation_time, sim.state().time);  // the stamp is the caller's (wall clock)
   ASSERT_EQ(c.on_wire.size(), 1u);
   ASSERT_TRUE(c.on_wire[0]);
   EXPECT_DOUBLE_EQ(c.height, direct[0].height);
@@ -319,6 +320,9 @@ TEST(ContactPoints, TheMotionUnderTheExternalPantographAndNeverNaN) {
   ContactPointArray bad = msg;
   bad.pantographs[0].wire_velocity[0] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(all_finite(bad));
+  ContactPointArray bad_time = msg;
+  bad_time.simulation_time = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(all_finite(bad_time));
 }
 
 // One step per period and no delay: the rig's answer to each contact point is applied in the very

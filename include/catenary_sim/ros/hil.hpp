@@ -40,6 +40,7 @@ struct HilParams {
                                     //   safe hold and accelerates back after it, [0, 50] (0: at once)
   std::string report_file;          // ~hil/report_file: JSON with the loop's latency and overruns,
                                     //   written at exit (empty: none)
+  bool auto_start = true;           // ~hil/auto_start: false: the pass starts only after ~arm
   AtEnd at_end = AtEnd::kStop;      // ~at_end: stop | loop | exit
   std::string stats_file;           // ~stats_file: pass statistics JSON at the end of each pass
   std::string line_frame = "line";  // ~line_frame
@@ -126,8 +127,9 @@ class LatencyHistogram {
 };
 
 // hil/contact_point for the current state: the motion of the wire under every external
-// pantograph (contact_point_motion), its applied force, and the header; the node fills mode,
-// pass_count, measurement_step and measurement_age. `scratch` is reused between calls.
+// pantograph (contact_point_motion), its applied force, the simulation time and the header
+// (`stamp`: the node gives the wall-clock time); the node fills mode, pass_count,
+// measurement_step and measurement_age. `scratch` is reused between calls.
 ContactPointArray to_contact_points(const Model& m, const State& s, const ros::Time& stamp, const std::string& frame,
                                     int steps_per_period, std::vector<ContactPointMotion>& scratch);
 

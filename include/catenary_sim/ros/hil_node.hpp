@@ -19,6 +19,12 @@
 // external pantograph) or, for a scene with one external pantograph, as hil/contact_wrench
 // (geometry_msgs/WrenchStamped: force.z, z up, is the force the pantograph exerts on the wire).
 //
+// Control, as the pass node's: ~arm (start the pass with ~hil/auto_start false, or a new pass
+// after the end), ~set_paused, ~reset, ~stop (services) and cmd/train_speed. They are served on a
+// queue and a thread of their own; a request is handed to the loop thread, which carries it out
+// at its next period and answers (the loop never waits for the control thread: it only
+// try-locks the hand-over, once per period, when a request is pending).
+//
 // The node runs as a process (catenary_sim_hil_node: run() on the main thread) or as a nodelet
 // (catenary_sim/HilNodelet: run() on a thread of its own, stop() ends it), e.g. with
 // catenary_sim/VirtualRigNodelet in the same manager: the messages then pass as shared pointers.
@@ -28,6 +34,9 @@
 #include <geometry_msgs/WrenchStamped.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
+#include <std_msgs/Float64.h>
+#include <std_srvs/SetBool.h>
+#include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <atomic>
@@ -35,7 +44,9 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "catenary_sim/ContactPointArray.h"
@@ -74,7 +85,9 @@ class HilNode {
   };
 
  private:
-  enum class Mode { kWaiting, kRunning, kHold, kEnded };
+  enum class Mode { kWaiting, kRunning, kHold, kPaused, kEnded };
+  // Requests of the services, carried out by the loop thread.
+  enum class Request { kArm, kPause, kResume, kReset, kStop };
 
   void on_measurement(const MeasuredContactForce::ConstPtr& msg);
   void on_wrench(const geometry_msgs::WrenchStamped::ConstPtr& msg);
@@ -96,13 +109,29 @@ class HilNode {
   bool write_report() const;  // false: ~hil/report_file could not be written (said on stderr)
   void stop_worker();         // after it has written the statistics of a pass that has ended
   static std::uint8_t mode_code(Mode m);
+  static const char* mode_name(Mode m);
+
+  // Control thread: services and cmd/train_speed.
+  bool on_arm(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
+  bool on_set_paused(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res);
+  bool on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
+  bool on_stop(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
+  void on_speed(const std_msgs::Float64::ConstPtr& msg);
+  // Hands `r` to the loop thread and waits for its answer: (done, message).
+  std::pair<bool, std::string> ask_loop(Request r, const char* service);
+  // Loop thread: a pending speed command or request, at most one each per period.
+  void poll_control();
+  bool execute(Request r, std::string& message);
+  void begin_stop();
+  void new_pass();  // the line back at its initial static state, time running on, pass_count + 1
+  bool stop_settled() const;
 
   ros::NodeHandle nh_, pnh_;
   HilParams params_;
   HilTiming timing_;
   std::unique_ptr<Simulation> sim_;
   std::vector<int> external_;
-  double commanded_speed_ = 0.0;  // m/s, the scene's (or ~speed_kmh)
+  double commanded_speed_ = 0.0;  // m/s, the scene's (or ~speed_kmh), then cmd/train_speed (loop thread)
 
   // Loop state (loop thread only).
   ros::CallbackQueue hil_queue_;
@@ -110,6 +139,11 @@ class HilNode {
   std::atomic<bool> stop_{false};
   ros::Publisher point_pub_;
   Mode mode_ = Mode::kWaiting;
+  bool armed_ = true;              // in kWaiting: the first valid measurement starts the pass
+  Mode paused_from_ = Mode::kRunning;  // kPaused: the mode to return to
+  bool stopping_ = false;          // kHold after ~stop: ends in kEnded once the line has settled
+  bool recovering_ = false;        // accelerating back to the commanded speed after a safe hold
+  double point_motion_ = 0.0;      // m/s, largest |velocity| and |path_velocity| in the last contact point
   MeasurementHold hold_;
   bool fresh_ = false;             // a valid measurement that may start a period (answers the last contact point)
   bool unused_ = false;            // the newest valid measurement has not been used by a period yet
@@ -143,8 +177,9 @@ class HilNode {
     Counters counters;
     double age = -1.0, age_in_effect = -1.0;
     double latency[3] = {0, 0, 0};
-    bool diverged = false;
+    bool diverged = false, armed = true, stopping = false, recovering = false;
     std::uint32_t pass_count = 0;
+    double commanded_speed = 0.0;
   };
   std::mutex snap_mu_;
   std::condition_variable snap_cv_;
@@ -165,6 +200,21 @@ class HilNode {
   double last_tf_time_ = -1.0;
   ros::Time last_view_stamp_;
   double next_marker_wall_ = 0.0;
+
+  // Control: its own queue and thread (never the loop's); the hand-over of a request.
+  ros::CallbackQueue ctrl_queue_;
+  std::unique_ptr<ros::AsyncSpinner> ctrl_spinner_;
+  ros::ServiceServer arm_srv_, pause_srv_, reset_srv_, stop_srv_;
+  ros::Subscriber speed_sub_;
+  std::mutex ctrl_mu_;                   // the loop only try-locks it
+  std::condition_variable ctrl_cv_;
+  std::atomic<bool> ctrl_posted_{false};  // a request waits for the loop
+  Request ctrl_request_ = Request::kArm;  // (under ctrl_mu_, with the answer)
+  bool ctrl_done_ = false, ctrl_ok_ = false;
+  std::string ctrl_reply_;
+  std::atomic<bool> loop_running_{false};
+  std::atomic<bool> speed_posted_{false};  // a valid cmd/train_speed waits for the loop
+  std::atomic<double> speed_command_{0.0};
 };
 
 // Loop-thread set-up: timer slack of 1 us (wake-ups on time), and with `realtime_priority` > 0
