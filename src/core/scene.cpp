@@ -573,6 +573,16 @@ Scene scene_from_yaml(const YAML::Node& root) {
     }
     s.output.filter_cutoff = r.number("filter_cutoff", 0.0, 10000.0, 20.0, true);
     s.output.sample_rate = r.number("sample_rate", 0.0, 1e6, 0.0);
+    s.output.sensor_bandwidth = r.number("sensor_bandwidth", 0.0, 10000.0, 20.0, true);
+    s.output.dropper_series = r.boolean("dropper_series", false);
+    auto optional_number = [&](const char* key, double lo, double hi, bool lo_open) -> std::optional<double> {
+      if (!r.has(key)) return std::nullopt;
+      return r.number(key, lo, hi, std::nullopt, lo_open);
+    };
+    s.output.allowed_uplift = optional_number("allowed_uplift", 0.0, 10.0, true);
+    s.output.max_stat_force = optional_number("max_stat_force", 0.0, 1e5, true);
+    s.output.min_stat_force = optional_number("min_stat_force", -1e5, 1e5, false);
+    s.output.max_contact_loss_percent = optional_number("max_contact_loss_percent", 0.0, 100.0, false);
     r.finish();
   }
   top.finish();

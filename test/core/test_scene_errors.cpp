@@ -65,6 +65,26 @@ TEST(SceneErrors, OutOfRangeNamesFieldValueAndRange) {
   EXPECT_MENTIONS(error_of({"pantographs.0.static_uplift=-1"}), "pantographs[0].static_uplift", "-1", "allowed range");
 }
 
+// The report's fields (issue 15): limits absent by default, each checked like the others.
+TEST(SceneErrors, OutputLimitsAndMeasurementFields) {
+  EXPECT_EQ(error_of({"output.allowed_uplift=0.12", "output.max_stat_force=350", "output.min_stat_force=0",
+                      "output.max_contact_loss_percent=0.1", "output.sensor_bandwidth=40", "output.dropper_series=true"}),
+            "");
+  EXPECT_MENTIONS(error_of({"output.allowed_uplift=0"}), "output.allowed_uplift", "0", "(0, 10]");
+  EXPECT_MENTIONS(error_of({"output.allowed_uplift=-0.1"}), "output.allowed_uplift", "-0.1", "allowed range");
+  EXPECT_MENTIONS(error_of({"output.max_stat_force=.nan"}), "output.max_stat_force", "allowed range");
+  EXPECT_MENTIONS(error_of({"output.max_contact_loss_percent=101"}), "output.max_contact_loss_percent", "101", "[0, 100]");
+  EXPECT_MENTIONS(error_of({"output.min_stat_force=low"}), "output.min_stat_force", "'low'", "a number");
+  EXPECT_MENTIONS(error_of({"output.sensor_bandwidth=0"}), "output.sensor_bandwidth", "(0, ");
+  EXPECT_MENTIONS(error_of({"output.dropper_series=sometimes"}), "output.dropper_series", "'sometimes'", "true or false");
+  EXPECT_MENTIONS(error_of({"output.allowed_uplfit=0.1"}), "output.allowed_uplfit", "unknown field");
+  const Scene s = load_scene_file(kReference);
+  EXPECT_FALSE(s.output.allowed_uplift || s.output.max_stat_force || s.output.min_stat_force ||
+               s.output.max_contact_loss_percent);
+  EXPECT_EQ(s.output.sensor_bandwidth, 20.0);
+  EXPECT_FALSE(s.output.dropper_series);
+}
+
 TEST(SceneErrors, NotANumber) {
   EXPECT_MENTIONS(error_of({"contact_wire.linear_mass=heavy"}), "contact_wire.linear_mass", "'heavy'", "a number");
   EXPECT_MENTIONS(error_of({"droppers.positions=7"}), "droppers.positions", "a list of numbers");

@@ -129,6 +129,14 @@ struct OutputSpec {
   std::optional<int> analysis_last_span;
   double filter_cutoff = 20.0;  // Hz, low-pass for the filtered statistics
   double sample_rate = 0.0;     // Hz for the CSV time series; 0 = every step
+  // Measuring pantograph's view (outputs.hpp): bandwidth of its force measurement, Hz.
+  double sensor_bandwidth = 20.0;
+  bool dropper_series = false;  // also record every analysed dropper's force at the sample rate
+  // Limits the report marks (absent: not checked). allowed_uplift: m, largest steady-arm uplift;
+  // max_stat_force / min_stat_force: N, bounds on Fm + 3 sigma and Fm - 3 sigma of the filtered
+  // force (EN 50367 asks Fm + 3 sigma below a maximum and Fm - 3 sigma above 0);
+  // max_contact_loss_percent: share of time without contact.
+  std::optional<double> allowed_uplift, max_stat_force, min_stat_force, max_contact_loss_percent;
 };
 
 // A line as built rather than as designed (design statics first, then these errors, as on a real

@@ -1,0 +1,159 @@
+// simulate_pass --report on a short pass: every file of the pass and of the report is written, the
+// HTML holds every section with its picture embedded, the limits are marked, and the report
+// fails with a clear message on a directory without a pass. Runs the tools as child processes.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+#ifndef CATENARY_SIM_DEVEL_LIB
+#define CATENARY_SIM_DEVEL_LIB "."
+#endif
+
+extern char** environ;
+
+namespace {
+
+const std::string kSimulatePass = CATENARY_SIM_DEVEL_LIB "/simulate_pass";
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+bool exists(const std::string& p) {
+  struct stat st {};
+  return stat(p.c_str(), &st) == 0;
+}
+
+struct ChildRun {
+  int exit_code = -1;
+  bool hung = false;
+  std::string output;
+};
+
+// Runs argv with stdout and stderr to a file; kills it after `limit` seconds.
+ChildRun run(const std::vector<std::string>& args, const std::string& log, double limit) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  pid_t pid = 0;
+  ChildRun r;
+  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) {
+    r.output = "spawn failed";
+    return r;
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      r.hung = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
+  r.output = slurp(log);
+  return r;
+}
+
+class PassReport : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char t[] = "/tmp/catenary_sim_report_XXXXXX";
+    dir_ = mkdtemp(t);
+  }
+  void TearDown() override {
+    if (!HasFailure()) std::system(("rm -rf '" + dir_ + "'").c_str());
+  }
+  std::string dir_;
+};
+
+// Six 55 m spans of the reference line at 250 km/h with 0.5 m elements: a pass of about two
+// seconds that still has an analysis section (spans 2-3), droppers, steady arms and a spectrum.
+// The limits are set so that some pass and one fails: 1 mm of uplift is far below any pass's.
+TEST_F(PassReport, ShortPassBuildsEverySection) {
+  const std::string out = dir_ + "/out";
+  const ChildRun r = run({kSimulatePass, "--scene", CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", "--out", out,
+                          "--speed", "250", "--set", "line.span_count=6", "--set", "numerics.element_length=0.5",
+                          "--set", "output.allowed_uplift=0.001", "--set", "output.max_stat_force=400", "--set",
+                          "output.min_stat_force=0", "--set", "output.max_contact_loss_percent=0", "--set",
+                          "output.dropper_series=true", "--report", "--no-progress"},
+                         dir_ + "/log.txt", 300.0);
+  ASSERT_FALSE(r.hung);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* f : {"stats.json", "timeseries.csv", "force_processed.csv", "contact_losses.csv", "droppers.csv",
+                        "dropper_rainflow.csv", "psd.csv", "dropper_series.csv", "report.html"})
+    EXPECT_TRUE(exists(out + "/" + f)) << f;
+  const std::vector<std::string> sections{"force", "head", "uplift", "histogram", "psd", "droppers", "losses"};
+  for (const std::string& s : sections) {
+    const std::string png = out + "/report_" + s + ".png";
+    ASSERT_TRUE(exists(png)) << png;
+    EXPECT_EQ(slurp(png).substr(1, 3), "PNG") << png;
+  }
+  const std::string page = slurp(out + "/report.html");
+  EXPECT_NE(page.find("id='statistics'"), std::string::npos);
+  for (const std::string& s : sections) EXPECT_NE(page.find("<h2 id='" + s + "'>"), std::string::npos) << s;
+  // Self-contained: the pictures are in the page, nothing is linked.
+  std::size_t images = 0;
+  for (std::size_t at = page.find("src='data:image/png;base64,"); at != std::string::npos;
+       at = page.find("src='data:image/png;base64,", at + 1))
+    ++images;
+  EXPECT_EQ(images, sections.size());
+  EXPECT_EQ(page.find(".png'"), std::string::npos);
+  // The limits: uplift fails (1 mm), the statistical maximum passes (400 N).
+  const nlohmann::json j = nlohmann::json::parse(slurp(out + "/stats.json"));
+  bool uplift_failed = false, max_passed = false;
+  for (const auto& l : j.at("limits")) {
+    if (l.at("name") == "max_uplift_m") uplift_failed = !l.at("pass").get<bool>();
+    if (l.at("name") == "stat_max_force_N") max_passed = l.at("pass").get<bool>();
+  }
+  EXPECT_TRUE(uplift_failed);
+  EXPECT_TRUE(max_passed);
+  EXPECT_NE(page.find("FAIL"), std::string::npos);
+  EXPECT_NE(page.find(">pass<"), std::string::npos);
+  // The old keys are still there, the new ones beside them.
+  const auto& p = j.at("pantographs").at(0);
+  for (const char* k : {"mean_force_N", "contact_loss_percent", "max_uplift_at_support_m", "unfiltered",
+                        "contact_loss_events", "spectrum", "measured"})
+    EXPECT_TRUE(p.contains(k)) << k;
+  EXPECT_FALSE(j.at("droppers").at("list").empty());
+  EXPECT_EQ(j.at("steady_arms").size(), 3u);  // supports 2, 3, 4 bound the section [110, 220] m
+}
+
+TEST_F(PassReport, ReportOfAnEmptyDirectoryFailsNamingTheFile) {
+  const ChildRun r = run({"/usr/bin/python3", CATENARY_SIM_SOURCE_DIR "/scripts/pass_report", dir_},
+                         dir_ + "/log.txt", 60.0);
+  ASSERT_FALSE(r.hung);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("stats.json is missing"), std::string::npos) << r.output;
+  EXPECT_FALSE(exists(dir_ + "/report.html"));
+}
+
+}  // namespace
