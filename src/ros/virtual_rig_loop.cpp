@@ -39,8 +39,10 @@ VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
     throw std::runtime_error("parameter ~rate rejected: allowed 0 (the node's loop rate) to 20000 Hz");
   pnh.param("extrapolate", extrapolate_, true);
   pnh.param<std::string>("report_file", report_file_, "");
+  // Every contact point, even after a stall of the loop thread (up to 1 s at 10 kHz): the
+  // pantograph is stepped through each one (a lost one: two periods against an extrapolated wire).
   ros::SubscribeOptions so = ros::SubscribeOptions::create<ContactPointArray>(
-      "hil/contact_point", 100, [this](const ContactPointArray::ConstPtr& m) { on_point(m); }, ros::VoidPtr(),
+      "hil/contact_point", 10000, [this](const ContactPointArray::ConstPtr& m) { on_point(m); }, ros::VoidPtr(),
       &queue_);
   so.transport_hints = ros::TransportHints().tcpNoDelay();
   sub_ = nh_.subscribe(so);
