@@ -118,7 +118,12 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   recorder_->record(m, sim_->state());
   stamp_offset_ = std::floor(ros::WallTime::now().toSec());
 
-  point_pub_ = nh_.advertise<ContactPointArray>("hil/contact_point", 10);
+  // One second of contact points queued per subscriber: a subscriber stalled for a few periods (a
+  // loaded machine) gets them late instead of losing them; roscpp drops the oldest of a fuller
+  // queue, and a rig that loses one integrates its pantograph against an extrapolated wire for
+  // two periods, a recorder a hole in its series (seen in test_ros_hil_loop at 2 kHz on a loaded
+  // 2-core machine with the former 10: 41 lost in a pass).
+  point_pub_ = nh_.advertise<ContactPointArray>("hil/contact_point", static_cast<std::uint32_t>(std::ceil(params_.rate)));
   contact_pub_ = nh_.advertise<ContactForceArray>("contact_force", 10);
   pantograph_pub_ = nh_.advertise<PantographStateArray>("pantograph_state", 10);
   shape_pub_ = nh_.advertise<WireShapeArray>("wire_shape", 2);

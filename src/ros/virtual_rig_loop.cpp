@@ -47,8 +47,10 @@ VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   } catch (const SceneError& e) {
     throw ParamError("parameter ~pantograph_scene = '" + scene_file + "': " + e.what());
   }
+  // Every contact point, even after a stall of the loop thread (up to 1 s at 10 kHz): the
+  // pantograph is stepped through each one (a lost one: two periods against an extrapolated wire).
   ros::SubscribeOptions so = ros::SubscribeOptions::create<ContactPointArray>(
-      "hil/contact_point", 100, [this](const ContactPointArray::ConstPtr& m) { on_point(m); }, ros::VoidPtr(),
+      "hil/contact_point", 10000, [this](const ContactPointArray::ConstPtr& m) { on_point(m); }, ros::VoidPtr(),
       &queue_);
   so.transport_hints = ros::TransportHints().tcpNoDelay();
   sub_ = nh_.subscribe(so);

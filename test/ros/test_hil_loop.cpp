@@ -1,16 +1,36 @@
-// rostest companion of hil.test (1 kHz) and hil_2khz.test: catenary_sim_hil_node and
-// virtual_rig close the loop over the topics, on the wall clock, on config/reference_55m_hil.yaml
-// (the whole 550 m pass at 300 km/h: 6.6 s). The contact force collected from hil/contact_point
-// must give the statistics of the internal lumped pantograph of config/reference_55m.yaml (same
-// dt, same sampling), within the tolerance that test_hil.cpp's delay study justifies: a loop
-// delay of one or two periods is a phase lag that moves the 20 Hz filtered mean by < 0.1 N and its
-// standard deviation by < 1 %; allowed here: 0.5 N and 3 % (the live loop also sees stalls).
+// rostest companion of hil.test (1 kHz), hil_2khz.test and hil_inprocess.test:
+// catenary_sim_hil_node and virtual_rig close the loop over the topics, on the wall clock, on
+// config/reference_55m_hil.yaml (the whole 550 m pass at 300 km/h: 6.6 s).
+//
+// What the wall clock does to the loop is its delay: the force applied in a period is the rig's
+// answer to the contact point of one period before (the design point) or, when the answer was not
+// there in time, to an older one, held (`measurement_step` in each contact point names it). On a
+// loaded 2-core machine (a build beside the test) 5 to 20 % of the periods ran with an older
+// answer, in stalls of up to 9 periods at 1 kHz and 26 at 2 kHz, and these alone moved the
+// 20 Hz filtered mean of the pass by -0.23 to +0.09 N (0.76 N seen on a CI machine), with a sign
+// and size that depend on where the stalls fall (the held force kicks the line and the
+// pantograph; the effect is not a function of the mean delay: capping the same stalls at 1 period
+// leaves -0.05 N of -0.22 N). A comparison with the internal pantograph under a fixed tolerance
+// therefore failed by chance. Instead the test compares like with like:
+//  1. it replays the pass offline with the same code (the core with the external pantograph, the
+//     virtual rig's RigPantograph stepped as virtual_rig steps it) and the delay sequence the
+//     live loop had: the live contact points must be reproduced period by period (the same
+//     numbers through the same operations: a difference is a defect of the node, the rig or the
+//     transport, e.g. a force applied that is not the answer it names, or a lost contact point);
+//  2. the same replay with every answer in time (no delay) must give the statistics of the
+//     internal lumped pantograph of config/reference_55m.yaml within test_hil.cpp's tolerance of
+//     a loop delay of up to two periods (0.1 N on the mean, 1 % on the standard deviation).
+// The delay the machine imposed and its effect on the statistics (live - no delay) are recorded in
+// the summary property.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <string>
@@ -21,12 +41,14 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
 #include "catenary_sim/ros/hil.hpp"
+#include "catenary_sim/ros/virtual_rig.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."
 #endif
 
 using namespace catenary_sim;
+using namespace catenary_sim::ros_layer;
 
 namespace {
 
@@ -46,9 +68,96 @@ void on_measurement(const MeasuredContactForce::ConstPtr& m) {
   measurement_frames.push_back(m->header.frame_id);
 }
 
+const std::string kDir = CATENARY_SIM_SOURCE_DIR;
+
+Scene scene_with_dt(const std::string& file, double dt) {
+  YAML::Node root = YAML::LoadFile(kDir + "/config/" + file);
+  root["numerics"]["dt"] = dt;
+  std::stringstream yaml;
+  yaml << root;
+  return load_scene_string(yaml.str());
+}
+
+// The contact point of each period: step, position and applied force of the first pantograph.
+struct Series {
+  std::vector<std::uint64_t> step;
+  std::vector<double> x, f;
+};
+
+// The loop of catenary_sim_hil_node (config/reference_55m_hil.yaml, `dt`, `k` steps a period, the
+// newest measurement held) and virtual_rig (the lumped pantograph of the same name in
+// config/reference_55m.yaml, stepped up to each contact point against the previous one's wire
+// extrapolated along its path velocity, answering with its contact force), period by period
+// without a clock. The force of period i is the rig's answer to the contact point of step
+// `measurement_step[i]` (null: to the last one, no delay). Returns false with `error` set when a
+// period names a step that was not published before it.
+bool replay(double dt, int k, const std::vector<std::uint64_t>* measurement_step, Series& out, std::string& error) {
+  Simulation sim(scene_with_dt("reference_55m_hil.yaml", dt));
+  const Model& m = sim.model();
+  const std::vector<int> external = external_pantographs(m);
+  if (external.size() != 1) {
+    error = "reference_55m_hil.yaml has " + std::to_string(external.size()) + " external pantographs, 1 expected";
+    return false;
+  }
+  const int p = external[0];
+  const Scene lumped = load_scene_file(kDir + "/config/reference_55m.yaml");
+  const PantographSpec* spec = nullptr;
+  for (const PantographSpec& ps : lumped.pantographs)
+    if (ps.name == m.pantographs[p].name) spec = &ps;
+  if (!spec) {
+    error = "no pantograph '" + m.pantographs[p].name + "' in reference_55m.yaml";
+    return false;
+  }
+  RigPantograph rig(*spec, lumped.contact.stiffness);
+  std::vector<ContactPointMotion> scratch;
+  ContactPointArray msg = to_contact_points(m, sim.state(), ros::Time(1), "line", k, scratch);
+  std::vector<WirePoint> wire = wire_points(msg.pantographs[0]);
+  rig.reset(wire, msg.speed);
+  double speed = msg.speed;
+  std::map<std::uint64_t, double> answers{{msg.step, rig.contact_force(wire)}};
+  std::uint64_t rig_step = msg.step;
+  std::string err;
+  for (std::size_t i = 0; !sim.finished(); ++i) {
+    std::uint64_t used = rig_step;
+    if (measurement_step) {
+      if (i >= measurement_step->size()) {
+        error = "the live pass had " + std::to_string(i) + " periods, the replay has more";
+        return false;
+      }
+      used = (*measurement_step)[i];
+    }
+    const auto a = answers.find(used);
+    if (a == answers.end()) {
+      error = "period " + std::to_string(i) + " used the answer to step " + std::to_string(used) +
+              ", which is not a contact point published before it (last: " + std::to_string(rig_step) + ")";
+      return false;
+    }
+    // As the node: the measurement goes through the core's check, is held and clamped.
+    sim.set_external_force(p, a->second, &err);
+    sim.set_external_force(p, std::clamp(sim.state().external_force[p], 0.0, Simulation::kMaxExternalForce), &err);
+    for (int j = 0; j < k && !sim.finished(); ++j)
+      if (sim.step() != StepStatus::kOk) {
+        error = "the replay diverged: " + sim.status_message();
+        return false;
+      }
+    msg = to_contact_points(m, sim.state(), ros::Time(1), "line", k, scratch);
+    out.step.push_back(msg.step);
+    out.x.push_back(msg.pantographs[0].position);
+    out.f.push_back(msg.pantographs[0].applied_force);
+    // As virtual_rig::on_point, then send().
+    for (std::uint64_t s = rig_step; s < msg.step; ++s)
+      rig.step(dt, rig.contact_force(wire, static_cast<double>(s - rig_step) * dt), speed);
+    rig_step = msg.step;
+    wire = wire_points(msg.pantographs[0]);
+    speed = msg.speed;
+    answers[rig_step] = rig.contact_force(wire);
+  }
+  return true;
+}
+
 }  // namespace
 
-TEST(HilLoop, ClosedLoopStatisticsMatchTheInternalPantograph) {
+TEST(HilLoop, LiveLoopIsItsOwnReplayAndWithoutDelayTheInternalPantograph) {
   ros::NodeHandle pnh("~");
   double rate = 0.0;
   ASSERT_TRUE(pnh.getParam("rate", rate));
@@ -84,53 +193,82 @@ TEST(HilLoop, ClosedLoopStatisticsMatchTheInternalPantograph) {
   const int k = static_cast<int>(run[0]->steps_per_period);
   const double dt = run[0]->dt;
   EXPECT_NEAR(k * dt, 1.0 / rate, 1e-12);
-  std::size_t gaps = 0, zero_delay = 0;
+  std::size_t gaps = 0;
   for (std::size_t i = 1; i < run.size(); ++i) {
     EXPECT_GT(run[i]->header.stamp, run[i - 1]->header.stamp);
     gaps += run[i]->step != run[i - 1]->step + k;
-    zero_delay += run[i]->measurement_step + k == run[i]->step;
   }
-  // (a contact point lost on the way: tolerated, the statistics use the position of each sample)
-  EXPECT_LE(gaps, run.size() / 100) << "contact points lost";
+  // (the node queues a second of contact points for a slow subscriber: none is lost short of a
+  // stall of that length, and the replay needs the measurement_step of every period)
+  ASSERT_EQ(gaps, 0u) << "contact points lost on the way to the test";
 
-  // The internal lumped pantograph of the same line, same dt, sampled at the same steps.
-  YAML::Node root = YAML::LoadFile(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml");
-  root["numerics"]["dt"] = dt;
-  std::stringstream yaml;
-  yaml << root;
-  Simulation internal(load_scene_string(yaml.str()));
+  // 1. The live loop is the replay of its own delays.
+  Series live;
+  std::vector<std::uint64_t> used;
+  std::map<long long, std::size_t> late;  // periods of delay beyond the design point -> count
+  for (const ContactPointArray* c : run) {
+    live.step.push_back(c->step);
+    live.x.push_back(c->pantographs[0].position);
+    live.f.push_back(c->pantographs[0].applied_force);
+    used.push_back(c->measurement_step);
+    ++late[(static_cast<long long>(c->step) - static_cast<long long>(c->measurement_step)) / k - 1];
+  }
+  Series same, prompt;
+  std::string error;
+  ASSERT_TRUE(replay(dt, k, &used, same, error)) << error;
+  ASSERT_EQ(same.step.size(), live.step.size()) << "periods in the replay and in the live pass";
+  // The same numbers through the same operations (TCPROS carries the float64 values exactly): the
+  // differences are round-off at most (1e-6 N: far below any force a defect would change).
+  std::size_t differ = 0, first = 0;
+  for (std::size_t i = 0; i < live.f.size(); ++i) {
+    const bool d = same.step[i] != live.step[i] || std::fabs(same.x[i] - live.x[i]) > 1e-9 ||
+                   std::fabs(same.f[i] - live.f[i]) > 1e-6;
+    if (d && differ++ == 0) first = i;
+  }
+  EXPECT_EQ(differ, 0u) << "periods where the live loop is not its replay; first: step " << live.step[first]
+                        << " (replay " << same.step[first] << "), applied force " << live.f[first] << " N (replay "
+                        << same.f[first] << " N), using the answer to step " << used[first];
+
+  // 2. Without the delay the loop is the internal pantograph.
+  ASSERT_TRUE(replay(dt, k, nullptr, prompt, error)) << error;
+  Simulation internal(scene_with_dt("reference_55m.yaml", dt));
   const Model& m = internal.model();
   ASSERT_NEAR(internal.state().speed, run.back()->speed, 1e-9);
-  std::vector<double> xi, fi;
+  Series in;
   while (!internal.finished()) {
     for (int j = 0; j < k; ++j) internal.step();
-    xi.push_back(pantograph_position(m, internal.state(), 0));
-    fi.push_back(total_contact_force(m, internal.state(), 0));
-  }
-  std::vector<double> xh, fh;
-  for (const ContactPointArray* c : run) {
-    xh.push_back(c->pantographs[0].position);
-    fh.push_back(c->pantographs[0].applied_force);
+    in.x.push_back(pantograph_position(m, internal.state(), 0));
+    in.f.push_back(total_contact_force(m, internal.state(), 0));
   }
   const double x0 = m.support_x[m.scene.analysis_first()], x1 = m.support_x[m.scene.analysis_last()];
-  auto stats = [&](const std::vector<double>& x, const std::vector<double>& f) {
-    const std::vector<double> filtered = lowpass_zero_phase(f, rate, m.scene.output.filter_cutoff);
-    std::vector<double> in;
-    for (std::size_t i = 0; i < f.size(); ++i)
-      if (x[i] >= x0 && x[i] <= x1) in.push_back(filtered[i]);
-    return force_statistics(in);
+  auto stats = [&](const Series& s) {
+    const std::vector<double> filtered = lowpass_zero_phase(s.f, rate, m.scene.output.filter_cutoff);
+    std::vector<double> sec;
+    for (std::size_t i = 0; i < s.f.size(); ++i)
+      if (s.x[i] >= x0 && s.x[i] <= x1) sec.push_back(filtered[i]);
+    return force_statistics(sec);
   };
-  const ForceStatistics si = stats(xi, fi), sh = stats(xh, fh);
-  char summary[512];
+  const ForceStatistics sl = stats(live), sp = stats(prompt), si = stats(in);
+  // test_hil.cpp, ClosedLoop.DelayOfOneOrTwoPeriodsChangesTheStatisticsLittle (1 kHz) and
+  // WithoutDelayTheLoopIsTheInternalPantograph (2 kHz: equal but for round-off).
+  EXPECT_NEAR(sp.mean, si.mean, 0.1);
+  EXPECT_NEAR(sp.std_dev, si.std_dev, 0.01 * si.std_dev);
+
+  std::string hist;
+  std::size_t delayed = 0;
+  for (const auto& [d, n] : late) {
+    hist += (hist.empty() ? "" : " ") + std::to_string(d) + ":" + std::to_string(n);
+    if (d > 0) delayed += n;
+  }
+  char summary[768];
   std::snprintf(summary, sizeof summary,
-                "%g Hz (%d x %g ms): loop mean %.3f N std %.3f N max %.2f min %.2f; internal mean %.3f N std %.3f N "
-                "max %.2f min %.2f; %zu periods, %.1f %% used the answer to the previous contact point, %zu gaps",
-                rate, k, dt * 1e3, sh.mean, sh.std_dev, sh.max, sh.min, si.mean, si.std_dev, si.max, si.min,
-                run.size(), 100.0 * zero_delay / run.size(), gaps);
+                "%g Hz (%d x %g ms), %zu periods: %.1f %% with an older answer than the design point (periods late: "
+                "count %s); live mean %.3f N std %.3f N; without delay mean %.3f N std %.3f N; internal mean %.3f N "
+                "std %.3f N; the delay's effect: mean %+.3f N, std %+.2f %%",
+                rate, k, dt * 1e3, run.size(), 100.0 * delayed / run.size(), hist.c_str(), sl.mean, sl.std_dev, sp.mean,
+                sp.std_dev, si.mean, si.std_dev, sl.mean - sp.mean, 100.0 * (sl.std_dev / sp.std_dev - 1.0));
   RecordProperty("summary", summary);
   ROS_INFO("test_hil_loop: %s", summary);
-  EXPECT_NEAR(sh.mean, si.mean, 0.5);
-  EXPECT_NEAR(sh.std_dev, si.std_dev, 0.03 * si.std_dev);
 }
 
 int main(int argc, char** argv) {
