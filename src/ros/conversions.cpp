@@ -369,7 +369,8 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     // curving down at both ends.
     const bool point_force = pg.moving_force && !pg.external;
     Marker head = marker(h, "pantograph_head", id, point_force ? Marker::SPHERE : Marker::CUBE);
-    head.pose.position = point(x, 0.0, z_head - 0.05);
+    // Its top at the drawn head height (the strips' running surface), where the arrow starts.
+    head.pose.position = point(x, 0.0, point_force ? z_head - 0.03 : z_head - 0.02);
     if (point_force) head.scale.x = head.scale.y = head.scale.z = 0.2;
     else {
       head.scale.x = 0.1;
