@@ -54,7 +54,8 @@ int node_at(const std::vector<double>& x, double xs) {
   return static_cast<int>(it - x.begin());
 }
 
-void assemble_band(Wire& w) {
+// ei_factor: per element, a multiplier of EI (a worn contact wire); empty = the wire's EI.
+void assemble_band(Wire& w, const std::vector<double>& ei_factor) {
   const int n = w.nodes();
   w.d_ww.assign(n, 0.0);
   w.d_wt.assign(n, 0.0);
@@ -64,7 +65,8 @@ void assemble_band(Wire& w) {
   w.e_tw.assign(n - 1, 0.0);
   w.e_tt.assign(n - 1, 0.0);
   for (int e = 0; e + 1 < n; ++e) {
-    const Matrix4 k = beam_stiffness(w.x[e + 1] - w.x[e], w.spec.bending_stiffness, w.spec.tension);
+    const double ei = w.spec.bending_stiffness * (ei_factor.empty() ? 1.0 : ei_factor[e]);
+    const Matrix4 k = beam_stiffness(w.x[e + 1] - w.x[e], ei, w.spec.tension);
     w.d_ww[e] += k[0][0];
     w.d_wt[e] += k[0][1];
     w.d_tt[e] += k[1][1];
@@ -372,6 +374,7 @@ namespace {
 class NormalErrors {
  public:
   explicit NormalErrors(std::uint64_t seed) : gen_(seed) {}
+  double uniform() { return (static_cast<double>(gen_() >> 11) + 0.5) * 0x1.0p-53; }  // (0, 1)
   double next(double std_dev) {
     const double u1 = (static_cast<double>(gen_() >> 11) + 0.5) * 0x1.0p-53;  // (0, 1)
     const double u2 = (static_cast<double>(gen_() >> 11) + 0.5) * 0x1.0p-53;
@@ -381,6 +384,42 @@ class NormalErrors {
  private:
   std::mt19937_64 gen_;
 };
+
+// Spectral representation of a random profile (Shinozuka): sum_j a_j cos(k_j x + phi_j) with the
+// one-sided power-law spectrum S(k) ~ k^-n shared among kHarmonics bands equally spaced in log k
+// between 2 pi / wavelength_max and 2 pi / wavelength_min, a_j^2 / 2 = S(k_j) dk_j scaled so that
+// sum a_j^2 / 2 = rms^2; each k_j drawn inside its band (no common period) and each phase uniform.
+std::vector<double> irregularity_profile(const IrregularitySpec& ir, NormalErrors& gen, const std::vector<Wire>& wires) {
+  std::vector<double> out;
+  if (!ir.profile.empty()) {
+    for (const Wire& w : wires)
+      if (w.is_contact_wire)
+        for (double x : w.x) out.push_back(ir.profile.at(x));
+    return out;
+  }
+  constexpr int kHarmonics = 256;
+  const double k0 = 2.0 * M_PI / ir.wavelength_max, k1 = 2.0 * M_PI / ir.wavelength_min;
+  const double step = std::log(k1 / k0) / kHarmonics;
+  std::vector<double> k(kHarmonics), a(kHarmonics), phase(kHarmonics);
+  double power = 0.0;
+  for (int j = 0; j < kHarmonics; ++j) {
+    const double lo = k0 * std::exp(j * step), hi = k0 * std::exp((j + 1) * step);
+    k[j] = lo + (hi - lo) * gen.uniform();
+    phase[j] = 2.0 * M_PI * gen.uniform();
+    a[j] = std::pow(0.5 * (lo + hi), -ir.exponent) * (hi - lo);  // S(k_j) dk_j, scaled below
+    power += a[j];
+  }
+  for (double& aj : a) aj = std::sqrt(2.0 * aj / power) * ir.rms;
+  for (const Wire& w : wires) {
+    if (!w.is_contact_wire) continue;
+    for (double x : w.x) {
+      double r = 0.0;
+      for (int j = 0; j < kHarmonics; ++j) r += a[j] * std::cos(k[j] * x + phase[j]);
+      out.push_back(r);
+    }
+  }
+  return out;
+}
 
 // The line as built: the design statics set the dropper lengths and support heights; the errors
 // act on the built line through the constant load (at u = 0 it no longer balances, and the eq. 23
@@ -429,6 +468,16 @@ void apply_imperfections(const Scene& scene, Model& m, const std::vector<bool>& 
     m.load[m.springs[arms[j]].dof] += m.springs[arms[j]].stiffness * e;
   }
   const double g = scene.gravity;
+  const IrregularitySpec& ir = im.contact_wire_irregularity;
+  if (ir.any()) {
+    NormalErrors own_irregularity(ir.seed.value_or(0));
+    const std::vector<double> r = irregularity_profile(ir, ir.seed ? own_irregularity : shared, m.wires);
+    std::size_t at = 0;
+    for (Wire& w : m.wires) {
+      if (!w.is_contact_wire) continue;
+      for (int i = 0; i < w.nodes(); ++i) w.height[i] += r[at++];
+    }
+  }
   for (const PointMassSpec& pm : im.point_masses) {
     const Wire& w = m.wires[m.contact_wires.front()];
     const auto it = std::lower_bound(w.x.begin(), w.x.end(), pm.station);
@@ -549,7 +598,7 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
         dof += static_cast<int>(x.size());
       }
       for (double sx : section_supports[si]) w.support_nodes.push_back(node_at(x, sx));
-      assemble_band(w);
+      assemble_band(w, {});
       if (contact) m.contact_wires.push_back(static_cast<int>(m.wires.size()));
       else info.messenger = static_cast<int>(m.wires.size());
       info.wires.push_back(static_cast<int>(m.wires.size()));
@@ -749,6 +798,27 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
                                  [&](const Wire& w) { return sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes(); });
     sp.static_force = react[it - m.wires.begin()][sp.section_support];
   }
+
+  // Wear (the line as built, after the design statics): a worn contact wire element is lighter
+  // and bends more easily; the constant load below then no longer balances at u = 0, and the
+  // eq. 23 statics find where the worn line hangs.
+  const WearSpec& wear = scene.imperfections.contact_wire_wear;
+  if (wear.any())
+    for (Wire& w : m.wires) {
+      if (!w.is_contact_wire) continue;
+      std::vector<double> ei_factor(w.nodes() - 1, 1.0);
+      for (int e = 0; e + 1 < w.nodes(); ++e) {
+        const double loss = wear.at(0.5 * (w.x[e] + w.x[e + 1])), he = w.x[e + 1] - w.x[e];
+        ei_factor[e] = std::pow(1.0 - loss, wear.ei_exponent);
+        m.mass[w.w_dof + e] -= loss * beam_translational_mass(he, w.spec.linear_mass);
+        m.mass[w.w_dof + e + 1] -= loss * beam_translational_mass(he, w.spec.linear_mass);
+        if (lumped_rot) {
+          m.mass[w.theta_dof + e] -= loss * beam_rotary_mass(he, w.spec.linear_mass);
+          m.mass[w.theta_dof + e + 1] -= loss * beam_rotary_mass(he, w.spec.linear_mass);
+        }
+      }
+      assemble_band(w, ei_factor);
+    }
 
   // Constant load: gravity + support preloads - K y_design. At u = 0 it balances the static
   // dropper tensions exactly (that is what the design statics solved for).

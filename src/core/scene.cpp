@@ -379,7 +379,96 @@ int Scene::analysis_last() const {
   return output.analysis_last_span ? *output.analysis_last_span : (n > 4 ? n - 2 : n);
 }
 
-Scene scene_from_yaml(const YAML::Node& root) {
+namespace {
+
+// A two-column CSV (station in m, value): '#' starts a comment, one header line allowed, comma,
+// semicolon, tab or blank separated. Errors name the file, the line and what is allowed.
+LineProfile read_profile_csv(const std::string& field, const std::string& path, double lo, double hi) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) fail(field, "'" + path + "'", std::string("a readable CSV file (") + std::strerror(errno) + ")");
+  if (S_ISDIR(st.st_mode)) fail(field, "'" + path + "'", "a CSV file, not a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(field, "'" + path + "'", std::string("a readable CSV file (") + std::strerror(errno) + ")");
+  // Read at most the cap and one byte more (/dev/zero or a huge file must not fill the memory).
+  std::string text(kMaxSceneFileBytes + 1, '\0');
+  in.read(&text[0], static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxSceneFileBytes)
+    fail(field, "'" + path + "'", "a CSV of at most " + std::to_string(kMaxSceneFileBytes >> 20) + " MiB");
+  if (in.bad()) fail(field, "'" + path + "'", std::string("a readable CSV file (") + std::strerror(errno) + ")");
+  std::istringstream lines(text);
+  LineProfile p;
+  std::string line;
+  bool header_allowed = true;
+  for (int no = 1; std::getline(lines, line); ++no) {
+    const std::size_t hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    for (char& c : line)
+      if (c == ',' || c == ';' || c == '\t' || c == '\r' || c == '"') c = ' ';
+    std::istringstream cols(line);
+    std::vector<std::string> cell;
+    for (std::string c; cols >> c;) cell.push_back(c);
+    if (cell.empty()) continue;
+    const std::string where = "'" + path + "' line " + std::to_string(no);
+    std::vector<double> v;
+    for (const std::string& c : cell) {
+      char* end = nullptr;
+      const double d = std::strtod(c.c_str(), &end);
+      if (end != c.c_str() + c.size() || !std::isfinite(d)) {
+        v.clear();
+        break;
+      }
+      v.push_back(d);
+    }
+    if (v.empty() && header_allowed) {  // a header: the first line that is not a comment
+      header_allowed = false;
+      continue;
+    }
+    header_allowed = false;
+    if (v.size() != 2) fail(field, where + " ('" + (line.size() > 60 ? line.substr(0, 60) + "..." : line) + "')", "two finite numbers: station (m), value");
+    if (!p.stations.empty() && v[0] <= p.stations.back())
+      fail(field, where + " (station " + fmt(v[0]) + " m)", "stations strictly increasing (previous " + fmt(p.stations.back()) + " m)");
+    if (v[1] < lo || v[1] > hi) fail(field, where + " (value " + fmt(v[1]) + ")", "values in [" + fmt(lo) + ", " + fmt(hi) + "]");
+    p.stations.push_back(v[0]);
+    p.values.push_back(v[1]);
+  }
+  if (p.stations.size() < 2) fail(field, "'" + path + "' (" + std::to_string(p.stations.size()) + " rows)", "at least two rows: station (m), value");
+  return p;
+}
+
+// A profile given as `csv: FILE` or as `stations: [..]` with `<values>: [..]`.
+LineProfile read_profile(Reader& r, const std::string& values_key, double lo, double hi, const std::string& base_dir) {
+  LineProfile p;
+  if (r.has("csv")) {
+    if (r.has("stations") || r.has(values_key))
+      fail(r.field("csv"), "(given with stations)", "either csv or stations and " + values_key);
+    std::string path = r.text("csv", "");
+    if (!path.empty() && path[0] != '/' && !base_dir.empty()) path = base_dir + "/" + path;
+    return read_profile_csv(r.field("csv"), path, lo, hi);
+  }
+  p.stations = r.numbers("stations", -1e7, 1e7);
+  p.values = r.numbers(values_key, lo, hi);
+  if (p.values.size() != p.stations.size())
+    fail(r.field(values_key), "(" + std::to_string(p.values.size()) + " values)", "one per station (" + std::to_string(p.stations.size()) + ")");
+  if (p.stations.size() < 2) fail(r.field("stations"), "(" + std::to_string(p.stations.size()) + " values)", "at least two stations");
+  for (std::size_t i = 1; i < p.stations.size(); ++i)
+    if (p.stations[i] <= p.stations[i - 1])
+      fail(r.field("stations") + "[" + std::to_string(i) + "]", fmt(p.stations[i]), "strictly increasing (previous " + fmt(p.stations[i - 1]) + ")");
+  return p;
+}
+
+}  // namespace
+
+double LineProfile::at(double x) const {
+  if (stations.empty() || x < stations.front() || x > stations.back()) return 0.0;
+  const auto it = std::upper_bound(stations.begin(), stations.end(), x);
+  if (it == stations.end()) return values.back();
+  const std::size_t j = static_cast<std::size_t>(it - stations.begin());
+  const double t = (x - stations[j - 1]) / (stations[j] - stations[j - 1]);
+  return values[j - 1] + t * (values[j] - values[j - 1]);
+}
+
+Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   if (!root || !root.IsMap()) throw SceneError("scene: the document must be a YAML map of sections (line, contact_wire, ...)");
   Reader top(root, "");
   Scene s;
@@ -560,6 +649,42 @@ Scene scene_from_yaml(const YAML::Node& root) {
         im.point_masses.push_back(p);
       }
     }
+    if (r.has("contact_wire_irregularity")) {
+      Reader q(r.child("contact_wire_irregularity"), "imperfections.contact_wire_irregularity");
+      IrregularitySpec& ir = im.contact_wire_irregularity;
+      const bool measured = q.has("csv") || q.has("stations") || q.has("deviations");
+      if (measured) {
+        for (const char* k : {"rms", "wavelength_min", "wavelength_max", "exponent", "seed"})
+          if (q.has(k)) fail(q.field(k), "(given with a measured profile)", "either a profile (csv or stations/deviations) or a random one (rms, wavelengths)");
+        ir.profile = read_profile(q, "deviations", -0.5, 0.5, base_dir);
+      } else {
+        ir.rms = q.number("rms", 0.0, 0.1, std::nullopt, true);
+        ir.wavelength_min = q.number("wavelength_min", 0.0, 1e4, std::nullopt, true);
+        ir.wavelength_max = q.number("wavelength_max", 0.0, 1e4, std::nullopt, true);
+        if (ir.wavelength_max <= ir.wavelength_min)
+          fail(q.field("wavelength_max"), fmt(ir.wavelength_max), "above wavelength_min (" + fmt(ir.wavelength_min) + " m)");
+        ir.exponent = q.number("exponent", 0.0, 6.0, 2.0);
+        if (q.has("seed")) {
+          const double v = q.number("seed", 0.0, 9007199254740992.0);
+          if (v != std::floor(v)) fail(q.field("seed"), fmt(v), "a whole number >= 0");
+          ir.seed = static_cast<std::uint64_t>(v);
+        }
+      }
+      q.finish();
+    }
+    if (r.has("contact_wire_wear")) {
+      Reader q(r.child("contact_wire_wear"), "imperfections.contact_wire_wear");
+      WearSpec& w = im.contact_wire_wear;
+      // Standards replace a contact wire at 20-30 % wear; 0.5 leaves room for studies beyond.
+      const double max_loss = 0.5;
+      if (q.has("csv") || q.has("stations")) {
+        w.section_loss = read_profile(q, "section_loss", 0.0, max_loss, base_dir);
+      } else {
+        w.uniform = q.number("section_loss", 0.0, max_loss);
+      }
+      w.ei_exponent = q.number("ei_exponent", 0.0, 4.0, 2.0);
+      q.finish();
+    }
     r.finish();
   }
   if (top.has("output")) {
@@ -632,6 +757,12 @@ void validate(const Scene& s) {
   if (s.imperfections.any()) {
     if (s.endless)
       fail("imperfections", "(given)", "a finite line: an endless line repeats one perfect span");
+    // The mesh carries a wavelength of at least two elements (shorter ones alias onto longer ones).
+    const IrregularitySpec& ir = s.imperfections.contact_wire_irregularity;
+    if (ir.rms > 0.0 && ir.wavelength_min < 2.0 * s.numerics.element_length)
+      fail("imperfections.contact_wire_irregularity.wavelength_min", fmt(ir.wavelength_min),
+           "at least two elements (2 x numerics.element_length = " + fmt(2.0 * s.numerics.element_length) +
+               " m): the mesh cannot carry a shorter wave");
     for (std::size_t i = 0; i < s.imperfections.point_masses.size(); ++i)
       if (s.imperfections.point_masses[i].station > line + 1e-9)
         fail("imperfections.point_masses[" + std::to_string(i) + "].station", fmt(s.imperfections.point_masses[i].station),
@@ -730,12 +861,12 @@ void apply_override(YAML::Node root, const std::string& assignment) {
   }
 }
 
-Scene load_from_node(YAML::Node root, const std::vector<std::string>& overrides) {
+Scene load_from_node(YAML::Node root, const std::vector<std::string>& overrides, const std::string& base_dir) {
   if (!root || !root.IsMap()) throw SceneError("scene: the document must be a YAML map of sections (line, contact_wire, ...)");
   try {
     for (const auto& o : overrides) apply_override(root, o);
     check_document(root, "");
-    return scene_from_yaml(root);
+    return scene_from_yaml(root, base_dir);
   } catch (const YAML::Exception& e) {
     // Not expected after check_document; a field is still better named by the reader, but never abort.
     throw SceneError(std::string("scene: ") + e.what());
@@ -746,14 +877,14 @@ Scene load_from_node(YAML::Node root, const std::vector<std::string>& overrides)
 
 }  // namespace
 
-Scene load_scene_string(const std::string& yaml, const std::vector<std::string>& overrides) {
+Scene load_scene_string(const std::string& yaml, const std::vector<std::string>& overrides, const std::string& base_dir) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml);
   } catch (const YAML::Exception& e) {
     throw SceneError(std::string("scene: not valid YAML: ") + e.what());
   }
-  return load_from_node(root, overrides);
+  return load_from_node(root, overrides, base_dir);
 }
 
 
@@ -773,7 +904,8 @@ Scene load_scene_file(const std::string& path, const std::vector<std::string>& o
                      " MiB, the limit for a scene (scenes are a few kB of YAML)");
   if (in.bad()) throw SceneError("scene file '" + path + "': read error (" + std::strerror(errno) + ")");
   try {
-    return load_scene_string(text, overrides);
+    const std::size_t slash = path.rfind('/');
+    return load_scene_string(text, overrides, slash == std::string::npos ? "" : path.substr(0, slash == 0 ? 1 : slash));
   } catch (const SceneError& e) {
     throw SceneError(path + ": " + e.what());
   }

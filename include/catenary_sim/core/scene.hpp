@@ -146,6 +146,40 @@ struct PointMassSpec {
   double station = 0.0;  // m along the line
   double mass = 0.0;     // kg on the contact wire (a section insulator, a splice, a clamp: a hard spot)
 };
+// A profile along the line: values at increasing stations, linear between them, 0 outside
+// (a measured record covers the stretch it was measured on).
+struct LineProfile {
+  std::vector<double> stations;  // m, strictly increasing
+  std::vector<double> values;
+  bool empty() const { return stations.empty(); }
+  double at(double x) const;
+};
+// Contact-wire height irregularity: a stress-free deviation of the contact wire's height from the
+// design (kinks, waviness, clamps set off height), + up. The contact sees it (eq. 12: the collector
+// rides on design height + deviation + displacement); the beam does not (K acts on displacements
+// from the design shape), as rail irregularities enter a vehicle model. A measured profile, or
+// random from a one-sided power-law spectrum S(k) ~ k^-exponent between two wavelengths, scaled to
+// an rms and drawn with random phases (spectral representation) from a seeded generator.
+struct IrregularitySpec {
+  LineProfile profile;                 // m of deviation at stations (measured)
+  double rms = 0.0;                    // m, random irregularity (0: none)
+  double wavelength_min = 0.0;         // m
+  double wavelength_max = 0.0;         // m
+  double exponent = 2.0;               // of S(k) ~ k^-exponent
+  std::optional<std::uint64_t> seed;   // unset: drawn from imperfections.seed after the other classes
+  bool any() const { return !profile.empty() || rms > 0.0; }
+};
+// Contact-wire wear: the share of the cross-section worn away along the line (0 new). The worn
+// wire is lighter (rhoA (1 - loss)) and bends more easily (EI (1 - loss)^ei_exponent; 2 for a
+// section that shrinks alike in every direction, assumed: a wire worn flat at the bottom loses
+// more), while its tension stays (set by the tensioning device).
+struct WearSpec {
+  LineProfile section_loss;  // share at stations; a uniform wear is one value over the whole line
+  double uniform = 0.0;      // share over the whole line (instead of the profile)
+  double ei_exponent = 2.0;
+  bool any() const { return uniform > 0.0 || !section_loss.empty(); }
+  double at(double x) const { return section_loss.empty() ? uniform : section_loss.at(x); }
+};
 struct ImperfectionSpec {
   std::uint64_t seed = 0;
   // Per class (a study can vary one class's realisation alone, e.g. for grouped Sobol indices);
@@ -156,9 +190,12 @@ struct ImperfectionSpec {
   double support_height_std = 0.0;            // m: each steady arm's assembly height y0 of eq. 4 raised by a normal error
   std::vector<double> support_height_errors;  // m per steady arm in line order (instead of the std)
   std::vector<PointMassSpec> point_masses;
+  IrregularitySpec contact_wire_irregularity;
+  WearSpec contact_wire_wear;
   bool any() const {
     return dropper_length_std > 0.0 || !dropper_length_errors.empty() || support_height_std > 0.0 ||
-           !support_height_errors.empty() || !point_masses.empty();
+           !support_height_errors.empty() || !point_masses.empty() || contact_wire_irregularity.any() ||
+           contact_wire_wear.any();
   }
 };
 
@@ -204,8 +241,11 @@ constexpr std::size_t kMaxSceneFileBytes = std::size_t{16} << 20;
 // Loads and validates; throws SceneError. `overrides` are "dotted.key=value" pairs applied to the
 // YAML tree before validation (the same keys as the file, e.g. "numerics.element_length=0.125").
 Scene load_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
-Scene load_scene_string(const std::string& yaml, const std::vector<std::string>& overrides = {});
-Scene scene_from_yaml(const YAML::Node& root);
+// base_dir: where relative file names in the scene (profiles given as csv) are looked up;
+// empty = the working directory. load_scene_file uses the scene file's directory.
+Scene load_scene_string(const std::string& yaml, const std::vector<std::string>& overrides = {},
+                        const std::string& base_dir = "");
+Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir = "");
 // Checks cross-field consistency; throws SceneError. Called by the loaders; call it again after
 // changing a Scene in code.
 void validate(const Scene& scene);
