@@ -17,6 +17,7 @@ the simulation as it was. Statistics are the same JSON as simulate_pass's stats.
 """
 import json
 import re
+import os
 import time
 from pkgutil import extend_path
 
@@ -181,9 +182,11 @@ def check_scene(scene, overrides=None):
     if isinstance(scene, str):
         with open(scene, "rb") as f:
             text = f.read(16 << 20).decode("utf-8", errors="replace")
+        base = os.path.dirname(os.path.abspath(scene))  # profiles (csv) are looked up beside the scene
     else:
         text = _scene_text(scene)
-    _translate(lambda: _core._check_scene_string(text, ov))
+        base = ""
+    _translate(lambda: _core._check_scene_string(text, ov, base))
 
 
 def run_pass(scene, overrides=None, speed_kmh=None, sample_rate=None):

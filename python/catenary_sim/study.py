@@ -13,7 +13,9 @@ A study file (YAML; paths relative to it):
     seed: 1
     parameters:
       - key: pantographs.0.static_uplift            # any scene field, as simulate_pass --set
-        values: [80, 100, 120]                      # grid
+        values: [80, 100, 120]                      # grid; any YAML value: a list for a list field,
+                                                    # null for the scene's default (a rule's choice)
+        labels: [low, nominal, high]                # optional, grid: names in results.csv and plots
       - key: train.speed_kmh
         distribution: {type: uniform, low: 200, high: 300}      # random, lhs, sobol, saltelli
         # {type: normal, mean: 0, std: 0.01}, {type: truncated_normal, mean, std, low, high},
@@ -95,8 +97,8 @@ def load_study(path):
         if not isinstance(p, dict) or not isinstance(p.get("key"), str) or not p["key"]:
             _fail(f + ".key", p, "a scene field as a dotted key, e.g. pantographs.0.static_uplift")
         for k in p:
-            if k not in ("key", "values", "distribution"):
-                _fail(f"{f}.{k}", p[k], "unknown field; allowed: key, values, distribution")
+            if k not in ("key", "values", "labels", "distribution"):
+                _fail(f"{f}.{k}", p[k], "unknown field; allowed: key, values, labels, distribution")
         if p["key"] in seen:
             _fail(f + ".key", p["key"], "each parameter once")
         seen.add(p["key"])
@@ -104,7 +106,16 @@ def load_study(path):
             v = p.get("values")
             if not isinstance(v, list) or not v:
                 _fail(f + ".values", v, "a non-empty list of values (sampling: grid)")
-            s["parameters"].append({"key": p["key"], "values": v})
+            labels = p.get("labels")
+            if labels is None:
+                labels = [_label(x) for x in v]
+            elif not isinstance(labels, list) or len(labels) != len(v) or not all(isinstance(x, (str, int, float)) for x in labels):
+                _fail(f + ".labels", labels, f"a list of {len(v)} names, one per value")
+            if len(set(map(str, labels))) != len(labels):
+                _fail(f + ".labels", labels, "distinct names (give labels for values that print alike)")
+            s["parameters"].append({"key": p["key"], "values": v, "labels": labels})
+        elif "labels" in p:
+            _fail(f + ".labels", p["labels"], "only with sampling: grid")
         else:
             s["parameters"].append({"key": p["key"], "distribution": _check_distribution(p.get("distribution"), f)})
     if s["sampling"] != "grid":
@@ -125,6 +136,16 @@ def load_study(path):
         _fail("bootstrap", b, "a whole number of resamples in [0, 100000]")
     s["bootstrap"] = b
     return s
+
+
+def _label(value):
+    """A grid value as results.csv and the plots show it: numbers as they are, null as the scene's
+    default, anything else (a list) as its YAML flow text."""
+    if value is None:
+        return "default"
+    if isinstance(value, (int, float, str)) and not isinstance(value, bool):
+        return value
+    return yaml.safe_dump(value, default_flow_style=True, width=1 << 20).strip()
 
 
 def _check_distribution(d, f):
@@ -191,6 +212,13 @@ def make_cases(study):
     ints = [p["distribution"]["type"] == "integers" for p in params]
     return [{k: (int(values[i, j]) if ints[j] else float(values[i, j])) for j, k in enumerate(keys)}
             for i in range(values.shape[0])]
+
+
+def _index_of(values, v):
+    for j, x in enumerate(values):
+        if json.dumps(x) == json.dumps(v):
+            return j
+    raise StudyError(f"case value {v!r} is not among the grid's values")
 
 
 def _output(stats, path):
@@ -307,7 +335,11 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
     for i in range(len(cases)):
         with open(_case_path(out, i)) as f:
             r = json.load(f)
-        rows.append({"case": i, **r["parameters"], **r["outputs"], "status": r["status"],
+        shown = dict(r["parameters"])
+        if study["sampling"] == "grid":  # a list or null value shows as its label
+            for p in study["parameters"]:
+                shown[p["key"]] = p["labels"][_index_of(p["values"], shown[p["key"]])]
+        rows.append({"case": i, **shown, **r["outputs"], "status": r["status"],
                      "message": r["message"], "wall_time_s": r["wall_time_s"]})
     table = pd.DataFrame(rows)
     _write_atomically(os.path.join(out, "results.csv"), table.to_csv(index=False))

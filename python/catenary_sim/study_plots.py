@@ -12,6 +12,10 @@ def _save(fig, path):
     os.replace(tmp, path)
 
 
+def _tick(v):
+    return f"{v:g}" if isinstance(v, (int, float, np.integer, np.floating)) else str(v)
+
+
 def plot_study(study, table, out):
     import matplotlib
     matplotlib.use("Agg")
@@ -22,24 +26,57 @@ def plot_study(study, table, out):
     written = []
     for o in study["outputs"]:
         safe = o.replace(".", "_")
-        if study["sampling"] == "grid" and len(keys) == 2:
-            piv = ok.pivot_table(index=keys[1], columns=keys[0], values=o)
-            fig, ax = plt.subplots(figsize=(7, 5))
-            im = ax.pcolormesh(np.arange(piv.shape[1] + 1), np.arange(piv.shape[0] + 1), piv.to_numpy(), shading="flat")
-            ax.set_xticks(np.arange(piv.shape[1]) + 0.5, [f"{v:g}" for v in piv.columns])
-            ax.set_yticks(np.arange(piv.shape[0]) + 0.5, [f"{v:g}" for v in piv.index])
-            vals = piv.to_numpy()
-            mid = np.nanmin(vals) + 0.6 * (np.nanmax(vals) - np.nanmin(vals))
-            for (r, c), v in np.ndenumerate(vals):  # dark text on the light end of viridis
-                ax.text(c + 0.5, r + 0.5, f"{v:.3g}", ha="center", va="center", fontsize=9,
-                        color="k" if v > mid else "w")
-            ax.set_xlabel(keys[0])
-            ax.set_ylabel(keys[1])
-            fig.colorbar(im, ax=ax, label=o)
-            ax.set_title(f"{study['name']}: {o}")
+        if study["sampling"] == "grid" and len(keys) in (2, 3):
+            # A map of the first two parameters; with a third, one map per value of it, on one
+            # colour scale so that the maps compare.
+            params = study["parameters"]
+            panels = params[2]["labels"] if len(keys) == 3 else [None]
+            vals_all = ok[o].to_numpy(dtype=float)
+            finite = vals_all[np.isfinite(vals_all)]
+            vmin, vmax = (finite.min(), finite.max()) if finite.size else (0.0, 1.0)
+            cols = min(len(panels), 3)
+            rows = (len(panels) + cols - 1) // cols
+            fig, axes = plt.subplots(rows, cols, figsize=(5.4 * cols + 1.2, 4.4 * rows + 0.4), squeeze=False,
+                                     layout="constrained")
+            for ax in axes.flat[len(panels):]:
+                ax.set_visible(False)
+            for n, (ax, panel) in enumerate(zip(axes.flat, panels)):
+                sub = ok if panel is None else ok[ok[keys[2]].astype(str) == str(panel)]
+                piv = sub.pivot_table(index=keys[1], columns=keys[0], values=o, dropna=False)
+                # grid order, not sorted order (labels may be text)
+                piv = piv.reindex(index=[x for x in params[1]["labels"] if x in piv.index],
+                                  columns=[x for x in params[0]["labels"] if x in piv.columns])
+                vals = piv.to_numpy(dtype=float)
+                im = ax.pcolormesh(np.arange(piv.shape[1] + 1), np.arange(piv.shape[0] + 1), vals, shading="flat",
+                                   vmin=vmin, vmax=vmax)
+                ax.set_xticks(np.arange(piv.shape[1]) + 0.5, [_tick(v) for v in piv.columns],
+                              rotation=30 if any(len(_tick(v)) > 6 for v in piv.columns) else 0, ha="right"
+                              if any(len(_tick(v)) > 6 for v in piv.columns) else "center", fontsize=8)
+                ax.set_yticks(np.arange(piv.shape[0]) + 0.5, [_tick(v) for v in piv.index], fontsize=8)
+                mid = vmin + 0.6 * (vmax - vmin)
+                for (r, c), v in np.ndenumerate(vals):  # dark text on the light end of viridis
+                    if np.isfinite(v):
+                        ax.text(c + 0.5, r + 0.5, f"{v:.3g}", ha="center", va="center", fontsize=8,
+                                color="k" if v > mid else "w")
+                    else:  # a case that failed (its message is in results.csv)
+                        ax.text(c + 0.5, r + 0.5, "failed", ha="center", va="center", fontsize=7, color="0.5")
+                ax.set_xlabel(keys[0])
+                if n % cols == 0:  # the rows share the y axis: one label, at the left
+                    ax.set_ylabel(keys[1])
+                ax.set_title(f"{keys[2]} = {_tick(panel)}" if panel is not None else f"{study['name']}: {o}",
+                             fontsize=10)
+            fig.colorbar(im, ax=axes.ravel().tolist(), label=o)
+            if len(keys) == 3:
+                fig.suptitle(f"{study['name']}: {o}")
         elif study["sampling"] == "grid" and len(keys) == 1:
             fig, ax = plt.subplots(figsize=(7, 4.5))
-            ax.plot(ok[keys[0]], ok[o], "o-")
+            if all(isinstance(x, (int, float)) for x in study["parameters"][0]["labels"]):
+                ax.plot(ok[keys[0]], ok[o], "o-")
+            else:  # named values: in grid order, one tick each
+                order = {str(x): j for j, x in enumerate(study["parameters"][0]["labels"])}
+                xs = [order[str(x)] for x in ok[keys[0]]]
+                ax.plot(xs, ok[o], "o")
+                ax.set_xticks(range(len(order)), list(order), rotation=30, ha="right", fontsize=8)
             ax.set_xlabel(keys[0])
             ax.set_ylabel(o)
             ax.grid(True, alpha=0.3)
@@ -61,7 +98,8 @@ def plot_study(study, table, out):
                 ax.set_ylabel(o)
                 ax.grid(True, alpha=0.3)
             fig.suptitle(f"{study['name']}: {o}")
-        fig.tight_layout()
+        if not (study["sampling"] == "grid" and len(keys) in (2, 3)):
+            fig.tight_layout()  # (the maps share a colour bar placed by matplotlib itself)
         path = os.path.join(out, f"{safe}.png")
         _save(fig, path)
         plt.close(fig)

@@ -781,6 +781,14 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
       throw SceneError("droppers: at x = " + fmt(d.x) + " m the messenger hangs " + fmt(-d.length) +
                        " m below the contact wire (dropper length " + fmt(d.length) +
                        " m): raise line.encumbrance or the messenger tension, or reduce the presag");
+    const int nspan = static_cast<int>(sec.spans.size());
+    const bool in_transition = (d.span == 0 && sec.first_span_transition) || (d.span == nspan - 1 && sec.last_span_transition);
+    if (d.static_tension <= 0.0 && in_transition)
+      throw SceneError("droppers: at x = " + fmt(d.x) + " m, in a transition span, the dropper would have to push (static force " +
+                       fmt(d.static_tension) + " N): the raised support (rise d = " +
+                       fmt(std::max(m.sections[d.section].rise_first, m.sections[d.section].rise_last)) +
+                       " m) pulls the wire up past it; lower overlap.support_rise (or overlap.design_force) or hang "
+                       "droppers.transition_positions nearer the section's own support");
     if (d.static_tension <= 0.0)
       throw SceneError("droppers: at x = " + fmt(d.x) + " m the dropper would have to push (static force " +
                        fmt(d.static_tension) + " N): contact_wire.presag " + fmt(sec.contact_wire.presag) +

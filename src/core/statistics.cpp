@@ -523,6 +523,12 @@ std::string statistics_json(const Model& m, const State& s, const std::vector<Pa
   analysis_section(m, &x0, &x1);
   j["analysis_section_m"] = {x0, x1};
   j["filter_cutoff_hz"] = scene.output.filter_cutoff;
+  if (m.sections.size() > 1) {
+    // The transition supports' rise d (eq. 8, or overlap.support_rise): what an overlap study varies.
+    Json rises = Json::array();
+    for (const Section& sec : m.sections) rises.push_back({{"first_m", sec.rise_first}, {"last_m", sec.rise_last}});
+    j["section_support_rises"] = rises;
+  }
   Json pantographs = Json::array();
   for (const PantographStatistics& p : stats) {
     Json pj;

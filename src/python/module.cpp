@@ -96,9 +96,12 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "catenary_sim core (pybind11): scenes, passes, stepping; see catenary_sim.__doc__";
   py::register_exception<SceneError>(m, "_SceneError", PyExc_ValueError);
 
-  m.def("_check_scene_string", [](const std::string& yaml, const std::vector<std::string>& overrides) {
-    load_scene_string(yaml, overrides);
-  });
+  m.def(
+      "_check_scene_string",
+      [](const std::string& yaml, const std::vector<std::string>& overrides, const std::string& base_dir) {
+        load_scene_string(yaml, overrides, base_dir);
+      },
+      py::arg("yaml"), py::arg("overrides"), py::arg("base_dir") = "");
 
   py::class_<PySimulation>(m, "_Simulation")
       .def(py::init([](const std::string& yaml, const std::vector<std::string>& overrides, double sample_rate) {

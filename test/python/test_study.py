@@ -105,3 +105,34 @@ def test_bad_study_files_name_the_field(tmp_path):
                                      parameters=[{"key": "a", "distribution": {"type": "uniform", "low": 0, "high": 1}}]))
     with pytest.raises(study.StudyError, match="spam"):
         study.load_study(write_study(str(tmp_path / "d.yaml"), spam=1, parameters=[{"key": "a", "values": [1]}]))
+
+
+def test_grid_values_may_be_lists_and_null_with_labels(tmp_path):
+    # The overlap-design study's kind of grid: null (the scene's rule, eq. 6-8), a fixed rise, and a
+    # list-valued field (where the transition droppers hang), on three axes. Each case must be the
+    # pass run_pass gives for the same overrides (deterministic: equal), the table must show the
+    # labels, and the three-parameter grid must give its maps.
+    import catenary_sim as cs
+    calpe = os.path.join(ROOT, "config", "calpe_example.yaml")
+    spec = write_study(str(tmp_path / "s.yaml"), scene=calpe, overrides={"output.analysis_spans": [2, 3]},
+                       sampling="grid", outputs=["pantographs.0.std_force_N", "section_support_rises.0.last_m"],
+                       parameters=[{"key": "overlap.support_rise", "values": [None, 0.06], "labels": ["eq. 6-8", "d 0.06"]},
+                                   {"key": "droppers.transition_positions", "values": [[3.83], [3.83, 5.83]]},
+                                   {"key": "train.speed_kmh", "values": [120, 160]}])
+    out = tmp_path / "out"
+    table = study.run_study(spec, str(out), workers=2, progress=False, plots=True)
+    assert (table["status"] == "ok").all(), table["message"].tolist()
+    assert set(table["overlap.support_rise"]) == {"eq. 6-8", "d 0.06"}
+    assert set(table["droppers.transition_positions"]) == {"[3.83]", "[3.83, 5.83]"}
+    row = table[(table["overlap.support_rise"] == "eq. 6-8") & (table["droppers.transition_positions"] == "[3.83]")
+                & (table["train.speed_kmh"] == 160)].iloc[0]
+    stats, _ = cs.run_pass(calpe, overrides={"output.analysis_spans": [2, 3], "droppers.transition_positions": [3.83],
+                                             "train.speed_kmh": 160}, sample_rate=0)
+    assert row["pantographs.0.std_force_N"] == stats["pantographs"][0]["std_force_N"]
+    assert row["section_support_rises.0.last_m"] == stats["section_support_rises"][0]["last_m"]
+    fixed = table[table["overlap.support_rise"] == "d 0.06"]
+    assert (fixed["section_support_rises.0.last_m"] == 0.06).all()
+    assert os.path.exists(str(out / "pantographs_0_std_force_N.png"))
+    with pytest.raises(study.StudyError, match=r"parameters\[0\].labels"):
+        study.load_study(write_study(str(tmp_path / "b.yaml"), sampling="grid",
+                                     parameters=[{"key": "a", "values": [1, 2], "labels": ["one"]}]))
