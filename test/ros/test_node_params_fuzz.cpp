@@ -40,7 +40,9 @@
 #define CATENARY_SIM_DEVEL_LIB "."
 #endif
 
-extern char** environ;
+#include "../support/child_process.hpp"
+
+using namespace catenary_sim_test;
 
 namespace {
 
@@ -49,18 +51,6 @@ const std::string kHilNode = CATENARY_SIM_DEVEL_LIB "/catenary_sim_hil_node";
 const std::string kRig = CATENARY_SIM_DEVEL_LIB "/virtual_rig";
 const std::string kScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
 const std::string kHilScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_hil.yaml";
-
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-bool exists(const std::string& p) {
-  struct stat st {};
-  return stat(p.c_str(), &st) == 0;
-}
 
 int free_port() {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -86,68 +76,6 @@ bool port_open(int port) {
   return ok;
 }
 
-struct ChildRun {
-  int exit_code = -1;
-  int signal = 0;
-  bool hung = false;
-  std::string out;  // stdout and stderr
-};
-
-class Child {
- public:
-  // Starts args[0] with stdout and stderr to `log` and the environment `env` added.
-  Child(const std::vector<std::string>& args, const std::vector<std::string>& env, const std::string& log) : log_(log) {
-    std::vector<char*> argv;
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    std::vector<std::string> envs = env;
-    for (char** e = environ; *e; ++e) envs.push_back(*e);  // (the first of a name wins in getenv)
-    std::vector<char*> envp;
-    for (std::string& e : envs) envp.push_back(&e[0]);
-    envp.push_back(nullptr);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), envp.data()) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&fa);
-  }
-  bool started() const { return pid_ > 0; }
-  pid_t pid() const { return pid_; }
-  // Waits up to `limit` s, then kills it (SIGKILL) and reports it as hung.
-  ChildRun wait(double limit) {
-    ChildRun r;
-    if (pid_ <= 0) return r;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
-    int status = 0;
-    while (waitpid(pid_, &status, WNOHANG) == 0) {
-      if (std::chrono::steady_clock::now() > deadline) {
-        kill(pid_, SIGKILL);
-        waitpid(pid_, &status, 0);
-        r.hung = true;
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    pid_ = -1;
-    if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
-    if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
-    r.out = slurp(log_);
-    return r;
-  }
-  ~Child() {
-    if (pid_ > 0) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-
- private:
-  std::string log_;
-  pid_t pid_ = -1;
-};
-
 // A master of the test's own on a free loopback port, and a scratch directory.
 class NodeParamsFuzz : public ::testing::Test {
  public:
@@ -159,7 +87,7 @@ class NodeParamsFuzz : public ::testing::Test {
             "ROS_LOG_DIR=" + dir_ + "/log", "ROSCONSOLE_FORMAT=[${severity}] ${message}",
             // (the tests below wait for a line of the node's: stdout to a file is else block-buffered)
             "ROSCONSOLE_STDOUT_LINE_BUFFERED=1"};
-    master_ = new Child({"/usr/bin/rosmaster", "--core", "-p", std::to_string(port_)}, env_, dir_ + "/master.log");
+    master_ = new Child({"/usr/bin/rosmaster", "--core", "-p", std::to_string(port_)}, dir_ + "/master.log", env_);
     for (int i = 0; i < 400 && !port_open(port_); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   static void TearDownTestSuite() {
@@ -174,7 +102,7 @@ class NodeParamsFuzz : public ::testing::Test {
   ChildRun run(const std::string& program, const std::vector<std::string>& params, double limit = 20.0) {
     std::vector<std::string> args{program, "__name:=fuzz" + std::to_string(++runs_)};
     for (const std::string& p : params) args.push_back(p);
-    Child c(args, env_, dir_ + "/run.log");
+    Child c(args, dir_ + "/run.log", env_);
     return c.wait(limit);
   }
 
@@ -256,7 +184,7 @@ void fuzz(NodeParamsFuzz* t, const std::string& program, const std::vector<Param
   for (std::size_t first = 0; first < jobs.size(); first += kParallel) {
     std::vector<std::unique_ptr<Child>> children;
     for (std::size_t k = first; k < jobs.size() && k < first + kParallel; ++k)
-      children.push_back(std::make_unique<Child>(jobs[k].args, t->env_, t->dir_ + "/run" + std::to_string(k - first) + ".log"));
+      children.push_back(std::make_unique<Child>(jobs[k].args, t->dir_ + "/run" + std::to_string(k - first) + ".log", t->env_));
     for (std::size_t k = 0; k < children.size(); ++k) {
       const ChildRun r = children[k]->wait(20.0);
       expect_rejected(r, jobs[first + k].what, jobs[first + k].name);
@@ -370,7 +298,7 @@ TEST_F(NodeParamsFuzz, StatsFileThatFailsAtTheEndFailsTheExitCode) {
   const std::string log = dir_ + "/vanishing.log";
   Child c({kNode, "__name:=vanishing", "_scene:=" + kScene, "_speed_kmh:=250", "_real_time_factor:=0",
            "_at_end:=exit", "_publish_clock:=false", "_start_delay:=3", "_stats_file:=" + out + "/stats.json"},
-          env_, log);
+          log, env_);
   ASSERT_TRUE(c.started());
   // The start-up check has passed once the start delay is announced.
   bool announced = false;
@@ -394,7 +322,7 @@ TEST_F(NodeParamsFuzz, HilReportFileThatFailsAtExitFailsTheExitCode) {
   mkdir(out.c_str(), 0755);
   const std::string log = dir_ + "/vanishing_hil.log";
   Child c({kHilNode, "__name:=vanishing_hil", "_scene:=" + kHilScene, "_hil/report_file:=" + out + "/report.json"},
-          env_, log);
+          log, env_);
   ASSERT_TRUE(c.started());
   bool waiting = false;
   for (int i = 0; i < 600 && !waiting; ++i) {

@@ -32,7 +32,9 @@
 #define CATENARY_SIM_DEVEL_LIB "."
 #endif
 
-extern char** environ;
+#include "../support/child_process.hpp"
+
+using namespace catenary_sim_test;
 
 namespace {
 
@@ -40,63 +42,14 @@ const std::string kReference = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.ya
 const std::string kSimulatePass = CATENARY_SIM_DEVEL_LIB "/simulate_pass";
 const std::string kElasticity = CATENARY_SIM_DEVEL_LIB "/elasticity_curve";
 
-struct ChildRun {
-  int exit_code = -1;
-  int signal = 0;
-  bool hung = false;
-  std::string err;
-};
-
 std::string temp_dir() {
   char t[] = "/tmp/catenary_sim_fuzz_XXXXXX";
   return mkdtemp(t);
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-// Runs argv with stdout and stderr to files; kills it after `limit` seconds.
+// Runs argv to its end (at most `limit` s) with its output in dir/output.txt.
 ChildRun run(const std::vector<std::string>& args, const std::string& dir, double limit = 10.0) {
-  std::vector<char*> argv;
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&fa, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  pid_t pid = 0;
-  ChildRun r;
-  if (posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ) != 0) {
-    r.err = "spawn failed";
-    return r;
-  }
-  posix_spawn_file_actions_destroy(&fa);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
-  int status = 0;
-  while (waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() > deadline) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-      r.hung = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
-  r.err = slurp(err) + slurp(out);
-  return r;
-}
-
-bool exists(const std::string& p) {
-  struct stat st {};
-  return stat(p.c_str(), &st) == 0;
+  return run_child(args, dir + "/output.txt", limit);
 }
 
 // One bad input: the run must fail cleanly and name `field` (any of the alternatives).
@@ -112,13 +65,13 @@ void expect_rejected(const std::string& program, const Case& c, const std::strin
   for (const std::string& a : c.args) args.push_back(a == "@OUT" ? out : a);
   const ChildRun r = run(args, dir);
   ++*count;
-  SCOPED_TRACE(c.what + "\n  message: " + r.err);
+  SCOPED_TRACE(c.what + "\n  message: " + r.out);
   EXPECT_FALSE(r.hung) << "hung (killed after 10 s)";
   EXPECT_EQ(r.signal, 0) << "killed by signal " << r.signal;
   EXPECT_NE(r.exit_code, 0) << "accepted";
   EXPECT_NE(r.exit_code, -1);
   bool named = false;
-  for (const std::string& n : c.names) named = named || r.err.find(n) != std::string::npos;
+  for (const std::string& n : c.names) named = named || r.out.find(n) != std::string::npos;
   EXPECT_TRUE(named) << "the message names none of: " << ::testing::PrintToString(c.names);
   // Nothing written: a refused pass leaves no stats.json or CSV (so none half-written or NaN).
   EXPECT_FALSE(exists(out + "/stats.json")) << "stats.json written";
@@ -282,7 +235,7 @@ TEST(FuzzBadInput, CorruptedSceneFiles) {
     const std::string path = dir + "/scene.yaml";
     std::ofstream(path) << t;
     const ChildRun r = run({kSimulatePass, "--scene", path, "--out", dir + "/out"}, dir);
-    SCOPED_TRACE("random bytes at " + std::to_string(p) + ": " + r.err);
+    SCOPED_TRACE("random bytes at " + std::to_string(p) + ": " + r.out);
     EXPECT_FALSE(r.hung);
     EXPECT_EQ(r.signal, 0);
     if (r.exit_code == 0) {
@@ -293,7 +246,7 @@ TEST(FuzzBadInput, CorruptedSceneFiles) {
       EXPECT_NE(stats.find("\"pantographs\""), std::string::npos);
     } else {
       EXPECT_EQ(r.exit_code, 2);
-      EXPECT_NE(r.err.find("scene"), std::string::npos) << "an error not about the scene";
+      EXPECT_NE(r.out.find("scene"), std::string::npos) << "an error not about the scene";
     }
     std::system(("rm -rf '" + dir + "/out'").c_str());
     ++count;

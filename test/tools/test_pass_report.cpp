@@ -25,62 +25,17 @@
 #define CATENARY_SIM_DEVEL_LIB "."
 #endif
 
-extern char** environ;
+#include "../support/child_process.hpp"
+
+using namespace catenary_sim_test;
 
 namespace {
 
 const std::string kSimulatePass = CATENARY_SIM_DEVEL_LIB "/simulate_pass";
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-bool exists(const std::string& p) {
-  struct stat st {};
-  return stat(p.c_str(), &st) == 0;
-}
-
-struct ChildRun {
-  int exit_code = -1;
-  bool hung = false;
-  std::string output;
-};
-
-// Runs argv with stdout and stderr to a file; kills it after `limit` seconds.
+// Runs argv to its end (at most `limit` s) with its output in `log`.
 ChildRun run(const std::vector<std::string>& args, const std::string& log, double limit) {
-  std::vector<char*> argv;
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  pid_t pid = 0;
-  ChildRun r;
-  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) {
-    r.output = "spawn failed";
-    return r;
-  }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
-  int status = 0;
-  while (waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() > deadline) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-      r.hung = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
-  r.output = slurp(log);
-  return r;
+  return run_child(args, log, limit);
 }
 
 class PassReport : public ::testing::Test {
@@ -107,7 +62,7 @@ TEST_F(PassReport, ShortPassBuildsEverySection) {
                           "output.dropper_series=true", "--report", "--no-progress"},
                          dir_ + "/log.txt", 300.0);
   ASSERT_FALSE(r.hung);
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_EQ(r.exit_code, 0) << r.out;
   for (const char* f : {"stats.json", "timeseries.csv", "force_processed.csv", "contact_losses.csv", "droppers.csv",
                         "dropper_rainflow.csv", "psd.csv", "dropper_series.csv", "report.html"})
     EXPECT_TRUE(exists(out + "/" + f)) << f;
@@ -151,8 +106,8 @@ TEST_F(PassReport, ReportOfAnEmptyDirectoryFailsNamingTheFile) {
   const ChildRun r = run({"/usr/bin/python3", CATENARY_SIM_SOURCE_DIR "/scripts/pass_report", dir_},
                          dir_ + "/log.txt", 60.0);
   ASSERT_FALSE(r.hung);
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("stats.json is missing"), std::string::npos) << r.output;
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("stats.json is missing"), std::string::npos) << r.out;
   EXPECT_FALSE(exists(dir_ + "/report.html"));
 }
 
