@@ -17,6 +17,7 @@
 #include "catenary_sim/PassEvent.h"
 #include "catenary_sim/WireShapeArray.h"
 #include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/pass_files.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 
 namespace catenary_sim {
@@ -31,8 +32,15 @@ long span_along_line(const Model& m, const State& s) {
   return std::clamp<long>(i, 0, static_cast<long>(m.support_x.size()) - 2);
 }
 
-// Sample rate of the recorder's decimated time series (unused by the node; statistics use every step).
+// Sample rate of the recorder's decimated time series without a report (statistics use every step).
 constexpr double kRecorderRowRate = 10.0;
+
+// The report's data files and pictures go in the directory of the page.
+std::string report_directory(const std::string& html) {
+  const std::size_t slash = html.rfind('/');
+  return slash == std::string::npos ? "." : slash == 0 ? "/" : html.substr(0, slash);
+}
+
 // At real_time_factor > 0, a tick may take this many times its nominal share of steps before the
 // backlog is dropped (counted as an overrun) instead of trying to catch up.
 constexpr double kCatchUp = 2.0;
@@ -48,6 +56,14 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   }
   std::string err;
   if (!sim_->set_max_acceleration(params_.max_acceleration, &err)) throw ParamError("parameter ~max_acceleration: " + err);
+  if (!params_.report_file.empty()) {
+    // The report's data files go beside it: all of them writable now, not after the pass.
+    try {
+      check_pass_files_writable(report_directory(params_.report_file), sim_->model());
+    } catch (const OutputError& e) {
+      throw ParamError("parameter ~report_file = '" + params_.report_file + "' rejected: " + e.what());
+    }
+  }
   restart_recording();
 
   paused_ = params_.paused;
@@ -84,7 +100,10 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
 void SimulationNode::restart_recording() {
   loss_since_.assign(sim_->model().pantographs.size(), std::nan(""));
   loss_station_ = loss_since_;
-  recorder_ = std::make_unique<PassRecorder>(sim_->model(), kRecorderRowRate);
+  // With a report, the time series as the scene asks for them (simulate_pass's); else a few rows
+  // (the statistics use every step either way).
+  const double rows = params_.report_file.empty() ? kRecorderRowRate : sim_->model().scene.output.sample_rate;
+  recorder_ = std::make_unique<PassRecorder>(sim_->model(), rows);
   recorder_->record(sim_->model(), sim_->state());
   running_.assign(sim_->model().pantographs.size(), Running{});
   arm_max_uplift_.assign(sim_->model().springs.size(), 0.0);
@@ -192,6 +211,7 @@ int SimulationNode::run() {
     advance(next_tick + ros::WallDuration(1.0 / params_.publish_rate));
     if (sim_->finished() || ended_) track_contact_loss();  // closes a loss still open at the end
     handle_end();
+    if (report_pid_ > 0) reap_report(false);
     publish(false);
     publish_status();
     // Health on the wall clock: with simulated time the updater's own timer would stop while paused.
@@ -207,6 +227,10 @@ int SimulationNode::run() {
     } else {
       next_tick = now;  // behind: do not try to catch up on ticks
     }
+  }
+  if (report_pid_ > 0) {
+    ROS_INFO("catenary_sim: waiting for the pass report to be drawn (%s)", params_.report_file.c_str());
+    reap_report(true);
   }
   return exit_code_;
 }
@@ -376,6 +400,10 @@ void SimulationNode::handle_end() {
       ROS_INFO("catenary_sim: %s; exiting (at_end exit)", what);
       publish(true);
       report_statistics();
+      if (report_pid_ > 0) {  // (before the shutdown, which silences the log)
+        ROS_INFO("catenary_sim: waiting for the pass report to be drawn (%s)", params_.report_file.c_str());
+        reap_report(true);
+      }
       exit_requested_ = true;
       ros::shutdown();
       break;
@@ -392,6 +420,7 @@ void SimulationNode::report_statistics() {
              s.filtered.stat_min, s.contact_loss_percent, s.max_uplift_at_support_m * 1e3, s.samples,
              m.scene.output.filter_cutoff);
   }
+  write_report();
   if (params_.stats_file.empty()) return;
   const std::string json =
       statistics_json(m, sim_->state(), stats, RunInfo{(ros::WallTime::now() - wall_start_).toSec(), -1.0, overruns_});
@@ -402,6 +431,47 @@ void SimulationNode::report_statistics() {
     ROS_INFO("catenary_sim: statistics written to %s", params_.stats_file.c_str());
   } catch (const OutputError& e) {
     ROS_ERROR("catenary_sim: ~stats_file: %s", e.what());
+    exit_code_ = 1;
+  }
+}
+
+void SimulationNode::write_report() {
+  if (params_.report_file.empty()) return;
+  if (report_pid_ > 0) {
+    reap_report(false);
+    if (report_pid_ > 0) {  // (a loop faster than matplotlib: the next pass's report follows)
+      ROS_WARN("catenary_sim: the last pass's report is still being drawn; no report for this pass");
+      return;
+    }
+  }
+  const std::string dir = report_directory(params_.report_file);
+  try {
+    write_pass_files(dir, sim_->model(), sim_->state(), *recorder_,
+                     RunInfo{(ros::WallTime::now() - wall_start_).toSec(), -1.0, overruns_});
+  } catch (const OutputError& e) {
+    ROS_ERROR("catenary_sim: ~report_file: %s", e.what());
+    exit_code_ = 1;
+    return;
+  }
+  std::string why;
+  report_pid_ = start_pass_report(dir, params_.report_file, true, &why);
+  if (report_pid_ < 0) {
+    ROS_ERROR("catenary_sim: ~report_file: %s (the pass's data files are in %s)", why.c_str(), dir.c_str());
+    exit_code_ = 1;
+    return;
+  }
+  ROS_INFO("catenary_sim: pass files written to %s; drawing the report %s", dir.c_str(), params_.report_file.c_str());
+}
+
+void SimulationNode::reap_report(bool block) {
+  const int rc = pass_report_status(report_pid_, block);
+  if (rc == kReportRunning) return;
+  report_pid_ = -1;
+  if (rc == 0) {
+    ROS_INFO("catenary_sim: pass report written to %s", params_.report_file.c_str());
+  } else {
+    ROS_ERROR("catenary_sim: ~report_file: scripts/pass_report failed (exit %d); the pass's data files are written",
+              rc);
     exit_code_ = 1;
   }
 }

@@ -261,7 +261,7 @@ bool read_speed_kmh(ParamReader& r, const ros::NodeHandle& nh, std::optional<dou
 NodeParams load_params(const ros::NodeHandle& nh) {
   ParamReader r(nh, "catenary_sim",
                 {"scene", "speed_kmh", "real_time_factor", "publish_rate", "shape_rate", "marker_rate",
-                 "shape_resolution", "vertical_scale", "line_frame", "at_end", "stats_file", "publish_clock",
+                 "shape_resolution", "vertical_scale", "line_frame", "at_end", "stats_file", "report_file", "publish_clock",
                  "paused", "wait_for_viewer", "max_acceleration", "start_delay", "strip_chart", "chart_window",
                  "diagnostic_period"});  // (the last read by diagnostic_updater)
   NodeParams p;
@@ -281,12 +281,14 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   r.text("at_end", at_end, "stop, loop or exit");
   p.at_end = parse_at_end(at_end);
   r.text("stats_file", p.stats_file, "a file path (empty: none)");
+  r.text("report_file", p.report_file, "an HTML file path (empty: none)");
   r.boolean("publish_clock", p.publish_clock);
   r.boolean("paused", p.paused);
   r.boolean("strip_chart", p.strip_chart);
   r.number("chart_window", p.chart_window, kChartWindow.text());
   validate(p);
   check_output_param("stats_file", p.stats_file);
+  check_output_param("report_file", p.report_file);
   return p;
 }
 

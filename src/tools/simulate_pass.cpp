@@ -5,9 +5,7 @@
 // dropper_series.csv when output.dropper_series), each whole or not at all (temporary file +
 // rename), with DIR locked against a second run writing into it. --report then runs
 // scripts/pass_report on DIR (report.html and its PNGs).
-#include <spawn.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -23,6 +21,7 @@
 #include <vector>
 
 #include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/pass_files.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
 #include "catenary_sim/ros/pass_bag.hpp"
@@ -40,14 +39,6 @@ constexpr int kBadInput = 2, kDiverged = 3;
 // ~0.1 ms per step of the 4405-DOF reference scene (BENCHMARKS.md) 2e7 steps are about half an
 // hour; a speed of 0.001 km/h would need billions and never end.
 constexpr double kDefaultMaxSteps = 2e7;
-
-// RFC 4180: a field with a comma, a quote or a line break is quoted, its quotes doubled.
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
 
 // A progress line on a terminal (stderr), redrawn at most twice a second: share done, simulated
 // time, the real-time factor so far and the estimated end. Silent when stderr is not a terminal.
@@ -79,75 +70,6 @@ class Progress {
   bool enabled_, drawn_ = false;
   Clock::time_point start_, last_;
 };
-
-// A CSV of rows (time first) in pieces of about 1 MiB.
-void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const std::vector<PassRecorder::Row>& rows) {
-  std::ostringstream c;
-  c << "time_s";
-  for (const std::string& col : columns) c << "," << csv_field(col);
-  c << "\n";
-  c << std::setprecision(9);
-  for (const auto& row : rows) {
-    c << row.time;
-    for (double v : row.values) c << "," << v;
-    c << "\n";
-    if (c.tellp() > (1 << 20)) {
-      f.write(c.str());
-      c.str("");
-    }
-  }
-  f.write(c.str());
-}
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR ""
-#endif
-#ifndef CATENARY_SIM_SHARE_DIR
-#define CATENARY_SIM_SHARE_DIR ""
-#endif
-
-// scripts/pass_report: beside the sources this was built from, or in the installed share path.
-std::string find_report_script() {
-  for (const std::string& dir : {std::string(CATENARY_SIM_SOURCE_DIR), std::string(CATENARY_SIM_SHARE_DIR)}) {
-    if (dir.empty()) continue;
-    const std::string path = dir + "/scripts/pass_report";
-    struct stat st;
-    if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return path;
-  }
-  return "";
-}
-
-// Runs /usr/bin/python3 scripts/pass_report DIR; returns its exit status (or -1, message in *why).
-int run_report(const std::string& out_dir, bool quiet, std::string* why) {
-  const std::string script = find_report_script();
-  if (script.empty()) {
-    *why = "scripts/pass_report not found beside the sources (" CATENARY_SIM_SOURCE_DIR ") or in the share path";
-    return -1;
-  }
-  const char* python = "/usr/bin/python3";
-  if (::access(python, X_OK) != 0) {
-    *why = "/usr/bin/python3 is missing: install python3, python3-numpy and python3-matplotlib (scripts/setup)";
-    return -1;
-  }
-  std::vector<std::string> args{python, script, out_dir};
-  if (quiet) args.push_back("--quiet");
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, python, nullptr, nullptr, argv.data(), environ) != 0) {
-    *why = "cannot start " + std::string(python);
-    return -1;
-  }
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) {
-      *why = "waitpid failed";
-      return -1;
-    }
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-}
 
 bool all_finite(const std::vector<PantographStatistics>& stats) {
   for (const PantographStatistics& s : stats)
@@ -240,14 +162,10 @@ int main(int argc, char** argv) {
   // pass (a full or read-only target is found now, not after the pass).
   std::unique_ptr<DirectoryLock> lock;
   const std::string stats_path = out_dir + "/stats.json", csv_path = out_dir + "/timeseries.csv";
-  const std::vector<std::string> extra_names{"force_processed.csv", "contact_losses.csv", "droppers.csv",
-                                             "dropper_rainflow.csv", "psd.csv", "dropper_series.csv"};
   try {
     make_directories(out_dir);
     lock = std::make_unique<DirectoryLock>(out_dir);
-    check_writable(stats_path);
-    check_writable(csv_path);
-    for (const std::string& name : extra_names) check_writable(out_dir + "/" + name);
+    check_pass_files_writable(out_dir, m);
     if (!bag_path.empty()) check_writable(bag_path);
   } catch (const OutputError& e) {
     std::cerr << "simulate_pass: " << e.what() << "\n";
@@ -314,57 +232,7 @@ int main(int argc, char** argv) {
     RunInfo run;
     run.wall_time_s = wall;
     run.build_time_s = build_s;
-    AtomicFile csv(csv_path);
-    write_rows(csv, recorder.columns(), recorder.rows());
-    const LineStatistics line = recorder.line_statistics(m);
-    AtomicFile json(stats_path);
-    json.write(statistics_json(m, st, stats, run, &line));
-    std::vector<std::unique_ptr<AtomicFile>> extra;
-    auto add = [&](const std::string& name) -> AtomicFile& {
-      extra.push_back(std::make_unique<AtomicFile>(out_dir + "/" + name));
-      return *extra.back();
-    };
-    write_rows(add("force_processed.csv"), recorder.processed_columns(), recorder.processed_rows(m));
-    {
-      std::ostringstream c;
-      c << std::setprecision(9) << "pantograph,start_time_s,station_m,duration_s,length_m\n";
-      for (const PantographStatistics& p : stats)
-        for (const ContactLossEvent& e : p.loss_events)
-          c << csv_field(p.name) << "," << e.start_time << "," << e.station << "," << e.duration << "," << e.length << "\n";
-      add("contact_losses.csv").write(c.str());
-    }
-    {
-      std::ostringstream c, r;
-      c << std::setprecision(9)
-        << "station_m,static_tension_N,max_force_N,min_force_N,slack_percent,rainflow_cycles,max_range_N\n";
-      r << std::setprecision(9) << "station_m,range_from_N,range_to_N,cycles\n";
-      for (const DropperStatistics& d : line.droppers) {
-        c << d.station << "," << d.static_tension << "," << d.max_force << "," << d.min_force << "," << d.slack_percent
-          << "," << d.cycles << "," << d.max_range << "\n";
-        for (std::size_t b = 0; b < d.histogram.size(); ++b)
-          r << d.station << "," << b * line.range_bin_n << "," << (b + 1) * line.range_bin_n << "," << d.histogram[b] << "\n";
-      }
-      add("droppers.csv").write(c.str());
-      add("dropper_rainflow.csv").write(r.str());
-    }
-    {
-      std::ostringstream c;
-      c << std::setprecision(9) << "pantograph,frequency_hz,psd_N2_per_hz\n";
-      const std::vector<Spectrum> spectra = recorder.spectra(m);
-      for (std::size_t p = 0; p < spectra.size(); ++p)
-        for (std::size_t k = 0; k < spectra[p].frequency.size() && spectra[p].frequency[k] <= kSpectrumMaxHz; ++k)
-          c << csv_field(m.pantographs[p].name) << "," << spectra[p].frequency[k] << "," << spectra[p].psd[k] << "\n";
-      add("psd.csv").write(c.str());
-    }
-    if (scene.output.dropper_series) write_rows(add("dropper_series.csv"), recorder.dropper_columns(), recorder.dropper_rows());
-    // All on the disk before any is renamed into place: a full disk leaves the old set (or
-    // none), never a new CSV beside an old stats.json.
-    csv.flush();
-    json.flush();
-    for (auto& f : extra) f->flush();
-    csv.commit();
-    json.commit();
-    for (auto& f : extra) f->commit();
+    write_pass_files(out_dir, m, st, recorder, run);
     if (!bag_tmp.empty() && std::rename(bag_tmp.c_str(), bag_path.c_str()) != 0)
       throw OutputError("cannot write '" + bag_path + "': rename failed");
   } catch (const OutputError& e) {
@@ -427,7 +295,8 @@ int main(int argc, char** argv) {
   if (report) {
     std::cout.flush();  // the summary before the report's lines
     std::string why;
-    const int rc = run_report(out_dir, quiet, &why);
+    const pid_t pid = start_pass_report(out_dir, "", quiet, &why);
+    const int rc = pid < 0 ? -1 : pass_report_status(pid, true);
     if (rc != 0) {
       std::cerr << "simulate_pass: --report: " << (rc < 0 ? why : "scripts/pass_report failed (exit " + std::to_string(rc) + ")")
                 << "; the pass's files are written\n";

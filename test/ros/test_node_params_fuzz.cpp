@@ -206,7 +206,7 @@ TEST_F(NodeParamsFuzz, NodeRejectsEveryBadValueNamingTheParameter) {
       {"shape_resolution", Kind::kNumber}, {"vertical_scale", Kind::kRate},  {"line_frame", Kind::kFrame},
       {"at_end", Kind::kAtEnd},          {"stats_file", Kind::kPath},        {"publish_clock", Kind::kBool},
       {"paused", Kind::kBool},           {"wait_for_viewer", Kind::kNumber}, {"max_acceleration", Kind::kNumber},
-      {"start_delay", Kind::kNumber}};
+      {"start_delay", Kind::kNumber},    {"report_file", Kind::kPath}};
   int count = 0;
   fuzz(this, kNode, params, {{"scene", kScene}, {"stats_file", out + "/stats.json"}}, out, &count);
   EXPECT_GT(count, 60);
@@ -314,6 +314,58 @@ TEST_F(NodeParamsFuzz, StatsFileThatFailsAtTheEndFailsTheExitCode) {
   EXPECT_EQ(r.exit_code, 1) << r.out;
   EXPECT_NE(r.out.find("~stats_file: cannot write '" + out + "/stats.json'"), std::string::npos) << r.out;
   EXPECT_FALSE(exists(out));
+}
+
+// ~report_file: at the end of the pass the node writes the pass's files beside the page and draws
+// the same report as simulate_pass --report (same sections, pictures embedded), then exits 0.
+// A short pass (six spans, 0.5 m elements) at full speed; the page's checks are test_pass_report's.
+TEST_F(NodeParamsFuzz, ReportFileIsWrittenAtTheEndOfThePass) {
+  const std::string out = dir_ + "/report";
+  mkdir(out.c_str(), 0755);
+  const std::string scene = out + "/short.yaml";
+  std::string text = slurp(kScene);  // the reference scene, shortened (the node takes no --set)
+  const auto set = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  set("span_count: 10", "span_count: 6");
+  set("preset: accurate", "preset: accurate\n  element_length: 0.5");
+  std::ofstream(scene) << text;
+  const std::string html = out + "/pass_report.html";
+  const ChildRun r = Child({kNode, "__name:=reporting", "_scene:=" + scene, "_speed_kmh:=250", "_real_time_factor:=0",
+                            "_at_end:=exit", "_publish_clock:=false", "_report_file:=" + html},
+                           dir_ + "/reporting.log", env_)
+                         .wait(300.0);
+  ASSERT_FALSE(r.hung) << r.out;
+  EXPECT_EQ(r.signal, 0);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("pass report written to " + html), std::string::npos) << r.out;
+  for (const char* f : {"stats.json", "timeseries.csv", "force_processed.csv", "contact_losses.csv", "droppers.csv",
+                        "dropper_rainflow.csv", "psd.csv"})
+    EXPECT_TRUE(exists(out + "/" + f)) << f;
+  EXPECT_FALSE(exists(out + "/report.html"));  // the page is where ~report_file says
+  const std::string page = slurp(html);
+  const std::vector<std::string> sections{"force", "head", "uplift", "histogram", "psd", "droppers", "losses"};
+  EXPECT_NE(page.find("id='statistics'"), std::string::npos);
+  for (const std::string& s : sections) {
+    EXPECT_NE(page.find("<h2 id='" + s + "'>"), std::string::npos) << s;
+    EXPECT_EQ(slurp(out + "/report_" + s + ".png").substr(1, 3), "PNG") << s;
+  }
+  std::size_t images = 0;
+  for (std::size_t at = page.find("src='data:image/png;base64,"); at != std::string::npos;
+       at = page.find("src='data:image/png;base64,", at + 1))
+    ++images;
+  EXPECT_EQ(images, sections.size());
+  // The statistics are the node's pass: the same keys as simulate_pass's, finite.
+  const nlohmann::json j = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_GT(j.at("pantographs").at(0).at("std_force_N").get<double>(), 0.0);
+}
+
+// A report whose directory cannot take the pass's files is refused at start-up, naming ~report_file.
+TEST_F(NodeParamsFuzz, ReportFileInAReadOnlyPlaceIsRefusedAtStartUp) {
+  const ChildRun r = run(kNode, {"_scene:=" + kScene, "_report_file:=/proc/catenary_report.html"});
+  expect_rejected(r, "~report_file in /proc", "report_file");
 }
 
 // The same for the HIL node's ~hil/report_file, written when the node is stopped (SIGINT).

@@ -47,6 +47,10 @@ class SimulationNode {
   void reanchor();
   void restart_recording();
   void report_statistics();
+  // ~report_file: writes the pass's files beside it and starts scripts/pass_report (a child
+  // process: the pictures take seconds, the pacing loop goes on); reap_report() collects it.
+  void write_report();
+  void reap_report(bool block);
 
   void on_speed(const std_msgs::Float64::ConstPtr& msg);
   void on_uplift(const std_msgs::Float64MultiArray::ConstPtr& msg);
@@ -97,6 +101,7 @@ class SimulationNode {
   bool ended_ = false;          // the end of the pass (or a divergence) has been handled
   bool exit_requested_ = false;
   int exit_code_ = 0;
+  pid_t report_pid_ = -1;       // scripts/pass_report drawing the last pass's report, -1: none
 
   // Pacing.
   ros::WallTime wall_anchor_, wall_start_;

@@ -110,6 +110,8 @@ struct NodeParams {
   std::string line_frame = "line";  // ~line_frame: fixed frame, x along the track, z up
   AtEnd at_end = AtEnd::kStop;      // ~at_end: stop | loop | exit
   std::string stats_file;           // ~stats_file: JSON statistics written at the end (empty: none)
+  std::string report_file;          // ~report_file: the pass report (HTML, scripts/pass_report) written at the
+                                    //   end of each pass, its data files and pictures beside it (empty: none)
   bool publish_clock = true;        // ~publish_clock: publish rosgraph_msgs/Clock on /clock (simulated time,
                                     //   from 0, also while paused; pass.launch sets /use_sim_time with it)
   bool paused = false;              // ~paused: start paused (like gazebo's paused:=true); ~set_paused false starts

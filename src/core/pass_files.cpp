@@ -1,0 +1,167 @@
+#include "catenary_sim/core/pass_files.hpp"
+
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <iomanip>
+#include <memory>
+#include <sstream>
+
+#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/outputs.hpp"
+
+extern char** environ;
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR ""
+#endif
+#ifndef CATENARY_SIM_SHARE_DIR
+#define CATENARY_SIM_SHARE_DIR ""
+#endif
+
+namespace catenary_sim {
+
+namespace {
+
+// A CSV of rows (time first), written in pieces of about 1 MiB.
+void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const std::vector<PassRecorder::Row>& rows) {
+  std::ostringstream c;
+  c << "time_s";
+  for (const std::string& col : columns) c << "," << csv_field(col);
+  c << "\n";
+  c << std::setprecision(9);
+  for (const auto& row : rows) {
+    c << row.time;
+    for (double v : row.values) c << "," << v;
+    c << "\n";
+    if (c.tellp() > (1 << 20)) {
+      f.write(c.str());
+      c.str("");
+    }
+  }
+  f.write(c.str());
+}
+
+}  // namespace
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::vector<std::string> pass_file_names(const Model& model) {
+  std::vector<std::string> names{"stats.json",   "timeseries.csv",       "force_processed.csv", "contact_losses.csv",
+                                 "droppers.csv", "dropper_rainflow.csv", "psd.csv"};
+  if (model.scene.output.dropper_series) names.push_back("dropper_series.csv");
+  return names;
+}
+
+void check_pass_files_writable(const std::string& dir, const Model& model) {
+  make_directories(dir);
+  for (const std::string& name : pass_file_names(model)) check_writable(dir + "/" + name);
+}
+
+void write_pass_files(const std::string& dir, const Model& m, const State& st, const PassRecorder& recorder,
+                      const RunInfo& run) {
+  const std::vector<PantographStatistics> stats = recorder.statistics(m);
+  const LineStatistics line = recorder.line_statistics(m);
+  std::vector<std::unique_ptr<AtomicFile>> files;
+  auto add = [&](const std::string& name) -> AtomicFile& {
+    files.push_back(std::make_unique<AtomicFile>(dir + "/" + name));
+    return *files.back();
+  };
+  write_rows(add("timeseries.csv"), recorder.columns(), recorder.rows());
+  add("stats.json").write(statistics_json(m, st, stats, run, &line));
+  write_rows(add("force_processed.csv"), recorder.processed_columns(), recorder.processed_rows(m));
+  {
+    std::ostringstream c;
+    c << std::setprecision(9) << "pantograph,start_time_s,station_m,duration_s,length_m\n";
+    for (const PantographStatistics& p : stats)
+      for (const ContactLossEvent& e : p.loss_events)
+        c << csv_field(p.name) << "," << e.start_time << "," << e.station << "," << e.duration << "," << e.length << "\n";
+    add("contact_losses.csv").write(c.str());
+  }
+  {
+    std::ostringstream c, r;
+    c << std::setprecision(9) << "station_m,static_tension_N,max_force_N,min_force_N,slack_percent,rainflow_cycles,max_range_N\n";
+    r << std::setprecision(9) << "station_m,range_from_N,range_to_N,cycles\n";
+    for (const DropperStatistics& d : line.droppers) {
+      c << d.station << "," << d.static_tension << "," << d.max_force << "," << d.min_force << "," << d.slack_percent << ","
+        << d.cycles << "," << d.max_range << "\n";
+      for (std::size_t b = 0; b < d.histogram.size(); ++b)
+        r << d.station << "," << b * line.range_bin_n << "," << (b + 1) * line.range_bin_n << "," << d.histogram[b] << "\n";
+    }
+    add("droppers.csv").write(c.str());
+    add("dropper_rainflow.csv").write(r.str());
+  }
+  {
+    std::ostringstream c;
+    c << std::setprecision(9) << "pantograph,frequency_hz,psd_N2_per_hz\n";
+    const std::vector<Spectrum> spectra = recorder.spectra(m);
+    for (std::size_t p = 0; p < spectra.size(); ++p)
+      for (std::size_t k = 0; k < spectra[p].frequency.size() && spectra[p].frequency[k] <= kSpectrumMaxHz; ++k)
+        c << csv_field(m.pantographs[p].name) << "," << spectra[p].frequency[k] << "," << spectra[p].psd[k] << "\n";
+    add("psd.csv").write(c.str());
+  }
+  if (m.scene.output.dropper_series) write_rows(add("dropper_series.csv"), recorder.dropper_columns(), recorder.dropper_rows());
+  // All on the disk before any is renamed into place: a full disk leaves the old set (or none),
+  // never a new CSV beside an old stats.json.
+  for (auto& f : files) f->flush();
+  for (auto& f : files) f->commit();
+}
+
+std::string find_pass_report_script() {
+  for (const std::string& dir : {std::string(CATENARY_SIM_SOURCE_DIR), std::string(CATENARY_SIM_SHARE_DIR)}) {
+    if (dir.empty()) continue;
+    const std::string path = dir + "/scripts/pass_report";
+    struct stat st {};
+    if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return path;
+  }
+  return "";
+}
+
+pid_t start_pass_report(const std::string& dir, const std::string& html, bool quiet, std::string* why) {
+  const std::string script = find_pass_report_script();
+  if (script.empty()) {
+    *why = "scripts/pass_report not found beside the sources (" CATENARY_SIM_SOURCE_DIR ") or in the share path";
+    return -1;
+  }
+  const char* python = "/usr/bin/python3";
+  if (::access(python, X_OK) != 0) {
+    *why = "/usr/bin/python3 is missing: install python3, python3-numpy and python3-matplotlib (scripts/setup)";
+    return -1;
+  }
+  std::vector<std::string> args{python, script, dir};
+  if (!html.empty()) {
+    args.push_back("--html");
+    args.push_back(html);
+  }
+  if (quiet) args.push_back("--quiet");
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, python, nullptr, nullptr, argv.data(), environ) != 0) {
+    *why = "cannot start " + std::string(python);
+    return -1;
+  }
+  return pid;
+}
+
+int pass_report_status(pid_t pid, bool block) {
+  int status = 0;
+  for (;;) {
+    const pid_t r = ::waitpid(pid, &status, block ? 0 : WNOHANG);
+    if (r == pid) break;
+    if (r == 0) return kReportRunning;
+    if (errno != EINTR) return kReportLost;
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+}  // namespace catenary_sim
