@@ -137,6 +137,12 @@ class Simulation:
         """The pass statistics so far, as simulate_pass's stats.json (a dict)."""
         return json.loads(self._sim.statistics_json(float(wall_time_s)))
 
+    def write_files(self, directory, wall_time_s=0.0):
+        """Writes the pass's files into `directory` as simulate_pass --out does (stats.json,
+        timeseries.csv, the measurement CSVs), each whole or not at all; scripts/pass_report draws
+        the report from them. Raises ValueError naming a file that cannot be written."""
+        self._sim.write_pass_files(str(directory), float(wall_time_s))
+
     def series(self):
         """The recorded time series as numpy arrays by column name (time_s, <pantograph>_force_N, ...)."""
         return self._sim.series()

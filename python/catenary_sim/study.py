@@ -22,6 +22,9 @@ A study file (YAML; paths relative to it):
         # {type: integers, low: 0, high: 1000000} (e.g. the seed of a random line)
     outputs: [pantographs.0.std_force_N, pantographs.0.max_force_N]   # paths into stats.json
     bootstrap: 200                                  # saltelli: resamples for the confidence intervals
+    report: false                                   # true: each case's pass report (scripts/pass_report)
+                                                    # in DIR/cases/NNNNNN/, linked from results.csv and
+                                                    # DIR/index.html
 
 Each case is written atomically to DIR/cases/NNNNNN.json when it finishes; a study started again
 on the same DIR resumes where it stopped (the plan must be the same); a failed case is recorded
@@ -68,7 +71,7 @@ def load_study(path):
         raise StudyError(f"study file '{path}': not valid YAML: {e}") from None
     if not isinstance(doc, dict):
         raise StudyError(f"study file '{path}': expected a map of fields (name, scene, parameters, ...)")
-    known = {"name", "scene", "overrides", "sampling", "samples", "seed", "parameters", "outputs", "bootstrap"}
+    known = {"name", "scene", "overrides", "sampling", "samples", "seed", "parameters", "outputs", "bootstrap", "report"}
     for k in doc:
         if k not in known:
             _fail(k, doc[k], f"unknown field; allowed: {', '.join(sorted(known))}")
@@ -135,6 +138,10 @@ def load_study(path):
     if not isinstance(b, int) or isinstance(b, bool) or not 0 <= b <= 100_000:
         _fail("bootstrap", b, "a whole number of resamples in [0, 100000]")
     s["bootstrap"] = b
+    report = doc.get("report", False)
+    if not isinstance(report, bool):
+        _fail("report", report, "true or false (true: a pass report per case)")
+    s["report"] = report
     return s
 
 
@@ -239,13 +246,39 @@ def _output(stats, path):
     return float(node)
 
 
-def run_case(scene, overrides, case, outputs):
-    """One pass (runs on a Dask worker). Returns the case's record; never raises."""
+def _pass_report_script():
+    here = os.path.dirname(os.path.abspath(__file__))
+    # the sources (devel space: the package is loaded from python/catenary_sim), or an install
+    # (PREFIX/lib/python3/dist-packages/catenary_sim -> PREFIX/share/catenary_sim/scripts)
+    for d in (os.path.join(here, "..", "..", "scripts"),
+              os.path.join(here, "..", "..", "..", "..", "share", "catenary_sim", "scripts")):
+        p = os.path.normpath(os.path.join(d, "pass_report"))
+        if os.path.isfile(p):
+            return p
+    raise RuntimeError("scripts/pass_report not found beside the catenary_sim package")
+
+
+def run_case(scene, overrides, case, outputs, report_dir=None):
+    """One pass (runs on a Dask worker). Returns the case's record; never raises. With report_dir,
+    the pass's files and its report (scripts/pass_report) are written there before the record."""
     import catenary_sim as cs
     start = time.perf_counter()
     record = {"parameters": case, "status": "ok", "message": "", "outputs": {}}
     try:
-        stats, _ = cs.run_pass(scene, overrides={**overrides, **case}, sample_rate=0)
+        if report_dir is None:
+            stats, _ = cs.run_pass(scene, overrides={**overrides, **case}, sample_rate=0)
+        else:
+            import subprocess
+            import sys
+            sim = cs.Simulation(scene, overrides={**overrides, **case})
+            sim.run()
+            stats = sim.statistics(time.perf_counter() - start)
+            sim.write_files(report_dir, time.perf_counter() - start)
+            r = subprocess.run([sys.executable, _pass_report_script(), report_dir, "--quiet"], capture_output=True,
+                               text=True, timeout=600)
+            if r.returncode != 0:
+                raise RuntimeError(f"pass report of the case failed: {r.stderr.strip() or r.returncode}")
+            record["report"] = os.path.join(report_dir, "report.html")
         record["outputs"] = {o: _output(stats, o) for o in outputs}
     except (SceneError, ValueError, RuntimeError, KeyError) as e:
         record["status"] = "failed"
@@ -276,6 +309,11 @@ def _write_atomically(path, text):
 
 def _case_path(out, i):
     return os.path.join(out, "cases", f"{i:06d}.json")
+
+
+def _report_dir(out, i):
+    # absolute: the workers of a cluster write it too (a shared file system, as for the scene)
+    return os.path.join(os.path.abspath(out), "cases", f"{i:06d}")
 
 
 # --------------------------------------------------------------------------------------------
@@ -316,6 +354,7 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
             client = Client(own)
         try:
             futures = {client.submit(run_case, study["scene"], study["overrides"], cases[i], study["outputs"],
+                                     _report_dir(out, i) if study["report"] else None,
                                      key=f"case-{study['name']}-{i}", pure=False): i for i in todo}
             bar = tqdm(total=len(cases), initial=len(cases) - len(todo), unit="case", disable=not progress,
                        desc=study["name"])
@@ -339,10 +378,15 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
         if study["sampling"] == "grid":  # a list or null value shows as its label
             for p in study["parameters"]:
                 shown[p["key"]] = p["labels"][_index_of(p["values"], shown[p["key"]])]
-        rows.append({"case": i, **shown, **r["outputs"], "status": r["status"],
-                     "message": r["message"], "wall_time_s": r["wall_time_s"]})
+        row = {"case": i, **shown, **r["outputs"], "status": r["status"], "message": r["message"],
+               "wall_time_s": r["wall_time_s"]}
+        if study["report"]:  # relative to DIR: the table and index.html move with the directory
+            row["report"] = os.path.relpath(r["report"], out) if r.get("report") else ""
+        rows.append(row)
     table = pd.DataFrame(rows)
     _write_atomically(os.path.join(out, "results.csv"), table.to_csv(index=False))
+    if study["report"]:
+        _write_atomically(os.path.join(out, "index.html"), _index_page(study, table))
     if study["sampling"] == "saltelli":
         sens = sobol_indices_from_table(table, study)
         _write_atomically(os.path.join(out, "sensitivity.json"), json.dumps(sens, indent=1))
@@ -351,6 +395,20 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
         study_plots.plot_study(study, table, out)
     lock.close()
     return table
+
+
+def _index_page(study, table):
+    """DIR/index.html: the results table with each case's report linked (pandas' to_html)."""
+    import html
+    shown = table.copy()
+    shown["report"] = [f"<a href='{html.escape(p, quote=True)}'>report</a>" if p else "" for p in table["report"]]
+    shown["message"] = [html.escape(str(m)) for m in table["message"]]
+    body = shown.to_html(index=False, escape=False, na_rep="-", float_format=lambda v: f"{v:.4g}")
+    return ("<!DOCTYPE html><html><head><meta charset='utf-8'><title>" + html.escape(study["name"]) + "</title>"
+            "<style>body{font-family:sans-serif;margin:1.5em} table{border-collapse:collapse;font-size:0.9em}"
+            "td,th{border:1px solid #ccc;padding:0.2em 0.5em;text-align:right}</style></head><body>"
+            f"<h1>{html.escape(study['name'])}</h1><p>{len(table)} cases; scene {html.escape(study['scene'])}; "
+            "each case's pass report linked.</p>" + body + "</body></html>")
 
 
 # --------------------------------------------------------------------------------------------

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/pass_files.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
 
@@ -63,6 +64,16 @@ class PySimulation {
   std::string statistics_json(double wall_s) const {
     return catenary_sim::statistics_json(sim_.model(), sim_.state(), recorder_.statistics(sim_.model()),
                                          RunInfo{wall_s, -1.0, -1});
+  }
+
+  // simulate_pass's files of the pass in `dir` (core/pass_files: each whole or not at all).
+  void write_pass_files(const std::string& dir, double wall_s) const {
+    try {
+      make_directories(dir);
+      catenary_sim::write_pass_files(dir, sim_.model(), sim_.state(), recorder_, RunInfo{wall_s, -1.0, -1});
+    } catch (const OutputError& e) {
+      throw py::value_error(e.what());
+    }
   }
 
   py::dict series() const {
@@ -119,6 +130,7 @@ PYBIND11_MODULE(_core, m) {
       .def("step", &PySimulation::step, py::arg("n") = 1, py::call_guard<py::gil_scoped_release>())
       .def("run", &PySimulation::run, py::arg("max_steps") = 2e7)
       .def("statistics_json", &PySimulation::statistics_json, py::arg("wall_s") = 0.0)
+      .def("write_pass_files", &PySimulation::write_pass_files, py::arg("dir"), py::arg("wall_s") = 0.0)
       .def("series", &PySimulation::series)
       .def("finished", [](const PySimulation& s) { return s.sim_.finished(); })
       .def("reset", [](PySimulation& s) {

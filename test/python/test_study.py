@@ -136,3 +136,30 @@ def test_grid_values_may_be_lists_and_null_with_labels(tmp_path):
     with pytest.raises(study.StudyError, match=r"parameters\[0\].labels"):
         study.load_study(write_study(str(tmp_path / "b.yaml"), sampling="grid",
                                      parameters=[{"key": "a", "values": [1, 2], "labels": ["one"]}]))
+
+
+def test_a_study_links_a_report_per_case(tmp_path):
+    # report: true: each case's pass files and report in DIR/cases/NNNNNN/, the path in results.csv
+    # and a link in DIR/index.html; every linked page is a complete report (its sections and
+    # pictures, as test_pass_report checks simulate_pass --report's). A short line keeps it quick.
+    spec = write_study(str(tmp_path / "s.yaml"), sampling="grid", report=True,
+                       overrides={"line.span_count": 6, "numerics.element_length": 0.5},
+                       parameters=[{"key": "train.speed_kmh", "values": [200, 250]}])
+    out = tmp_path / "out"
+    table = study.run_study(spec, str(out), workers=2, progress=False, plots=False)
+    assert (table["status"] == "ok").all(), table["message"].tolist()
+    index = (out / "index.html").read_text()
+    for rel in table["report"]:
+        assert not os.path.isabs(rel)
+        page = (out / rel).read_text()
+        for section in ("force", "head", "uplift", "histogram", "psd", "droppers", "losses"):
+            assert f"<h2 id='{section}'>" in page
+            assert (out / os.path.dirname(rel) / f"report_{section}.png").read_bytes()[1:4] == b"PNG"
+        assert f"href='{rel}'" in index
+        # the case's own stats.json holds the outputs the table shows
+        import json as _json
+        stats = _json.loads((out / os.path.dirname(rel) / "stats.json").read_text())
+        row = table[table["report"] == rel].iloc[0]
+        assert stats["pantographs"][0]["std_force_N"] == row["pantographs.0.std_force_N"]
+    with pytest.raises(study.StudyError, match="report"):
+        study.load_study(write_study(str(tmp_path / "b.yaml"), report="yes", parameters=[{"key": "a", "values": [1]}]))
