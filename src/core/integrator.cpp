@@ -11,6 +11,7 @@
 #include "catenary_sim/core/implicit.hpp"
 #include "catenary_sim/core/state.hpp"
 #include "window.hpp"
+#include "wire_lanes.hpp"
 
 namespace catenary_sim {
 
@@ -93,6 +94,15 @@ State make_state(const Model& m) {
     s.correction_small.assign(corrections * corrections + corrections, 0.0);
   }
   s.z = Eigen::VectorXd::Zero(m.n_dof);
+  if (!m.wire_packs.empty()) {
+    s.u_next = Eigen::VectorXd::Zero(m.n_dof);
+    s.v_next = Eigen::VectorXd::Zero(m.n_dof);
+    s.sweep.assign(m.sweep_size, 0.0);
+    if (m.scene.numerics.windowed()) {
+      s.sweep_lower.assign(m.sweep_size, 0.0);
+      s.sweep_inv_pivot.assign(m.sweep_size, 0.0);
+    }
+  }
   int max_nodes = 1;
   for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
   s.theta.assign(max_nodes, 0.0);
@@ -199,24 +209,15 @@ void advance_train(const Model& m, State& s, double dt) {
   contact_forces(m, s, s.u.data(), nullptr);
 }
 
-// Total force on every DOF at displacements u and velocities v (eq. 1 right-hand side minus the
-// internal and damping forces): constant load, beams, supports, tension-only droppers, Rayleigh
-// damping (eq. 5) through z = u + beta v, pantograph chains with their uplift, and the contact.
-// With `given_slack` (the implicit scheme) the droppers are not switched here: those marked slack in
-// state.dropper_slack carry nothing and the others the linear force of the matrix, so that the
-// force and the corrected matrix describe the same active set.
-void assemble_force(const Model& m, State& s, const double* u, const double* v, double* z, double* f,
-                    bool given_slack = false) {
+// The forces that act on single DOFs, added after the wires' band (assemble_force): the window's
+// dashpots, supports, tension-only droppers, pantograph chains with their uplift, and the contact.
+// Reads z = u + beta v only at the DOFs of supports and droppers. With `given_slack` (the implicit
+// scheme) the droppers are not switched here: those marked slack in state.dropper_slack carry
+// nothing and the others the linear force of the matrix, so that the force and the corrected
+// matrix describe the same active set.
+void add_point_forces(const Model& m, State& s, const double* u, const double* v, const double* z, double* f,
+                      bool given_slack) {
   const int n = m.n_dof, nc = m.n_catenary_dof;
-  const double beta = m.beta, alpha = m.alpha;
-  const double* load = m.load.data();
-  const double* mass = m.mass.data();
-  auto init = [&](int i0, int i1) {
-    for (int i = i0; i < i1; ++i) {
-      z[i] = u[i] + beta * v[i];
-      f[i] = load[i] - alpha * mass[i] * v[i];
-    }
-  };
   auto dropper = [&](std::size_t k) {
     // Droppers work only in tension; the switch is decided on the elastic stretch.
     const Dropper& d = m.droppers[k];
@@ -240,12 +241,6 @@ void assemble_force(const Model& m, State& s, const double* u, const double* v, 
     for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
       const WireWindow& ww = s.window[wi];
       const Wire& w = m.wires[wi];
-      init(w.w_dof + ww.lo, w.w_dof + ww.hi + 1);
-    }
-    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
-      const WireWindow& ww = s.window[wi];
-      const Wire& w = m.wires[wi];
-      wire_elastic_force_window(w, ww, z, f, s.theta.data());
       // Where the window cuts the wire, a dashpot of the wire's impedance sqrt(T rhoA) lets
       // outgoing waves leave (the exact condition for a taut string).
       const double c = std::sqrt(w.spec.tension * w.spec.linear_mass);
@@ -258,8 +253,6 @@ void assemble_force(const Model& m, State& s, const double* u, const double* v, 
     }
     for (int j = 0; j < s.window_dropper_count; ++j) dropper(static_cast<std::size_t>(s.window_droppers[j]));
   } else {
-    init(0, nc);
-    for (const Wire& w : m.wires) wire_elastic_force(w, z, f, s.theta.data());
     for (const SupportSpring& sp : m.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
     for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(k);
   }
@@ -285,6 +278,193 @@ void assemble_force(const Model& m, State& s, const double* u, const double* v, 
   contact_forces(m, s, u, f);
 }
 
+// Total force on every DOF at displacements u and velocities v (eq. 1 right-hand side minus the
+// internal and damping forces): constant load, beams, Rayleigh damping (eq. 5) through
+// z = u + beta v, then the point forces (add_point_forces). The generic step (rotations as DOFs,
+// the implicit scheme); the fused explicit step gives the same bits (explicit_fused_step).
+void assemble_force(const Model& m, State& s, const double* u, const double* v, double* z, double* f,
+                    bool given_slack = false) {
+  const int nc = m.n_catenary_dof;
+  const double beta = m.beta, alpha = m.alpha;
+  const double* load = m.load.data();
+  const double* mass = m.mass.data();
+  auto init = [&](int i0, int i1) {
+    for (int i = i0; i < i1; ++i) {
+      z[i] = u[i] + beta * v[i];
+      f[i] = load[i] - alpha * mass[i] * v[i];
+    }
+  };
+  if (m.scene.numerics.windowed()) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const WireWindow& ww = s.window[wi];
+      const Wire& w = m.wires[wi];
+      init(w.w_dof + ww.lo, w.w_dof + ww.hi + 1);
+    }
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) wire_elastic_force_window(m.wires[wi], s.window[wi], z, f, s.theta.data());
+  } else {
+    init(0, nc);
+    for (const Wire& w : m.wires) wire_elastic_force(w, z, f, s.theta.data());
+  }
+  add_point_forces(m, s, u, v, z, f, given_slack);
+}
+
+// The explicit step with the wires packed (Model::wire_packs): one fused sweep pair per pack
+// (sweep_pack) computes every wire node's force from the band, load and damping and updates it;
+// the few nodes that also carry a point force (supports, droppers, the window's dashpots, the
+// contact) are then redone: their band force is recomputed from the kept rotations, the point
+// forces are added in the generic step's order, and the update repeated. Every value is the
+// generic step's to the bit. Writes u_next, v_next, accel; returns the diverged DOF or -1, and
+// false in `done` if the packs cannot take this state (a window of under two nodes).
+int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
+  const double* u = s.u.data();
+  const double* v = s.v.data();
+  double* un = s.u_next.data();
+  double* vn = s.v_next.data();
+  double* acc = s.accel.data();
+  double* f = s.force.data();
+  double* z = s.z.data();
+  const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
+  done = true;
+  if (windowed) {
+    for (const WireWindow& ww : s.window)
+      if (ww.hi == ww.lo) done = false;
+    for (const WireLanes& p : m.wire_packs)
+      if (p.lanes == 2 && (s.window[p.wire[0]].lo != s.window[p.wire[1]].lo || s.window[p.wire[0]].hi != s.window[p.wire[1]].hi))
+        done = false;
+    if (!done) return -1;
+  }
+  bool outside = false;
+  for (const WireLanes& p : m.wire_packs) {
+    const WireWindow& ww0 = s.window[p.wire[0]];
+    PackSweep a;
+    a.pack = &p;
+    a.lo = windowed ? ww0.lo : 0;
+    a.hi = windowed ? ww0.hi : p.nodes - 1;
+    if (a.hi < a.lo) continue;
+    a.lower = windowed ? s.sweep_lower.data() + p.offset : p.tt_lower.data();
+    a.inv_pivot = windowed ? s.sweep_inv_pivot.data() + p.offset : p.tt_inv_pivot.data();
+    for (int k = 0; k < p.lanes; ++k) {
+      const Wire& w = m.wires[p.wire[k]];
+      const WireWindow& ww = s.window[p.wire[k]];
+      const double c[4] = {windowed ? ww.lo_ww : 0.0, windowed ? ww.lo_wt : 0.0, windowed ? ww.hi_ww : 0.0,
+                           windowed ? ww.hi_wt : 0.0};
+      // condensed_band_force's dww_at/dwt_at at the ends (x - 0.0 is x: no change without a cut)
+      a.ww_lo[k] = w.d_ww[a.lo] - c[0];
+      a.wt_lo[k] = w.d_wt[a.lo] - c[1];
+      a.ww_hi[k] = w.d_ww[a.hi] - c[2];
+      a.wt_hi[k] = w.d_wt[a.hi] - c[3];
+      a.u[k] = u + w.w_dof;
+      a.v[k] = v + w.w_dof;
+      a.u_next[k] = un + w.w_dof;
+      a.v_next[k] = vn + w.w_dof;
+      a.accel[k] = acc + w.w_dof;
+    }
+    a.theta = s.sweep.data() + p.offset;
+    a.beta = beta;
+    a.dt = dt;
+    a.limit = limit;
+    outside |= sweep_pack(a);
+  }
+
+  // The nodes with point forces, each passed to fn (a node may come more than once).
+  auto wire_node = [&](int dof, int& wi, int& i) {
+    for (std::size_t k = 0; k < m.wires.size(); ++k)
+      if (dof >= m.wires[k].w_dof && dof < m.wires[k].w_dof + m.wires[k].nodes()) {
+        wi = static_cast<int>(k);
+        i = dof - m.wires[k].w_dof;
+        return !windowed || (i >= s.window[k].lo && i <= s.window[k].hi);
+      }
+    return false;
+  };
+  auto for_each_point = [&](auto&& fn) {
+    auto visit = [&](int dof) {
+      int wi = 0, i = 0;
+      if (wire_node(dof, wi, i)) fn(dof, wi, i);
+    };
+    if (windowed) {
+      for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+        const WireWindow& ww = s.window[wi];
+        if (ww.hi < ww.lo) continue;
+        if (ww.cut_lo) visit(m.wires[wi].w_dof + ww.lo);
+        if (ww.cut_hi) visit(m.wires[wi].w_dof + ww.hi);
+      }
+      for (int j = 0; j < s.window_spring_count; ++j) visit(m.springs[s.window_springs[j]].dof);
+      for (int j = 0; j < s.window_dropper_count; ++j) {
+        const Dropper& d = m.droppers[s.window_droppers[j]];
+        visit(d.contact_dof);
+        visit(d.messenger_dof);
+      }
+    } else {
+      for (const SupportSpring& sp : m.springs) visit(sp.dof);
+      for (const Dropper& d : m.droppers) {
+        visit(d.contact_dof);
+        visit(d.messenger_dof);
+      }
+    }
+    // The contact wire's nodes under every collector (contact_forces' weights).
+    for (const Pantograph& p : m.pantographs)
+      for (int ci : p.collectors) {
+        const double xc = s.front - p.position + m.collectors[ci].offset;
+        for (int cw : m.contact_wires) {
+          const Wire& w = m.wires[cw];
+          const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
+          for (int k = 0; k < cnt; ++k) visit(w.w_dof + s.weight_node[k]);
+        }
+      }
+  };
+  // Their band force alone, as assemble_force and condensed_band_force compute it.
+  const double alpha = m.alpha;
+  for_each_point([&](int dof, int wi, int i) {
+    const Wire& w = m.wires[wi];
+    const WireLanes& p = m.wire_packs[m.wire_pack[wi]];
+    const double* th = s.sweep.data() + p.offset + m.wire_lane[wi];
+    const int L = p.lanes, w0 = w.w_dof;
+    const WireWindow& ww = s.window[wi];
+    const int lo = windowed ? ww.lo : 0, hi = windowed ? ww.hi : w.nodes() - 1;
+    auto zz = [&](int j) { return u[w0 + j] + beta * v[w0 + j]; };
+    double dww = w.d_ww[i], dwt = w.d_wt[i];
+    if (i == lo) {
+      dww = dww - (windowed ? ww.lo_ww : 0.0);
+      dwt = dwt - (windowed ? ww.lo_wt : 0.0);
+    } else if (i == hi) {
+      dww = dww - (windowed ? ww.hi_ww : 0.0);
+      dwt = dwt - (windowed ? ww.hi_wt : 0.0);
+    }
+    double band = dww * zz(i) + dwt * th[i * L];
+    if (i > lo) band = (band + w.e_ww[i - 1] * zz(i - 1)) + w.e_tw[i - 1] * th[(i - 1) * L];
+    double fi = (m.load[dof] - alpha * m.mass[dof] * v[dof]) - band;
+    if (i < hi) fi = fi - (w.e_ww[i] * zz(i + 1) + w.e_wt[i] * th[(i + 1) * L]);
+    f[dof] = fi;
+    z[dof] = zz(i);
+  });
+  add_point_forces(m, s, u, v, z, f, false);
+  auto update = [&](int i) {
+    acc[i] = m.inv_mass[i] * f[i];  // q'' at t_n (eq. 20)
+    vn[i] = v[i] + dt * acc[i];
+    un[i] = u[i] + dt * vn[i];
+  };
+  for_each_point([&](int dof, int, int) { update(dof); });
+  for (int i = m.n_catenary_dof; i < m.n_dof; ++i) update(i);
+  // The displacement check: the sweeps' flag is only a hint (they saw the nodes before the point
+  // forces), so on a flag, or a pantograph or point beyond the limit, every new value is scanned
+  // in the generic step's order.
+  auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
+  for (int i = m.n_catenary_dof; i < m.n_dof && !outside; ++i) outside = beyond(i);
+  for_each_point([&](int dof, int, int) { outside |= beyond(dof); });
+  if (!outside) return -1;
+  int bad = -1;
+  if (windowed) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
+      for (int i = s.window[wi].lo; i <= s.window[wi].hi; ++i)
+        if (beyond(m.wires[wi].w_dof + i)) bad = m.wires[wi].w_dof + i;
+    for (int i = m.n_catenary_dof; i < m.n_dof; ++i)
+      if (beyond(i)) bad = i;
+  } else {
+    for (int i = 0; i < m.n_dof; ++i)
+      if (beyond(i)) bad = i;
+  }
+  return bad;
+}
 
 // Columns for the contacts in touch at the prediction (state.contact_force > 0): their sparse
 // g = e_head - sum_a w_a e_a (eq. 12), the factor dt^2/4 k0, and A^-1 g. Returns their count;
@@ -429,6 +609,34 @@ StepStatus step(const Model& m, State& s) {
     const bool windowed = m.scene.numerics.windowed();
     if (m.endless) shift_endless_block(m, s);
     if (windowed) update_window(m, s);
+    if (!m.wire_packs.empty()) {
+      bool done = false;
+      const int diverged = explicit_fused_update(m, s, windowed, done);
+      if (done) {
+        if (diverged >= 0) {
+          s.status = StepStatus::kDiverged;
+          s.diverged_dof = diverged;
+          return s.status;
+        }
+        if (windowed) {
+          // Outside the window the new buffers hold nothing current: copy the window back.
+          auto commit = [&](int i0, int i1) {
+            for (int i = i0; i < i1; ++i) {
+              v[i] = s.v_next[i];
+              u[i] = s.u_next[i];
+            }
+          };
+          for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
+            commit(m.wires[wi].w_dof + s.window[wi].lo, m.wires[wi].w_dof + s.window[wi].hi + 1);
+          commit(m.n_catenary_dof, n);
+        } else {
+          s.u.swap(s.u_next);  // O(1): every DOF has its new value
+          s.v.swap(s.v_next);
+        }
+        advance_train(m, s, dt);
+        return s.status;
+      }
+    }
     assemble_force(m, s, u, v, z, f);
     // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. The new values go to the
     // workspace first: a displacement beyond the divergence limit (or NaN) stops the run and the

@@ -132,6 +132,15 @@ void update_window(const Model& m, State& s) {
       ww.tt_inv_pivot[i] = 1.0 / d;
     }
   }
+  // The factors interleaved for the fused step (both lanes of a pack share the node range).
+  for (const WireLanes& p : m.wire_packs)
+    for (int k = 0; k < p.lanes; ++k) {
+      const WireWindow& ww = s.window[p.wire[k]];
+      for (int i = ww.lo; i <= ww.hi; ++i) {
+        s.sweep_lower[p.offset + static_cast<std::size_t>(i) * p.lanes + k] = ww.tt_lower[i];
+        s.sweep_inv_pivot[p.offset + static_cast<std::size_t>(i) * p.lanes + k] = ww.tt_inv_pivot[i];
+      }
+    }
   auto inside = [&](int dof) {
     for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
       const Wire& w = m.wires[wi];

@@ -98,6 +98,19 @@ struct ImplicitMatrix {
   std::vector<double> inv_diag;    // 1 / D
 };
 
+// Wires packed for the fused explicit step (condensed rotations): one wire, or two on the same node
+// stations (a section's contact wire and messenger) side by side, so that their independent
+// recurrences (the condensation's tridiagonal sweeps) run in the two lanes of one vector register.
+// Node i of lane k is entry i * lanes + k. Copies of the wires' band, factors, load and masses.
+struct WireLanes {
+  int lanes = 1;
+  int wire[2] = {-1, -1};  // indices into Model::wires
+  int nodes = 0;
+  std::size_t offset = 0;  // of this pack in State::sweep (nodes * lanes entries)
+  std::vector<double> d_ww, d_wt, e_ww, e_wt, e_tw, tt_lower, tt_inv_pivot;
+  std::vector<double> load, damping_mass, inv_mass;  // damping_mass = alpha * mass (eq. 5)
+};
+
 struct Model {
   Scene scene;
   std::vector<Section> sections;
@@ -122,6 +135,11 @@ struct Model {
   double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction (inf: implicit)
   double dt = 0.0;              // s, the step in use
   std::shared_ptr<const ImplicitMatrix> implicit;  // set when the integrator is implicit
+  // Explicit with condensed rotations: the wires packed for the fused step (empty otherwise: the
+  // generic step). wire_pack[wi], wire_lane[wi]: where wire wi is.
+  std::vector<WireLanes> wire_packs;
+  std::vector<int> wire_pack, wire_lane;
+  std::size_t sweep_size = 0;  // entries of State::sweep
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
   double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)

@@ -66,6 +66,11 @@ struct State {
 
   // Workspace, sized once by make_state().
   Eigen::VectorXd force, z;
+  // Fused explicit step: the new displacements and velocities (swapped in, or copied back in the
+  // window, once all are good), the rotations of every wire pack (interleaved as in WireLanes),
+  // and the window's LDL^T factors interleaved the same way.
+  Eigen::VectorXd u_next, v_next;
+  std::vector<double> sweep, sweep_lower, sweep_inv_pivot;
   // Implicit integrator only: the prediction, and the rank-1 corrections of the factorised
   // matrix A (contacts in touch add k0 g g^T, slack droppers take their stiffness out again),
   // each with its sparse g, its stiffness factor and its column A^-1 g.
@@ -90,6 +95,10 @@ State make_state(const Model& model);
 // Advances one fixed dt with the explicit central differences of eq. 19-21 (half-step velocity).
 // Never reads a clock, never allocates, never logs. Returns the state's status.
 StepStatus step(const Model& model, State& state);
+
+// The instruction set the fused explicit step's runtime dispatch chose on this machine: "avx512f",
+// "avx2" or "default" (the portable x86-64 baseline). All give the same bits.
+const char* sweep_pack_isa();
 
 // Fills the observations (contact forces, collector heights) for the current state without
 // advancing it, e.g. for the initial state.
