@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
+#include "../src/core/wire_lanes.hpp"  // the step's kernel, timed alone
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."
@@ -32,9 +33,10 @@ typedef double D2 __attribute__((vector_size(16)));
 typedef long L2 __attribute__((vector_size(16)));
 
 // One section, both wires interleaved: entry 2 i + k is node i of wire k.
+// Coefficients as the step keeps them: one record per node (WireLanes::coef, factors).
 struct Floor {
   int n = 0;
-  std::vector<double> dww, dwt, eww, ewt, etw, lower, ip, load, am, im;
+  std::vector<double> coef, fac;
   std::vector<double> u, v, un, vn, acc, th;
   double beta = 0, dt = 0, limit = 5.0;
 };
@@ -42,6 +44,18 @@ struct Floor {
 inline D2 ld(const std::vector<double>& a, int i) {
   D2 x;
   std::memcpy(&x, a.data() + 2 * i, 16);
+  return x;
+}
+using W = WireLanes;
+constexpr int NC = W::kCoefficients;
+inline D2 cf(const Floor& F, int i, int k) {
+  D2 x;
+  std::memcpy(&x, F.coef.data() + 2 * (i * NC + k), 16);
+  return x;
+}
+inline D2 fc(const Floor& F, int i, int k) {
+  D2 x;
+  std::memcpy(&x, F.fac.data() + 2 * (2 * i + k), 16);
   return x;
 }
 inline void st(std::vector<double>& a, int i, D2 x) { std::memcpy(a.data() + 2 * i, &x, 16); }
@@ -61,36 +75,36 @@ __attribute__((always_inline)) inline bool floor_kernel(Floor& F) {
   const D2 beta = {F.beta, F.beta}, dt = {F.dt, F.dt}, lim = {F.limit, F.limit}, nlim = -lim;
   auto z = [&](int i) { return mul_add(ld(F.u, i), beta, ld(F.v, i)); };
   D2 zp = z(0), zc = z(1);
-  D2 y = mul_sub(-ld(F.dwt, 0) * zp, ld(F.etw, 0), zc);
+  D2 y = mul_sub(-cf(F, 0, W::kDwt) * zp, cf(F, 0, W::kEtw), zc);
   st(F.th, 0, y);
   for (int i = 1; i < hi; ++i) {
     const D2 zn = z(i + 1);
-    const D2 r = mul_sub(mul_sub(-ld(F.dwt, i) * zc, ld(F.etw, i), zn), ld(F.ewt, i - 1), zp);
-    y = mul_sub(r, ld(F.lower, i), y);
+    const D2 r = mul_sub(mul_sub(-cf(F, i, W::kDwt) * zc, cf(F, i, W::kEtw), zn), cf(F, i - 1, W::kEwt), zp);
+    y = mul_sub(r, fc(F, i, 0), y);
     st(F.th, i, y);
     zp = zc;
     zc = zn;
   }
-  y = mul_sub(mul_sub(-ld(F.dwt, hi) * zc, ld(F.ewt, hi - 1), zp), ld(F.lower, hi), y);
+  y = mul_sub(mul_sub(-cf(F, hi, W::kDwt) * zc, cf(F, hi - 1, W::kEwt), zp), fc(F, hi, 0), y);
   L2 ok = {-1, -1};
   auto update = [&](int j, D2 f, D2 u, D2 v) {
-    const D2 a = ld(F.im, j) * f, vn = mul_add(v, dt, a), un = mul_add(u, dt, vn);
+    const D2 a = cf(F, j, W::kInvMass) * f, vn = mul_add(v, dt, a), un = mul_add(u, dt, vn);
     ok &= (un <= lim) & (un >= nlim);
     st(F.acc, j, a);
     st(F.vn, j, vn);
     st(F.un, j, un);
   };
-  D2 th1 = y * ld(F.ip, hi), th2 = {0, 0}, z2 = {0, 0};
+  D2 th1 = y * fc(F, hi, 1), th2 = {0, 0}, z2 = {0, 0};
   st(F.th, hi, th1);
   D2 u1 = ld(F.u, hi), v1 = ld(F.v, hi), z1 = mul_add(u1, beta, v1);
   for (int i = hi - 1; i >= 0; --i) {
-    const D2 th0 = mul_sub(ld(F.th, i) * ld(F.ip, i), ld(F.lower, i + 1), th1);
+    const D2 th0 = mul_sub(ld(F.th, i) * fc(F, i, 1), fc(F, i + 1, 0), th1);
     st(F.th, i, th0);
     const D2 u0 = ld(F.u, i), v0 = ld(F.v, i), z0 = mul_add(u0, beta, v0);
     const int j = i + 1;
-    const D2 A = mul_add(mul_add(mul_add(ld(F.dww, j) * z1, ld(F.dwt, j), th1), ld(F.eww, i), z0), ld(F.etw, i), th0);
-    const D2 B = mul_add(ld(F.eww, j) * z2, ld(F.ewt, j), th2);  // zero coefficients at hi
-    update(j, mul_sub(ld(F.load, j), ld(F.am, j), v1) - A - B, u1, v1);
+    const D2 A = mul_add(mul_add(mul_add(cf(F, j, W::kDww) * z1, cf(F, j, W::kDwt), th1), cf(F, i, W::kEww), z0), cf(F, i, W::kEtw), th0);
+    const D2 B = mul_add(cf(F, j, W::kEww) * z2, cf(F, j, W::kEwt), th2);  // zero coefficients at hi
+    update(j, mul_sub(cf(F, j, W::kLoad), cf(F, j, W::kDampingMass), v1) - A - B, u1, v1);
     th2 = th1;
     th1 = th0;
     z2 = z1;
@@ -98,15 +112,15 @@ __attribute__((always_inline)) inline bool floor_kernel(Floor& F) {
     u1 = u0;
     v1 = v0;
   }
-  const D2 A = mul_add(ld(F.dww, 0) * z1, ld(F.dwt, 0), th1);
-  const D2 B = mul_add(ld(F.eww, 0) * z2, ld(F.ewt, 0), th2);
-  update(0, mul_sub(ld(F.load, 0), ld(F.am, 0), v1) - A - B, u1, v1);
+  const D2 A = mul_add(cf(F, 0, W::kDww) * z1, cf(F, 0, W::kDwt), th1);
+  const D2 B = mul_add(cf(F, 0, W::kEww) * z2, cf(F, 0, W::kEwt), th2);
+  update(0, mul_sub(cf(F, 0, W::kLoad), cf(F, 0, W::kDampingMass), v1) - A - B, u1, v1);
   std::swap(F.u, F.un);
   std::swap(F.v, F.vn);
   return !(ok[0] && ok[1]);
 }
 
-__attribute__((target_clones("avx512f", "avx2", "default"))) bool floor_step(Floor& F) { return floor_kernel<false>(F); }
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) bool floor_step(Floor& F) { return floor_kernel<false>(F); }
 __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) bool floor_step_fma(Floor& F) {
   return floor_kernel<true>(F);
 }
@@ -119,33 +133,33 @@ bool floor_step_scalar(Floor& F) {
     auto at = [&](const std::vector<double>& a, int i) { return a[2 * i + k]; };
     auto z = [&](int i) { return at(F.u, i) + F.beta * at(F.v, i); };
     double zp = z(0), zc = z(1);
-    double y = -at(F.dwt, 0) * zp - at(F.etw, 0) * zc;
+    double y = -F.coef[2 * (0 * NC + W::kDwt) + k] * zp - F.coef[2 * (0 * NC + W::kEtw) + k] * zc;
     F.th[k] = y;
     for (int i = 1; i < hi; ++i) {
       const double zn = z(i + 1);
-      y = ((-at(F.dwt, i) * zc - at(F.etw, i) * zn) - at(F.ewt, i - 1) * zp) - at(F.lower, i) * y;
+      y = ((-F.coef[2 * (i * NC + W::kDwt) + k] * zc - F.coef[2 * (i * NC + W::kEtw) + k] * zn) - F.coef[2 * (i - 1 * NC + W::kEwt) + k] * zp) - F.fac[2 * (2 * i) + k] * y;
       F.th[2 * i + k] = y;
       zp = zc;
       zc = zn;
     }
-    y = (-at(F.dwt, hi) * zc - at(F.ewt, hi - 1) * zp) - at(F.lower, hi) * y;
-    double th1 = y * at(F.ip, hi), th2 = 0, z2 = 0, u1 = at(F.u, hi), v1 = at(F.v, hi), z1 = u1 + F.beta * v1;
+    y = (-F.coef[2 * (hi * NC + W::kDwt) + k] * zc - F.coef[2 * (hi - 1 * NC + W::kEwt) + k] * zp) - F.fac[2 * (2 * hi) + k] * y;
+    double th1 = y * F.fac[2 * (2 * hi + 1) + k], th2 = 0, z2 = 0, u1 = at(F.u, hi), v1 = at(F.v, hi), z1 = u1 + F.beta * v1;
     F.th[2 * hi + k] = th1;
     auto update = [&](int j, double f, double u, double v) {
-      const double a = at(F.im, j) * f, vn = v + F.dt * a, un = u + F.dt * vn;
+      const double a = F.coef[2 * (j * NC + W::kInvMass) + k] * f, vn = v + F.dt * a, un = u + F.dt * vn;
       bad |= !(std::fabs(un) <= F.limit);
       F.acc[2 * j + k] = a;
       F.vn[2 * j + k] = vn;
       F.un[2 * j + k] = un;
     };
     for (int i = hi - 1; i >= 0; --i) {
-      const double th0 = at(F.th, i) * at(F.ip, i) - at(F.lower, i + 1) * th1;
+      const double th0 = at(F.th, i) * F.fac[2 * (2 * i + 1) + k] - F.fac[2 * (2 * i + 1) + k] * th1;
       F.th[2 * i + k] = th0;
       const double u0 = at(F.u, i), v0 = at(F.v, i), z0 = u0 + F.beta * v0;
       const int j = i + 1;
-      const double A = ((at(F.dww, j) * z1 + at(F.dwt, j) * th1) + at(F.eww, i) * z0) + at(F.etw, i) * th0;
-      const double B = at(F.eww, j) * z2 + at(F.ewt, j) * th2;
-      update(j, ((at(F.load, j) - at(F.am, j) * v1) - A) - B, u1, v1);
+      const double A = ((F.coef[2 * (j * NC + W::kDww) + k] * z1 + F.coef[2 * (j * NC + W::kDwt) + k] * th1) + F.coef[2 * (i * NC + W::kEww) + k] * z0) + F.coef[2 * (i * NC + W::kEtw) + k] * th0;
+      const double B = F.coef[2 * (j * NC + W::kEww) + k] * z2 + F.coef[2 * (j * NC + W::kEwt) + k] * th2;
+      update(j, ((F.coef[2 * (j * NC + W::kLoad) + k] - F.coef[2 * (j * NC + W::kDampingMass) + k] * v1) - A) - B, u1, v1);
       th2 = th1;
       th1 = th0;
       z2 = z1;
@@ -153,8 +167,8 @@ bool floor_step_scalar(Floor& F) {
       u1 = u0;
       v1 = v0;
     }
-    update(0, ((at(F.load, 0) - at(F.am, 0) * v1) - (at(F.dww, 0) * z1 + at(F.dwt, 0) * th1)) -
-                  (at(F.eww, 0) * z2 + at(F.ewt, 0) * th2),
+    update(0, ((F.coef[2 * (0 * NC + W::kLoad) + k] - F.coef[2 * (0 * NC + W::kDampingMass) + k] * v1) - (F.coef[2 * (0 * NC + W::kDww) + k] * z1 + F.coef[2 * (0 * NC + W::kDwt) + k] * th1)) -
+                  (F.coef[2 * (0 * NC + W::kEww) + k] * z2 + F.coef[2 * (0 * NC + W::kEwt) + k] * th2),
            u1, v1);
   }
   std::swap(F.u, F.un);
@@ -169,16 +183,8 @@ std::vector<Floor> floors_of(const Model& m, const State& s0) {
     if (p.lanes != 2) continue;
     Floor F;
     F.n = p.nodes;
-    F.dww = p.d_ww;
-    F.dwt = p.d_wt;
-    F.eww = p.e_ww;
-    F.ewt = p.e_wt;
-    F.etw = p.e_tw;
-    F.lower = p.tt_lower;
-    F.ip = p.tt_inv_pivot;
-    F.load = p.load;
-    F.am = p.damping_mass;
-    F.im = p.inv_mass;
+    F.coef = p.coef;
+    F.fac = p.factors;
     const std::size_t sz = 2 * static_cast<std::size_t>(p.nodes);
     F.u.assign(sz, 0.0);
     F.v.assign(sz, 0.0);
@@ -221,6 +227,7 @@ int main(int argc, char** argv) {
   };
   std::vector<Row> rows{{"step (Simulation::step, whole pass)", {}},
                         {"floor: fused kernel, 2 lanes", {}},
+                        {"step's kernel alone (sweep_pack)", {}},
                         {"floor: scalar, wires in turn", {}},
                         {"floor with FMA (not reproducible)", {}}};
   long flagged = 0;  // floor sweeps that saw a displacement beyond the limit (keeps their results alive)
@@ -229,14 +236,49 @@ int main(int argc, char** argv) {
     for (std::size_t v = 0; v < rows.size(); ++v) {
       Simulation sim(scene);
       std::vector<Floor> F = floors_of(sim.model(), sim.state());
+      State s = sim.state();  // for the kernel alone
       const auto t0 = std::chrono::steady_clock::now();
       if (v == 0) {
         while (sim.step() == StepStatus::kOk) {
         }
+      } else if (v == 2) {
+        // The step's wire kernel on the step's own layout (the state's arrays), no point forces.
+        const Model& mm = sim.model();
+        bool bad = false;
+        for (long k = 0; k < steps; ++k) {
+          for (const WireLanes& p : mm.wire_packs) {
+            PackSweep a;
+            a.pack = &p;
+            a.lo = 0;
+            a.hi = p.nodes - 1;
+            a.factors = p.factors.data();
+            for (int l = 0; l < p.lanes; ++l) {
+              const int w0 = mm.wires[p.wire[l]].w_dof;
+              a.ww_lo[l] = a.ww_hi[l] = 0.0;
+              a.wt_lo[l] = mm.wires[p.wire[l]].d_wt[0];
+              a.wt_hi[l] = mm.wires[p.wire[l]].d_wt[p.nodes - 1];
+              a.ww_lo[l] = mm.wires[p.wire[l]].d_ww[0];
+              a.ww_hi[l] = mm.wires[p.wire[l]].d_ww[p.nodes - 1];
+              a.u[l] = s.u.data() + w0;
+              a.v[l] = s.v.data() + w0;
+              a.u_next[l] = s.u_next.data() + w0;
+              a.v_next[l] = s.v_next.data() + w0;
+              a.accel[l] = s.accel.data() + w0;
+            }
+            a.record = s.sweep.data() + kSweepRecord * p.offset;
+            a.beta = mm.beta;
+            a.dt = mm.dt;
+            a.limit = mm.scene.numerics.divergence_limit;
+            bad |= sweep_pack(a);
+          }
+          s.u.swap(s.u_next);
+          s.v.swap(s.v_next);
+        }
+        flagged += bad;
       } else {
         bool bad = false;
         for (long k = 0; k < steps; ++k)
-          for (Floor& f : F) bad |= v == 1 ? floor_step(f) : v == 2 ? floor_step_scalar(f) : floor_step_fma(f);
+          for (Floor& f : F) bad |= v == 1 ? floor_step(f) : v == 3 ? floor_step_scalar(f) : floor_step_fma(f);
         flagged += bad;
       }
       rows[v].walls.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());

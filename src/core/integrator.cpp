@@ -97,10 +97,10 @@ State make_state(const Model& m) {
   if (!m.wire_packs.empty()) {
     s.u_next = Eigen::VectorXd::Zero(m.n_dof);
     s.v_next = Eigen::VectorXd::Zero(m.n_dof);
-    s.sweep.assign(m.sweep_size, 0.0);
+    s.sweep.assign(kSweepRecord * m.sweep_size, 0.0);
+    s.point_node.assign(m.collectors.size() * m.contact_wires.size() * m.max_contact_nodes, 0);
     if (m.scene.numerics.windowed()) {
-      s.sweep_lower.assign(m.sweep_size, 0.0);
-      s.sweep_inv_pivot.assign(m.sweep_size, 0.0);
+      s.sweep_factors.assign(2 * m.sweep_size, 0.0);
     }
   }
   int max_nodes = 1;
@@ -341,8 +341,7 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
     a.lo = windowed ? ww0.lo : 0;
     a.hi = windowed ? ww0.hi : p.nodes - 1;
     if (a.hi < a.lo) continue;
-    a.lower = windowed ? s.sweep_lower.data() + p.offset : p.tt_lower.data();
-    a.inv_pivot = windowed ? s.sweep_inv_pivot.data() + p.offset : p.tt_inv_pivot.data();
+    a.factors = windowed ? s.sweep_factors.data() + 2 * p.offset : p.factors.data();
     for (int k = 0; k < p.lanes; ++k) {
       const Wire& w = m.wires[p.wire[k]];
       const WireWindow& ww = s.window[p.wire[k]];
@@ -359,98 +358,75 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
       a.v_next[k] = vn + w.w_dof;
       a.accel[k] = acc + w.w_dof;
     }
-    a.theta = s.sweep.data() + p.offset;
+    a.record = s.sweep.data() + kSweepRecord * p.offset;
     a.beta = beta;
     a.dt = dt;
     a.limit = limit;
     outside |= sweep_pack(a);
   }
 
-  // The nodes with point forces, each passed to fn (a node may come more than once).
-  auto wire_node = [&](int dof, int& wi, int& i) {
-    for (std::size_t k = 0; k < m.wires.size(); ++k)
-      if (dof >= m.wires[k].w_dof && dof < m.wires[k].w_dof + m.wires[k].nodes()) {
-        wi = static_cast<int>(k);
-        i = dof - m.wires[k].w_dof;
-        return !windowed || (i >= s.window[k].lo && i <= s.window[k].hi);
+  // The nodes with point forces: the window's cut ends, supports, droppers (each DOF in the window
+  // by construction of its lists), and the contact wire's nodes under every collector
+  // (contact_forces' weights), listed once per step. `fn` may see a node more than once.
+  int contacts = 0;
+  int* contact_node = s.point_node.data();
+  for (const Pantograph& p : m.pantographs)
+    for (int ci : p.collectors) {
+      const double xc = s.front - p.position + m.collectors[ci].offset;
+      for (int cw : m.contact_wires) {
+        const Wire& w = m.wires[cw];
+        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
+        for (int k = 0; k < cnt; ++k) {
+          const int i = s.weight_node[k];
+          if (!windowed || (i >= s.window[cw].lo && i <= s.window[cw].hi)) contact_node[contacts++] = w.w_dof + i;
+        }
       }
-    return false;
-  };
+    }
   auto for_each_point = [&](auto&& fn) {
-    auto visit = [&](int dof) {
-      int wi = 0, i = 0;
-      if (wire_node(dof, wi, i)) fn(dof, wi, i);
-    };
     if (windowed) {
       for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
         const WireWindow& ww = s.window[wi];
         if (ww.hi < ww.lo) continue;
-        if (ww.cut_lo) visit(m.wires[wi].w_dof + ww.lo);
-        if (ww.cut_hi) visit(m.wires[wi].w_dof + ww.hi);
+        if (ww.cut_lo) fn(m.wires[wi].w_dof + ww.lo);
+        if (ww.cut_hi) fn(m.wires[wi].w_dof + ww.hi);
       }
-      for (int j = 0; j < s.window_spring_count; ++j) visit(m.springs[s.window_springs[j]].dof);
+      for (int j = 0; j < s.window_spring_count; ++j) fn(m.springs[s.window_springs[j]].dof);
       for (int j = 0; j < s.window_dropper_count; ++j) {
         const Dropper& d = m.droppers[s.window_droppers[j]];
-        visit(d.contact_dof);
-        visit(d.messenger_dof);
+        fn(d.contact_dof);
+        fn(d.messenger_dof);
       }
     } else {
-      for (const SupportSpring& sp : m.springs) visit(sp.dof);
+      for (const SupportSpring& sp : m.springs) fn(sp.dof);
       for (const Dropper& d : m.droppers) {
-        visit(d.contact_dof);
-        visit(d.messenger_dof);
+        fn(d.contact_dof);
+        fn(d.messenger_dof);
       }
     }
-    // The contact wire's nodes under every collector (contact_forces' weights).
-    for (const Pantograph& p : m.pantographs)
-      for (int ci : p.collectors) {
-        const double xc = s.front - p.position + m.collectors[ci].offset;
-        for (int cw : m.contact_wires) {
-          const Wire& w = m.wires[cw];
-          const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
-          for (int k = 0; k < cnt; ++k) visit(w.w_dof + s.weight_node[k]);
-        }
-      }
+    for (int q = 0; q < contacts; ++q) fn(contact_node[q]);
   };
-  // Their band force alone, as assemble_force and condensed_band_force compute it.
-  const double alpha = m.alpha;
-  for_each_point([&](int dof, int wi, int i) {
-    const Wire& w = m.wires[wi];
-    const WireLanes& p = m.wire_packs[m.wire_pack[wi]];
-    const double* th = s.sweep.data() + p.offset + m.wire_lane[wi];
-    const int L = p.lanes, w0 = w.w_dof;
-    const WireWindow& ww = s.window[wi];
-    const int lo = windowed ? ww.lo : 0, hi = windowed ? ww.hi : w.nodes() - 1;
-    auto zz = [&](int j) { return u[w0 + j] + beta * v[w0 + j]; };
-    double dww = w.d_ww[i], dwt = w.d_wt[i];
-    if (i == lo) {
-      dww = dww - (windowed ? ww.lo_ww : 0.0);
-      dwt = dwt - (windowed ? ww.lo_wt : 0.0);
-    } else if (i == hi) {
-      dww = dww - (windowed ? ww.hi_ww : 0.0);
-      dwt = dwt - (windowed ? ww.hi_wt : 0.0);
-    }
-    double band = dww * zz(i) + dwt * th[i * L];
-    if (i > lo) band = (band + w.e_ww[i - 1] * zz(i - 1)) + w.e_tw[i - 1] * th[(i - 1) * L];
-    double fi = (m.load[dof] - alpha * m.mass[dof] * v[dof]) - band;
-    if (i < hi) fi = fi - (w.e_ww[i] * zz(i + 1) + w.e_wt[i] * th[(i + 1) * L]);
-    f[dof] = fi;
-    z[dof] = zz(i);
+  // Their band force alone (with the load and damping) and z, as the sweep left them.
+  const double* rec = s.sweep.data();
+  const int* f_at = m.dof_sweep_force.data();
+  const int* z_at = m.dof_sweep_z.data();
+  for_each_point([&](int dof) {
+    f[dof] = rec[f_at[dof]];
+    z[dof] = rec[z_at[dof]];
   });
   add_point_forces(m, s, u, v, z, f, false);
+  const double* im = m.inv_mass.data();
+  auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
   auto update = [&](int i) {
-    acc[i] = m.inv_mass[i] * f[i];  // q'' at t_n (eq. 20)
+    acc[i] = im[i] * f[i];  // q'' at t_n (eq. 20)
     vn[i] = v[i] + dt * acc[i];
     un[i] = u[i] + dt * vn[i];
+    outside |= beyond(i);
   };
-  for_each_point([&](int dof, int, int) { update(dof); });
+  for_each_point(update);
   for (int i = m.n_catenary_dof; i < m.n_dof; ++i) update(i);
   // The displacement check: the sweeps' flag is only a hint (they saw the nodes before the point
   // forces), so on a flag, or a pantograph or point beyond the limit, every new value is scanned
   // in the generic step's order.
-  auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
-  for (int i = m.n_catenary_dof; i < m.n_dof && !outside; ++i) outside = beyond(i);
-  for_each_point([&](int dof, int, int) { outside |= beyond(dof); });
   if (!outside) return -1;
   int bad = -1;
   if (windowed) {

@@ -136,9 +136,10 @@ void update_window(const Model& m, State& s) {
   for (const WireLanes& p : m.wire_packs)
     for (int k = 0; k < p.lanes; ++k) {
       const WireWindow& ww = s.window[p.wire[k]];
+      double* f = s.sweep_factors.data() + 2 * p.offset;
       for (int i = ww.lo; i <= ww.hi; ++i) {
-        s.sweep_lower[p.offset + static_cast<std::size_t>(i) * p.lanes + k] = ww.tt_lower[i];
-        s.sweep_inv_pivot[p.offset + static_cast<std::size_t>(i) * p.lanes + k] = ww.tt_inv_pivot[i];
+        f[(2 * static_cast<std::size_t>(i) + 0) * p.lanes + k] = ww.tt_lower[i];
+        f[(2 * static_cast<std::size_t>(i) + 1) * p.lanes + k] = ww.tt_inv_pivot[i];
       }
     }
   auto inside = [&](int dof) {

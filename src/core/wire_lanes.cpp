@@ -38,31 +38,39 @@ void build_wire_packs(Model& m) {
     p.nodes = n;
     p.offset = m.sweep_size;
     m.sweep_size += static_cast<std::size_t>(n) * L;
-    for (auto* v : {&p.d_ww, &p.d_wt, &p.e_ww, &p.e_wt, &p.e_tw, &p.tt_lower, &p.tt_inv_pivot, &p.load, &p.damping_mass,
-                    &p.inv_mass})
-      v->assign(static_cast<std::size_t>(n) * L, 0.0);
+    p.coef.assign(static_cast<std::size_t>(n) * WireLanes::kCoefficients * L, 0.0);
+    p.factors.assign(static_cast<std::size_t>(n) * 2 * L, 0.0);
     for (int k = 0; k < L; ++k) {
       const Wire& w = m.wires[p.wire[k]];
       m.wire_pack[p.wire[k]] = static_cast<int>(m.wire_packs.size());
       m.wire_lane[p.wire[k]] = k;
       for (int i = 0; i < n; ++i) {
-        const std::size_t j = static_cast<std::size_t>(i) * L + k;
-        p.d_ww[j] = w.d_ww[i];
-        p.d_wt[j] = w.d_wt[i];
-        p.tt_lower[j] = w.tt_lower[i];
-        p.tt_inv_pivot[j] = w.tt_inv_pivot[i];
-        p.load[j] = m.load[w.w_dof + i];
-        p.damping_mass[j] = m.alpha * m.mass[w.w_dof + i];  // the generic step's alpha * mass[i] * v[i]
-        p.inv_mass[j] = m.inv_mass[w.w_dof + i];
+        double* c = p.coef.data() + static_cast<std::size_t>(i) * WireLanes::kCoefficients * L + k;
+        c[WireLanes::kDww * L] = w.d_ww[i];
+        c[WireLanes::kDwt * L] = w.d_wt[i];
         if (i + 1 < n) {
-          p.e_ww[j] = w.e_ww[i];
-          p.e_wt[j] = w.e_wt[i];
-          p.e_tw[j] = w.e_tw[i];
+          c[WireLanes::kEww * L] = w.e_ww[i];
+          c[WireLanes::kEwt * L] = w.e_wt[i];
+          c[WireLanes::kEtw * L] = w.e_tw[i];
         }
+        c[WireLanes::kLoad * L] = m.load[w.w_dof + i];
+        c[WireLanes::kDampingMass * L] = m.alpha * m.mass[w.w_dof + i];  // the generic step's alpha * mass[i] * v[i]
+        c[WireLanes::kInvMass * L] = m.inv_mass[w.w_dof + i];
+        p.factors[(static_cast<std::size_t>(i) * 2 + 0) * L + k] = w.tt_lower[i];
+        p.factors[(static_cast<std::size_t>(i) * 2 + 1) * L + k] = w.tt_inv_pivot[i];
       }
     }
     m.wire_packs.push_back(std::move(p));
   }
+  m.dof_sweep_force.assign(m.n_catenary_dof, 0);
+  m.dof_sweep_z.assign(m.n_catenary_dof, 0);
+  for (const WireLanes& p : m.wire_packs)
+    for (int k = 0; k < p.lanes; ++k)
+      for (int i = 0; i < p.nodes; ++i) {
+        const std::size_t r = kSweepRecord * p.offset + static_cast<std::size_t>(i) * kSweepRecord * p.lanes + k;
+        m.dof_sweep_force[m.wires[p.wire[k]].w_dof + i] = static_cast<int>(r + kRecForce * p.lanes);
+        m.dof_sweep_z[m.wires[p.wire[k]].w_dof + i] = static_cast<int>(r + kRecZ * p.lanes);
+      }
 }
 
 namespace {
@@ -72,129 +80,208 @@ typedef long Long2 __attribute__((vector_size(16)));
 
 template <int L>
 struct Lane;
+// One wire: plain doubles.
 template <>
 struct Lane<1> {
   using T = double;
-  static T load(const double* p, int i) { return p[i]; }
-  static T gather(const double* const* p, int i) { return p[0][i]; }
-  static void scatter(double* const* p, int i, T x) { p[0][i] = x; }
-  static void store(double* p, int i, T x) { p[i] = x; }
+  static T at(const double* p, std::ptrdiff_t k) { return p[k]; }
+  static void put(double* p, std::ptrdiff_t k, T x) { p[k] = x; }
+  static T gather(const double* p, std::ptrdiff_t, int i) { return p[i]; }
+  static void gather2(const double* p, std::ptrdiff_t, int i, T& x0, T& x1) {
+    x0 = p[i];
+    x1 = p[i + 1];
+  }
   static T splat(double a) { return a; }
   static T pair(const double* a) { return a[0]; }
-  struct Inside {
-    bool all = true;
-    void add(T x, double limit) { all &= std::fabs(x) <= limit; }
-    bool ok() const { return all; }
-  };
+  using Mask = bool;
+  static Mask all() { return true; }
+  // |x| <= limit, NaN outside: the generic step's !(fabs(un) <= limit) (limit >= 0).
+  static Mask inside(Mask m, T x, T above, T below) { return m & (x <= above) & (x >= below); }
+  static bool ok(Mask m) { return m; }
+  // Eq. 20-21 at node i given its acceleration (the velocity first, then the displacement).
+  static void update(const double* u, const double* v, double* un, double* vn, double* acc, std::ptrdiff_t, int i,
+                     T a, T dt, Mask& ok, T above, T below) {
+    const T vi = v[i] + dt * a, ui = u[i] + dt * vi;
+    ok = inside(ok, ui, above, below);
+    acc[i] = a;
+    vn[i] = vi;
+    un[i] = ui;
+  }
+  static void update2(const double* u, const double* v, double* un, double* vn, double* acc, std::ptrdiff_t d, int i,
+                      T a0, T a1, T dt, Mask& ok, T above, T below) {
+    update(u, v, un, vn, acc, d, i, a0, dt, ok, above, below);
+    update(u, v, un, vn, acc, d, i + 1, a1, dt, ok, above, below);
+  }
 };
+// Two wires in the two lanes. Interleaved arrays (coefficients, factors, the sweep's record) load
+// whole; the state's arrays hold each wire's nodes in a row, the second wire `d` entries after the
+// first: they are read in blocks of two nodes and shuffled into lanes, and updated per wire, two
+// nodes to a register, so that nothing is shuffled back.
 template <>
 struct Lane<2> {
   using T = Double2;
-  static T load(const double* p, int i) {
+  static T at(const double* p, std::ptrdiff_t k) {
     T x;
-    std::memcpy(&x, p + 2 * i, sizeof x);
+    std::memcpy(&x, p + 2 * k, sizeof x);
     return x;
   }
-  static T gather(const double* const* p, int i) { return T{p[0][i], p[1][i]}; }
-  static void scatter(double* const* p, int i, T x) {
-    p[0][i] = x[0];
-    p[1][i] = x[1];
+  static void put(double* p, std::ptrdiff_t k, T x) { std::memcpy(p + 2 * k, &x, sizeof x); }
+  static T gather(const double* p, std::ptrdiff_t d, int i) { return T{p[i], p[i + d]}; }
+  // Nodes i and i + 1 of both wires: two loads and two shuffles instead of four scalar loads.
+  static void gather2(const double* p, std::ptrdiff_t d, int i, T& x0, T& x1) {
+    const T a = row(p + i), b = row(p + i + d);
+    x0 = __builtin_shuffle(a, b, Long2{0, 2});
+    x1 = __builtin_shuffle(a, b, Long2{1, 3});
   }
-  static void store(double* p, int i, T x) { std::memcpy(p + 2 * i, &x, sizeof x); }
   static T splat(double a) { return T{a, a}; }
   static T pair(const double* a) { return T{a[0], a[1]}; }
-  struct Inside {
-    Long2 all = {-1, -1};
-    // |x| <= limit, NaN outside: as the generic step's !(fabs(un) <= limit).
-    void add(T x, double limit) { all &= (x <= splat(limit)) & (x >= splat(-limit)); }
-    bool ok() const { return all[0] && all[1]; }
-  };
+  using Mask = Long2;
+  static Mask all() { return Long2{-1, -1}; }
+  static Mask inside(Mask m, T x, T above, T below) { return m & (x <= above) & (x >= below); }
+  static bool ok(Mask m) { return m[0] && m[1]; }
+  static T row(const double* p) {
+    T x;
+    std::memcpy(&x, p, sizeof x);
+    return x;
+  }
+  static void put_row(double* p, T x) { std::memcpy(p, &x, sizeof x); }
+  static void update(const double* u, const double* v, double* un, double* vn, double* acc, std::ptrdiff_t d, int i,
+                     T a, T dt, Mask& ok, T above, T below) {
+    const T vi = gather(v, d, i) + dt * a, ui = gather(u, d, i) + dt * vi;
+    ok = inside(ok, ui, above, below);
+    acc[i] = a[0];
+    acc[i + d] = a[1];
+    vn[i] = vi[0];
+    vn[i + d] = vi[1];
+    un[i] = ui[0];
+    un[i + d] = ui[1];
+  }
+  // Nodes i and i + 1 given their accelerations (both wires in lanes): per wire, two nodes a register.
+  static void update2(const double* u, const double* v, double* un, double* vn, double* acc, std::ptrdiff_t d, int i,
+                      T a0, T a1, T dt, Mask& ok, T above, T below) {
+    const T aa = __builtin_shuffle(a0, a1, Long2{0, 2}), ab = __builtin_shuffle(a0, a1, Long2{1, 3});
+    const T va = row(v + i) + dt * aa, vb = row(v + i + d) + dt * ab;
+    const T ua = row(u + i) + dt * va, ub = row(u + i + d) + dt * vb;
+    ok = inside(inside(ok, ua, above, below), ub, above, below);
+    put_row(acc + i, aa);
+    put_row(acc + i + d, ab);
+    put_row(vn + i, va);
+    put_row(vn + i + d, vb);
+    put_row(un + i, ua);
+    put_row(un + i + d, ub);
+  }
 };
 
 template <int L>
 __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   using V = Lane<L>;
   using T = typename V::T;
-  const WireLanes& p = *a.pack;
-  const double *dww = p.d_ww.data(), *dwt = p.d_wt.data(), *eww = p.e_ww.data(), *ewt = p.e_wt.data(),
-               *etw = p.e_tw.data(), *load = p.load.data(), *am = p.damping_mass.data(), *im = p.inv_mass.data();
-  const double *lower = a.lower, *ip = a.inv_pivot;
-  double* th = a.theta;
+  using W = WireLanes;
+  constexpr int NC = W::kCoefficients, NR = kSweepRecord;
+  // Few base pointers (one coefficient record per node, one sweep record per node, the second
+  // wire at an offset in the state's arrays), all in restrict locals, so that they stay in
+  // registers and no store can be taken to change them.
+  const double* __restrict coef = a.pack->coef.data();
+  const double* __restrict fac = a.factors;
+  double* __restrict rec = a.record;
+  const double *__restrict u = a.u[0], *__restrict v = a.v[0];
+  double *__restrict un = a.u_next[0], *__restrict vn = a.v_next[0], *__restrict acc = a.accel[0];
+  const std::ptrdiff_t d = L == 2 ? a.u[1] - a.u[0] : 0;
+  auto c = [&](int i, int k) __attribute__((always_inline)) { return V::at(coef, static_cast<std::ptrdiff_t>(i) * NC + k); };
+  auto lower = [&](int i) __attribute__((always_inline)) { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i)); };
+  auto ip = [&](int i) __attribute__((always_inline)) { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i) + 1); };
+  auto get = [&](int i, int k) __attribute__((always_inline)) { return V::at(rec, static_cast<std::ptrdiff_t>(i) * NR + k); };
+  auto set = [&](int i, int k, T x) __attribute__((always_inline)) { V::put(rec, static_cast<std::ptrdiff_t>(i) * NR + k, x); };
   const T beta = V::splat(a.beta), dt = V::splat(a.dt);
   const int lo = a.lo, hi = a.hi;
   const T ww_lo = V::pair(a.ww_lo), wt_lo = V::pair(a.wt_lo), ww_hi = V::pair(a.ww_hi), wt_hi = V::pair(a.wt_hi);
-  auto z_at = [&](int i) { return V::gather(a.u, i) + beta * V::gather(a.v, i); };
 
-  // Forward sweep: K_tt theta = -K_tw z, the L of LDL^T (condensed_band_force's first loop).
-  T zp = z_at(lo), zc = z_at(lo + 1);
-  T y = -wt_lo * zp - V::load(etw, lo) * zc;
-  V::store(th, lo, y);
-  for (int i = lo + 1; i < hi; ++i) {
-    const T zn = z_at(i + 1);
-    const T r = (-V::load(dwt, i) * zc - V::load(etw, i) * zn) - V::load(ewt, i - 1) * zp;
-    y = r - V::load(lower, i) * y;
-    V::store(th, i, y);
+  // Forward: z = u + beta v and the load less the mass-proportional damping, load - alpha m v
+  // (assemble_force's init), kept for the backward sweep; and K_tt theta = -K_tw z, the L of
+  // LDL^T (condensed_band_force's first loop).
+  auto start = [&](int i, T ui, T vi) __attribute__((always_inline)) {
+    const T z = ui + beta * vi;
+    set(i, kRecZ, z);
+    set(i, kRecInit, c(i, W::kLoad) - c(i, W::kDampingMass) * vi);
+    return z;
+  };
+  T zp = start(lo, V::gather(u, d, lo), V::gather(v, d, lo));
+  T zc = start(lo + 1, V::gather(u, d, lo + 1), V::gather(v, d, lo + 1));
+  T y = -wt_lo * zp - c(lo, W::kEtw) * zc;
+  set(lo, kRecTheta, y);
+  auto forward = [&](int i, T zn) __attribute__((always_inline)) {
+    const T r = (-c(i, W::kDwt) * zc - c(i, W::kEtw) * zn) - c(i - 1, W::kEwt) * zp;
+    y = r - lower(i) * y;
+    set(i, kRecTheta, y);
     zp = zc;
     zc = zn;
-  }
-  y = (-wt_hi * zc - V::load(ewt, hi - 1) * zp) - V::load(lower, hi) * y;
-
-  // Backward sweep: D^-1 and L^T, and behind it node j = i + 1 is complete: its band force
-  // f_j = (load - alpha m v - A_j) - B_j (band_w_rows' order), and the update of eq. 20-21.
-  typename V::Inside inside;
-  auto update = [&](int j, T f, T u, T v) {
-    const T acc = V::load(im, j) * f;
-    const T vn = v + dt * acc;
-    const T un = u + dt * vn;
-    inside.add(un, a.limit);
-    V::scatter(a.accel, j, acc);
-    V::scatter(a.v_next, j, vn);
-    V::scatter(a.u_next, j, un);
   };
-  T th1 = y * V::load(ip, hi);  // theta_{i+1}
-  V::store(th, hi, th1);
-  T u1 = V::gather(a.u, hi), v1 = V::gather(a.v, hi);
-  T z1 = u1 + beta * v1;
-  T th2, z2;  // theta_{i+2}, z_{i+2}
+  int i = lo + 1;
+  for (; i + 1 < hi; i += 2) {  // two nodes a turn: u, v of both wires loaded as blocks
+    T u0, u1, v0, v1;
+    V::gather2(u, d, i + 1, u0, u1);
+    V::gather2(v, d, i + 1, v0, v1);
+    forward(i, start(i + 1, u0, v0));
+    forward(i + 1, start(i + 2, u1, v1));
+  }
+  if (i < hi) forward(i, start(i + 1, V::gather(u, d, i + 1), V::gather(v, d, i + 1)));
+  y = (-wt_hi * zc - c(hi - 1, W::kEwt) * zp) - lower(hi) * y;
+
+  // Backward: D^-1 and L^T, and behind it node j = i + 1 is complete: its band force
+  // f_j = (load - alpha m v - A_j) - B_j (band_w_rows' order), kept for the nodes with point
+  // forces, its acceleration, and the update of eq. 20-21.
+  typename V::Mask ok = V::all();
+  const T above = V::splat(a.limit), below = V::splat(-a.limit);
+  T th1 = y * ip(hi);  // theta_{i+1}, theta_{i+2}, z likewise
+  set(hi, kRecTheta, th1);
+  T z1 = get(hi, kRecZ), th2, z2;
+  auto accel = [&](int j, T f) __attribute__((always_inline)) {
+    set(j, kRecForce, f);
+    return c(j, W::kInvMass) * f;
+  };
+  auto backward = [&](int i) __attribute__((always_inline)) {
+    const T th0 = get(i, kRecTheta) * ip(i) - lower(i + 1) * th1;
+    set(i, kRecTheta, th0);
+    const T z0 = get(i, kRecZ);
+    const int j = i + 1;
+    const T A = ((c(j, W::kDww) * z1 + c(j, W::kDwt) * th1) + c(i, W::kEww) * z0) + c(i, W::kEtw) * th0;
+    const T B = c(j, W::kEww) * z2 + c(j, W::kEwt) * th2;
+    const T f = (get(j, kRecInit) - A) - B;
+    th2 = th1;
+    th1 = th0;
+    z2 = z1;
+    z1 = z0;
+    return accel(j, f);
+  };
   {
     const int i = hi - 1;
-    const T th0 = V::load(th, i) * V::load(ip, i) - V::load(lower, i + 1) * th1;
-    V::store(th, i, th0);
-    const T u0 = V::gather(a.u, i), v0 = V::gather(a.v, i), z0 = u0 + beta * v0;
-    const T A = ((ww_hi * z1 + wt_hi * th1) + V::load(eww, i) * z0) + V::load(etw, i) * th0;
-    update(hi, (V::load(load, hi) - V::load(am, hi) * v1) - A, u1, v1);
+    const T th0 = get(i, kRecTheta) * ip(i) - lower(i + 1) * th1;
+    set(i, kRecTheta, th0);
+    const T z0 = get(i, kRecZ);
+    const T A = ((ww_hi * z1 + wt_hi * th1) + c(i, W::kEww) * z0) + c(i, W::kEtw) * th0;
+    V::update(u, v, un, vn, acc, d, hi, accel(hi, get(hi, kRecInit) - A), dt, ok, above, below);
     th2 = th1;
     th1 = th0;
     z2 = z1;
     z1 = z0;
-    u1 = u0;
-    v1 = v0;
   }
-  for (int i = hi - 2; i >= lo; --i) {
-    const T th0 = V::load(th, i) * V::load(ip, i) - V::load(lower, i + 1) * th1;
-    V::store(th, i, th0);
-    const T u0 = V::gather(a.u, i), v0 = V::gather(a.v, i), z0 = u0 + beta * v0;
-    const int j = i + 1;
-    const T A = ((V::load(dww, j) * z1 + V::load(dwt, j) * th1) + V::load(eww, i) * z0) + V::load(etw, i) * th0;
-    const T B = V::load(eww, j) * z2 + V::load(ewt, j) * th2;
-    update(j, ((V::load(load, j) - V::load(am, j) * v1) - A) - B, u1, v1);
-    th2 = th1;
-    th1 = th0;
-    z2 = z1;
-    z1 = z0;
-    u1 = u0;
-    v1 = v0;
+  i = hi - 2;
+  for (; i - 1 >= lo; i -= 2) {  // nodes i + 1 and i complete: updated as a block
+    const T a1 = backward(i);
+    const T a0 = backward(i - 1);
+    V::update2(u, v, un, vn, acc, d, i, a0, a1, dt, ok, above, below);
   }
+  if (i == lo) V::update(u, v, un, vn, acc, d, lo + 1, backward(lo), dt, ok, above, below);
   const T A = ww_lo * z1 + wt_lo * th1;
-  const T B = V::load(eww, lo) * z2 + V::load(ewt, lo) * th2;
-  update(lo, ((V::load(load, lo) - V::load(am, lo) * v1) - A) - B, u1, v1);
-  return !inside.ok();
+  const T B = c(lo, W::kEww) * z2 + c(lo, W::kEwt) * th2;
+  V::update(u, v, un, vn, acc, d, lo, accel(lo, (get(lo, kRecInit) - A) - B), dt, ok, above, below);
+  return !V::ok(ok);
 }
 
 }  // namespace
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define CATENARY_SIM_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#define CATENARY_SIM_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define CATENARY_SIM_CLONES
 #endif

@@ -10,20 +10,23 @@ namespace catenary_sim {
 // rotations; leaves them empty otherwise.
 void build_wire_packs(Model& model);
 
+// The sweep's record per node and lane (State::sweep, kSweepRecord values per node, each for
+// every lane): the rotation, z = u + beta v, the load less the damping, and the band force.
+enum { kRecTheta, kRecZ, kRecInit, kRecForce, kSweepRecord };
+
 // One pack over nodes lo..hi (hi >= lo + 1), the same range in every lane.
 struct PackSweep {
   const WireLanes* pack = nullptr;
-  const double* lower = nullptr;       // LDL^T of K_theta_theta over lo..hi, interleaved
-  const double* inv_pivot = nullptr;
+  const double* factors = nullptr;  // LDL^T of K_theta_theta over lo..hi (WireLanes::factors' layout)
   int lo = 0, hi = -1;
   // Diagonal band entries at lo and hi less the share of elements left out (a window's cut).
   double ww_lo[2] = {0, 0}, wt_lo[2] = {0, 0}, ww_hi[2] = {0, 0}, wt_hi[2] = {0, 0};
-  const double* u[2] = {nullptr, nullptr};  // node 0 of each lane's wire
+  const double* u[2] = {nullptr, nullptr};  // node 0 of each lane's wire (all in the state's arrays)
   const double* v[2] = {nullptr, nullptr};
   double* u_next[2] = {nullptr, nullptr};
   double* v_next[2] = {nullptr, nullptr};
   double* accel[2] = {nullptr, nullptr};
-  double* theta = nullptr;  // State::sweep at the pack's offset: the rotations, kept for fix-ups
+  double* record = nullptr;  // State::sweep at the pack's records: kept for the nodes with point forces
   double beta = 0.0, dt = 0.0, limit = 0.0;
 };
 

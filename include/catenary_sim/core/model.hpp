@@ -107,8 +107,11 @@ struct WireLanes {
   int wire[2] = {-1, -1};  // indices into Model::wires
   int nodes = 0;
   std::size_t offset = 0;  // of this pack in State::sweep (nodes * lanes entries)
-  std::vector<double> d_ww, d_wt, e_ww, e_wt, e_tw, tt_lower, tt_inv_pivot;
-  std::vector<double> load, damping_mass, inv_mass;  // damping_mass = alpha * mass (eq. 5)
+  // One record per node: kCoefficients values, each for every lane ([node][value][lane]); the
+  // element values (e_*) belong to the element from the node to the next.
+  enum { kDww, kDwt, kEww, kEwt, kEtw, kLoad, kDampingMass, kInvMass, kCoefficients };  // kDampingMass: alpha m (eq. 5)
+  std::vector<double> coef;
+  std::vector<double> factors;  // LDL^T of K_theta_theta: [node][lower, inv_pivot][lane]
 };
 
 struct Model {
@@ -139,6 +142,8 @@ struct Model {
   // generic step). wire_pack[wi], wire_lane[wi]: where wire wi is.
   std::vector<WireLanes> wire_packs;
   std::vector<int> wire_pack, wire_lane;
+  // Per catenary DOF: where the sweep leaves its band force and its z in State::sweep.
+  std::vector<int> dof_sweep_force, dof_sweep_z;
   std::size_t sweep_size = 0;  // entries of State::sweep
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
