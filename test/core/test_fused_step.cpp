@@ -20,6 +20,10 @@
 #include <string>
 #include <vector>
 
+#include <yaml-cpp/yaml.h>
+
+#include <sstream>
+
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statics.hpp"
 
@@ -32,6 +36,22 @@ using namespace catenary_sim;
 namespace {
 
 const std::string kDir = CATENARY_SIM_SOURCE_DIR "/config/";
+
+// The reference catenary as one 6-span section with a twin contact wire: three wires on the same
+// stations, packed as two lanes and one.
+Scene twin_contact_wire(const std::vector<std::string>& overrides) {
+  YAML::Node root = YAML::LoadFile(kDir + "reference_55m.yaml");
+  root["line"].remove("span_length");
+  root["line"].remove("span_count");
+  YAML::Node sec;
+  sec["span_length"] = 55.0;
+  sec["span_count"] = 6;
+  sec["contact_wire_count"] = 2;
+  root["sections"].push_back(sec);
+  std::stringstream s;
+  s << root;
+  return load_scene_string(s.str(), overrides);
+}
 
 bool same_bits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;
@@ -134,7 +154,8 @@ TEST(FusedStep, MatchesThePlainStepBitForBitOverAPass) {
 
 // The fused step against the library's generic step (the same model with its packs removed) on
 // the other ways a pass runs: the moving window, the endless line, two pantographs, two sections
-// (an overlap: two packs), and the finer ladder rungs.
+// (an overlap: two packs), the coarsest and finest rungs, and a twin contact wire (a pack of one
+// wire beside one of two), with and without a window.
 TEST(FusedStep, MatchesTheGenericStepBitForBit) {
   struct Case {
     std::string file;
@@ -148,12 +169,18 @@ TEST(FusedStep, MatchesTheGenericStepBitForBit) {
       {"reference_55m_two_sections.yaml", {}, 3000},
       {"reference_55m.yaml", {"numerics.preset=fast", "train.speed_kmh=250"}, 2000},
       {"reference_55m.yaml", {"numerics.preset=reference"}, 1500},
+      {"twin", {}, 2000},
+      {"twin", {"numerics.window=auto", "train.speed_kmh=250"}, 3000},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.file + (c.overrides.empty() ? "" : " " + c.overrides.front()));
-    const Scene scene = load_scene_file(kDir + c.file, c.overrides);
+    const Scene scene = c.file == "twin" ? twin_contact_wire(c.overrides) : load_scene_file(kDir + c.file, c.overrides);
     Model fused = build_model(scene);
     ASSERT_FALSE(fused.wire_packs.empty());
+    if (c.file == "twin") {
+      ASSERT_EQ(fused.wire_packs.size(), 2u);
+      EXPECT_EQ(fused.wire_packs[1].lanes, 1);
+    }
     Model generic = fused;
     generic.wire_packs.clear();
     State a = make_state(fused), b = make_state(generic);
