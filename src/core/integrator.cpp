@@ -209,34 +209,27 @@ void advance_train(const Model& m, State& s, double dt) {
   contact_forces(m, s, s.u.data(), nullptr);
 }
 
-// The forces that act on single DOFs, added after the wires' band (assemble_force): the window's
-// dashpots, supports, tension-only droppers, pantograph chains with their uplift, and the contact.
-// Reads z = u + beta v only at the DOFs of supports and droppers. With `given_slack` (the implicit
-// scheme) the droppers are not switched here: those marked slack in state.dropper_slack carry
-// nothing and the others the linear force of the matrix, so that the force and the corrected
-// matrix describe the same active set.
-void add_point_forces(const Model& m, State& s, const double* u, const double* v, const double* z, double* f,
-                      bool given_slack) {
-  const int n = m.n_dof, nc = m.n_catenary_dof;
+template <class ForceAt, class ZAt>
+void add_wire_point_forces(const Model& m, State& s, const double* u, const double* v, ForceAt f, ZAt z,
+                           bool given_slack) {
   auto dropper = [&](std::size_t k) {
     // Droppers work only in tension; the switch is decided on the elastic stretch.
     const Dropper& d = m.droppers[k];
     if (given_slack) {
       if (s.dropper_slack[k]) return;
-      const double t = d.static_tension + d.stiffness * (z[d.messenger_dof] - z[d.contact_dof]);
-      f[d.contact_dof] += t;
-      f[d.messenger_dof] -= t;
+      const double t = d.static_tension + d.stiffness * (z(d.messenger_dof) - z(d.contact_dof));
+      f(d.contact_dof) += t;
+      f(d.messenger_dof) -= t;
       return;
     }
     const double stretch = u[d.messenger_dof] - u[d.contact_dof];
     const bool taut = d.static_tension + d.stiffness * stretch > 0.0;
     s.dropper_slack[k] = !taut;
     if (!taut) return;
-    const double t = std::max(0.0, d.static_tension + d.stiffness * (z[d.messenger_dof] - z[d.contact_dof]));
-    f[d.contact_dof] += t;
-    f[d.messenger_dof] -= t;
+    const double t = std::max(0.0, d.static_tension + d.stiffness * (z(d.messenger_dof) - z(d.contact_dof)));
+    f(d.contact_dof) += t;
+    f(d.messenger_dof) -= t;
   };
-  for (int i = nc; i < n; ++i) f[i] = 0.0;
   if (m.scene.numerics.windowed()) {
     for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
       const WireWindow& ww = s.window[wi];
@@ -244,20 +237,23 @@ void add_point_forces(const Model& m, State& s, const double* u, const double* v
       // Where the window cuts the wire, a dashpot of the wire's impedance sqrt(T rhoA) lets
       // outgoing waves leave (the exact condition for a taut string).
       const double c = std::sqrt(w.spec.tension * w.spec.linear_mass);
-      if (ww.hi >= ww.lo && ww.cut_lo) f[w.w_dof + ww.lo] -= c * v[w.w_dof + ww.lo];
-      if (ww.hi >= ww.lo && ww.cut_hi) f[w.w_dof + ww.hi] -= c * v[w.w_dof + ww.hi];
+      if (ww.hi >= ww.lo && ww.cut_lo) f(w.w_dof + ww.lo) -= c * v[w.w_dof + ww.lo];
+      if (ww.hi >= ww.lo && ww.cut_hi) f(w.w_dof + ww.hi) -= c * v[w.w_dof + ww.hi];
     }
     for (int j = 0; j < s.window_spring_count; ++j) {
       const SupportSpring& sp = m.springs[s.window_springs[j]];
-      f[sp.dof] -= sp.stiffness * z[sp.dof];
+      f(sp.dof) -= sp.stiffness * z(sp.dof);
     }
     for (int j = 0; j < s.window_dropper_count; ++j) dropper(static_cast<std::size_t>(s.window_droppers[j]));
   } else {
-    for (const SupportSpring& sp : m.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
+    for (const SupportSpring& sp : m.springs) f(sp.dof) -= sp.stiffness * z(sp.dof);
     for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(k);
   }
+}
 
-  // Pantographs: lumped chains (eq. 9), uplift on the lowest mass.
+// Pantographs: lumped chains (eq. 9), uplift on the lowest mass; then the contact.
+void add_pantograph_forces(const Model& m, State& s, const double* u, const double* v, double* f) {
+  for (int i = m.n_catenary_dof; i < m.n_dof; ++i) f[i] = 0.0;
   const double v2 = s.speed * s.speed;
   for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
     const Pantograph& p = m.pantographs[pi];
@@ -276,6 +272,19 @@ void add_point_forces(const Model& m, State& s, const double* u, const double* v
     }
   }
   contact_forces(m, s, u, f);
+}
+
+// The forces that act on single DOFs, added after the wires' band (assemble_force) in this order:
+// the window's dashpots, supports, tension-only droppers (add_wire_point_forces, which reads
+// z = u + beta v only at the DOFs of supports and droppers), pantograph chains with their uplift,
+// and the contact. With `given_slack` (the implicit scheme) the droppers are not switched here:
+// those marked slack in state.dropper_slack carry nothing and the others the linear force of the
+// matrix, so that the force and the corrected matrix describe the same active set.
+void add_point_forces(const Model& m, State& s, const double* u, const double* v, const double* z, double* f,
+                      bool given_slack) {
+  add_wire_point_forces(
+      m, s, u, v, [f](int i) -> double& { return f[i]; }, [z](int i) { return z[i]; }, given_slack);
+  add_pantograph_forces(m, s, u, v, f);
 }
 
 // Total force on every DOF at displacements u and velocities v (eq. 1 right-hand side minus the
@@ -311,9 +320,8 @@ void assemble_force(const Model& m, State& s, const double* u, const double* v, 
 // The explicit step with the wires packed (Model::wire_packs): one fused sweep pair per pack
 // (sweep_pack) computes every wire node's force from the band, load and damping and updates it;
 // the few nodes that also carry a point force (supports, droppers, the window's dashpots, the
-// contact) are then redone: their band force is recomputed from the kept rotations, the point
-// forces are added in the generic step's order, and the update repeated. Every value is the
-// generic step's to the bit. Writes u_next, v_next, accel; returns the diverged DOF or -1, and
+// contact) are then redone: the point forces are added to the band force the sweep kept, in the
+// generic step's order, and the update repeated. Every value is the generic step's to the bit. Writes u_next, v_next, accel; returns the diverged DOF or -1, and
 // false in `done` if the packs cannot take this state (a window of under two nodes).
 int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
   const double* u = s.u.data();
@@ -322,7 +330,6 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
   double* vn = s.v_next.data();
   double* acc = s.accel.data();
   double* f = s.force.data();
-  double* z = s.z.data();
   const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
   done = true;
   if (windowed) {
@@ -365,9 +372,9 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
     outside |= sweep_pack(a);
   }
 
-  // The nodes with point forces: the window's cut ends, supports, droppers (each DOF in the window
-  // by construction of its lists), and the contact wire's nodes under every collector
-  // (contact_forces' weights), listed once per step. `fn` may see a node more than once.
+  // The nodes with point forces: the contact wire's nodes under every collector (contact_forces'
+  // weights), listed once per step; and (for_each_point) the window's cut ends, supports and
+  // droppers, each DOF in the window by construction of its lists. A node may come more than once.
   int contacts = 0;
   int* contact_node = s.point_node.data();
   for (const Pantograph& p : m.pantographs)
@@ -403,27 +410,29 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
         fn(d.messenger_dof);
       }
     }
-    for (int q = 0; q < contacts; ++q) fn(contact_node[q]);
   };
-  // Their band force alone (with the load and damping) and z, as the sweep left them.
-  const double* rec = s.sweep.data();
+  // Supports, droppers and the window's dashpots act straight on the band forces the sweep left in
+  // its records (where z is too), in the generic step's order; the contact nodes then take their
+  // force so far into the force vector, where the pantographs' contact adds to it.
+  double* rec = s.sweep.data();
   const int* f_at = m.dof_sweep_force.data();
   const int* z_at = m.dof_sweep_z.data();
-  for_each_point([&](int dof) {
-    f[dof] = rec[f_at[dof]];
-    z[dof] = rec[z_at[dof]];
-  });
-  add_point_forces(m, s, u, v, z, f, false);
+  add_wire_point_forces(
+      m, s, u, v, [rec, f_at](int i) -> double& { return rec[f_at[i]]; }, [rec, z_at](int i) { return rec[z_at[i]]; },
+      false);
+  for (int q = 0; q < contacts; ++q) f[contact_node[q]] = rec[f_at[contact_node[q]]];
+  add_pantograph_forces(m, s, u, v, f);
   const double* im = m.inv_mass.data();
   auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
-  auto update = [&](int i) {
-    acc[i] = im[i] * f[i];  // q'' at t_n (eq. 20)
+  auto update = [&](int i, double fi) {
+    acc[i] = im[i] * fi;  // q'' at t_n (eq. 20)
     vn[i] = v[i] + dt * acc[i];
     un[i] = u[i] + dt * vn[i];
     outside |= beyond(i);
   };
-  for_each_point(update);
-  for (int i = m.n_catenary_dof; i < m.n_dof; ++i) update(i);
+  for_each_point([&](int i) { update(i, rec[f_at[i]]); });  // the contact nodes last: theirs has the contact
+  for (int q = 0; q < contacts; ++q) update(contact_node[q], f[contact_node[q]]);
+  for (int i = m.n_catenary_dof; i < m.n_dof; ++i) update(i, f[i]);
   // The displacement check: the sweeps' flag is only a hint (they saw the nodes before the point
   // forces), so on a flag, or a pantograph or point beyond the limit, every new value is scanned
   // in the generic step's order.
