@@ -382,11 +382,20 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
       const double xc = s.front - p.position + m.collectors[ci].offset;
       for (int cw : m.contact_wires) {
         const Wire& w = m.wires[cw];
-        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
-        for (int k = 0; k < cnt; ++k) {
-          const int i = s.weight_node[k];
-          if (!windowed || (i >= s.window[cw].lo && i <= s.window[cw].hi)) contact_node[contacts++] = w.w_dof + i;
+        // The nodes contact_weights gives weights to (without the weights: no sin, cos).
+        int first = 0, last = -1;
+        const double x0 = w.x.front(), x1 = w.x.back();
+        if (m.rub_length <= 0.0) {
+          if (xc >= x0 && xc <= x1) last = (first = w.element_at(xc)) + 1;
+        } else {
+          const double a = xc - 0.5 * m.rub_length, b = xc + 0.5 * m.rub_length;
+          if (!(b <= x0 || a >= x1)) {
+            first = w.element_at(a);
+            last = w.element_at(b) + 1;
+          }
         }
+        for (int i = first; i <= last; ++i)
+          if (!windowed || (i >= s.window[cw].lo && i <= s.window[cw].hi)) contact_node[contacts++] = w.w_dof + i;
       }
     }
   auto for_each_point = [&](auto&& fn) {
