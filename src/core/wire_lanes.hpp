@@ -35,11 +35,9 @@ struct PackSweep {
 // one forward and one backward pass. The same IEEE operations in the same order as the generic
 // step (condensed_band_force), so the results are bit-identical to it. Returns true if some new
 // displacement is beyond the limit or not a number (the caller finds which).
-// Runtime dispatch (GCC target_clones): AVX-512, AVX2 or the portable x86-64 baseline.
+// Runtime dispatch (GCC target_clones): x86-64-v4 (AVX-512), x86-64-v3 (AVX2) or the portable
+// x86-64 baseline.
 bool sweep_pack(const PackSweep& sweep);
 
-// The instruction set the dispatcher chose on this machine ("avx512f", "avx2" or "default"):
-// resolved by the same ifunc mechanism and order as sweep_pack.
-const char* sweep_pack_isa();
 
 }  // namespace catenary_sim

@@ -97,8 +97,9 @@ State make_state(const Model& model);
 // Never reads a clock, never allocates, never logs. Returns the state's status.
 StepStatus step(const Model& model, State& state);
 
-// The instruction set the fused explicit step's runtime dispatch chose on this machine: "avx512f",
-// "avx2" or "default" (the portable x86-64 baseline). All give the same bits.
+// The instruction set the fused explicit step's runtime dispatch chose on this machine:
+// "x86-64-v4" (AVX-512), "x86-64-v3" (AVX2) or "default" (the x86-64 baseline). All give the
+// same bits.
 const char* sweep_pack_isa();
 
 // Fills the observations (contact forces, collector heights) for the current state without
