@@ -106,7 +106,7 @@ struct WireLanes {
   int lanes = 1;
   int wire[2] = {-1, -1};  // indices into Model::wires
   int nodes = 0;
-  std::size_t offset = 0;  // of this pack in State::sweep (nodes * lanes entries)
+  std::size_t offset = 0;  // of this pack, in node-lanes: its records start at State::sweep[4 * offset]
   // One record per node: kCoefficients values, each for every lane ([node][value][lane]); the
   // element values (e_*) belong to the element from the node to the next.
   enum { kDww, kDwt, kEww, kEwt, kEtw, kLoad, kDampingMass, kInvMass, kCoefficients };  // kDampingMass: alpha m (eq. 5)
@@ -144,7 +144,7 @@ struct Model {
   std::vector<int> wire_pack, wire_lane;
   // Per catenary DOF: where the sweep leaves its band force and its z in State::sweep.
   std::vector<int> dof_sweep_force, dof_sweep_z;
-  std::size_t sweep_size = 0;  // entries of State::sweep
+  std::size_t sweep_size = 0;  // node-lanes of all packs (State::sweep holds 4 values for each)
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
   double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)

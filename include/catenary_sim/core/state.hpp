@@ -67,11 +67,12 @@ struct State {
   // Workspace, sized once by make_state().
   Eigen::VectorXd force, z;
   // Fused explicit step: the new displacements and velocities (swapped in, or copied back in the
-  // window, once all are good), the rotations of every wire pack (interleaved as in WireLanes),
-  // and the window's LDL^T factors laid out as WireLanes::factors.
+  // window, once all are good); per node and lane of every wire pack the sweep's record (rotation,
+  // z, load less damping, band force: src/core/wire_lanes.hpp); the window's LDL^T factors laid
+  // out as WireLanes::factors; the contact wire's nodes under the collectors this step.
   Eigen::VectorXd u_next, v_next;
   std::vector<double> sweep, sweep_factors;
-  std::vector<int> point_node;  // the contact wire's nodes under the collectors this step
+  std::vector<int> point_node;
   // Implicit integrator only: the prediction, and the rank-1 corrections of the factorised
   // matrix A (contacts in touch add k0 g g^T, slack droppers take their stiffness out again),
   // each with its sparse g, its stiffness factor and its column A^-1 g.
