@@ -11,6 +11,7 @@
 #include "catenary_sim/core/implicit.hpp"
 #include "catenary_sim/core/state.hpp"
 #include "window.hpp"
+#include "wire_lanes.hpp"
 
 namespace catenary_sim {
 
@@ -93,6 +94,15 @@ State make_state(const Model& m) {
     s.correction_small.assign(corrections * corrections + corrections, 0.0);
   }
   s.z = Eigen::VectorXd::Zero(m.n_dof);
+  if (!m.wire_packs.empty()) {
+    s.u_next = Eigen::VectorXd::Zero(m.n_dof);
+    s.v_next = Eigen::VectorXd::Zero(m.n_dof);
+    s.sweep.assign(kSweepRecord * m.sweep_size, 0.0);
+    s.point_node.assign(m.collectors.size() * m.contact_wires.size() * m.max_contact_nodes, 0);
+    if (m.scene.numerics.windowed()) {
+      s.sweep_factors.assign(2 * m.sweep_size, 0.0);
+    }
+  }
   int max_nodes = 1;
   for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
   s.theta.assign(max_nodes, 0.0);
@@ -199,72 +209,51 @@ void advance_train(const Model& m, State& s, double dt) {
   contact_forces(m, s, s.u.data(), nullptr);
 }
 
-// Total force on every DOF at displacements u and velocities v (eq. 1 right-hand side minus the
-// internal and damping forces): constant load, beams, supports, tension-only droppers, Rayleigh
-// damping (eq. 5) through z = u + beta v, pantograph chains with their uplift, and the contact.
-// With `given_slack` (the implicit scheme) the droppers are not switched here: those marked slack in
-// state.dropper_slack carry nothing and the others the linear force of the matrix, so that the
-// force and the corrected matrix describe the same active set.
-void assemble_force(const Model& m, State& s, const double* u, const double* v, double* z, double* f,
-                    bool given_slack = false) {
-  const int n = m.n_dof, nc = m.n_catenary_dof;
-  const double beta = m.beta, alpha = m.alpha;
-  const double* load = m.load.data();
-  const double* mass = m.mass.data();
-  auto init = [&](int i0, int i1) {
-    for (int i = i0; i < i1; ++i) {
-      z[i] = u[i] + beta * v[i];
-      f[i] = load[i] - alpha * mass[i] * v[i];
-    }
-  };
+template <class ForceAt, class ZAt>
+void add_wire_point_forces(const Model& m, State& s, const double* u, const double* v, ForceAt f, ZAt z,
+                           bool given_slack) {
   auto dropper = [&](std::size_t k) {
     // Droppers work only in tension; the switch is decided on the elastic stretch.
     const Dropper& d = m.droppers[k];
     if (given_slack) {
       if (s.dropper_slack[k]) return;
-      const double t = d.static_tension + d.stiffness * (z[d.messenger_dof] - z[d.contact_dof]);
-      f[d.contact_dof] += t;
-      f[d.messenger_dof] -= t;
+      const double t = d.static_tension + d.stiffness * (z(d.messenger_dof) - z(d.contact_dof));
+      f(d.contact_dof) += t;
+      f(d.messenger_dof) -= t;
       return;
     }
     const double stretch = u[d.messenger_dof] - u[d.contact_dof];
     const bool taut = d.static_tension + d.stiffness * stretch > 0.0;
     s.dropper_slack[k] = !taut;
     if (!taut) return;
-    const double t = std::max(0.0, d.static_tension + d.stiffness * (z[d.messenger_dof] - z[d.contact_dof]));
-    f[d.contact_dof] += t;
-    f[d.messenger_dof] -= t;
+    const double t = std::max(0.0, d.static_tension + d.stiffness * (z(d.messenger_dof) - z(d.contact_dof)));
+    f(d.contact_dof) += t;
+    f(d.messenger_dof) -= t;
   };
-  for (int i = nc; i < n; ++i) f[i] = 0.0;
   if (m.scene.numerics.windowed()) {
     for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
       const WireWindow& ww = s.window[wi];
       const Wire& w = m.wires[wi];
-      init(w.w_dof + ww.lo, w.w_dof + ww.hi + 1);
-    }
-    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
-      const WireWindow& ww = s.window[wi];
-      const Wire& w = m.wires[wi];
-      wire_elastic_force_window(w, ww, z, f, s.theta.data());
       // Where the window cuts the wire, a dashpot of the wire's impedance sqrt(T rhoA) lets
       // outgoing waves leave (the exact condition for a taut string).
       const double c = std::sqrt(w.spec.tension * w.spec.linear_mass);
-      if (ww.hi >= ww.lo && ww.cut_lo) f[w.w_dof + ww.lo] -= c * v[w.w_dof + ww.lo];
-      if (ww.hi >= ww.lo && ww.cut_hi) f[w.w_dof + ww.hi] -= c * v[w.w_dof + ww.hi];
+      if (ww.hi >= ww.lo && ww.cut_lo) f(w.w_dof + ww.lo) -= c * v[w.w_dof + ww.lo];
+      if (ww.hi >= ww.lo && ww.cut_hi) f(w.w_dof + ww.hi) -= c * v[w.w_dof + ww.hi];
     }
     for (int j = 0; j < s.window_spring_count; ++j) {
       const SupportSpring& sp = m.springs[s.window_springs[j]];
-      f[sp.dof] -= sp.stiffness * z[sp.dof];
+      f(sp.dof) -= sp.stiffness * z(sp.dof);
     }
     for (int j = 0; j < s.window_dropper_count; ++j) dropper(static_cast<std::size_t>(s.window_droppers[j]));
   } else {
-    init(0, nc);
-    for (const Wire& w : m.wires) wire_elastic_force(w, z, f, s.theta.data());
-    for (const SupportSpring& sp : m.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
+    for (const SupportSpring& sp : m.springs) f(sp.dof) -= sp.stiffness * z(sp.dof);
     for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(k);
   }
+}
 
-  // Pantographs: lumped chains (eq. 9), uplift on the lowest mass.
+// Pantographs: lumped chains (eq. 9), uplift on the lowest mass; then the contact.
+void add_pantograph_forces(const Model& m, State& s, const double* u, const double* v, double* f) {
+  for (int i = m.n_catenary_dof; i < m.n_dof; ++i) f[i] = 0.0;
   const double v2 = s.speed * s.speed;
   for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
     const Pantograph& p = m.pantographs[pi];
@@ -285,6 +274,191 @@ void assemble_force(const Model& m, State& s, const double* u, const double* v, 
   contact_forces(m, s, u, f);
 }
 
+// The forces that act on single DOFs, added after the wires' band (assemble_force) in this order:
+// the window's dashpots, supports, tension-only droppers (add_wire_point_forces, which reads
+// z = u + beta v only at the DOFs of supports and droppers), pantograph chains with their uplift,
+// and the contact. With `given_slack` (the implicit scheme) the droppers are not switched here:
+// those marked slack in state.dropper_slack carry nothing and the others the linear force of the
+// matrix, so that the force and the corrected matrix describe the same active set.
+void add_point_forces(const Model& m, State& s, const double* u, const double* v, const double* z, double* f,
+                      bool given_slack) {
+  add_wire_point_forces(
+      m, s, u, v, [f](int i) -> double& { return f[i]; }, [z](int i) { return z[i]; }, given_slack);
+  add_pantograph_forces(m, s, u, v, f);
+}
+
+// Total force on every DOF at displacements u and velocities v (eq. 1 right-hand side minus the
+// internal and damping forces): constant load, beams, Rayleigh damping (eq. 5) through
+// z = u + beta v, then the point forces (add_point_forces). The generic step (rotations as DOFs,
+// the implicit scheme); the fused explicit step gives the same bits (explicit_fused_step).
+void assemble_force(const Model& m, State& s, const double* u, const double* v, double* z, double* f,
+                    bool given_slack = false) {
+  const int nc = m.n_catenary_dof;
+  const double beta = m.beta, alpha = m.alpha;
+  const double* load = m.load.data();
+  const double* mass = m.mass.data();
+  auto init = [&](int i0, int i1) {
+    for (int i = i0; i < i1; ++i) {
+      z[i] = u[i] + beta * v[i];
+      f[i] = load[i] - alpha * mass[i] * v[i];
+    }
+  };
+  if (m.scene.numerics.windowed()) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const WireWindow& ww = s.window[wi];
+      const Wire& w = m.wires[wi];
+      init(w.w_dof + ww.lo, w.w_dof + ww.hi + 1);
+    }
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) wire_elastic_force_window(m.wires[wi], s.window[wi], z, f, s.theta.data());
+  } else {
+    init(0, nc);
+    for (const Wire& w : m.wires) wire_elastic_force(w, z, f, s.theta.data());
+  }
+  add_point_forces(m, s, u, v, z, f, given_slack);
+}
+
+// The explicit step with the wires packed (Model::wire_packs): one fused sweep pair per pack
+// (sweep_pack) computes every wire node's force from the band, load and damping and updates it;
+// the few nodes that also carry a point force (supports, droppers, the window's dashpots, the
+// contact) are then redone: the point forces are added to the band force the sweep kept, in the
+// generic step's order, and the update repeated. Every value is the generic step's to the bit. Writes u_next, v_next, accel; returns the diverged DOF or -1, and
+// false in `done` if the packs cannot take this state (a window of under two nodes).
+int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
+  const double* u = s.u.data();
+  const double* v = s.v.data();
+  double* un = s.u_next.data();
+  double* vn = s.v_next.data();
+  double* acc = s.accel.data();
+  double* f = s.force.data();
+  const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
+  done = true;
+  if (windowed) {
+    for (const WireWindow& ww : s.window)
+      if (ww.hi == ww.lo) done = false;
+    for (const WireLanes& p : m.wire_packs)
+      if (p.lanes == 2 && (s.window[p.wire[0]].lo != s.window[p.wire[1]].lo || s.window[p.wire[0]].hi != s.window[p.wire[1]].hi))
+        done = false;
+    if (!done) return -1;
+  }
+  bool outside = false;
+  for (const WireLanes& p : m.wire_packs) {
+    const WireWindow& ww0 = s.window[p.wire[0]];
+    PackSweep a;
+    a.pack = &p;
+    a.lo = windowed ? ww0.lo : 0;
+    a.hi = windowed ? ww0.hi : p.nodes - 1;
+    if (a.hi < a.lo) continue;
+    a.factors = windowed ? s.sweep_factors.data() + 2 * p.offset : p.factors.data();
+    for (int k = 0; k < p.lanes; ++k) {
+      const Wire& w = m.wires[p.wire[k]];
+      const WireWindow& ww = s.window[p.wire[k]];
+      const double c[4] = {windowed ? ww.lo_ww : 0.0, windowed ? ww.lo_wt : 0.0, windowed ? ww.hi_ww : 0.0,
+                           windowed ? ww.hi_wt : 0.0};
+      // condensed_band_force's dww_at/dwt_at at the ends (x - 0.0 is x: no change without a cut)
+      a.ww_lo[k] = w.d_ww[a.lo] - c[0];
+      a.wt_lo[k] = w.d_wt[a.lo] - c[1];
+      a.ww_hi[k] = w.d_ww[a.hi] - c[2];
+      a.wt_hi[k] = w.d_wt[a.hi] - c[3];
+      a.u[k] = u + w.w_dof;
+      a.v[k] = v + w.w_dof;
+      a.u_next[k] = un + w.w_dof;
+      a.v_next[k] = vn + w.w_dof;
+      a.accel[k] = acc + w.w_dof;
+    }
+    a.record = s.sweep.data() + kSweepRecord * p.offset;
+    a.beta = beta;
+    a.dt = dt;
+    a.limit = limit;
+    outside |= sweep_pack(a);
+  }
+
+  // The nodes with point forces: the contact wire's nodes under every collector (contact_forces'
+  // weights), listed once per step; and (for_each_point) the window's cut ends, supports and
+  // droppers, each DOF in the window by construction of its lists. A node may come more than once.
+  int contacts = 0;
+  int* contact_node = s.point_node.data();
+  for (const Pantograph& p : m.pantographs)
+    for (int ci : p.collectors) {
+      const double xc = s.front - p.position + m.collectors[ci].offset;
+      for (int cw : m.contact_wires) {
+        const Wire& w = m.wires[cw];
+        // The nodes contact_weights gives weights to (without the weights: no sin, cos).
+        int first = 0, last = -1;
+        const double x0 = w.x.front(), x1 = w.x.back();
+        if (m.rub_length <= 0.0) {
+          if (xc >= x0 && xc <= x1) last = (first = w.element_at(xc)) + 1;
+        } else {
+          const double a = xc - 0.5 * m.rub_length, b = xc + 0.5 * m.rub_length;
+          if (!(b <= x0 || a >= x1)) {
+            first = w.element_at(a);
+            last = w.element_at(b) + 1;
+          }
+        }
+        for (int i = first; i <= last; ++i)
+          if (!windowed || (i >= s.window[cw].lo && i <= s.window[cw].hi)) contact_node[contacts++] = w.w_dof + i;
+      }
+    }
+  auto for_each_point = [&](auto&& fn) {
+    if (windowed) {
+      for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+        const WireWindow& ww = s.window[wi];
+        if (ww.hi < ww.lo) continue;
+        if (ww.cut_lo) fn(m.wires[wi].w_dof + ww.lo);
+        if (ww.cut_hi) fn(m.wires[wi].w_dof + ww.hi);
+      }
+      for (int j = 0; j < s.window_spring_count; ++j) fn(m.springs[s.window_springs[j]].dof);
+      for (int j = 0; j < s.window_dropper_count; ++j) {
+        const Dropper& d = m.droppers[s.window_droppers[j]];
+        fn(d.contact_dof);
+        fn(d.messenger_dof);
+      }
+    } else {
+      for (const SupportSpring& sp : m.springs) fn(sp.dof);
+      for (const Dropper& d : m.droppers) {
+        fn(d.contact_dof);
+        fn(d.messenger_dof);
+      }
+    }
+  };
+  // Supports, droppers and the window's dashpots act straight on the band forces the sweep left in
+  // its records (where z is too), in the generic step's order; the contact nodes then take their
+  // force so far into the force vector, where the pantographs' contact adds to it.
+  double* rec = s.sweep.data();
+  const int* f_at = m.dof_sweep_force.data();
+  const int* z_at = m.dof_sweep_z.data();
+  add_wire_point_forces(
+      m, s, u, v, [rec, f_at](int i) -> double& { return rec[f_at[i]]; }, [rec, z_at](int i) { return rec[z_at[i]]; },
+      false);
+  for (int q = 0; q < contacts; ++q) f[contact_node[q]] = rec[f_at[contact_node[q]]];
+  add_pantograph_forces(m, s, u, v, f);
+  const double* im = m.inv_mass.data();
+  auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
+  auto update = [&](int i, double fi) {
+    acc[i] = im[i] * fi;  // q'' at t_n (eq. 20)
+    vn[i] = v[i] + dt * acc[i];
+    un[i] = u[i] + dt * vn[i];
+    outside |= beyond(i);
+  };
+  for_each_point([&](int i) { update(i, rec[f_at[i]]); });  // the contact nodes last: theirs has the contact
+  for (int q = 0; q < contacts; ++q) update(contact_node[q], f[contact_node[q]]);
+  for (int i = m.n_catenary_dof; i < m.n_dof; ++i) update(i, f[i]);
+  // The displacement check: the sweeps' flag is only a hint (they saw the nodes before the point
+  // forces), so on a flag, or a pantograph or point beyond the limit, every new value is scanned
+  // in the generic step's order.
+  if (!outside) return -1;
+  int bad = -1;
+  if (windowed) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
+      for (int i = s.window[wi].lo; i <= s.window[wi].hi; ++i)
+        if (beyond(m.wires[wi].w_dof + i)) bad = m.wires[wi].w_dof + i;
+    for (int i = m.n_catenary_dof; i < m.n_dof; ++i)
+      if (beyond(i)) bad = i;
+  } else {
+    for (int i = 0; i < m.n_dof; ++i)
+      if (beyond(i)) bad = i;
+  }
+  return bad;
+}
 
 // Columns for the contacts in touch at the prediction (state.contact_force > 0): their sparse
 // g = e_head - sum_a w_a e_a (eq. 12), the factor dt^2/4 k0, and A^-1 g. Returns their count;
@@ -429,6 +603,34 @@ StepStatus step(const Model& m, State& s) {
     const bool windowed = m.scene.numerics.windowed();
     if (m.endless) shift_endless_block(m, s);
     if (windowed) update_window(m, s);
+    if (!m.wire_packs.empty()) {
+      bool done = false;
+      const int diverged = explicit_fused_update(m, s, windowed, done);
+      if (done) {
+        if (diverged >= 0) {
+          s.status = StepStatus::kDiverged;
+          s.diverged_dof = diverged;
+          return s.status;
+        }
+        if (windowed) {
+          // Outside the window the new buffers hold nothing current: copy the window back.
+          auto commit = [&](int i0, int i1) {
+            for (int i = i0; i < i1; ++i) {
+              v[i] = s.v_next[i];
+              u[i] = s.u_next[i];
+            }
+          };
+          for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
+            commit(m.wires[wi].w_dof + s.window[wi].lo, m.wires[wi].w_dof + s.window[wi].hi + 1);
+          commit(m.n_catenary_dof, n);
+        } else {
+          s.u.swap(s.u_next);  // O(1): every DOF has its new value
+          s.v.swap(s.v_next);
+        }
+        advance_train(m, s, dt);
+        return s.status;
+      }
+    }
     assemble_force(m, s, u, v, z, f);
     // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. The new values go to the
     // workspace first: a displacement beyond the divergence limit (or NaN) stops the run and the

@@ -14,6 +14,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statics.hpp"
 #include "window.hpp"
+#include "wire_lanes.hpp"
 
 namespace catenary_sim {
 namespace {
@@ -963,6 +964,7 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
 
 Model build_model(const Scene& scene, const BuildOptions& options) {
   Model m = build_model_unchecked(scene, options);
+  build_wire_packs(m);
   if (!options.stability) return m;
   // The statistics filter runs at the step rate: a cutoff at or above its Nyquist frequency would
   // be no filter at all (lowpass_zero_phase returns the input unchanged).

@@ -132,6 +132,16 @@ void update_window(const Model& m, State& s) {
       ww.tt_inv_pivot[i] = 1.0 / d;
     }
   }
+  // The factors interleaved for the fused step (both lanes of a pack share the node range).
+  for (const WireLanes& p : m.wire_packs)
+    for (int k = 0; k < p.lanes; ++k) {
+      const WireWindow& ww = s.window[p.wire[k]];
+      double* f = s.sweep_factors.data() + 2 * p.offset;
+      for (int i = ww.lo; i <= ww.hi; ++i) {
+        f[(2 * static_cast<std::size_t>(i) + 0) * p.lanes + k] = ww.tt_lower[i];
+        f[(2 * static_cast<std::size_t>(i) + 1) * p.lanes + k] = ww.tt_inv_pivot[i];
+      }
+    }
   auto inside = [&](int dof) {
     for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
       const Wire& w = m.wires[wi];

@@ -98,6 +98,22 @@ struct ImplicitMatrix {
   std::vector<double> inv_diag;    // 1 / D
 };
 
+// Wires packed for the fused explicit step (condensed rotations): one wire, or two on the same node
+// stations (a section's contact wire and messenger) side by side, so that their independent
+// recurrences (the condensation's tridiagonal sweeps) run in the two lanes of one vector register.
+// Node i of lane k is entry i * lanes + k. Copies of the wires' band, factors, load and masses.
+struct WireLanes {
+  int lanes = 1;
+  int wire[2] = {-1, -1};  // indices into Model::wires
+  int nodes = 0;
+  std::size_t offset = 0;  // of this pack, in node-lanes: its records start at State::sweep[4 * offset]
+  // One record per node: kCoefficients values, each for every lane ([node][value][lane]); the
+  // element values (e_*) belong to the element from the node to the next.
+  enum { kDww, kDwt, kEww, kEwt, kEtw, kLoad, kDampingMass, kInvMass, kCoefficients };  // kDampingMass: alpha m (eq. 5)
+  std::vector<double> coef;
+  std::vector<double> factors;  // LDL^T of K_theta_theta: [node][lower, inv_pivot][lane]
+};
+
 struct Model {
   Scene scene;
   std::vector<Section> sections;
@@ -122,6 +138,13 @@ struct Model {
   double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction (inf: implicit)
   double dt = 0.0;              // s, the step in use
   std::shared_ptr<const ImplicitMatrix> implicit;  // set when the integrator is implicit
+  // Explicit with condensed rotations: the wires packed for the fused step (empty otherwise: the
+  // generic step). wire_pack[wi], wire_lane[wi]: where wire wi is.
+  std::vector<WireLanes> wire_packs;
+  std::vector<int> wire_pack, wire_lane;
+  // Per catenary DOF: where the sweep leaves its band force and its z in State::sweep.
+  std::vector<int> dof_sweep_force, dof_sweep_z;
+  std::size_t sweep_size = 0;  // node-lanes of all packs (State::sweep holds 4 values for each)
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
   double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)

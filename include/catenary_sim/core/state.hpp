@@ -66,6 +66,13 @@ struct State {
 
   // Workspace, sized once by make_state().
   Eigen::VectorXd force, z;
+  // Fused explicit step: the new displacements and velocities (swapped in, or copied back in the
+  // window, once all are good); per node and lane of every wire pack the sweep's record (rotation,
+  // z, load less damping, band force: src/core/wire_lanes.hpp); the window's LDL^T factors laid
+  // out as WireLanes::factors; the contact wire's nodes under the collectors this step.
+  Eigen::VectorXd u_next, v_next;
+  std::vector<double> sweep, sweep_factors;
+  std::vector<int> point_node;
   // Implicit integrator only: the prediction, and the rank-1 corrections of the factorised
   // matrix A (contacts in touch add k0 g g^T, slack droppers take their stiffness out again),
   // each with its sparse g, its stiffness factor and its column A^-1 g.
@@ -90,6 +97,11 @@ State make_state(const Model& model);
 // Advances one fixed dt with the explicit central differences of eq. 19-21 (half-step velocity).
 // Never reads a clock, never allocates, never logs. Returns the state's status.
 StepStatus step(const Model& model, State& state);
+
+// The instruction set the fused explicit step's runtime dispatch chose on this machine:
+// "x86-64-v4" (AVX-512), "x86-64-v3" (AVX2) or "default" (the x86-64 baseline). All give the
+// same bits.
+const char* sweep_pack_isa();
 
 // Fills the observations (contact forces, collector heights) for the current state without
 // advancing it, e.g. for the initial state.

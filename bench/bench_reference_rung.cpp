@@ -1,0 +1,136 @@
+// Choosing the `reference` rung: candidates against a still finer solution. The finest solution is
+// the explicit scheme at h = 0.03125 m (automatic dt: the stability limit falls with h, so dt is
+// refined with it); every candidate's 0-20 Hz statistics (mean, std, max, min) and 0-200 Hz max are
+// compared with it, with its wall time, on the reference scene at 250 and 300 km/h.
+//   bench_reference_rung [scene=config/reference_55m.yaml] [csv=reference_rung.csv] [finest_h=0.03125] [all]
+// Errors as in bench_speed_accuracy: relative to the finest value (the min relative to the mean).
+// The finest runs take about 10 minutes each: their statistics are kept in <csv>.finest and reused
+// when that file exists (delete it after changing the scene or the model).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/simulation.hpp"
+#include "catenary_sim/core/statistics.hpp"
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+
+using namespace catenary_sim;
+
+namespace {
+
+struct Result {
+  int dofs = 0;
+  double dt = 0.0, wall = 0.0, rtf = 0.0;
+  PantographStatistics s20, s200;
+};
+
+Result run(const std::string& path, std::vector<std::string> overrides, double kmh) {
+  overrides.push_back("train.speed_kmh=" + std::to_string(kmh));
+  const Scene scene = load_scene_file(path, overrides);
+  Result r;
+  Simulation sim(scene);
+  const Model& m = sim.model();
+  PassRecorder rec(m);
+  rec.record(m, sim.state());
+  const auto t0 = std::chrono::steady_clock::now();
+  while (sim.step() == StepStatus::kOk) rec.record(m, sim.state());
+  r.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.dofs = m.n_dof;
+  r.dt = m.dt;
+  r.s20 = rec.statistics(m, 20.0)[0];
+  r.s200 = rec.statistics(m, 200.0)[0];
+  r.rtf = sim.state().time / r.wall;
+  return r;
+}
+
+double rel(double a, double ref) { return 100.0 * std::fabs(a - ref) / std::fabs(ref); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string path = argc > 1 ? argv[1] : CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string csv_path = argc > 2 ? argv[2] : "reference_rung.csv";
+  const std::string finest_h = argc > 3 ? argv[3] : "0.03125";
+  std::ofstream csv(csv_path);
+  csv << "speed_kmh,variant,dofs,dt_s,wall_s,rtf,err_mean_pct,err_std_pct,err_max_pct,err_min_pct,err_max200_pct\n";
+  // The first five were measured first (BENCHMARKS.md); the rest refine the explicit scheme's dt
+  // at h = 0.125 m and try h = 0.1 m. Give `all` as 4th argument for the first five too.
+  const bool all = argc > 4 && std::string(argv[4]) == "all";
+  std::vector<std::pair<std::string, std::vector<std::string>>> candidates = {
+      {"explicit h=0.125", {"numerics.element_length=0.125"}},
+      {"explicit h=0.125 dt=auto/2", {"numerics.element_length=0.125", "numerics.safety_factor=0.45"}},
+      {"explicit h=0.125 dt=auto/4", {"numerics.element_length=0.125", "numerics.safety_factor=0.225"}},
+      {"explicit h=0.1", {"numerics.element_length=0.1"}},
+      {"explicit h=0.1 dt=auto/2", {"numerics.element_length=0.1", "numerics.safety_factor=0.45"}},
+  };
+  if (all)
+    candidates.insert(
+        candidates.begin(),
+        {{"explicit h=0.0625 (old reference)", {"numerics.element_length=0.0625"}},
+         {"implicit h=0.125 dt=1ms", {"numerics.integrator=implicit", "numerics.element_length=0.125", "numerics.dt=0.001"}},
+         {"implicit h=0.125 dt=0.5ms", {"numerics.integrator=implicit", "numerics.element_length=0.125", "numerics.dt=0.0005"}},
+         {"implicit h=0.0625 dt=0.5ms",
+          {"numerics.integrator=implicit", "numerics.element_length=0.0625", "numerics.dt=0.0005"}}});
+  // Finest statistics kept from an earlier run: kmh -> mean, std, max, min, max200, dofs, dt, wall.
+  std::map<double, std::vector<double>> kept;
+  {
+    std::ifstream in(csv_path + ".finest");
+    std::string line;
+    while (std::getline(in, line)) {
+      std::istringstream ls(line);
+      std::vector<double> v;
+      for (std::string x; std::getline(ls, x, ',');) v.push_back(std::stod(x));
+      if (v.size() == 9) kept[v[0]] = std::vector<double>(v.begin() + 1, v.end());
+    }
+  }
+  for (double kmh : {250.0, 300.0}) {
+    Result fine;
+    if (kept.count(kmh)) {
+      const std::vector<double>& k = kept[kmh];
+      fine.s20.filtered.mean = k[0];
+      fine.s20.filtered.std_dev = k[1];
+      fine.s20.filtered.max = k[2];
+      fine.s20.filtered.min = k[3];
+      fine.s200.filtered.max = k[4];
+      fine.dofs = static_cast<int>(k[5]);
+      fine.dt = k[6];
+      fine.wall = k[7];
+    } else {
+      fine = run(path, {"numerics.element_length=" + finest_h}, kmh);
+      std::ofstream out(csv_path + ".finest", std::ios::app);
+      out.precision(17);
+      out << kmh << "," << fine.s20.filtered.mean << "," << fine.s20.filtered.std_dev << "," << fine.s20.filtered.max << ","
+          << fine.s20.filtered.min << "," << fine.s200.filtered.max << "," << fine.dofs << "," << fine.dt << "," << fine.wall
+          << "\n";
+    }
+    std::printf("\n%.0f km/h, finest: explicit h=%s m, %d DOFs, dt %.4f ms, %.1f s wall; std %.3f N, max %.3f N, 200 Hz max %.3f N\n",
+                kmh, finest_h.c_str(), fine.dofs, fine.dt * 1e3, fine.wall, fine.s20.filtered.std_dev,
+                fine.s20.filtered.max, fine.s200.filtered.max);
+    std::printf("%-30s %6s %8s %8s %8s | %7s %7s %7s %7s | %8s\n", "candidate", "DOFs", "dt_ms", "wall_s", "RTF", "mean%",
+                "std%", "max%", "min%", "max200%");
+    for (const auto& [label, ov] : candidates) {
+      const Result r = run(path, ov, kmh);
+      const double em = rel(r.s20.filtered.mean, fine.s20.filtered.mean);
+      const double es = rel(r.s20.filtered.std_dev, fine.s20.filtered.std_dev);
+      const double ex = rel(r.s20.filtered.max, fine.s20.filtered.max);
+      const double en = 100.0 * std::fabs(r.s20.filtered.min - fine.s20.filtered.min) / fine.s20.filtered.mean;
+      const double e200 = rel(r.s200.filtered.max, fine.s200.filtered.max);
+      std::printf("%-30s %6d %8.4f %8.2f %8.2f | %7.3f %7.3f %7.3f %7.3f | %8.3f\n", label.c_str(), r.dofs, r.dt * 1e3,
+                  r.wall, r.rtf, em, es, ex, en, e200);
+      std::fflush(stdout);
+      csv << kmh << "," << label << "," << r.dofs << "," << r.dt << "," << r.wall << "," << r.rtf << "," << em << "," << es
+          << "," << ex << "," << en << "," << e200 << "\n";
+    }
+  }
+  std::printf("\nwrote %s\n", csv_path.c_str());
+  return 0;
+}

@@ -1,0 +1,43 @@
+// The fused explicit step's kernel (wire_lanes.cpp): one sweep pair per wire pack does the whole
+// wire part of eq. 19-21 with the rotations condensed.
+#pragma once
+
+#include "catenary_sim/core/model.hpp"
+
+namespace catenary_sim {
+
+// Packs the wires for the fused step (Model::wire_packs) when the model is explicit with condensed
+// rotations; leaves them empty otherwise.
+void build_wire_packs(Model& model);
+
+// The sweep's record per node and lane (State::sweep, kSweepRecord values per node, each for
+// every lane): the rotation, z = u + beta v, the load less the damping, and the band force.
+enum { kRecTheta, kRecZ, kRecInit, kRecForce, kSweepRecord };
+
+// One pack over nodes lo..hi (hi >= lo + 1), the same range in every lane.
+struct PackSweep {
+  const WireLanes* pack = nullptr;
+  const double* factors = nullptr;  // LDL^T of K_theta_theta over lo..hi (WireLanes::factors' layout)
+  int lo = 0, hi = -1;
+  // Diagonal band entries at lo and hi less the share of elements left out (a window's cut).
+  double ww_lo[2] = {0, 0}, wt_lo[2] = {0, 0}, ww_hi[2] = {0, 0}, wt_hi[2] = {0, 0};
+  const double* u[2] = {nullptr, nullptr};  // node 0 of each lane's wire (all in the state's arrays)
+  const double* v[2] = {nullptr, nullptr};
+  double* u_next[2] = {nullptr, nullptr};
+  double* v_next[2] = {nullptr, nullptr};
+  double* accel[2] = {nullptr, nullptr};
+  double* record = nullptr;  // State::sweep at the pack's records: kept for the nodes with point forces
+  double beta = 0.0, dt = 0.0, limit = 0.0;
+};
+
+// z = u + beta v, the condensed rotations (forward and backward tridiagonal sweeps), the band
+// force with the load and the mass-proportional damping, and the update of eq. 20-21, fused in
+// one forward and one backward pass. The same IEEE operations in the same order as the generic
+// step (condensed_band_force), so the results are bit-identical to it. Returns true if some new
+// displacement is beyond the limit or not a number (the caller finds which).
+// Runtime dispatch (GCC target_clones): x86-64-v4 (AVX-512), x86-64-v3 (AVX2) or the portable
+// x86-64 baseline.
+bool sweep_pack(const PackSweep& sweep);
+
+
+}  // namespace catenary_sim

@@ -1,0 +1,225 @@
+// The fused explicit step (wire packs, runtime-dispatched vector kernel) against straightforward
+// implementations of the same equations (eq. 19-22, 25, condensed rotations).
+//
+// The bound: zero. Each value is computed by the same sequence of IEEE-754 double operations
+// (+, -, *, in the same order, the same rounding) as in the straightforward step: the fused kernel
+// only changes which loop a node is in and packs the two wires' recurrences in the two lanes of a
+// vector register, and packed lanes round exactly like scalar operations. There is no division in
+// the step (the pivots' inverses are stored), no reassociation (no -ffast-math) and no FMA
+// contraction (-ffp-contract=off, CMakeLists.txt), so whatever clone the dispatcher takes
+// (AVX-512, AVX2, baseline), the results are the straightforward step's to the last bit; the
+// statistics of a pass therefore equal those of 25f35a6, whose step was the straightforward one.
+// A nonzero difference would mean a reordered operation, which the tests must catch: they compare
+// bits, over whole passes (thousands of steps, where any round-off difference is amplified by the
+// dynamics and would not stay hidden).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include <sstream>
+
+#include "catenary_sim/core/simulation.hpp"
+#include "catenary_sim/core/statics.hpp"
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+
+using namespace catenary_sim;
+
+namespace {
+
+const std::string kDir = CATENARY_SIM_SOURCE_DIR "/config/";
+
+// The reference catenary as one 6-span section with a twin contact wire: three wires on the same
+// stations, packed as two lanes and one.
+Scene twin_contact_wire(const std::vector<std::string>& overrides) {
+  YAML::Node root = YAML::LoadFile(kDir + "reference_55m.yaml");
+  root["line"].remove("span_length");
+  root["line"].remove("span_count");
+  YAML::Node sec;
+  sec["span_length"] = 55.0;
+  sec["span_count"] = 6;
+  sec["contact_wire_count"] = 2;
+  root["sections"].push_back(sec);
+  std::stringstream s;
+  s << root;
+  return load_scene_string(s.str(), overrides);
+}
+
+bool same_bits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;
+}
+
+// The explicit step written out plainly for a full line (no window) with lumped pantographs:
+// z = u + beta v, f = R - alpha M v - K z (wire by wire, condensed rotations), supports,
+// tension-only droppers, pantograph chains with the uplift, the contact of eq. 12, 22, 25, then
+// v += dt M^-1 f, u += dt v (eq. 20-21).
+struct Plain {
+  Eigen::VectorXd u, v, z, f;
+  std::vector<double> theta;
+};
+
+void plain_step(const Model& m, const State& s, Plain& p) {
+  const int n = m.n_dof, nc = m.n_catenary_dof;
+  for (int i = 0; i < nc; ++i) {
+    p.z[i] = p.u[i] + m.beta * p.v[i];
+    p.f[i] = m.load[i] - m.alpha * m.mass[i] * p.v[i];
+  }
+  for (int i = nc; i < n; ++i) p.f[i] = 0.0;
+  for (const Wire& w : m.wires) wire_elastic_force(w, p.z.data(), p.f.data(), p.theta.data());
+  for (const SupportSpring& sp : m.springs) p.f[sp.dof] -= sp.stiffness * p.z[sp.dof];
+  for (const Dropper& d : m.droppers) {
+    if (!(d.static_tension + d.stiffness * (p.u[d.messenger_dof] - p.u[d.contact_dof]) > 0.0)) continue;
+    const double t = std::max(0.0, d.static_tension + d.stiffness * (p.z[d.messenger_dof] - p.z[d.contact_dof]));
+    p.f[d.contact_dof] += t;
+    p.f[d.messenger_dof] -= t;
+  }
+  for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
+    const Pantograph& pg = m.pantographs[pi];
+    const int nm = pg.masses_count(), a0 = pg.first_dof;
+    for (int i = 0; i < nm; ++i) {
+      const int a = a0 + i;
+      const bool roof = i + 1 == nm;
+      const double c = pg.spring_preload[i] + pg.stiffness[i] * ((roof ? 0.0 : p.u[a + 1]) - p.u[a]) +
+                       pg.damping[i] * ((roof ? 0.0 : p.v[a + 1]) - p.v[a]);
+      p.f[a] += c;
+      if (!roof) p.f[a + 1] -= c;
+    }
+    p.f[a0 + nm - 1] += s.uplift[pi] + pg.aero_coefficient * s.speed * s.speed;
+  }
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  for (const Pantograph& pg : m.pantographs) {
+    const double head = pg.reference_height + p.u[pg.first_dof];
+    for (int ci : pg.collectors)
+      for (int cw : m.contact_wires) {
+        const Wire& w = m.wires[cw];
+        const int cnt = contact_weights(w, m.rub_length, s.front - pg.position + m.collectors[ci].offset, node.data(),
+                                        weight.data());
+        if (!cnt) continue;
+        double yw = 0.0;
+        for (int a = 0; a < cnt; ++a) yw += weight[a] * (w.height[node[a]] + p.u[w.w_dof + node[a]]);
+        const double fc = std::max(0.0, m.contact_stiffness * (head - yw));
+        if (fc == 0.0) continue;
+        p.f[pg.first_dof] -= fc;
+        for (int a = 0; a < cnt; ++a) p.f[w.w_dof + node[a]] += fc * weight[a];
+      }
+  }
+  for (int i = 0; i < n; ++i) {
+    p.v[i] = p.v[i] + m.dt * (m.inv_mass[i] * p.f[i]);
+    p.u[i] = p.u[i] + m.dt * p.v[i];
+  }
+}
+
+}  // namespace
+
+TEST(FusedStep, TakesTheWirePacks) {
+  // Contact wire and messenger of the section share their stations: one pack of two lanes.
+  const Model m = build_model(load_scene_file(kDir + "reference_55m.yaml"));
+  ASSERT_EQ(m.wire_packs.size(), 1u);
+  EXPECT_EQ(m.wire_packs[0].lanes, 2);
+  // Rotations as DOFs or the implicit scheme: no packs, the generic step.
+  EXPECT_TRUE(build_model(load_scene_file(kDir + "reference_55m.yaml", {"numerics.rotary_inertia=lumped"})).wire_packs.empty());
+  EXPECT_TRUE(build_model(load_scene_file(kDir + "reference_55m.yaml", {"numerics.integrator=implicit"})).wire_packs.empty());
+  const std::string isa = sweep_pack_isa();
+  EXPECT_TRUE(isa == "x86-64-v4" || isa == "x86-64-v3" || isa == "default") << isa;
+}
+
+TEST(FusedStep, MatchesThePlainStepBitForBitOverAPass) {
+  // The reference pass at 300 km/h (accurate preset): every step's displacements and velocities.
+  Simulation sim(load_scene_file(kDir + "reference_55m.yaml"));
+  const Model& m = sim.model();
+  ASSERT_FALSE(m.wire_packs.empty());
+  Plain p{sim.state().u, sim.state().v, Eigen::VectorXd::Zero(m.n_dof), Eigen::VectorXd::Zero(m.n_dof),
+          std::vector<double>(m.n_catenary_dof)};
+  long steps = 0;
+  while (true) {
+    const State before = sim.state();
+    if (sim.step() != StepStatus::kOk) break;
+    plain_step(m, before, p);
+    ++steps;
+    ASSERT_TRUE(same_bits(sim.state().u, p.u)) << "displacements differ at step " << steps;
+    ASSERT_TRUE(same_bits(sim.state().v, p.v)) << "velocities differ at step " << steps;
+  }
+  EXPECT_GT(steps, 7000);  // the whole pass (550 m at 300 km/h, dt 0.87 ms)
+  EXPECT_EQ(sim.state().status, StepStatus::kFinished);
+}
+
+// The fused step against the library's generic step (the same model with its packs removed) on
+// the other ways a pass runs: the moving window, the endless line, two pantographs, two sections
+// (an overlap: two packs), the coarsest and finest rungs, and a twin contact wire (a pack of one
+// wire beside one of two), with and without a window.
+TEST(FusedStep, MatchesTheGenericStepBitForBit) {
+  struct Case {
+    std::string file;
+    std::vector<std::string> overrides;
+    long steps;
+  };
+  const std::vector<Case> cases{
+      {"reference_55m.yaml", {"numerics.window=auto"}, 4000},
+      {"reference_55m_endless.yaml", {}, 4000},
+      {"reference_55m_two_pantographs.yaml", {}, 3000},
+      {"reference_55m_two_sections.yaml", {}, 3000},
+      {"reference_55m.yaml", {"numerics.preset=fast", "train.speed_kmh=250"}, 2000},
+      {"reference_55m.yaml", {"numerics.preset=reference"}, 1500},
+      {"twin", {}, 2000},
+      {"twin", {"numerics.window=auto", "train.speed_kmh=250"}, 3000},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file + (c.overrides.empty() ? "" : " " + c.overrides.front()));
+    const Scene scene = c.file == "twin" ? twin_contact_wire(c.overrides) : load_scene_file(kDir + c.file, c.overrides);
+    Model fused = build_model(scene);
+    ASSERT_FALSE(fused.wire_packs.empty());
+    if (c.file == "twin") {
+      ASSERT_EQ(fused.wire_packs.size(), 2u);
+      EXPECT_EQ(fused.wire_packs[1].lanes, 1);
+    }
+    Model generic = fused;
+    generic.wire_packs.clear();
+    State a = make_state(fused), b = make_state(generic);
+    solve_initial_state(fused, a);
+    solve_initial_state(generic, b);
+    ASSERT_TRUE(same_bits(a.u, b.u));
+    for (long k = 0; k < c.steps; ++k) {
+      const StepStatus sa = step(fused, a), sb = step(generic, b);
+      ASSERT_EQ(sa, sb) << "step " << k;
+      if (sa != StepStatus::kOk) break;
+      ASSERT_TRUE(same_bits(a.u, b.u)) << "displacements differ at step " << k;
+      ASSERT_TRUE(same_bits(a.v, b.v)) << "velocities differ at step " << k;
+      ASSERT_TRUE(same_bits(a.accel, b.accel)) << "accelerations differ at step " << k;
+      ASSERT_EQ(0, std::memcmp(a.contact_force.data(), b.contact_force.data(), sizeof(double) * a.contact_force.size()));
+      ASSERT_EQ(a.line_offset, b.line_offset);
+    }
+  }
+}
+
+TEST(FusedStep, StopsAtTheSameDivergedDof) {
+  // dt above the stability limit on purpose (the watchdog's case): both steps stop at the same
+  // step and name the same DOF, and the state keeps the last good step.
+  const Scene scene = load_scene_file(kDir + "reference_55m.yaml", {"numerics.element_length=1.0"});
+  Model fused = build_model(scene);
+  fused.dt *= 1.5;  // beyond the limit: only a test may do this (build_model refuses it)
+  Model generic = fused;
+  generic.wire_packs.clear();
+  State a = make_state(fused), b = make_state(generic);
+  solve_initial_state(fused, a);
+  solve_initial_state(generic, b);
+  int k = 0;
+  for (; k < 200000 && a.status == StepStatus::kOk; ++k) {
+    const Eigen::VectorXd before = a.u;
+    ASSERT_EQ(step(fused, a), step(generic, b));
+    if (a.status == StepStatus::kDiverged) {
+      EXPECT_TRUE(same_bits(a.u, before));
+    }
+  }
+  ASSERT_EQ(a.status, StepStatus::kDiverged) << "did not diverge in " << k << " steps";
+  EXPECT_EQ(a.diverged_dof, b.diverged_dof);
+  EXPECT_TRUE(same_bits(a.u, b.u));
+}
