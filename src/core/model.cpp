@@ -860,7 +860,8 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
   if (m.rub_length > 0.0) max_nodes = static_cast<int>(std::ceil(m.rub_length / hmin)) + 3;
   m.max_contact_nodes = max_nodes;
   for (Pantograph& p : m.pantographs)
-    for (int i = 0; i < p.masses_count(); ++i) m.mass[p.first_dof + i] = p.masses[i];
+    if (!p.moving_force)  // a moving force set in code may keep masses it does not use (no DOFs)
+      for (int i = 0; i < p.masses_count(); ++i) m.mass[p.first_dof + i] = p.masses[i];
 
   m.inv_mass = Eigen::VectorXd::Zero(dof);
   for (int i = 0; i < dof; ++i) {
