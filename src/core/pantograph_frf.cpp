@@ -33,16 +33,21 @@ void add_link(Eigen::MatrixXd& k, int a, int b, double value) {
 }
 
 // Static force on the pantograph's DOFs at displacement 0 without the contact: spring preloads
-// and the uplift on the lowest frame mass (as assemble_force in integrator.cpp).
+// and the uplift on the lowest frame mass (as assemble_force in integrator.cpp; the rig runs at
+// speed 0, so no aerodynamic terms).
 Eigen::VectorXd preload_force(const Model& m, int pi, double uplift) {
   const Pantograph& p = m.pantographs[pi];
   const int n = p.masses_count();
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(p.dof_count());
   for (int i = 0; i < n; ++i) {
     f[i] += p.spring_preload[i];
     if (i + 1 < n) f[i + 1] -= p.spring_preload[i];
   }
   f[n - 1] += uplift;
+  for (const Head& h : p.heads) {
+    f[h.dof - p.first_dof] += h.preload;
+    f[0] -= h.preload;
+  }
   return f;
 }
 
@@ -64,18 +69,25 @@ void driven_system(const Model& m, const PantographSystem& sys, double w, Eigen:
 PantographSystem pantograph_system(const Model& m, int pi) {
   const Pantograph& p = m.pantographs.at(pi);
   if (p.moving_force) throw SceneError("pantograph '" + p.name + "': a moving force has no masses, hence no frequency response");
-  const int n = p.masses_count();
+  const int n = p.dof_count();
   PantographSystem s;
   s.mass = Eigen::MatrixXd::Zero(n, n);
   s.stiffness = Eigen::MatrixXd::Zero(n, n);
   s.damping = Eigen::MatrixXd::Zero(n, n);
-  for (int i = 0; i < n; ++i) {
+  const int nm = p.masses_count();
+  for (int i = 0; i < nm; ++i) {
     s.mass(i, i) = p.masses[i];
-    const int below = i + 1 < n ? i + 1 : -1;  // eq. 9: mass i on spring i to the mass below (the roof last)
+    const int below = i + 1 < nm ? i + 1 : -1;  // eq. 9: mass i on spring i to the mass below (the roof last)
     add_link(s.stiffness, i, below, p.stiffness[i]);
     add_link(s.damping, i, below, p.damping[i]);
   }
-  for (std::size_t c = 0; c < p.collectors.size(); ++c) s.contact.push_back(0);
+  for (const Head& h : p.heads) {  // each head on its suspension to the top frame mass
+    const int a = h.dof - p.first_dof;
+    s.mass(a, a) = h.mass;
+    add_link(s.stiffness, a, 0, h.stiffness);
+    add_link(s.damping, a, 0, h.damping);
+  }
+  for (int ci : p.collectors) s.contact.push_back(m.collectors[ci].dof - p.first_dof);
   return s;
 }
 
