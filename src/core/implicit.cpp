@@ -31,6 +31,10 @@ std::shared_ptr<const ImplicitMatrix> newmark_matrix(const Model& m, double dt) 
       add_spring(k, unused, a, b, p.stiffness[i], 0.0);
       add_spring(c, unused, a, b, p.damping[i], 0.0);
     }
+    for (const Head& h : p.heads) {
+      add_spring(k, unused, h.dof, p.first_dof, h.stiffness, 0.0);
+      add_spring(c, unused, h.dof, p.first_dof, h.damping, 0.0);
+    }
   }
   Triplets a;
   for (int i = 0; i < n; ++i) a.emplace_back(i, i, m.mass[i]);

@@ -27,10 +27,12 @@ void contact_forces(const Model& m, State& s, const double* u, double* f) {
   for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
     const Pantograph& p = m.pantographs[pi];
     const double uplift = s.uplift[pi] + p.aero_coefficient * v2;
-    const double head = p.moving_force ? 0.0 : p.reference_height + u[p.first_dof];
     const double x_ref = s.front - p.position;
     for (int ci : p.collectors) {
-      const double xc = x_ref + m.collectors[ci].offset;
+      const Collector& col = m.collectors[ci];
+      // The mass this strip sits on: the chain's first mass, or its own head (Section VI).
+      const double head = p.moving_force ? 0.0 : p.contact_reference(col) + u[col.dof];
+      const double xc = x_ref + col.offset;
       // Collector heights on every contact wire under it (eq. 12).
       double lowest = std::numeric_limits<double>::infinity();
       for (std::size_t wk = 0; wk < nw; ++wk) {
@@ -59,7 +61,7 @@ void contact_forces(const Model& m, State& s, const double* u, double* f) {
         if (fc == 0.0 || !f) continue;
         const Wire& w = m.wires[m.contact_wires[wk]];
         const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
-        if (!p.moving_force) f[p.first_dof] -= fc;
+        if (!p.moving_force) f[col.dof] -= fc;
         for (int a = 0; a < cnt; ++a) f[w.w_dof + s.weight_node[a]] += fc * s.weight[a];
       }
     }
@@ -180,7 +182,10 @@ double pantograph_position(const Model& m, const State& s, int p) {
 double head_height(const Model& m, const State& s, int p) {
   const Pantograph& pg = m.pantographs[p];
   if (pg.moving_force) return std::nan("");
-  return pg.reference_height + s.u[pg.first_dof];
+  if (pg.heads.empty()) return pg.reference_height + s.u[pg.first_dof];
+  double sum = 0.0;  // several heads: their mean
+  for (const Head& h : pg.heads) sum += h.reference_height + s.u[h.dof];
+  return sum / static_cast<double>(pg.heads.size());
 }
 
 double total_contact_force(const Model& m, const State& s, int p) {
@@ -269,6 +274,12 @@ void add_pantograph_forces(const Model& m, State& s, const double* u, const doub
         if (!roof) f[a + 1] -= c;
       }
       f[a0 + nm - 1] += uplift;
+      // Heads on their suspensions to the top frame mass, each with its own aerodynamic uplift.
+      for (const Head& h : p.heads) {
+        const double c = h.preload + h.stiffness * (u[a0] - u[h.dof]) + h.damping * (v[a0] - v[h.dof]);
+        f[h.dof] += c + h.aero_coefficient * v2;
+        f[a0] -= c;
+      }
     }
   }
   contact_forces(m, s, u, f);
@@ -481,7 +492,7 @@ int contact_corrections(const Model& m, State& s) {
         std::fill(y, y + n, 0.0);
         int* gi = s.correction_g_index.data() + active * stride;
         double* gv = s.correction_g_value.data() + active * stride;
-        gi[0] = p.first_dof;
+        gi[0] = m.collectors[ci].dof;
         gv[0] = 1.0;
         for (int a = 0; a < cnt; ++a) {
           gi[a + 1] = w.w_dof + s.weight_node[a];

@@ -254,7 +254,13 @@ void apply_stiffness(const Model& m, double front, const double* x, double* y, d
       y[a] += c;
       if (i + 1 < p.masses_count()) y[a + 1] -= c;
     }
+    for (const Head& h : p.heads) {
+      const double c = h.stiffness * (x[p.first_dof] - x[h.dof]);
+      y[h.dof] += c;
+      y[p.first_dof] -= c;
+    }
     for (int ci : p.collectors) {
+      const int hd = m.collectors[ci].dof;
       const double xc = front - p.position + m.collectors[ci].offset;
       for (int wi : m.contact_wires) {
         const Wire& w = m.wires[wi];
@@ -262,8 +268,8 @@ void apply_stiffness(const Model& m, double front, const double* x, double* y, d
         double yw = 0.0;
         for (int k = 0; k < n; ++k) yw += weight[k] * x[w.w_dof + node[k]];
         if (n == 0) continue;
-        const double f = m.contact_stiffness * (x[p.first_dof] - yw);
-        y[p.first_dof] -= f;
+        const double f = m.contact_stiffness * (x[hd] - yw);
+        y[hd] -= f;
         for (int k = 0; k < n; ++k) y[w.w_dof + node[k]] += f * weight[k];
       }
     }
@@ -624,14 +630,30 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
     p.stiffness = ps.stiffness;
     p.damping = ps.damping;
     p.static_uplift = ps.static_uplift;
-    p.aero_coefficient = ps.aero_coefficient;
+    p.aero_coefficient = ps.frame_aero();
     if (!p.moving_force) {
       p.first_dof = dof;
       dof += p.masses_count();
     }
     for (const CollectorSpec& c : ps.collectors) {
       p.collectors.push_back(static_cast<int>(m.collectors.size()));
-      m.collectors.push_back(Collector{static_cast<int>(i), c.offset});
+      m.collectors.push_back(Collector{static_cast<int>(i), c.offset, -1, p.moving_force ? -1 : p.first_dof});
+    }
+    // Heads: one DOF each after the chain, on a suspension to the chain's first (top) mass.
+    for (std::size_t h = 0; h < ps.heads.size(); ++h) {
+      const HeadSpec& hs = ps.heads[h];
+      Head head;
+      head.dof = dof++;
+      head.mass = hs.mass;
+      head.stiffness = hs.stiffness;
+      head.damping = hs.damping;
+      head.aero_coefficient = PantographSpec::head_aero(hs, ps.knee_trailing);
+      for (const CollectorSpec& c : hs.collectors) {
+        head.collectors.push_back(static_cast<int>(m.collectors.size()));
+        p.collectors.push_back(static_cast<int>(m.collectors.size()));
+        m.collectors.push_back(Collector{static_cast<int>(i), hs.offset + c.offset, static_cast<int>(h), head.dof});
+      }
+      p.heads.push_back(std::move(head));
     }
     m.pantographs.push_back(std::move(p));
   }
@@ -861,7 +883,10 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
   if (m.rub_length > 0.0) max_nodes = static_cast<int>(std::ceil(m.rub_length / hmin)) + 3;
   m.max_contact_nodes = max_nodes;
   for (Pantograph& p : m.pantographs)
-    for (int i = 0; i < p.masses_count(); ++i) m.mass[p.first_dof + i] = p.masses[i];
+    if (!p.moving_force) {  // a moving force set in code may keep masses it does not use (no DOFs)
+      for (int i = 0; i < p.masses_count(); ++i) m.mass[p.first_dof + i] = p.masses[i];
+      for (const Head& h : p.heads) m.mass[h.dof] = h.mass;
+    }
 
   m.inv_mass = Eigen::VectorXd::Zero(dof);
   for (int i = 0; i < dof; ++i) {

@@ -189,6 +189,18 @@ PantographSpec read_pantograph(const YAML::Node& node, const std::string& path, 
   }
   p.static_uplift = r.number("static_uplift", 0.0, 2000.0);
   p.aero_coefficient = r.number("aero_coefficient", -1.0, 1.0, 0.0);
+  if (r.has("aero_coefficient_trailing")) p.aero_coefficient_trailing = r.number("aero_coefficient_trailing", -1.0, 1.0);
+  const std::string knee = r.text("knee", "leading");
+  if (knee != "leading" && knee != "trailing")
+    fail(r.field("knee"), "'" + knee + "'", "leading or trailing (the frame's knee in the direction of travel)");
+  p.knee_trailing = knee == "trailing";
+  if (r.has("target_mean_force")) {
+    const YAML::Node t = r.child("target_mean_force");
+    Reader tr(t, r.field("target_mean_force"));
+    p.target_force_a = tr.number("a", 0.0, 1.0);
+    p.target_force_b = tr.number("b", 0.0, 2000.0);
+    tr.finish();
+  }
   if (!p.moving_force) {
     p.masses = r.numbers("masses", 0.0, 1000.0, true);
     p.stiffness = r.numbers("stiffness", 0.0, 1e8);
@@ -208,7 +220,11 @@ PantographSpec read_pantograph(const YAML::Node& node, const std::string& path, 
     for (const char* k : {"masses", "stiffness", "damping"})
       if (r.has(k)) fail(r.field(k), "(given)", "not allowed for type " + type + " (it has no masses)");
   }
-  if (r.has("collectors")) {
+  auto read_collectors = [](Reader& r, std::vector<CollectorSpec>& out) {
+    if (!r.has("collectors")) {
+      out.push_back(CollectorSpec{});
+      return;
+    }
     const YAML::Node cs = r.child("collectors");
     if (!cs.IsSequence() || cs.size() == 0) fail(r.field("collectors"), "(not a non-empty list)", "a list of {offset: m}");
     for (std::size_t i = 0; i < cs.size(); ++i) {
@@ -216,10 +232,38 @@ PantographSpec read_pantograph(const YAML::Node& node, const std::string& path, 
       CollectorSpec col;
       col.offset = c.number("offset", -5.0, 5.0, 0.0);
       c.finish();
-      p.collectors.push_back(col);
+      out.push_back(col);
+    }
+  };
+  if (r.has("heads")) {
+    if (p.moving_force) fail(r.field("heads"), "(given)", "not allowed for type " + type + " (it has no masses)");
+    if (r.has("collectors"))
+      fail(r.field("collectors"), "(given with heads)", "collectors on the heads (heads[i].collectors) when heads are given");
+    const YAML::Node hs = r.child("heads");
+    if (!hs.IsSequence() || hs.size() == 0) fail(r.field("heads"), "(not a non-empty list)", "a list of heads");
+    for (std::size_t i = 0; i < hs.size(); ++i) {
+      Reader h(hs[i], r.field("heads") + "[" + std::to_string(i) + "]");
+      HeadSpec head;
+      head.mass = h.number("mass", 0.0, 1000.0, std::nullopt, true);
+      if (!h.has("stiffness"))
+        fail(h.field("stiffness"), "(missing)", "a suspension spring > 0 N/m to the top frame mass (a head without "
+                                                "suspension is the chain's first mass: give no heads)");
+      head.stiffness = h.number("stiffness", 0.0, 1e8, std::nullopt, true);
+      head.damping = h.number("damping", 0.0, 1e6, 0.0);
+      head.offset = h.number("offset", -5.0, 5.0, 0.0);
+      head.length = h.number("length", 0.0, 5.0, 0.5, true);
+      head.aero_coefficient = h.number("aero_coefficient", -1.0, 1.0, 0.0);
+      if (h.has("aero_coefficient_trailing")) head.aero_coefficient_trailing = h.number("aero_coefficient_trailing", -1.0, 1.0);
+      read_collectors(h, head.collectors);
+      for (std::size_t c = 0; c < head.collectors.size(); ++c)
+        if (std::fabs(head.collectors[c].offset) > 0.5 * head.length + 1e-12)
+          fail(h.field("collectors") + "[" + std::to_string(c) + "].offset", fmt(head.collectors[c].offset),
+               "within the head: |offset| <= length / 2 = " + fmt(0.5 * head.length) + " m from its centre");
+      h.finish();
+      p.heads.push_back(head);
     }
   } else {
-    p.collectors.push_back(CollectorSpec{});
+    read_collectors(r, p.collectors);
   }
   r.finish();
   return p;
@@ -752,11 +796,24 @@ void validate(const Scene& s) {
     if (!names.insert(p.name).second) fail(pre + "name", "'" + p.name + "'", "unique among pantographs");
     // The uplift F0 + a v^2 pushes the head up against the wire; a net downward push is not a
     // pantograph (it would pull the head off the wire and the roof spring alone cannot hold it).
-    const double v = s.train_speed, uplift = p.static_uplift + p.aero_coefficient * v * v;
-    if (!p.moving_force && uplift < 0.0)
-      fail(pre + "aero_coefficient", fmt(p.aero_coefficient),
-           "at least " + fmt(-p.static_uplift / (v * v)) + " N s^2/m^2 at " + fmt(v * 3.6) +
-               " km/h: the uplift static_uplift + aero_coefficient v^2 = " + fmt(uplift) + " N must not be negative");
+    const double v = s.train_speed, uplift = p.net_uplift(v);
+    if (!p.moving_force && uplift < 0.0) {
+      // Name the term that pulls down most (the frame's, or a head's, for the knee in use).
+      std::string f = pre + (p.knee_trailing && p.aero_coefficient_trailing ? "aero_coefficient_trailing" : "aero_coefficient");
+      double worst = p.frame_aero();
+      for (std::size_t h = 0; h < p.heads.size(); ++h) {
+        const double a = PantographSpec::head_aero(p.heads[h], p.knee_trailing);
+        if (a < worst) {
+          worst = a;
+          f = pre + "heads[" + std::to_string(h) + "]." +
+              (p.knee_trailing && p.heads[h].aero_coefficient_trailing ? "aero_coefficient_trailing" : "aero_coefficient");
+        }
+      }
+      fail(f, fmt(worst),
+           "a net uplift >= 0 at " + fmt(v * 3.6) + " km/h (knee " + (p.knee_trailing ? "trailing" : "leading") +
+               "): static_uplift + (frame and heads' aero coefficients) v^2 = " + fmt(uplift) +
+               " N; a net downward aerodynamic pull is not physical for a pantograph in service");
+    }
   }
   if (s.imperfections.any()) {
     if (s.endless)

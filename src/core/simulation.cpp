@@ -42,6 +42,8 @@ std::string Simulation::status_message() const {
       for (const Pantograph& p : model_.pantographs)
         if (!p.moving_force && d >= p.first_dof && d < p.first_dof + p.masses_count())
           where = "pantograph " + p.name + " mass " + std::to_string(d - p.first_dof);
+        else if (!p.moving_force && d >= p.first_dof && d < p.first_dof + p.dof_count())
+          where = "pantograph " + p.name + " head " + std::to_string(d - p.first_dof - p.masses_count());
       s << "diverged at t = " << state_.time << " s: displacement of " << where << " is "
         << state_.u[d] << " m (limit " << model_.scene.numerics.divergence_limit
         << " m); the run was stopped. ";

@@ -61,7 +61,7 @@ void compute_stability_limit(Model& m) {
   double contact = 0.0;
   for (const Collector& c : m.collectors) {
     const Pantograph& p = m.pantographs[c.pantograph];
-    if (!p.moving_force) contact += m.contact_stiffness * (m.inv_mass[p.first_dof] + lightest) * m.contact_wires.size();
+    if (!p.moving_force) contact += m.contact_stiffness * (m.inv_mass[c.dof] + lightest) * m.contact_wires.size();
   }
   m.omega_max = std::sqrt(m.omega_max * m.omega_max + contact);
   m.dt_critical = critical_time_step(m.omega_max, m.alpha, m.beta);
@@ -70,17 +70,26 @@ void compute_stability_limit(Model& m) {
   // Each mass with its own springs and dampers as one DOF (w^2 = k/m, mass-proportional damping
   // c/m in the formula of validation.md section 5): far from binding on real pantographs (the
   // reference's lower frame: 33 ms), binding on absurdly light ones, which then get a dt that holds.
+  auto limit_by = [&](double k, double c, double mass) {
+    if (!(c > 0.0)) return;
+    const double w = std::sqrt(k / mass);
+    const double dt = w > 0.0 ? critical_time_step(w, c / mass, 0.0) : 2.0 * mass / c;
+    m.dt_critical = std::min(m.dt_critical, dt);
+  };
   for (const Pantograph& p : m.pantographs) {
     if (p.moving_force) continue;
     for (int i = 0; i < p.masses_count(); ++i) {
       double k = p.stiffness[i], c = p.damping[i];
       if (i > 0) k += p.stiffness[i - 1], c += p.damping[i - 1];
-      if (i == 0) k += m.contact_stiffness * static_cast<double>(p.collectors.size() * m.contact_wires.size());
-      if (!(c > 0.0)) continue;
-      const double w = std::sqrt(k / p.masses[i]);
-      const double dt = w > 0.0 ? critical_time_step(w, c / p.masses[i], 0.0) : 2.0 * p.masses[i] / c;
-      m.dt_critical = std::min(m.dt_critical, dt);
+      if (i == 0 && p.heads.empty()) k += m.contact_stiffness * static_cast<double>(p.collectors.size() * m.contact_wires.size());
+      if (i == 0)
+        for (const Head& h : p.heads) k += h.stiffness, c += h.damping;
+      limit_by(k, c, p.masses[i]);
     }
+    // Each head: its suspension to the frame and its strips' contact springs.
+    for (const Head& h : p.heads)
+      limit_by(h.stiffness + m.contact_stiffness * static_cast<double>(h.collectors.size() * m.contact_wires.size()),
+               h.damping, h.mass);
   }
 }
 

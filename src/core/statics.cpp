@@ -128,6 +128,11 @@ void solve_initial_state(const Model& m, State& st, bool roof_springs) {
           add_spring(t, r, p.first_dof + i, roof ? -1 : p.first_dof + i + 1, p.stiffness[i], p.spring_preload[i]);
         }
         r[p.first_dof + p.masses_count() - 1] += uplift;
+        // Heads on their suspensions, with their own aerodynamic uplift.
+        for (const Head& h : p.heads) {
+          add_spring(t, r, h.dof, p.first_dof, h.stiffness, h.preload);
+          r[h.dof] += h.aero_coefficient * st.speed * st.speed;
+        }
       }
       for (std::size_t cj = 0; cj < p.collectors.size(); ++cj) {
         const int ci = p.collectors[cj];
@@ -162,8 +167,8 @@ void solve_initial_state(const Model& m, State& st, bool roof_springs) {
           if (!contact_on[ci * m.contact_wires.size() + wk]) continue;
           double yd = 0.0;
           for (int a = 0; a < cnt; ++a) yd += weight[a] * w.height[node[a]];
-          const double gap0 = p.reference_height - yd, k0 = m.contact_stiffness;
-          const int h = p.first_dof;
+          const double gap0 = p.contact_reference(m.collectors[ci]) - yd, k0 = m.contact_stiffness;
+          const int h = m.collectors[ci].dof;
           t.emplace_back(h, h, k0);
           r[h] -= k0 * gap0;
           for (int a = 0; a < cnt; ++a) {
@@ -209,7 +214,8 @@ void solve_initial_state(const Model& m, State& st, bool roof_springs) {
         const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
         double yw = 0.0;
         for (int a = 0; a < cnt; ++a) yw += weight[a] * (w.height[node[a]] + x[w.w_dof + node[a]]);
-        const bool on = cnt > 0 && p.reference_height + x[p.first_dof] - yw >= 0.0;
+        const Collector& col = m.collectors[ci];
+        const bool on = cnt > 0 && p.contact_reference(col) + x[col.dof] - yw >= 0.0;
         const std::size_t idx = ci * m.contact_wires.size() + wk;
         if (on != contact_on[idx]) changed = true;
         contact_on[idx] = on;
@@ -245,6 +251,21 @@ void set_pantograph_references(Model& m) {
     p.reference_height = count ? sum / count : m.scene.contact_wire_height;
     p.spring_preload.assign(p.masses.size(), p.static_uplift);
     if (!p.masses.empty()) p.spring_preload.back() = 0.0;
+    // Each head likewise at the wire over its own strips, its suspension carrying its strips'
+    // share of the static uplift (the initial statics then settle the split, eq. 23).
+    for (Head& h : p.heads) {
+      double hs = 0.0;
+      int hc = 0;
+      for (int ci : h.collectors) {
+        const double lowest = lowest_design_height(m, m.train_start - p.position + m.collectors[ci].offset);
+        if (std::isfinite(lowest)) {
+          hs += lowest;
+          ++hc;
+        }
+      }
+      h.reference_height = hc ? hs / hc : p.reference_height;
+      h.preload = p.static_uplift * static_cast<double>(h.collectors.size()) / static_cast<double>(p.collectors.size());
+    }
   }
   if (m.pantographs.empty()) return;
   State st = make_state(m);
@@ -256,7 +277,9 @@ void set_pantograph_references(Model& m) {
     // lumped pantograph: with no uplift it may not press on the wire, and nothing holds it.
     for (std::size_t i = 0; i < m.pantographs.size(); ++i) {
       const Pantograph& p = m.pantographs[i];
-      const double v = m.scene.train_speed, uplift = p.static_uplift + p.aero_coefficient * v * v;
+      const double v = m.scene.train_speed;
+      double uplift = p.static_uplift + p.aero_coefficient * v * v;
+      for (const Head& h : p.heads) uplift += h.aero_coefficient * v * v;
       if (!p.moving_force && !(uplift > 0.0)) {
         std::ostringstream s;
         s << "scene field 'pantographs[" << i << "].static_uplift' = " << p.static_uplift

@@ -185,7 +185,7 @@ PantographStateArray to_pantograph_state(const Model& m, const State& s, const r
     ps.speed = s.speed;
     ps.head_height = head_height(m, s, static_cast<int>(p));
     if (!pg.moving_force) {
-      for (int i = 0; i < pg.masses_count(); ++i) {
+      for (int i = 0; i < pg.dof_count(); ++i) {
         ps.displacement.push_back(s.u[pg.first_dof + i]);
         ps.velocity.push_back(s.v[pg.first_dof + i]);
       }

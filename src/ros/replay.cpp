@@ -83,7 +83,7 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
     if (ps.name != pg.name) return field + ".name = '" + ps.name + "': expected '" + pg.name + "'" + kOtherScene;
     if (c.name != pg.name)
       return "contact_force.pantographs[" + num(p) + "].name = '" + c.name + "': expected '" + pg.name + "'" + kOtherScene;
-    const std::size_t masses = pg.moving_force ? 0 : static_cast<std::size_t>(pg.masses_count());
+    const std::size_t masses = pg.moving_force ? 0 : static_cast<std::size_t>(pg.dof_count());  // chain, then heads
     if (ps.displacement.size() != masses || ps.velocity.size() != masses)
       return field + ": " + num(ps.displacement.size()) + " displacements and " + num(ps.velocity.size()) +
              " velocities: expected " + num(masses) + " of each (the masses of '" + pg.name + "')" + kOtherScene;

@@ -73,6 +73,18 @@ struct Section {
 struct Collector {
   int pantograph = 0;
   double offset = 0.0;  // m along the track from the pantograph reference point
+  int head = -1;        // index into Pantograph::heads; -1: on the chain's first mass
+  int dof = -1;         // the mass it presses (eq. 22: k0 (y_dof - y_wire)); -1 for a moving force
+};
+
+// A head on its own suspension to the top frame mass (HeadSpec).
+struct Head {
+  int dof = 0;
+  double mass = 0.0, stiffness = 0.0, damping = 0.0;
+  double aero_coefficient = 0.0;  // N s^2/m^2, for the pantograph's knee direction
+  double preload = 0.0;           // N: compression of the suspension at displacement 0 (its static share)
+  double reference_height = 0.0;  // m: absolute height at displacement 0
+  std::vector<int> collectors;    // indices into Model::collectors
 };
 
 struct Pantograph {
@@ -82,11 +94,15 @@ struct Pantograph {
   bool external = false;      // hardware-in-the-loop: the force comes from a real pantograph
   int first_dof = -1;     // head DOF; masses follow down the chain
   std::vector<double> masses, stiffness, damping;
-  double static_uplift = 0.0, aero_coefficient = 0.0;
+  double static_uplift = 0.0, aero_coefficient = 0.0;  // aero: the frame's, for the knee direction
   std::vector<int> collectors;  // indices into Model::collectors
+  std::vector<Head> heads;      // empty: the first chain mass is the head (DOFs after the chain's)
   double reference_height = 0.0;  // m: absolute head height at displacement 0
   std::vector<double> spring_preload;  // N: compression of each spring at displacement 0
   int masses_count() const { return static_cast<int>(masses.size()); }
+  int dof_count() const { return masses_count() + static_cast<int>(heads.size()); }
+  // Absolute height at displacement 0 of the mass collector `ci` presses.
+  double contact_reference(const Collector& c) const { return c.head < 0 ? reference_height : heads[c.head].reference_height; }
 };
 
 // The Newmark matrix M + dt/2 C + dt^2/4 K0, factorised once: L D L^T of P A P^T with L unit

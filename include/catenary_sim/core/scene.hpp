@@ -52,7 +52,22 @@ struct SupportSpec {
 };
 
 struct CollectorSpec {
-  double offset = 0.0;  // m along the track from the pantograph's reference point (+ = ahead)
+  double offset = 0.0;  // m along the track from the pantograph's reference point (+ = ahead);
+                        // on a head: from the head's centre
+};
+
+// A pantograph head: a mass on its own suspension (spring and damper) to the top frame mass,
+// carrying one or more collector strips (modern pantographs: two heads, or two strips on
+// independent suspensions; the paper's Section VI "two head masses").
+struct HeadSpec {
+  double mass = 0.0;        // kg
+  double stiffness = 0.0;   // N/m, suspension to the top frame mass (> 0)
+  double damping = 0.0;     // N s/m
+  double offset = 0.0;      // m along the track from the pantograph's reference point, head centre
+  double length = 0.5;      // m along the track: the strips sit within +-length/2 of the centre
+  double aero_coefficient = 0.0;                   // N s^2/m^2 on this head, knee leading
+  std::optional<double> aero_coefficient_trailing;  // knee trailing; empty: aero_coefficient
+  std::vector<CollectorSpec> collectors;           // offsets from the head's centre
 };
 
 struct PantographSpec {
@@ -62,13 +77,30 @@ struct PantographSpec {
   bool external = false;      // true: hardware in the loop, the force is measured on a real pantograph
                               // (a moving force set by Simulation::set_external_force)
   // Lumped-mass chain, head first (paper Fig. 3 / eq. 9): masses[i] is joined to masses[i+1]
-  // (the last to the roof) by stiffness[i] and damping[i].
+  // (the last to the roof) by stiffness[i] and damping[i]. With `heads` the chain is the frame,
+  // its top mass first, and the heads sit on it.
   std::vector<double> masses;     // kg
   std::vector<double> stiffness;  // N/m
   std::vector<double> damping;    // N s/m
   double static_uplift = 0.0;     // N, static contact force at the working height
-  double aero_coefficient = 0.0;  // N s^2/m^2, adds aero_coefficient * v^2 to the uplift
-  std::vector<CollectorSpec> collectors;
+  double aero_coefficient = 0.0;  // N s^2/m^2, adds aero_coefficient * v^2 to the uplift (on the frame)
+  std::optional<double> aero_coefficient_trailing;  // knee trailing; empty: aero_coefficient
+  bool knee_trailing = false;     // direction of travel: the frame's knee leading (default) or trailing
+  std::vector<CollectorSpec> collectors;  // without heads: on the chain's first mass
+  std::vector<HeadSpec> heads;            // empty: the chain's first mass is the head
+  // Target mean contact force Fm(v) = a v^2 + b (the standards' permissible mean force curve):
+  // the statistics report the mean against it. Absent: not reported.
+  std::optional<double> target_force_a, target_force_b;  // N s^2/m^2, N
+  double frame_aero() const { return knee_trailing && aero_coefficient_trailing ? *aero_coefficient_trailing : aero_coefficient; }
+  static double head_aero(const HeadSpec& h, bool trailing) {
+    return trailing && h.aero_coefficient_trailing ? *h.aero_coefficient_trailing : h.aero_coefficient;
+  }
+  // Net uplift at speed v (m/s): static, frame and heads' aerodynamic terms.
+  double net_uplift(double v) const {
+    double a = frame_aero();
+    for (const HeadSpec& h : heads) a += head_aero(h, knee_trailing);
+    return static_uplift + a * v * v;
+  }
 };
 
 struct ContactSpec {

@@ -1,0 +1,190 @@
+// pantograph_frf: a pantograph model's frequency response at the head (receptance and apparent
+// mass), from the model's equations (eq. 9 in the frequency domain) and measured in the simulator
+// (the pantograph alone under a rigid wire driven by stepped sines, the force read from the
+// contact, eq. 22), as DIR/frf.csv and a Bode plot DIR/frf.png (scripts/plot_frf).
+//   pantograph_frf SCENE --pantograph NAME --out DIR [--fmin HZ] [--fmax HZ] [--points N] [--dt S]
+#include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <spawn.h>
+#include <sstream>
+#include <string>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <vector>
+
+#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/pantograph_frf.hpp"
+#include "cli_checks.hpp"
+
+extern char** environ;
+
+using namespace catenary_sim;
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR ""
+#endif
+#ifndef CATENARY_SIM_SHARE_DIR
+#define CATENARY_SIM_SHARE_DIR ""
+#endif
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Runs /usr/bin/python3 scripts/plot_frf CSV PNG; returns its exit status (or -1, message in *why).
+int run_plot(const std::string& csv, const std::string& png, const std::string& title, std::string* why) {
+  std::string script;
+  for (const std::string& dir : {std::string(CATENARY_SIM_SOURCE_DIR), std::string(CATENARY_SIM_SHARE_DIR)}) {
+    struct stat st;
+    if (!dir.empty() && ::stat((dir + "/scripts/plot_frf").c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+      script = dir + "/scripts/plot_frf";
+      break;
+    }
+  }
+  if (script.empty()) {
+    *why = "scripts/plot_frf not found beside the sources or in the share path";
+    return -1;
+  }
+  const char* python = "/usr/bin/python3";
+  std::vector<std::string> args{python, script, csv, png, title};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, python, nullptr, nullptr, argv.data(), environ) != 0) {
+    *why = "cannot start /usr/bin/python3 (install python3-matplotlib: scripts/setup)";
+    return -1;
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) {
+      *why = "waitpid failed";
+      return -1;
+    }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+double deg(std::complex<double> z) { return std::arg(z) * 180.0 / kPi; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"A pantograph model's frequency response at the head: analytic (eq. 9) and measured on a simulated "
+               "rig (stepped sines, force from the contact), as CSV and a Bode plot.",
+               "pantograph_frf"};
+  std::string scene_path, name, out_dir;
+  std::vector<std::string> overrides;
+  double fmin = 0.5, fmax = 20.0, dt = 1e-4, share = 0.5;
+  int points = 30;
+  bool no_plot = false;
+  app.add_option("scene", scene_path, "scene YAML")->required()->type_name("SCENE");
+  app.add_option("--pantograph", name, "name of the pantograph in the scene")->required();
+  app.add_option("--out", out_dir, "output directory (frf.csv, frf.png)")->required()->type_name("DIR");
+  app.add_option("--fmin", fmin, "lowest measured frequency, Hz")->check(kFinite & CLI::Range(0.05, 200.0))->capture_default_str();
+  app.add_option("--fmax", fmax, "highest measured frequency, Hz")->check(kFinite & CLI::Range(0.05, 200.0))->capture_default_str();
+  app.add_option("--points", points, "measured frequencies (log spaced)")->check(CLI::Range(1, 400))->capture_default_str();
+  app.add_option("--dt", dt, "largest time step of the simulated rig, s (smaller if its stability limit asks)")
+      ->check(kFinite & CLI::Range(1e-7, 1e-2))
+      ->capture_default_str();
+  app.add_option("--force-share", share, "dynamic contact force amplitude as a share of the static uplift")
+      ->check(kFinite & CLI::Range(0.01, 0.9))
+      ->capture_default_str();
+  app.add_option("--set", overrides, "override a scene field (as simulate_pass --set)")->type_name("KEY=VALUE")->take_all();
+  app.add_flag("--no-plot", no_plot, "write the CSV only");
+  try {
+    app.parse(argc, argv);
+    if (fmax < fmin) throw CLI::ValidationError("--fmax", "must be >= --fmin (" + std::to_string(fmin) + ")");
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    const Scene scene = load_scene_file(scene_path, overrides);
+    int pi = -1;
+    std::string names;
+    for (std::size_t i = 0; i < scene.pantographs.size(); ++i) {
+      names += (i ? ", " : "") + scene.pantographs[i].name;
+      if (scene.pantographs[i].name == name) pi = static_cast<int>(i);
+    }
+    if (pi < 0) {
+      std::cerr << "pantograph_frf: --pantograph '" << name << "' is not in the scene; allowed: " << names << "\n";
+      return 2;
+    }
+    const PantographSpec& ps = scene.pantographs[pi];
+    if (ps.moving_force || ps.external) {
+      std::cerr << "pantograph_frf: --pantograph '" << name << "' is a " << (ps.external ? "external" : "moving_force")
+                << " pantograph: it has no model masses; allowed: a lumped pantograph\n";
+      return 2;
+    }
+    if (!(ps.static_uplift > 0.0)) {
+      std::cerr << "pantograph_frf: pantograph '" << name << "' has static_uplift " << ps.static_uplift
+                << " N; the rig needs > 0 N to keep the head on the wire\n";
+      return 2;
+    }
+    make_directories(out_dir);
+    DirectoryLock lock(out_dir);
+    const std::string csv_path = out_dir + "/frf.csv", png_path = out_dir + "/frf.png";
+    const std::string model_path = out_dir + "/frf_model.csv";
+    check_writable(csv_path);
+    check_writable(model_path);
+
+    // The rig at the scene's automatic step, or --dt if smaller.
+    Model rig = build_model(frf_rig_scene(scene, pi, 0.0));
+    if (rig.dt > dt) rig = build_model(frf_rig_scene(scene, pi, dt));
+    std::vector<double> freqs;
+    for (int i = 0; i < points; ++i)
+      freqs.push_back(points == 1 ? fmin : fmin * std::pow(fmax / fmin, static_cast<double>(i) / (points - 1)));
+    FrfMeasurement how;
+    how.dt = rig.dt;
+    how.force_share = share;
+    const std::vector<FrfPoint> model = analytic_frf(rig, 0, freqs);
+    const std::vector<FrfPoint> measured = measured_frf(rig, freqs, how);
+
+    std::ostringstream out;
+    out.precision(10);
+    out << "frequency_hz,analytic_receptance_re_m_per_n,analytic_receptance_im_m_per_n,analytic_apparent_mass_kg,"
+           "analytic_apparent_mass_phase_deg,measured_receptance_re_m_per_n,measured_receptance_im_m_per_n,"
+           "measured_apparent_mass_kg,measured_apparent_mass_phase_deg,drive_amplitude_mm,settle_time_s\n";
+    double worst = 0.0;
+    for (std::size_t k = 0; k < freqs.size(); ++k) {
+      const FrfPoint &a = model[k], &b = measured[k];
+      out << a.frequency << "," << a.receptance.real() << "," << a.receptance.imag() << "," << std::abs(a.apparent_mass)
+          << "," << deg(a.apparent_mass) << "," << b.receptance.real() << "," << b.receptance.imag() << ","
+          << std::abs(b.apparent_mass) << "," << deg(b.apparent_mass) << "," << b.drive_amplitude * 1e3 << ","
+          << b.settle_time << "\n";
+      worst = std::max(worst, std::abs(b.receptance / a.receptance - 1.0));
+    }
+    write_file_atomically(csv_path, out.str());
+    // The model's curve on a fine grid (0.02 Hz up to fmax) for the plot's lines.
+    std::vector<double> fine;
+    for (double f = 0.02; f <= fmax + 1e-9; f += 0.02) fine.push_back(f);
+    std::ostringstream curve;
+    curve.precision(10);
+    curve << "frequency_hz,receptance_re_m_per_n,receptance_im_m_per_n,apparent_mass_kg,apparent_mass_phase_deg\n";
+    for (const FrfPoint& a : analytic_frf(rig, 0, fine))
+      curve << a.frequency << "," << a.receptance.real() << "," << a.receptance.imag() << "," << std::abs(a.apparent_mass)
+            << "," << deg(a.apparent_mass) << "\n";
+    write_file_atomically(model_path, curve.str());
+    std::cerr << "pantograph_frf: " << freqs.size() << " frequencies " << fmin << "-" << fmax << " Hz, rig dt " << rig.dt
+              << " s, slowest free decay " << slowest_decay_rate(rig, 0) << " 1/s; largest |measured/analytic - 1| "
+              << worst << "; wrote " << csv_path << "\n";
+    if (!no_plot) {
+      std::string why;
+      const int rc = run_plot(csv_path, png_path, scene.name + ": pantograph " + name, &why);
+      if (rc != 0) {
+        std::cerr << "pantograph_frf: the plot failed" << (why.empty() ? "" : ": " + why) << " (the CSV is written)\n";
+        return 3;
+      }
+    }
+  } catch (const SceneError& e) {
+    std::cerr << "pantograph_frf: " << e.what() << "\n";
+    return 2;
+  } catch (const OutputError& e) {
+    std::cerr << "pantograph_frf: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}

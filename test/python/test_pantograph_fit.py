@@ -1,0 +1,89 @@
+"""fit_pantograph: a chain's parameters recovered from its own FRF with measurement noise added,
+and bad input named."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from catenary_sim.pantograph_fit import chain_receptance, fit_chain, read_frf_csv
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+FIT_CLI = os.path.join(ROOT, "scripts", "fit_pantograph")
+
+# The paper's two-mass pantograph (config/calpe_example.yaml) and a three-mass chain like the
+# reference one (config/reference_55m.yaml) with a damper at every stage.
+CHAINS = [
+    ([7.2, 15.0], [4200.0, 50.0], [10.0, 100.0]),
+    ([7.5, 9.0, 6.0], [7000.0, 15500.0, 160.0], [20.0, 30.0, 100.0]),
+]
+
+
+def noisy_frf(chain, sigma, seed, n=40):
+    f = np.geomspace(0.5, 20.0, n)
+    rng = np.random.default_rng(seed)
+    h = chain_receptance(f, *chain)
+    # A laboratory FRF's error: relative, complex, independent per frequency (sigma per part).
+    return f, h * (1.0 + sigma * (rng.standard_normal(n) + 1j * rng.standard_normal(n)))
+
+
+@pytest.mark.parametrize("chain", CHAINS, ids=["two_masses", "three_masses"])
+def test_fit_recovers_known_parameters_from_a_noisy_frf(chain):
+    sigma = 0.01
+    f, h = noisy_frf(chain, sigma, seed=7)
+    fit = fit_chain(f, h, masses=len(chain[0]))
+    # The residual is the noise: rms sigma sqrt(2) (two parts); with 2 x 40 values its sample rms
+    # is within 10 % of that at one standard deviation (1 / sqrt(2 * 80)): 30 % is three.
+    assert fit.residual_rms == pytest.approx(sigma * np.sqrt(2), rel=0.3)
+    for name, truth in zip(("masses", "stiffness", "damping"), chain):
+        got, std = getattr(fit, name), fit.std[name]
+        # Each parameter within 4 standard deviations of the fit's covariance (a 6e-5 chance per
+        # parameter for a normal error), and that deviation is small enough to mean something:
+        # masses and springs to 10 % (the lower frame masses of three: about 5 %); dampers to 50 % (the three-mass chain's middle damper acts
+        # on the relative motion of the two frame masses, which the head barely sees: 1 % noise
+        # leaves it known to about a third).
+        assert np.all(np.abs(got - truth) < 4 * std), (name, got, truth, std)
+        assert np.all(std < (0.5 if name == "damping" else 0.1) * np.asarray(truth)), (name, std)
+
+
+def test_noise_free_fit_is_exact():
+    # Without noise the least squares reach the parameters to the solver's tolerance.
+    f, h = noisy_frf(CHAINS[0], 0.0, seed=0)
+    fit = fit_chain(f, h, masses=2)
+    for got, truth in zip((fit.masses, fit.stiffness, fit.damping), CHAINS[0]):
+        np.testing.assert_allclose(got, truth, rtol=1e-5)
+
+
+def test_cli_writes_a_scene_snippet_and_the_residual(tmp_path):
+    f, h = noisy_frf(CHAINS[0], 0.005, seed=3)
+    csv = tmp_path / "frf.csv"
+    pd.DataFrame({"frequency_hz": f, "receptance_re_m_per_n": h.real, "receptance_im_m_per_n": h.imag}).to_csv(csv, index=False)
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, FIT_CLI, str(csv), "--masses", "2", "--out", str(out), "--static-uplift", "120"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    snippet = yaml.safe_load((out / "pantograph_fit.yaml").read_text())
+    p = snippet["pantographs"][0]
+    np.testing.assert_allclose(p["masses"], CHAINS[0][0], rtol=0.05)
+    assert p["static_uplift"] == 120
+    table = pd.read_csv(out / "fit_residual.csv")
+    assert len(table) == len(f) and table["relative_residual"].max() < 0.05
+
+
+def test_bad_input_is_named(tmp_path):
+    f, h = noisy_frf(CHAINS[0], 0.0, seed=0)
+    with pytest.raises(ValueError, match="masses = 4"):
+        fit_chain(f, h, masses=4)
+    with pytest.raises(ValueError, match="at least 7"):
+        fit_chain(f[:5], h[:5], masses=2)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("freq,x\n1,2\n")
+    with pytest.raises(ValueError, match="frequency_hz"):
+        read_frf_csv(bad)
+    r = subprocess.run([sys.executable, FIT_CLI, str(bad), "--out", str(tmp_path / "o")], capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode != 0 and "frequency_hz" in r.stderr
+    assert not (tmp_path / "o" / "pantograph_fit.yaml").exists()
