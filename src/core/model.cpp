@@ -10,6 +10,7 @@
 
 #include "catenary_sim/core/beam.hpp"
 #include "catenary_sim/core/implicit.hpp"
+#include "catenary_sim/core/lateral.hpp"
 #include "catenary_sim/core/stability.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statics.hpp"
@@ -997,6 +998,7 @@ Model build_model(const Scene& scene, const BuildOptions& options) {
   if (!(scene.output.filter_cutoff < nyquist))
     throw SceneError("scene field 'output.filter_cutoff' = " + fmt(scene.output.filter_cutoff) + ": allowed below " +
                      fmt(nyquist) + " Hz, the Nyquist frequency of the time step (dt " + fmt(m.dt) + " s)");
+  if (scene.lateral()) m.lateral = build_lateral(m);  // the 3-D line; nothing built for a 2-D scene
   return m;
 }
 

@@ -512,6 +512,109 @@ double LineProfile::at(double x) const {
   return values[j - 1] + t * (values[j] - values[j - 1]);
 }
 
+namespace {
+
+std::uint64_t read_seed(Reader& r, const std::string& key) {
+  const double v = r.number(key, 0.0, 9007199254740992.0, 0.0);
+  if (v != std::floor(v)) fail(r.field(key), fmt(v), "a whole number >= 0");
+  return static_cast<std::uint64_t>(v);
+}
+
+// The 3-D line's rooms: stagger, alignment, wind, pantograph_head (scene.hpp).
+void read_lateral_parts(Reader& top, Scene& s) {
+  if (top.has("stagger")) {
+    Reader r(top.child("stagger"), "stagger");
+    StaggerSpec st;
+    st.contact_wire = r.numbers("contact_wire", -1.0, 1.0);
+    if (st.contact_wire.empty()) fail("stagger.contact_wire", "(empty list)", "at least one offset, m");
+    if (r.has("messenger")) st.messenger = r.numbers("messenger", -1.0, 1.0);
+    st.per_support = r.boolean("per_support", false);
+    if (r.has("steady_arm_stiffness")) st.steady_arm_stiffness = r.number("steady_arm_stiffness", 0.0, 1e9, std::nullopt, true);
+    if (r.has("messenger_support_stiffness"))
+      st.messenger_support_stiffness = r.number("messenger_support_stiffness", 0.0, 1e9, std::nullopt, true);
+    r.finish();
+    s.stagger = st;
+  }
+  if (top.has("alignment")) {
+    Reader r(top.child("alignment"), "alignment");
+    const YAML::Node cs = r.child("curves");
+    if (!cs || !cs.IsSequence()) fail("alignment.curves", "(missing or not a list)", "a list of {start, length, radius[, transition]}");
+    for (std::size_t i = 0; i < cs.size(); ++i) {
+      Reader q(cs[i], "alignment.curves[" + std::to_string(i) + "]");
+      CurveSpec c;
+      c.start = q.number("start", 0.0, 1e7);
+      c.length = q.number("length", 0.0, 1e6, std::nullopt, true);
+      // Wires are chords between supports; the small-angle lateral plane needs radius >> span.
+      c.radius = q.number("radius", -1e6, 1e6);
+      if (std::fabs(c.radius) < 100.0)
+        fail(q.field("radius"), fmt(c.radius), "|radius| of at least 100 m (+ to the left, - to the right)");
+      c.transition = q.number("transition", 0.0, 1e6, 0.0);
+      if (2.0 * c.transition > c.length)
+        fail(q.field("transition"), fmt(c.transition), "at most half the curve's length (" + fmt(0.5 * c.length) + " m)");
+      if (i > 0 && c.start < s.alignment.curves.back().start + s.alignment.curves.back().length)
+        fail(q.field("start"), fmt(c.start), "after the end of the previous curve (" +
+             fmt(s.alignment.curves.back().start + s.alignment.curves.back().length) + " m)");
+      q.finish();
+      s.alignment.curves.push_back(c);
+    }
+    r.finish();
+  }
+  if (top.has("wind")) {
+    Reader r(top.child("wind"), "wind");
+    WindSpec w;
+    w.speed = r.number("speed", 0.0, 70.0);
+    w.direction = r.number("direction", -360.0, 360.0, 90.0);
+    w.air_density = r.number("air_density", 0.0, 2.0, 1.225, true);
+    auto drag = [&](const char* key, WireDragSpec& d) {
+      if (!r.has(key)) return;
+      Reader q(r.child(key), std::string("wind.") + key);
+      d.diameter = q.number("diameter", 0.0, 0.1, d.diameter, true);
+      d.drag_coefficient = q.number("drag_coefficient", 0.0, 3.0, d.drag_coefficient);
+      q.finish();
+    };
+    drag("contact_wire", w.contact_wire);
+    drag("messenger", w.messenger);
+    if (r.has("turbulence")) {
+      Reader q(r.child("turbulence"), "wind.turbulence");
+      TurbulenceSpec t;
+      t.intensity = q.number("intensity", 0.0, 0.5, std::nullopt, true);
+      t.length_scale = q.number("length_scale", 0.0, 1000.0, 50.0, true);
+      t.coherence_decay = q.number("coherence_decay", 0.0, 100.0, 10.0, true);
+      t.max_frequency = q.number("max_frequency", 0.0, 50.0, 5.0, true);
+      t.spacing = q.number("spacing", 0.0, 100.0, 5.0, true);
+      t.seed = read_seed(q, "seed");
+      q.finish();
+      if (!(w.speed > 0.0)) fail("wind.speed", fmt(w.speed), "above 0 with wind.turbulence (its spectrum scales with the mean speed)");
+      w.turbulence = t;
+    }
+    if (r.has("blow_off_limit")) w.blow_off_limit = r.number("blow_off_limit", 0.0, 10.0, std::nullopt, true);
+    r.finish();
+    s.wind = w;
+  }
+  if (top.has("pantograph_head")) {
+    Reader r(top.child("pantograph_head"), "pantograph_head");
+    PantographHeadSpec& h = s.pantograph_head;
+    h.working_width = r.number("working_width", 0.0, 5.0, 1.2, true);
+    h.horn_width = r.number("horn_width", 0.0, 5.0, std::max(1.95, h.working_width), true);
+    if (h.horn_width < h.working_width)
+      fail("pantograph_head.horn_width", fmt(h.horn_width), "at least the working width (" + fmt(h.working_width) + " m)");
+    const std::string act = r.text("on_dewirement", "continue");
+    if (act == "continue") h.on_dewirement = DewirementAction::kContinue;
+    else if (act == "stop") h.on_dewirement = DewirementAction::kStop;
+    else fail("pantograph_head.on_dewirement", "'" + act + "'", "one of: continue (record and go on), stop (end the pass)");
+    if (r.has("sway")) {
+      Reader q(r.child("sway"), "pantograph_head.sway");
+      h.sway_amplitude = q.number("amplitude", 0.0, 1.0);
+      h.sway_frequency = q.number("frequency", 0.0, 20.0);
+      q.finish();
+    }
+    h.histogram_bin = r.number("histogram_bin", 0.0, 1.0, 0.02, true);
+    r.finish();
+  }
+}
+
+}  // namespace
+
 Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   if (!root || !root.IsMap()) throw SceneError("scene: the document must be a YAML map of sections (line, contact_wire, ...)");
   Reader top(root, "");
@@ -758,6 +861,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
     s.output.max_contact_loss_percent = optional_number("max_contact_loss_percent", 0.0, 100.0, false);
     r.finish();
   }
+  read_lateral_parts(top, s);
   top.finish();
   validate(s);
   return s;
@@ -828,6 +932,31 @@ void validate(const Scene& s) {
       if (s.imperfections.point_masses[i].station > line + 1e-9)
         fail("imperfections.point_masses[" + std::to_string(i) + "].station", fmt(s.imperfections.point_masses[i].station),
              "on the line, [0, " + fmt(line) + "] m");
+  }
+  if (s.lateral()) {
+    if (s.endless)
+      fail(s.stagger ? "stagger" : s.wind ? "wind" : s.alignment.any() ? "alignment" : "pantograph_head.sway", "(given)",
+           "a finite line: the 3-D line is not built on an endless line yet");
+    const double half = 0.5 * s.pantograph_head.working_width;
+    if (s.stagger) {
+      for (std::size_t i = 0; i < s.stagger->contact_wire.size(); ++i)
+        if (std::fabs(s.stagger->contact_wire[i]) >= half)
+          fail("stagger.contact_wire[" + std::to_string(i) + "]", fmt(s.stagger->contact_wire[i]),
+               "inside the pantograph head's working width, |stagger| < " + fmt(half) + " m (pantograph_head.working_width / 2)");
+      if (s.stagger->per_support) {
+        // Supports along the line, counting an overlap's shared supports once.
+        const std::size_t line_supports = s.spans.size() + 1;
+        if (s.stagger->contact_wire.size() != line_supports)
+          fail("stagger.contact_wire", "(" + std::to_string(s.stagger->contact_wire.size()) + " values)",
+               "one per support of the line with per_support: true (" + std::to_string(line_supports) + ")");
+        if (!s.stagger->messenger.empty() && s.stagger->messenger.size() != line_supports)
+          fail("stagger.messenger", "(" + std::to_string(s.stagger->messenger.size()) + " values)",
+               "one per support of the line with per_support: true (" + std::to_string(line_supports) + ")");
+      }
+    }
+    for (std::size_t i = 0; i < s.alignment.curves.size(); ++i)
+      if (s.alignment.curves[i].start >= line)
+        fail("alignment.curves[" + std::to_string(i) + "].start", fmt(s.alignment.curves[i].start), "on the line, below " + fmt(line) + " m");
   }
   if (s.endless) {
     if (!s.numerics.windowed())

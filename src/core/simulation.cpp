@@ -12,6 +12,10 @@ Simulation::Simulation(const Scene& scene) : model_(build_model(scene)) {
   initial_ = make_state(model_);
   solve_initial_state(model_, initial_);
   observe(model_, initial_);
+  if (model_.lateral) {
+    initial_.lateral = make_lateral_state(model_);
+    lateral_observe(model_, initial_);
+  }
   state_ = initial_;
 }
 
@@ -24,6 +28,17 @@ std::string Simulation::status_message() const {
       else
         s << "running";
       break;
+    case StepStatus::kDewired: {
+      if (state_.lateral.events.empty()) {
+        s << "stopped at t = " << state_.time << " s: dewirement (pantograph_head.on_dewirement: stop)";
+        break;
+      }
+      const DewirementEvent& e = state_.lateral.events.back();
+      s << "stopped at t = " << state_.time << " s: dewirement of pantograph " << model_.pantographs[e.pantograph].name
+        << " at " << e.station << " m, contact point " << e.lateral << " m across the strip (working width +-"
+        << 0.5 * model_.scene.pantograph_head.working_width << " m; pantograph_head.on_dewirement: stop)";
+      break;
+    }
     case StepStatus::kFinished:
       s << "pass finished at t = " << state_.time << " s (train front at " << state_.front + state_.line_offset << " m)";
       break;
@@ -32,6 +47,12 @@ std::string Simulation::status_message() const {
         s << "stopped at t = " << state_.time << " s: more than " << kSlackDropperCapacity
           << " droppers slack at once, beyond what the implicit integrator takes out of its matrix; "
              "use numerics.integrator explicit for this scene";
+        break;
+      }
+      if (state_.lateral.diverged) {
+        s << "diverged at t = " << state_.time << " s: a lateral displacement left the divergence limit ("
+          << model_.scene.numerics.divergence_limit << " m); the run was stopped. Check the lateral stiffnesses "
+          << "(stagger.steady_arm_stiffness, messenger_support_stiffness) and the wind";
         break;
       }
       const int d = state_.diverged_dof;

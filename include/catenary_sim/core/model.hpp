@@ -14,6 +14,8 @@
 
 namespace catenary_sim {
 
+struct LateralModel;  // lateral.hpp: the 3-D line's lateral plane
+
 // One tensioned wire of a tension section, meshed with pre-stressed Euler-Bernoulli (Hermite)
 // beam elements (eq. 3). Its stiffness is stored as a block-tridiagonal band of 2x2 blocks
 // (w, theta per node): that is exactly the bandwidth of a beam, so a product costs O(nodes).
@@ -177,6 +179,8 @@ struct Model {
   std::vector<int> dropper_order, spring_order;       // indices in line order (stable)
   std::vector<double> dropper_order_x, spring_order_x;  // m, their stations
   std::vector<std::string> warnings;  // what the scene asks that is outside design practice
+  // The wires' lateral planes (3-D line); null when the scene has no stagger, curve, wind or sway.
+  std::shared_ptr<const LateralModel> lateral;
 };
 
 // Builds the model, solves the design statics (dropper lengths for the presag) and the stability

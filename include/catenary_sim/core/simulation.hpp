@@ -18,8 +18,13 @@ class Simulation {
   const Model& model() const { return model_; }
   const State& state() const { return state_; }
 
-  StepStatus step() { return catenary_sim::step(model_, state_); }
-  bool finished() const { return state_.status == StepStatus::kFinished || state_.front + state_.line_offset >= model_.train_end; }
+  // The vertical step, then (3-D line) the lateral one; a run stopped by either stays stopped.
+  StepStatus step() {
+    if (state_.status == StepStatus::kDewired) return state_.status;
+    const StepStatus s = catenary_sim::step(model_, state_);
+    return s == StepStatus::kOk && model_.lateral ? lateral_step(model_, state_) : s;
+  }
+  bool finished() const { return state_.status == StepStatus::kFinished || state_.status == StepStatus::kDewired || state_.front + state_.line_offset >= model_.train_end; }
   // Human-readable status, naming the DOF and time of a divergence.
   std::string status_message() const;
 

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "catenary_sim/core/lateral.hpp"
 #include "catenary_sim/core/model.hpp"
 
 namespace catenary_sim {
@@ -17,6 +18,7 @@ enum class StepStatus {
   kDiverged,   // a displacement would leave the divergence limit or become NaN/inf: the run is
                // stopped and the state keeps the last good step
   kFinished,   // the train front reached the end of the pass; step() does nothing more
+  kDewired,    // a contact point left the strip's working width and the scene says stop (3-D line)
 };
 
 // The part of one wire a moving window integrates: nodes lo..hi (empty when hi < lo). Where the
@@ -89,6 +91,9 @@ struct State {
   std::vector<double> theta;
   std::vector<int> weight_node;
   std::vector<double> weight;
+
+  // 3-D line (Model::lateral): the wires' lateral planes; empty without one.
+  LateralState lateral;
 };
 
 // A state sized for the model with zero displacement (the design state, no pantograph force).

@@ -1,0 +1,130 @@
+// The 3-D line: every wire's lateral (horizontal) plane, built from the same pre-stressed beam
+// band as its vertical plane (same T, EI and nodes; a round wire bends alike both ways) and
+// stepped with its own explicit central differences after the vertical step.
+//
+// Coordinates: y is the wire's lateral position from the track centre line (+ to the left in the
+// direction of increasing station), in the track's own frame. A curve of curvature kappa then
+// acts on a wire of tension T as the distributed lateral load T kappa (the wire is straight in
+// plan, so in the curved frame T (y'' + kappa) + q = 0): the chords between supports come out of
+// the statics, and the steady arms carry the pull-off T x (change of direction).
+// Droppers are pendulums of stiffness S / l (tension over length) between the messenger and the
+// contact wire; steady arms and messenger supports are lateral springs (or rigid) at the
+// stagger; anchors are rigid. Wind pushes each node with 0.5 rho Cd d h V|V|, V the wind's
+// speed normal to the wire less the node's lateral velocity (aerodynamic damping included).
+//
+// One-way coupling (a first model, docs/model_and_numerics.md): the vertical state sets the
+// droppers' pendulum stiffness (their tension now); the lateral motion does not act back on the
+// vertical equations, so the vertical results are bit-identical with and without a lateral plane.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "catenary_sim/core/model.hpp"
+#include "catenary_sim/core/wind.hpp"
+
+namespace catenary_sim {
+
+struct State;
+enum class StepStatus;
+
+struct LateralSpring {
+  int dof = 0;             // lateral index
+  double stiffness = 0.0;  // N/m
+  double anchor = 0.0;     // m, the support's lateral position (the stagger)
+};
+
+struct LateralPendulum {
+  int contact = 0, messenger = 0;  // lateral indices
+  int dropper = 0;                 // index into Model::droppers (its tension now sets S)
+  double inv_length = 0.0;         // 1/m
+};
+
+// A support of a wire in plan, with its static lateral force (pull-off).
+struct LateralSupport {
+  int wire = 0;          // index into Model::wires
+  int node = 0;
+  int line_support = 0;  // index into Model::support_x
+  double x = 0.0;        // m
+  double stagger = 0.0;  // m
+  bool rigid = true, anchor = false;
+  // N, lateral force of the wire on the support in the static state, + toward +y: without wind,
+  // and under the mean wind.
+  double pull_off = 0.0, pull_off_wind = 0.0;
+};
+
+struct LateralModel {
+  std::vector<Wire> wires;  // per Model::wires: its band; w_dof indexes the lateral arrays; rotations condensed
+  int n = 0;                // lateral DOFs (one per wire node)
+  Eigen::VectorXd mass, inv_mass;  // kg; inv_mass 0 on rigidly held nodes
+  Eigen::VectorXd load;            // N, constant: the curve's T kappa h and the springs' k stagger
+  std::vector<LateralSpring> springs;
+  std::vector<LateralPendulum> pendulums;
+  std::vector<LateralSupport> supports;
+  Eigen::VectorXd calm;     // m, static lateral positions without wind
+  Eigen::VectorXd initial;  // m, static under the mean wind (the pass starts here)
+  // Wind: per node 0.5 rho Cd d h (kg/m) and the sine of the wind's angle to the wire.
+  bool windy = false;
+  double wind_speed = 0.0;
+  Eigen::VectorXd wind_coefficient, wind_normal;
+  WindField field;                 // turbulence (empty: steady wind)
+  std::vector<int> field_index;    // per node: the field point at or before it
+  std::vector<double> field_weight;  // per node: linear weight of the next point
+  double omega_max = 0.0;          // rad/s, highest lateral eigenfrequency
+  int substeps = 1;                // lateral steps per vertical step
+  double dt = 0.0;                 // s, lateral step
+  double half_working_width = 0.0, half_horn_width = 0.0;  // m
+  std::vector<int> node_span;      // per lateral DOF: span along the line for contact-wire nodes, -1 otherwise
+  int spans = 0;
+  std::vector<double> static_blow_off;  // m, per span: largest |initial - calm| on the contact wire(s)
+};
+
+// Builds the lateral plane of a model whose scene asks for one (Scene::lateral()); throws SceneError.
+std::shared_ptr<const LateralModel> build_lateral(const Model& model);
+
+// Lateral static state of the wires (y: n entries) under the constant loads, the droppers at their
+// static tension, with (mean wind) or without wind; `force_on_support` (optional, per
+// LateralModel::supports) receives the lateral force of each wire on its supports.
+void solve_lateral_statics(const Model& model, const LateralModel& lat, bool with_wind, Eigen::VectorXd* y,
+                           std::vector<double>* force_on_support);
+
+struct DewirementEvent {
+  double time = 0.0;     // s
+  double station = 0.0;  // m, of the collector along the line
+  int pantograph = 0, collector = 0;
+  double lateral = 0.0;  // m, contact point on the strip when it left the working width
+};
+constexpr std::size_t kMaxDewirementEvents = 1024;  // kept per pass; more are counted only
+
+struct LateralState {
+  Eigen::VectorXd y, v;      // m, m/s (v at the half step, eq. 20)
+  Eigen::VectorXd f, z;      // workspace
+  std::vector<double> theta, wind_points;
+  std::vector<int> weight_node;
+  std::vector<double> weight;
+  // Per collector x contact wire: the contact point's lateral position on the strip (wire minus
+  // pantograph), NaN where the collector is not under that wire.
+  std::vector<double> contact_lateral;
+  // Per collector: on the running wire (the one it touches, else the lowest), NaN if none.
+  std::vector<double> collector_lateral;
+  std::vector<double> pantograph_lateral;  // m, per pantograph (sway)
+  std::vector<std::uint8_t> off_strip;     // per collector: outside the working width now
+  std::vector<DewirementEvent> events;     // capacity reserved: never allocates in step
+  std::int64_t events_total = 0;
+  bool diverged = false, dewired_stop = false;
+};
+
+LateralState make_lateral_state(const Model& model);
+// Contact point positions of the current state (no step).
+void lateral_observe(const Model& model, State& state);
+// One lateral step of the model's dt (its substeps), after the vertical step moved the state to
+// its new time. Never allocates. Returns kDiverged or kDewired (on_dewirement: stop), else kOk.
+StepStatus lateral_step(const Model& model, State& state);
+
+// Lateral energy without wind: 0.5 v M v + 0.5 y K y - load . y with the droppers at their static
+// tension (J); constant in an undamped, windless free motion.
+double lateral_energy(const Model& model, const State& state);
+
+}  // namespace catenary_sim

@@ -1,0 +1,479 @@
+#include "catenary_sim/core/lateral.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "catenary_sim/core/beam.hpp"
+#include "catenary_sim/core/state.hpp"
+
+namespace catenary_sim {
+namespace {
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+// Index of the support at station xs in Model::support_x (supports shared by an overlap's two
+// sections are one support along the line).
+int line_support(const Model& m, double xs) {
+  const auto it = std::lower_bound(m.support_x.begin(), m.support_x.end(), xs - 1e-6);
+  return static_cast<int>(std::min<std::ptrdiff_t>(it - m.support_x.begin(), m.support_x.size() - 1));
+}
+
+double stagger_at(const Scene& s, bool contact, int support) {
+  if (!s.stagger) return 0.0;
+  const StaggerSpec& st = *s.stagger;
+  const std::vector<double>& p = contact || st.messenger.empty() ? st.contact_wire : st.messenger;
+  return st.at(p, static_cast<std::size_t>(support));
+}
+
+// f -= K_lateral z over all wires, springs and pendulums (pendulum stiffness from `tension`, per
+// dropper, or the static tension when null). theta: scratch of the longest wire's nodes.
+void elastic_force(const Model& m, const LateralModel& lat, const double* tension, const double* z, double* f,
+                   double* theta) {
+  for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, theta);
+  for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
+  for (const LateralPendulum& p : lat.pendulums) {
+    const double s = tension ? tension[p.dropper] : m.droppers[p.dropper].static_tension;
+    const double k = std::max(0.0, s) * p.inv_length;
+    const double d = k * (z[p.messenger] - z[p.contact]);
+    f[p.contact] += d;
+    f[p.messenger] -= d;
+  }
+}
+
+// Highest eigenfrequency of M^-1 K on the free nodes by power iteration (the bound the explicit
+// step must respect); 5 % added for the iteration's shortfall.
+double lateral_omega_max(const Model& m, const LateralModel& lat) {
+  const int n = lat.n;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n), y(n);
+  std::vector<double> theta(n);
+  for (int i = 0; i < n; ++i) x[i] = lat.inv_mass[i] > 0.0 ? ((i * 7919) % 13 + 1.0) : 0.0;
+  double lambda = 0.0;
+  for (int it = 0; it < 300; ++it) {
+    const double nx = x.norm();
+    if (!(nx > 0.0)) break;
+    x /= nx;
+    y.setZero();
+    elastic_force(m, lat, nullptr, x.data(), y.data(), theta.data());
+    for (int i = 0; i < n; ++i) y[i] = -y[i] * lat.inv_mass[i];
+    lambda = x.dot(y);
+    x = y;
+  }
+  return 1.05 * std::sqrt(std::max(0.0, lambda));
+}
+
+}  // namespace
+
+void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wind, Eigen::VectorXd* y_out,
+                           std::vector<double>* force_on_support) {
+  // Full system with the rotations as unknowns: y_i at i, theta_i at n + i. Rigid nodes are
+  // eliminated (their rows become y_i = stagger); the unconstrained matrix gives the reactions.
+  const int n = lat.n, N = 2 * n;
+  Eigen::VectorXd F = Eigen::VectorXd::Zero(N), fixed_value = Eigen::VectorXd::Zero(n);
+  std::vector<bool> fixed(n, false);
+  for (int i = 0; i < n; ++i) F[i] = lat.load[i];
+  if (with_wind && lat.windy)
+    for (int i = 0; i < n; ++i) {
+      const double vn = lat.wind_speed * lat.wind_normal[i];
+      F[i] += lat.wind_coefficient[i] * vn * std::fabs(vn);
+    }
+  for (const LateralSupport& s : lat.supports)
+    if (s.rigid) {
+      const int i = lat.wires[s.wire].w_dof + s.node;
+      fixed[i] = true;
+      fixed_value[i] = s.stagger;
+    }
+  std::vector<Eigen::Triplet<double>> full, reduced;
+  Eigen::VectorXd Fr = F;
+  auto add = [&](int i, int j, double v) {
+    full.emplace_back(i, j, v);
+    const bool fi = i < n && fixed[i], fj = j < n && fixed[j];
+    if (fi) return;
+    if (fj) Fr[i] -= v * fixed_value[j];
+    else reduced.emplace_back(i, j, v);
+  };
+  for (const Wire& w : lat.wires) {
+    const int o = w.w_dof, nn = w.nodes();
+    for (int i = 0; i < nn; ++i) {
+      const int a = o + i, t = n + o + i;
+      add(a, a, w.d_ww[i]);
+      add(a, t, w.d_wt[i]);
+      add(t, a, w.d_wt[i]);
+      add(t, t, w.d_tt[i]);
+    }
+    for (int e = 0; e + 1 < nn; ++e) {
+      const int a = o + e, b = o + e + 1, ta = n + a, tb = n + b;
+      add(a, b, w.e_ww[e]);
+      add(b, a, w.e_ww[e]);
+      add(a, tb, w.e_wt[e]);
+      add(tb, a, w.e_wt[e]);
+      add(ta, b, w.e_tw[e]);
+      add(b, ta, w.e_tw[e]);
+      add(ta, tb, w.e_tt[e]);
+      add(tb, ta, w.e_tt[e]);
+    }
+  }
+  for (const LateralSpring& sp : lat.springs) add(sp.dof, sp.dof, sp.stiffness);
+  for (const LateralPendulum& p : lat.pendulums) {
+    const double k = std::max(0.0, m.droppers[p.dropper].static_tension) * p.inv_length;
+    add(p.contact, p.contact, k);
+    add(p.messenger, p.messenger, k);
+    add(p.contact, p.messenger, -k);
+    add(p.messenger, p.contact, -k);
+  }
+  for (int i = 0; i < n; ++i)
+    if (fixed[i]) {
+      reduced.emplace_back(i, i, 1.0);
+      Fr[i] = fixed_value[i];
+    }
+  Eigen::SparseMatrix<double> K(N, N), Kf(N, N);
+  K.setFromTriplets(reduced.begin(), reduced.end());
+  Kf.setFromTriplets(full.begin(), full.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(K);
+  if (solver.info() != Eigen::Success)
+    throw SceneError("scene: the lateral statics has no solution: a wire is free to move sideways (check stagger.steady_arm_stiffness and stagger.messenger_support_stiffness)");
+  const Eigen::VectorXd x = solver.solve(Fr);
+  if (solver.info() != Eigen::Success || !x.allFinite())
+    throw SceneError("scene: the lateral statics has no solution (a wire free to move sideways)");
+  *y_out = x.head(n);
+  if (force_on_support) {
+    // The wire's force on each support: the load at its node less the elastic force K x there
+    // (for a spring support, the spring's share k (y - stagger) is the wire's push on it).
+    const Eigen::VectorXd r = F - Kf * x;
+    force_on_support->assign(lat.supports.size(), 0.0);
+    std::vector<double> spring_term(n, 0.0);  // k (y - stagger): r holds it with the opposite sign
+    for (const LateralSpring& sp : lat.springs) spring_term[sp.dof] = sp.stiffness * (x[sp.dof] - sp.anchor);
+    for (std::size_t k = 0; k < lat.supports.size(); ++k) {
+      const LateralSupport& s = lat.supports[k];
+      const int i = lat.wires[s.wire].w_dof + s.node;
+      const double v = r[i] + spring_term[i];
+      (*force_on_support)[k] = v;
+    }
+  }
+}
+
+std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
+  const Scene& sc = m.scene;
+  auto lat = std::make_shared<LateralModel>();
+  int off = 0;
+  for (const Wire& w : m.wires) {
+    Wire l = w;
+    l.w_dof = off;
+    l.theta_dof = -1;  // massless rotations, condensed (assemble_band always factorises K_tt)
+    off += w.nodes();
+    lat->wires.push_back(std::move(l));
+  }
+  const int n = lat->n = off;
+  lat->mass = Eigen::VectorXd::Zero(n);
+  lat->inv_mass = Eigen::VectorXd::Zero(n);
+  lat->load = Eigen::VectorXd::Zero(n);
+  lat->node_span.assign(n, -1);
+  lat->spans = static_cast<int>(m.support_x.size()) - 1;
+  const std::optional<double> arm_k = sc.stagger ? sc.stagger->steady_arm_stiffness : std::nullopt;
+  const std::optional<double> msup_k = sc.stagger ? sc.stagger->messenger_support_stiffness : std::nullopt;
+  std::vector<bool> fixed(n, false);
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    const Wire& w = m.wires[wi];
+    const Wire& l = lat->wires[wi];
+    const int nn = w.nodes();
+    for (int i = 0; i < nn; ++i) {
+      const int a = l.w_dof + i;
+      // Translational mass as in the vertical plane (wire, clamps, support masses); the vertical
+      // plane leaves it 0 where it holds a node rigidly, so the wire's own share is used there.
+      double mi = m.mass[w.w_dof + i];
+      if (!(mi > 0.0)) {
+        mi = 0.0;
+        if (i > 0) mi += beam_translational_mass(w.x[i] - w.x[i - 1], w.spec.linear_mass);
+        if (i + 1 < nn) mi += beam_translational_mass(w.x[i + 1] - w.x[i], w.spec.linear_mass);
+      }
+      lat->mass[a] = mi;
+      // The curve in the track's frame: a load T kappa per metre (lateral.hpp).
+      const double h = 0.5 * ((i + 1 < nn ? w.x[i + 1] : w.x[i]) - (i > 0 ? w.x[i - 1] : w.x[i]));
+      lat->load[a] += w.spec.tension * sc.alignment.curvature(w.x[i]) * h;
+      if (w.is_contact_wire) {
+        const auto it = std::upper_bound(m.support_x.begin(), m.support_x.end(), w.x[i]);
+        lat->node_span[a] = std::clamp(static_cast<int>(it - m.support_x.begin()) - 1, 0, lat->spans - 1);
+      }
+    }
+    const int ns = static_cast<int>(w.support_nodes.size());
+    for (int k = 0; k < ns; ++k) {
+      LateralSupport s;
+      s.wire = static_cast<int>(wi);
+      s.node = w.support_nodes[k];
+      s.x = w.x[s.node];
+      s.line_support = line_support(m, s.x);
+      s.stagger = stagger_at(sc, w.is_contact_wire, s.line_support);
+      s.anchor = k == 0 || k == ns - 1;
+      const std::optional<double>& spring = w.is_contact_wire ? arm_k : msup_k;
+      s.rigid = s.anchor || !spring;
+      const int a = l.w_dof + s.node;
+      if (s.rigid) {
+        fixed[a] = true;
+      } else {
+        lat->springs.push_back(LateralSpring{a, *spring, s.stagger});
+        lat->load[a] += *spring * s.stagger;
+      }
+      lat->supports.push_back(s);
+    }
+  }
+  for (int i = 0; i < n; ++i) lat->inv_mass[i] = fixed[i] ? 0.0 : 1.0 / lat->mass[i];
+  // Droppers as pendulums between their two nodes.
+  auto lateral_dof = [&](int vertical) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const Wire& w = m.wires[wi];
+      if (vertical >= w.w_dof && vertical < w.w_dof + w.nodes()) return lat->wires[wi].w_dof + vertical - w.w_dof;
+    }
+    return -1;
+  };
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+    const Dropper& d = m.droppers[k];
+    LateralPendulum p;
+    p.contact = lateral_dof(d.contact_dof);
+    p.messenger = lateral_dof(d.messenger_dof);
+    p.dropper = static_cast<int>(k);
+    // A dropper shorter than 5 cm would be a lateral clamp, not a pendulum: held at 5 cm.
+    p.inv_length = 1.0 / std::max(0.05, d.length);
+    lat->pendulums.push_back(p);
+  }
+  // Wind: the normal component of the mean wind on each node's wire, following the track's heading.
+  if (sc.wind) {
+    const WindSpec& ws = *sc.wind;
+    lat->windy = ws.speed > 0.0;
+    lat->wind_speed = ws.speed;
+    lat->wind_coefficient = Eigen::VectorXd::Zero(n);
+    lat->wind_normal = Eigen::VectorXd::Zero(n);
+    const double phi = ws.direction * M_PI / 180.0;
+    double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo;
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const Wire& w = m.wires[wi];
+      const WireDragSpec& d = w.is_contact_wire ? ws.contact_wire : ws.messenger;
+      const int nn = w.nodes();
+      for (int i = 0; i < nn; ++i) {
+        const int a = lat->wires[wi].w_dof + i;
+        const double h = 0.5 * ((i + 1 < nn ? w.x[i + 1] : w.x[i]) - (i > 0 ? w.x[i - 1] : w.x[i]));
+        lat->wind_coefficient[a] = 0.5 * ws.air_density * d.drag_coefficient * d.diameter * h;
+        lat->wind_normal[a] = std::sin(phi - sc.alignment.heading(w.x[i]));
+      }
+      x_lo = std::min(x_lo, w.x.front());
+      x_hi = std::max(x_hi, w.x.back());
+    }
+    if (ws.turbulence) {
+      const double duration = sc.train_speed > 0.0 ? (m.train_end - m.train_start) / sc.train_speed : 600.0;
+      lat->field = make_wind_field(ws, x_lo, x_hi, duration);
+      lat->field_index.assign(n, 0);
+      lat->field_weight.assign(n, 0.0);
+      for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+        const Wire& w = m.wires[wi];
+        for (int i = 0; i < w.nodes(); ++i) {
+          const int a = lat->wires[wi].w_dof + i;
+          const double s = (w.x[i] - lat->field.x0) / lat->field.dx;
+          const int j = std::clamp(static_cast<int>(std::floor(s)), 0, lat->field.points - 2);
+          lat->field_index[a] = j;
+          lat->field_weight[a] = std::clamp(s - j, 0.0, 1.0);
+        }
+      }
+    }
+  }
+  const PantographHeadSpec& head = sc.pantograph_head;
+  lat->half_working_width = 0.5 * head.working_width;
+  lat->half_horn_width = 0.5 * head.horn_width;
+
+  // Statics: without wind (the design in plan, and the pull-off), then under the mean wind.
+  std::vector<double> calm_force, wind_force;
+  solve_lateral_statics(m, *lat, false, &lat->calm, &calm_force);
+  solve_lateral_statics(m, *lat, true, &lat->initial, &wind_force);
+  for (std::size_t k = 0; k < lat->supports.size(); ++k) {
+    lat->supports[k].pull_off = calm_force[k];
+    lat->supports[k].pull_off_wind = wind_force[k];
+  }
+  lat->static_blow_off.assign(std::max(0, lat->spans), 0.0);
+  for (int i = 0; i < n; ++i)
+    if (lat->node_span[i] >= 0)
+      lat->static_blow_off[lat->node_span[i]] =
+          std::max(lat->static_blow_off[lat->node_span[i]], std::fabs(lat->initial[i] - lat->calm[i]));
+
+  // Stability: the lateral plane's own limit (Rayleigh damping reduces it as in the vertical
+  // plane); it takes as many substeps of the vertical dt as it needs.
+  lat->omega_max = lateral_omega_max(m, *lat);
+  const double xi = 0.5 * (m.alpha / std::max(lat->omega_max, 1e-9) + m.beta * lat->omega_max);
+  const double dt_crit = lat->omega_max > 0.0 ? 2.0 / lat->omega_max * (std::sqrt(1.0 + xi * xi) - xi)
+                                               : std::numeric_limits<double>::infinity();
+  lat->substeps = std::max(1, static_cast<int>(std::ceil(m.dt / (0.9 * dt_crit))));
+  if (lat->substeps > 1000)
+    throw SceneError("scene field 'stagger.steady_arm_stiffness': the lateral plane's stability limit (" + fmt(dt_crit) +
+                     " s) would need " + std::to_string(lat->substeps) + " substeps of dt " + fmt(m.dt) +
+                     " s; allowed at most 1000: lower the lateral support stiffnesses");
+  lat->dt = m.dt / lat->substeps;
+  return lat;
+}
+
+LateralState make_lateral_state(const Model& m) {
+  const LateralModel& lat = *m.lateral;
+  LateralState s;
+  s.y = lat.initial;
+  s.v = Eigen::VectorXd::Zero(lat.n);
+  s.f = Eigen::VectorXd::Zero(lat.n);
+  s.z = Eigen::VectorXd::Zero(lat.n);
+  int longest = 0;
+  for (const Wire& w : lat.wires) longest = std::max(longest, w.nodes());
+  s.theta.assign(longest, 0.0);
+  s.wind_points.assign(std::max(0, lat.field.points), 0.0);
+  s.weight_node.assign(m.max_contact_nodes, 0);
+  s.weight.assign(m.max_contact_nodes, 0.0);
+  s.contact_lateral.assign(m.collectors.size() * m.contact_wires.size(), std::nan(""));
+  s.collector_lateral.assign(m.collectors.size(), std::nan(""));
+  s.pantograph_lateral.assign(m.pantographs.size(), 0.0);
+  s.off_strip.assign(m.collectors.size(), 0);
+  s.events.reserve(kMaxDewirementEvents);
+  return s;
+}
+
+namespace {
+
+// Contact points across the strips and dewirement (a change of the off-strip flag). Returns true
+// when a collector left the working width in this call.
+bool contact_points(const Model& m, State& s, bool record) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const PantographHeadSpec& head = m.scene.pantograph_head;
+  const double sway = head.sway_amplitude * std::sin(2.0 * M_PI * head.sway_frequency * s.time);
+  const std::size_t nw = m.contact_wires.size();
+  bool left = false;
+  for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
+    const Pantograph& p = m.pantographs[pi];
+    ls.pantograph_lateral[pi] = sway;
+    const double x_ref = s.front - p.position;
+    for (int ci : p.collectors) {
+      const double xc = x_ref + m.collectors[ci].offset;
+      double best_force = 0.0;
+      int running = -1;
+      for (std::size_t wk = 0; wk < nw; ++wk) {
+        const Wire& w = lat.wires[m.contact_wires[wk]];
+        const int cnt = contact_weights(w, m.rub_length, xc, ls.weight_node.data(), ls.weight.data());
+        double y = 0.0;
+        for (int a = 0; a < cnt; ++a) y += ls.weight[a] * ls.y[w.w_dof + ls.weight_node[a]];
+        ls.contact_lateral[ci * nw + wk] = cnt ? y - sway : std::nan("");
+        const double fc = s.contact_force[ci * nw + wk];
+        if (cnt && fc > best_force) {
+          best_force = fc;
+          running = static_cast<int>(wk);
+        }
+      }
+      if (running < 0) lowest_design_height(m, xc, &running);  // not touching: the wire it meets first
+      const double yc = running >= 0 ? ls.contact_lateral[ci * nw + running] : std::nan("");
+      ls.collector_lateral[ci] = yc;
+      const bool off = std::fabs(yc) > lat.half_working_width;  // false for NaN
+      if (off && !ls.off_strip[ci] && record) {
+        left = true;
+        ++ls.events_total;
+        if (ls.events.size() < kMaxDewirementEvents)
+          ls.events.push_back(DewirementEvent{s.time, xc + s.line_offset, static_cast<int>(pi), ci, yc});
+      }
+      ls.off_strip[ci] = off;
+    }
+  }
+  return left;
+}
+
+}  // namespace
+
+void lateral_observe(const Model& m, State& s) {
+  if (m.lateral) contact_points(m, s, false);
+}
+
+StepStatus lateral_step(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const int n = lat.n;
+  const double h = lat.dt, beta = m.beta, alpha = m.alpha;
+  const double* load = lat.load.data();
+  const double* mass = lat.mass.data();
+  const double* inv_mass = lat.inv_mass.data();
+  double* y = ls.y.data();
+  double* v = ls.v.data();
+  double* f = ls.f.data();
+  double* z = ls.z.data();
+  const double limit = m.scene.numerics.divergence_limit;
+  const double* u = s.u.data();
+  const double t0 = s.time - m.dt;  // the vertical step has already moved the clock on
+  for (int sub = 0; sub < lat.substeps; ++sub) {
+    const double t = t0 + sub * h;
+    for (int i = 0; i < n; ++i) {
+      z[i] = y[i] + beta * v[i];
+      f[i] = load[i] - alpha * mass[i] * v[i];
+    }
+    for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, ls.theta.data());
+    for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
+    // Pendulums at the droppers' tension now (the one-way coupling): 0 when slack.
+    for (const LateralPendulum& p : lat.pendulums) {
+      const Dropper& d = m.droppers[p.dropper];
+      const double tension = d.static_tension + d.stiffness * (u[d.messenger_dof] - u[d.contact_dof]);
+      const double k = std::max(0.0, tension) * p.inv_length;
+      const double df = k * (z[p.messenger] - z[p.contact]);
+      f[p.contact] += df;
+      f[p.messenger] -= df;
+    }
+    if (lat.windy) {
+      const double U = lat.wind_speed;
+      const double* cw = lat.wind_coefficient.data();
+      const double* sn = lat.wind_normal.data();
+      if (!lat.field.empty()) {
+        lat.field.at_time(t, ls.wind_points.data());
+        const double* wp = ls.wind_points.data();
+        for (int i = 0; i < n; ++i) {
+          const int j = lat.field_index[i];
+          const double a = lat.field_weight[i];
+          const double speed = U + (1.0 - a) * wp[j] + a * wp[j + 1];
+          const double vn = speed * sn[i] - v[i];  // relative to the moving wire
+          f[i] += cw[i] * vn * std::fabs(vn);
+        }
+      } else {
+        for (int i = 0; i < n; ++i) {
+          const double vn = U * sn[i] - v[i];
+          f[i] += cw[i] * vn * std::fabs(vn);
+        }
+      }
+    }
+    double worst = 0.0;
+    for (int i = 0; i < n; ++i) {
+      v[i] += h * inv_mass[i] * f[i];
+      y[i] += h * v[i];
+      worst = std::max(worst, std::fabs(y[i]));
+    }
+    if (!(worst < limit)) {  // also NaN
+      ls.diverged = true;
+      s.status = StepStatus::kDiverged;
+      return s.status;
+    }
+  }
+  const bool left = contact_points(m, s, true);
+  if (left && m.scene.pantograph_head.on_dewirement == DewirementAction::kStop) {
+    ls.dewired_stop = true;
+    s.status = StepStatus::kDewired;
+  }
+  return s.status;
+}
+
+double lateral_energy(const Model& m, const State& s) {
+  const LateralModel& lat = *m.lateral;
+  const int n = lat.n;
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+  std::vector<double> theta(n);
+  elastic_force(m, lat, nullptr, s.lateral.y.data(), f.data(), theta.data());  // f = -K y
+  double e = 0.0;
+  for (int i = 0; i < n; ++i)
+    e += 0.5 * lat.mass[i] * s.lateral.v[i] * s.lateral.v[i] * (lat.inv_mass[i] > 0.0) - 0.5 * s.lateral.y[i] * f[i] -
+         lat.load[i] * s.lateral.y[i];
+  return e;
+}
+
+}  // namespace catenary_sim
