@@ -2,7 +2,8 @@
 //   simulate_pass --scene FILE [--speed KMH] [--set key=value ...] --out DIR [--report]
 // Prints a summary, writes DIR/stats.json, DIR/timeseries.csv and the measurement files
 // (force_processed.csv, contact_losses.csv, droppers.csv, dropper_rainflow.csv, psd.csv, and
-// dropper_series.csv when output.dropper_series), each whole or not at all (temporary file +
+// dropper_series.csv when output.dropper_series; lateral.csv, lateral_histogram.csv, blow_off.csv,
+// pull_off.csv and dewirements.csv on a 3-D line), each whole or not at all (temporary file +
 // rename), with DIR locked against a second run writing into it. --report then runs
 // scripts/pass_report on DIR (report.html and its PNGs).
 #include <spawn.h>
@@ -22,6 +23,9 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "catenary_sim/core/lateral_statistics.hpp"
 #include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
@@ -241,7 +245,9 @@ int main(int argc, char** argv) {
   std::unique_ptr<DirectoryLock> lock;
   const std::string stats_path = out_dir + "/stats.json", csv_path = out_dir + "/timeseries.csv";
   const std::vector<std::string> extra_names{"force_processed.csv", "contact_losses.csv", "droppers.csv",
-                                             "dropper_rainflow.csv", "psd.csv", "dropper_series.csv"};
+                                             "dropper_rainflow.csv", "psd.csv", "dropper_series.csv",
+                                             "lateral.csv", "lateral_histogram.csv", "blow_off.csv", "pull_off.csv",
+                                             "dewirements.csv"};
   try {
     make_directories(out_dir);
     lock = std::make_unique<DirectoryLock>(out_dir);
@@ -255,6 +261,7 @@ int main(int argc, char** argv) {
   }
 
   PassRecorder recorder(m, scene.output.sample_rate);
+  LateralRecorder lateral(m, scene.output.sample_rate);  // records nothing on a 2-D line
   if (!quiet) {
     if (m.endless)
       std::cout << "scene " << scene.name << ": endless line of " << m.endless_span << " m spans (a block of "
@@ -279,8 +286,10 @@ int main(int argc, char** argv) {
     }
     Progress progress(steps_needed, !quiet && !no_progress);
     recorder.record(m, sim->state());
+    lateral.record(m, sim->state());
     while ((status = sim->step()) == StepStatus::kOk) {
       recorder.record(m, sim->state());
+      lateral.record(m, sim->state());
       if (bag) bag->write(m, sim->state());
       progress.update(sim->state().steps, sim->state().time);
     }
@@ -300,8 +309,16 @@ int main(int argc, char** argv) {
     return kDiverged;
   }
 
+  if (status == StepStatus::kDewired) {
+    // The pass ends here as the scene asks (pantograph_head.on_dewirement: stop); what it ran is written.
+    recorder.record(m, sim->state());
+    lateral.record(m, sim->state());
+    std::cerr << "simulate_pass: " << sim->status_message() << "\n";
+  }
   const std::vector<PantographStatistics> stats = recorder.statistics(m);
   if (!all_finite(stats)) {
+    if (status == StepStatus::kDewired)
+      std::cerr << "simulate_pass: the pass stopped at the dewirement before it crossed the analysis section; nothing written\n";
     // Guarded by the scene checks (every pantograph crosses the analysis section); never written as null.
     std::cerr << "simulate_pass: the pass gave no statistics over the analysis section (output.analysis_spans); "
                  "nothing written\n";
@@ -318,7 +335,15 @@ int main(int argc, char** argv) {
     write_rows(csv, recorder.columns(), recorder.rows());
     const LineStatistics line = recorder.line_statistics(m);
     AtomicFile json(stats_path);
-    json.write(statistics_json(m, st, stats, run, &line));
+    const LateralStatistics lateral_stats = lateral.statistics(m, st);
+    if (m.lateral) {
+      nlohmann::json j = nlohmann::json::parse(statistics_json(m, st, stats, run, &line));
+      j["lateral"] = nlohmann::json::parse(lateral_statistics_json(m, lateral_stats));
+      j["stopped_by_dewirement"] = status == StepStatus::kDewired;
+      json.write(j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+    } else {
+      json.write(statistics_json(m, st, stats, run, &line));
+    }
     std::vector<std::unique_ptr<AtomicFile>> extra;
     auto add = [&](const std::string& name) -> AtomicFile& {
       extra.push_back(std::make_unique<AtomicFile>(out_dir + "/" + name));
@@ -357,6 +382,30 @@ int main(int argc, char** argv) {
       add("psd.csv").write(c.str());
     }
     if (scene.output.dropper_series) write_rows(add("dropper_series.csv"), recorder.dropper_columns(), recorder.dropper_rows());
+    if (m.lateral) {
+      write_rows(add("lateral.csv"), lateral.columns(), lateral.rows());
+      std::ostringstream h, b, p, d;
+      h << std::setprecision(9) << "pantograph,collector,from_m,to_m,percent_of_contact_time\n";
+      for (const LateralContactStatistics& c : lateral_stats.contacts)
+        for (std::size_t k = 0; k < c.histogram_percent.size(); ++k)
+          h << csv_field(c.pantograph) << "," << c.collector << "," << c.from + k * c.bin << "," << c.from + (k + 1) * c.bin
+            << "," << c.histogram_percent[k] << "\n";
+      add("lateral_histogram.csv").write(h.str());
+      b << std::setprecision(9) << "span,start_m,end_m,static_blow_off_m,max_blow_off_m,exceeded\n";
+      for (const SpanBlowOff& s : lateral_stats.spans)
+        b << s.span << "," << s.start << "," << s.end << "," << s.static_m << "," << s.max_m << "," << s.exceeded << "\n";
+      add("blow_off.csv").write(b.str());
+      p << std::setprecision(9) << "wire,station_m,stagger_m,anchor,rigid,pull_off_N,pull_off_mean_wind_N\n";
+      for (const LateralSupport& s : m.lateral->supports)
+        p << csv_field(m.wires[s.wire].name) << "," << s.x << "," << s.stagger << "," << s.anchor << "," << s.rigid << ","
+          << s.pull_off << "," << s.pull_off_wind << "\n";
+      add("pull_off.csv").write(p.str());
+      d << std::setprecision(9) << "pantograph,collector,time_s,station_m,lateral_m\n";
+      for (const DewirementEvent& e : lateral_stats.events)
+        d << csv_field(m.pantographs[e.pantograph].name) << "," << e.collector << "," << e.time << "," << e.station << ","
+          << e.lateral << "\n";
+      add("dewirements.csv").write(d.str());
+    }
     // All on the disk before any is renamed into place: a full disk leaves the old set (or
     // none), never a new CSV beside an old stats.json.
     csv.flush();
@@ -421,6 +470,31 @@ int main(int argc, char** argv) {
     if (scene.output.allowed_uplift)
       std::cout << "steady arms: " << exceeded << " of " << line.steady_arms.size() << " above the allowed uplift of "
                 << *scene.output.allowed_uplift * 1e3 << " mm\n";
+    if (m.lateral) {
+      const LateralStatistics ls = lateral.statistics(m, st);
+      std::cout << std::setprecision(3) << "3-D line (lateral plane, one-way coupling): working width +-"
+                << 0.5 * scene.pantograph_head.working_width << " m\n";
+      for (const LateralContactStatistics& c : ls.contacts)
+        std::cout << "  " << c.pantograph << " contact point across the strip: mean " << c.mean << " m, range " << c.min
+                  << " .. " << c.max << " m, sweep speed mean " << c.sweep_mean << " m/s (max " << c.sweep_max
+                  << " m/s), beyond the working width " << std::setprecision(2) << c.outside_working_percent << " % of the time\n"
+                  << std::setprecision(3);
+      double worst = 0.0, worst_static = 0.0;
+      int exceeded = 0;
+      for (const SpanBlowOff& b : ls.spans) {
+        worst = std::max(worst, b.max_m);
+        worst_static = std::max(worst_static, b.static_m);
+        exceeded += b.exceeded;
+      }
+      std::cout << "  blow-off of the contact wire: static " << worst_static << " m, max " << worst << " m";
+      if (scene.wind && scene.wind->blow_off_limit)
+        std::cout << "; " << exceeded << " of " << ls.spans.size() << " spans above the limit of " << *scene.wind->blow_off_limit << " m";
+      double pull = 0.0;
+      for (const LateralSupport& s : m.lateral->supports)
+        if (!s.anchor && m.wires[s.wire].is_contact_wire) pull = std::max(pull, std::fabs(s.pull_off));
+      std::cout << "\n  largest steady-arm pull-off " << std::setprecision(1) << pull << " N; dewirements: "
+                << ls.events_total << "\n";
+    }
     std::cout << "wrote " << stats_path << ", " << csv_path << " and the measurement files in " << out_dir << "\n";
     if (bag) std::cout << "wrote " << bag->messages() << " messages to " << bag_path << "\n";
   }
