@@ -14,6 +14,9 @@
 namespace catenary_sim {
 namespace {
 
+// Share of the turbulent field's sample time between refreshes of the wind on the nodes.
+constexpr double kWindUpdate = 0.1;
+
 std::string fmt(double v) {
   std::ostringstream s;
   s.precision(6);
@@ -327,6 +330,7 @@ LateralState make_lateral_state(const Model& m) {
   for (const Wire& w : lat.wires) longest = std::max(longest, w.nodes());
   s.theta.assign(longest, 0.0);
   s.wind_points.assign(std::max(0, lat.field.points), 0.0);
+  if (lat.windy) s.wind_speed = lat.wind_speed * lat.wind_normal;  // the mean wind until the field's first refresh
   s.weight_node.assign(m.max_contact_nodes, 0);
   s.weight.assign(m.max_contact_nodes, 0.0);
   s.contact_lateral.assign(m.collectors.size() * m.contact_wires.size(), std::nan(""));
@@ -407,9 +411,35 @@ StepStatus lateral_step(const Model& m, State& s) {
   const double t0 = s.time - m.dt;  // the vertical step has already moved the clock on
   for (int sub = 0; sub < lat.substeps; ++sub) {
     const double t = t0 + sub * h;
-    for (int i = 0; i < n; ++i) {
-      z[i] = y[i] + beta * v[i];
-      f[i] = load[i] - alpha * mass[i] * v[i];
+    if (lat.windy && !lat.field.empty() && t + 1e-12 >= ls.next_wind_update) {
+      // The wind's speed normal to each node's wire, W = (U + u') sin(angle), is refreshed every
+      // kWindUpdate of the field's sample time (it is linear between samples 0.1 s apart at the
+      // default 5 Hz); the drag on the moving wire is taken every step.
+      ls.next_wind_update = t + kWindUpdate * lat.field.dt;
+      lat.field.at_time(t, ls.wind_points.data());
+      const double* wp = ls.wind_points.data();
+      const double U = lat.wind_speed;
+      const double* sn = lat.wind_normal.data();
+      double* W = ls.wind_speed.data();
+      for (int i = 0; i < n; ++i) {
+        const int j = lat.field_index[i];
+        const double a = lat.field_weight[i];
+        W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
+      }
+    }
+    if (lat.windy) {
+      const double* cw = lat.wind_coefficient.data();
+      const double* W = ls.wind_speed.data();
+      for (int i = 0; i < n; ++i) {
+        z[i] = y[i] + beta * v[i];
+        const double vn = W[i] - v[i];  // relative to the moving wire: aerodynamic damping
+        f[i] = load[i] - alpha * mass[i] * v[i] + cw[i] * vn * std::fabs(vn);
+      }
+    } else {
+      for (int i = 0; i < n; ++i) {
+        z[i] = y[i] + beta * v[i];
+        f[i] = load[i] - alpha * mass[i] * v[i];
+      }
     }
     for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, ls.theta.data());
     for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
@@ -422,34 +452,13 @@ StepStatus lateral_step(const Model& m, State& s) {
       f[p.contact] += df;
       f[p.messenger] -= df;
     }
-    if (lat.windy) {
-      const double U = lat.wind_speed;
-      const double* cw = lat.wind_coefficient.data();
-      const double* sn = lat.wind_normal.data();
-      if (!lat.field.empty()) {
-        lat.field.at_time(t, ls.wind_points.data());
-        const double* wp = ls.wind_points.data();
-        for (int i = 0; i < n; ++i) {
-          const int j = lat.field_index[i];
-          const double a = lat.field_weight[i];
-          const double speed = U + (1.0 - a) * wp[j] + a * wp[j + 1];
-          const double vn = speed * sn[i] - v[i];  // relative to the moving wire
-          f[i] += cw[i] * vn * std::fabs(vn);
-        }
-      } else {
-        for (int i = 0; i < n; ++i) {
-          const double vn = U * sn[i] - v[i];
-          f[i] += cw[i] * vn * std::fabs(vn);
-        }
-      }
-    }
-    double worst = 0.0;
+    int out = 0;  // an integer OR vectorises where a max over doubles (NaN rules) does not
     for (int i = 0; i < n; ++i) {
       v[i] += h * inv_mass[i] * f[i];
       y[i] += h * v[i];
-      worst = std::max(worst, std::fabs(y[i]));
+      out |= !(std::fabs(y[i]) < limit);  // also NaN
     }
-    if (!(worst < limit)) {  // also NaN
+    if (out) {
       ls.diverged = true;
       s.status = StepStatus::kDiverged;
       return s.status;

@@ -10,6 +10,8 @@
 #include <memory>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/core/outputs.hpp"
 
@@ -58,6 +60,9 @@ std::vector<std::string> pass_file_names(const Model& model) {
   std::vector<std::string> names{"stats.json",   "timeseries.csv",       "force_processed.csv", "contact_losses.csv",
                                  "droppers.csv", "dropper_rainflow.csv", "psd.csv"};
   if (model.scene.output.dropper_series) names.push_back("dropper_series.csv");
+  if (model.lateral)
+    for (const char* n : {"lateral.csv", "lateral_histogram.csv", "blow_off.csv", "pull_off.csv", "dewirements.csv"})
+      names.push_back(n);
   return names;
 }
 
@@ -67,7 +72,7 @@ void check_pass_files_writable(const std::string& dir, const Model& model) {
 }
 
 void write_pass_files(const std::string& dir, const Model& m, const State& st, const PassRecorder& recorder,
-                      const RunInfo& run) {
+                      const RunInfo& run, const LateralRecorder* lateral, bool stopped_by_dewirement) {
   const std::vector<PantographStatistics> stats = recorder.statistics(m);
   const LineStatistics line = recorder.line_statistics(m);
   std::vector<std::unique_ptr<AtomicFile>> files;
@@ -76,7 +81,16 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
     return *files.back();
   };
   write_rows(add("timeseries.csv"), recorder.columns(), recorder.rows());
-  add("stats.json").write(statistics_json(m, st, stats, run, &line));
+  const bool three_d = m.lateral && lateral;
+  const LateralStatistics lateral_stats = three_d ? lateral->statistics(m, st) : LateralStatistics{};
+  if (three_d) {
+    nlohmann::json j = nlohmann::json::parse(statistics_json(m, st, stats, run, &line));
+    j["lateral"] = nlohmann::json::parse(lateral_statistics_json(m, lateral_stats));
+    j["stopped_by_dewirement"] = stopped_by_dewirement;
+    add("stats.json").write(j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  } else {
+    add("stats.json").write(statistics_json(m, st, stats, run, &line));
+  }
   write_rows(add("force_processed.csv"), recorder.processed_columns(), recorder.processed_rows(m));
   {
     std::ostringstream c;
@@ -109,6 +123,30 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
     add("psd.csv").write(c.str());
   }
   if (m.scene.output.dropper_series) write_rows(add("dropper_series.csv"), recorder.dropper_columns(), recorder.dropper_rows());
+  if (three_d) {
+    write_rows(add("lateral.csv"), lateral->columns(), lateral->rows());
+    std::ostringstream h, b, p, d;
+    h << std::setprecision(9) << "pantograph,collector,from_m,to_m,percent_of_contact_time\n";
+    for (const LateralContactStatistics& c : lateral_stats.contacts)
+      for (std::size_t k = 0; k < c.histogram_percent.size(); ++k)
+        h << csv_field(c.pantograph) << "," << c.collector << "," << c.from + k * c.bin << "," << c.from + (k + 1) * c.bin
+          << "," << c.histogram_percent[k] << "\n";
+    add("lateral_histogram.csv").write(h.str());
+    b << std::setprecision(9) << "span,start_m,end_m,static_blow_off_m,max_blow_off_m,exceeded\n";
+    for (const SpanBlowOff& s : lateral_stats.spans)
+      b << s.span << "," << s.start << "," << s.end << "," << s.static_m << "," << s.max_m << "," << s.exceeded << "\n";
+    add("blow_off.csv").write(b.str());
+    p << std::setprecision(9) << "wire,station_m,stagger_m,anchor,rigid,pull_off_N,pull_off_mean_wind_N\n";
+    for (const LateralSupport& s : m.lateral->supports)
+      p << csv_field(m.wires[s.wire].name) << "," << s.x << "," << s.stagger << "," << s.anchor << "," << s.rigid << ","
+        << s.pull_off << "," << s.pull_off_wind << "\n";
+    add("pull_off.csv").write(p.str());
+    d << std::setprecision(9) << "pantograph,collector,time_s,station_m,lateral_m\n";
+    for (const DewirementEvent& e : lateral_stats.events)
+      d << csv_field(m.pantographs[e.pantograph].name) << "," << e.collector << "," << e.time << "," << e.station << ","
+        << e.lateral << "\n";
+    add("dewirements.csv").write(d.str());
+  }
   // All on the disk before any is renamed into place: a full disk leaves the old set (or none),
   // never a new CSV beside an old stats.json.
   for (auto& f : files) f->flush();

@@ -2,7 +2,8 @@
 //   simulate_pass --scene FILE [--speed KMH] [--set key=value ...] --out DIR [--report]
 // Prints a summary, writes DIR/stats.json, DIR/timeseries.csv and the measurement files
 // (force_processed.csv, contact_losses.csv, droppers.csv, dropper_rainflow.csv, psd.csv, and
-// dropper_series.csv when output.dropper_series), each whole or not at all (temporary file +
+// dropper_series.csv when output.dropper_series; lateral.csv, lateral_histogram.csv, blow_off.csv,
+// pull_off.csv and dewirements.csv on a 3-D line), each whole or not at all (temporary file +
 // rename), with DIR locked against a second run writing into it. --report then runs
 // scripts/pass_report on DIR (report.html and its PNGs).
 #include <sys/stat.h>
@@ -20,6 +21,9 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "catenary_sim/core/lateral_statistics.hpp"
 #include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/core/pass_files.hpp"
 #include "catenary_sim/core/simulation.hpp"
@@ -173,6 +177,7 @@ int main(int argc, char** argv) {
   }
 
   PassRecorder recorder(m, scene.output.sample_rate);
+  LateralRecorder lateral(m, scene.output.sample_rate);  // records nothing on a 2-D line
   if (!quiet) {
     if (m.endless)
       std::cout << "scene " << scene.name << ": endless line of " << m.endless_span << " m spans (a block of "
@@ -197,8 +202,10 @@ int main(int argc, char** argv) {
     }
     Progress progress(steps_needed, !quiet && !no_progress);
     recorder.record(m, sim->state());
+    lateral.record(m, sim->state());
     while ((status = sim->step()) == StepStatus::kOk) {
       recorder.record(m, sim->state());
+      lateral.record(m, sim->state());
       if (bag) bag->write(m, sim->state());
       progress.update(sim->state().steps, sim->state().time);
     }
@@ -218,8 +225,16 @@ int main(int argc, char** argv) {
     return kDiverged;
   }
 
+  if (status == StepStatus::kDewired) {
+    // The pass ends here as the scene asks (pantograph_head.on_dewirement: stop); what it ran is written.
+    recorder.record(m, sim->state());
+    lateral.record(m, sim->state());
+    std::cerr << "simulate_pass: " << sim->status_message() << "\n";
+  }
   const std::vector<PantographStatistics> stats = recorder.statistics(m);
   if (!all_finite(stats)) {
+    if (status == StepStatus::kDewired)
+      std::cerr << "simulate_pass: the pass stopped at the dewirement before it crossed the analysis section; nothing written\n";
     // Guarded by the scene checks (every pantograph crosses the analysis section); never written as null.
     std::cerr << "simulate_pass: the pass gave no statistics over the analysis section (output.analysis_spans); "
                  "nothing written\n";
@@ -232,7 +247,7 @@ int main(int argc, char** argv) {
     RunInfo run;
     run.wall_time_s = wall;
     run.build_time_s = build_s;
-    write_pass_files(out_dir, m, st, recorder, run);
+    write_pass_files(out_dir, m, st, recorder, run, &lateral, status == StepStatus::kDewired);
     if (!bag_tmp.empty() && std::rename(bag_tmp.c_str(), bag_path.c_str()) != 0)
       throw OutputError("cannot write '" + bag_path + "': rename failed");
   } catch (const OutputError& e) {
@@ -289,6 +304,31 @@ int main(int argc, char** argv) {
     if (scene.output.allowed_uplift)
       std::cout << "steady arms: " << exceeded << " of " << line.steady_arms.size() << " above the allowed uplift of "
                 << *scene.output.allowed_uplift * 1e3 << " mm\n";
+    if (m.lateral) {
+      const LateralStatistics ls = lateral.statistics(m, st);
+      std::cout << std::setprecision(3) << "3-D line (lateral plane, one-way coupling): working width +-"
+                << 0.5 * scene.pantograph_head.working_width << " m\n";
+      for (const LateralContactStatistics& c : ls.contacts)
+        std::cout << "  " << c.pantograph << " contact point across the strip: mean " << c.mean << " m, range " << c.min
+                  << " .. " << c.max << " m, sweep speed mean " << c.sweep_mean << " m/s (max " << c.sweep_max
+                  << " m/s), beyond the working width " << std::setprecision(2) << c.outside_working_percent << " % of the time\n"
+                  << std::setprecision(3);
+      double worst = 0.0, worst_static = 0.0;
+      int exceeded = 0;
+      for (const SpanBlowOff& b : ls.spans) {
+        worst = std::max(worst, b.max_m);
+        worst_static = std::max(worst_static, b.static_m);
+        exceeded += b.exceeded;
+      }
+      std::cout << "  blow-off of the contact wire: static " << worst_static << " m, max " << worst << " m";
+      if (scene.wind && scene.wind->blow_off_limit)
+        std::cout << "; " << exceeded << " of " << ls.spans.size() << " spans above the limit of " << *scene.wind->blow_off_limit << " m";
+      double pull = 0.0;
+      for (const LateralSupport& s : m.lateral->supports)
+        if (!s.anchor && m.wires[s.wire].is_contact_wire) pull = std::max(pull, std::fabs(s.pull_off));
+      std::cout << "\n  largest steady-arm pull-off " << std::setprecision(1) << pull << " N; dewirements: "
+                << ls.events_total << "\n";
+    }
     std::cout << "wrote " << stats_path << ", " << csv_path << " and the measurement files in " << out_dir << "\n";
     if (bag) std::cout << "wrote " << bag->messages() << " messages to " << bag_path << "\n";
   }

@@ -102,6 +102,8 @@ struct LateralState {
   Eigen::VectorXd y, v;      // m, m/s (v at the half step, eq. 20)
   Eigen::VectorXd f, z;      // workspace
   std::vector<double> theta, wind_points;
+  Eigen::VectorXd wind_speed;    // m/s, per node: the wind's speed normal to the wire now
+  double next_wind_update = 0.0;  // s
   std::vector<int> weight_node;
   std::vector<double> weight;
   // Per collector x contact wire: the contact point's lateral position on the strip (wire minus

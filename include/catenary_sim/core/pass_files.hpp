@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "catenary_sim/core/lateral_statistics.hpp"
 #include "catenary_sim/core/model.hpp"
 #include "catenary_sim/core/state.hpp"
 #include "catenary_sim/core/statistics.hpp"
@@ -19,15 +20,19 @@ namespace catenary_sim {
 // RFC 4180: a field with a comma, a quote or a line break is quoted, its quotes doubled.
 std::string csv_field(const std::string& s);
 
-// The names written by write_pass_files (dropper_series.csv only with output.dropper_series).
+// The names written by write_pass_files (dropper_series.csv only with output.dropper_series,
+// the lateral files only on a 3-D line).
 std::vector<std::string> pass_file_names(const Model& model);
 
 // Creates `dir` and checks every pass file in it can be written; throws OutputError naming it.
 void check_pass_files_writable(const std::string& dir, const Model& model);
 
 // Writes the pass's files into `dir`; throws OutputError (then none is renamed into place).
+// On a 3-D line (model.lateral) with `lateral`, also stats.json's "lateral" object and
+// lateral.csv, lateral_histogram.csv, blow_off.csv, pull_off.csv and dewirements.csv.
 void write_pass_files(const std::string& dir, const Model& model, const State& state, const PassRecorder& recorder,
-                      const RunInfo& run);
+                      const RunInfo& run, const LateralRecorder* lateral = nullptr,
+                      bool stopped_by_dewirement = false);
 
 // scripts/pass_report beside the sources this was built from, or in the installed share path;
 // empty if neither has it.

@@ -1,0 +1,83 @@
+// The 3-D line's cost: the reference pass (config/reference_55m.yaml, 300 km/h, accurate preset)
+// as the 2-D model and with a lateral plane (stagger alone; stagger with a turbulent cross wind,
+// as config/reference_55m_3d.yaml), bare and with the recorders simulate_pass runs, in one
+// process with the repetitions interleaved, so the real-time factors compare as ratios.
+//   bench_lateral [repetitions=5]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/lateral_statistics.hpp"
+#include "catenary_sim/core/simulation.hpp"
+#include "catenary_sim/core/statistics.hpp"
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+
+using namespace catenary_sim;
+
+int main(int argc, char** argv) {
+  const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
+  const std::string path = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  struct Variant {
+    std::string label;
+    std::vector<std::string> overrides;
+    bool record;
+  };
+  const std::vector<std::string> stagger{"stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]",
+                                         "stagger.steady_arm_stiffness=2e5"};
+  std::vector<std::string> windy = stagger;
+  for (const char* o : {"wind.speed=20", "wind.turbulence.intensity=0.15", "wind.turbulence.seed=1"}) windy.push_back(o);
+  const std::vector<Variant> variants{{"2-D", {}, false},
+                                      {"3-D stagger", stagger, false},
+                                      {"3-D stagger + turbulent wind", windy, false},
+                                      {"2-D + recorders", {}, true},
+                                      {"3-D stagger + wind + recorders", windy, true}};
+  std::vector<Scene> scenes;
+  for (const Variant& v : variants) scenes.push_back(load_scene_file(path, v.overrides));
+  std::vector<std::vector<double>> walls(variants.size());
+  std::vector<double> sim_time(variants.size()), dt(variants.size());
+  std::vector<int> dofs(variants.size());
+  for (int r = 0; r < reps; ++r)
+    for (std::size_t i = 0; i < variants.size(); ++i) {
+      Simulation sim(scenes[i]);  // building (statics, wind field) is not timed: only the pass
+      const Model& m = sim.model();
+      std::unique_ptr<PassRecorder> rec;
+      std::unique_ptr<LateralRecorder> lat;
+      if (variants[i].record) {
+        rec = std::make_unique<PassRecorder>(m, scenes[i].output.sample_rate);
+        lat = std::make_unique<LateralRecorder>(m, scenes[i].output.sample_rate);
+      }
+      const auto t0 = std::chrono::steady_clock::now();
+      if (rec) {
+        rec->record(m, sim.state());
+        lat->record(m, sim.state());
+        while (sim.step() == StepStatus::kOk) {
+          rec->record(m, sim.state());
+          lat->record(m, sim.state());
+        }
+      } else {
+        while (sim.step() == StepStatus::kOk) {
+        }
+      }
+      walls[i].push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      sim_time[i] = sim.state().time;
+      dt[i] = m.dt;
+      dofs[i] = m.n_dof + (m.lateral ? m.lateral->n : 0);
+    }
+  std::printf("%-34s %6s %9s %10s %10s %8s %10s\n", "variant", "DOFs", "dt_ms", "wall_med_s", "wall_min_s", "RTF_med", "RTF/2-D");
+  double base_rtf = 0.0, base_rec_rtf = 0.0;
+  for (std::size_t i = 0; i < variants.size(); ++i) {
+    std::sort(walls[i].begin(), walls[i].end());
+    const double med = walls[i][walls[i].size() / 2], rtf = sim_time[i] / med;
+    if (i == 0) base_rtf = rtf;
+    if (i == 3) base_rec_rtf = rtf;
+    std::printf("%-34s %6d %9.4f %10.4f %10.4f %8.1f %10.3f\n", variants[i].label.c_str(), dofs[i], dt[i] * 1e3, med,
+                walls[i].front(), rtf, rtf / (variants[i].record ? base_rec_rtf : base_rtf));
+  }
+  return 0;
+}

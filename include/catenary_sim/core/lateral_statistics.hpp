@@ -1,0 +1,67 @@
+// What the 3-D line reports (docs/offline_runs.md): where the contact point runs across the
+// strips (a histogram, the wear distribution, and the sweep speed), the wires' blow-off per span
+// against wind.blow_off_limit, the supports' pull-off forces and the dewirement events.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/lateral.hpp"
+#include "catenary_sim/core/state.hpp"
+#include "catenary_sim/core/statistics.hpp"
+
+namespace catenary_sim {
+
+// One collector over the analysis section.
+struct LateralContactStatistics {
+  std::string pantograph;
+  int collector = 0;
+  std::size_t samples = 0, contact_samples = 0;  // steps in the section; those with contact force
+  double mean = 0.0, std_dev = 0.0, min = 0.0, max = 0.0;  // m across the strip (+ left)
+  double sweep_mean = 0.0, sweep_max = 0.0;  // m/s, |d(lateral)/dt| (the rate the contact point crosses the strip)
+  // Share (%) of the contact time (steps with contact force) per bin of width `bin` from `from`,
+  // over the head's horn width: the strips' wear distribution.
+  double from = 0.0, bin = 0.0;
+  std::vector<double> histogram_percent;
+  double outside_working_percent = 0.0;  // share of the steps in the section beyond the working width
+};
+
+struct SpanBlowOff {
+  int span = 0;
+  double start = 0.0, end = 0.0;  // m
+  double static_m = 0.0;  // m, under the mean wind (largest |y - calm| on the contact wire)
+  double max_m = 0.0;     // m, over the pass (turbulence included), sampled every 5 ms
+  bool exceeded = false;  // max_m above wind.blow_off_limit
+};
+
+struct LateralStatistics {
+  std::vector<LateralContactStatistics> contacts;
+  std::vector<SpanBlowOff> spans;
+  std::vector<DewirementEvent> events;
+  std::int64_t events_total = 0;
+};
+
+class LateralRecorder {
+ public:
+  LateralRecorder(const Model& model, double sample_rate_hz = 0.0);
+  // The initial state, then the state after each successful step().
+  void record(const Model& model, const State& state);
+  LateralStatistics statistics(const Model& model, const State& state) const;
+  // Time series at the output sample rate: per collector its station and lateral position.
+  std::vector<std::string> columns() const { return columns_; }
+  const std::vector<PassRecorder::Row>& rows() const { return rows_; }
+
+ private:
+  double sample_period_ = 0.0, next_sample_ = 0.0, next_blow_off_ = 0.0;
+  std::vector<std::string> columns_;
+  std::vector<PassRecorder::Row> rows_;
+  std::vector<double> time_;
+  std::vector<std::vector<double>> station_, lateral_;  // per collector, every step
+  std::vector<std::vector<char>> contact_;             // per collector, every step: force on it
+  std::vector<double> max_blow_off_;                   // per span
+};
+
+// The "lateral" object of stats.json (JSON text).
+std::string lateral_statistics_json(const Model& model, const LateralStatistics& stats);
+
+}  // namespace catenary_sim

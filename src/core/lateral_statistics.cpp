@@ -1,0 +1,184 @@
+#include "catenary_sim/core/lateral_statistics.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace catenary_sim {
+
+namespace {
+constexpr double kBlowOffPeriod = 0.005;  // s: the wind moves the wires at a few Hz at most
+}
+
+LateralRecorder::LateralRecorder(const Model& m, double sample_rate_hz)
+    : sample_period_(sample_rate_hz > 0.0 ? 1.0 / sample_rate_hz : 0.0) {
+  station_.resize(m.collectors.size());
+  lateral_.resize(m.collectors.size());
+  contact_.resize(m.collectors.size());
+  for (std::size_t c = 0; c < m.collectors.size(); ++c) {
+    const std::string name = m.pantographs[m.collectors[c].pantograph].name +
+                             (m.pantographs[m.collectors[c].pantograph].collectors.size() > 1 ? "_" + std::to_string(c) : "");
+    columns_.push_back(name + "_station_m");
+    columns_.push_back(name + "_lateral_m");
+  }
+  if (m.lateral) max_blow_off_.assign(m.lateral->spans, 0.0);
+}
+
+void LateralRecorder::record(const Model& m, const State& s) {
+  if (!m.lateral) return;
+  const LateralModel& lat = *m.lateral;
+  const std::size_t nw = m.contact_wires.size();
+  time_.push_back(s.time);
+  for (std::size_t c = 0; c < m.collectors.size(); ++c) {
+    const Collector& col = m.collectors[c];
+    const double x = s.front + s.line_offset - m.pantographs[col.pantograph].position + col.offset;
+    station_[c].push_back(x);
+    lateral_[c].push_back(s.lateral.collector_lateral[c]);
+    double f = 0.0;
+    for (std::size_t k = 0; k < nw; ++k) f += s.contact_force[c * nw + k];
+    contact_[c].push_back(f > 0.0);
+  }
+  if (s.time + 1e-12 >= next_blow_off_) {
+    next_blow_off_ = s.time + kBlowOffPeriod;
+    for (int i = 0; i < lat.n; ++i) {
+      const int span = lat.node_span[i];
+      if (span < 0) continue;
+      max_blow_off_[span] = std::max(max_blow_off_[span], std::fabs(s.lateral.y[i] - lat.calm[i]));
+    }
+  }
+  if (sample_period_ > 0.0 && s.time + 1e-12 < next_sample_) return;
+  next_sample_ += sample_period_;
+  PassRecorder::Row r{s.time, {}};
+  for (std::size_t c = 0; c < m.collectors.size(); ++c) {
+    r.values.push_back(station_[c].back());
+    r.values.push_back(lateral_[c].back());
+  }
+  rows_.push_back(std::move(r));
+}
+
+LateralStatistics LateralRecorder::statistics(const Model& m, const State& s) const {
+  LateralStatistics out;
+  if (!m.lateral) return out;
+  const LateralModel& lat = *m.lateral;
+  const PantographHeadSpec& head = m.scene.pantograph_head;
+  double x0 = 0.0, x1 = 0.0;
+  analysis_section(m, &x0, &x1);
+  for (std::size_t c = 0; c < m.collectors.size(); ++c) {
+    LateralContactStatistics st;
+    st.pantograph = m.pantographs[m.collectors[c].pantograph].name;
+    st.collector = static_cast<int>(c);
+    st.bin = head.histogram_bin;
+    const int bins = std::max(1, static_cast<int>(std::ceil(head.horn_width / st.bin - 1e-9)));
+    st.from = -0.5 * bins * st.bin;
+    st.histogram_percent.assign(bins, 0.0);
+    double sum = 0.0, sum2 = 0.0, sweep = 0.0;
+    st.min = std::numeric_limits<double>::infinity();
+    st.max = -st.min;
+    std::size_t outside = 0, sweeps = 0;
+    for (std::size_t k = 0; k < time_.size(); ++k) {
+      const double x = station_[c][k], y = lateral_[c][k];
+      if (x < x0 || x > x1 || std::isnan(y)) continue;
+      ++st.samples;
+      sum += y;
+      sum2 += y * y;
+      st.min = std::min(st.min, y);
+      st.max = std::max(st.max, y);
+      outside += std::fabs(y) > lat.half_working_width;
+      if (k > 0 && !std::isnan(lateral_[c][k - 1]) && time_[k] > time_[k - 1]) {
+        const double v = std::fabs(y - lateral_[c][k - 1]) / (time_[k] - time_[k - 1]);
+        sweep += v;
+        st.sweep_max = std::max(st.sweep_max, v);
+        ++sweeps;
+      }
+      if (contact_[c][k]) {
+        ++st.contact_samples;
+        const int b = static_cast<int>(std::floor((y - st.from) / st.bin));
+        if (b >= 0 && b < bins) st.histogram_percent[b] += 1.0;
+      }
+    }
+    if (st.samples) {
+      const double n = static_cast<double>(st.samples);
+      st.mean = sum / n;
+      st.std_dev = std::sqrt(std::max(0.0, sum2 / n - st.mean * st.mean));
+      st.outside_working_percent = 100.0 * outside / n;
+    } else {
+      st.min = st.max = std::nan("");
+    }
+    if (sweeps) st.sweep_mean = sweep / sweeps;
+    if (st.contact_samples)
+      for (double& h : st.histogram_percent) h *= 100.0 / st.contact_samples;
+    out.contacts.push_back(std::move(st));
+  }
+  const std::optional<double> limit = m.scene.wind ? m.scene.wind->blow_off_limit : std::nullopt;
+  for (int k = 0; k < lat.spans; ++k) {
+    SpanBlowOff b;
+    b.span = k;
+    b.start = m.support_x[k] + s.line_offset;
+    b.end = m.support_x[k + 1] + s.line_offset;
+    b.static_m = lat.static_blow_off[k];
+    b.max_m = std::max(max_blow_off_[k], b.static_m);
+    b.exceeded = limit && b.max_m > *limit;
+    out.spans.push_back(b);
+  }
+  out.events = s.lateral.events;
+  out.events_total = s.lateral.events_total;
+  return out;
+}
+
+std::string lateral_statistics_json(const Model& m, const LateralStatistics& st) {
+  using Json = nlohmann::json;
+  Json j;
+  if (!m.lateral) return "null";
+  const LateralModel& lat = *m.lateral;
+  const Scene& sc = m.scene;
+  j["working_width_m"] = sc.pantograph_head.working_width;
+  j["horn_width_m"] = sc.pantograph_head.horn_width;
+  j["coupling"] = "one-way: dropper tensions set the lateral pendulums; the lateral motion does not act on the vertical plane";
+  j["lateral_dofs"] = lat.n;
+  j["lateral_substeps"] = lat.substeps;
+  Json contacts = Json::array();
+  for (const LateralContactStatistics& c : st.contacts) {
+    Json cj;
+    cj["pantograph"] = c.pantograph;
+    cj["collector"] = c.collector;
+    cj["samples"] = c.samples;
+    cj["contact_samples"] = c.contact_samples;
+    cj["mean_m"] = c.mean;
+    cj["std_m"] = c.std_dev;
+    cj["min_m"] = c.min;
+    cj["max_m"] = c.max;
+    cj["sweep_speed_mean_mps"] = c.sweep_mean;
+    cj["sweep_speed_max_mps"] = c.sweep_max;
+    cj["outside_working_width_percent"] = c.outside_working_percent;
+    cj["histogram"] = {{"from_m", c.from}, {"bin_m", c.bin}, {"percent_of_contact_time", c.histogram_percent}};
+    contacts.push_back(cj);
+  }
+  j["contact_points"] = contacts;
+  Json spans = Json::array();
+  for (const SpanBlowOff& b : st.spans)
+    spans.push_back({{"span", b.span}, {"start_m", b.start}, {"end_m", b.end}, {"static_blow_off_m", b.static_m},
+                     {"max_blow_off_m", b.max_m}, {"exceeded", b.exceeded}});
+  j["blow_off"] = spans;
+  if (sc.wind && sc.wind->blow_off_limit) {
+    int exceeded = 0;
+    for (const SpanBlowOff& b : st.spans) exceeded += b.exceeded;
+    j["blow_off_limit_m"] = *sc.wind->blow_off_limit;
+    j["blow_off_spans_exceeded"] = exceeded;
+  }
+  Json supports = Json::array();
+  for (const LateralSupport& s : lat.supports)
+    supports.push_back({{"wire", m.wires[s.wire].name}, {"station_m", s.x}, {"stagger_m", s.stagger}, {"anchor", s.anchor},
+                        {"rigid", s.rigid}, {"pull_off_N", s.pull_off}, {"pull_off_mean_wind_N", s.pull_off_wind}});
+  j["supports"] = supports;
+  Json events = Json::array();
+  for (const DewirementEvent& e : st.events)
+    events.push_back({{"time_s", e.time}, {"station_m", e.station}, {"pantograph", m.pantographs[e.pantograph].name},
+                      {"collector", e.collector}, {"lateral_m", e.lateral}});
+  j["dewirements"] = events;
+  j["dewirements_total"] = st.events_total;
+  j["on_dewirement"] = sc.pantograph_head.on_dewirement == DewirementAction::kStop ? "stop" : "continue";
+  return j.dump(2, ' ', false, Json::error_handler_t::replace);
+}
+
+}  // namespace catenary_sim
