@@ -322,6 +322,7 @@ def _report_dir(out, i):
 def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=True):
     """Runs (or resumes) a study into `out`; returns the results table (pandas.DataFrame)."""
     import pandas as pd
+    import dask
     from dask.distributed import Client, LocalCluster, as_completed
     from tqdm import tqdm
 
@@ -350,7 +351,11 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
         if scheduler:
             client = Client(scheduler)
         else:
-            own = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+            # Without the workers' statistical profiler: it samples every 10 ms a thread that sits in
+            # one C++ call, learns nothing, and takes CPU from the other worker on a 2-core machine
+            # (2 workers ran 1.69x one worker with it, 1.8x without; BENCHMARKS.md).
+            with dask.config.set({"distributed.worker.profile.enabled": False}):
+                own = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
             client = Client(own)
         try:
             futures = {client.submit(run_case, study["scene"], study["overrides"], cases[i], study["outputs"],

@@ -128,7 +128,8 @@ PYBIND11_MODULE(_core, m) {
            },
            py::arg("path"), py::arg("overrides"), py::arg("sample_rate"))
       .def("step", &PySimulation::step, py::arg("n") = 1, py::call_guard<py::gil_scoped_release>())
-      .def("run", &PySimulation::run, py::arg("max_steps") = 2e7)
+      // The whole pass without the GIL: other Python threads (a Dask worker's heartbeats) run meanwhile.
+      .def("run", &PySimulation::run, py::arg("max_steps") = 2e7, py::call_guard<py::gil_scoped_release>())
       .def("statistics_json", &PySimulation::statistics_json, py::arg("wall_s") = 0.0)
       .def("write_pass_files", &PySimulation::write_pass_files, py::arg("dir"), py::arg("wall_s") = 0.0)
       .def("series", &PySimulation::series)
