@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <sstream>
 
 #include "catenary_sim/core/beam.hpp"
@@ -164,8 +165,35 @@ void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wi
   }
 }
 
+// The built line's stagger errors per line support (imperfections.stagger_std or stagger_errors):
+// normal errors from a generator of their own, so adding them leaves every other draw as it was.
+std::vector<double> stagger_errors(const Model& m) {
+  const ImperfectionSpec& im = m.scene.imperfections;
+  const std::size_t n = m.support_x.size();
+  if (!im.stagger_errors.empty()) {
+    if (im.stagger_errors.size() != n)
+      throw SceneError("scene field 'imperfections.stagger_errors' = (" + std::to_string(im.stagger_errors.size()) +
+                       " values): one per support in line order (" + std::to_string(n) + ")");
+    return im.stagger_errors;
+  }
+  std::vector<double> e(n, 0.0);
+  if (!(im.stagger_std > 0.0)) return e;
+  // SplitMix64 of the study seed: a stream apart from the dropper and steady-arm draws of `seed`.
+  std::uint64_t z = im.seed + 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  std::mt19937_64 gen(im.stagger_seed ? *im.stagger_seed : z ^ (z >> 31));
+  auto unit = [&] { return (static_cast<double>(gen() >> 11) + 0.5) * 0x1.0p-53; };  // (0, 1)
+  for (double& v : e) {
+    const double u1 = unit(), u2 = unit();
+    v = im.stagger_std * std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);  // Box-Muller
+  }
+  return e;
+}
+
 std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   const Scene& sc = m.scene;
+  const std::vector<double> stagger_error = stagger_errors(m);
   auto lat = std::make_shared<LateralModel>();
   int off = 0;
   for (const Wire& w : m.wires) {
@@ -214,7 +242,7 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
       s.node = w.support_nodes[k];
       s.x = w.x[s.node];
       s.line_support = line_support(m, s.x);
-      s.stagger = stagger_at(sc, w.is_contact_wire, s.line_support);
+      s.stagger = stagger_at(sc, w.is_contact_wire, s.line_support) + (w.is_contact_wire ? stagger_error[s.line_support] : 0.0);
       s.anchor = k == 0 || k == ns - 1;
       const std::optional<double>& spring = w.is_contact_wire ? arm_k : msup_k;
       s.rigid = s.anchor || !spring;

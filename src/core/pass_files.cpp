@@ -71,6 +71,15 @@ void check_pass_files_writable(const std::string& dir, const Model& model) {
   for (const std::string& name : pass_file_names(model)) check_writable(dir + "/" + name);
 }
 
+std::string add_lateral_statistics(const std::string& stats_json, const Model& m, const LateralStatistics& lateral,
+                                   bool stopped_by_dewirement) {
+  if (!m.lateral) return stats_json;
+  nlohmann::json j = nlohmann::json::parse(stats_json);
+  j["lateral"] = nlohmann::json::parse(lateral_statistics_json(m, lateral));
+  j["stopped_by_dewirement"] = stopped_by_dewirement;
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
 void write_pass_files(const std::string& dir, const Model& m, const State& st, const PassRecorder& recorder,
                       const RunInfo& run, const LateralRecorder* lateral, bool stopped_by_dewirement) {
   const std::vector<PantographStatistics> stats = recorder.statistics(m);
@@ -83,14 +92,8 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
   write_rows(add("timeseries.csv"), recorder.columns(), recorder.rows());
   const bool three_d = m.lateral && lateral;
   const LateralStatistics lateral_stats = three_d ? lateral->statistics(m, st) : LateralStatistics{};
-  if (three_d) {
-    nlohmann::json j = nlohmann::json::parse(statistics_json(m, st, stats, run, &line));
-    j["lateral"] = nlohmann::json::parse(lateral_statistics_json(m, lateral_stats));
-    j["stopped_by_dewirement"] = stopped_by_dewirement;
-    add("stats.json").write(j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
-  } else {
-    add("stats.json").write(statistics_json(m, st, stats, run, &line));
-  }
+  add("stats.json").write(add_lateral_statistics(statistics_json(m, st, stats, run, &line), m, lateral_stats,
+                                                  stopped_by_dewirement));
   write_rows(add("force_processed.csv"), recorder.processed_columns(), recorder.processed_rows(m));
   {
     std::ostringstream c;

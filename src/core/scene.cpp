@@ -774,11 +774,14 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
     const double seed = r.number("seed", 0.0, 9007199254740992.0, 0.0);
     if (seed != std::floor(seed)) fail("imperfections.seed", fmt(seed), "a whole number >= 0");
     im.seed = static_cast<std::uint64_t>(seed);
-    for (const char* k : {"dropper_length_seed", "support_height_seed"}) {
+    for (const char* k : {"dropper_length_seed", "support_height_seed", "stagger_seed"}) {
       if (!r.has(k)) continue;
       const double v = r.number(k, 0.0, 9007199254740992.0);
       if (v != std::floor(v)) fail(std::string("imperfections.") + k, fmt(v), "a whole number >= 0");
-      (std::string(k) == "dropper_length_seed" ? im.dropper_length_seed : im.support_height_seed) = static_cast<std::uint64_t>(v);
+      const std::string key(k);
+      (key == "dropper_length_seed"   ? im.dropper_length_seed
+       : key == "support_height_seed" ? im.support_height_seed
+                                      : im.stagger_seed) = static_cast<std::uint64_t>(v);
     }
     im.dropper_length_std = r.number("dropper_length_std", 0.0, 0.1, 0.0);
     if (r.has("dropper_length_errors")) im.dropper_length_errors = r.numbers("dropper_length_errors", -0.5, 0.5);
@@ -788,6 +791,10 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
     if (r.has("support_height_errors")) im.support_height_errors = r.numbers("support_height_errors", -0.5, 0.5);
     if (im.support_height_std > 0.0 && !im.support_height_errors.empty())
       fail("imperfections.support_height_errors", "(given with support_height_std)", "give either errors or a std");
+    im.stagger_std = r.number("stagger_std", 0.0, 0.2, 0.0);
+    if (r.has("stagger_errors")) im.stagger_errors = r.numbers("stagger_errors", -0.5, 0.5);
+    if (im.stagger_std > 0.0 && !im.stagger_errors.empty())
+      fail("imperfections.stagger_errors", "(given with stagger_std)", "give either errors or a std");
     if (r.has("point_masses")) {
       const YAML::Node pm = r.child("point_masses");
       if (!pm.IsSequence()) fail("imperfections.point_masses", "(not a list)", "a list of {station: m, mass: kg}");
@@ -919,6 +926,9 @@ void validate(const Scene& s) {
                " N; a net downward aerodynamic pull is not physical for a pantograph in service");
     }
   }
+  if ((s.imperfections.stagger_std > 0.0 || !s.imperfections.stagger_errors.empty()) && !s.stagger)
+    fail(s.imperfections.stagger_std > 0.0 ? "imperfections.stagger_std" : "imperfections.stagger_errors", "(given)",
+         "a 3-D line: give the design stagger (scene field 'stagger') the errors move");
   if (s.imperfections.any()) {
     if (s.endless)
       fail("imperfections", "(given)", "a finite line: an endless line repeats one perfect span");

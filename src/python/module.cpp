@@ -33,8 +33,11 @@ class PySimulation {
  public:
   // sample_rate < 0: the scene's output.sample_rate.
   PySimulation(const Scene& scene, double sample_rate)
-      : sim_(scene), recorder_(sim_.model(), sample_rate < 0.0 ? scene.output.sample_rate : sample_rate) {
+      : sim_(scene),
+        recorder_(sim_.model(), sample_rate < 0.0 ? scene.output.sample_rate : sample_rate),
+        lateral_(sim_.model(), sample_rate < 0.0 ? scene.output.sample_rate : sample_rate) {
     recorder_.record(sim_.model(), sim_.state());
+    lateral_.record(sim_.model(), sim_.state());
   }
 
   // Steps up to n times; stops at the end of the pass or a divergence. Returns the steps taken.
@@ -44,6 +47,7 @@ class PySimulation {
     for (; done < n && !sim_.finished(); ++done) {
       if (sim_.step() != StepStatus::kOk) break;
       recorder_.record(sim_.model(), sim_.state());
+      lateral_.record(sim_.model(), sim_.state());
     }
     if (sim_.state().status == StepStatus::kDiverged) throw std::runtime_error(sim_.status_message());
     return done;
@@ -62,15 +66,20 @@ class PySimulation {
   }
 
   std::string statistics_json(double wall_s) const {
-    return catenary_sim::statistics_json(sim_.model(), sim_.state(), recorder_.statistics(sim_.model()),
-                                         RunInfo{wall_s, -1.0, -1});
+    const Model& m = sim_.model();
+    const std::string s =
+        catenary_sim::statistics_json(m, sim_.state(), recorder_.statistics(m), RunInfo{wall_s, -1.0, -1});
+    return m.lateral ? add_lateral_statistics(s, m, lateral_.statistics(m, sim_.state()),
+                                              sim_.state().status == StepStatus::kDewired)
+                     : s;
   }
 
   // simulate_pass's files of the pass in `dir` (core/pass_files: each whole or not at all).
   void write_pass_files(const std::string& dir, double wall_s) const {
     try {
       make_directories(dir);
-      catenary_sim::write_pass_files(dir, sim_.model(), sim_.state(), recorder_, RunInfo{wall_s, -1.0, -1});
+      catenary_sim::write_pass_files(dir, sim_.model(), sim_.state(), recorder_, RunInfo{wall_s, -1.0, -1}, &lateral_,
+                                     sim_.state().status == StepStatus::kDewired);
     } catch (const OutputError& e) {
       throw py::value_error(e.what());
     }
@@ -99,6 +108,7 @@ class PySimulation {
 
   Simulation sim_;
   PassRecorder recorder_;
+  LateralRecorder lateral_;  // records nothing on a 2-D line
 };
 
 }  // namespace
@@ -138,6 +148,8 @@ PYBIND11_MODULE(_core, m) {
         s.sim_.reset(true);
         s.recorder_ = PassRecorder(s.sim_.model(), 0.0);
         s.recorder_.record(s.sim_.model(), s.sim_.state());
+        s.lateral_ = LateralRecorder(s.sim_.model(), 0.0);
+        s.lateral_.record(s.sim_.model(), s.sim_.state());
       })
       .def_property_readonly("time", [](const PySimulation& s) { return s.sim_.state().time; })
       .def_property_readonly("steps", [](const PySimulation& s) { return static_cast<long long>(s.sim_.state().steps); })

@@ -387,3 +387,135 @@ TEST(Lateral, BadInputNamesTheField) {
     EXPECT_NE(std::string(e.what()).find("stagger"), std::string::npos) << e.what();
   }
 }
+
+TEST(Lateral, StaggerErrorsMoveTheRegistration) {
+  // A built line's registrations are off their design stagger (imperfections.stagger_errors).
+  // (a) A contact wire alone on 4 spans of 50 m, rigid registrations: it is held at design + error
+  // at each support and runs along the chords between them, up to the tensioned beam's rounding
+  // of each kink (StaggerChordsUnderThePantograph): c = |slope change| / (lambda - 2 / L).
+  {
+    const std::vector<double> err{0.0, 0.05, -0.04, 0.02, 0.0};
+    const std::string yaml = "line: {spans: [50, 50, 50, 50]}\n"
+                             "contact_wire: {linear_mass: 1.35, bending_stiffness: 195, tension: 20000}\n"
+                             "stagger: {contact_wire: [0.3, -0.3]}\n"
+                             "imperfections: {stagger_errors: [0.0, 0.05, -0.04, 0.02, 0.0]}\n";
+    const Model m = build_model(load_scene_string(yaml));
+    ASSERT_TRUE(m.lateral);
+    ASSERT_EQ(m.support_x.size(), err.size());
+    const Eigen::VectorXd& y = m.lateral->calm;
+    const Wire& cw = m.lateral->wires[0];
+    const double L = 50.0, lambda = std::sqrt(20000.0 / 195.0);
+    for (const LateralSupport& s : m.lateral->supports) {
+      const double design = s.line_support % 2 ? -0.3 : 0.3;
+      EXPECT_NEAR(s.stagger, design + err[s.line_support], 1e-12);
+      EXPECT_NEAR(y[cw.w_dof + s.node], design + err[s.line_support], 1e-12);  // held rigidly
+    }
+    auto at = [&](int k) { return (k % 2 ? -0.3 : 0.3) + err[k]; };
+    double worst = 0.0, c_max = 0.0;
+    for (int k = 1; k < 4; ++k)
+      c_max = std::max(c_max, std::fabs((at(k + 1) - at(k)) - (at(k) - at(k - 1))) / L / (lambda - 2.0 / L));
+    for (int i = 0; i < cw.nodes(); ++i) {
+      const double x = cw.x[i];
+      const int k = std::min(3, static_cast<int>(std::floor(x / L)));
+      const double chord = at(k) + (at(k + 1) - at(k)) * (x - L * k) / L;
+      worst = std::max(worst, std::fabs(y[cw.w_dof + i] - chord));
+    }
+    // Each rounding decays as exp(-lambda |x - support|) away from its support: the largest c bounds
+    // the departure anywhere (1.2 mm here); a registration not moved would be off by up to 50 mm.
+    EXPECT_LT(worst, c_max * 1.05);
+    EXPECT_GT(c_max, 5e-4);
+  }
+  // (b) On the reference line the messenger stays where it was designed, and the droppers
+  // (pendulums, tension / length) couple it to the moved contact wire: the change against the line
+  // without errors is held at the errors at the supports and, by the maximum principle of the
+  // tensioned wires' statics, lies between the largest and smallest error (and the messenger's 0)
+  // everywhere, up to the beam's rounding c (3e-4 m for these errors).
+  {
+    const std::vector<double> err{0.0, 0.05, -0.04, 0.02, 0.0};
+    const std::vector<std::string> base{"line.span_count=4", "output.analysis_spans=[1,3]", "stagger.contact_wire=[0.3,-0.3]"};
+    std::vector<std::string> with_errors = base;
+    with_errors.push_back("imperfections.stagger_errors=[0.0,0.05,-0.04,0.02,0.0]");
+    const Model m = build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", with_errors));
+    const Model m0 = build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", base));
+    const Eigen::VectorXd& y = m.lateral->calm;
+    const Eigen::VectorXd& y0 = m0.lateral->calm;
+    const Wire& cw = m.lateral->wires[m.contact_wires.front()];
+    for (const LateralSupport& s : m.lateral->supports) {
+      if (!m.wires[s.wire].is_contact_wire) continue;
+      EXPECT_NEAR(y[cw.w_dof + s.node] - y0[cw.w_dof + s.node], err[s.line_support], 1e-12);
+    }
+    const double c = 0.18 / 55.0 / (std::sqrt(22000.0 / 195.0) - 2.0 / 55.0);
+    for (int i = 0; i < y.size(); ++i) {
+      EXPECT_GE(y[i] - y0[i], -0.04 - c);
+      EXPECT_LE(y[i] - y0[i], 0.05 + c);
+    }
+  }
+}
+
+TEST(Lateral, RandomStaggerErrorsHaveTheirStdAndLeaveTheOtherDraws) {
+  // 101 supports with stagger_std 0.03 m: the sample std within 4 standard errors of the std
+  // (the standard error of a sample std is std / sqrt(2 n) = 7 %) and the mean within 4 std / sqrt(n).
+  // The realisation is fixed by the seed (not drawn anew per run): the bounds say the generator
+  // draws the asked distribution, and only a wrong one fails them.
+  const std::vector<std::string> base{"line.span_count=100", "output.analysis_spans=[1,3]",
+                                      "stagger.contact_wire=[0.3,-0.3]", "imperfections.dropper_length_std=0.003",
+                                      "imperfections.seed=7"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> o = base;
+    o.insert(o.end(), extra.begin(), extra.end());
+    return build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", o));
+  };
+  auto errors = [](const Model& m) {
+    std::vector<double> e;
+    for (const LateralSupport& s : m.lateral->supports)
+      if (m.wires[s.wire].is_contact_wire) e.push_back(s.stagger - (s.line_support % 2 ? -0.3 : 0.3));
+    return e;
+  };
+  const Model a = with({"imperfections.stagger_std=0.03"});
+  const std::vector<double> e = errors(a);
+  ASSERT_EQ(e.size(), 101u);
+  const double n = static_cast<double>(e.size());
+  const double mean = std::accumulate(e.begin(), e.end(), 0.0) / n;
+  double ss = 0.0;
+  for (double v : e) ss += (v - mean) * (v - mean);
+  const double sd = std::sqrt(ss / (n - 1.0));
+  EXPECT_NEAR(mean, 0.0, 4.0 * 0.03 / std::sqrt(n));
+  EXPECT_NEAR(sd, 0.03, 4.0 * 0.03 / std::sqrt(2.0 * n));
+  // The same seed gives the same line; stagger_seed another realisation.
+  EXPECT_EQ(errors(with({"imperfections.stagger_std=0.03"})), e);
+  EXPECT_NE(errors(with({"imperfections.stagger_std=0.03", "imperfections.stagger_seed=8"})), e);
+  // The dropper errors drawn from `seed` are the same with or without stagger errors, and the
+  // stagger errors are not the dropper errors' numbers again (their own stream).
+  const Model b = with({});
+  ASSERT_EQ(a.droppers.size(), b.droppers.size());
+  for (std::size_t k = 0; k < a.droppers.size(); ++k) EXPECT_EQ(a.droppers[k].static_tension, b.droppers[k].static_tension);
+  const Model ref = build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+                                                {"line.span_count=100", "output.analysis_spans=[1,3]"}));
+  const double k0 = ref.droppers[0].stiffness;
+  // Dropper k's error e_d = (T_ref - T) / k; the first dropper's would be e[0] / 0.03 * 0.003 if shared.
+  const double first_dropper_error = (ref.droppers[0].static_tension - b.droppers[0].static_tension) / k0;
+  EXPECT_GT(std::fabs(first_dropper_error / 0.003 - e[0] / 0.03), 1e-6);
+}
+
+TEST(Lateral, StaggerErrorsBadInputNamesTheField) {
+  auto error_of = [](const std::vector<std::string>& o) {
+    try {
+      build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", o));
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(error_of({"imperfections.stagger_std=0.02"}).find("imperfections.stagger_std"), std::string::npos);
+  EXPECT_NE(error_of({"stagger.contact_wire=[0.3,-0.3]", "imperfections.stagger_std=-0.02"}).find("imperfections.stagger_std"),
+            std::string::npos);
+  EXPECT_NE(error_of({"stagger.contact_wire=[0.3,-0.3]", "imperfections.stagger_errors=[0.01,0.02]"})
+                .find("imperfections.stagger_errors"),
+            std::string::npos);
+  EXPECT_NE(error_of({"stagger.contact_wire=[0.3,-0.3]", "imperfections.stagger_std=0.02",
+                      "imperfections.stagger_errors=[0.01]"})
+                .find("imperfections.stagger_errors"),
+            std::string::npos);
+  EXPECT_NE(error_of({"stagger.contact_wire=[0.3,-0.3]", "imperfections.stagger_seed=1.5"}).find("imperfections.stagger_seed"),
+            std::string::npos);
+}

@@ -141,3 +141,29 @@ def test_steady_arms_sit_at_the_supports_at_the_contact_wire_height():
         assert abs(spans - round(spans)) < 1e-9 and 0 <= round(spans) <= line["span_count"]
         assert a["design_height_m"] == pytest.approx(line["contact_wire_height"], abs=1e-9)
         assert a["wire_start_m"] == 0.0
+
+
+def test_a_3d_pass_reports_the_contact_point_across_the_strip_as_simulate_pass_does():
+    # Stagger +-0.3 m, no wind: the wire runs along the chords between the registrations, so the
+    # contact point sweeps the strip from -0.3 to +0.3 m (within the beam's 1 mm rounding of each
+    # kink, test_lateral's StaggerChordsUnderThePantograph) at the rate the chord slope and the
+    # speed set: 0.6 m per 55 m span at 300 km/h = 0.909 m/s. The statistics are those of
+    # simulate_pass (one writer, core/pass_files), and a 2-D scene has no lateral object.
+    over = {"line.span_count": 6, "output.analysis_spans": [1, 5], "stagger.contact_wire": [0.3, -0.3],
+            "train.speed_kmh": 300}
+    stats, _ = cs.run_pass(REFERENCE, overrides=over)
+    c = stats["lateral"]["contact_points"][0]
+    assert c["max_m"] == pytest.approx(0.3, abs=1e-3)
+    assert c["min_m"] == pytest.approx(-0.3, abs=1e-3)
+    assert c["sweep_speed_mean_mps"] == pytest.approx(0.6 / 55.0 * 300 / 3.6, rel=0.01)
+    assert stats["stopped_by_dewirement"] is False
+    with tempfile.TemporaryDirectory() as d:
+        binary = os.path.join(os.environ.get("CATENARY_SIM_DEVEL_LIB", os.path.join(ROOT, ".ws/devel/lib/catenary_sim")),
+                              "simulate_pass")
+        subprocess.run([binary, "--scene", REFERENCE, "--out", d, "--quiet"] +
+                       [f"--set={k}={json.dumps(v).replace(' ', '')}" for k, v in over.items()], check=True)
+        with open(os.path.join(d, "stats.json")) as f:
+            tool = json.load(f)
+        assert os.path.exists(os.path.join(d, "lateral.csv"))
+    assert tool["lateral"]["contact_points"][0]["max_m"] == c["max_m"]
+    assert "lateral" not in cs.run_pass(REFERENCE, overrides={"line.span_count": 4, "output.analysis_spans": [1, 3]})[0]

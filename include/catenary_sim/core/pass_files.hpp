@@ -27,6 +27,11 @@ std::vector<std::string> pass_file_names(const Model& model);
 // Creates `dir` and checks every pass file in it can be written; throws OutputError naming it.
 void check_pass_files_writable(const std::string& dir, const Model& model);
 
+// stats.json text with the 3-D line's "lateral" object and "stopped_by_dewirement" added (the
+// text as it is on a 2-D line).
+std::string add_lateral_statistics(const std::string& stats_json, const Model& model, const LateralStatistics& lateral,
+                                   bool stopped_by_dewirement);
+
 // Writes the pass's files into `dir`; throws OutputError (then none is renamed into place).
 // On a 3-D line (model.lateral) with `lateral`, also stats.json's "lateral" object and
 // lateral.csv, lateral_histogram.csv, blow_off.csv, pull_off.csv and dewirements.csv.

@@ -221,12 +221,19 @@ struct ImperfectionSpec {
   std::vector<double> dropper_length_errors;  // m per dropper in line order (instead of the std)
   double support_height_std = 0.0;            // m: each steady arm's assembly height y0 of eq. 4 raised by a normal error
   std::vector<double> support_height_errors;  // m per steady arm in line order (instead of the std)
+  // m: each support's contact-wire stagger (the steady arm's registration, 3-D line only) moved
+  // sideways by a normal error, or per support in line order; drawn from stagger_seed, unset: from
+  // a stream of `seed` of its own (SplitMix64 of seed; the dropper and arm draws stay as they were).
+  double stagger_std = 0.0;
+  std::vector<double> stagger_errors;
+  std::optional<std::uint64_t> stagger_seed;
   std::vector<PointMassSpec> point_masses;
   IrregularitySpec contact_wire_irregularity;
   WearSpec contact_wire_wear;
   bool any() const {
     return dropper_length_std > 0.0 || !dropper_length_errors.empty() || support_height_std > 0.0 ||
-           !support_height_errors.empty() || !point_masses.empty() || contact_wire_irregularity.any() ||
+           !support_height_errors.empty() || stagger_std > 0.0 || !stagger_errors.empty() || !point_masses.empty() ||
+           contact_wire_irregularity.any() ||
            contact_wire_wear.any();
   }
 };
