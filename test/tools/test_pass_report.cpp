@@ -102,6 +102,27 @@ TEST_F(PassReport, ShortPassBuildsEverySection) {
   EXPECT_EQ(j.at("steady_arms").size(), 3u);  // supports 2, 3, 4 bound the section [110, 220] m
 }
 
+// The 3-D line's section: its files written and drawn, the page one picture longer.
+TEST_F(PassReport, ThreeDimensionalLineAddsTheLateralSection) {
+  const std::string out = dir_ + "/out";
+  const ChildRun r = run({kSimulatePass, "--scene", CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", "--out", out,
+                          "--speed", "250", "--set", "line.span_count=6", "--set", "numerics.element_length=0.5",
+                          "--set", "stagger.contact_wire=[0.3,-0.3]", "--report", "--no-progress"},
+                         dir_ + "/log.txt", 300.0);
+  ASSERT_FALSE(r.hung);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  for (const char* f : {"lateral.csv", "lateral_histogram.csv", "blow_off.csv", "pull_off.csv", "dewirements.csv",
+                        "report_lateral.png"})
+    EXPECT_TRUE(exists(out + "/" + f)) << f;
+  const std::string page = slurp(out + "/report.html");
+  EXPECT_NE(page.find("<h2 id='lateral'>"), std::string::npos);
+  std::size_t images = 0;
+  for (std::size_t at = page.find("src='data:image/png;base64,"); at != std::string::npos;
+       at = page.find("src='data:image/png;base64,", at + 1))
+    ++images;
+  EXPECT_EQ(images, 8u);  // the seven sections of a 2-D pass and the lateral one
+}
+
 TEST_F(PassReport, ReportOfAnEmptyDirectoryFailsNamingTheFile) {
   const ChildRun r = run({"/usr/bin/python3", CATENARY_SIM_SOURCE_DIR "/scripts/pass_report", dir_},
                          dir_ + "/log.txt", 60.0);
