@@ -76,6 +76,8 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   status_pub_ = nh_.advertise<std_msgs::String>("pass_status", 1, true);
   events_pub_ = nh_.advertise<PassEvent>("events", 100);
   line_state_pub_ = nh_.advertise<LineState>("line_state", 10);
+  // A 3-D line (stagger, curve, wind or sway) also says where each strip meets the wire across it.
+  if (sim_->model().lateral) lateral_pub_ = nh_.advertise<LateralContactArray>("lateral_contact", 10);
   speed_sub_ = nh_.subscribe("cmd/train_speed", 10, &SimulationNode::on_speed, this);
   uplift_sub_ = nh_.subscribe("cmd/uplift_force", 10, &SimulationNode::on_uplift, this);
   reset_srv_ = pnh_.advertiseService("reset", &SimulationNode::on_reset, this);
@@ -105,6 +107,8 @@ void SimulationNode::restart_recording() {
   const double rows = params_.report_file.empty() ? kRecorderRowRate : sim_->model().scene.output.sample_rate;
   recorder_ = std::make_unique<PassRecorder>(sim_->model(), rows);
   recorder_->record(sim_->model(), sim_->state());
+  lateral_recorder_ = std::make_unique<LateralRecorder>(sim_->model(), rows);  // records nothing on a 2-D line
+  lateral_recorder_->record(sim_->model(), sim_->state());
   running_.assign(sim_->model().pantographs.size(), Running{});
   arm_max_uplift_.assign(sim_->model().springs.size(), 0.0);
   chart_ = ChartData{};
@@ -322,6 +326,7 @@ std::int64_t SimulationNode::do_steps(std::int64_t n, const ros::WallTime* deadl
     if (sim_->step() != StepStatus::kOk) break;
     const State& s = sim_->state();
     recorder_->record(m, s);
+    lateral_recorder_->record(m, s);
     track_contact_loss();  // every step: the events resolve dt, not the publishing tick
     // The chart's samples on simulated time (a thousand per window), also when ~step jumps ahead.
     if (params_.strip_chart && s.time - last_chart_time_ >= 1e-3 * params_.chart_window) sample_chart();
@@ -378,6 +383,7 @@ void SimulationNode::handle_end() {
   }
   if (!sim_->finished()) return;
   // (finished() is true as soon as the front reaches the end, before step() marks the state)
+  if (s.status == StepStatus::kDewired) ROS_WARN("catenary_sim: %s", sim_->status_message().c_str());
   char what[256];
   std::snprintf(what, sizeof what, "pass finished at t = %.4f s (train front at %.2f m), %lld chunks, %lld overruns",
                 s.time, s.front + s.line_offset, static_cast<long long>(chunks_), static_cast<long long>(overruns_));
@@ -447,7 +453,8 @@ void SimulationNode::write_report() {
   const std::string dir = report_directory(params_.report_file);
   try {
     write_pass_files(dir, sim_->model(), sim_->state(), *recorder_,
-                     RunInfo{(ros::WallTime::now() - wall_start_).toSec(), -1.0, overruns_});
+                     RunInfo{(ros::WallTime::now() - wall_start_).toSec(), -1.0, overruns_}, lateral_recorder_.get(),
+                     sim_->state().status == StepStatus::kDewired);
   } catch (const OutputError& e) {
     ROS_ERROR("catenary_sim: ~report_file: %s", e.what());
     exit_code_ = 1;
@@ -503,6 +510,7 @@ void SimulationNode::publish(bool force) {
     }
     contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
     pantograph_pub_.publish(to_pantograph_state(m, s, stamp, params_.line_frame));
+    if (m.lateral) lateral_pub_.publish(to_lateral_contact(m, s, stamp, params_.line_frame));
     last_published_time_ = s.time;
     if (shape_due || force) {
       last_shape_wall_ = now;
