@@ -172,7 +172,7 @@ struct Lane<2> {
   }
 };
 
-template <int L>
+template <int L, bool Extra>
 __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   using V = Lane<L>;
   using T = typename V::T;
@@ -187,6 +187,9 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   const double *__restrict u = a.u[0], *__restrict v = a.v[0];
   double *__restrict un = a.u_next[0], *__restrict vn = a.v_next[0], *__restrict acc = a.accel[0];
   const std::ptrdiff_t d = L == 2 ? a.u[1] - a.u[0] : 0;
+  // The extra load's second lane lies as far from its first as the state's (both are per-wire
+  // rows of one array of the lateral plane's DOFs).
+  const double* __restrict ex = a.extra_load[0];
   auto c = [&](int i, int k) __attribute__((always_inline)) { return V::at(coef, static_cast<std::ptrdiff_t>(i) * NC + k); };
   auto lower = [&](int i) __attribute__((always_inline)) { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i)); };
   auto ip = [&](int i) __attribute__((always_inline)) { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i) + 1); };
@@ -202,7 +205,8 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   auto start = [&](int i, T ui, T vi) __attribute__((always_inline)) {
     const T z = ui + beta * vi;
     set(i, kRecZ, z);
-    set(i, kRecInit, c(i, W::kLoad) - c(i, W::kDampingMass) * vi);
+    if constexpr (Extra) set(i, kRecInit, (c(i, W::kLoad) - c(i, W::kDampingMass) * vi) + V::gather(ex, d, i));
+    else set(i, kRecInit, c(i, W::kLoad) - c(i, W::kDampingMass) * vi);
     return z;
   };
   T zp = start(lo, V::gather(u, d, lo), V::gather(v, d, lo));
@@ -287,7 +291,8 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
 #endif
 
 CATENARY_SIM_CLONES bool sweep_pack(const PackSweep& a) {
-  return a.pack->lanes == 2 ? sweep<2>(a) : sweep<1>(a);
+  if (a.extra_load[0]) return a.pack->lanes == 2 ? sweep<2, true>(a) : sweep<1, true>(a);
+  return a.pack->lanes == 2 ? sweep<2, false>(a) : sweep<1, false>(a);
 }
 
 // GCC's resolver takes the clone of the highest priority the CPU supports: x86-64-v4 (AVX-512
