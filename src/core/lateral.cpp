@@ -442,7 +442,6 @@ LateralState make_lateral_state(const Model& m) {
   s.y_next = s.y;
   s.v_next = Eigen::VectorXd::Zero(lat.n);
   s.accel = Eigen::VectorXd::Zero(lat.n);
-  s.drag = Eigen::VectorXd::Zero(lat.n);
   s.sweep.assign(kSweepRecord * lat.sweep_size, 0.0);
   int longest = 0;
   for (const Wire& w : lat.wires) longest = std::max(longest, w.nodes());
@@ -514,9 +513,9 @@ void lateral_observe(const Model& m, State& s) {
 
 namespace {
 
-// One lateral substep fused as the vertical plane's (wire_lanes.hpp): the wind's drag on every
-// node, then per pack one sweep pair for z, the condensed rotations, the band force with the
-// load, damping and drag, and the update; then the nodes with point forces (steady arms and
+// One lateral substep fused as the vertical plane's (wire_lanes.hpp): per pack one sweep pair for
+// z, the condensed rotations, the band force with the load, damping and the wind's drag, and the
+// update; then the nodes with point forces (steady arms and
 // messenger supports as springs, droppers as pendulums) are updated again with theirs, in the
 // generic step's order. The new values go to y_next, v_next and are swapped in when all are
 // inside the divergence limit (else the state keeps the last good substep and this returns true).
@@ -530,17 +529,9 @@ bool fused_substep(const Model& m, State& s) {
   double* yn = ls.y_next.data();
   double* vn = ls.v_next.data();
   double* acc = ls.accel.data();
-  const double* extra = nullptr;
-  if (lat.windy) {
-    const double* cw = lat.wind_coefficient.data();
-    const double* W = ls.wind_speed.data();
-    double* drag = ls.drag.data();
-    for (int i = 0; i < n; ++i) {
-      const double vr = W[i] - v[i];  // relative to the moving wire: aerodynamic damping
-      drag[i] = cw[i] * vr * std::fabs(vr);
-    }
-    extra = drag;
-  }
+  // The wind's drag is taken in the sweep (PackSweep::wind), on the velocity it reads anyway.
+  const double* W = lat.windy ? ls.wind_speed.data() : nullptr;
+  const double* cw = lat.windy ? lat.wind_coefficient.data() : nullptr;
   bool outside = false;
   for (const WireLanes& p : lat.packs) {
     PackSweep a;
@@ -559,7 +550,8 @@ bool fused_substep(const Model& m, State& s) {
       a.u_next[k] = yn + w.w_dof;
       a.v_next[k] = vn + w.w_dof;
       a.accel[k] = acc + w.w_dof;
-      a.extra_load[k] = extra ? extra + w.w_dof : nullptr;
+      a.wind[k] = W ? W + w.w_dof : nullptr;
+      a.drag_coefficient[k] = cw ? cw + w.w_dof : nullptr;
     }
     a.record = ls.sweep.data() + kSweepRecord * p.offset;
     a.beta = beta;

@@ -93,6 +93,7 @@ struct Lane<1> {
   }
   static T splat(double a) { return a; }
   static T pair(const double* a) { return a[0]; }
+  static T abs(T x) { return std::fabs(x); }
   using Mask = bool;
   static Mask all() { return true; }
   // |x| <= limit, NaN outside: the generic step's !(fabs(un) <= limit) (limit >= 0).
@@ -135,6 +136,14 @@ struct Lane<2> {
   }
   static T splat(double a) { return T{a, a}; }
   static T pair(const double* a) { return T{a[0], a[1]}; }
+  // |x| by clearing the sign bits: what fabs does, lane by lane.
+  static T abs(T x) {
+    Long2 b;
+    std::memcpy(&b, &x, sizeof b);
+    b &= Long2{0x7fffffffffffffffL, 0x7fffffffffffffffL};
+    std::memcpy(&x, &b, sizeof x);
+    return x;
+  }
   using Mask = Long2;
   static Mask all() { return Long2{-1, -1}; }
   static Mask inside(Mask m, T x, T above, T below) { return m & (x <= above) & (x >= below); }
@@ -172,7 +181,7 @@ struct Lane<2> {
   }
 };
 
-template <int L, bool Extra>
+template <int L, bool Drag>
 __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   using V = Lane<L>;
   using T = typename V::T;
@@ -187,9 +196,10 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   const double *__restrict u = a.u[0], *__restrict v = a.v[0];
   double *__restrict un = a.u_next[0], *__restrict vn = a.v_next[0], *__restrict acc = a.accel[0];
   const std::ptrdiff_t d = L == 2 ? a.u[1] - a.u[0] : 0;
-  // The extra load's second lane lies as far from its first as the state's (both are per-wire
-  // rows of one array of the lateral plane's DOFs).
-  const double* __restrict ex = a.extra_load[0];
+  // The wind's arrays: second lanes as far from the first as the state's (per-wire rows of one
+  // array of the lateral plane's DOFs).
+  const double* __restrict wind = a.wind[0];
+  const double* __restrict cw = a.drag_coefficient[0];
   auto c = [&](int i, int k) __attribute__((always_inline)) { return V::at(coef, static_cast<std::ptrdiff_t>(i) * NC + k); };
   auto lower = [&](int i) __attribute__((always_inline)) { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i)); };
   auto ip = [&](int i) __attribute__((always_inline)) { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i) + 1); };
@@ -205,8 +215,12 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   auto start = [&](int i, T ui, T vi) __attribute__((always_inline)) {
     const T z = ui + beta * vi;
     set(i, kRecZ, z);
-    if constexpr (Extra) set(i, kRecInit, (c(i, W::kLoad) - c(i, W::kDampingMass) * vi) + V::gather(ex, d, i));
-    else set(i, kRecInit, c(i, W::kLoad) - c(i, W::kDampingMass) * vi);
+    if constexpr (Drag) {
+      const T vr = V::gather(wind, d, i) - vi;
+      set(i, kRecInit, (c(i, W::kLoad) - c(i, W::kDampingMass) * vi) + V::gather(cw, d, i) * vr * V::abs(vr));
+    } else {
+      set(i, kRecInit, c(i, W::kLoad) - c(i, W::kDampingMass) * vi);
+    }
     return z;
   };
   T zp = start(lo, V::gather(u, d, lo), V::gather(v, d, lo));
@@ -291,7 +305,7 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
 #endif
 
 CATENARY_SIM_CLONES bool sweep_pack(const PackSweep& a) {
-  if (a.extra_load[0]) return a.pack->lanes == 2 ? sweep<2, true>(a) : sweep<1, true>(a);
+  if (a.wind[0]) return a.pack->lanes == 2 ? sweep<2, true>(a) : sweep<1, true>(a);
   return a.pack->lanes == 2 ? sweep<2, false>(a) : sweep<1, false>(a);
 }
 

@@ -28,9 +28,11 @@ struct PackSweep {
   double* accel[2] = {nullptr, nullptr};
   double* record = nullptr;  // State::sweep at the pack's records: kept for the nodes with point forces
   double beta = 0.0, dt = 0.0, limit = 0.0;
-  // Optional per-node load added to the pack's constant load (laid out as u): the wind's drag on
-  // the lateral plane, which changes with the wire's velocity (lateral.cpp). Null: none.
-  const double* extra_load[2] = {nullptr, nullptr};
+  // Optional wind drag on the lateral plane (lateral.cpp), laid out as u: per node the wind's speed
+  // normal to the wire W and the coefficient cw = 0.5 rho Cd d h; the drag cw (W - v)|W - v| (the
+  // wire's own velocity v gives the aerodynamic damping) is added to the load. Null: none.
+  const double* wind[2] = {nullptr, nullptr};
+  const double* drag_coefficient[2] = {nullptr, nullptr};
 };
 
 // z = u + beta v, the condensed rotations (forward and backward tridiagonal sweeps), the band
@@ -38,7 +40,7 @@ struct PackSweep {
 // one forward and one backward pass. The same IEEE operations in the same order as the generic
 // step (condensed_band_force), so the results are bit-identical to it. Returns true if some new
 // displacement is beyond the limit or not a number (the caller finds which).
-// With extra_load, the load is (load - alpha m v) + extra, in that order.
+// With wind, the load is (load - alpha m v) + (cw (W - v)) |W - v|, in that order.
 // Runtime dispatch (GCC target_clones): x86-64-v4 (AVX-512), x86-64-v3 (AVX2) or the portable
 // x86-64 baseline.
 bool sweep_pack(const PackSweep& sweep);

@@ -109,7 +109,7 @@ constexpr std::size_t kMaxDewirementEvents = 1024;  // kept per pass; more are c
 struct LateralState {
   Eigen::VectorXd y, v;      // m, m/s (v at the half step, eq. 20)
   Eigen::VectorXd f, z;      // workspace
-  Eigen::VectorXd y_next, v_next, accel, drag;  // the fused step's new values and the wind's drag (N)
+  Eigen::VectorXd y_next, v_next, accel;  // the fused step's new values
   std::vector<double> sweep;                     // the fused step's records (wire_lanes.hpp)
   std::vector<double> theta, wind_points;
   Eigen::VectorXd wind_speed;    // m/s, per node: the wind's speed normal to the wire now
