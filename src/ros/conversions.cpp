@@ -480,7 +480,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
       if (m.lateral) {
         // Where each strip meets the wire: yellow on the working width, red beyond it (dewired).
         Marker spots = marker(h, "lateral_contact", id, Marker::SPHERE_LIST);
-        spots.scale.x = spots.scale.y = spots.scale.z = 0.08;
+        spots.scale.x = spots.scale.y = spots.scale.z = 0.2;
         for (int ci : pg.collectors) {
           const double yc = static_cast<std::size_t>(ci) < s.lateral.collector_lateral.size()
                                 ? s.lateral.collector_lateral[ci] : std::nan("");
@@ -533,7 +533,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
       }
     }
     if (m.lateral && y_force != yh) {  // the contact point across the strip (mean over the collectors)
-      t << std::showpos << std::setprecision(2) << y_force - yh << std::noshowpos << " m across the strip\n";
+      t << "strip " << std::showpos << std::setprecision(2) << y_force - yh << std::noshowpos << " m\n";
       ++lines;
     }
     t << std::setprecision(1) << s.speed * 3.6 << " km/h";
@@ -541,6 +541,14 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     label.pose.position = point(x, 0.0, z_head + kLabelClearance + 0.5 * lines * kLabelLineHeight);
     label.text = t.str();
     out.markers.push_back(label);
+  }
+  if (o.lateral_scale != 1.0) {
+    // Stretch across the track: positions, points and the widths of boxes and dots.
+    for (Marker& mk : out.markers) {
+      mk.pose.position.y *= o.lateral_scale;
+      for (geometry_msgs::Point& p : mk.points) p.y *= o.lateral_scale;
+      if (mk.type == Marker::CUBE || mk.type == Marker::CUBE_LIST || mk.type == Marker::SPHERE_LIST) mk.scale.y *= o.lateral_scale;
+    }
   }
   return out;
 }

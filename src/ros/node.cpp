@@ -306,6 +306,7 @@ void SimulationNode::on_reconfigure(NodeConfig& c, uint32_t) {
   if (c.real_time_factor != params_.real_time_factor) reanchor();
   params_.real_time_factor = c.real_time_factor;
   params_.vertical_scale = c.vertical_scale;
+  params_.lateral_scale = c.lateral_scale;
   params_.publish_rate = c.publish_rate;
   params_.shape_rate = c.shape_rate;
   params_.marker_rate = c.marker_rate;
@@ -527,6 +528,7 @@ void SimulationNode::publish(bool force) {
       MarkerOptions o;
       o.frame = params_.line_frame;
       o.vertical_scale = params_.vertical_scale;
+      o.lateral_scale = params_.lateral_scale;
       o.shape_resolution = params_.shape_resolution;
       visualization_msgs::MarkerArray arr = to_markers(m, s, stamp, o);
       if (params_.strip_chart) {
@@ -539,6 +541,7 @@ void SimulationNode::publish(bool force) {
         if (paused_ || waiting_ || ended_ || sim_->finished()) head << (paused_ ? "paused" : ended_ || sim_->finished() ? "ended" : "waiting");
         else head << achieved_rtf_ << "x real time";
         head << "  vertical x" << std::setprecision(0) << params_.vertical_scale;
+        if (m.lateral && params_.lateral_scale != 1.0) head << "  lateral x" << params_.lateral_scale;
         chart_.heading = head.str();
         chart_.stats.clear();
         for (std::size_t p = 0; p < running_.size(); ++p) {

@@ -203,7 +203,7 @@ TEST_F(NodeParamsFuzz, NodeRejectsEveryBadValueNamingTheParameter) {
   const std::vector<Param> params{
       {"scene", Kind::kScene},           {"speed_kmh", Kind::kNumber},       {"real_time_factor", Kind::kNumber},
       {"publish_rate", Kind::kRate},     {"shape_rate", Kind::kRate},        {"marker_rate", Kind::kRate},
-      {"shape_resolution", Kind::kNumber}, {"vertical_scale", Kind::kRate},  {"line_frame", Kind::kFrame},
+      {"shape_resolution", Kind::kNumber}, {"vertical_scale", Kind::kRate}, {"lateral_scale", Kind::kRate},  {"line_frame", Kind::kFrame},
       {"at_end", Kind::kAtEnd},          {"stats_file", Kind::kPath},        {"publish_clock", Kind::kBool},
       {"paused", Kind::kBool},           {"wait_for_viewer", Kind::kNumber}, {"max_acceleration", Kind::kNumber},
       {"start_delay", Kind::kNumber},    {"report_file", Kind::kPath}};

@@ -78,6 +78,9 @@ std::vector<geometry_msgs::TransformStamped> to_transforms(const Model& m, const
 struct MarkerOptions {
   std::string frame = "line";
   double vertical_scale = 10.0;   // displacements multiplied by this
+  // Every lateral coordinate and width multiplied by this (a y axis stretched like a plot's, so
+  // that a 0.3 m stagger shows from above; the head and the wire keep their relation). 1: true.
+  double lateral_scale = 1.0;
   double shape_resolution = 1.0;  // m between line-strip points (0: every node)
   bool include_static = true;     // masts and steady arms (constant parts)
 };
