@@ -79,66 +79,45 @@ double lateral_omega_max(const Model& m, const LateralModel& lat) {
   return 1.05 * std::sqrt(std::max(0.0, lambda));
 }
 
-// The fused step's packs: wires on the same stations (a section's contact wire and messenger) in
-// the two lanes, as build_wire_packs does for the vertical plane, with the lateral plane's load,
-// damping and masses.
+// The fused step's planes: per vertical pack (Model::wire_packs, wires on the same stations side
+// by side), the lateral plane's load, alpha m and 1/m in the pack's layout; and the point nodes.
 void build_lateral_packs(const Model& m, LateralModel& lat) {
-  lat.packs.clear();
-  lat.sweep_size = 0;
-  std::vector<int> packed(lat.wires.size(), 0);
-  for (std::size_t a = 0; a < lat.wires.size(); ++a) {
-    if (packed[a] || lat.wires[a].nodes() < 2) continue;
-    WireLanes p;
-    p.wire[0] = static_cast<int>(a);
-    for (std::size_t b = a + 1; b < lat.wires.size() && p.lanes == 1; ++b)
-      if (!packed[b] && lat.wires[b].x == lat.wires[a].x) {
-        p.wire[1] = static_cast<int>(b);
-        p.lanes = 2;
-      }
-    const int n = lat.wires[a].nodes(), L = p.lanes;
-    p.nodes = n;
-    p.offset = lat.sweep_size;
-    lat.sweep_size += static_cast<std::size_t>(n) * L;
-    p.coef.assign(static_cast<std::size_t>(n) * WireLanes::kCoefficients * L, 0.0);
-    p.factors.assign(static_cast<std::size_t>(n) * 2 * L, 0.0);
+  lat.planes.clear();
+  lat.point_nodes.clear();
+  lat.point_record.clear();
+  if (m.wire_packs.empty()) return;  // the vertical step is not fused: neither is this one
+  for (const WireLanes& p : m.wire_packs) {
+    const int L = p.lanes;
+    std::vector<double> plane(static_cast<std::size_t>(p.nodes) * 3 * L, 0.0);
     for (int k = 0; k < L; ++k) {
       const Wire& w = lat.wires[p.wire[k]];
-      packed[p.wire[k]] = 1;
-      for (int i = 0; i < n; ++i) {
-        double* c = p.coef.data() + static_cast<std::size_t>(i) * WireLanes::kCoefficients * L + k;
-        c[WireLanes::kDww * L] = w.d_ww[i];
-        c[WireLanes::kDwt * L] = w.d_wt[i];
-        if (i + 1 < n) {
-          c[WireLanes::kEww * L] = w.e_ww[i];
-          c[WireLanes::kEwt * L] = w.e_wt[i];
-          c[WireLanes::kEtw * L] = w.e_tw[i];
-        }
-        c[WireLanes::kLoad * L] = lat.load[w.w_dof + i];
-        c[WireLanes::kDampingMass * L] = m.alpha * lat.mass[w.w_dof + i];
-        c[WireLanes::kInvMass * L] = lat.inv_mass[w.w_dof + i];
-        p.factors[(static_cast<std::size_t>(i) * 2 + 0) * L + k] = w.tt_lower[i];
-        p.factors[(static_cast<std::size_t>(i) * 2 + 1) * L + k] = w.tt_inv_pivot[i];
+      if (w.nodes() != p.nodes) {  // (never: the lateral wires are the vertical ones' copies)
+        lat.planes.clear();
+        return;
+      }
+      for (int i = 0; i < p.nodes; ++i) {
+        double* c = plane.data() + static_cast<std::size_t>(i) * 3 * L + k;
+        c[0 * L] = lat.load[w.w_dof + i];
+        c[1 * L] = m.alpha * lat.mass[w.w_dof + i];
+        c[2 * L] = lat.inv_mass[w.w_dof + i];
       }
     }
-    lat.packs.push_back(std::move(p));
+    lat.planes.push_back(std::move(plane));
   }
-  for (std::size_t a = 0; a < lat.wires.size(); ++a)
-    if (!packed[a]) {  // (a wire of one node: none in a model; the generic step then)
-      lat.packs.clear();
-      return;
-    }
-  std::vector<int> record(lat.n, -1);
-  for (const WireLanes& p : lat.packs)
-    for (int k = 0; k < p.lanes; ++k)
-      for (int i = 0; i < p.nodes; ++i)
-        record[lat.wires[p.wire[k]].w_dof + i] = static_cast<int>(
-            kSweepRecord * p.offset + static_cast<std::size_t>(i) * kSweepRecord * p.lanes + k + kRecForce * p.lanes);
+  // The band force of lateral node i of wire wi lies where the vertical sweep leaves that of the
+  // wire's vertical node i.
   std::vector<char> listed(lat.n, 0);
   auto add = [&](int i) {
     if (listed[i]) return;
     listed[i] = 1;
-    lat.point_nodes.push_back(i);
-    lat.point_record.push_back(record[i]);
+    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+      const Wire& w = lat.wires[wi];
+      if (i >= w.w_dof && i < w.w_dof + w.nodes()) {
+        lat.point_nodes.push_back(i);
+        lat.point_record.push_back(m.dof_sweep_force[m.wires[wi].w_dof + i - w.w_dof]);
+        return;
+      }
+    }
   };
   for (const LateralSpring& sp : lat.springs) add(sp.dof);
   for (const LateralPendulum& p : lat.pendulums) {
@@ -442,7 +421,6 @@ LateralState make_lateral_state(const Model& m) {
   s.y_next = s.y;
   s.v_next = Eigen::VectorXd::Zero(lat.n);
   s.accel = Eigen::VectorXd::Zero(lat.n);
-  s.sweep.assign(kSweepRecord * lat.sweep_size, 0.0);
   int longest = 0;
   for (const Wire& w : lat.wires) longest = std::max(longest, w.nodes());
   s.theta.assign(longest, 0.0);
@@ -533,9 +511,11 @@ bool fused_substep(const Model& m, State& s) {
   const double* W = lat.windy ? ls.wind_speed.data() : nullptr;
   const double* cw = lat.windy ? lat.wind_coefficient.data() : nullptr;
   bool outside = false;
-  for (const WireLanes& p : lat.packs) {
+  for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
+    const WireLanes& p = m.wire_packs[pk];
     PackSweep a;
     a.pack = &p;
+    a.plane = lat.planes[pk].data();
     a.lo = 0;
     a.hi = p.nodes - 1;
     a.factors = p.factors.data();
@@ -553,7 +533,7 @@ bool fused_substep(const Model& m, State& s) {
       a.wind[k] = W ? W + w.w_dof : nullptr;
       a.drag_coefficient[k] = cw ? cw + w.w_dof : nullptr;
     }
-    a.record = ls.sweep.data() + kSweepRecord * p.offset;
+    a.record = s.sweep.data() + kSweepRecord * p.offset;  // the vertical step's scratch
     a.beta = beta;
     a.dt = h;
     a.limit = limit;
@@ -561,7 +541,7 @@ bool fused_substep(const Model& m, State& s) {
   }
   // Point forces on the band forces the sweep left in its records, as the generic step adds them.
   double* f = ls.f.data();
-  const double* rec = ls.sweep.data();
+  const double* rec = s.sweep.data();
   const std::size_t np = lat.point_nodes.size();
   for (std::size_t q = 0; q < np; ++q) f[lat.point_nodes[q]] = rec[lat.point_record[q]];
   for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * (y[sp.dof] + beta * v[sp.dof]);
@@ -638,7 +618,7 @@ StepStatus lateral_step(const Model& m, State& s) {
         }
       }
     }
-    if (!lat.packs.empty()) {
+    if (!lat.planes.empty()) {
       if (fused_substep(m, s)) {
         ls.diverged = true;
         s.status = StepStatus::kDiverged;

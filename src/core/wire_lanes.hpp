@@ -28,6 +28,10 @@ struct PackSweep {
   double* accel[2] = {nullptr, nullptr};
   double* record = nullptr;  // State::sweep at the pack's records: kept for the nodes with point forces
   double beta = 0.0, dt = 0.0, limit = 0.0;
+  // The lateral plane (lateral.cpp) sweeps with the vertical pack's band and factors (the same
+  // beam both ways) but its own load, mass-proportional damping and inverse mass: per node and
+  // lane [load, alpha m, 1/m] in `plane` ([node][value][lane]). Null: the pack's own.
+  const double* plane = nullptr;
   // Optional wind drag on the lateral plane (lateral.cpp), laid out as u: per node the wind's speed
   // normal to the wire W and the coefficient cw = 0.5 rho Cd d h; the drag cw (W - v)|W - v| (the
   // wire's own velocity v gives the aerodynamic damping) is added to the load. Null: none.

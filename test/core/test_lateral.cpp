@@ -690,11 +690,11 @@ TEST(Lateral, FusedStepIsTheGenericStepBitForBit) {
                                {"numerics.preset=balanced", "line.span_count=4", "pantograph_head.sway.amplitude=0.05",
                                 "pantograph_head.sway.frequency=0.9"}));
   ASSERT_TRUE(a.model().lateral);
-  ASSERT_FALSE(a.model().lateral->packs.empty());
-  EXPECT_EQ(a.model().lateral->packs[0].lanes, 2);  // contact wire and messenger side by side
+  ASSERT_FALSE(a.model().lateral->planes.empty());
+  EXPECT_EQ(a.model().wire_packs[0].lanes, 2);  // contact wire and messenger side by side
   Model generic = a.model();
   auto lat = std::make_shared<LateralModel>(*generic.lateral);
-  lat->packs.clear();
+  lat->planes.clear();
   generic.lateral = lat;
   State g = a.state();
   int steps = 0;

@@ -81,11 +81,13 @@ struct LateralModel {
                                    // (and everywhere on an endless line, whose block spans are not the line's)
   int spans = 0;
   std::vector<double> static_blow_off;  // m, per span: largest |initial - calm| on the contact wire(s)
-  // The fused step (wire_lanes.hpp: the vertical plane's sweep, the wind's drag as an extra load):
-  // the wires packed two to a vector register, the sweep's size, and the nodes with point forces
-  // (springs, pendulums) with where the sweep leaves their band force. No packs: the generic step.
-  std::vector<WireLanes> packs;
-  std::size_t sweep_size = 0;
+  // The fused step (wire_lanes.hpp): the vertical plane's packs (Model::wire_packs: the same
+  // band and factors, a round wire bends alike both ways) swept with the lateral plane's own load,
+  // damping and inverse mass (per pack [node][load, alpha m, 1/m][lane]) and the wind's drag, the
+  // records in the vertical step's scratch (State::sweep, free between steps); the nodes with
+  // point forces (springs, pendulums) with where the sweep leaves their band force. No planes
+  // (the vertical step not fused: implicit, or rotations as DOFs): the generic step.
+  std::vector<std::vector<double>> planes;
   std::vector<int> point_nodes, point_record;
 };
 
@@ -110,7 +112,6 @@ struct LateralState {
   Eigen::VectorXd y, v;      // m, m/s (v at the half step, eq. 20)
   Eigen::VectorXd f, z;      // workspace
   Eigen::VectorXd y_next, v_next, accel;  // the fused step's new values
-  std::vector<double> sweep;                     // the fused step's records (wire_lanes.hpp)
   std::vector<double> theta, wind_points;
   Eigen::VectorXd wind_speed;    // m/s, per node: the wind's speed normal to the wire now
   double next_wind_update = 0.0;  // s
