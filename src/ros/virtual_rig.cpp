@@ -21,6 +21,12 @@ RigPantograph::RigPantograph(const PantographSpec& spec, double k0) : spec_(spec
   if (spec.moving_force || spec.external || spec.masses.empty())
     throw std::invalid_argument("virtual rig: pantograph '" + spec.name +
                                 "' is not a lumped pantograph with masses (type lumped)");
+  // The rig's pantograph is a chain (eq. 9) pressing one contact point; a head on its own
+  // suspension would need the tree and per-head contacts: refused rather than silently merged.
+  if (!spec.heads.empty())
+    throw std::invalid_argument("virtual rig: pantograph '" + spec.name + "' has " + std::to_string(spec.heads.size()) +
+                                " heads on their own suspensions (pantographs[].heads); allowed: a chain without "
+                                "heads (masses, stiffness, damping, head first)");
   if (spec.stiffness.size() != spec.masses.size() || spec.damping.size() != spec.masses.size())
     throw std::invalid_argument("virtual rig: pantograph '" + spec.name + "': one stiffness and damping per mass");
   for (double m : spec.masses)
