@@ -13,6 +13,7 @@
 #include "catenary_sim/MeasuredContactForce.h"
 #include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/ros/params.hpp"
+#include "catenary_sim/hil/udp_loop.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
@@ -28,7 +29,7 @@ double mono_now() {
 }  // namespace
 
 VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
-  ParamReader r(pnh, "virtual_rig", {"pantograph_scene", "rate", "extrapolate", "report_file"});
+  ParamReader r(pnh, "virtual_rig", {"pantograph_scene", "rate", "extrapolate", "report_file", "transport", "simulator"});
   std::string scene_file;
   r.text("pantograph_scene", scene_file, "the path of a scene YAML file");
   if (scene_file.empty())
@@ -42,11 +43,16 @@ VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   r.boolean("extrapolate", extrapolate_);
   r.text("report_file", report_file_, "a file path (empty: none)");
   check_output_param("report_file", report_file_);
+  r.text("transport", transport_, "topics or udp");
+  if (transport_ != "topics" && transport_ != "udp")
+    throw ParamError("parameter ~transport = '" + transport_ + "' rejected: allowed topics or udp");
+  r.text("simulator", simulator_, "HOST:PORT");
   try {
     scene_ = load_scene_file(scene_file);
   } catch (const SceneError& e) {
     throw ParamError("parameter ~pantograph_scene = '" + scene_file + "': " + e.what());
   }
+  if (transport_ == "udp") return;  // (run_udp: no topics)
   // Every contact point, even after a stall of the loop thread (up to 1 s at 10 kHz): the
   // pantograph is stepped through each one (a lost one: two periods against an extrapolated wire).
   ros::SubscribeOptions so = ros::SubscribeOptions::create<ContactPointArray>(
@@ -59,8 +65,45 @@ VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
            scene_.contact.stiffness, sub_.getTopic().c_str());
 }
 
+int VirtualRig::run_udp() {
+  // The same pantograph and stepping over the packets of udp_packets.h (hil::UdpVirtualRig).
+  hil::UdpRigOptions o;
+  const auto colon = simulator_.rfind(':');
+  int port = -1;
+  try {
+    if (colon != std::string::npos) port = std::stoi(simulator_.substr(colon + 1));
+  } catch (const std::exception&) {
+  }
+  if (colon == std::string::npos || colon == 0 || port < 1 || port > 65535) {
+    ROS_FATAL("virtual_rig: parameter ~simulator = '%s' rejected: allowed HOST:PORT, e.g. 127.0.0.1:47800",
+              simulator_.c_str());
+    return 2;
+  }
+  o.simulator_address = simulator_.substr(0, colon);
+  o.simulator_port = port;
+  o.rate = rate_;
+  o.extrapolate = extrapolate_;
+  try {
+    hil::UdpVirtualRig rig(scene_, o);
+    ROS_INFO("virtual_rig: over UDP to %s (local port %d)", simulator_.c_str(), rig.port());
+    rig.run([this] { return running(); });
+    const auto& q = rig.sequence();
+    std::printf("virtual_rig: %llu measurements sent over UDP, %llu missed ticks; contact points %llu received, %llu "
+                "lost; round trip p50 %.1f us, p99 %.1f us, max %.1f us\n",
+                static_cast<unsigned long long>(rig.sent()), static_cast<unsigned long long>(rig.missed_ticks()),
+                static_cast<unsigned long long>(q.received()), static_cast<unsigned long long>(q.lost()),
+                rig.round_trip().quantile(0.5) * 1e6, rig.round_trip().quantile(0.99) * 1e6, rig.round_trip().max() * 1e6);
+    std::fflush(stdout);
+  } catch (const hil::HilError& e) {
+    ROS_FATAL("virtual_rig: %s", e.what());
+    return 2;
+  }
+  return 0;
+}
+
 int VirtualRig::run() {
   prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);  // wake-ups on time (this thread)
+  if (transport_ == "udp") return run_udp();
   while (running() && !have_) queue_.callAvailable(ros::WallDuration(0.1));
   if (!running()) return 0;
   const double period = rate_ > 0.0 ? 1.0 / rate_ : dt_ * steps_per_period_;

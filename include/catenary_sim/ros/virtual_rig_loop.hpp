@@ -11,6 +11,9 @@
 //                      (an actuator tracking the trajectory); false: held
 //   ~report_file       JSON with the round trip (measurement sent -> the contact point that used it
 //                      received) at exit; checked writable at start-up
+//   ~transport         topics (hil/contact_point -> hil/contact_force) or udp: the packets of
+//                      hil/udp_packets.h with catenary_sim_hil_udp_node (hil::UdpVirtualRig)
+//   ~simulator         with udp: HOST:PORT of the simulator (default 127.0.0.1:47800)
 // Typed and checked as the nodes' parameters (params.hpp: ParamReader); unknown ones are warned about.
 #pragma once
 
@@ -53,6 +56,9 @@ class VirtualRig {
   double rate_ = 0.0;
   bool extrapolate_ = true;
   std::string report_file_;
+  std::string transport_ = "topics";
+  std::string simulator_ = "127.0.0.1:47800";
+  int run_udp();
   std::string frame_;  // frame_id of the last contact point, sent back with the measurements
   std::vector<RigPantograph> rigs_;
   std::vector<std::vector<WirePoint>> points_;
