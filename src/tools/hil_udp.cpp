@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <exception>
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -51,7 +52,8 @@ std::pair<std::string, int> host_port(const std::string& text, const std::string
 
 int main(int argc, char** argv) {
   CLI::App app{"Hardware in the loop over UDP (no ROS): the catenary against a rig's measured contact force."};
-  std::string scene_file, rig, report_file, stats_file, at_end = "exit", cpus;
+  std::string scene_file, rig, report_file, stats_file, at_end = "exit";
+  std::optional<std::string> cpus;  // (given empty: refused by parse_cpu_list)
   std::optional<double> speed_kmh;
   hil::LoopOptions lo;
   lo.who = "catenary_sim_hil_udp";
@@ -90,7 +92,7 @@ int main(int argc, char** argv) {
 
   try {
     if (!rig.empty()) std::tie(uo.rig_address, uo.rig_port) = host_port(rig, "--rig");
-    if (!cpus.empty()) rt.cpus = hil::parse_cpu_list(cpus, "--cpus");
+    if (cpus) rt.cpus = hil::parse_cpu_list(*cpus, "--cpus");
   } catch (const CLI::ValidationError& e) {
     std::fprintf(stderr, "catenary_sim_hil_udp: %s\n", e.what());
     return 2;
