@@ -70,5 +70,31 @@ void RigPantograph::step(double dt, double contact, double speed) {
   }
 }
 
+void RigStepper::restart(std::vector<RigPantograph> rigs, std::vector<std::vector<WirePoint>> points,
+                         std::uint32_t pass, std::uint64_t step, double dt, double speed) {
+  rigs_ = std::move(rigs);
+  points_ = std::move(points);
+  for (std::size_t i = 0; i < rigs_.size() && i < points_.size(); ++i) rigs_[i].reset(points_[i], speed);
+  have_ = true;
+  pass_ = pass;
+  step_ = step;
+  dt_ = dt;
+  speed_ = speed;
+}
+
+void RigStepper::advance(std::uint64_t step, std::vector<std::vector<WirePoint>>& points, double dt, double speed) {
+  // Step up to the new state, against the wire of the previous contact point.
+  for (std::size_t i = 0; i < rigs_.size(); ++i) {
+    for (std::uint64_t s = step_; s < step; ++s) {
+      const double ahead = extrapolate_ ? static_cast<double>(s - step_) * dt_ : 0.0;
+      rigs_[i].step(dt_, rigs_[i].contact_force(points_[i], ahead), speed_);
+    }
+  }
+  points_.swap(points);
+  step_ = step;
+  dt_ = dt;
+  speed_ = speed;
+}
+
 }  // namespace hil
 }  // namespace catenary_sim

@@ -222,7 +222,7 @@ void UdpLoopSkin::add_report(nlohmann::ordered_json& j) const {
 // ---- The simulated rig ----
 
 UdpVirtualRig::UdpVirtualRig(const Scene& scene, const UdpRigOptions& o)
-    : scene_(scene), opt_(o), socket_(o.bind_address, o.port, "--bind/--port") {
+    : scene_(scene), opt_(o), socket_(o.bind_address, o.port, "--bind/--port"), stepper_(o.extrapolate) {
   simulator_ = udp_address(o.simulator_address, o.simulator_port, "--simulator");
   if (!std::isfinite(o.rate) || !(o.rate == 0.0 || (o.rate >= 1.0 && o.rate <= 20000.0)))
     throw HilError("--rate = " + format_value(o.rate) + " rejected: allowed 0 (the simulator's loop rate) or [1, 20000] Hz");
@@ -248,30 +248,17 @@ void UdpVirtualRig::on_point(const csim_udp_contact_point& msg) {
     }
     return w;
   };
-  const bool restart = !have_ || msg.pass_count != pass_ || msg.step < step_ || points_.size() != msg.pantographs ||
-                       msg.step - step_ > 1000000;
-  if (restart) {
-    points_.clear();
-    for (std::uint32_t i = 0; i < msg.pantographs; ++i) {
-      points_.push_back(points_of(msg.pantograph[i]));
-      rigs_[i].reset(points_.back(), msg.speed);
-    }
-  } else {
-    // Step up to the new state, against the wire of the previous contact point (as virtual_rig).
-    for (std::size_t i = 0; i < points_.size(); ++i) {
-      for (std::uint64_t s = step_; s < msg.step; ++s) {
-        const double ahead = opt_.extrapolate ? static_cast<double>(s - step_) * dt_ : 0.0;
-        rigs_[i].step(dt_, rigs_[i].contact_force(points_[i], ahead), speed_);
-      }
-      points_[i] = points_of(msg.pantograph[i]);
-    }
-  }
+  std::vector<std::vector<WirePoint>> points;
+  for (std::uint32_t i = 0; i < msg.pantographs; ++i) points.push_back(points_of(msg.pantograph[i]));
+  if (stepper_.needs_restart(msg.pass_count, msg.step, msg.pantographs))
+    stepper_.restart(std::vector<RigPantograph>(rigs_.begin(), rigs_.begin() + msg.pantographs), std::move(points),
+                     msg.pass_count, msg.step, msg.dt, msg.speed);
+  else
+    stepper_.advance(msg.step, points, msg.dt, msg.speed);
   have_ = true;
-  pass_ = msg.pass_count;
   step_ = msg.step;
   dt_ = msg.dt;
   steps_per_period_ = msg.steps_per_period;
-  speed_ = msg.speed;
   if (msg.measurement_step > 0) {
     auto& slot = sent_at_[msg.measurement_step % sent_at_.size()];
     if (slot.first == msg.measurement_step && slot.second > 0.0) {
@@ -289,8 +276,8 @@ void UdpVirtualRig::send_measurement() {
   udp::fill_header(m.header, CSIM_UDP_KIND_MEASUREMENT, CSIM_UDP_MEASUREMENT_SIZE, ++sequence_, now);
   m.answers_step = step_;
   m.measured_time_ns = now;
-  m.pantographs = static_cast<std::uint32_t>(points_.size());
-  for (std::size_t i = 0; i < points_.size(); ++i) m.force[i] = rigs_[i].contact_force(points_[i]);
+  m.pantographs = static_cast<std::uint32_t>(stepper_.size());
+  for (std::size_t i = 0; i < stepper_.size(); ++i) m.force[i] = stepper_.force(i);
   if (opt_.send_head_acceleration) m.flags = 0;  // (the simulated head's acceleration is not sent: optional)
   if (socket_.send(&m, sizeof m, simulator_)) {
     ++sent_;

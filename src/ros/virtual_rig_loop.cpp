@@ -41,6 +41,7 @@ VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
     throw ParamError("parameter ~rate = " + format_number(rate_) +
                      " rejected: allowed 0 (the node's loop rate) or [1, 20000] Hz");
   r.boolean("extrapolate", extrapolate_);
+  stepper_ = RigStepper(extrapolate_);
   r.text("report_file", report_file_, "a file path (empty: none)");
   check_output_param("report_file", report_file_);
   r.text("transport", transport_, "topics or udp");
@@ -107,7 +108,7 @@ int VirtualRig::run() {
   while (running() && !have_) queue_.callAvailable(ros::WallDuration(0.1));
   if (!running()) return 0;
   const double period = rate_ > 0.0 ? 1.0 / rate_ : dt_ * steps_per_period_;
-  ROS_INFO("virtual_rig: %zu pantograph(s), loop %g Hz, dt %g ms, %s wire between contact points", rigs_.size(),
+  ROS_INFO("virtual_rig: %zu pantograph(s), loop %g Hz, dt %g ms, %s wire between contact points", stepper_.size(),
            1.0 / period, dt_ * 1e3, extrapolate_ ? "extrapolated" : "held");
   double next = mono_now() + 0.25 * period;
   const double start = mono_now();
@@ -154,11 +155,10 @@ int VirtualRig::run() {
 
 void VirtualRig::on_point(const ContactPointArray::ConstPtr& msg) {
   if (!(msg->dt > 0.0 && msg->dt < 1.0) || msg->steps_per_period == 0) return;  // (also NaN)
-  const bool restart = !have_ || msg->pass_count != pass_ || msg->step < step_ ||
-                       msg->pantographs.size() != rigs_.size() || msg->step - step_ > 1000000;
-  if (restart) {
-    rigs_.clear();
-    points_.clear();
+  std::vector<std::vector<WirePoint>> points;
+  for (const ContactPoint& c : msg->pantographs) points.push_back(wire_points(c));
+  if (stepper_.needs_restart(msg->pass_count, msg->step, msg->pantographs.size())) {
+    std::vector<RigPantograph> rigs;
     for (const ContactPoint& c : msg->pantographs) {
       const PantographSpec* spec = nullptr;
       for (const PantographSpec& ps : scene_.pantographs)
@@ -166,30 +166,21 @@ void VirtualRig::on_point(const ContactPointArray::ConstPtr& msg) {
       if (!spec) {
         ROS_ERROR_THROTTLE(5.0, "virtual_rig: no pantograph named '%s' in ~pantograph_scene", c.name.c_str());
         have_ = false;
+        stepper_.clear();
         return;
       }
-      rigs_.emplace_back(*spec, scene_.contact.stiffness);
-      points_.push_back(wire_points(c));
-      rigs_.back().reset(points_.back(), msg->speed);
+      rigs.emplace_back(*spec, scene_.contact.stiffness);
     }
+    stepper_.restart(std::move(rigs), std::move(points), msg->pass_count, msg->step, msg->dt, msg->speed);
     if (have_) ROS_INFO("virtual_rig: pass %u: pantograph(s) reset at the static state", msg->pass_count);
   } else {
-    // Step up to the new state, against the wire of the previous contact point.
-    for (std::size_t i = 0; i < rigs_.size(); ++i) {
-      for (std::uint64_t s = step_; s < msg->step; ++s) {
-        const double ahead = extrapolate_ ? static_cast<double>(s - step_) * dt_ : 0.0;
-        rigs_[i].step(dt_, rigs_[i].contact_force(points_[i], ahead), speed_);
-      }
-      points_[i] = wire_points(msg->pantographs[i]);
-    }
+    stepper_.advance(msg->step, points, msg->dt, msg->speed);
   }
   have_ = true;
   frame_ = msg->header.frame_id;
-  pass_ = msg->pass_count;
   step_ = msg->step;
   dt_ = msg->dt;
   steps_per_period_ = msg->steps_per_period;
-  speed_ = msg->speed;
   // Round trip of the measurement this contact point used.
   const auto it = sent_at_.find(msg->measurement_step);
   if (msg->measurement_step > 0 && it != sent_at_.end()) {
@@ -205,7 +196,7 @@ void VirtualRig::send() {
   m->header.stamp = ros::Time::now();
   m->header.frame_id = frame_;  // the frame of the contact point answered (the line frame)
   m->step = step_;
-  for (std::size_t i = 0; i < rigs_.size(); ++i) m->force.push_back(rigs_[i].contact_force(points_[i]));
+  for (std::size_t i = 0; i < stepper_.size(); ++i) m->force.push_back(stepper_.force(i));
   pub_.publish(m);
   ++sent_;
   sent_at_.emplace(step_, mono_now());  // (a repeated step keeps its first time)

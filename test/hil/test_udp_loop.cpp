@@ -19,8 +19,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <sstream>
 #include <thread>
@@ -209,4 +211,63 @@ TEST(UdpLoop, ClosedOverLoopbackAt1kHzIsItsOwnReplayAndWithoutDelayTheInternalPa
                         std::to_string(loop.energy().delay_j) + " J";
   RecordProperty("summary", summary);
   std::printf("test_udp_loop: %s\n", summary.c_str());
+}
+
+TEST(UdpLoop, BadLostReorderedAndDuplicatedPacketsAreCountedAndChangeNothing) {
+  // A rig that misbehaves, packet by packet, against the running loop: a hello, measurement 1,
+  // then a duplicate of 1, measurement 3, a late 2 (reordered), a NaN force, a short packet and a
+  // force out of range. Only 1 and 3 may reach the loop; every other one is counted, and none
+  // changes the force in effect.
+  LoopOptions lo;
+  lo.rate = 1000.0;
+  lo.timeout = 5.0;
+  lo.who = "test_udp_loop";
+  HilLoop loop(scene_with_dt("reference_55m_hil.yaml", 0.0), lo);
+  UdpLoopOptions uo;
+  uo.bind_address = "127.0.0.1";
+  uo.port = 0;
+  UdpLoopSkin skin(loop, uo);
+  std::atomic<bool> done{false};
+  skin.set_running([&] { return !done.load(); });
+  skin.set_log([](LogLevel, const std::string&) {});
+  std::thread runner([&] { loop.run(); });
+
+  UdpSocket rig("127.0.0.1", 0, "rig");
+  const sockaddr_in to = udp_address("127.0.0.1", skin.port(), "simulator");
+  auto measurement = [](std::uint32_t seq, double f) {
+    csim_udp_measurement m;
+    std::memset(&m, 0, sizeof m);
+    udp::fill_header(m.header, CSIM_UDP_KIND_MEASUREMENT, CSIM_UDP_MEASUREMENT_SIZE, seq, monotonic_ns());
+    m.pantographs = f < 0.0 ? 0 : 1;
+    m.force[0] = f;
+    return m;
+  };
+  auto send = [&](const csim_udp_measurement& m, std::size_t size = sizeof(csim_udp_measurement)) {
+    ASSERT_TRUE(rig.send(&m, size, to));
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));  // (one at a time through the loop)
+  };
+  send(measurement(1, -1.0));   // hello
+  send(measurement(2, 120.0));  // 1st measurement: the pass starts
+  send(measurement(2, 500.0));  // duplicate
+  send(measurement(4, 130.0));  // 3 skipped
+  send(measurement(3, 700.0));  // late
+  send(measurement(5, std::nan("")));
+  send(measurement(6, 150.0), 40);  // short
+  send(measurement(7, 5000.0));     // out of range (the loop's check, shared with ROS)
+  done = true;
+  runner.join();
+  const auto& seq = skin.sequence();
+  EXPECT_EQ(seq.duplicates(), 1u);
+  EXPECT_EQ(seq.reordered(), 1u);
+  // 3 came, late; 5 and 6 were rejected before their sequence number was taken (a packet that
+  // fails validation has no number to trust), so they count as lost as well as rejected.
+  EXPECT_EQ(seq.lost(), 2u);
+  EXPECT_EQ(skin.unusable(), 2u);
+  EXPECT_EQ(skin.rejected()[static_cast<int>(udp::Reject::kNonFinite)], 1u);
+  EXPECT_EQ(skin.rejected()[static_cast<int>(udp::Reject::kSize)], 1u);
+  EXPECT_EQ(loop.counters().accepted, 2);
+  EXPECT_EQ(loop.counters().rejected, 3);  // NaN, short, out of range
+  EXPECT_EQ(loop.mode(), Mode::kRunning);
+  // The force in effect is the last good measurement's (130 N), not a rejected or stale one.
+  EXPECT_DOUBLE_EQ(loop.state().external_force[loop.external()[0]], 130.0);
 }

@@ -8,6 +8,7 @@
 // internal lumped pantograph exactly (test_ros_hil): the same equations in the same order.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "catenary_sim/core/scene.hpp"
@@ -55,6 +56,40 @@ class RigPantograph {
   double head_static_ = 0.0;   // m, head height at the static state
   double static_force_ = 0.0;  // N, the preload of the springs between masses
   std::vector<double> d_, v_, f_;
+};
+
+// The rig's side of the loop with simulated pantographs, shared by virtual_rig (topics) and
+// UdpVirtualRig (UDP): at each contact point received, every pantograph is stepped from the
+// previous point's step to the new one against the previous point's wire (extrapolated along its
+// path velocity, as an actuator tracking it would, or held), then the new wire is taken; the force
+// to send is the contact force on it. A new pass, a step back or another number of pantographs
+// starts again from the static state.
+class RigStepper {
+ public:
+  explicit RigStepper(bool extrapolate = true) : extrapolate_(extrapolate) {}
+  bool needs_restart(std::uint32_t pass, std::uint64_t step, std::size_t pantographs) const {
+    return !have_ || pass != pass_ || step < step_ || pantographs != points_.size() || step - step_ > 1000000;
+  }
+  // `rigs` (one per external pantograph, in order) pressed on `points` at their static state.
+  void restart(std::vector<RigPantograph> rigs, std::vector<std::vector<WirePoint>> points, std::uint32_t pass,
+               std::uint64_t step, double dt, double speed);
+  // Steps every pantograph up to `step`, then takes `points` (swapped in).
+  void advance(std::uint64_t step, std::vector<std::vector<WirePoint>>& points, double dt, double speed);
+  void clear() { have_ = false; }
+  double force(std::size_t i) const { return rigs_[i].contact_force(points_[i]); }
+  std::size_t size() const { return rigs_.size(); }
+  bool have() const { return have_; }
+  std::uint32_t pass() const { return pass_; }
+  std::uint64_t step() const { return step_; }
+  double dt() const { return dt_; }
+
+ private:
+  bool extrapolate_ = true, have_ = false;
+  std::vector<RigPantograph> rigs_;
+  std::vector<std::vector<WirePoint>> points_;
+  std::uint32_t pass_ = 0;
+  std::uint64_t step_ = 0;
+  double dt_ = 0.0, speed_ = 0.0;
 };
 
 }  // namespace hil

@@ -170,13 +170,12 @@ class UdpVirtualRig {
   UdpRigOptions opt_;
   UdpSocket socket_;
   sockaddr_in simulator_{};
-  std::vector<RigPantograph> rigs_;
-  std::vector<std::vector<WirePoint>> points_;
-  std::vector<double> head_velocity_before_;
+  std::vector<RigPantograph> rigs_;  // the scene's lumped pantographs, in order
+  RigStepper stepper_;
   bool have_ = false, ended_ = false;
-  std::uint32_t pass_ = 0, sequence_ = 0;
+  std::uint32_t sequence_ = 0;
   std::uint64_t step_ = 0;
-  double dt_ = 0.0, speed_ = 0.0;
+  double dt_ = 0.0;
   std::uint32_t steps_per_period_ = 1;
   std::uint64_t sent_ = 0, missed_ = 0, rejected_ = 0;
   std::array<std::pair<std::uint64_t, double>, 256> sent_at_{};  // (step, steady s), a ring

@@ -11,6 +11,7 @@ namespace catenary_sim {
 namespace ros_layer {
 
 using hil::RigPantograph;
+using hil::RigStepper;
 using hil::WirePoint;
 
 // The wire points of one pantograph's hil/contact_point entry.

@@ -60,12 +60,10 @@ class VirtualRig {
   std::string simulator_ = "127.0.0.1:47800";
   int run_udp();
   std::string frame_;  // frame_id of the last contact point, sent back with the measurements
-  std::vector<RigPantograph> rigs_;
-  std::vector<std::vector<WirePoint>> points_;
+  hil::RigStepper stepper_;  // the pantographs and their stepping (shared with the UDP rig)
   bool have_ = false;
-  std::uint32_t pass_ = 0;
   std::uint64_t step_ = 0;
-  double dt_ = 0.0, speed_ = 0.0;
+  double dt_ = 0.0;
   std::uint32_t steps_per_period_ = 1;
   std::uint64_t sent_ = 0, missed_ = 0;
   std::map<std::uint64_t, double> sent_at_;
