@@ -150,9 +150,9 @@ void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_i
 }
 
 void UdpLoopSkin::send(const PointFrame& f) {
-  // Which measurement the period used: the newest accepted, when the loop applied one.
-  if (f.measurement_step > 0 || loop_.mode() == Mode::kRunning) in_effect_sequence_ = measurement_sequence_;
-  if (loop_.mode() != Mode::kRunning) in_effect_sequence_ = 0;
+  // Which measurement the period used: the newest accepted while running (the loop applies the
+  // newest), none otherwise (waiting, safe hold, paused, ended).
+  in_effect_sequence_ = loop_.mode() == Mode::kRunning ? measurement_sequence_ : 0;
   std::uint32_t flags = 0;
   const LoopCounters& c = loop_.counters();
   if (c.held != last_held_) flags |= CSIM_UDP_FLAG_HELD;
@@ -196,6 +196,7 @@ void UdpLoopSkin::send(const PointFrame& f) {
     s.jitter_p50 = loop_.jitter_summary().p50;
     s.jitter_p99 = loop_.jitter_summary().p99;
     s.jitter_max = loop_.jitter_summary().max;
+    s.jitter_counts = loop_.jitter_summary().counts;
     s.delay_energy = loop_.energy().delay_j;
     monitor_->push(s);  // (never waits: a full ring drops and counts)
   }
@@ -278,7 +279,7 @@ void UdpVirtualRig::send_measurement() {
   m.measured_time_ns = now;
   m.pantographs = static_cast<std::uint32_t>(stepper_.size());
   for (std::size_t i = 0; i < stepper_.size(); ++i) m.force[i] = stepper_.force(i);
-  if (opt_.send_head_acceleration) m.flags = 0;  // (the simulated head's acceleration is not sent: optional)
+  // (no head acceleration: the field is optional, flags 0)
   if (socket_.send(&m, sizeof m, simulator_)) {
     ++sent_;
     auto& slot = sent_at_[step_ % sent_at_.size()];

@@ -442,12 +442,8 @@ void HilNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("jitter p50 [s]", s.jitter.p50);
   stat.add("jitter p99 [s]", s.jitter.p99);
   stat.add("jitter max [s]", s.jitter.max);
-  {
-    static const char* const kBins[] = {"< 10 us", "10-20 us", "20-50 us", "50-100 us", "100-200 us",
-                                        "200-500 us", "0.5-1 ms", ">= 1 ms"};
-    for (std::size_t i = 0; i < s.jitter.counts.size(); ++i)
-      stat.add(std::string("jitter ") + kBins[i] + " [periods]", s.jitter.counts[i]);
-  }
+  for (std::size_t i = 0; i < s.jitter.counts.size(); ++i)
+    stat.add(std::string("jitter ") + hil::JitterSummary::kLabels[i] + " [periods]", s.jitter.counts[i]);
   stat.add("sim time [s]", s.state.time);
   stat.add("steps", s.state.steps);
   stat.add("train front [m]", s.state.front + s.state.line_offset);

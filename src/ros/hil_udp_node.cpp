@@ -174,6 +174,8 @@ void HilUdpNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("jitter p50 [s]", s.jitter_p50);
   stat.add("jitter p99 [s]", s.jitter_p99);
   stat.add("jitter max [s]", s.jitter_max);
+  for (std::size_t i = 0; i < s.jitter_counts.size(); ++i)
+    stat.add(std::string("jitter ") + hil::JitterSummary::kLabels[i] + " [periods]", s.jitter_counts[i]);
   stat.add("delay energy [J]", s.delay_energy);
   stat.add("monitor dropped", ring_.dropped());
   stat.add("sim time [s]", s.simulation_time);

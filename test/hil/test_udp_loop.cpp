@@ -31,6 +31,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
 #include "catenary_sim/hil/loop.hpp"
+#include "catenary_sim/hil/report.hpp"
 #include "catenary_sim/hil/udp_loop.hpp"
 #include "hil_test_support.hpp"
 
@@ -199,6 +200,21 @@ TEST(UdpLoop, ClosedOverLoopbackAt1kHzIsItsOwnReplayAndWithoutDelayTheInternalPa
   EXPECT_NEAR(sp.mean, si.mean, 0.1);
   EXPECT_NEAR(sp.std_dev, si.std_dev, 0.01 * si.std_dev);
 
+  // The report file's figures: the jitter histogram holds every period that started after the
+  // first measurement, and the UDP counts are there.
+  nlohmann::ordered_json report = loop_report(loop);
+  skin.add_report(report);
+  std::uint64_t jitter_periods = 0;
+  for (const auto& n : report["jitter"]["counts"]) jitter_periods += n.get<std::uint64_t>();
+  EXPECT_EQ(jitter_periods, loop.jitter().count());
+  EXPECT_GE(loop.jitter().count(), run.size() - 1);
+  const JitterSummary js = summarize_jitter(loop.jitter());
+  std::uint64_t in_bins = 0;
+  for (std::uint64_t n : js.counts) in_bins += n;
+  EXPECT_EQ(in_bins, loop.jitter().count());
+  EXPECT_EQ(report["udp"]["packets_received"].get<std::uint64_t>(), skin.sequence().received());
+  EXPECT_TRUE(report["coupling"].contains("delay_energy_j"));
+
   std::string hist;
   for (const auto& [d, n] : late) hist += (hist.empty() ? "" : " ") + std::to_string(d) + ":" + std::to_string(n);
   const auto& q = rig.sequence();
@@ -270,4 +286,53 @@ TEST(UdpLoop, BadLostReorderedAndDuplicatedPacketsAreCountedAndChangeNothing) {
   EXPECT_EQ(loop.mode(), Mode::kRunning);
   // The force in effect is the last good measurement's (130 N), not a rejected or stale one.
   EXPECT_DOUBLE_EQ(loop.state().external_force[loop.external()[0]], 130.0);
+}
+
+TEST(UdpLoop, ARigThatFallsSilentPutsTheLineIntoTheSafeHold) {
+  // The safe hold is the loop's (test_ros_hil_safety covers it through the topics): over UDP too,
+  // a rig silent for longer than the timeout stops the train and ramps the force, and the contact
+  // points keep coming, finite, with the SAFE_HOLD mode in their state flags.
+  LoopOptions lo;
+  lo.rate = 1000.0;
+  lo.timeout = 0.1;
+  lo.hold_ramp = 0.1;
+  lo.who = "test_udp_loop";
+  HilLoop loop(scene_with_dt("reference_55m_hil.yaml", 0.0), lo);
+  UdpLoopOptions uo;
+  uo.bind_address = "127.0.0.1";
+  uo.port = 0;
+  UdpLoopSkin skin(loop, uo);
+  std::atomic<bool> done{false};
+  skin.set_running([&] { return !done.load(); });
+  skin.set_log([](LogLevel, const std::string&) {});
+  std::thread runner([&] { loop.run(); });
+  UdpSocket rig("127.0.0.1", 0, "rig");
+  const sockaddr_in to = udp_address("127.0.0.1", skin.port(), "simulator");
+  csim_udp_measurement m;
+  std::memset(&m, 0, sizeof m);
+  udp::fill_header(m.header, CSIM_UDP_KIND_MEASUREMENT, CSIM_UDP_MEASUREMENT_SIZE, 1, monotonic_ns());
+  m.pantographs = 1;
+  m.force[0] = 120.0;
+  ASSERT_TRUE(rig.send(&m, sizeof m, to));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // silent: 5 timeouts
+  // The last contact point the rig got says SAFE_HOLD.
+  std::uint32_t last_flags = 0;
+  alignas(8) std::uint8_t buf[2048];
+  sockaddr_in from{};
+  long n;
+  std::size_t points = 0;
+  while ((n = rig.receive(buf, sizeof buf, &from)) >= 0) {
+    csim_udp_contact_point p;
+    udp::Reject why;
+    std::string reason;
+    ASSERT_TRUE(udp::decode_contact_point(buf, static_cast<std::size_t>(n), p, why, reason)) << reason;
+    last_flags = p.state_flags;
+    ++points;
+  }
+  done = true;
+  runner.join();
+  EXPECT_GT(points, 300u);  // (one a period: the rig is sent contact points in the hold too)
+  EXPECT_EQ(last_flags & CSIM_UDP_MODE_MASK, CSIM_UDP_MODE_SAFE_HOLD);
+  EXPECT_EQ(loop.counters().holds, 1);
+  EXPECT_EQ(loop.mode(), Mode::kHold);
 }

@@ -196,6 +196,8 @@ struct LoopCounters {
 // The loop's jitter for diagnostics: percentiles and counts between fixed edges.
 struct JitterSummary {
   static constexpr std::array<double, 7> kEdges{10e-6, 20e-6, 50e-6, 100e-6, 200e-6, 500e-6, 1e-3};  // s
+  static constexpr std::array<const char*, 8> kLabels{"< 10 us",    "10-20 us",   "20-50 us", "50-100 us",
+                                                      "100-200 us", "200-500 us", "0.5-1 ms", ">= 1 ms"};
   double p50 = 0.0, p99 = 0.0, max = 0.0;
   std::array<std::uint64_t, 8> counts{};  // [0, 10 us), [10, 20 us), ..., [0.5, 1 ms), >= 1 ms
 };

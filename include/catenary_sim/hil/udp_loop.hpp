@@ -66,6 +66,7 @@ struct MonitorSample {
   std::int64_t periods = 0, overruns = 0, held = 0, holds = 0, rejected = 0;
   std::uint64_t packets_lost = 0, packets_reordered = 0, packets_duplicated = 0;
   double latency_p99 = 0.0, jitter_p50 = 0.0, jitter_p99 = 0.0, jitter_max = 0.0, delay_energy = 0.0;
+  std::array<std::uint64_t, 8> jitter_counts{};  // JitterSummary::counts
 };
 using MonitorRing = SpscRing<MonitorSample, 4096>;  // 4 s at 1 kHz
 
@@ -145,7 +146,6 @@ struct UdpRigOptions {
   int port = 0;  // 0: any
   double rate = 0.0;
   bool extrapolate = true;
-  bool send_head_acceleration = true;
 };
 
 class UdpVirtualRig {
