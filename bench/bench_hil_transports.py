@@ -25,7 +25,7 @@ import os
 import signal
 import subprocess
 import sys
-import time
+import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
 import bench_hil_latency as hl  # noqa: E402
@@ -95,7 +95,7 @@ def main():
     atexit.register(bn.cleanup)
     for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         signal.signal(s, bn.on_signal)
-    bn._tmp = __import__("tempfile").mkdtemp(prefix="bench_hil_transports_")
+    bn._tmp = tempfile.mkdtemp(prefix="bench_hil_transports_")
     port = bn.free_port()
     env = bn.ros_env(bn._tmp, port)
     bn.start_roscore(env, port, bn._tmp)
