@@ -514,7 +514,12 @@ void HilLoop::wait_for_period(double w, double half, double& t) {
   const double spin = opt_.spin_wait;
   while (skin_->running() && !stop_) {
     if (fresh_ && t >= w - half) break;
-    if (t >= w + half) break;
+    if (t >= w + half) {
+      // The window has closed (the loop is late, e.g. after an overrun): a measurement that is
+      // already waiting is still taken for this period rather than running it with the held one.
+      if (!fresh_) skin_->receive(t);
+      break;
+    }
     const double until = fresh_ ? w - half : w + half;
     double block_until = until;
     if (spin > 0.0) {
