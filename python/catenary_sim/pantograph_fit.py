@@ -128,10 +128,36 @@ def read_frf_csv(path, columns="measured"):
                      f"receptance_im_m_per_n; found {', '.join(d.columns)}")
 
 
-def scene_snippet(fit, name="fitted", static_uplift=100.0):
-    """A `pantographs:` entry of a scene (docs/scene_reference.md) with the fitted chain."""
+def scene_snippet(fit, name="fitted", static_uplift=100.0, heads=0, head_spacing=0.5):
+    """A `pantographs:` entry of a scene (docs/scene_reference.md) with the fitted chain; with
+    heads = N >= 1, the chain's top mass written as N identical heads on their own suspensions to
+    the frame (the rest of the chain), head_spacing metres apart along the track.
+
+    The heads of a laboratory FRF are driven together: N identical heads (mass m, spring k, damper
+    c to the frame) move as one mass N m on N k and N c, so the FRF fixes only those sums, and the
+    fitted top mass, spring and damper are shared out equally. Unequal heads cannot be told apart
+    from equal ones by such an FRF."""
     def fmt(v):
         return "[" + ", ".join(f"{x:.6g}" for x in v) + "]"
+    if heads:
+        if not isinstance(heads, int) or heads < 1 or len(fit.masses) < 2:
+            raise ValueError(f"heads = {heads!r}: allowed a whole number >= 1 on a chain of 2 or 3 masses "
+                             "(the top one is shared out over the heads, the rest is the frame)")
+        n = heads
+        lines = [f"# fitted to a head FRF by fit_pantograph: rms relative residual {fit.residual_rms:.3g}",
+                 f"# {n} identical heads: the FRF fixes their sums (N m, N k, N c), shared out equally",
+                 "# static_uplift is not in an FRF: set it to the pantograph's static contact force;",
+                 "# the heads' offsets are not in it either: set them to the pantograph's geometry",
+                 "pantographs:", f"  - name: {name}", "    type: lumped",
+                 f"    masses: {fmt(fit.masses[1:])}        # kg, the frame, top mass first",
+                 f"    stiffness: {fmt(fit.stiffness[1:])}  # N/m, below each frame mass, the last to the roof",
+                 f"    damping: {fmt(fit.damping[1:])}      # N s/m",
+                 f"    static_uplift: {static_uplift:.6g}", "    heads:"]
+        for i in range(n):
+            off = (i - 0.5 * (n - 1)) * head_spacing
+            lines.append(f"      - {{mass: {fit.masses[0] / n:.6g}, stiffness: {fit.stiffness[0] / n:.6g}, "
+                         f"damping: {fit.damping[0] / n:.6g}, offset: {off:.6g}, collectors: [{{offset: 0.0}}]}}")
+        return "\n".join(lines) + "\n"
     return (f"# fitted to a head FRF by fit_pantograph: rms relative residual {fit.residual_rms:.3g}\n"
             f"# static_uplift is not in an FRF: set it to the pantograph's static contact force\n"
             f"pantographs:\n"

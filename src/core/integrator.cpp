@@ -188,6 +188,26 @@ double head_height(const Model& m, const State& s, int p) {
   return sum / static_cast<double>(pg.heads.size());
 }
 
+int head_count(const Model& m, int p) {
+  const Pantograph& pg = m.pantographs[p];
+  if (pg.moving_force) return 0;
+  return pg.heads.empty() ? 1 : static_cast<int>(pg.heads.size());
+}
+
+double head_height(const Model& m, const State& s, int p, int head) {
+  const Pantograph& pg = m.pantographs[p];
+  if (pg.moving_force) return std::nan("");
+  if (pg.heads.empty()) return pg.reference_height + s.u[pg.first_dof];
+  const Head& h = pg.heads[head];
+  return h.reference_height + s.u[h.dof];
+}
+
+double head_aero_uplift(const Model& m, const State& s, int p, int head) {
+  const Pantograph& pg = m.pantographs[p];
+  if (pg.moving_force || pg.heads.empty()) return 0.0;
+  return pg.heads[head].aero_coefficient * s.speed * s.speed;
+}
+
 double total_contact_force(const Model& m, const State& s, int p) {
   double f = 0.0;
   const std::size_t nw = m.contact_wires.size();

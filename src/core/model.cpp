@@ -286,13 +286,18 @@ namespace {
 void collector_extent(const Scene& scene, double* lead, double* rear) {
   bool first = true;
   *lead = *rear = 0.0;
-  for (const PantographSpec& p : scene.pantographs)
-    for (const CollectorSpec& c : p.collectors) {
-      const double off = c.offset - p.position;
-      *lead = first ? off : std::max(*lead, off);
-      *rear = first ? off : std::min(*rear, off);
-      first = false;
-    }
+  auto add = [&](double off) {
+    *lead = first ? off : std::max(*lead, off);
+    *rear = first ? off : std::min(*rear, off);
+    first = false;
+  };
+  for (const PantographSpec& p : scene.pantographs) {
+    for (const CollectorSpec& c : p.collectors) add(c.offset - p.position);
+    // Strips on heads: their offsets are from the head's centre (without this a head could start
+    // or end off the line, its strip touching nothing and the head rising on its preload).
+    for (const HeadSpec& h : p.heads)
+      for (const CollectorSpec& c : h.collectors) add(h.offset + c.offset - p.position);
+  }
 }
 
 // Spans at each end of an endless line's block that the window never reaches: the anchors'

@@ -198,9 +198,17 @@ PantographSpec read_pantograph(const YAML::Node& node, const std::string& path, 
   if (r.has("target_mean_force")) {
     const YAML::Node t = r.child("target_mean_force");
     Reader tr(t, r.field("target_mean_force"));
-    p.target_force_a = tr.number("a", 0.0, 1.0);
-    p.target_force_b = tr.number("b", 0.0, 2000.0);
+    TargetMeanForce target;
+    const std::string unit = tr.text("speed_unit", "m/s");
+    if (unit != "m/s" && unit != "km/h")
+      fail(tr.field("speed_unit"), "'" + unit + "'", "m/s or km/h (the unit of v in Fm(v) = a v^2 + b)");
+    target.speed_kmh = unit == "km/h";
+    // a: up to 1 N s^2/m^2 (1/12.96 of that per (km/h)^2), about 10 times EN 50367's curves.
+    target.a = tr.number("a", 0.0, target.speed_kmh ? 1.0 / 12.96 : 1.0);
+    target.b = tr.number("b", 0.0, 2000.0);
+    if (tr.has("tolerance")) target.tolerance = tr.number("tolerance", 0.0, 2000.0);
     tr.finish();
+    p.target_mean_force = target;
   }
   if (!p.moving_force) {
     p.masses = r.numbers("masses", 0.0, 1000.0, true);

@@ -145,6 +145,18 @@ inline double dropper_force(const Dropper& d, const State& s, bool* slack) {
   return *slack ? 0.0 : t;
 }
 
+// Mean train speed over the samples in the section (m/s).
+double section_speed(const std::vector<double>& t, const std::vector<double>& x, double x0, double x1) {
+  std::size_t first = t.size(), last = 0;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (x[i] >= x0 && x[i] <= x1) {
+      first = std::min(first, i);
+      last = i;
+    }
+  if (first >= last || !(t[last] > t[first])) return std::nan("");
+  return (x[last] - x[first]) / (t[last] - t[first]);
+}
+
 }  // namespace
 
 void PassRecorder::record(const Model& m, const State& s) {
@@ -165,12 +177,23 @@ void PassRecorder::record(const Model& m, const State& s) {
       // Head suspension: the spring (and damper) from the head to the mass below (the roof for a
       // one-mass pantograph, whose uplift then acts on the head too).
       const int a0 = pg.first_dof, nm = pg.masses_count();
-      const double stretch = (nm > 1 ? s.u[a0 + 1] : 0.0) - s.u[a0];
-      double fe = pg.spring_preload[0] + pg.stiffness[0] * stretch;
-      if (nm == 1) fe += s.uplift[p] + pg.aero_coefficient * s.speed * s.speed;
-      head_u_[p].push_back(s.u[a0]);
-      suspension_stretch_[p].push_back(stretch);
-      suspension_force_[p].push_back(fe);
+      if (pg.heads.empty()) {
+        const double stretch = (nm > 1 ? s.u[a0 + 1] : 0.0) - s.u[a0];
+        double fe = pg.spring_preload[0] + pg.stiffness[0] * stretch;
+        if (nm == 1) fe += s.uplift[p] + pg.aero_coefficient * s.speed * s.speed;
+        head_u_[p].push_back(s.u[a0]);
+        suspension_stretch_[p].push_back(stretch);
+        suspension_force_[p].push_back(fe);
+      } else {
+        // Every head's own suspension to the top frame mass (and its own aero force, which acts
+        // on the head), one entry per head per step: the load cells sit under each head.
+        for (const Head& h : pg.heads) {
+          const double stretch = s.u[a0] - s.u[h.dof];
+          head_u_[p].push_back(s.u[h.dof]);
+          suspension_stretch_[p].push_back(stretch);
+          suspension_force_[p].push_back(h.preload + h.stiffness * stretch + h.aero_coefficient * s.speed * s.speed);
+        }
+      }
     }
     const double xp = s.front - pg.position;  // model station
     position_[p].push_back(xp + s.line_offset);
@@ -274,6 +297,18 @@ std::vector<PantographStatistics> PassRecorder::statistics(const Model& m, doubl
     for (const ContactLossEvent& e : st.loss_events) st.longest_loss_s = std::max(st.longest_loss_s, e.duration);
     st.spectrum = spectrum_summary(m, p, spectrum(m, p));
     measured_statistics(m, p, x0, x1, filtered, &st.measured);
+    const std::optional<TargetMeanForce>& target = m.scene.pantographs[p].target_mean_force;
+    const double v = section_speed(time_, position_[p], x0, x1);
+    if (target && std::isfinite(v) && std::isfinite(st.filtered.mean)) {
+      // The standards' permissible mean force against the pass's (filtered) mean, at the mean speed.
+      PantographStatistics::TargetMean t;
+      t.speed_mps = v;
+      t.target = target->at(v);
+      t.difference = st.filtered.mean - t.target;
+      t.tolerance = target->tolerance;
+      t.within = !t.tolerance || std::fabs(t.difference) <= *t.tolerance;
+      st.target_mean = t;
+    }
     out.push_back(st);
   }
   return out;
@@ -284,17 +319,23 @@ std::vector<double> PassRecorder::measured_force(const Model& m, std::size_t p) 
   const std::vector<double>& u = head_u_[p];
   const std::vector<double>& d = suspension_stretch_[p];
   const std::vector<double>& fe = suspension_force_[p];
-  const std::size_t n = u.size();
-  if (pg.moving_force || n < 3) return {};
+  if (pg.moving_force) return {};
+  const std::size_t heads = pg.heads.empty() ? 1 : pg.heads.size(), n = u.size() / heads;
+  if (n < 3) return {};
   // Head: m a = F_suspension - F_contact, so F_contact = F_suspension - m a, with the damper's
   // velocity and the head's acceleration by central differences of the recorded displacements
-  // (as an accelerometer and load cells would give them, at every step).
-  const double dt = m.dt, mass = pg.masses[0], c = pg.damping[0];
-  std::vector<double> f(n);
-  for (std::size_t i = 1; i + 1 < n; ++i) {
-    const double vel = (d[i + 1] - d[i - 1]) / (2.0 * dt);
-    const double acc = (u[i + 1] - 2.0 * u[i] + u[i - 1]) / (dt * dt);
-    f[i] = fe[i] + c * vel - mass * acc;
+  // (as an accelerometer and load cells would give them, at every step); summed over the heads.
+  const double dt = m.dt;
+  std::vector<double> f(n, 0.0);
+  for (std::size_t h = 0; h < heads; ++h) {
+    const double mass = pg.heads.empty() ? pg.masses[0] : pg.heads[h].mass;
+    const double c = pg.heads.empty() ? pg.damping[0] : pg.heads[h].damping;
+    for (std::size_t i = 1; i + 1 < n; ++i) {
+      const std::size_t j = i * heads + h, jp = j + heads, jm = j - heads;
+      const double vel = (d[jp] - d[jm]) / (2.0 * dt);
+      const double acc = (u[jp] - 2.0 * u[j] + u[jm]) / (dt * dt);
+      f[i] += fe[j] + c * vel - mass * acc;
+    }
   }
   f[0] = f[1];
   f[n - 1] = f[n - 2];
@@ -353,17 +394,6 @@ double dropper_spacing(const Model& m, double x0, double x1) {
   return gaps[gaps.size() / 2];
 }
 
-// Mean train speed over the samples in the section (m/s).
-double section_speed(const std::vector<double>& t, const std::vector<double>& x, double x0, double x1) {
-  std::size_t first = t.size(), last = 0;
-  for (std::size_t i = 0; i < t.size(); ++i)
-    if (x[i] >= x0 && x[i] <= x1) {
-      first = std::min(first, i);
-      last = i;
-    }
-  if (first >= last || !(t[last] > t[first])) return std::nan("");
-  return (x[last] - x[first]) / (t[last] - t[first]);
-}
 
 }  // namespace
 
@@ -568,6 +598,19 @@ std::string statistics_json(const Model& m, const State& s, const std::vector<Pa
       peaks.push_back(Json{{"frequency_hz", k.frequency}, {"psd_N2_per_hz", k.psd}, {"amplitude_N", k.amplitude}});
     sp["peaks"] = peaks;
     pj["spectrum"] = sp;
+    if (p.target_mean) {
+      const PantographStatistics::TargetMean& t = *p.target_mean;
+      const TargetMeanForce* spec = nullptr;
+      for (const PantographSpec& ps : scene.pantographs)
+        if (ps.name == p.name && ps.target_mean_force) spec = &*ps.target_mean_force;
+      Json tj{{"speed_kmh", 3.6 * t.speed_mps}, {"target_N", t.target}, {"mean_N", p.filtered.mean},
+              {"difference_N", t.difference}, {"tolerance_N", t.tolerance ? Json(*t.tolerance) : Json(nullptr)},
+              {"within", t.within}};
+      if (spec) tj["curve"] = Json{{"a", spec->a}, {"b", spec->b}, {"speed_unit", spec->speed_kmh ? "km/h" : "m/s"}};
+      pj["target_mean_force"] = tj;
+    } else {
+      pj["target_mean_force"] = nullptr;
+    }
     if (p.measured.available) {
       Json me;
       me["sensor_bandwidth_hz"] = p.measured.bandwidth_hz;

@@ -215,6 +215,24 @@ PYBIND11_MODULE(_core, m) {
         d["contact_force_N"] = total_contact_force(m, st, i);
         d["head_height_m"] = head_height(m, st, i);
         d["uplift_N"] = st.uplift[i];
+        // Every head (several on their own suspensions; a chain's first mass; none for a moving
+        // force): its height, the force on its strips and its own aero uplift.
+        const Pantograph& pg = m.pantographs[i];
+        const std::size_t nw = m.contact_wires.size();
+        py::list heights, forces, aero;
+        for (int h = 0; h < head_count(m, i); ++h) {
+          heights.append(head_height(m, st, i, h));
+          double f = 0.0;
+          for (int ci : pg.collectors)
+            if (pg.heads.empty() || m.collectors[ci].head == h)
+              for (std::size_t w = 0; w < nw; ++w) f += st.contact_force[ci * nw + w];
+          forces.append(f);
+          aero.append(head_aero_uplift(m, st, i, h));
+        }
+        d["head_heights_m"] = heights;
+        d["head_contact_forces_N"] = forces;
+        d["head_aero_uplift_N"] = aero;
+        d["knee"] = m.scene.pantographs[i].knee_trailing ? "trailing" : "leading";
         return d;
       }, py::arg("index") = 0)
       .def("set_speed", [](PySimulation& s, double v) {

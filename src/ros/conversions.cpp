@@ -99,12 +99,14 @@ double collector_x(const Model& m, const State& s, int p, int ci) {
 // one the head meets first, as in set_pantograph_references): its design height and its displaced
 // height (weighted over the contact nodes, eq. 12), averaged over the collectors under a wire.
 // Returns false (outputs untouched) when no collector is under a contact wire.
-bool lowest_contact_wire(const Model& m, const State& s, int p, double* design, double* displaced) {
+// head >= 0: only the strips of that head of Pantograph::heads.
+bool lowest_contact_wire(const Model& m, const State& s, int p, double* design, double* displaced, int head = -1) {
   std::vector<int> node(m.max_contact_nodes);
   std::vector<double> weight(m.max_contact_nodes);
   double sum_design = 0.0, sum_displaced = 0.0;
   int count = 0;
   for (int ci : m.pantographs[p].collectors) {
+    if (head >= 0 && m.collectors[ci].head != head) continue;
     const double xc = collector_x(m, s, p, ci);
     int k = -1;
     const double best = lowest_design_height(m, xc, &k);
@@ -212,6 +214,12 @@ PantographStateArray to_pantograph_state(const Model& m, const State& s, const r
     }
     ps.uplift = p < s.uplift.size() ? s.uplift[p] : 0.0;
     ps.aero_uplift = pg.aero_coefficient * s.speed * s.speed;
+    ps.head_count = head_count(m, static_cast<int>(p));
+    for (int hd = 0; hd < ps.head_count; ++hd) {
+      ps.head_heights.push_back(head_height(m, s, static_cast<int>(p), hd));
+      ps.head_aero_uplift.push_back(head_aero_uplift(m, s, static_cast<int>(p), hd));
+    }
+    ps.knee = m.scene.pantographs[p].knee_trailing ? "trailing" : "leading";
     out.pantographs.push_back(ps);
   }
   return out;
@@ -283,6 +291,16 @@ double drawn_head_height(const Model& m, const State& s, int p, double k) {
   lowest_contact_wire(m, s, p, &d, &y);
   const double head = m.pantographs[p].moving_force ? y : head_height(m, s, p);
   return d + k * (head - d);
+}
+
+double drawn_head_height(const Model& m, const State& s, int p, int head, double k) {
+  const Pantograph& pg = m.pantographs[p];
+  if (pg.heads.empty()) return drawn_head_height(m, s, p, k);
+  // Each head about the design height of the wire over its own strips (two heads on a transition
+  // span can be under different wires).
+  double d = m.scene.contact_wire_height, y = d;
+  if (!lowest_contact_wire(m, s, p, &d, &y, head)) lowest_contact_wire(m, s, p, &d, &y);
+  return d + k * (head_height(m, s, p, head) - d);
 }
 
 std::string train_frame_id() { return "train"; }
@@ -420,9 +438,6 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     const bool contact = force > 0.0;
     // Across the track: the head's centre (sway), its strips' working width and horn extent.
     const double yh = head_lateral(m, s, p);
-    const PantographHeadSpec& geo = m.scene.pantograph_head;
-    const double half_strip = 0.5 * geo.working_width;
-    const double horn = std::max(0.05, 0.5 * (geo.horn_width - geo.working_width));
     // Where the force is drawn: the mean contact point across the strips on a 3-D line.
     double y_force = yh;
     if (m.lateral) {
@@ -439,44 +454,81 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
       if (count) y_force = yh + sum / count;
     }
 
-    // A plain moving force is a point; a pantograph (lumped, or a real one on a rig) has a head:
-    // its collector strips across the track (carbon, 1.2 m working width) on a frame, and horns
-    // curving down at both ends.
+    // A plain moving force is a point; a pantograph (lumped, or a real one on a rig) has one or
+    // more heads: collector strips across the track (carbon, pantograph_head.working_width) on a
+    // head, and horns curving down at both ends to pantograph_head.horn_width. Several heads (each
+    // on its own suspension) are drawn each at its own height, centred on its own strips, with a
+    // suspension link down to the frame; head 0 keeps id p, head h > 0 has id kHeadIdStride h + p.
     const bool point_force = pg.moving_force && !pg.external;
-    Marker head = marker(h, "pantograph_head", id, point_force ? Marker::SPHERE : Marker::CUBE);
-    // Its top at the drawn head height (the strips' running surface), where the arrow starts.
-    head.pose.position = point(x, point_force ? y_force : yh, point_force ? z_head - 0.03 : z_head - 0.02);
-    if (point_force) head.scale.x = head.scale.y = head.scale.z = 0.2;
-    else {
-      head.scale.x = 0.1;
-      head.scale.y = 2.0 * half_strip;
-      head.scale.z = 0.04;
-    }
-    head.color = contact ? color(0.25f, 0.25f, 0.28f) : color(1.0f, 0.1f, 0.1f);
-    out.markers.push_back(head);
-    if (!point_force) {
-      Marker strips = marker(h, "pantograph_strips", id, Marker::CUBE_LIST);
-      strips.scale.x = 0.035;  // strip width along the track
-      strips.scale.y = 2.0 * half_strip;  // working width
-      strips.scale.z = 0.03;
-      strips.color = contact ? color(0.05f, 0.05f, 0.05f) : color(1.0f, 0.1f, 0.1f);
-      for (int ci : pg.collectors) strips.points.push_back(point(x + m.collectors[ci].offset, yh, z_head - 0.015));
-      add_list(out, strips);
-      Marker horns = marker(h, "pantograph_horns", id, Marker::LINE_LIST);
-      horns.scale.x = 0.03;
-      horns.color = color(0.3f, 0.3f, 0.32f);
+    const int heads = std::max(1, head_count(m, id));
+    const bool several = !pg.heads.empty();
+    const double half_width = 0.5 * m.scene.pantograph_head.working_width;
+    const double horn = std::max(0.05, 0.5 * (m.scene.pantograph_head.horn_width - m.scene.pantograph_head.working_width));
+    Marker strips = marker(h, "pantograph_strips", id, Marker::CUBE_LIST);
+    strips.scale.x = 0.035;  // strip width along the track
+    strips.scale.y = 2.0 * half_width;
+    strips.scale.z = 0.03;
+    strips.color = contact ? color(0.05f, 0.05f, 0.05f) : color(1.0f, 0.1f, 0.1f);
+    Marker horns = marker(h, "pantograph_horns", id, Marker::LINE_LIST);
+    horns.scale.x = 0.03;
+    horns.color = color(0.3f, 0.3f, 0.32f);
+    Marker links = marker(h, "pantograph_suspension", id, Marker::LINE_LIST);
+    links.scale.x = 0.03;
+    links.color = color(0.55f, 0.55f, 0.6f);
+    for (int hd = 0; hd < heads; ++hd) {
+      const double zh = several ? drawn_head_height(m, s, id, hd, k) : z_head;
+      double xh = x, head_force = 0.0;
+      if (several) {
+        xh = x + m.scene.pantographs[p].heads[hd].offset;
+        for (int ci : pg.collectors)
+          if (m.collectors[ci].head == hd)
+            for (std::size_t kw = 0; kw < nw; ++kw) head_force += s.contact_force[ci * nw + kw];
+      }
+      const bool head_contact = several ? head_force > 0.0 : contact;
+      Marker head = marker(h, "pantograph_head", hd == 0 ? id : kHeadIdStride * hd + id,
+                           point_force ? Marker::SPHERE : Marker::CUBE);
+      if (point_force) {
+        head.pose.position = point(x, y_force, z_head - 0.03);
+        head.scale.x = head.scale.y = head.scale.z = 0.2;
+      } else if (several) {
+        // A plate under the head's strips, as long as the head (scene `length`).
+        head.pose.position = point(xh, yh, zh - 0.045);
+        head.scale.x = m.scene.pantographs[p].heads[hd].length;
+        head.scale.y = 2.0 * half_width;
+        head.scale.z = 0.03;
+      } else {
+        // Its top at the drawn head height (the strips' running surface), where the arrow starts.
+        head.pose.position = point(x, yh, z_head - 0.02);
+        head.scale.x = 0.1;
+        head.scale.y = 2.0 * half_width;
+        head.scale.z = 0.04;
+      }
+      head.color = head_contact ? color(0.25f, 0.25f, 0.28f) : color(1.0f, 0.1f, 0.1f);
+      out.markers.push_back(head);
+      if (point_force) continue;
+      for (int ci : pg.collectors)
+        if (!several || m.collectors[ci].head == hd)
+          strips.points.push_back(point(x + m.collectors[ci].offset, yh, zh - 0.015));
       for (double side : {-1.0, 1.0}) {  // from the strip's end out and down: a quarter arc in 4 pieces
-        double py = yh + side * half_strip, pz = z_head - 0.03;
+        double py = yh + side * half_width, pz = zh - 0.03;
         for (int i = 1; i <= 4; ++i) {
           const double a = 0.5 * M_PI * i / 4.0;
-          const double ny = yh + side * (half_strip + horn * std::sin(a)), nz = z_head - 0.03 - horn * (1.0 - std::cos(a));
-          horns.points.push_back(point(x, py, pz));
-          horns.points.push_back(point(x, ny, nz));
+          const double ny = yh + side * (half_width + horn * std::sin(a)), nz = zh - 0.03 - 0.25 * (1.0 - std::cos(a));
+          horns.points.push_back(point(xh, py, pz));
+          horns.points.push_back(point(xh, ny, nz));
           py = ny;
           pz = nz;
         }
       }
+      if (several) {  // the head's suspension, down to the top of the frame under the reference point
+        links.points.push_back(point(xh, yh, zh - 0.06));
+        links.points.push_back(point(x, yh, z_head - 0.2));
+      }
+    }
+    if (!point_force) {
+      add_list(out, strips);
       add_list(out, horns);
+      if (several) add_list(out, links);
       if (m.lateral) {
         // Where each strip meets the wire: yellow on the working width, red beyond it (dewired).
         Marker spots = marker(h, "lateral_contact", id, Marker::SPHERE_LIST);
@@ -486,7 +538,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
                                 ? s.lateral.collector_lateral[ci] : std::nan("");
           if (!std::isfinite(yc)) continue;
           spots.points.push_back(point(x + m.collectors[ci].offset, yh + yc, z_head));
-          spots.colors.push_back(std::fabs(yc) <= half_strip ? color(1.0f, 0.85f, 0.1f) : color(1.0f, 0.1f, 0.1f));
+          spots.colors.push_back(std::fabs(yc) <= half_width ? color(1.0f, 0.85f, 0.1f) : color(1.0f, 0.1f, 0.1f));
         }
         add_list(out, spots);
       }
@@ -498,7 +550,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     const double z_roof = std::min(4.0, z_head - 1.0);
     frame.points.push_back(point(x - 1.2, yh, z_roof));
     frame.points.push_back(point(x + 0.6, yh, 0.5 * (z_roof + z_head)));
-    frame.points.push_back(point(x, yh, z_head - 0.06));
+    frame.points.push_back(point(x, yh, pg.heads.empty() ? z_head - 0.06 : z_head - 0.2));
     add_list(out, frame);
 
     Marker arrow = marker(h, "contact_force", id, Marker::ARROW);

@@ -37,6 +37,43 @@ void validate_hil_params(const HilParams& p) {
     throw ParamError("parameter ~hil/realtime_priority = " + std::to_string(p.realtime_priority) +
                      " rejected: allowed 0 (normal scheduling) to 99 (SCHED_FIFO priority)");
   check_frame_id("line_frame", p.line_frame);
+  check_range("hil/delay_compensation", p.delay_compensation, 0.0, 0.1, false, "s");
+  if (p.udp_port < 0 || p.udp_port > 65535)
+    throw ParamError("parameter ~hil/udp_port = " + std::to_string(p.udp_port) + " rejected: allowed 0 to 65535");
+  if (const std::string e = hil::check_realtime(realtime_options(p)); !e.empty()) throw ParamError("parameter " + e);
+}
+
+hil::RealtimeOptions realtime_options(const HilParams& p) {
+  hil::RealtimeOptions o;
+  o.fifo_priority = p.realtime_priority;
+  o.lock_memory = p.lock_memory || p.realtime_priority > 0;  // (a real-time loop also locks its memory)
+  if (!p.cpus.empty()) {
+    try {
+      o.cpus = hil::parse_cpu_list(p.cpus, "~hil/cpus");
+    } catch (const std::invalid_argument& e) {
+      throw ParamError(std::string("parameter ") + e.what());
+    }
+  }
+  o.lock_memory_name = "~hil/lock_memory";
+  o.priority_name = "~hil/realtime_priority";
+  o.cpus_name = "~hil/cpus";
+  return o;
+}
+
+hil::LoopOptions loop_options(const HilParams& p) {
+  hil::LoopOptions o;
+  o.rate = p.rate;
+  o.timeout = p.timeout;
+  o.extrapolate = p.extrapolate;
+  o.hold_ramp = p.hold_ramp;
+  o.hold_deceleration = p.hold_deceleration;
+  o.auto_start = p.auto_start;
+  o.at_end = p.at_end == AtEnd::kLoop ? hil::EndAction::kLoop
+             : p.at_end == AtEnd::kExit ? hil::EndAction::kExit : hil::EndAction::kStop;
+  o.start_delay = p.start_delay;
+  o.spin_wait = p.spin_wait;
+  o.delay_compensation = p.delay_compensation;
+  return o;
 }
 
 HilParams load_hil_params(const ros::NodeHandle& nh) {
@@ -44,7 +81,8 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
                 {"scene", "speed_kmh", "hil/rate", "hil/timeout", "hil/extrapolate", "hil/hold_ramp",
                  "hil/hold_deceleration", "hil/report_file", "hil/realtime_priority", "hil/spin_wait", "hil/auto_start", "at_end",
                  "stats_file", "line_frame", "publish_rate", "marker_rate", "start_delay", "shape_rate",
-                 "shape_resolution", "diagnostic_period"});  // (the last read by diagnostic_updater)
+                 "shape_resolution", "diagnostic_period", "hil/lock_memory", "hil/cpus", "hil/delay_compensation",
+                 "hil/udp_bind", "hil/udp_port", "hil/udp_rig"});  // (the last read by diagnostic_updater)
   HilParams p;
   // (the ranges are checked by validate_hil_params; the type errors name them too)
   r.text("scene", p.scene, "the path of a scene YAML file");
@@ -62,6 +100,12 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
   r.integer("hil/realtime_priority", p.realtime_priority, "an integer in [0, 99]");
   r.boolean("hil/extrapolate", p.extrapolate);
   r.boolean("hil/auto_start", p.auto_start);
+  r.boolean("hil/lock_memory", p.lock_memory);
+  r.text("hil/cpus", p.cpus, "CPU numbers, e.g. 3, 2,3 or 0-3 (empty: any)");
+  r.number("hil/delay_compensation", p.delay_compensation, "a number in [0, 0.1] s");
+  r.text("hil/udp_bind", p.udp_bind, "a numeric IPv4 address");
+  r.integer("hil/udp_port", p.udp_port, "an integer in [0, 65535]");
+  r.text("hil/udp_rig", p.udp_rig, "HOST:PORT (empty: the source of the rig's measurements)");
   r.text("hil/report_file", p.report_file, "a file path (empty: none)");
   r.text("stats_file", p.stats_file, "a file path (empty: none)");
   r.text("line_frame", p.line_frame, "a frame id");

@@ -13,6 +13,7 @@
 #include "catenary_sim/MeasuredContactForce.h"
 #include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/ros/params.hpp"
+#include "catenary_sim/hil/udp_loop.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
@@ -28,7 +29,7 @@ double mono_now() {
 }  // namespace
 
 VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
-  ParamReader r(pnh, "virtual_rig", {"pantograph_scene", "rate", "extrapolate", "report_file"});
+  ParamReader r(pnh, "virtual_rig", {"pantograph_scene", "rate", "extrapolate", "report_file", "transport", "simulator"});
   std::string scene_file;
   r.text("pantograph_scene", scene_file, "the path of a scene YAML file");
   if (scene_file.empty())
@@ -40,13 +41,19 @@ VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
     throw ParamError("parameter ~rate = " + format_number(rate_) +
                      " rejected: allowed 0 (the node's loop rate) or [1, 20000] Hz");
   r.boolean("extrapolate", extrapolate_);
+  stepper_ = RigStepper(extrapolate_);
   r.text("report_file", report_file_, "a file path (empty: none)");
   check_output_param("report_file", report_file_);
+  r.text("transport", transport_, "topics or udp");
+  if (transport_ != "topics" && transport_ != "udp")
+    throw ParamError("parameter ~transport = '" + transport_ + "' rejected: allowed topics or udp");
+  r.text("simulator", simulator_, "HOST:PORT");
   try {
     scene_ = load_scene_file(scene_file);
   } catch (const SceneError& e) {
     throw ParamError("parameter ~pantograph_scene = '" + scene_file + "': " + e.what());
   }
+  if (transport_ == "udp") return;  // (run_udp: no topics)
   // Every contact point, even after a stall of the loop thread (up to 1 s at 10 kHz): the
   // pantograph is stepped through each one (a lost one: two periods against an extrapolated wire).
   ros::SubscribeOptions so = ros::SubscribeOptions::create<ContactPointArray>(
@@ -59,12 +66,49 @@ VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
            scene_.contact.stiffness, sub_.getTopic().c_str());
 }
 
+int VirtualRig::run_udp() {
+  // The same pantograph and stepping over the packets of udp_packets.h (hil::UdpVirtualRig).
+  hil::UdpRigOptions o;
+  const auto colon = simulator_.rfind(':');
+  int port = -1;
+  try {
+    if (colon != std::string::npos) port = std::stoi(simulator_.substr(colon + 1));
+  } catch (const std::exception&) {
+  }
+  if (colon == std::string::npos || colon == 0 || port < 1 || port > 65535) {
+    ROS_FATAL("virtual_rig: parameter ~simulator = '%s' rejected: allowed HOST:PORT, e.g. 127.0.0.1:47800",
+              simulator_.c_str());
+    return 2;
+  }
+  o.simulator_address = simulator_.substr(0, colon);
+  o.simulator_port = port;
+  o.rate = rate_;
+  o.extrapolate = extrapolate_;
+  try {
+    hil::UdpVirtualRig rig(scene_, o);
+    ROS_INFO("virtual_rig: over UDP to %s (local port %d)", simulator_.c_str(), rig.port());
+    rig.run([this] { return running(); });
+    const auto& q = rig.sequence();
+    std::printf("virtual_rig: %llu measurements sent over UDP, %llu missed ticks; contact points %llu received, %llu "
+                "lost; round trip p50 %.1f us, p99 %.1f us, max %.1f us\n",
+                static_cast<unsigned long long>(rig.sent()), static_cast<unsigned long long>(rig.missed_ticks()),
+                static_cast<unsigned long long>(q.received()), static_cast<unsigned long long>(q.lost()),
+                rig.round_trip().quantile(0.5) * 1e6, rig.round_trip().quantile(0.99) * 1e6, rig.round_trip().max() * 1e6);
+    std::fflush(stdout);
+  } catch (const hil::HilError& e) {
+    ROS_FATAL("virtual_rig: %s", e.what());
+    return 2;
+  }
+  return 0;
+}
+
 int VirtualRig::run() {
   prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);  // wake-ups on time (this thread)
+  if (transport_ == "udp") return run_udp();
   while (running() && !have_) queue_.callAvailable(ros::WallDuration(0.1));
   if (!running()) return 0;
   const double period = rate_ > 0.0 ? 1.0 / rate_ : dt_ * steps_per_period_;
-  ROS_INFO("virtual_rig: %zu pantograph(s), loop %g Hz, dt %g ms, %s wire between contact points", rigs_.size(),
+  ROS_INFO("virtual_rig: %zu pantograph(s), loop %g Hz, dt %g ms, %s wire between contact points", stepper_.size(),
            1.0 / period, dt_ * 1e3, extrapolate_ ? "extrapolated" : "held");
   double next = mono_now() + 0.25 * period;
   const double start = mono_now();
@@ -111,11 +155,10 @@ int VirtualRig::run() {
 
 void VirtualRig::on_point(const ContactPointArray::ConstPtr& msg) {
   if (!(msg->dt > 0.0 && msg->dt < 1.0) || msg->steps_per_period == 0) return;  // (also NaN)
-  const bool restart = !have_ || msg->pass_count != pass_ || msg->step < step_ ||
-                       msg->pantographs.size() != rigs_.size() || msg->step - step_ > 1000000;
-  if (restart) {
-    rigs_.clear();
-    points_.clear();
+  std::vector<std::vector<WirePoint>> points;
+  for (const ContactPoint& c : msg->pantographs) points.push_back(wire_points(c));
+  if (stepper_.needs_restart(msg->pass_count, msg->step, msg->pantographs.size())) {
+    std::vector<RigPantograph> rigs;
     for (const ContactPoint& c : msg->pantographs) {
       const PantographSpec* spec = nullptr;
       for (const PantographSpec& ps : scene_.pantographs)
@@ -123,30 +166,21 @@ void VirtualRig::on_point(const ContactPointArray::ConstPtr& msg) {
       if (!spec) {
         ROS_ERROR_THROTTLE(5.0, "virtual_rig: no pantograph named '%s' in ~pantograph_scene", c.name.c_str());
         have_ = false;
+        stepper_.clear();
         return;
       }
-      rigs_.emplace_back(*spec, scene_.contact.stiffness);
-      points_.push_back(wire_points(c));
-      rigs_.back().reset(points_.back(), msg->speed);
+      rigs.emplace_back(*spec, scene_.contact.stiffness);
     }
+    stepper_.restart(std::move(rigs), std::move(points), msg->pass_count, msg->step, msg->dt, msg->speed);
     if (have_) ROS_INFO("virtual_rig: pass %u: pantograph(s) reset at the static state", msg->pass_count);
   } else {
-    // Step up to the new state, against the wire of the previous contact point.
-    for (std::size_t i = 0; i < rigs_.size(); ++i) {
-      for (std::uint64_t s = step_; s < msg->step; ++s) {
-        const double ahead = extrapolate_ ? static_cast<double>(s - step_) * dt_ : 0.0;
-        rigs_[i].step(dt_, rigs_[i].contact_force(points_[i], ahead), speed_);
-      }
-      points_[i] = wire_points(msg->pantographs[i]);
-    }
+    stepper_.advance(msg->step, points, msg->dt, msg->speed);
   }
   have_ = true;
   frame_ = msg->header.frame_id;
-  pass_ = msg->pass_count;
   step_ = msg->step;
   dt_ = msg->dt;
   steps_per_period_ = msg->steps_per_period;
-  speed_ = msg->speed;
   // Round trip of the measurement this contact point used.
   const auto it = sent_at_.find(msg->measurement_step);
   if (msg->measurement_step > 0 && it != sent_at_.end()) {
@@ -162,7 +196,7 @@ void VirtualRig::send() {
   m->header.stamp = ros::Time::now();
   m->header.frame_id = frame_;  // the frame of the contact point answered (the line frame)
   m->step = step_;
-  for (std::size_t i = 0; i < rigs_.size(); ++i) m->force.push_back(rigs_[i].contact_force(points_[i]));
+  for (std::size_t i = 0; i < stepper_.size(); ++i) m->force.push_back(stepper_.force(i));
   pub_.publish(m);
   ++sent_;
   sent_at_.emplace(step_, mono_now());  // (a repeated step keeps its first time)

@@ -271,6 +271,13 @@ int main(int argc, char** argv) {
                 << std::setprecision(1) << s.max_uplift_at_support_m * 1e3 << " mm\n"
                 << "      unfiltered: max " << s.unfiltered.max << " N, min " << s.unfiltered.min << " N, std "
                 << s.unfiltered.std_dev << " N\n";
+      if (s.target_mean) {
+        const PantographStatistics::TargetMean& t = *s.target_mean;
+        std::cout << std::setprecision(1) << "      target mean force Fm(" << 3.6 * t.speed_mps << " km/h) " << t.target
+                  << " N: mean " << std::showpos << t.difference << std::noshowpos << " N from it";
+        if (t.tolerance) std::cout << ", " << (t.within ? "within" : "OUTSIDE") << " the tolerance of +-" << *t.tolerance << " N";
+        std::cout << "\n";
+      }
       if (s.wires.size() > 1)
         for (const WireContactStatistics& w : s.wires)
           std::cout << "      on " << w.wire << ": mean " << w.mean_force << " N, max " << w.max_force << " N, in contact "

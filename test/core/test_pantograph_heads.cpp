@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <sstream>
 
@@ -192,6 +194,112 @@ TEST(PantographHeads, EightContactsOnATwinOverlapEachSwitchingOnItsOwn) {
   EXPECT_GT(partial_steps, 0) << "the strips must switch on their own somewhere in the overlap";
 }
 
+// Aerodynamic uplift per head and on the frame, for the knee's direction, and the target mean
+// force curve. Momentum balance of the whole pantograph over the section: the mean contact force
+// is the net uplift static_uplift + (frame + heads' aero) v^2 less the roof spring and damper's
+// mean force and the masses' mean inertia force. On CALPE at 120 km/h the frame moves a few cm
+// (roof spring 50 N/m: under 2.5 N; damper 100 N s/m over the 1.8 s section: under 3 N) and
+// the masses' mean acceleration is their velocity change over the section (22 kg x under
+// 0.3 m/s / 1.8 s: under 4 N): the mean is the net uplift within 10 N. The knee directions'
+// aero terms here differ by 0.04112 x (33.3 m/s)^2 = 46 N, far outside that.
+TEST(PantographHeads, MeanForceFollowsPerHeadAeroForTheKneeAndIsReportedAgainstTheTarget) {
+  const double v = 120.0 / 3.6;  // m/s, the scene's speed
+  auto scene = [&](const std::string& knee, bool with_target) {
+    YAML::Node root = calpe();
+    YAML::Node p = two_half_heads(-0.2, 0.2, 2100.0, 2100.0);
+    p["aero_coefficient"] = 0.01888;  // frame, knee leading
+    p["aero_coefficient_trailing"] = 0.0;
+    for (YAML::Node h : p["heads"]) {
+      h["aero_coefficient"] = 0.01;
+      h["aero_coefficient_trailing"] = 0.04;
+    }
+    p["knee"] = knee;
+    // The curve of the knee-leading uplift, written as EN 50367 writes it (v in km/h):
+    // a = 0.003 N/(km/h)^2 = 0.003 x 3.6^2 = 0.03888 N s^2/m^2, b = the static uplift.
+    if (with_target) p["target_mean_force"] = YAML::Load("{a: 0.003, b: 120, speed_unit: km/h, tolerance: 10}");
+    root["pantographs"][0] = p;
+    return load(root);
+  };
+  const double target = 0.003 * 120.0 * 120.0 + 120.0;           // Fm(120 km/h) = 163.2 N
+  const double leading = 120.0 + (0.01888 + 2 * 0.01) * v * v;  // net uplift, knee leading: 163.2 N
+  const double trailing = 120.0 + (0.0 + 2 * 0.04) * v * v;      // knee trailing: 208.9 N
+  ASSERT_NEAR(target, leading, 1e-9);
+
+  const Scene lead = scene("leading", true);
+  Simulation sim(lead);
+  PassRecorder rec(sim.model());
+  rec.record(sim.model(), sim.state());
+  while (sim.step() == StepStatus::kOk) rec.record(sim.model(), sim.state());
+  const auto a = rec.statistics(sim.model());
+  ASSERT_TRUE(a[0].target_mean.has_value());
+  const auto& t = *a[0].target_mean;
+  EXPECT_NEAR(t.speed_mps, v, 1e-9 * v);  // constant speed: distance over time
+  EXPECT_NEAR(t.target, target, 1e-9 * target);
+  EXPECT_NEAR(a[0].filtered.mean, leading, 10.0);
+  EXPECT_DOUBLE_EQ(t.difference, a[0].filtered.mean - t.target);
+  EXPECT_TRUE(t.within);
+  const nlohmann::json j = nlohmann::json::parse(statistics_json(sim.model(), sim.state(), a, RunInfo{}));
+  const nlohmann::json& tj = j["pantographs"][0]["target_mean_force"];
+  EXPECT_NEAR(tj["target_N"].get<double>(), target, 1e-9 * target);
+  EXPECT_NEAR(tj["speed_kmh"].get<double>(), 120.0, 1e-9 * 120.0);
+  EXPECT_DOUBLE_EQ(tj["tolerance_N"].get<double>(), 10.0);
+  EXPECT_TRUE(tj["within"].get<bool>());
+  EXPECT_EQ(tj["curve"]["speed_unit"], "km/h");
+
+  // Knee trailing, same curve: the trailing aero terms apply, 44 N above the target.
+  const auto b = run(scene("trailing", true));
+  ASSERT_TRUE(b[0].target_mean.has_value());
+  EXPECT_NEAR(b[0].filtered.mean, trailing, 10.0);
+  EXPECT_NEAR(b[0].target_mean->difference, trailing - target, 10.0);
+  EXPECT_FALSE(b[0].target_mean->within);
+
+  // Without a target nothing is reported.
+  Simulation plain(scene("leading", false));
+  PassRecorder none(plain.model());
+  none.record(plain.model(), plain.state());
+  for (int i = 0; i < 10; ++i) plain.step(), none.record(plain.model(), plain.state());
+  EXPECT_FALSE(none.statistics(plain.model())[0].target_mean.has_value());
+}
+
+// The measuring pantograph (load cells under each head, an accelerometer on it) sums its heads:
+// F_c = sum_h (suspension + damper + own aero - m_h a_h). Without head dampers the balance holds
+// exactly at every step of the central-difference scheme (as for the one-head chain in
+// test_pass_outputs): the reconstruction equals the true force to rounding; 1e-6 N is far above
+// that and far below any slip (a missing head or aero term is tens of N).
+TEST(PantographHeads, MeasuringPantographSumsItsHeads) {
+  // The example two-head scene (heads' own aero 0.002 N s^2/m^2 each), its head dampers removed.
+  YAML::Node root = YAML::LoadFile(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_heads.yaml");
+  for (YAML::Node h : root["pantographs"][0]["heads"]) h["damping"] = 0.0;
+  const auto st = run(load(root));
+  ASSERT_TRUE(st[0].measured.available);
+  EXPECT_LT(st[0].measured.max_abs_difference, 1e-6);
+  EXPECT_NEAR(st[0].measured.force.mean, st[0].filtered.mean, 1e-6);
+}
+
+// The pass runs from the rearmost strip at the line start to the foremost at its end, counting
+// the heads' strips (offset of the head + offset of the strip): at the start both heads of the
+// example scene (at +-0.25 m) are under the wire and pressed on it (eq. 23), none hanging off
+// the line's end rising on its preload; a train.start with a head off the line is refused.
+TEST(PantographHeads, EveryHeadsStripStartsAndEndsOnTheLine) {
+  const YAML::Node root = YAML::LoadFile(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_heads.yaml");
+  Simulation sim(load(root));
+  const Model& m = sim.model();
+  EXPECT_NEAR(m.train_start, 0.25, 1e-12);
+  EXPECT_NEAR(m.train_end, m.line_length - 0.25, 1e-12);
+  for (const Head& h : m.pantographs[0].heads)
+    for (int ci : h.collectors) EXPECT_GT(sim.state().contact_force[ci * m.contact_wires.size()], 0.0);
+  YAML::Node r = YAML::Clone(root);
+  r["train"]["start"] = 0.1;
+  std::string e = "(no error)";
+  try {
+    Simulation off(load(r));
+  } catch (const SceneError& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find("train.start"), std::string::npos) << e;
+  EXPECT_NE(e.find("0.25"), std::string::npos) << e;
+}
+
 TEST(PantographHeads, BadInputNamesTheField) {
   YAML::Node root = calpe();
   root["pantographs"][0] = two_half_heads(0.0, 0.0, 2100.0, 2100.0);
@@ -215,6 +323,18 @@ TEST(PantographHeads, BadInputNamesTheField) {
     r["pantographs"][0]["heads"][1]["aero_coefficient"] = -0.5;  // -0.5 x 33.3^2 = -556 N against 120 N
     const std::string e = error_of(r);
     EXPECT_NE(e.find("pantographs[0].heads[1].aero_coefficient"), std::string::npos) << e;
+  }
+  {
+    YAML::Node r = YAML::Clone(root);
+    r["pantographs"][0]["target_mean_force"] = YAML::Load("{a: 0.001, b: 70, speed_unit: mph}");
+    const std::string e = error_of(r);
+    EXPECT_NE(e.find("pantographs[0].target_mean_force.speed_unit"), std::string::npos) << e;
+    EXPECT_NE(e.find("km/h"), std::string::npos) << e;
+  }
+  {
+    YAML::Node r = YAML::Clone(root);
+    r["pantographs"][0]["target_mean_force"] = YAML::Load("{a: 0.001, b: 70, tolerance: -5}");
+    EXPECT_NE(error_of(r).find("pantographs[0].target_mean_force.tolerance"), std::string::npos);
   }
   {
     YAML::Node r = YAML::Clone(root);

@@ -101,6 +101,26 @@ def test_views_follow_the_state_without_copies_and_are_read_only():
     assert sim.pantograph_state()["contact_force_N"] == pytest.approx(f.sum(), rel=1e-12)
 
 
+def test_pantograph_state_gives_every_head():
+    # config/reference_55m_two_heads.yaml: two heads at +-0.25 m, each with aero 0.002 N s^2/m^2.
+    sim = cs.Simulation(os.path.join(ROOT, "config", "reference_55m_two_heads.yaml"))
+    sim.step(200)
+    st = sim.pantograph_state(0)
+    assert len(st["head_heights_m"]) == 2 and len(st["head_contact_forces_N"]) == 2
+    # The head height of old is the heads' mean; the heads' forces add up to the pantograph's.
+    assert st["head_height_m"] == pytest.approx(sum(st["head_heights_m"]) / 2, rel=1e-15)
+    assert sum(st["head_contact_forces_N"]) == pytest.approx(st["contact_force_N"], rel=1e-12)
+    assert all(f >= 0.0 for f in st["head_contact_forces_N"]) and st["contact_force_N"] > 0.0
+    assert st["head_heights_m"][0] != st["head_heights_m"][1]  # each on its own suspension
+    v = 300.0 / 3.6  # the scene's speed
+    assert st["head_aero_uplift_N"] == pytest.approx([0.002 * v * v] * 2, rel=1e-12)
+    assert st["knee"] == "leading"
+    # A chain is one head, its first mass.
+    one = cs.Simulation(REFERENCE).pantograph_state(0)
+    assert one["head_heights_m"] == [one["head_height_m"]]
+    assert one["head_aero_uplift_N"] == [0.0]
+
+
 def test_a_pass_from_python_equals_simulate_pass():
     # The module adds no physics: the same scene gives the same statistics, bit for bit, as the
     # offline runner (the same core and the same fixed dt; only the skin differs).

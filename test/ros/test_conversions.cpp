@@ -82,6 +82,13 @@ TEST_F(Fixture, PantographStateHasEveryMass) {
   EXPECT_DOUBLE_EQ(ps.uplift, s.uplift[0]);
   EXPECT_DOUBLE_EQ(ps.head_height, head_height(m, s, 0));
   EXPECT_DOUBLE_EQ(ps.speed, s.speed);
+  // A chain is one head (its first mass), whose aero is the frame's.
+  EXPECT_EQ(ps.head_count, 1);
+  ASSERT_EQ(ps.head_heights.size(), 1u);
+  EXPECT_DOUBLE_EQ(ps.head_heights[0], pg.reference_height + s.u[pg.first_dof]);
+  ASSERT_EQ(ps.head_aero_uplift.size(), 1u);
+  EXPECT_EQ(ps.head_aero_uplift[0], 0.0);
+  EXPECT_EQ(ps.knee, "leading");
 }
 
 TEST_F(Fixture, WireShapeSamplesAtResolutionAndKeepsEnds) {
@@ -242,6 +249,74 @@ TEST(Markers, HeadIsDrawnOnTheWireItTouchesAtMidSpan) {
   EXPECT_EQ(std::count(label->text.begin(), label->text.end(), '\n'), 1) << label->text;
   EXPECT_EQ(label->text.rfind(pg.name + ": ", 0), 0u) << label->text;
   EXPECT_GT(label->pose.position.z, arrow->points[1].z) << "label over the arrow";
+}
+
+// A pantograph with two heads (config/reference_55m_two_heads.yaml: heads at +-0.25 m on their
+// own suspensions, each with its own aero term 0.002 N s^2/m^2): the state carries both heads and
+// the markers draw each at its own height on the wire over its own strip, with its own horns.
+TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
+  Simulation sim(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m_two_heads.yaml"));
+  const Model& m = sim.model();
+  const double x_mid = m.support_x[1] + 0.5 * (m.support_x[2] - m.support_x[1]);
+  step_to(sim, x_mid);
+  const State& s = sim.state();
+  const Pantograph& pg = m.pantographs[0];
+  ASSERT_EQ(pg.heads.size(), 2u);
+
+  const PantographStateArray msg = to_pantograph_state(m, s, ros::Time(1.0), "line");
+  const PantographState& ps = msg.pantographs[0];
+  EXPECT_EQ(ps.head_count, 2);
+  ASSERT_EQ(ps.head_heights.size(), 2u);
+  ASSERT_EQ(ps.head_aero_uplift.size(), 2u);
+  ASSERT_EQ(ps.displacement.size(), static_cast<std::size_t>(pg.masses_count() + 2));  // frame, then heads
+  for (int h = 0; h < 2; ++h) {
+    EXPECT_DOUBLE_EQ(ps.head_heights[h], pg.heads[h].reference_height + s.u[pg.heads[h].dof]);
+    EXPECT_DOUBLE_EQ(ps.displacement[pg.masses_count() + h], s.u[pg.heads[h].dof]);
+    EXPECT_NEAR(ps.head_aero_uplift[h], 0.002 * s.speed * s.speed, 1e-12);  // the scene's a_h v^2
+  }
+  EXPECT_NEAR(ps.head_height, 0.5 * (ps.head_heights[0] + ps.head_heights[1]), 1e-12);
+  EXPECT_NE(ps.head_heights[0], ps.head_heights[1]) << "each head on its own suspension";
+  EXPECT_EQ(ps.knee, "leading");
+  EXPECT_EQ(ps.aero_uplift, 0.0);  // the frame's
+
+  const double k = 10.0;
+  MarkerOptions o;
+  o.vertical_scale = k;
+  o.shape_resolution = 0.0;
+  const auto arr = to_markers(m, s, ros::Time(1.0), o);
+  const double x = pantograph_position(m, s, 0);
+  const auto* wire = find_marker(arr, "wires", m.contact_wires[0]);
+  const auto* strips = find_marker(arr, "pantograph_strips", 0);
+  const auto* horns = find_marker(arr, "pantograph_horns", 0);
+  const auto* links = find_marker(arr, "pantograph_suspension", 0);
+  ASSERT_TRUE(wire && strips && horns && links);
+  ASSERT_EQ(strips->points.size(), 2u);
+  // Two heads x two sides x a quarter arc of 4 segments, 2 points each.
+  EXPECT_EQ(horns->points.size(), 32u);
+  EXPECT_EQ(links->points.size(), 4u);
+  const std::size_t nw = m.contact_wires.size();
+  for (int h = 0; h < 2; ++h) {
+    const double xh = x + (h == 0 ? 0.25 : -0.25);  // the scene's head offsets
+    const auto* head = find_marker(arr, "pantograph_head", h == 0 ? 0 : kHeadIdStride);
+    ASSERT_TRUE(head) << "head " << h;
+    EXPECT_NEAR(head->pose.position.x, xh, 1e-9);
+    EXPECT_NEAR(head->scale.x, 0.3, 1e-12);  // the head's length
+    const auto& strip = strips->points[h];
+    EXPECT_NEAR(strip.x, xh, 1e-9);
+    // Its strip's top on the wire over it, k x that strip's contact-spring compression above.
+    double f = 0.0;
+    for (int ci : pg.heads[h].collectors)
+      for (std::size_t w = 0; w < nw; ++w) f += s.contact_force[ci * nw + w];
+    ASSERT_GT(f, 0.0);
+    const double top = strip.z + 0.5 * strips->scale.z;
+    EXPECT_NEAR(top - strip_z(*wire, xh), k * f / m.contact_stiffness, 0.02) << "head " << h;
+    EXPECT_NEAR(top, drawn_head_height(m, s, 0, h, k), 1e-12);
+    // Its horns at its own station, reaching the scene's horn width.
+    double reach = 0.0;
+    for (const auto& pt : horns->points)
+      if (std::fabs(pt.x - xh) < 1e-9) reach = std::max(reach, std::fabs(pt.y));
+    EXPECT_NEAR(reach, 0.5 * m.scene.pantograph_head.horn_width, 1e-9) << "head " << h;
+  }
 }
 
 // In the overlap of calpe_example the collectors are under both contact wires: the head is drawn

@@ -285,6 +285,22 @@ TEST(RigPantograph, ResetPressesOnWithTheStaticForce) {
   EXPECT_THROW(RigPantograph(moving, 50000.0), std::invalid_argument);
 }
 
+// The rig's pantograph is a chain; a pantograph with heads on their own suspensions is refused by
+// name (not merged into one head, which would change its dynamics silently).
+TEST(RigPantograph, RefusesAPantographWithSeveralHeadsByName) {
+  const Scene scene = load_scene_file(kDir + "/config/reference_55m_two_heads.yaml");
+  ASSERT_EQ(scene.pantographs[0].heads.size(), 2u);
+  try {
+    RigPantograph rig(scene.pantographs[0], scene.contact.stiffness);
+    ADD_FAILURE() << "a two-head pantograph was accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'" + scene.pantographs[0].name + "'"), std::string::npos) << what;
+    EXPECT_NE(what.find("2 heads"), std::string::npos) << what;
+    EXPECT_NE(what.find("pantographs[].heads"), std::string::npos) << what;
+  }
+}
+
 TEST(ContactPoints, TheMotionUnderTheExternalPantographAndNeverNaN) {
   Simulation sim(external_of(reference(0.0005, 300.0)));
   const Model& m = sim.model();

@@ -70,6 +70,19 @@ struct HeadSpec {
   std::vector<CollectorSpec> collectors;           // offsets from the head's centre
 };
 
+// Target mean contact force Fm(v) = a v^2 + b. EN 50367 writes it with v in km/h (e.g.
+// 0.00097 v^2 + 70 N on AC lines), so the scene says which unit its a is for.
+struct TargetMeanForce {
+  double a = 0.0;              // N per (speed unit)^2
+  double b = 0.0;              // N
+  bool speed_kmh = false;      // a is for v in km/h (else m/s)
+  std::optional<double> tolerance;  // N: the mean is within the target when |mean - Fm(v)| <= tolerance
+  double at(double speed_mps) const {
+    const double v = speed_kmh ? 3.6 * speed_mps : speed_mps;
+    return a * v * v + b;
+  }
+};
+
 struct PantographSpec {
   std::string name;
   double position = 0.0;  // m behind the train's front
@@ -90,7 +103,7 @@ struct PantographSpec {
   std::vector<HeadSpec> heads;            // empty: the chain's first mass is the head
   // Target mean contact force Fm(v) = a v^2 + b (the standards' permissible mean force curve):
   // the statistics report the mean against it. Absent: not reported.
-  std::optional<double> target_force_a, target_force_b;  // N s^2/m^2, N
+  std::optional<TargetMeanForce> target_mean_force;
   double frame_aero() const { return knee_trailing && aero_coefficient_trailing ? *aero_coefficient_trailing : aero_coefficient; }
   static double head_aero(const HeadSpec& h, bool trailing) {
     return trailing && h.aero_coefficient_trailing ? *h.aero_coefficient_trailing : h.aero_coefficient;

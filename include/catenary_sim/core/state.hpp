@@ -127,8 +127,17 @@ struct ContactPointMotion {
 };
 void contact_point_motion(const Model& model, const State& state, int pantograph, std::vector<ContactPointMotion>& out);
 
-// Absolute height of a contact collector's pantograph head (m); NaN for a moving force.
+// Absolute height of a contact collector's pantograph head (m); NaN for a moving force. With
+// several heads: their mean.
 double head_height(const Model& model, const State& state, int pantograph);
+// Heads of a pantograph: 0 for a moving force, 1 for a chain without `heads` (its first mass),
+// else one per head on its own suspension.
+int head_count(const Model& model, int pantograph);
+// Absolute height (m) of one head, 0 <= head < head_count; NaN for a moving force.
+double head_height(const Model& model, const State& state, int pantograph, int head);
+// The head's own aerodynamic uplift at the state's speed (N): a_h v^2 for the knee direction; 0
+// for a chain without `heads` (its aero acts on the frame) and for a moving force.
+double head_aero_uplift(const Model& model, const State& state, int pantograph, int head);
 // Position of a pantograph's reference point along the line (m).
 double pantograph_position(const Model& model, const State& state, int pantograph);
 // Sum of the contact forces of one pantograph over its collectors and the contact wires (N).

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,16 @@ struct PantographStatistics {
   double loss_events_per_km = 0.0, longest_loss_s = 0.0;
   SpectrumSummary spectrum;
   MeasuredForceStatistics measured;
+  // The scene's target mean force Fm(v) = a v^2 + b (pantographs[].target_mean_force) at the
+  // train's mean speed through the section: present only when the scene gives one.
+  struct TargetMean {
+    double speed_mps = 0.0;   // mean speed through the section
+    double target = 0.0;      // N, Fm(speed)
+    double difference = 0.0;  // N, filtered mean - target
+    std::optional<double> tolerance;  // N, from the scene
+    bool within = true;       // |difference| <= tolerance (true without a tolerance)
+  };
+  std::optional<TargetMean> target_mean;
 };
 
 // One dropper of the analysis section over the whole pass: its force (elastic tension, 0 when

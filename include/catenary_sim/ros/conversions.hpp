@@ -57,6 +57,12 @@ double contact_design_height(const Model& m, const State& s, int pantograph);
 // that a head in contact is drawn on the wire it touches (k x the contact spring's compression,
 // a few cm, above it). A moving force is drawn on the displaced wire under it.
 double drawn_head_height(const Model& m, const State& s, int pantograph, double k);
+// The same for one head of a pantograph with several heads, about the design height of the wire
+// over that head's strips (a chain without heads: as above).
+double drawn_head_height(const Model& m, const State& s, int pantograph, int head, double k);
+// Marker ids in namespace pantograph_head: head 0 has the pantograph's index p, head h > 0
+// kHeadIdStride h + p.
+constexpr int kHeadIdStride = 1000;
 
 // Frame ids of the train (x = train front), of a pantograph head, and of the view frame the rviz
 // camera follows (train_view: also at the train front, but sent with each marker message only).

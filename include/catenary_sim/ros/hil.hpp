@@ -20,6 +20,8 @@
 #include "catenary_sim/core/model.hpp"
 #include "catenary_sim/core/scene.hpp"
 #include "catenary_sim/core/state.hpp"
+#include "catenary_sim/hil/loop.hpp"
+#include "catenary_sim/hil/realtime.hpp"
 #include "catenary_sim/ros/params.hpp"
 
 namespace catenary_sim {
@@ -55,7 +57,21 @@ struct HilParams {
                                     //   its queue on the steady clock, [0, half a loop period]
   int realtime_priority = 0;        // ~hil/realtime_priority: > 0: SCHED_FIFO priority of the loop
                                     //   thread (and memory locked), [0, 99]
+  bool lock_memory = false;         // ~hil/lock_memory: mlockall also without a real-time priority
+  std::string cpus;                 // ~hil/cpus: CPUs of the loop thread, e.g. "3" or "2,3" (empty: any)
+  double delay_compensation = 0.0;  // ~hil/delay_compensation: s, [0, 0.1]: the contact point sent is
+                                    //   predicted this far ahead (the known loop delay)
+  // catenary_sim_hil_udp_node only (the rig over UDP, udp_packets.h):
+  std::string udp_bind = "0.0.0.0"; // ~hil/udp_bind: local IPv4 address
+  int udp_port = 47800;             // ~hil/udp_port: local UDP port, [0, 65535]
+  std::string udp_rig;              // ~hil/udp_rig: HOST:PORT of the rig (empty: the source of its
+                                    //   newest valid measurement)
 };
+
+// The real-time options of the parameters, named as parameters in errors.
+hil::RealtimeOptions realtime_options(const HilParams& p);
+// The loop's options of the parameters.
+hil::LoopOptions loop_options(const HilParams& p);
 
 // Throws ParamError naming the parameter, the value and the allowed range.
 void validate_hil_params(const HilParams& p);
@@ -67,64 +83,15 @@ HilParams load_hil_params(const ros::NodeHandle& private_nh);
 // ParamError naming ~scene.
 Scene load_hil_scene(const HilParams& p);
 
-// The loop period and the core steps in it. The core's dt must divide the period: a scene with
-// numerics.dt: auto gets the largest dt = period / k not above the automatic dt (`auto_dt`, the
-// safety factor times the stability limit); an explicit numerics.dt must divide the period (to
-// 1e-6 relative), else ParamError naming both values.
-struct HilTiming {
-  double period = 0.0;        // s
-  int steps_per_period = 0;
-  double dt = 0.0;            // s, period / steps_per_period exactly
-};
+// The ROS-free parts shared with the UDP loop (hil/loop.hpp).
+using hil::HilTiming;
+using hil::hold_ramp_force;
+using hil::LatencyHistogram;
+using hil::MeasurementHold;
+using hil::external_pantographs;
+
+// hil::hil_timing with its errors as ParamError (naming ~hil/rate and ~scene).
 HilTiming hil_timing(double rate_hz, std::optional<double> scene_dt, double auto_dt);
-
-// The newest valid measurement, held, with the previous one for the optional extrapolation.
-// Times are seconds on one monotonic clock.
-class MeasurementHold {
- public:
-  explicit MeasurementHold(std::size_t pantographs = 0) : force_(pantographs), previous_(pantographs) {}
-  // A valid measurement (one total force per external pantograph) that arrived at `arrival`;
-  // `measured` is its own stamp (0: unknown, the arrival is used for the slope).
-  void accept(const std::vector<double>& force, double arrival, double measured, std::uint64_t step);
-  bool has_value() const { return count_ > 0; }
-  std::uint64_t count() const { return count_; }
-  double arrival() const { return arrival_; }
-  std::uint64_t step() const { return step_; }
-  // s since the newest arrival; +inf before the first.
-  double age(double now) const { return count_ ? now - arrival_ : std::numeric_limits<double>::infinity(); }
-  // Force (N) for pantograph i at time t: the newest value, or with `extrapolate` the line through
-  // the last two measurements continued to t, at most `horizon` s past the newest arrival (the
-  // newest value when there is no earlier one or their times do not increase).
-  double value(std::size_t i, double t, bool extrapolate, double horizon) const;
-
- private:
-  std::vector<double> force_, previous_;
-  double arrival_ = 0.0, time_ = 0.0, previous_time_ = 0.0;
-  bool stamped_ = false, previous_stamped_ = false;
-  std::uint64_t count_ = 0, step_ = 0;
-};
-
-// Safe hold: force ramped linearly from `from` to `to` over `ramp` s (0: `to` at once).
-double hold_ramp_force(double from, double to, double elapsed, double ramp);
-
-// Latencies (s) in 1 us bins up to 10 ms (longer ones count in the last bin and in max()).
-// Fixed size: add() never allocates.
-class LatencyHistogram {
- public:
-  LatencyHistogram();
-  void add(double seconds);
-  std::uint64_t count() const { return count_; }
-  double max() const { return max_; }
-  double mean() const { return count_ ? sum_ / count_ : 0.0; }
-  // q in [0, 1]: the upper edge of the bin holding the q-quantile (0 when empty).
-  double quantile(double q) const;
-  void clear();
-
- private:
-  std::vector<std::uint64_t> bins_;
-  std::uint64_t count_ = 0;
-  double max_ = 0.0, sum_ = 0.0;
-};
 
 // hil/contact_point for the current state: the motion of the wire under every external
 // pantograph (contact_point_motion), its applied force, the simulation time and the header
@@ -136,8 +103,9 @@ ContactPointArray to_contact_points(const Model& m, const State& s, const ros::T
 // True when every floating-point field is finite.
 bool all_finite(const ContactPointArray& msg);
 
-// Indices of the external pantographs of a model, in scene order.
-std::vector<int> external_pantographs(const Model& m);
+// hil/contact_point from the loop's frame (the header's stamp and frame given).
+ContactPointArray to_contact_points(const Model& m, const hil::PointFrame& frame, const ros::Time& stamp,
+                                    const std::string& frame_id);
 
 }  // namespace ros_layer
 }  // namespace catenary_sim

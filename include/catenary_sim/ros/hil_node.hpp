@@ -53,63 +53,51 @@
 #include "catenary_sim/MeasuredContactForce.h"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/ros/hil.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
 
-class HilNode {
+// The ROS skin of the loop (hil::HilLoop: the periods, the held measurement, the safe hold,
+// the control requests): hil/contact_force and hil/contact_wrench in, hil/contact_point out,
+// services and cmd/train_speed handed to the loop, and the slow publications on a worker thread.
+class HilNode : public hil::LoopSkin {
  public:
   // Reads and validates the parameters, loads the scene and chooses dt; throws ParamError.
   HilNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
-  ~HilNode();
+  ~HilNode() override;
   // Runs the loop until shutdown, stop() or the end of the pass with at_end exit. Returns the exit
   // code. The calling thread is the loop thread: with ~hil/realtime_priority it is made SCHED_FIFO.
   int run();
   // Ends run() within a loop period (from any thread).
-  void stop() { stop_ = true; }
+  void stop() {
+    stop_ = true;
+    loop_->stop();
+  }
 
-  // Loop figures, also written to ~hil/report_file.
-  struct Counters {
-    std::int64_t batches = 0;        // loop periods that stepped
-    std::int64_t triggered = 0;      // of those, started by a fresh measurement
-    std::int64_t held = 0;           // running without a fresh measurement in the window (held input)
-    std::int64_t hold_batches = 0;   // in the safe hold
-    std::int64_t overruns = 0;       // the loop fell behind: a window closed before its steps began
-    std::int64_t accepted = 0, rejected = 0;
-    std::int64_t superseded = 0;     // replaced by a newer one before any period used them
-    std::int64_t late = 0;           // answered an older contact point than the last published
-    std::int64_t holds = 0;          // times the safe hold was entered
-    std::int64_t relocks = 0;        // the windows were centred on an arrival again (after an overrun)
-    double max_age_running = 0.0;    // s, oldest measurement used while running
-  };
+  using Counters = hil::LoopCounters;
 
  private:
-  enum class Mode { kWaiting, kRunning, kHold, kPaused, kEnded };
-  // Requests of the services, carried out by the loop thread.
-  enum class Request { kArm, kPause, kResume, kReset, kStop };
+  using Mode = hil::Mode;
+  using Request = hil::Request;
+
+  // hil::LoopSkin (loop thread)
+  bool running() override { return ros::ok() && !ros::isShuttingDown() && !stop_; }
+  void receive(double until) override;
+  void send(const hil::PointFrame& frame) override;
+  void log(hil::LogLevel level, const std::string& text) override;
+  void after_period(double now) override;
+  void pass_ended(std::unique_ptr<PassRecorder> recorder, const State& state) override;
 
   void on_measurement(const MeasuredContactForce::ConstPtr& msg);
   void on_wrench(const geometry_msgs::WrenchStamped::ConstPtr& msg);
-  // A measurement of `force` (one value per external pantograph, named `field`[i] in errors, or
-  // `field` alone for a single value): validated whole, then held. False when rejected.
-  bool accept(const double* force, double arrival, const ros::Time& stamp, std::uint64_t step, const char* field,
-              bool indexed);
-  void reject(const std::string& what);
-  void wait_for_period(double w, double half, double& t);
-  void batch(double t, bool triggered);
-  void publish_point();
-  void handle_end();
-  void enter_hold(double t, double age);
-  void leave_hold();
   void snapshot(double t);
   void worker();
   void publish_pantograph_state(const Model& m, const State& s, const ros::Time& stamp);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   bool write_report() const;  // false: ~hil/report_file could not be written (said on stderr)
   void stop_worker();         // after it has written the statistics of a pass that has ended
-  static std::uint8_t mode_code(Mode m);
-  static const char* mode_name(Mode m);
 
   // Control thread: services and cmd/train_speed.
   bool on_arm(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
@@ -117,58 +105,21 @@ class HilNode {
   bool on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
   bool on_stop(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
   void on_speed(const std_msgs::Float64::ConstPtr& msg);
-  // Hands `r` to the loop thread and waits for its answer: (done, message).
+  // Hands `r` to the loop and waits for its answer: (done, message), logged.
   std::pair<bool, std::string> ask_loop(Request r, const char* service);
-  // Loop thread: a pending speed command or request, at most one each per period.
-  void poll_control();
-  bool execute(Request r, std::string& message);
-  void begin_stop();
-  void new_pass();  // the line back at its initial static state, time running on, pass_count + 1
-  bool stop_settled() const;
 
   ros::NodeHandle nh_, pnh_;
   HilParams params_;
-  HilTiming timing_;
-  std::unique_ptr<Simulation> sim_;
+  std::unique_ptr<hil::HilLoop> loop_;
   std::vector<int> external_;
-  double commanded_speed_ = 0.0;  // m/s, the scene's (or ~speed_kmh), then cmd/train_speed (loop thread)
 
-  // Loop state (loop thread only).
+  // Loop thread.
   ros::CallbackQueue hil_queue_;
   ros::Subscriber force_sub_, wrench_sub_;
   std::atomic<bool> stop_{false};
   ros::Publisher point_pub_;
-  Mode mode_ = Mode::kWaiting;
-  bool armed_ = true;              // in kWaiting: the first valid measurement starts the pass
-  Mode paused_from_ = Mode::kRunning;  // kPaused: the mode to return to
-  bool stopping_ = false;          // kHold after ~stop: ends in kEnded once the line has settled
-  bool recovering_ = false;        // accelerating back to the commanded speed after a safe hold
-  double point_motion_ = 0.0;      // m/s, largest |velocity| and |path_velocity| in the last contact point
-  MeasurementHold hold_;
-  bool fresh_ = false;             // a valid measurement that may start a period (answers the last contact point)
-  bool unused_ = false;            // the newest valid measurement has not been used by a period yet
-  std::uint64_t published_step_ = 0;  // step of the last contact point published
-  bool owed_ = false;              // the last period ran at its deadline without a measurement
-  std::vector<double> accept_buf_;
-  double age_in_effect_ = -1.0;    // s, age of the measurement used by the last batch
-  std::uint64_t step_in_effect_ = 0;
-  double hold_start_time_ = 0.0;   // s, simulation time when the safe hold began
-  std::vector<double> hold_from_;  // N, per pantograph, force when it began
-  bool diverged_ = false;
-  bool exit_requested_ = false;
-  int exit_code_ = 0;
-  std::uint32_t pass_count_ = 0;
   double stamp_offset_ = 0.0;
-  double started_ = 0.0;           // s (steady), first measurement
-  std::vector<ContactPointMotion> scratch_;
-  std::unique_ptr<PassRecorder> recorder_;
-  Counters c_;
-  LatencyHistogram latency_;       // measurement arrival -> its contact point published
-  LatencyHistogram transport_;     // rig stamp -> arrival (same machine clocks)
-  LatencyHistogram compute_;       // batch start -> contact point published
-  LatencyHistogram wait_;          // measurement arrival -> the steps that use it start
-  double next_snapshot_ = 0.0, next_quantiles_ = 0.0;
-  double q_latency_[3] = {0, 0, 0};  // p50, p99, max for the diagnostics
+  double next_snapshot_ = 0.0;
 
   // Snapshot for the worker thread (slow publications).
   struct Snapshot {
@@ -177,6 +128,7 @@ class HilNode {
     Counters counters;
     double age = -1.0, age_in_effect = -1.0;
     double latency[3] = {0, 0, 0};
+    hil::JitterSummary jitter;
     bool diverged = false, armed = true, stopping = false, recovering = false;
     std::uint32_t pass_count = 0;
     double commanded_speed = 0.0;
@@ -201,26 +153,13 @@ class HilNode {
   ros::Time last_view_stamp_;
   double next_marker_wall_ = 0.0;
 
-  // Control: its own queue and thread (never the loop's); the hand-over of a request.
+  // Control: its own queue and thread (never the loop's).
   ros::CallbackQueue ctrl_queue_;
   std::unique_ptr<ros::AsyncSpinner> ctrl_spinner_;
   ros::ServiceServer arm_srv_, pause_srv_, reset_srv_, stop_srv_;
   ros::Subscriber speed_sub_;
-  std::mutex ctrl_mu_;                   // the loop only try-locks it
-  std::condition_variable ctrl_cv_;
-  std::atomic<bool> ctrl_posted_{false};  // a request waits for the loop
-  Request ctrl_request_ = Request::kArm;  // (under ctrl_mu_, with the answer)
-  bool ctrl_done_ = false, ctrl_ok_ = false;
-  std::string ctrl_reply_;
-  std::atomic<bool> loop_running_{false};
-  std::atomic<bool> speed_posted_{false};  // a valid cmd/train_speed waits for the loop
-  std::atomic<double> speed_command_{0.0};
 };
 
-// Loop-thread set-up: timer slack of 1 us (wake-ups on time), and with `realtime_priority` > 0
-// SCHED_FIFO at that priority for the calling thread and all memory locked (needs CAP_SYS_NICE or
-// an rtprio limit; refused: a warning, normal scheduling). `who` prefixes the log lines.
-void prepare_loop_thread(int realtime_priority, const char* who);
 
 }  // namespace ros_layer
 }  // namespace catenary_sim

@@ -1,64 +1,21 @@
-// The pantograph of the virtual rig: the scene's lumped pantograph (eq. 9: masses, springs and
-// dampers head first, the uplift on the lowest mass, the contact spring k0 of eq. 22 with loss of
-// contact, eq. 25) integrated on its own with the core's explicit central differences, against
-// the wire heights it receives on hil/contact_point. Pure (no ROS, no clock): gtest-able.
-//
-// Fed every step with the wire under it and applied with no delay, it reproduces the core's
-// internal lumped pantograph exactly (test_ros_hil): the same equations in the same order.
+// The virtual rig's pantograph (hil::RigPantograph, hil/rig_pantograph.hpp) fed from
+// hil/contact_point.
 #pragma once
 
 #include <vector>
 
 #include "catenary_sim/ContactPoint.h"
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/hil/rig_pantograph.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
 
-// The contact wire under one collector (one entry of ContactPoint's per-wire arrays).
-struct WirePoint {
-  bool on_wire = false;
-  double height = 0.0;         // m, absolute
-  double path_velocity = 0.0;  // m/s, rate of change of `height` seen by the moving pantograph
-};
+using hil::RigPantograph;
+using hil::RigStepper;
+using hil::WirePoint;
 
 // The wire points of one pantograph's hil/contact_point entry.
 std::vector<WirePoint> wire_points(const ContactPoint& c);
-
-class RigPantograph {
- public:
-  // `spec`: a lumped pantograph (type lumped, at least one mass); `contact_stiffness`: k0 (N/m,
-  // the scene's contact.stiffness). Throws std::invalid_argument otherwise.
-  RigPantograph(const PantographSpec& spec, double contact_stiffness);
-
-  // Static equilibrium pressed against `points` (the wire at rest), every mass at rest: the total
-  // contact force equals the uplift at `speed` (static_uplift + aero_coefficient speed^2), as in
-  // the core's initial state (eq. 23, roof spring relaxed there). Displacements count from here.
-  void reset(const std::vector<WirePoint>& points, double speed);
-
-  // Total contact force (N): over the points on a wire, max(0, k0 (head - y)) with each height
-  // extrapolated `ahead` s along its path velocity (eq. 22 with eq. 25, one contact per
-  // collector and wire, as the core's lumped pantograph).
-  double contact_force(const std::vector<WirePoint>& points, double ahead = 0.0) const;
-
-  // One step of dt (the core's scheme: half-step velocities, dampers on the half-step velocity):
-  // the springs and dampers, the uplift at `speed` on the lowest mass, -contact_force on the head.
-  void step(double dt, double contact_force, double speed);
-
-  double head_height() const { return head_static_ + d_[0]; }   // m, absolute
-  const std::vector<double>& displacement() const { return d_; }  // m, from the static state, head first
-  const std::vector<double>& velocity() const { return v_; }      // m/s, half-step, head first
-  double static_force() const { return static_force_; }           // N, contact force at reset
-  const PantographSpec& spec() const { return spec_; }
-  double contact_stiffness() const { return k0_; }
-
- private:
-  PantographSpec spec_;
-  double k0_ = 0.0;
-  double head_static_ = 0.0;   // m, head height at the static state
-  double static_force_ = 0.0;  // N, the preload of the springs between masses
-  std::vector<double> d_, v_, f_;
-};
 
 }  // namespace ros_layer
 }  // namespace catenary_sim

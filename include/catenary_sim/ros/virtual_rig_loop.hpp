@@ -11,6 +11,9 @@
 //                      (an actuator tracking the trajectory); false: held
 //   ~report_file       JSON with the round trip (measurement sent -> the contact point that used it
 //                      received) at exit; checked writable at start-up
+//   ~transport         topics (hil/contact_point -> hil/contact_force) or udp: the packets of
+//                      hil/udp_packets.h with catenary_sim_hil_udp_node (hil::UdpVirtualRig)
+//   ~simulator         with udp: HOST:PORT of the simulator (default 127.0.0.1:47800)
 // Typed and checked as the nodes' parameters (params.hpp: ParamReader); unknown ones are warned about.
 #pragma once
 
@@ -53,13 +56,14 @@ class VirtualRig {
   double rate_ = 0.0;
   bool extrapolate_ = true;
   std::string report_file_;
+  std::string transport_ = "topics";
+  std::string simulator_ = "127.0.0.1:47800";
+  int run_udp();
   std::string frame_;  // frame_id of the last contact point, sent back with the measurements
-  std::vector<RigPantograph> rigs_;
-  std::vector<std::vector<WirePoint>> points_;
+  hil::RigStepper stepper_;  // the pantographs and their stepping (shared with the UDP rig)
   bool have_ = false;
-  std::uint32_t pass_ = 0;
   std::uint64_t step_ = 0;
-  double dt_ = 0.0, speed_ = 0.0;
+  double dt_ = 0.0;
   std::uint32_t steps_per_period_ = 1;
   std::uint64_t sent_ = 0, missed_ = 0;
   std::map<std::uint64_t, double> sent_at_;

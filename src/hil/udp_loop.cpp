@@ -1,0 +1,341 @@
+#include "catenary_sim/hil/udp_loop.hpp"
+
+#include <arpa/inet.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include <nlohmann/json.hpp>
+
+namespace catenary_sim {
+namespace hil {
+
+std::int64_t monotonic_ns() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
+}
+
+sockaddr_in udp_address(const std::string& address, int port, const std::string& name) {
+  if (port < 0 || port > 65535)
+    throw HilError(name + " port = " + std::to_string(port) + " rejected: allowed 0 to 65535");
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  if (inet_pton(AF_INET, address.c_str(), &a.sin_addr) != 1)
+    throw HilError(name + " = '" + address + "' rejected: allowed a numeric IPv4 address, e.g. 127.0.0.1 or 0.0.0.0");
+  return a;
+}
+
+UdpSocket::UdpSocket(const std::string& address, int port, const std::string& name) {
+  const sockaddr_in a = udp_address(address, port, name);
+  fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (fd_ < 0) throw HilError(name + ": no UDP socket: " + std::strerror(errno));
+  // Room for a stall of the loop (a second at 10 kHz of ~100-byte measurements).
+  const int rcv = 1 << 20;
+  setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &rcv, sizeof rcv);
+  if (::bind(fd_, reinterpret_cast<const sockaddr*>(&a), sizeof a) != 0) {
+    const int err = errno;
+    ::close(fd_);
+    fd_ = -1;
+    throw HilError(name + " = " + address + ":" + std::to_string(port) + ": cannot bind: " + std::strerror(err) +
+                   (err == EADDRINUSE ? " (another process uses the port: choose another)" : ""));
+  }
+}
+
+UdpSocket::~UdpSocket() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+int UdpSocket::port() const {
+  sockaddr_in a{};
+  socklen_t n = sizeof a;
+  if (getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &n) != 0) return -1;
+  return ntohs(a.sin_port);
+}
+
+bool UdpSocket::wait_readable(double until) const {
+  const double left = until - steady_now();
+  pollfd p{fd_, POLLIN, 0};
+  timespec ts{};
+  if (left > 0.0) {
+    ts.tv_sec = static_cast<time_t>(left);
+    ts.tv_nsec = static_cast<long>((left - static_cast<double>(ts.tv_sec)) * 1e9);
+  }
+  return ppoll(&p, 1, &ts, nullptr) > 0 && (p.revents & POLLIN);
+}
+
+long UdpSocket::receive(void* buf, std::size_t cap, sockaddr_in* from) const {
+  socklen_t n = sizeof(sockaddr_in);
+  const ssize_t r = ::recvfrom(fd_, buf, cap, MSG_DONTWAIT, reinterpret_cast<sockaddr*>(from), &n);
+  return r < 0 ? -1 : static_cast<long>(r);
+}
+
+bool UdpSocket::send(const void* data, std::size_t n, const sockaddr_in& to) const {
+  return ::sendto(fd_, data, n, MSG_DONTWAIT, reinterpret_cast<const sockaddr*>(&to), sizeof to) ==
+         static_cast<ssize_t>(n);
+}
+
+// ---- The simulator's side ----
+
+UdpLoopSkin::UdpLoopSkin(HilLoop& loop, const UdpLoopOptions& o, MonitorRing* monitor)
+    : loop_(loop), opt_(o), socket_(o.bind_address, o.port, "--bind/--port"), monitor_(monitor) {
+  if (const std::string e = udp::check_fits(loop.model()); !e.empty()) throw HilError("~scene: " + e);
+  if (!o.rig_address.empty()) {
+    if (o.rig_port <= 0 || o.rig_port > 65535)
+      throw HilError("--rig-port = " + std::to_string(o.rig_port) + " rejected: allowed 1 to 65535 with --rig");
+    rig_ = udp_address(o.rig_address, o.rig_port, "--rig");
+    fixed_rig_ = have_rig_ = true;
+  }
+  loop_.attach(this);
+}
+
+void UdpLoopSkin::log(LogLevel level, const std::string& text) {
+  if (log_sink_) {
+    log_sink_(level, text);
+    return;
+  }
+  std::fprintf(stderr, "[%s] %s\n", level == LogLevel::kInfo ? "INFO" : level == LogLevel::kWarn ? "WARN" : "ERROR",
+               text.c_str());
+}
+
+void UdpLoopSkin::receive(double until) {
+  while (true) {
+    sockaddr_in from{};
+    const long n = socket_.receive(buf_, sizeof buf_, &from);
+    if (n >= 0) {
+      take(buf_, static_cast<std::size_t>(n), from, steady_now());
+      continue;  // (all that are waiting: only the newest is used)
+    }
+    if (loop_.fresh() || steady_now() >= until || !running()) return;
+    socket_.wait_readable(until);
+    if (steady_now() >= until && !socket_.wait_readable(0.0)) return;
+  }
+}
+
+void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_in& from, double arrival) {
+  csim_udp_measurement m;
+  udp::Reject why;
+  std::string reason;
+  if (!udp::decode_measurement(data, n, static_cast<std::uint32_t>(loop_.external().size()), m, why, reason)) {
+    ++rejected_[static_cast<int>(why)];
+    loop_.reject("UDP " + reason);
+    return;
+  }
+  if (!udp::SequenceTracker::usable(tracker_.observe(m.header.sequence))) {
+    ++unusable_;  // older than one already taken (reordered) or a duplicate: counted, not used
+    return;
+  }
+  if (!fixed_rig_) {
+    rig_ = from;
+    have_rig_ = true;
+  }
+  if (m.pantographs == 0) return;  // a hello: the rig's address, no measurement
+  for (std::uint32_t i = 0; i < m.pantographs; ++i) force_[i] = m.force[i];
+  const double measured = m.measured_time_ns > 0 ? 1e-9 * static_cast<double>(m.measured_time_ns) : 0.0;
+  if (!loop_.accept(force_.data(), m.pantographs, arrival, measured, m.answers_step, "UDP measurement.force", true))
+    return;
+  measurement_sequence_ = m.header.sequence;
+  if (opt_.same_clock && m.header.send_time_ns > 0) {
+    const double transport = arrival - 1e-9 * static_cast<double>(m.header.send_time_ns);
+    if (transport >= 0.0 && transport < 1.0) loop_.add_transport(transport);
+  }
+}
+
+void UdpLoopSkin::send(const PointFrame& f) {
+  // Which measurement the period used: the newest accepted while running (the loop applies the
+  // newest), none otherwise (waiting, safe hold, paused, ended).
+  in_effect_sequence_ = loop_.mode() == Mode::kRunning ? measurement_sequence_ : 0;
+  std::uint32_t flags = 0;
+  const LoopCounters& c = loop_.counters();
+  if (c.held != last_held_) flags |= CSIM_UDP_FLAG_HELD;
+  if (c.overruns != last_overruns_) flags |= CSIM_UDP_FLAG_OVERRUN;
+  last_held_ = c.held;
+  last_overruns_ = c.overruns;
+  if (loop_.options().delay_compensation > 0.0) flags |= CSIM_UDP_FLAG_COMPENSATED;
+  if (have_rig_) {
+    udp::encode_contact_point(f, ++sequence_, monotonic_ns(), in_effect_sequence_, flags, packet_);  // (fits: checked)
+    if (socket_.send(&packet_, sizeof packet_, rig_)) ++sent_;
+    else ++send_errors_;
+  }
+  if (monitor_) {
+    MonitorSample s;
+    s.wall = steady_now();
+    s.simulation_time = f.simulation_time;
+    s.speed = f.speed;
+    s.step = f.step;
+    s.measurement_step = f.measurement_step;
+    s.pass_count = f.pass_count;
+    s.mode = static_cast<std::uint8_t>(f.mode);
+    s.pantographs = static_cast<std::uint32_t>(std::min<std::size_t>(f.pantographs.size(), CSIM_UDP_MAX_PANTOGRAPHS));
+    for (std::uint32_t i = 0; i < s.pantographs; ++i) {
+      const PantographPoint& p = f.pantographs[i];
+      s.position[i] = p.position;
+      s.height[i] = p.height;
+      s.velocity[i] = p.velocity;
+      s.path_velocity[i] = p.path_velocity;
+      s.applied_force[i] = p.applied_force;
+      s.measurement_age[i] = p.measurement_age;
+    }
+    s.periods = c.batches;
+    s.overruns = c.overruns;
+    s.held = c.held;
+    s.holds = c.holds;
+    s.rejected = c.rejected;
+    s.packets_lost = tracker_.lost();
+    s.packets_reordered = tracker_.reordered();
+    s.packets_duplicated = tracker_.duplicates();
+    s.latency_p99 = loop_.latency_quantiles()[1];
+    s.jitter_p50 = loop_.jitter_summary().p50;
+    s.jitter_p99 = loop_.jitter_summary().p99;
+    s.jitter_max = loop_.jitter_summary().max;
+    s.jitter_counts = loop_.jitter_summary().counts;
+    s.delay_energy = loop_.energy().delay_j;
+    monitor_->push(s);  // (never waits: a full ring drops and counts)
+  }
+}
+
+void UdpLoopSkin::add_report(nlohmann::ordered_json& j) const {
+  nlohmann::ordered_json u;
+  u["port"] = socket_.port();
+  u["packets_received"] = tracker_.received();
+  u["packets_lost"] = tracker_.lost();
+  u["packets_reordered"] = tracker_.reordered();
+  u["packets_duplicated"] = tracker_.duplicates();
+  u["sender_restarts"] = tracker_.restarts();
+  nlohmann::ordered_json r;
+  for (int i = 0; i < static_cast<int>(udp::Reject::kNumReasons); ++i)
+    r[udp::reject_name(static_cast<udp::Reject>(i))] = rejected_[i];
+  u["packets_rejected"] = r;
+  u["contact_points_sent"] = sent_;
+  u["send_errors"] = send_errors_;
+  if (monitor_) u["monitor_dropped"] = monitor_->dropped();
+  j["udp"] = u;
+}
+
+// ---- The simulated rig ----
+
+UdpVirtualRig::UdpVirtualRig(const Scene& scene, const UdpRigOptions& o)
+    : scene_(scene), opt_(o), socket_(o.bind_address, o.port, "--bind/--port"), stepper_(o.extrapolate) {
+  simulator_ = udp_address(o.simulator_address, o.simulator_port, "--simulator");
+  if (!std::isfinite(o.rate) || !(o.rate == 0.0 || (o.rate >= 1.0 && o.rate <= 20000.0)))
+    throw HilError("--rate = " + format_value(o.rate) + " rejected: allowed 0 (the simulator's loop rate) or [1, 20000] Hz");
+  for (const PantographSpec& ps : scene_.pantographs)
+    if (!ps.moving_force && !ps.external && !ps.masses.empty()) rigs_.emplace_back(ps, scene_.contact.stiffness);
+  if (rigs_.empty()) throw HilError("--pantograph-scene: no lumped pantograph (type lumped) in the scene");
+}
+
+void UdpVirtualRig::on_point(const csim_udp_contact_point& msg) {
+  if (!(msg.dt > 0.0 && msg.dt < 1.0) || msg.steps_per_period == 0) return;
+  if (msg.pantographs > rigs_.size()) {
+    ++rejected_;
+    return;
+  }
+  if (observer_) observer_(msg);
+  ended_ = (msg.state_flags & CSIM_UDP_MODE_MASK) == CSIM_UDP_MODE_ENDED;
+  auto points_of = [](const csim_udp_pantograph_point& p) {
+    std::vector<WirePoint> w(p.wire_points);
+    for (std::uint32_t k = 0; k < p.wire_points; ++k) {
+      w[k].on_wire = p.on_wire[k] != 0;
+      w[k].height = p.wire_height[k];
+      w[k].path_velocity = p.wire_path_velocity[k];
+    }
+    return w;
+  };
+  std::vector<std::vector<WirePoint>> points;
+  for (std::uint32_t i = 0; i < msg.pantographs; ++i) points.push_back(points_of(msg.pantograph[i]));
+  if (stepper_.needs_restart(msg.pass_count, msg.step, msg.pantographs))
+    stepper_.restart(std::vector<RigPantograph>(rigs_.begin(), rigs_.begin() + msg.pantographs), std::move(points),
+                     msg.pass_count, msg.step, msg.dt, msg.speed);
+  else
+    stepper_.advance(msg.step, points, msg.dt, msg.speed);
+  have_ = true;
+  step_ = msg.step;
+  dt_ = msg.dt;
+  steps_per_period_ = msg.steps_per_period;
+  if (msg.measurement_step > 0) {
+    auto& slot = sent_at_[msg.measurement_step % sent_at_.size()];
+    if (slot.first == msg.measurement_step && slot.second > 0.0) {
+      round_trip_.add(steady_now() - slot.second);
+      slot.second = 0.0;
+    }
+  }
+}
+
+void UdpVirtualRig::send_measurement() {
+  if (!have_) return;
+  csim_udp_measurement m;
+  std::memset(&m, 0, sizeof m);
+  const std::int64_t now = monotonic_ns();
+  udp::fill_header(m.header, CSIM_UDP_KIND_MEASUREMENT, CSIM_UDP_MEASUREMENT_SIZE, ++sequence_, now);
+  m.answers_step = step_;
+  m.measured_time_ns = now;
+  m.pantographs = static_cast<std::uint32_t>(stepper_.size());
+  for (std::size_t i = 0; i < stepper_.size(); ++i) m.force[i] = stepper_.force(i);
+  // (no head acceleration: the field is optional, flags 0)
+  if (socket_.send(&m, sizeof m, simulator_)) {
+    ++sent_;
+    auto& slot = sent_at_[step_ % sent_at_.size()];
+    if (slot.first != step_) slot = {step_, steady_now()};  // (a repeated step keeps its first time)
+  }
+}
+
+int UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_ended) {
+  auto stopped = [&] { return !keep_running(); };
+  alignas(8) std::uint8_t buf[2048];
+  csim_udp_contact_point p;
+  auto drain = [&] {
+    sockaddr_in from{};
+    long n;
+    while ((n = socket_.receive(buf, sizeof buf, &from)) >= 0) {
+      udp::Reject why;
+      std::string reason;
+      if (!udp::decode_contact_point(buf, static_cast<std::size_t>(n), p, why, reason)) {
+        ++rejected_;
+        continue;
+      }
+      if (!udp::SequenceTracker::usable(tracker_.observe(p.header.sequence))) continue;
+      on_point(p);
+    }
+  };
+  // Until the first contact point: a hello every 50 ms (a measurement of no pantographs), from
+  // which the simulator learns where to send (unless it was given --rig).
+  while (!stopped() && !have_) {
+    csim_udp_measurement hello;
+    std::memset(&hello, 0, sizeof hello);
+    udp::fill_header(hello.header, CSIM_UDP_KIND_MEASUREMENT, CSIM_UDP_MEASUREMENT_SIZE, ++sequence_, monotonic_ns());
+    socket_.send(&hello, sizeof hello, simulator_);
+    socket_.wait_readable(steady_now() + 0.05);
+    drain();
+  }
+  const double period0 = dt_ * steps_per_period_;
+  const double period = opt_.rate > 0.0 ? 1.0 / opt_.rate : period0;
+  double next = steady_now() + 0.25 * period;
+  while (!stopped() && !(until_ended && ended_)) {
+    // Take contact points as they come (stepping the pantograph up to each at once) until the
+    // tick, then send the contact force: the measurement, as a rig samples its load cell.
+    for (double now = steady_now(); now < next && !stopped(); now = steady_now()) {
+      socket_.wait_readable(next);
+      drain();
+    }
+    drain();
+    send_measurement();
+    next += period;
+    const double now = steady_now();
+    if (now > next) {  // late by more than a period: skip the missed ticks
+      ++missed_;
+      next += std::ceil((now - next) / period) * period;
+    }
+  }
+  return 0;
+}
+
+}  // namespace hil
+}  // namespace catenary_sim

@@ -1,0 +1,221 @@
+#include "catenary_sim/ros/hil_udp_node.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "catenary_sim/ContactPointArray.h"
+#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/hil/report.hpp"
+#include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/params.hpp"
+
+namespace catenary_sim {
+namespace ros_layer {
+
+namespace {
+constexpr double kControlWait = 5.0;  // s, as catenary_sim_hil_node
+}
+
+HilUdpNode::HilUdpNode(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), params_(load_hil_params(pnh)), updater_(nh, pnh) {
+  const Scene scene = load_hil_scene(params_);
+  hil::LoopOptions o = loop_options(params_);
+  o.who = "catenary_sim_hil_udp";
+  o.input = "UDP measurement";
+  hil::UdpLoopOptions u;
+  u.bind_address = params_.udp_bind;
+  u.port = params_.udp_port;
+  if (!params_.udp_rig.empty()) {
+    const auto colon = params_.udp_rig.rfind(':');
+    int port = -1;
+    try {
+      if (colon != std::string::npos) port = std::stoi(params_.udp_rig.substr(colon + 1));
+    } catch (const std::exception&) {
+    }
+    if (colon == std::string::npos || colon == 0 || port < 1 || port > 65535)
+      throw ParamError("parameter ~hil/udp_rig = '" + params_.udp_rig + "' rejected: allowed HOST:PORT, e.g. 10.0.0.2:47801");
+    u.rig_address = params_.udp_rig.substr(0, colon);
+    u.rig_port = port;
+  }
+  try {
+    loop_ = std::make_unique<hil::HilLoop>(scene, o);
+    skin_ = std::make_unique<hil::UdpLoopSkin>(*loop_, u, &ring_);
+  } catch (const SceneError& e) {
+    throw ParamError("parameter ~scene = '" + params_.scene + "': " + e.what());
+  } catch (const hil::HilError& e) {
+    throw ParamError(std::string("parameter ~hil/udp_*: ") + e.what());
+  }
+  skin_->set_running([] { return ros::ok() && !ros::isShuttingDown(); });
+  skin_->set_log([](hil::LogLevel level, const std::string& t) {
+    if (level == hil::LogLevel::kInfo) ROS_INFO("%s", t.c_str());
+    else if (level == hil::LogLevel::kWarn) ROS_WARN("%s", t.c_str());
+    else ROS_ERROR("%s", t.c_str());
+  });
+  wall_offset_ = ros::WallTime::now().toSec() - hil::steady_now();
+  point_pub_ = nh_.advertise<ContactPointArray>("hil/contact_point", static_cast<std::uint32_t>(std::ceil(params_.rate)));
+  auto trigger = [this](const char* name, hil::Request r) {
+    ros::AdvertiseServiceOptions so = ros::AdvertiseServiceOptions::create<std_srvs::Trigger>(
+        name,
+        [this, r, name](std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+          std::tie(res.success, res.message) = ask(r, name);
+          return true;
+        },
+        ros::VoidConstPtr(), &ctrl_queue_);
+    return pnh_.advertiseService(so);
+  };
+  arm_srv_ = trigger("arm", hil::Request::kArm);
+  reset_srv_ = trigger("reset", hil::Request::kReset);
+  stop_srv_ = trigger("stop", hil::Request::kStop);
+  ros::AdvertiseServiceOptions po = ros::AdvertiseServiceOptions::create<std_srvs::SetBool>(
+      "set_paused",
+      [this](std_srvs::SetBool::Request& q, std_srvs::SetBool::Response& res) {
+        std::tie(res.success, res.message) = ask(q.data ? hil::Request::kPause : hil::Request::kResume, "set_paused");
+        return true;
+      },
+      ros::VoidConstPtr(), &ctrl_queue_);
+  pause_srv_ = pnh_.advertiseService(po);
+  ros::SubscribeOptions vo = ros::SubscribeOptions::create<std_msgs::Float64>(
+      "cmd/train_speed", 10,
+      [this](const std_msgs::Float64::ConstPtr& msg) {
+        if (const std::string e = speed_command_error(msg->data); !e.empty()) {
+          ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil_udp: %s; command ignored", e.c_str());
+          return;
+        }
+        loop_->command_speed(msg->data);
+      },
+      ros::VoidPtr(), &ctrl_queue_);
+  speed_sub_ = nh_.subscribe(vo);
+  ctrl_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &ctrl_queue_);
+  ctrl_spinner_->start();
+  updater_.setHardwareID("catenary_sim_hil_udp/" + scene.name);
+  updater_.add("hardware in the loop (UDP)", this, &HilUdpNode::diagnose);
+  ROS_INFO("catenary_sim_hil_udp: scene %s: loop %g Hz = %d step(s) of %.6g ms; rig over UDP on %s:%d%s",
+           scene.name.c_str(), params_.rate, loop_->timing().steps_per_period, loop_->model().dt * 1e3,
+           params_.udp_bind.c_str(), skin_->port(),
+           params_.udp_rig.empty() ? "" : (", sending to " + params_.udp_rig).c_str());
+  publisher_ = std::thread([this] { publisher(); });
+}
+
+HilUdpNode::~HilUdpNode() {
+  if (ctrl_spinner_) ctrl_spinner_->stop();
+  stop_publisher_ = true;
+  if (publisher_.joinable()) publisher_.join();
+}
+
+std::pair<bool, std::string> HilUdpNode::ask(hil::Request r, const char* service) {
+  const auto answer = loop_->ask(r, kControlWait);
+  if (answer.first) ROS_INFO("catenary_sim_hil_udp: ~%s: %s", service, answer.second.c_str());
+  else ROS_WARN("catenary_sim_hil_udp: ~%s: %s", service, answer.second.c_str());
+  return answer;
+}
+
+void HilUdpNode::publisher() {
+  // Normal scheduling whatever the loop thread gets; drains the ring every millisecond.
+  hil::MonitorSample s;
+  double next_diag = 0.0;
+  while (!stop_publisher_) {
+    bool any = false;
+    while (ring_.pop(s)) {
+      any = true;
+      last_ = s;
+      ++published_;
+      if (point_pub_.getNumSubscribers() == 0) continue;
+      const boost::shared_ptr<ContactPointArray> m = boost::make_shared<ContactPointArray>();
+      m->header.stamp.fromSec(s.wall + wall_offset_);  // (wall time of sending, as the TCPROS node's)
+      m->header.frame_id = params_.line_frame;
+      m->simulation_time = s.simulation_time;
+      m->step = s.step;
+      m->pass_count = s.pass_count;
+      m->dt = loop_->model().dt;  // (constant)
+      m->steps_per_period = static_cast<std::uint32_t>(loop_->timing().steps_per_period);
+      m->speed = s.speed;
+      m->mode = s.mode;
+      m->measurement_step = s.measurement_step;
+      for (std::uint32_t i = 0; i < s.pantographs; ++i) {
+        ContactPoint c;
+        c.name = loop_->model().pantographs[loop_->external()[i]].name;
+        c.position = s.position[i];
+        c.height = s.height[i];
+        c.velocity = s.velocity[i];
+        c.path_velocity = s.path_velocity[i];
+        c.applied_force = s.applied_force[i];
+        c.measurement_age = s.measurement_age[i];
+        m->pantographs.push_back(std::move(c));
+      }
+      point_pub_.publish(m);
+    }
+    const double now = hil::steady_now();
+    if (now >= next_diag) {
+      next_diag = now + 0.1;
+      updater_.update();  // (at its own ~diagnostic_period)
+    }
+    if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
+void HilUdpNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  using diagnostic_msgs::DiagnosticStatus;
+  const hil::MonitorSample& s = last_;
+  const hil::Mode mode = static_cast<hil::Mode>(s.mode);
+  if (mode == hil::Mode::kHold) stat.summary(DiagnosticStatus::ERROR, "SAFE HOLD: no valid UDP measurement within ~hil/timeout");
+  else if (mode == hil::Mode::kWaiting) stat.summary(DiagnosticStatus::WARN, "waiting for the first UDP measurement");
+  else stat.summary(DiagnosticStatus::OK, hil::mode_name(mode));
+  stat.add("mode", hil::mode_name(mode));
+  stat.add("periods", s.periods);
+  stat.add("overruns", s.overruns);
+  stat.add("periods with the held measurement", s.held);
+  stat.add("safe holds", s.holds);
+  stat.add("measurements rejected", s.rejected);
+  stat.add("packets lost", s.packets_lost);
+  stat.add("packets reordered", s.packets_reordered);
+  stat.add("packets duplicated", s.packets_duplicated);
+  stat.add("latency p99 [s]", s.latency_p99);
+  stat.add("jitter p50 [s]", s.jitter_p50);
+  stat.add("jitter p99 [s]", s.jitter_p99);
+  stat.add("jitter max [s]", s.jitter_max);
+  for (std::size_t i = 0; i < s.jitter_counts.size(); ++i)
+    stat.add(std::string("jitter ") + hil::JitterSummary::kLabels[i] + " [periods]", s.jitter_counts[i]);
+  stat.add("delay energy [J]", s.delay_energy);
+  stat.add("monitor dropped", ring_.dropped());
+  stat.add("sim time [s]", s.simulation_time);
+}
+
+int HilUdpNode::run() {
+  if (const std::string e = hil::apply_realtime(realtime_options(params_)); !e.empty()) {
+    ROS_FATAL("catenary_sim_hil_udp: parameter %s", e.c_str());
+    return 2;
+  }
+  int rc = loop_->run();
+  stop_publisher_ = true;
+  if (publisher_.joinable()) publisher_.join();
+  std::printf("catenary_sim_hil_udp: %s\n", hil::loop_summary(*loop_).c_str());
+  std::fflush(stdout);
+  State end_state;
+  if (std::unique_ptr<PassRecorder> rec = skin_->take_finished(&end_state)) {
+    const std::vector<PantographStatistics> st = rec->statistics(loop_->model());
+    if (!params_.stats_file.empty()) {
+      try {
+        write_file_atomically(params_.stats_file,
+                              statistics_json(loop_->model(), end_state, st, RunInfo{-1.0, -1.0, loop_->counters().overruns}));
+      } catch (const OutputError& e) {
+        std::fprintf(stderr, "[ERROR] catenary_sim_hil_udp: ~stats_file: %s\n", e.what());
+        if (rc == 0) rc = 1;
+      }
+    }
+  }
+  if (!params_.report_file.empty()) {
+    nlohmann::ordered_json j = hil::loop_report(*loop_);
+    skin_->add_report(j);
+    try {
+      write_file_atomically(params_.report_file, j.dump(2) + "\n");
+    } catch (const OutputError& e) {
+      std::fprintf(stderr, "[ERROR] catenary_sim_hil_udp: ~hil/report_file: %s\n", e.what());
+      if (rc == 0) rc = 1;
+    }
+  }
+  return rc;
+}
+
+}  // namespace ros_layer
+}  // namespace catenary_sim

@@ -1,0 +1,160 @@
+// catenary_sim_hil_udp: hardware in the loop over UDP, without ROS. The catenary of a scene whose
+// pantograph is `type: external` against a rig controller that exchanges the fixed packets of
+// include/catenary_sim/hil/udp_packets.h (docs/hil.md, "UDP"). The loop is the ROS node's
+// (hil::HilLoop): held or extrapolated measurement, the safe hold after the timeout.
+//
+//   catenary_sim_hil_udp --scene config/reference_55m_hil.yaml --port 47800 --report hil.json
+//   udp_rig_client --pantograph-scene config/reference_55m.yaml --simulator 127.0.0.1:47800
+#include <CLI/CLI.hpp>
+
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/hil/loop.hpp"
+#include "catenary_sim/hil/realtime.hpp"
+#include "catenary_sim/hil/report.hpp"
+#include "catenary_sim/hil/udp_loop.hpp"
+#include "cli_checks.hpp"
+
+using namespace catenary_sim;
+
+namespace {
+
+hil::UdpLoopSkin* g_skin = nullptr;
+extern "C" void on_signal(int) {
+  if (g_skin) g_skin->stop();  // (an atomic store: async-signal-safe)
+}
+
+// "HOST:PORT" -> (host, port); throws CLI::ValidationError naming `flag`.
+std::pair<std::string, int> host_port(const std::string& text, const std::string& flag) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size())
+    throw CLI::ValidationError(flag, "'" + text + "' rejected: allowed HOST:PORT, e.g. 127.0.0.1:47801");
+  int port = -1;
+  try {
+    std::size_t used = 0;
+    port = std::stoi(text.substr(colon + 1), &used);
+    if (used != text.size() - colon - 1) port = -1;
+  } catch (const std::exception&) {
+  }
+  if (port < 1 || port > 65535)
+    throw CLI::ValidationError(flag, "'" + text + "' rejected: the port must be 1 to 65535");
+  return {text.substr(0, colon), port};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Hardware in the loop over UDP (no ROS): the catenary against a rig's measured contact force."};
+  std::string scene_file, rig, report_file, stats_file, at_end = "exit";
+  std::optional<std::string> cpus;  // (given empty: refused by parse_cpu_list)
+  std::optional<double> speed_kmh;
+  hil::LoopOptions lo;
+  lo.who = "catenary_sim_hil_udp";
+  lo.input = "UDP measurement";
+  hil::UdpLoopOptions uo;
+  hil::RealtimeOptions rt;
+  double duration = 0.0;
+  app.add_option("--scene", scene_file, "scene YAML with at least one `type: external` pantograph")->required()->type_name("FILE");
+  app.add_option("--speed-kmh", speed_kmh, "train speed, km/h (default: the scene's)")->check(kFinite & CLI::Range(0.0, 540.0));
+  app.add_option("--rate", lo.rate, "loop rate, Hz")->check(kFinite & CLI::Range(1000.0, 10000.0))->capture_default_str();
+  app.add_option("--timeout", lo.timeout, "s without a valid measurement before the safe hold (>= 2 periods)")
+      ->check(kFinite & CLI::Range(0.0002, 10.0))->capture_default_str();
+  app.add_flag("--extrapolate", lo.extrapolate, "extrapolate the last two measurements instead of holding the newest");
+  app.add_option("--hold-ramp", lo.hold_ramp, "s, force ramp to the static force in the safe hold")
+      ->check(kFinite & CLI::Range(0.0, 60.0))->capture_default_str();
+  app.add_option("--hold-deceleration", lo.hold_deceleration, "m/s^2, the train stops at this rate in the safe hold (0: at once)")
+      ->check(kFinite & CLI::Range(0.0, 50.0))->capture_default_str();
+  app.add_option("--start-delay", lo.start_delay, "s in which measurements are ignored")->check(kFinite & CLI::Range(0.0, 60.0));
+  app.add_option("--delay-compensation", lo.delay_compensation,
+                 "s: send the contact point predicted this far ahead (the known loop delay)")
+      ->check(kFinite & CLI::Range(0.0, 0.1))->capture_default_str();
+  app.add_option("--at-end", at_end, "at the end of the pass: exit, stop (hold the last state) or loop")
+      ->check(CLI::IsMember({"exit", "stop", "loop"}))->capture_default_str();
+  app.add_option("--bind", uo.bind_address, "local IPv4 address to receive on")->capture_default_str();
+  app.add_option("--port", uo.port, "local UDP port to receive on")->check(CLI::Range(0, 65535))->capture_default_str();
+  app.add_option("--rig", rig, "HOST:PORT of the rig (default: the source of its newest valid measurement)");
+  app.add_flag("--same-clock", uo.same_clock, "the rig's send_time_ns is this machine's CLOCK_MONOTONIC (transport measured)");
+  app.add_option("--report", report_file, "JSON at exit: latency, jitter, overruns, packets, coupling energy")->type_name("FILE");
+  app.add_option("--stats", stats_file, "the pass statistics JSON (as simulate_pass)")->type_name("FILE");
+  app.add_flag("--lock-memory", rt.lock_memory, "mlockall: no page faults in the loop");
+  app.add_option("--fifo-priority", rt.fifo_priority, "SCHED_FIFO priority of the loop thread (0: normal)")->check(CLI::Range(0, 99));
+  app.add_option("--cpus", cpus, "CPUs of the loop thread, e.g. 3 or 2,3 (isolcpus)");
+  app.add_option("--duration", duration, "s (wall) after which the loop stops (0: until the pass ends or a signal)")
+      ->check(kFinite & CLI::Range(0.0, 1e6));
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (!rig.empty()) std::tie(uo.rig_address, uo.rig_port) = host_port(rig, "--rig");
+    if (cpus) rt.cpus = hil::parse_cpu_list(*cpus, "--cpus");
+  } catch (const CLI::ValidationError& e) {
+    std::fprintf(stderr, "catenary_sim_hil_udp: %s\n", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "catenary_sim_hil_udp: %s\n", e.what());
+    return 2;
+  }
+  lo.at_end = at_end == "loop" ? hil::EndAction::kLoop : at_end == "stop" ? hil::EndAction::kStop : hil::EndAction::kExit;
+  try {
+    if (!report_file.empty()) check_writable(report_file);
+    if (!stats_file.empty()) check_writable(stats_file);
+    if (const std::string e = hil::check_realtime(rt); !e.empty()) throw hil::HilError(e);
+    Scene scene = load_scene_file(scene_file);
+    if (speed_kmh) scene.train_speed = *speed_kmh / 3.6;
+    hil::HilLoop loop(scene, lo, "--rate", "--scene " + scene_file);
+    hil::UdpLoopSkin skin(loop, uo);
+    const double start = hil::steady_now();
+    if (duration > 0.0) skin.set_running([&] { return hil::steady_now() - start < duration; });
+    g_skin = &skin;
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    if (const std::string e = hil::apply_realtime(rt); !e.empty()) throw hil::HilError(e);
+    std::fprintf(stderr, "[INFO] catenary_sim_hil_udp: %s: loop %g Hz = %d step(s) of %.6g ms; listening on UDP %s:%d%s\n",
+                 scene.name.c_str(), lo.rate, loop.timing().steps_per_period, loop.model().dt * 1e3,
+                 uo.bind_address.c_str(), skin.port(), rig.empty() ? "" : (", sending to " + rig).c_str());
+    const int rc = loop.run();
+    g_skin = nullptr;
+    std::printf("catenary_sim_hil_udp: %s\n", hil::loop_summary(loop).c_str());
+    const auto& seq = skin.sequence();
+    std::printf("catenary_sim_hil_udp: packets: %llu received, %llu lost, %llu reordered, %llu duplicated, %llu sent\n",
+                static_cast<unsigned long long>(seq.received()), static_cast<unsigned long long>(seq.lost()),
+                static_cast<unsigned long long>(seq.reordered()), static_cast<unsigned long long>(seq.duplicates()),
+                static_cast<unsigned long long>(skin.sent()));
+    const hil::CouplingEnergy& en = loop.energy();
+    std::printf("catenary_sim_hil_udp: coupling: %.4g J of work on the line at the interface, %.4g J of it added by "
+                "the loop delay (%lld of %lld periods with the answered contact point known)\n",
+                en.interface_j, en.delay_j, static_cast<long long>(en.known), static_cast<long long>(en.periods));
+    State end_state;
+    if (std::unique_ptr<PassRecorder> rec = skin.take_finished(&end_state)) {
+      const std::vector<PantographStatistics> st = rec->statistics(loop.model());
+      for (const PantographStatistics& s : st)
+        std::printf("catenary_sim_hil_udp: %s: mean %.1f N, std %.1f N, max %.1f N, min %.1f N, contact loss %.2f %%\n",
+                    s.name.c_str(), s.filtered.mean, s.filtered.std_dev, s.filtered.max, s.filtered.min,
+                    s.contact_loss_percent);
+      if (!stats_file.empty())
+        write_file_atomically(stats_file, statistics_json(loop.model(), end_state, st,
+                                                          RunInfo{hil::steady_now() - start, -1.0, loop.counters().overruns}));
+    }
+    if (!report_file.empty()) {
+      nlohmann::ordered_json j = hil::loop_report(loop);
+      skin.add_report(j);
+      write_file_atomically(report_file, j.dump(2) + "\n");
+    }
+    return rc;
+  } catch (const hil::HilError& e) {
+    std::fprintf(stderr, "catenary_sim_hil_udp: %s\n", e.what());
+    return 2;
+  } catch (const SceneError& e) {
+    std::fprintf(stderr, "catenary_sim_hil_udp: --scene %s: %s\n", scene_file.c_str(), e.what());
+    return 2;
+  } catch (const OutputError& e) {
+    std::fprintf(stderr, "catenary_sim_hil_udp: %s\n", e.what());
+    return 1;
+  }
+}

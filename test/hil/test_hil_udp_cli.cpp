@@ -1,0 +1,116 @@
+// Bad input to the UDP loop's command line and its real-time options: each run (a child process
+// of catenary_sim_hil_udp or udp_rig_client) must fail cleanly (exit 2, no signal, no hang) with
+// an error naming the option, the value and what is allowed; the real-time checks name their
+// option too. The tests run as root here, so "not permitted" is provoked by running the child as
+// the unprivileged user nobody (setpriv, util-linux), without CAP_SYS_NICE.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "../support/child_process.hpp"
+#include "catenary_sim/hil/realtime.hpp"
+
+using namespace catenary_sim_test;
+using catenary_sim::hil::RealtimeOptions;
+
+namespace {
+
+const std::string kSim = CATENARY_SIM_DEVEL_LIB "/catenary_sim_hil_udp";
+const std::string kRig = CATENARY_SIM_DEVEL_LIB "/udp_rig_client";
+const std::string kHil = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_hil.yaml";
+const std::string kLumped = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+
+ChildRun run(const std::vector<std::string>& args, const std::vector<std::string>& prefix = {}) {
+  std::vector<std::string> a = prefix;
+  a.insert(a.end(), args.begin(), args.end());
+  char dir[] = "/tmp/catenary_sim_udp_cli_XXXXXX";
+  const std::string d = mkdtemp(dir);
+  return run_child(a, d + "/output.txt", 60.0);
+}
+
+void expect_refused(const std::vector<std::string>& args, const std::vector<std::string>& names,
+                    const std::vector<std::string>& prefix = {}) {
+  const ChildRun r = run(args, prefix);
+  std::string cmd;
+  for (const std::string& s : args) cmd += " " + s;
+  EXPECT_FALSE(r.hung) << cmd;
+  EXPECT_EQ(r.signal, 0) << cmd;
+  EXPECT_NE(r.exit_code, 0) << cmd << "\n" << r.out;
+  EXPECT_NE(r.exit_code, -1) << cmd;
+  for (const std::string& n : names) EXPECT_NE(r.out.find(n), std::string::npos) << cmd << ": '" << n << "' not in\n" << r.out;
+}
+
+}  // namespace
+
+TEST(HilUdpCli, BadOptionsAreRefusedNamingTheOption) {
+  const std::vector<std::string> base = {kSim, "--scene", kHil, "--port", "0", "--duration", "1"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> a = base;
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  };
+  expect_refused(with({"--rate", "500"}), {"--rate", "500"});
+  expect_refused(with({"--rate", "nan"}), {"--rate", "nan"});
+  expect_refused(with({"--timeout", "0.0015", "--rate", "1000"}), {"timeout", "0.0015", "allowed"});
+  expect_refused(with({"--delay-compensation", "0.5"}), {"--delay-compensation"});
+  expect_refused(with({"--rig", "localhost"}), {"--rig", "HOST:PORT"});
+  expect_refused(with({"--rig", "127.0.0.1:0"}), {"--rig", "1 to 65535"});
+  expect_refused(with({"--rig", "example.org:47801"}), {"--rig", "IPv4"});
+  expect_refused(with({"--bind", "300.1.1.1"}), {"300.1.1.1", "IPv4"});
+  expect_refused(with({"--port", "70000"}), {"--port", "70000"});
+  expect_refused(with({"--at-end", "repeat"}), {"--at-end", "repeat"});
+  expect_refused(with({"--fifo-priority", "100"}), {"--fifo-priority", "100"});
+  expect_refused(with({"--cpus", "9999"}), {"--cpus", "9999", "does not exist"});
+  expect_refused(with({"--cpus", "1-a"}), {"--cpus", "1-a", "allowed"});
+  expect_refused(with({"--cpus", ""}), {"--cpus"});
+  expect_refused({kSim, "--scene", kLumped, "--port", "0", "--duration", "1"}, {"external"});
+  expect_refused({kSim, "--scene", "/nonexistent.yaml"}, {"--scene", "/nonexistent.yaml"});
+  expect_refused({kRig, "--pantograph-scene", kLumped, "--simulator", "127.0.0.1"}, {"--simulator", "HOST:PORT"});
+  expect_refused({kRig, "--pantograph-scene", kHil, "--simulator", "127.0.0.1:47800"}, {"lumped"});
+  expect_refused({kRig, "--pantograph-scene", kLumped, "--rate", "-1"}, {"--rate"});
+}
+
+TEST(HilUdpCli, RealTimeRefusedWithoutTheRightNamesTheOption) {
+  if (geteuid() != 0 || access("/usr/bin/setpriv", X_OK) != 0) GTEST_SKIP() << "needs root and setpriv";
+  // As nobody without capabilities: SCHED_FIFO and mlockall are refused (the default rtprio and
+  // memlock limits of an unprivileged user are 0 and 8 MiB here), each with the option named.
+  const std::vector<std::string> nobody = {"/usr/bin/setpriv", "--reuid=65534", "--regid=65534", "--clear-groups",
+                                           "--inh-caps=-all", "--"};
+  const std::vector<std::string> base = {kSim, "--scene", kHil, "--port", "0", "--duration", "1"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> a = base;
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  };
+  expect_refused(with({"--fifo-priority", "50"}), {"--fifo-priority", "50", "not permitted"}, nobody);
+}
+
+TEST(Realtime, ChecksNameTheOptionAndApplyAsRoot) {
+  RealtimeOptions o;
+  o.priority_name = "~hil/realtime_priority";
+  o.cpus_name = "~hil/cpus";
+  o.fifo_priority = 100;
+  EXPECT_NE(catenary_sim::hil::check_realtime(o).find("~hil/realtime_priority = 100"), std::string::npos);
+  o.fifo_priority = -3;
+  EXPECT_NE(catenary_sim::hil::check_realtime(o).find("allowed"), std::string::npos);
+  o.fifo_priority = 0;
+  o.cpus = {100000};
+  EXPECT_NE(catenary_sim::hil::check_realtime(o).find("~hil/cpus = 100000"), std::string::npos);
+  EXPECT_THROW(catenary_sim::hil::parse_cpu_list("0-", "~hil/cpus"), std::invalid_argument);
+  EXPECT_THROW(catenary_sim::hil::parse_cpu_list("3-1", "~hil/cpus"), std::invalid_argument);
+  EXPECT_EQ(catenary_sim::hil::parse_cpu_list("0-2,5", "x"), (std::vector<int>{0, 1, 2, 5}));
+  if (geteuid() != 0) GTEST_SKIP() << "applying needs root";
+  // Applied on a thread of its own (the test's main thread keeps its scheduling).
+  std::string err = "not run";
+  std::thread t([&] {
+    RealtimeOptions ok;
+    ok.fifo_priority = 10;
+    ok.cpus = {0};
+    err = catenary_sim::hil::apply_realtime(ok);
+  });
+  t.join();
+  EXPECT_EQ(err, "");
+}
