@@ -26,6 +26,7 @@
 #include "catenary_sim/core/model.hpp"
 #include "catenary_sim/core/scene.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/core/lateral.hpp"
 #include "catenary_sim/ros/replay.hpp"
 
 using namespace catenary_sim;
@@ -63,6 +64,7 @@ class ReplayMarkers {
       throw std::runtime_error("parameter ~scene = '" + scene + "': " + e.what());
     }
     state_ = make_state(*model_);
+    if (model_->lateral) state_.lateral = make_lateral_state(*model_);  // a 3-D line: wires drawn at their lateral positions
     options_.vertical_scale = number_param(pnh, "vertical_scale", 10.0, 1e-9, 10000.0, "");
     options_.shape_resolution = number_param(pnh, "shape_resolution", 1.0, 0.0, 100.0, "m (0: every node)");
     pnh.param("publish_view_frame", view_, true);

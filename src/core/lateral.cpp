@@ -11,6 +11,7 @@
 
 #include "catenary_sim/core/beam.hpp"
 #include "catenary_sim/core/state.hpp"
+#include "wire_lanes.hpp"
 
 namespace catenary_sim {
 namespace {
@@ -32,11 +33,14 @@ int line_support(const Model& m, double xs) {
   return static_cast<int>(std::min<std::ptrdiff_t>(it - m.support_x.begin(), m.support_x.size() - 1));
 }
 
-double stagger_at(const Scene& s, bool contact, int support) {
+// `support`: the support's index along the line (on an endless line, its block index plus the
+// spans of the block's initial offset; the block moves by whole patterns, so that stays right).
+double stagger_at(const Scene& s, bool contact, long support) {
   if (!s.stagger) return 0.0;
   const StaggerSpec& st = *s.stagger;
   const std::vector<double>& p = contact || st.messenger.empty() ? st.contact_wire : st.messenger;
-  return st.at(p, static_cast<std::size_t>(support));
+  const long n = static_cast<long>(p.size());
+  return st.at(p, static_cast<std::size_t>(((support % n) + n) % n));
 }
 
 // f -= K_lateral z over all wires, springs and pendulums (pendulum stiffness from `tension`, per
@@ -73,6 +77,53 @@ double lateral_omega_max(const Model& m, const LateralModel& lat) {
     x = y;
   }
   return 1.05 * std::sqrt(std::max(0.0, lambda));
+}
+
+// The fused step's planes: per vertical pack (Model::wire_packs, wires on the same stations side
+// by side), the lateral plane's load, alpha m and 1/m in the pack's layout; and the point nodes.
+void build_lateral_packs(const Model& m, LateralModel& lat) {
+  lat.planes.clear();
+  lat.point_nodes.clear();
+  lat.point_record.clear();
+  if (m.wire_packs.empty()) return;  // the vertical step is not fused: neither is this one
+  for (const WireLanes& p : m.wire_packs) {
+    const int L = p.lanes;
+    std::vector<double> plane(static_cast<std::size_t>(p.nodes) * 3 * L, 0.0);
+    for (int k = 0; k < L; ++k) {
+      const Wire& w = lat.wires[p.wire[k]];
+      if (w.nodes() != p.nodes) {  // (never: the lateral wires are the vertical ones' copies)
+        lat.planes.clear();
+        return;
+      }
+      for (int i = 0; i < p.nodes; ++i) {
+        double* c = plane.data() + static_cast<std::size_t>(i) * 3 * L + k;
+        c[0 * L] = lat.load[w.w_dof + i];
+        c[1 * L] = m.alpha * lat.mass[w.w_dof + i];
+        c[2 * L] = lat.inv_mass[w.w_dof + i];
+      }
+    }
+    lat.planes.push_back(std::move(plane));
+  }
+  // The band force of lateral node i of wire wi lies where the vertical sweep leaves that of the
+  // wire's vertical node i.
+  std::vector<char> listed(lat.n, 0);
+  auto add = [&](int i) {
+    if (listed[i]) return;
+    listed[i] = 1;
+    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+      const Wire& w = lat.wires[wi];
+      if (i >= w.w_dof && i < w.w_dof + w.nodes()) {
+        lat.point_nodes.push_back(i);
+        lat.point_record.push_back(m.dof_sweep_force[m.wires[wi].w_dof + i - w.w_dof]);
+        return;
+      }
+    }
+  };
+  for (const LateralSpring& sp : lat.springs) add(sp.dof);
+  for (const LateralPendulum& p : lat.pendulums) {
+    add(p.contact);
+    add(p.messenger);
+  }
 }
 
 }  // namespace
@@ -208,7 +259,9 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   lat->inv_mass = Eigen::VectorXd::Zero(n);
   lat->load = Eigen::VectorXd::Zero(n);
   lat->node_span.assign(n, -1);
-  lat->spans = static_cast<int>(m.support_x.size()) - 1;
+  // Blow-off per span along a finite line; an endless line's block spans are not the line's.
+  lat->spans = m.endless ? 0 : static_cast<int>(m.support_x.size()) - 1;
+  const long support_offset = m.endless ? std::lround(m.initial_line_offset / m.endless_span) : 0;
   const std::optional<double> arm_k = sc.stagger ? sc.stagger->steady_arm_stiffness : std::nullopt;
   const std::optional<double> msup_k = sc.stagger ? sc.stagger->messenger_support_stiffness : std::nullopt;
   std::vector<bool> fixed(n, false);
@@ -230,7 +283,8 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
       // The curve in the track's frame: a load T kappa per metre (lateral.hpp).
       const double h = 0.5 * ((i + 1 < nn ? w.x[i + 1] : w.x[i]) - (i > 0 ? w.x[i - 1] : w.x[i]));
       lat->load[a] += w.spec.tension * sc.alignment.curvature(w.x[i]) * h;
-      if (w.is_contact_wire) {
+      lat->node_x.push_back(w.x[i]);
+      if (w.is_contact_wire && !m.endless) {
         const auto it = std::upper_bound(m.support_x.begin(), m.support_x.end(), w.x[i]);
         lat->node_span[a] = std::clamp(static_cast<int>(it - m.support_x.begin()) - 1, 0, lat->spans - 1);
       }
@@ -242,7 +296,8 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
       s.node = w.support_nodes[k];
       s.x = w.x[s.node];
       s.line_support = line_support(m, s.x);
-      s.stagger = stagger_at(sc, w.is_contact_wire, s.line_support) + (w.is_contact_wire ? stagger_error[s.line_support] : 0.0);
+      s.stagger = stagger_at(sc, w.is_contact_wire, s.line_support + support_offset) +
+                  (w.is_contact_wire ? stagger_error[s.line_support] : 0.0);  // (no errors on an endless line)
       s.anchor = k == 0 || k == ns - 1;
       const std::optional<double>& spring = w.is_contact_wire ? arm_k : msup_k;
       s.rigid = s.anchor || !spring;
@@ -298,7 +353,15 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
       x_hi = std::max(x_hi, w.x.back());
     }
     if (ws.turbulence) {
-      const double duration = sc.train_speed > 0.0 ? (m.train_end - m.train_start) / sc.train_speed : 600.0;
+      const double start = m.train_start + (m.endless ? m.initial_line_offset : 0.0);  // along the line
+      const double duration = sc.train_speed > 0.0 ? (m.train_end - start) / sc.train_speed : 600.0;
+      if (m.endless) {
+        // The field along the line the block passes over (stations = block x + line offset),
+        // looked up at each refresh (lateral_step), so the wind a span feels is its own.
+        const double block = x_hi - x_lo;
+        x_lo += m.initial_line_offset;
+        x_hi = std::max(x_lo + block, m.train_end + block);
+      }
       lat->field = make_wind_field(ws, x_lo, x_hi, duration);
       lat->field_index.assign(n, 0);
       lat->field_weight.assign(n, 0.0);
@@ -344,6 +407,7 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
                      " s) would need " + std::to_string(lat->substeps) + " substeps of dt " + fmt(m.dt) +
                      " s; allowed at most 1000: lower the lateral support stiffnesses");
   lat->dt = m.dt / lat->substeps;
+  build_lateral_packs(m, *lat);
   return lat;
 }
 
@@ -354,6 +418,9 @@ LateralState make_lateral_state(const Model& m) {
   s.v = Eigen::VectorXd::Zero(lat.n);
   s.f = Eigen::VectorXd::Zero(lat.n);
   s.z = Eigen::VectorXd::Zero(lat.n);
+  s.y_next = s.y;
+  s.v_next = Eigen::VectorXd::Zero(lat.n);
+  s.accel = Eigen::VectorXd::Zero(lat.n);
   int longest = 0;
   for (const Wire& w : lat.wires) longest = std::max(longest, w.nodes());
   s.theta.assign(longest, 0.0);
@@ -377,7 +444,7 @@ bool contact_points(const Model& m, State& s, bool record) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
   const PantographHeadSpec& head = m.scene.pantograph_head;
-  const double sway = head.sway_amplitude * std::sin(2.0 * M_PI * head.sway_frequency * s.time);
+  const double sway = head.sway(s.time);  // the contact point on the strip is wire minus pantograph
   const std::size_t nw = m.contact_wires.size();
   bool left = false;
   for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
@@ -422,6 +489,91 @@ void lateral_observe(const Model& m, State& s) {
   if (m.lateral) contact_points(m, s, false);
 }
 
+namespace {
+
+// One lateral substep fused as the vertical plane's (wire_lanes.hpp): per pack one sweep pair for
+// z, the condensed rotations, the band force with the load, damping and the wind's drag, and the
+// update; then the nodes with point forces (steady arms and
+// messenger supports as springs, droppers as pendulums) are updated again with theirs, in the
+// generic step's order. The new values go to y_next, v_next and are swapped in when all are
+// inside the divergence limit (else the state keeps the last good substep and this returns true).
+bool fused_substep(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const int n = lat.n;
+  const double h = lat.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
+  const double* y = ls.y.data();
+  const double* v = ls.v.data();
+  double* yn = ls.y_next.data();
+  double* vn = ls.v_next.data();
+  double* acc = ls.accel.data();
+  // The wind's drag is taken in the sweep (PackSweep::wind), on the velocity it reads anyway.
+  const double* W = lat.windy ? ls.wind_speed.data() : nullptr;
+  const double* cw = lat.windy ? lat.wind_coefficient.data() : nullptr;
+  bool outside = false;
+  for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
+    const WireLanes& p = m.wire_packs[pk];
+    PackSweep a;
+    a.pack = &p;
+    a.plane = lat.planes[pk].data();
+    a.lo = 0;
+    a.hi = p.nodes - 1;
+    a.factors = p.factors.data();
+    for (int k = 0; k < p.lanes; ++k) {
+      const Wire& w = lat.wires[p.wire[k]];
+      a.ww_lo[k] = w.d_ww[a.lo] - 0.0;  // no cut ends (condensed_band_force's kNone)
+      a.wt_lo[k] = w.d_wt[a.lo] - 0.0;
+      a.ww_hi[k] = w.d_ww[a.hi] - 0.0;
+      a.wt_hi[k] = w.d_wt[a.hi] - 0.0;
+      a.u[k] = y + w.w_dof;
+      a.v[k] = v + w.w_dof;
+      a.u_next[k] = yn + w.w_dof;
+      a.v_next[k] = vn + w.w_dof;
+      a.accel[k] = acc + w.w_dof;
+      a.wind[k] = W ? W + w.w_dof : nullptr;
+      a.drag_coefficient[k] = cw ? cw + w.w_dof : nullptr;
+    }
+    a.record = s.sweep.data() + kSweepRecord * p.offset;  // the vertical step's scratch
+    a.beta = beta;
+    a.dt = h;
+    a.limit = limit;
+    outside |= sweep_pack(a);
+  }
+  // Point forces on the band forces the sweep left in its records, as the generic step adds them.
+  double* f = ls.f.data();
+  const double* rec = s.sweep.data();
+  const std::size_t np = lat.point_nodes.size();
+  for (std::size_t q = 0; q < np; ++q) f[lat.point_nodes[q]] = rec[lat.point_record[q]];
+  for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * (y[sp.dof] + beta * v[sp.dof]);
+  const double* u = s.u.data();
+  for (const LateralPendulum& p : lat.pendulums) {
+    const Dropper& d = m.droppers[p.dropper];
+    const double tension = d.static_tension + d.stiffness * (u[d.messenger_dof] - u[d.contact_dof]);
+    const double k = std::max(0.0, tension) * p.inv_length;
+    const double df = k * ((y[p.messenger] + beta * v[p.messenger]) - (y[p.contact] + beta * v[p.contact]));
+    f[p.contact] += df;
+    f[p.messenger] -= df;
+  }
+  const double* im = lat.inv_mass.data();
+  for (std::size_t q = 0; q < np; ++q) {
+    const int i = lat.point_nodes[q];
+    acc[i] = im[i] * f[i];
+    vn[i] = v[i] + h * acc[i];
+    yn[i] = y[i] + h * vn[i];
+    outside |= !(std::fabs(yn[i]) <= limit);
+  }
+  if (outside) {  // the sweeps' flag is a hint (they saw the point nodes before their forces)
+    int bad = 0;
+    for (int i = 0; i < n; ++i) bad |= !(std::fabs(yn[i]) <= limit);
+    if (bad) return true;
+  }
+  ls.y.swap(ls.y_next);  // O(1)
+  ls.v.swap(ls.v_next);
+  return false;
+}
+
+}  // namespace
+
 StepStatus lateral_step(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
@@ -449,12 +601,34 @@ StepStatus lateral_step(const Model& m, State& s) {
       const double U = lat.wind_speed;
       const double* sn = lat.wind_normal.data();
       double* W = ls.wind_speed.data();
-      for (int i = 0; i < n; ++i) {
-        const int j = lat.field_index[i];
-        const double a = lat.field_weight[i];
-        W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
+      if (m.endless) {
+        // The block's nodes at their stations along the line now.
+        const WindField& fd = lat.field;
+        for (int i = 0; i < n; ++i) {
+          const double q = (lat.node_x[i] + s.line_offset - fd.x0) / fd.dx;
+          const int j = std::clamp(static_cast<int>(std::floor(q)), 0, fd.points - 2);
+          const double a = std::clamp(q - j, 0.0, 1.0);
+          W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
+        }
+      } else {
+        for (int i = 0; i < n; ++i) {
+          const int j = lat.field_index[i];
+          const double a = lat.field_weight[i];
+          W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
+        }
       }
     }
+    if (!lat.planes.empty()) {
+      if (fused_substep(m, s)) {
+        ls.diverged = true;
+        s.status = StepStatus::kDiverged;
+        return s.status;
+      }
+      continue;
+    }
+    // The generic step (what the fused one computes, bit for bit: test_lateral).
+    y = ls.y.data();
+    v = ls.v.data();
     if (lat.windy) {
       const double* cw = lat.wind_coefficient.data();
       const double* W = ls.wind_speed.data();
@@ -482,9 +656,10 @@ StepStatus lateral_step(const Model& m, State& s) {
     }
     int out = 0;  // an integer OR vectorises where a max over doubles (NaN rules) does not
     for (int i = 0; i < n; ++i) {
-      v[i] += h * inv_mass[i] * f[i];
+      const double a = inv_mass[i] * f[i];  // eq. 20-21, in the fused sweep's order
+      v[i] += h * a;
       y[i] += h * v[i];
-      out |= !(std::fabs(y[i]) < limit);  // also NaN
+      out |= !(std::fabs(y[i]) <= limit);  // also NaN
     }
     if (out) {
       ls.diverged = true;
@@ -498,6 +673,29 @@ StepStatus lateral_step(const Model& m, State& s) {
     s.status = StepStatus::kDewired;
   }
   return s.status;
+}
+
+void shift_lateral_block(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    const Wire& w = lat.wires[wi];
+    const int ns = m.endless_shift_spans * m.span_nodes[wi], o = w.w_dof, nn = w.nodes();
+    // Upward, the destination below the source. Held nodes (supports at the stagger, which
+    // repeats with the block's move) keep their value.
+    for (int i = ns; i < nn; ++i)
+      if (lat.inv_mass[o + i - ns] > 0.0) {
+        ls.y[o + i - ns] = ls.y[o + i];
+        ls.v[o + i - ns] = ls.v[o + i];
+      }
+    // The spans that enter at the block's far end start at rest in the static state under the
+    // mean wind, as the vertical plane's start at u = 0 (they are beyond the window ahead).
+    for (int i = std::max(0, nn - ns); i < nn; ++i)
+      if (lat.inv_mass[o + i] > 0.0) {
+        ls.y[o + i] = lat.initial[o + i];
+        ls.v[o + i] = 0.0;
+      }
+  }
 }
 
 double lateral_energy(const Model& m, const State& s) {

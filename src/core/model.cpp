@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <limits>
 #include <random>
 #include <sstream>
@@ -536,7 +537,15 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
     auto spans_for = [&](double length) { return static_cast<int>(std::ceil(length / span - 1e-9)); };
     const int margin = kEndlessMargin, behind = spans_for(std::max(behind_slow, behind_fast)) + 1;
     const int ahead = spans_for(std::max(ahead_slow, ahead_fast)) + 1, train = spans_for(lead - rear);
-    const int home = margin + behind, count = home + 1 + train + ahead + margin;
+    // A 3-D line's stagger pattern repeats after `period` supports: the block moves by that many
+    // spans (the rearmost collector stays within [home, home + period) spans).
+    int period = 1;
+    if (scene.stagger) {
+      const int a = static_cast<int>(scene.stagger->contact_wire.size());
+      const int b = std::max(1, static_cast<int>(scene.stagger->messenger.size()));
+      period = a / std::gcd(a, b) * b;
+    }
+    const int home = margin + behind, count = home + period + train + ahead + margin;
     scene.spans.assign(count, span);
     scene.sections.front().spans = scene.spans;
     if (scene.sections.front().droppers) {
@@ -547,6 +556,7 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
     m.endless = true;
     m.endless_span = span;
     m.endless_home = home * span;
+    m.endless_shift_spans = period;
     m.rear_collector_offset = rear;
     // The block starts a whole number of spans behind, so that the line's supports stay at
     // multiples of the span.

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -528,6 +529,19 @@ std::uint64_t read_seed(Reader& r, const std::string& key) {
   return static_cast<std::uint64_t>(v);
 }
 
+}  // namespace
+
+double PantographHeadSpec::sway(double t) const {
+  if (sway_times.empty()) return sway_amplitude * std::sin(2.0 * M_PI * sway_frequency * t);
+  if (t <= sway_times.front()) return sway_lateral.front();
+  if (t >= sway_times.back()) return sway_lateral.back();
+  const std::size_t k = std::upper_bound(sway_times.begin(), sway_times.end(), t) - sway_times.begin();
+  const double a = (t - sway_times[k - 1]) / (sway_times[k] - sway_times[k - 1]);
+  return sway_lateral[k - 1] + a * (sway_lateral[k] - sway_lateral[k - 1]);
+}
+
+namespace {
+
 // The 3-D line's rooms: stagger, alignment, wind, pantograph_head (scene.hpp).
 void read_lateral_parts(Reader& top, Scene& s) {
   if (top.has("stagger")) {
@@ -612,8 +626,24 @@ void read_lateral_parts(Reader& top, Scene& s) {
     else fail("pantograph_head.on_dewirement", "'" + act + "'", "one of: continue (record and go on), stop (end the pass)");
     if (r.has("sway")) {
       Reader q(r.child("sway"), "pantograph_head.sway");
-      h.sway_amplitude = q.number("amplitude", 0.0, 1.0);
-      h.sway_frequency = q.number("frequency", 0.0, 20.0);
+      if (q.has("times") || q.has("lateral")) {
+        // A measured sway: samples in time (a car body's lateral motion at the pantograph).
+        if (q.has("amplitude") || q.has("frequency"))
+          fail("pantograph_head.sway", "(amplitude/frequency and times/lateral)", "one of: {amplitude, frequency} or {times, lateral}");
+        h.sway_times = q.numbers("times", 0.0, 1e6);
+        h.sway_lateral = q.numbers("lateral", -1.0, 1.0);
+        if (h.sway_times.empty()) fail("pantograph_head.sway.times", "(empty list)", "at least one time, s");
+        if (h.sway_lateral.size() != h.sway_times.size())
+          fail("pantograph_head.sway.lateral", "(" + std::to_string(h.sway_lateral.size()) + " values)",
+               "one per time of pantograph_head.sway.times (" + std::to_string(h.sway_times.size()) + ")");
+        for (std::size_t i = 1; i < h.sway_times.size(); ++i)
+          if (!(h.sway_times[i] > h.sway_times[i - 1]))
+            fail("pantograph_head.sway.times[" + std::to_string(i) + "]", fmt(h.sway_times[i]),
+                 "after the time before it (" + fmt(h.sway_times[i - 1]) + " s): increasing times");
+      } else {
+        h.sway_amplitude = q.number("amplitude", 0.0, 1.0);
+        h.sway_frequency = q.number("frequency", 0.0, 20.0);
+      }
       q.finish();
     }
     h.histogram_bin = r.number("histogram_bin", 0.0, 1.0, 0.02, true);
@@ -952,9 +982,20 @@ void validate(const Scene& s) {
              "on the line, [0, " + fmt(line) + "] m");
   }
   if (s.lateral()) {
-    if (s.endless)
-      fail(s.stagger ? "stagger" : s.wind ? "wind" : s.alignment.any() ? "alignment" : "pantograph_head.sway", "(given)",
-           "a finite line: the 3-D line is not built on an endless line yet");
+    // An endless line repeats its block of spans: a stagger pattern repeats with it (the block
+    // moves by whole patterns), a curve placed by station or a list per support does not.
+    if (s.endless && s.alignment.any())
+      fail("alignment.curves", "(given with line.endless: true)",
+           "a finite line: curves are placed by station and the endless line repeats one straight span");
+    if (s.endless && s.stagger && s.stagger->per_support)
+      fail("stagger.per_support", "true (with line.endless: true)",
+           "false on an endless line: give the stagger as a pattern repeated over the supports");
+    if (s.endless && s.stagger) {
+      const std::size_t a = s.stagger->contact_wire.size(), b = std::max<std::size_t>(1, s.stagger->messenger.size());
+      if (a * b / std::gcd(a, b) > 8)
+        fail("stagger.contact_wire", "(a pattern of " + std::to_string(a) + " with a messenger pattern of " + std::to_string(b) + ")",
+             "on an endless line, patterns that repeat together within 8 supports (the block moves by whole patterns)");
+    }
     const double half = 0.5 * s.pantograph_head.working_width;
     if (s.stagger) {
       for (std::size_t i = 0; i < s.stagger->contact_wire.size(); ++i)

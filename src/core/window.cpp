@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "catenary_sim/core/beam.hpp"
+#include "catenary_sim/core/lateral.hpp"
 
 namespace catenary_sim {
 
@@ -39,7 +40,8 @@ void window_lengths(const Model& m, double speed, double* ahead, double* behind)
 }
 
 void shift_endless_block(const Model& m, State& s) {
-  const double span = m.endless_span;
+  const int spans = m.endless_shift_spans;
+  const double span = spans * m.endless_span;
   if (!(s.front + m.rear_collector_offset >= m.endless_home + span)) return;
   double* u = s.u.data();
   double* v = s.v.data();
@@ -47,7 +49,7 @@ void shift_endless_block(const Model& m, State& s) {
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     WireWindow& ww = s.window[wi];
     if (ww.hi < ww.lo) continue;
-    const int ns = m.span_nodes[wi], w0 = m.wires[wi].w_dof;
+    const int ns = spans * m.span_nodes[wi], w0 = m.wires[wi].w_dof;
     for (int i = ww.lo; i <= ww.hi; ++i) {  // upward: the destination is always below the source
       u[w0 + i - ns] = u[w0 + i];
       v[w0 + i - ns] = v[w0 + i];
@@ -57,6 +59,7 @@ void shift_endless_block(const Model& m, State& s) {
     ww.lo -= ns;
     ww.hi -= ns;
   }
+  if (m.lateral) shift_lateral_block(m, s);
   s.front -= span;
   s.line_offset += span;
   // The window now spans one support less on both ends; update_window() rebuilds its factors and

@@ -14,9 +14,10 @@ void window_lengths_for(const NumericsSpec& numerics, double wave_speed, double 
 // Moves the window to the pantographs if they crossed into another span; no allocation.
 void update_window(const Model& model, State& state);
 
-// Endless line: once the rearmost collector has run a span past Model::endless_home, moves the
-// window's displacements, velocities and accelerations back one span (the block is periodic, so
-// this is exact), the train with them, and adds the span to State::line_offset. No allocation.
+// Endless line: once the rearmost collector has run Model::endless_shift_spans spans past
+// Model::endless_home, moves the window's displacements, velocities and accelerations back that
+// many spans (the block is periodic, so this is exact), a 3-D line's lateral state with them
+// (shift_lateral_block), the train too, and adds the distance to State::line_offset. No allocation.
 void shift_endless_block(const Model& model, State& state);
 
 // -K z over the window's nodes of one wire (condensed rotations, cut ends left free).

@@ -93,24 +93,27 @@ struct Lane<1> {
   }
   static T splat(double a) { return a; }
   static T pair(const double* a) { return a[0]; }
+  static T abs(T x) { return std::fabs(x); }
   using Mask = bool;
   static Mask all() { return true; }
   // |x| <= limit, NaN outside: the generic step's !(fabs(un) <= limit) (limit >= 0).
   static Mask inside(Mask m, T x, T above, T below) { return m & (x <= above) & (x >= below); }
   static bool ok(Mask m) { return m; }
   // Eq. 20-21 at node i given its acceleration (the velocity first, then the displacement).
+  template <bool Acc = true>  // Acc false: the acceleration is not kept (the lateral plane needs none)
   static void update(const double* u, const double* v, double* un, double* vn, double* acc, std::ptrdiff_t, int i,
                      T a, T dt, Mask& ok, T above, T below) {
     const T vi = v[i] + dt * a, ui = u[i] + dt * vi;
     ok = inside(ok, ui, above, below);
-    acc[i] = a;
+    if constexpr (Acc) acc[i] = a;
     vn[i] = vi;
     un[i] = ui;
   }
+  template <bool Acc = true>
   static void update2(const double* u, const double* v, double* un, double* vn, double* acc, std::ptrdiff_t d, int i,
                       T a0, T a1, T dt, Mask& ok, T above, T below) {
-    update(u, v, un, vn, acc, d, i, a0, dt, ok, above, below);
-    update(u, v, un, vn, acc, d, i + 1, a1, dt, ok, above, below);
+    update<Acc>(u, v, un, vn, acc, d, i, a0, dt, ok, above, below);
+    update<Acc>(u, v, un, vn, acc, d, i + 1, a1, dt, ok, above, below);
   }
 };
 // Two wires in the two lanes. Interleaved arrays (coefficients, factors, the sweep's record) load
@@ -135,6 +138,14 @@ struct Lane<2> {
   }
   static T splat(double a) { return T{a, a}; }
   static T pair(const double* a) { return T{a[0], a[1]}; }
+  // |x| by clearing the sign bits: what fabs does, lane by lane.
+  static T abs(T x) {
+    Long2 b;
+    std::memcpy(&b, &x, sizeof b);
+    b &= Long2{0x7fffffffffffffffL, 0x7fffffffffffffffL};
+    std::memcpy(&x, &b, sizeof x);
+    return x;
+  }
   using Mask = Long2;
   static Mask all() { return Long2{-1, -1}; }
   static Mask inside(Mask m, T x, T above, T below) { return m & (x <= above) & (x >= below); }
@@ -145,26 +156,32 @@ struct Lane<2> {
     return x;
   }
   static void put_row(double* p, T x) { std::memcpy(p, &x, sizeof x); }
+  template <bool Acc = true>  // Acc false: the acceleration is not kept (the lateral plane needs none)
   static void update(const double* u, const double* v, double* un, double* vn, double* acc, std::ptrdiff_t d, int i,
                      T a, T dt, Mask& ok, T above, T below) {
     const T vi = gather(v, d, i) + dt * a, ui = gather(u, d, i) + dt * vi;
     ok = inside(ok, ui, above, below);
-    acc[i] = a[0];
-    acc[i + d] = a[1];
+    if constexpr (Acc) {
+      acc[i] = a[0];
+      acc[i + d] = a[1];
+    }
     vn[i] = vi[0];
     vn[i + d] = vi[1];
     un[i] = ui[0];
     un[i + d] = ui[1];
   }
   // Nodes i and i + 1 given their accelerations (both wires in lanes): per wire, two nodes a register.
+  template <bool Acc = true>
   static void update2(const double* u, const double* v, double* un, double* vn, double* acc, std::ptrdiff_t d, int i,
                       T a0, T a1, T dt, Mask& ok, T above, T below) {
     const T aa = __builtin_shuffle(a0, a1, Long2{0, 2}), ab = __builtin_shuffle(a0, a1, Long2{1, 3});
     const T va = row(v + i) + dt * aa, vb = row(v + i + d) + dt * ab;
     const T ua = row(u + i) + dt * va, ub = row(u + i + d) + dt * vb;
     ok = inside(inside(ok, ua, above, below), ub, above, below);
-    put_row(acc + i, aa);
-    put_row(acc + i + d, ab);
+    if constexpr (Acc) {
+      put_row(acc + i, aa);
+      put_row(acc + i + d, ab);
+    }
     put_row(vn + i, va);
     put_row(vn + i + d, vb);
     put_row(un + i, ua);
@@ -172,7 +189,7 @@ struct Lane<2> {
   }
 };
 
-template <int L>
+template <int L, bool Plane, bool Drag>
 __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   using V = Lane<L>;
   using T = typename V::T;
@@ -187,7 +204,25 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   const double *__restrict u = a.u[0], *__restrict v = a.v[0];
   double *__restrict un = a.u_next[0], *__restrict vn = a.v_next[0], *__restrict acc = a.accel[0];
   const std::ptrdiff_t d = L == 2 ? a.u[1] - a.u[0] : 0;
+  // The wind's arrays: second lanes as far from the first as the state's (per-wire rows of one
+  // array of the lateral plane's DOFs).
+  const double* __restrict wind = a.wind[0];
+  const double* __restrict cw = a.drag_coefficient[0];
+  const double* __restrict plane = a.plane;
   auto c = [&](int i, int k) __attribute__((always_inline)) { return V::at(coef, static_cast<std::ptrdiff_t>(i) * NC + k); };
+  // The load, alpha m and 1/m of node i: the pack's, or the lateral plane's own.
+  auto load = [&](int i) __attribute__((always_inline)) {
+    if constexpr (Plane) return V::at(plane, static_cast<std::ptrdiff_t>(i) * 3 + 0);
+    else return c(i, W::kLoad);
+  };
+  auto damping = [&](int i) __attribute__((always_inline)) {
+    if constexpr (Plane) return V::at(plane, static_cast<std::ptrdiff_t>(i) * 3 + 1);
+    else return c(i, W::kDampingMass);
+  };
+  auto inv_mass = [&](int i) __attribute__((always_inline)) {
+    if constexpr (Plane) return V::at(plane, static_cast<std::ptrdiff_t>(i) * 3 + 2);
+    else return c(i, W::kInvMass);
+  };
   auto lower = [&](int i) __attribute__((always_inline)) { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i)); };
   auto ip = [&](int i) __attribute__((always_inline)) { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i) + 1); };
   auto get = [&](int i, int k) __attribute__((always_inline)) { return V::at(rec, static_cast<std::ptrdiff_t>(i) * NR + k); };
@@ -202,7 +237,12 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   auto start = [&](int i, T ui, T vi) __attribute__((always_inline)) {
     const T z = ui + beta * vi;
     set(i, kRecZ, z);
-    set(i, kRecInit, c(i, W::kLoad) - c(i, W::kDampingMass) * vi);
+    if constexpr (Drag) {
+      const T vr = V::gather(wind, d, i) - vi;
+      set(i, kRecInit, (load(i) - damping(i) * vi) + V::gather(cw, d, i) * vr * V::abs(vr));
+    } else {
+      set(i, kRecInit, load(i) - damping(i) * vi);
+    }
     return z;
   };
   T zp = start(lo, V::gather(u, d, lo), V::gather(v, d, lo));
@@ -237,7 +277,7 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   T z1 = get(hi, kRecZ), th2, z2;
   auto accel = [&](int j, T f) __attribute__((always_inline)) {
     set(j, kRecForce, f);
-    return c(j, W::kInvMass) * f;
+    return inv_mass(j) * f;
   };
   auto backward = [&](int i) __attribute__((always_inline)) {
     const T th0 = get(i, kRecTheta) * ip(i) - lower(i + 1) * th1;
@@ -259,7 +299,7 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
     set(i, kRecTheta, th0);
     const T z0 = get(i, kRecZ);
     const T A = ((ww_hi * z1 + wt_hi * th1) + c(i, W::kEww) * z0) + c(i, W::kEtw) * th0;
-    V::update(u, v, un, vn, acc, d, hi, accel(hi, get(hi, kRecInit) - A), dt, ok, above, below);
+    V::template update<!Plane>(u, v, un, vn, acc, d, hi, accel(hi, get(hi, kRecInit) - A), dt, ok, above, below);
     th2 = th1;
     th1 = th0;
     z2 = z1;
@@ -269,12 +309,12 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   for (; i - 1 >= lo; i -= 2) {  // nodes i + 1 and i complete: updated as a block
     const T a1 = backward(i);
     const T a0 = backward(i - 1);
-    V::update2(u, v, un, vn, acc, d, i, a0, a1, dt, ok, above, below);
+    V::template update2<!Plane>(u, v, un, vn, acc, d, i, a0, a1, dt, ok, above, below);
   }
-  if (i == lo) V::update(u, v, un, vn, acc, d, lo + 1, backward(lo), dt, ok, above, below);
+  if (i == lo) V::template update<!Plane>(u, v, un, vn, acc, d, lo + 1, backward(lo), dt, ok, above, below);
   const T A = ww_lo * z1 + wt_lo * th1;
   const T B = c(lo, W::kEww) * z2 + c(lo, W::kEwt) * th2;
-  V::update(u, v, un, vn, acc, d, lo, accel(lo, (get(lo, kRecInit) - A) - B), dt, ok, above, below);
+  V::template update<!Plane>(u, v, un, vn, acc, d, lo, accel(lo, (get(lo, kRecInit) - A) - B), dt, ok, above, below);
   return !V::ok(ok);
 }
 
@@ -287,7 +327,11 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
 #endif
 
 CATENARY_SIM_CLONES bool sweep_pack(const PackSweep& a) {
-  return a.pack->lanes == 2 ? sweep<2>(a) : sweep<1>(a);
+  if (a.plane) {
+    if (a.wind[0]) return a.pack->lanes == 2 ? sweep<2, true, true>(a) : sweep<1, true, true>(a);
+    return a.pack->lanes == 2 ? sweep<2, true, false>(a) : sweep<1, true, false>(a);
+  }
+  return a.pack->lanes == 2 ? sweep<2, false, false>(a) : sweep<1, false, false>(a);
 }
 
 // GCC's resolver takes the clone of the highest priority the CPU supports: x86-64-v4 (AVX-512

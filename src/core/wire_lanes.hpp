@@ -28,6 +28,15 @@ struct PackSweep {
   double* accel[2] = {nullptr, nullptr};
   double* record = nullptr;  // State::sweep at the pack's records: kept for the nodes with point forces
   double beta = 0.0, dt = 0.0, limit = 0.0;
+  // The lateral plane (lateral.cpp) sweeps with the vertical pack's band and factors (the same
+  // beam both ways) but its own load, mass-proportional damping and inverse mass: per node and
+  // lane [load, alpha m, 1/m] in `plane` ([node][value][lane]). Null: the pack's own.
+  const double* plane = nullptr;
+  // Optional wind drag on the lateral plane (lateral.cpp), laid out as u: per node the wind's speed
+  // normal to the wire W and the coefficient cw = 0.5 rho Cd d h; the drag cw (W - v)|W - v| (the
+  // wire's own velocity v gives the aerodynamic damping) is added to the load. Null: none.
+  const double* wind[2] = {nullptr, nullptr};
+  const double* drag_coefficient[2] = {nullptr, nullptr};
 };
 
 // z = u + beta v, the condensed rotations (forward and backward tridiagonal sweeps), the band
@@ -35,6 +44,7 @@ struct PackSweep {
 // one forward and one backward pass. The same IEEE operations in the same order as the generic
 // step (condensed_band_force), so the results are bit-identical to it. Returns true if some new
 // displacement is beyond the limit or not a number (the caller finds which).
+// With wind, the load is (load - alpha m v) + (cw (W - v)) |W - v|, in that order.
 // Runtime dispatch (GCC target_clones): x86-64-v4 (AVX-512), x86-64-v3 (AVX2) or the portable
 // x86-64 baseline.
 bool sweep_pack(const PackSweep& sweep);

@@ -62,6 +62,26 @@ visualization_msgs::Marker marker(const std_msgs::Header& h, const std::string& 
 }
 
 
+// Lateral position (m, + left of the track centre line) of node i of wire wi now; 0 on a 2-D line.
+double node_lateral(const Model& m, const State& s, std::size_t wi, int i) {
+  if (!m.lateral || s.lateral.y.size() != m.lateral->n) return 0.0;
+  return s.lateral.y[m.lateral->wires[wi].w_dof + i];
+}
+
+// Lateral position of the wire node behind a vertical DOF (a dropper's or steady arm's end).
+double dof_lateral(const Model& m, const State& s, int dof) {
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    const Wire& w = m.wires[wi];
+    if (dof >= w.w_dof && dof < w.w_dof + w.nodes()) return node_lateral(m, s, wi, dof - w.w_dof);
+  }
+  return 0.0;
+}
+
+// The pantograph head's centre across the track (sway); 0 on a 2-D line.
+double head_lateral(const Model& m, const State& s, std::size_t p) {
+  return m.lateral && p < s.lateral.pantograph_lateral.size() ? s.lateral.pantograph_lateral[p] : 0.0;
+}
+
 double collector_force(const Model& m, const State& s, int ci) {
   const std::size_t nw = m.contact_wires.size();
   double f = 0.0;
@@ -218,8 +238,38 @@ WireShapeArray to_wire_shape(const Model& m, const State& s, double resolution, 
     for (int i : sample_nodes(w, resolution)) {
       ws.stations.push_back(w.x[i] + s.line_offset);
       ws.heights.push_back(w.height[i] + s.u[w.w_dof + i]);
+      if (m.lateral) ws.lateral.push_back(node_lateral(m, s, &w - m.wires.data(), i));
     }
     out.wires.push_back(ws);
+  }
+  return out;
+}
+
+LateralContactArray to_lateral_contact(const Model& m, const State& s, const ros::Time& stamp,
+                                       const std::string& frame) {
+  LateralContactArray out;
+  out.header.stamp = stamp;
+  out.header.frame_id = frame;
+  out.sim_time = s.time;
+  if (!m.lateral) return out;
+  out.half_working_width = m.lateral->half_working_width;
+  out.half_horn_width = m.lateral->half_horn_width;
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    const Pantograph& pg = m.pantographs[p];
+    for (std::size_t k = 0; k < pg.collectors.size(); ++k) {
+      const int ci = pg.collectors[k];
+      LateralContact c;
+      c.pantograph = pg.name;
+      c.collector = static_cast<int>(k);
+      c.station = collector_x(m, s, static_cast<int>(p), ci) + s.line_offset;
+      c.pantograph_lateral = head_lateral(m, s, p);
+      c.lateral = static_cast<std::size_t>(ci) < s.lateral.collector_lateral.size() ? s.lateral.collector_lateral[ci]
+                                                                                  : std::nan("");
+      c.wire_lateral = c.lateral + c.pantograph_lateral;
+      c.in_contact = collector_force(m, s, ci) > 0.0;
+      c.on_working_width = std::fabs(c.lateral) <= m.lateral->half_working_width;  // false for NaN
+      out.contacts.push_back(c);
+    }
   }
   return out;
 }
@@ -324,7 +374,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     mk.scale.x = w.is_contact_wire ? 0.04 : 0.03;
     mk.color = w.is_contact_wire ? color(0.85f, 0.55f, 0.2f) : color(0.6f, 0.6f, 0.65f);
     for (int i : sample_nodes(w, o.shape_resolution))
-      mk.points.push_back(point(w.x[i] + s.line_offset, 0.0, w.height[i] + k * s.u[w.w_dof + i]));
+      mk.points.push_back(point(w.x[i] + s.line_offset, node_lateral(m, s, wi, i), w.height[i] + k * s.u[w.w_dof + i]));
     add_list(out, mk);
   }
 
@@ -337,8 +387,8 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
   for (std::size_t d = 0; d < m.droppers.size(); ++d) {
     const Dropper& dr = m.droppers[d];
     Marker& mk = (d < s.dropper_slack.size() && s.dropper_slack[d]) ? slack : taut;
-    mk.points.push_back(point(dr.x + s.line_offset, 0.0, shown(dr.contact_dof)));
-    mk.points.push_back(point(dr.x + s.line_offset, 0.0, shown(dr.messenger_dof)));
+    mk.points.push_back(point(dr.x + s.line_offset, dof_lateral(m, s, dr.contact_dof), shown(dr.contact_dof)));
+    mk.points.push_back(point(dr.x + s.line_offset, dof_lateral(m, s, dr.messenger_dof), shown(dr.messenger_dof)));
   }
   add_list(out, taut);
   add_list(out, slack);
@@ -350,12 +400,17 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     Marker masts = marker(h, "masts", 0, Marker::LINE_LIST);
     masts.scale.x = 0.15;
     masts.color = color(0.35f, 0.35f, 0.4f);
-    for (double xs : m.support_x) {
-      const double x = xs + s.line_offset;
+    // On a 3-D line the cantilever reaches over the messenger's stagger at that support.
+    std::vector<double> reach(m.support_x.size(), 0.0);
+    if (m.lateral)
+      for (const LateralSupport& ls : m.lateral->supports)
+        if (!m.wires[ls.wire].is_contact_wire) reach[ls.line_support] = ls.stagger;
+    for (std::size_t k = 0; k < m.support_x.size(); ++k) {
+      const double x = m.support_x[k] + s.line_offset;
       masts.points.push_back(point(x, y_mast, 0.0));
       masts.points.push_back(point(x, y_mast, top));
       masts.points.push_back(point(x, y_mast, top));
-      masts.points.push_back(point(x, 0.0, top));
+      masts.points.push_back(point(x, std::min(0.0, reach[k]), top));
     }
     add_list(out, masts);
     Marker arms = marker(h, "steady_arms", 0, Marker::LINE_LIST);
@@ -365,7 +420,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
       if (!sp.steady_arm) continue;
       const double z = shown(sp.dof);
       arms.points.push_back(point(sp.x + s.line_offset, y_mast, wire_dof_design_height(m, sp.dof)));
-      arms.points.push_back(point(sp.x + s.line_offset, 0.0, z));
+      arms.points.push_back(point(sp.x + s.line_offset, dof_lateral(m, s, sp.dof), z));
     }
     add_list(out, arms);
   }
@@ -381,6 +436,23 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     const double z_head = drawn_head_height(m, s, id, k);
     const double force = total_contact_force(m, s, id);
     const bool contact = force > 0.0;
+    // Across the track: the head's centre (sway), its strips' working width and horn extent.
+    const double yh = head_lateral(m, s, p);
+    // Where the force is drawn: the mean contact point across the strips on a 3-D line.
+    double y_force = yh;
+    if (m.lateral) {
+      double sum = 0.0;
+      int count = 0;
+      for (int ci : pg.collectors) {
+        const double yc = static_cast<std::size_t>(ci) < s.lateral.collector_lateral.size() ? s.lateral.collector_lateral[ci]
+                                                                                         : std::nan("");
+        if (std::isfinite(yc)) {
+          sum += yc;
+          ++count;
+        }
+      }
+      if (count) y_force = yh + sum / count;
+    }
 
     // A plain moving force is a point; a pantograph (lumped, or a real one on a rig) has one or
     // more heads: collector strips across the track (carbon, pantograph_head.working_width) on a
@@ -416,17 +488,17 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
       Marker head = marker(h, "pantograph_head", hd == 0 ? id : kHeadIdStride * hd + id,
                            point_force ? Marker::SPHERE : Marker::CUBE);
       if (point_force) {
-        head.pose.position = point(x, 0.0, z_head - 0.03);
+        head.pose.position = point(x, y_force, z_head - 0.03);
         head.scale.x = head.scale.y = head.scale.z = 0.2;
       } else if (several) {
         // A plate under the head's strips, as long as the head (scene `length`).
-        head.pose.position = point(xh, 0.0, zh - 0.045);
+        head.pose.position = point(xh, yh, zh - 0.045);
         head.scale.x = m.scene.pantographs[p].heads[hd].length;
         head.scale.y = 2.0 * half_width;
         head.scale.z = 0.03;
       } else {
         // Its top at the drawn head height (the strips' running surface), where the arrow starts.
-        head.pose.position = point(x, 0.0, z_head - 0.02);
+        head.pose.position = point(x, yh, z_head - 0.02);
         head.scale.x = 0.1;
         head.scale.y = 2.0 * half_width;
         head.scale.z = 0.04;
@@ -436,12 +508,12 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
       if (point_force) continue;
       for (int ci : pg.collectors)
         if (!several || m.collectors[ci].head == hd)
-          strips.points.push_back(point(x + m.collectors[ci].offset, 0.0, zh - 0.015));
+          strips.points.push_back(point(x + m.collectors[ci].offset, yh, zh - 0.015));
       for (double side : {-1.0, 1.0}) {  // from the strip's end out and down: a quarter arc in 4 pieces
-        double py = side * half_width, pz = zh - 0.03;
+        double py = yh + side * half_width, pz = zh - 0.03;
         for (int i = 1; i <= 4; ++i) {
           const double a = 0.5 * M_PI * i / 4.0;
-          const double ny = side * (half_width + horn * std::sin(a)), nz = zh - 0.03 - 0.25 * (1.0 - std::cos(a));
+          const double ny = yh + side * (half_width + horn * std::sin(a)), nz = zh - 0.03 - 0.25 * (1.0 - std::cos(a));
           horns.points.push_back(point(xh, py, pz));
           horns.points.push_back(point(xh, ny, nz));
           py = ny;
@@ -449,23 +521,36 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
         }
       }
       if (several) {  // the head's suspension, down to the top of the frame under the reference point
-        links.points.push_back(point(xh, 0.0, zh - 0.06));
-        links.points.push_back(point(x, 0.0, z_head - 0.2));
+        links.points.push_back(point(xh, yh, zh - 0.06));
+        links.points.push_back(point(x, yh, z_head - 0.2));
       }
     }
     if (!point_force) {
       add_list(out, strips);
       add_list(out, horns);
       if (several) add_list(out, links);
+      if (m.lateral) {
+        // Where each strip meets the wire: yellow on the working width, red beyond it (dewired).
+        Marker spots = marker(h, "lateral_contact", id, Marker::SPHERE_LIST);
+        spots.scale.x = spots.scale.y = spots.scale.z = 0.2;
+        for (int ci : pg.collectors) {
+          const double yc = static_cast<std::size_t>(ci) < s.lateral.collector_lateral.size()
+                                ? s.lateral.collector_lateral[ci] : std::nan("");
+          if (!std::isfinite(yc)) continue;
+          spots.points.push_back(point(x + m.collectors[ci].offset, yh + yc, z_head));
+          spots.colors.push_back(std::fabs(yc) <= half_width ? color(1.0f, 0.85f, 0.1f) : color(1.0f, 0.1f, 0.1f));
+        }
+        add_list(out, spots);
+      }
     }
 
     Marker frame = marker(h, "pantograph_frame", id, Marker::LINE_STRIP);
     frame.scale.x = 0.05;
     frame.color = color(0.3f, 0.3f, 0.3f);
     const double z_roof = std::min(4.0, z_head - 1.0);
-    frame.points.push_back(point(x - 1.2, 0.0, z_roof));
-    frame.points.push_back(point(x + 0.6, 0.0, 0.5 * (z_roof + z_head)));
-    frame.points.push_back(point(x, 0.0, pg.heads.empty() ? z_head - 0.06 : z_head - 0.2));
+    frame.points.push_back(point(x - 1.2, yh, z_roof));
+    frame.points.push_back(point(x + 0.6, yh, 0.5 * (z_roof + z_head)));
+    frame.points.push_back(point(x, yh, pg.heads.empty() ? z_head - 0.06 : z_head - 0.2));
     add_list(out, frame);
 
     Marker arrow = marker(h, "contact_force", id, Marker::ARROW);
@@ -473,8 +558,8 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     arrow.scale.y = 0.1;   // head diameter
     arrow.scale.z = 0.1;   // head length
     arrow.color = contact ? color(0.1f, 0.8f, 0.2f) : color(1.0f, 0.1f, 0.1f);
-    arrow.points.push_back(point(x, 0.0, z_head));
-    arrow.points.push_back(point(x, 0.0, z_head + std::max(0.0, force) * kArrowMetresPerNewton + 1e-3));
+    arrow.points.push_back(point(x, y_force, z_head));
+    arrow.points.push_back(point(x, y_force, z_head + std::max(0.0, force) * kArrowMetresPerNewton + 1e-3));
     out.markers.push_back(arrow);
 
     Marker label = marker(h, "label", id, Marker::TEXT_VIEW_FACING);
@@ -499,11 +584,23 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
         ++lines;
       }
     }
+    if (m.lateral && y_force != yh) {  // the contact point across the strip (mean over the collectors)
+      t << "strip " << std::showpos << std::setprecision(2) << y_force - yh << std::noshowpos << " m\n";
+      ++lines;
+    }
     t << std::setprecision(1) << s.speed * 3.6 << " km/h";
     // Text is centred on its position: keep its lowest line kLabelClearance above the head.
     label.pose.position = point(x, 0.0, z_head + kLabelClearance + 0.5 * lines * kLabelLineHeight);
     label.text = t.str();
     out.markers.push_back(label);
+  }
+  if (o.lateral_scale != 1.0) {
+    // Stretch across the track: positions, points and the widths of boxes and dots.
+    for (Marker& mk : out.markers) {
+      mk.pose.position.y *= o.lateral_scale;
+      for (geometry_msgs::Point& p : mk.points) p.y *= o.lateral_scale;
+      if (mk.type == Marker::CUBE || mk.type == Marker::CUBE_LIST || mk.type == Marker::SPHERE_LIST) mk.scale.y *= o.lateral_scale;
+    }
   }
   return out;
 }

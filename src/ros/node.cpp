@@ -76,6 +76,8 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   status_pub_ = nh_.advertise<std_msgs::String>("pass_status", 1, true);
   events_pub_ = nh_.advertise<PassEvent>("events", 100);
   line_state_pub_ = nh_.advertise<LineState>("line_state", 10);
+  // A 3-D line (stagger, curve, wind or sway) also says where each strip meets the wire across it.
+  if (sim_->model().lateral) lateral_pub_ = nh_.advertise<LateralContactArray>("lateral_contact", 10);
   speed_sub_ = nh_.subscribe("cmd/train_speed", 10, &SimulationNode::on_speed, this);
   uplift_sub_ = nh_.subscribe("cmd/uplift_force", 10, &SimulationNode::on_uplift, this);
   reset_srv_ = pnh_.advertiseService("reset", &SimulationNode::on_reset, this);
@@ -105,6 +107,8 @@ void SimulationNode::restart_recording() {
   const double rows = params_.report_file.empty() ? kRecorderRowRate : sim_->model().scene.output.sample_rate;
   recorder_ = std::make_unique<PassRecorder>(sim_->model(), rows);
   recorder_->record(sim_->model(), sim_->state());
+  lateral_recorder_ = std::make_unique<LateralRecorder>(sim_->model(), rows);  // records nothing on a 2-D line
+  lateral_recorder_->record(sim_->model(), sim_->state());
   running_.assign(sim_->model().pantographs.size(), Running{});
   arm_max_uplift_.assign(sim_->model().springs.size(), 0.0);
   chart_ = ChartData{};
@@ -302,6 +306,7 @@ void SimulationNode::on_reconfigure(NodeConfig& c, uint32_t) {
   if (c.real_time_factor != params_.real_time_factor) reanchor();
   params_.real_time_factor = c.real_time_factor;
   params_.vertical_scale = c.vertical_scale;
+  params_.lateral_scale = c.lateral_scale;
   params_.publish_rate = c.publish_rate;
   params_.shape_rate = c.shape_rate;
   params_.marker_rate = c.marker_rate;
@@ -322,6 +327,7 @@ std::int64_t SimulationNode::do_steps(std::int64_t n, const ros::WallTime* deadl
     if (sim_->step() != StepStatus::kOk) break;
     const State& s = sim_->state();
     recorder_->record(m, s);
+    lateral_recorder_->record(m, s);
     track_contact_loss();  // every step: the events resolve dt, not the publishing tick
     // The chart's samples on simulated time (a thousand per window), also when ~step jumps ahead.
     if (params_.strip_chart && s.time - last_chart_time_ >= 1e-3 * params_.chart_window) sample_chart();
@@ -378,6 +384,7 @@ void SimulationNode::handle_end() {
   }
   if (!sim_->finished()) return;
   // (finished() is true as soon as the front reaches the end, before step() marks the state)
+  if (s.status == StepStatus::kDewired) ROS_WARN("catenary_sim: %s", sim_->status_message().c_str());
   char what[256];
   std::snprintf(what, sizeof what, "pass finished at t = %.4f s (train front at %.2f m), %lld chunks, %lld overruns",
                 s.time, s.front + s.line_offset, static_cast<long long>(chunks_), static_cast<long long>(overruns_));
@@ -447,7 +454,8 @@ void SimulationNode::write_report() {
   const std::string dir = report_directory(params_.report_file);
   try {
     write_pass_files(dir, sim_->model(), sim_->state(), *recorder_,
-                     RunInfo{(ros::WallTime::now() - wall_start_).toSec(), -1.0, overruns_});
+                     RunInfo{(ros::WallTime::now() - wall_start_).toSec(), -1.0, overruns_}, lateral_recorder_.get(),
+                     sim_->state().status == StepStatus::kDewired);
   } catch (const OutputError& e) {
     ROS_ERROR("catenary_sim: ~report_file: %s", e.what());
     exit_code_ = 1;
@@ -503,6 +511,7 @@ void SimulationNode::publish(bool force) {
     }
     contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
     pantograph_pub_.publish(to_pantograph_state(m, s, stamp, params_.line_frame));
+    if (m.lateral) lateral_pub_.publish(to_lateral_contact(m, s, stamp, params_.line_frame));
     last_published_time_ = s.time;
     if (shape_due || force) {
       last_shape_wall_ = now;
@@ -519,6 +528,7 @@ void SimulationNode::publish(bool force) {
       MarkerOptions o;
       o.frame = params_.line_frame;
       o.vertical_scale = params_.vertical_scale;
+      o.lateral_scale = params_.lateral_scale;
       o.shape_resolution = params_.shape_resolution;
       visualization_msgs::MarkerArray arr = to_markers(m, s, stamp, o);
       if (params_.strip_chart) {
@@ -531,6 +541,7 @@ void SimulationNode::publish(bool force) {
         if (paused_ || waiting_ || ended_ || sim_->finished()) head << (paused_ ? "paused" : ended_ || sim_->finished() ? "ended" : "waiting");
         else head << achieved_rtf_ << "x real time";
         head << "  vertical x" << std::setprecision(0) << params_.vertical_scale;
+        if (m.lateral && params_.lateral_scale != 1.0) head << "  lateral x" << params_.lateral_scale;
         chart_.heading = head.str();
         chart_.stats.clear();
         for (std::size_t p = 0; p < running_.size(); ++p) {

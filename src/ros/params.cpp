@@ -223,6 +223,7 @@ const Range kShapeRate{kMinShapeRate, 1000.0, false, "Hz"};
 const Range kMarkerRate{kMinMarkerRate, 1000.0, false, "Hz"};
 const Range kShapeResolution{0.0, 100.0, false, "m (0: every node)"};
 const Range kVerticalScale{kMinVerticalScale, 10000.0, false, ""};
+const Range kLateralScale{1.0, 100.0, false, "(1: true scale)"};
 const Range kMaxAcceleration{0.0, 20.0, false, "m/s^2 (0: no limit)"};
 const Range kStartDelay{0.0, 60.0, false, "s"};
 const Range kWaitForViewer{0.0, 600.0, false, "s (0: no wait)"};
@@ -240,6 +241,7 @@ void validate(const NodeParams& p) {
   check("marker_rate", p.marker_rate, kMarkerRate);
   check("shape_resolution", p.shape_resolution, kShapeResolution);
   check("vertical_scale", p.vertical_scale, kVerticalScale);
+  check("lateral_scale", p.lateral_scale, kLateralScale);
   check("max_acceleration", p.max_acceleration, kMaxAcceleration);
   check("start_delay", p.start_delay, kStartDelay);
   check("wait_for_viewer", p.wait_for_viewer, kWaitForViewer);
@@ -261,7 +263,7 @@ bool read_speed_kmh(ParamReader& r, const ros::NodeHandle& nh, std::optional<dou
 NodeParams load_params(const ros::NodeHandle& nh) {
   ParamReader r(nh, "catenary_sim",
                 {"scene", "speed_kmh", "real_time_factor", "publish_rate", "shape_rate", "marker_rate",
-                 "shape_resolution", "vertical_scale", "line_frame", "at_end", "stats_file", "report_file", "publish_clock",
+                 "shape_resolution", "vertical_scale", "lateral_scale", "line_frame", "at_end", "stats_file", "report_file", "publish_clock",
                  "paused", "wait_for_viewer", "max_acceleration", "start_delay", "strip_chart", "chart_window",
                  "diagnostic_period"});  // (the last read by diagnostic_updater)
   NodeParams p;
@@ -273,6 +275,7 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   r.number("marker_rate", p.marker_rate, kMarkerRate.text());
   r.number("shape_resolution", p.shape_resolution, kShapeResolution.text());
   r.number("vertical_scale", p.vertical_scale, kVerticalScale.text());
+  r.number("lateral_scale", p.lateral_scale, kLateralScale.text());
   r.number("max_acceleration", p.max_acceleration, kMaxAcceleration.text());
   r.number("start_delay", p.start_delay, kStartDelay.text());
   r.number("wait_for_viewer", p.wait_for_viewer, kWaitForViewer.text());

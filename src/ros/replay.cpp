@@ -1,5 +1,7 @@
 #include "catenary_sim/ros/replay.hpp"
 
+#include "catenary_sim/core/lateral.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -58,6 +60,17 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
              " (the line offset of the first wire)" + kOtherScene;
     for (int i = 0; i < w.nodes(); ++i)
       s->u[w.w_dof + i] = interpolate(ws.stations, ws.heights, w.x[i] + o) - w.height[i];
+    // A 3-D line's lateral positions (an empty list on a 2-D line).
+    const std::size_t lateral_expected = m.lateral ? ws.stations.size() : 0;
+    if (ws.lateral.size() != lateral_expected)
+      return field + ".lateral has " + num(ws.lateral.size()) + " values: expected " + num(lateral_expected) +
+             (m.lateral ? " (one per station: the scene is a 3-D line)" : " (the scene is a 2-D line)") + kOtherScene;
+    for (std::size_t k = 0; k < ws.lateral.size(); ++k)
+      if (!std::isfinite(ws.lateral[k]))
+        return field + ".lateral[" + num(k) + "] = " + num(ws.lateral[k]) + ": expected a finite value, m";
+    if (m.lateral && s->lateral.y.size() == m.lateral->n)
+      for (int i = 0; i < w.nodes(); ++i)
+        s->lateral.y[m.lateral->wires[wi].w_dof + i] = interpolate(ws.stations, ws.lateral, w.x[i] + o);
   }
   s->line_offset = offset;
 
@@ -113,6 +126,7 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
     const double stretch = s->u[dr.messenger_dof] - s->u[dr.contact_dof];
     s->dropper_slack[d] = !(dr.static_tension + dr.stiffness * stretch > 0.0);
   }
+  if (m.lateral && s->lateral.y.size() == m.lateral->n) lateral_observe(m, *s);  // the contact points across the strips and the sway (3-D line)
   return "";
 }
 

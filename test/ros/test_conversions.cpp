@@ -586,3 +586,52 @@ TEST(Markers, NoListMarkerIsEverSentEmpty) {
       "pantographs: [{name: f, type: moving_force, static_uplift: 100}]\ntrain: {speed: 50.0}\n"));
   check(to_markers(wire.model(), wire.state(), ros::Time(1.0), MarkerOptions{}), "a single wire (no droppers, no arms)");
 }
+
+// A 3-D line drawn in 3-D: the contact wire at its stagger at the supports, the head at the sway,
+// the dot where the strip meets the wire at the contact point; ~lateral_scale stretches every
+// lateral coordinate and width alike (x and z untouched), so the wire stays where it is on the strip.
+TEST(Markers, ThreeDimensionalLineIsDrawnAcrossTheTrackAndStretchedAlike) {
+  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml",
+                                 {"pantograph_head.sway.amplitude=0.05", "pantograph_head.sway.frequency=0.5"}));
+  for (int i = 0; i < 800; ++i) ASSERT_EQ(sim.step(), StepStatus::kOk);
+  const Model& m = sim.model();
+  const State& s = sim.state();
+  MarkerOptions o;
+  o.shape_resolution = 0.0;
+  const visualization_msgs::MarkerArray a = to_markers(m, s, ros::Time(1.0), o);
+  o.lateral_scale = 7.0;
+  const visualization_msgs::MarkerArray b = to_markers(m, s, ros::Time(1.0), o);
+  ASSERT_EQ(a.markers.size(), b.markers.size());
+  bool dot = false, wire = false;
+  for (std::size_t k = 0; k < a.markers.size(); ++k) {
+    const visualization_msgs::Marker &x = a.markers[k], &y = b.markers[k];
+    ASSERT_EQ(x.points.size(), y.points.size()) << x.ns;
+    for (std::size_t j = 0; j < x.points.size(); ++j) {
+      EXPECT_EQ(x.points[j].x, y.points[j].x);
+      EXPECT_EQ(x.points[j].z, y.points[j].z);
+      EXPECT_NEAR(y.points[j].y, 7.0 * x.points[j].y, 1e-12) << x.ns;
+    }
+    EXPECT_NEAR(y.pose.position.y, 7.0 * x.pose.position.y, 1e-12) << x.ns;
+    if (x.ns == "lateral_contact" && x.action == visualization_msgs::Marker::ADD) {
+      ASSERT_EQ(x.points.size(), 1u);
+      // wire minus pantograph = contact point on the strip: drawn at the pantograph's + that
+      EXPECT_NEAR(x.points[0].y, s.lateral.pantograph_lateral[0] + s.lateral.collector_lateral[0], 1e-12);
+      EXPECT_NEAR(y.scale.y, 7.0 * x.scale.y, 1e-12);
+      dot = true;
+    }
+    if (x.ns == "pantograph_strips") {
+      EXPECT_NEAR(x.points[0].y, s.lateral.pantograph_lateral[0], 1e-12);
+    }
+    if (x.ns == "wires" && x.id == 0) {
+      // At the supports (rigid registration in plan here: springs of 2e5 N/m, within a few mm).
+      for (const geometry_msgs::Point& p : x.points)
+        for (int k2 = 1; k2 < 10; ++k2)
+          if (std::fabs(p.x - 55.0 * k2) < 1e-9) {
+            EXPECT_NEAR(p.y, k2 % 2 ? -0.3 : 0.3, 0.02) << "support " << k2;
+            wire = true;
+          }
+    }
+  }
+  EXPECT_TRUE(dot);
+  EXPECT_TRUE(wire);
+}

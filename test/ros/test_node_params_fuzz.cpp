@@ -203,7 +203,7 @@ TEST_F(NodeParamsFuzz, NodeRejectsEveryBadValueNamingTheParameter) {
   const std::vector<Param> params{
       {"scene", Kind::kScene},           {"speed_kmh", Kind::kNumber},       {"real_time_factor", Kind::kNumber},
       {"publish_rate", Kind::kRate},     {"shape_rate", Kind::kRate},        {"marker_rate", Kind::kRate},
-      {"shape_resolution", Kind::kNumber}, {"vertical_scale", Kind::kRate},  {"line_frame", Kind::kFrame},
+      {"shape_resolution", Kind::kNumber}, {"vertical_scale", Kind::kRate}, {"lateral_scale", Kind::kRate},  {"line_frame", Kind::kFrame},
       {"at_end", Kind::kAtEnd},          {"stats_file", Kind::kPath},        {"publish_clock", Kind::kBool},
       {"paused", Kind::kBool},           {"wait_for_viewer", Kind::kNumber}, {"max_acceleration", Kind::kNumber},
       {"start_delay", Kind::kNumber},    {"report_file", Kind::kPath}};
@@ -360,6 +360,39 @@ TEST_F(NodeParamsFuzz, ReportFileIsWrittenAtTheEndOfThePass) {
   // The statistics are the node's pass: the same keys as simulate_pass's, finite.
   const nlohmann::json j = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_GT(j.at("pantographs").at(0).at("std_force_N").get<double>(), 0.0);
+}
+
+// On a 3-D line the node's report directory also holds the lateral files, as simulate_pass's does,
+// and stats.json its "lateral" object (the contact point across the strip, blow-off per span).
+TEST_F(NodeParamsFuzz, ReportFileOfA3dLineHasTheLateralFiles) {
+  const std::string out = dir_ + "/report3d";
+  mkdir(out.c_str(), 0755);
+  const std::string scene = out + "/short.yaml";
+  std::string text = slurp(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml");
+  const auto set = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  set("span_count: 10", "span_count: 6");
+  set("preset: accurate", "preset: accurate\n  element_length: 0.5");
+  std::ofstream(scene) << text;
+  const std::string html = out + "/pass_report.html";
+  const ChildRun r = Child({kNode, "__name:=reporting3d", "_scene:=" + scene, "_speed_kmh:=250", "_real_time_factor:=0",
+                            "_at_end:=exit", "_publish_clock:=false", "_report_file:=" + html},
+                           dir_ + "/reporting3d.log", env_)
+                         .wait(300.0);
+  ASSERT_FALSE(r.hung) << r.out;
+  EXPECT_EQ(r.signal, 0);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  for (const char* f : {"stats.json", "timeseries.csv", "lateral.csv", "lateral_histogram.csv", "blow_off.csv",
+                        "pull_off.csv", "dewirements.csv"})
+    EXPECT_TRUE(exists(out + "/" + f)) << f;
+  const nlohmann::json j = nlohmann::json::parse(slurp(out + "/stats.json"));
+  ASSERT_TRUE(j.contains("lateral")) << j.dump();
+  // Over the analysed spans: the contact point sweeps the +-0.3 m zigzag.
+  const nlohmann::json& c = j.at("lateral").at("contact_points").at(0);
+  EXPECT_GT(c.at("max_m").get<double>() - c.at("min_m").get<double>(), 0.4) << c.dump();
 }
 
 // A report whose directory cannot take the pass's files is refused at start-up, naming ~report_file.

@@ -7,6 +7,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/core/lateral.hpp"
 #include "catenary_sim/ros/replay.hpp"
 
 using namespace catenary_sim;
@@ -56,6 +57,7 @@ struct Rebuilt {
 Rebuilt rebuild(const Model& m, const State& s, double resolution) {
   const ros::Time stamp(1.0 + s.time);  // a stamp offset, as simulate_pass --bag writes
   Rebuilt r{"", make_state(m)};
+  if (m.lateral) r.state.lateral = make_lateral_state(m);  // as replay_markers does
   r.error = state_from_messages(m, to_wire_shape(m, s, resolution, stamp, "line"),
                                 to_pantograph_state(m, s, stamp, "line"), to_contact_force(m, s, stamp, "line"),
                                 &r.state);
@@ -105,6 +107,10 @@ TEST(Replay, TwoPantographsAndTwoContactWires) {
   check_scene("reference_55m_two_pantographs.yaml", 3000);
   check_scene("reference_55m_two_sections.yaml", 3000);
 }
+
+// A 3-D line (stagger, gusty cross wind): the wires' lateral positions travel in wire_shape, the
+// sway and the contact points across the strips follow from them; every marker is the live one.
+TEST(Replay, ThreeDimensionalLineDrawsTheLiveMarkers) { check_scene("reference_55m_3d.yaml", 3000); }
 
 TEST(Replay, EndlessLineKeepsTheLineOffset) { check_scene("reference_55m_endless.yaml", 0, true); }
 

@@ -76,9 +76,19 @@ struct LateralModel {
   int substeps = 1;                // lateral steps per vertical step
   double dt = 0.0;                 // s, lateral step
   double half_working_width = 0.0, half_horn_width = 0.0;  // m
+  std::vector<double> node_x;      // m, per lateral DOF: the node's station (an endless line's block station)
   std::vector<int> node_span;      // per lateral DOF: span along the line for contact-wire nodes, -1 otherwise
+                                   // (and everywhere on an endless line, whose block spans are not the line's)
   int spans = 0;
   std::vector<double> static_blow_off;  // m, per span: largest |initial - calm| on the contact wire(s)
+  // The fused step (wire_lanes.hpp): the vertical plane's packs (Model::wire_packs: the same
+  // band and factors, a round wire bends alike both ways) swept with the lateral plane's own load,
+  // damping and inverse mass (per pack [node][load, alpha m, 1/m][lane]) and the wind's drag, the
+  // records in the vertical step's scratch (State::sweep, free between steps); the nodes with
+  // point forces (springs, pendulums) with where the sweep leaves their band force. No planes
+  // (the vertical step not fused: implicit, or rotations as DOFs): the generic step.
+  std::vector<std::vector<double>> planes;
+  std::vector<int> point_nodes, point_record;
 };
 
 // Builds the lateral plane of a model whose scene asks for one (Scene::lateral()); throws SceneError.
@@ -101,6 +111,7 @@ constexpr std::size_t kMaxDewirementEvents = 1024;  // kept per pass; more are c
 struct LateralState {
   Eigen::VectorXd y, v;      // m, m/s (v at the half step, eq. 20)
   Eigen::VectorXd f, z;      // workspace
+  Eigen::VectorXd y_next, v_next, accel;  // the fused step's new values
   std::vector<double> theta, wind_points;
   Eigen::VectorXd wind_speed;    // m/s, per node: the wind's speed normal to the wire now
   double next_wind_update = 0.0;  // s
@@ -124,6 +135,11 @@ void lateral_observe(const Model& model, State& state);
 // One lateral step of the model's dt (its substeps), after the vertical step moved the state to
 // its new time. Never allocates. Returns kDiverged or kDewired (on_dewirement: stop), else kOk.
 StepStatus lateral_step(const Model& model, State& state);
+
+// Endless line: moves the lateral state back Model::endless_shift_spans spans with the block
+// (called by shift_endless_block before it moves the train); the spans entering at the far end
+// start in the static state. No allocation.
+void shift_lateral_block(const Model& model, State& state);
 
 // Lateral energy without wind: 0.5 v M v + 0.5 y K y - load . y with the droppers at their static
 // tension (J); constant in an undamped, windless free motion.

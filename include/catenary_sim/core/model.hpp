@@ -175,6 +175,9 @@ struct Model {
   double initial_line_offset = 0.0;               // m, a whole number of spans
   double rear_collector_offset = 0.0;             // m, rearmost collector station - train front
   std::vector<int> span_nodes;                    // per wire: nodes per span (endless)
+  // Spans the block moves by: 1, or a 3-D line's stagger pattern (its supports repeat only after
+  // a whole pattern), so that endless_home..endless_home + shift spans holds the rearmost collector.
+  int endless_shift_spans = 1;
   double longest_span = 0.0;    // m
   std::vector<int> dropper_order, spring_order;       // indices in line order (stable)
   std::vector<double> dropper_order_x, spring_order_x;  // m, their stations

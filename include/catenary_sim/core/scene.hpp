@@ -317,6 +317,11 @@ struct PantographHeadSpec {
   DewirementAction on_dewirement = DewirementAction::kContinue;
   double sway_amplitude = 0.0;  // m, lateral motion a sin(2 pi f t)
   double sway_frequency = 0.0;  // Hz
+  // Or a measured sway (sway.times, sway.lateral): linear between the samples, held before the
+  // first and after the last (s, increasing; m, + to the left).
+  std::vector<double> sway_times, sway_lateral;
+  bool sways() const { return sway_amplitude > 0.0 || !sway_times.empty(); }
+  double sway(double t) const;  // m, the head's centre from the track centre line at time t
   double histogram_bin = 0.02;  // m, width of the bins of the lateral contact histogram
 };
 
@@ -355,7 +360,7 @@ struct Scene {
   std::optional<WindSpec> wind;
   PantographHeadSpec pantograph_head;
   bool lateral() const {
-    return stagger.has_value() || alignment.any() || wind.has_value() || pantograph_head.sway_amplitude > 0.0;
+    return stagger.has_value() || alignment.any() || wind.has_value() || pantograph_head.sways();
   }
 
   double line_length() const;

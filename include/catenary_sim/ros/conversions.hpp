@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "catenary_sim/ContactForceArray.h"
+#include "catenary_sim/LateralContactArray.h"
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/WireShapeArray.h"
 #include "catenary_sim/core/model.hpp"
@@ -36,6 +37,11 @@ PantographStateArray to_pantograph_state(const Model& m, const State& s, const r
 // Samples every wire at about `resolution` m (0: every node); the last node is always included.
 WireShapeArray to_wire_shape(const Model& m, const State& s, double resolution, const ros::Time& stamp,
                              const std::string& frame);
+
+// Per collector, where its strip meets the contact wire across the track (the contact point's
+// lateral position on the strip, the wire's and the pantograph's); no contacts on a 2-D line.
+LateralContactArray to_lateral_contact(const Model& m, const State& s, const ros::Time& stamp,
+                                       const std::string& frame);
 
 // Design height (m) of a wire's vertical DOF; NaN if `dof` is not a wire's vertical DOF.
 double wire_dof_design_height(const Model& m, int dof);
@@ -78,6 +84,9 @@ std::vector<geometry_msgs::TransformStamped> to_transforms(const Model& m, const
 struct MarkerOptions {
   std::string frame = "line";
   double vertical_scale = 10.0;   // displacements multiplied by this
+  // Every lateral coordinate and width multiplied by this (a y axis stretched like a plot's, so
+  // that a 0.3 m stagger shows from above; the head and the wire keep their relation). 1: true.
+  double lateral_scale = 1.0;
   double shape_resolution = 1.0;  // m between line-strip points (0: every node)
   bool include_static = true;     // masts and steady arms (constant parts)
 };
@@ -117,7 +126,11 @@ visualization_msgs::MarkerArray to_strip_chart(const ChartData& d, const ros::Ti
 // contact-force arrows (1 m per 100 N) and a white text label (0.5 m) with the force, per contact
 // wire under the pantograph when the line has several, and the speed. Vertical displacements are
 // exaggerated by vertical_scale about the design geometry, the heads about the design height of
-// the contact wire under them (drawn_head_height).
+// the contact wire under them (drawn_head_height). On a 3-D line everything sits at its lateral
+// position in the track's frame (line frame y, true scale, not exaggerated: on a curve the track
+// is drawn straightened out): the wires' zigzag and blow-off, the head at its sway with the scene's
+// working and horn widths, and a dot where each strip meets the wire (yellow, red off the working
+// width), the force arrow there and the contact point across the strip in the label.
 visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const ros::Time& stamp,
                                            const MarkerOptions& o);
 

@@ -18,6 +18,7 @@
 
 #include "catenary_sim/NodeConfig.h"
 #include "catenary_sim/Step.h"
+#include "catenary_sim/core/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
 #include "catenary_sim/ros/conversions.hpp"
@@ -74,9 +75,10 @@ class SimulationNode {
   NodeParams params_;
   std::unique_ptr<Simulation> sim_;
   std::unique_ptr<PassRecorder> recorder_;
+  std::unique_ptr<LateralRecorder> lateral_recorder_;  // a 3-D line's contact positions, blow-off, dewirements
 
   ros::Publisher contact_pub_, pantograph_pub_, shape_pub_, marker_pub_, clock_pub_, status_pub_, events_pub_,
-      line_state_pub_;
+      line_state_pub_, lateral_pub_;
   ros::Subscriber speed_sub_, uplift_sub_;
   ros::ServiceServer reset_srv_, pause_srv_, step_srv_;
   tf2_ros::TransformBroadcaster tf_;

@@ -107,6 +107,7 @@ struct NodeParams {
                                     //   (at most one per pacing tick: publish_rate bounds it)
   double shape_resolution = 1.0;    // ~shape_resolution: m between wire-shape samples, [0, 100] (0: every node)
   double vertical_scale = 10.0;     // ~vertical_scale: exaggeration of displacements in the markers, [0.1, 10000]
+  double lateral_scale = 1.0;       // ~lateral_scale: stretch of the markers across the track (3-D line), [1, 100]
   std::string line_frame = "line";  // ~line_frame: fixed frame, x along the track, z up
   AtEnd at_end = AtEnd::kStop;      // ~at_end: stop | loop | exit
   std::string stats_file;           // ~stats_file: JSON statistics written at the end (empty: none)
