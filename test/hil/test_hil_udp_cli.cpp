@@ -1,8 +1,8 @@
 // Bad input to the UDP loop's command line and its real-time options: each run (a child process
 // of catenary_sim_hil_udp or udp_rig_client) must fail cleanly (exit 2, no signal, no hang) with
 // an error naming the option, the value and what is allowed; the real-time checks name their
-// option too. The tests run as root here, so "not permitted" is provoked by running the child as
-// the unprivileged user nobody (setpriv, util-linux), without CAP_SYS_NICE.
+// option too. The tests run as root here, so "not permitted" is provoked by running the child
+// without CAP_SYS_NICE and CAP_IPC_LOCK and with an rtprio limit of 0 (setpriv, prlimit: util-linux).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -74,18 +74,21 @@ TEST(HilUdpCli, BadOptionsAreRefusedNamingTheOption) {
 }
 
 TEST(HilUdpCli, RealTimeRefusedWithoutTheRightNamesTheOption) {
-  if (geteuid() != 0 || access("/usr/bin/setpriv", X_OK) != 0) GTEST_SKIP() << "needs root and setpriv";
-  // As nobody without capabilities: SCHED_FIFO and mlockall are refused (the default rtprio and
-  // memlock limits of an unprivileged user are 0 and 8 MiB here), each with the option named.
-  const std::vector<std::string> nobody = {"/usr/bin/setpriv", "--reuid=65534", "--regid=65534", "--clear-groups",
-                                           "--inh-caps=-all", "--"};
+  if (geteuid() != 0 || access("/usr/bin/setpriv", X_OK) != 0 || access("/usr/bin/prlimit", X_OK) != 0)
+    GTEST_SKIP() << "needs root, setpriv and prlimit (util-linux)";
+  // As root without CAP_SYS_NICE and CAP_IPC_LOCK (dropped from the bounding set, so the exec
+  // cannot regain them) and with an rtprio limit of 0: SCHED_FIFO is refused, with the option
+  // named. Not as another user: a build under /root (the fresh-machine check's clone, mode 0700)
+  // cannot even load its libraries as nobody.
+  const std::vector<std::string> without_rights = {"/usr/bin/prlimit", "--rtprio=0:0", "/usr/bin/setpriv",
+                                           "--bounding-set=-sys_nice,-ipc_lock", "--inh-caps=-sys_nice,-ipc_lock", "--"};
   const std::vector<std::string> base = {kSim, "--scene", kHil, "--port", "0", "--duration", "1"};
   auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> a = base;
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
   };
-  expect_refused(with({"--fifo-priority", "50"}), {"--fifo-priority", "50", "not permitted"}, nobody);
+  expect_refused(with({"--fifo-priority", "50"}), {"--fifo-priority", "50", "not permitted"}, without_rights);
 }
 
 TEST(Realtime, ChecksNameTheOptionAndApplyAsRoot) {
