@@ -470,7 +470,7 @@ bool contact_points(const Model& m, State& s, bool record) {
       if (running < 0) lowest_design_height(m, xc, &running);  // not touching: the wire it meets first
       const double yc = running >= 0 ? ls.contact_lateral[ci * nw + running] : std::nan("");
       ls.collector_lateral[ci] = yc;
-      const bool off = std::fabs(yc) > lat.half_working_width;  // false for NaN
+      const bool off = std::fabs(yc) > m.collectors[ci].half_working_width;  // false for NaN
       if (off && !ls.off_strip[ci] && record) {
         left = true;
         ++ls.events_total;

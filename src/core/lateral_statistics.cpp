@@ -84,7 +84,7 @@ LateralStatistics LateralRecorder::statistics(const Model& m, const State& s) co
       sum2 += y * y;
       st.min = std::min(st.min, y);
       st.max = std::max(st.max, y);
-      outside += std::fabs(y) > lat.half_working_width;
+      outside += std::fabs(y) > m.collectors[c].half_working_width;
       if (k > 0 && !std::isnan(lateral_[c][k - 1]) && time_[k] > time_[k - 1]) {
         const double v = std::fabs(y - lateral_[c][k - 1]) / (time_[k] - time_[k - 1]);
         sweep += v;
@@ -150,6 +150,7 @@ std::string lateral_statistics_json(const Model& m, const LateralStatistics& st)
     cj["max_m"] = c.max;
     cj["sweep_speed_mean_mps"] = c.sweep_mean;
     cj["sweep_speed_max_mps"] = c.sweep_max;
+    cj["working_width_m"] = 2.0 * m.collectors[c.collector].half_working_width;
     cj["outside_working_width_percent"] = c.outside_working_percent;
     cj["histogram"] = {{"from_m", c.from}, {"bin_m", c.bin}, {"percent_of_contact_time", c.histogram_percent}};
     contacts.push_back(cj);

@@ -654,6 +654,7 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
     for (const CollectorSpec& c : ps.collectors) {
       p.collectors.push_back(static_cast<int>(m.collectors.size()));
       m.collectors.push_back(Collector{static_cast<int>(i), c.offset, -1, p.moving_force ? -1 : p.first_dof});
+      m.collectors.back().half_working_width = 0.5 * c.working_width.value_or(scene.pantograph_head.working_width);
     }
     // Heads: one DOF each after the chain, on a suspension to the chain's first (top) mass.
     for (std::size_t h = 0; h < ps.heads.size(); ++h) {
@@ -668,6 +669,7 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
         head.collectors.push_back(static_cast<int>(m.collectors.size()));
         p.collectors.push_back(static_cast<int>(m.collectors.size()));
         m.collectors.push_back(Collector{static_cast<int>(i), hs.offset + c.offset, static_cast<int>(h), head.dof});
+        m.collectors.back().half_working_width = 0.5 * c.working_width.value_or(scene.pantograph_head.working_width);
       }
       p.heads.push_back(std::move(head));
     }

@@ -235,11 +235,12 @@ PantographSpec read_pantograph(const YAML::Node& node, const std::string& path, 
       return;
     }
     const YAML::Node cs = r.child("collectors");
-    if (!cs.IsSequence() || cs.size() == 0) fail(r.field("collectors"), "(not a non-empty list)", "a list of {offset: m}");
+    if (!cs.IsSequence() || cs.size() == 0) fail(r.field("collectors"), "(not a non-empty list)", "a list of {offset: m, working_width: m}");
     for (std::size_t i = 0; i < cs.size(); ++i) {
       Reader c(cs[i], r.field("collectors") + "[" + std::to_string(i) + "]");
       CollectorSpec col;
       col.offset = c.number("offset", -5.0, 5.0, 0.0);
+      if (c.has("working_width")) col.working_width = c.number("working_width", 0.0, 5.0, std::nullopt, true);
       c.finish();
       out.push_back(col);
     }
@@ -982,6 +983,19 @@ void validate(const Scene& s) {
              "on the line, [0, " + fmt(line) + "] m");
   }
   if (s.lateral()) {
+    // A strip's own working width lies within the head's horns (pantograph_head.horn_width).
+    auto check_strips = [&](const std::vector<CollectorSpec>& cs, const std::string& field) {
+      for (std::size_t j = 0; j < cs.size(); ++j)
+        if (cs[j].working_width && *cs[j].working_width > s.pantograph_head.horn_width + 1e-12)
+          fail(field + "[" + std::to_string(j) + "].working_width", fmt(*cs[j].working_width),
+               "at most pantograph_head.horn_width = " + fmt(s.pantograph_head.horn_width) + " m");
+    };
+    for (std::size_t i = 0; i < s.pantographs.size(); ++i) {
+      const std::string pf = "pantographs[" + std::to_string(i) + "]";
+      check_strips(s.pantographs[i].collectors, pf + ".collectors");
+      for (std::size_t h = 0; h < s.pantographs[i].heads.size(); ++h)
+        check_strips(s.pantographs[i].heads[h].collectors, pf + ".heads[" + std::to_string(h) + "].collectors");
+    }
     // An endless line repeats its block of spans: a stagger pattern repeats with it (the block
     // moves by whole patterns), a curve placed by station or a list per support does not.
     if (s.endless && s.alignment.any())

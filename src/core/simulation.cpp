@@ -36,7 +36,7 @@ std::string Simulation::status_message() const {
       const DewirementEvent& e = state_.lateral.events.back();
       s << "stopped at t = " << state_.time << " s: dewirement of pantograph " << model_.pantographs[e.pantograph].name
         << " at " << e.station << " m, contact point " << e.lateral << " m across the strip (working width +-"
-        << 0.5 * model_.scene.pantograph_head.working_width << " m; pantograph_head.on_dewirement: stop)";
+        << model_.collectors[e.collector].half_working_width << " m; pantograph_head.on_dewirement: stop)";
       break;
     }
     case StepStatus::kFinished:

@@ -267,7 +267,7 @@ LateralContactArray to_lateral_contact(const Model& m, const State& s, const ros
                                                                                   : std::nan("");
       c.wire_lateral = c.lateral + c.pantograph_lateral;
       c.in_contact = collector_force(m, s, ci) > 0.0;
-      c.on_working_width = std::fabs(c.lateral) <= m.lateral->half_working_width;  // false for NaN
+      c.on_working_width = std::fabs(c.lateral) <= m.collectors[ci].half_working_width;  // false for NaN
       out.contacts.push_back(c);
     }
   }

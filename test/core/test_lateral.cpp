@@ -9,6 +9,7 @@
 #include <numeric>
 
 #include "catenary_sim/core/lateral.hpp"
+#include "catenary_sim/core/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statics.hpp"
 #include "catenary_sim/core/wind.hpp"
@@ -712,4 +713,43 @@ TEST(Lateral, FusedStepIsTheGenericStepBitForBit) {
     }
   }
   EXPECT_GT(steps, 1000);
+}
+
+TEST(Lateral, EachStripHasItsOwnWorkingWidth) {
+  // Two strips 0.6 m apart on one head, stagger +-0.3 m: the contact point runs along the chords
+  // from one stagger to the other. The wide strip (1.2 m: +-0.6 m) never leaves its width; the
+  // narrow one (0.5 m: +-0.25 m) is off it wherever |chord| > 0.25 m, a sixth of every span
+  // (0.05 / 0.3 at each end), and each time it leaves it is a dewirement of that strip alone. The
+  // beam rounds the chord by under 1 mm (StaggerChordsUnderThePantograph): 0.5 % of the span's
+  // share either way, and the exit point within 1 mm plus one step's sideways travel (0.9 m/s x
+  // dt) of 0.25 m.
+  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+                                 {"line.span_count=6", "output.analysis_spans=[1,5]", "stagger.contact_wire=[0.3,-0.3]",
+                                  "pantographs.0.collectors=[{offset: 0.3, working_width: 1.2}, "
+                                  "{offset: -0.3, working_width: 0.5}]"}));
+  const Model& m = sim.model();
+  ASSERT_EQ(m.collectors.size(), 2u);
+  EXPECT_DOUBLE_EQ(m.collectors[0].half_working_width, 0.6);
+  EXPECT_DOUBLE_EQ(m.collectors[1].half_working_width, 0.25);
+  LateralRecorder rec(m);
+  rec.record(m, sim.state());
+  while (sim.step() == StepStatus::kOk) rec.record(m, sim.state());
+  const LateralStatistics st = rec.statistics(m, sim.state());
+  ASSERT_EQ(st.contacts.size(), 2u);
+  EXPECT_EQ(st.contacts[0].outside_working_percent, 0.0);
+  EXPECT_NEAR(st.contacts[1].outside_working_percent, 100.0 / 6.0, 0.5);
+  ASSERT_GE(st.events.size(), 4u);  // one a span at least over the line's 6
+  for (const DewirementEvent& e : st.events) {
+    EXPECT_EQ(e.collector, 1);
+    EXPECT_GT(std::fabs(e.lateral), 0.25);
+    EXPECT_LT(std::fabs(e.lateral), 0.25 + 1e-3 + 0.9 * m.dt);
+  }
+  // A strip wider than the head's horns is refused, naming it.
+  try {
+    load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+                    {"stagger.contact_wire=[0.3,-0.3]", "pantographs.0.collectors=[{offset: 0.0, working_width: 2.5}]"});
+    ADD_FAILURE() << "a strip wider than the horns accepted";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("pantographs[0].collectors[0].working_width"), std::string::npos) << e.what();
+  }
 }

@@ -77,6 +77,7 @@ struct Collector {
   double offset = 0.0;  // m along the track from the pantograph reference point
   int head = -1;        // index into Pantograph::heads; -1: on the chain's first mass
   int dof = -1;         // the mass it presses (eq. 22: k0 (y_dof - y_wire)); -1 for a moving force
+  double half_working_width = 0.0;  // m, half the strip's working width (3-D line: beyond it, a dewirement)
 };
 
 // A head on its own suspension to the top frame mass (HeadSpec).

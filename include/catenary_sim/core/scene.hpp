@@ -54,6 +54,9 @@ struct SupportSpec {
 struct CollectorSpec {
   double offset = 0.0;  // m along the track from the pantograph's reference point (+ = ahead);
                         // on a head: from the head's centre
+  // m across the track that the contact point may use on a 3-D line (leaving it is a
+  // dewirement); unset: pantograph_head.working_width.
+  std::optional<double> working_width;
 };
 
 // A pantograph head: a mass on its own suspension (spring and damper) to the top frame mass,
