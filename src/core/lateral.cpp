@@ -1,3 +1,4 @@
+#include "format.hpp"
 #include "catenary_sim/core/lateral.hpp"
 
 #include <Eigen/SparseCholesky>
@@ -19,12 +20,6 @@ namespace {
 // Share of the turbulent field's sample time between refreshes of the wind on the nodes.
 constexpr double kWindUpdate = 0.1;
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
-}
 
 // Index of the support at station xs in Model::support_x (supports shared by an overlap's two
 // sections are one support along the line).

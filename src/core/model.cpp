@@ -1,3 +1,4 @@
+#include "format.hpp"
 #include "catenary_sim/core/model.hpp"
 
 #include <unistd.h>
@@ -21,12 +22,6 @@
 namespace catenary_sim {
 namespace {
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
-}
 
 // Node stations of one tension section: every support and dropper is a node; the segments
 // between them are split into equal elements no longer than the requested length.

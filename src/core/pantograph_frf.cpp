@@ -1,5 +1,6 @@
 // The pantograph's frequency response at the head: analytic (eq. 9 in the frequency domain) and
 // measured on a simulated rig (stepped sines, the force read from the contact, eq. 22).
+#include "format.hpp"
 #include "catenary_sim/core/pantograph_frf.hpp"
 
 #include <Eigen/Dense>
@@ -16,12 +17,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
-}
 
 // Adds a spring (or damper) of value k between local DOFs a and b (b < 0: the roof).
 void add_link(Eigen::MatrixXd& k, int a, int b, double value) {

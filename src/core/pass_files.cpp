@@ -156,14 +156,35 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
   for (auto& f : files) f->commit();
 }
 
-std::string find_pass_report_script() {
+std::string find_script(const std::string& name) {
   for (const std::string& dir : {std::string(CATENARY_SIM_SOURCE_DIR), std::string(CATENARY_SIM_SHARE_DIR)}) {
     if (dir.empty()) continue;
-    const std::string path = dir + "/scripts/pass_report";
+    const std::string path = dir + "/scripts/" + name;
     struct stat st {};
     if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return path;
   }
   return "";
+}
+
+std::string find_pass_report_script() { return find_script("pass_report"); }
+
+pid_t start_python_script(const std::string& script, const std::vector<std::string>& args, std::string* why) {
+  const char* python = "/usr/bin/python3";
+  if (::access(python, X_OK) != 0) {
+    *why = "/usr/bin/python3 is missing: install python3, python3-numpy and python3-matplotlib (scripts/setup)";
+    return -1;
+  }
+  std::vector<std::string> all{python, script};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, python, nullptr, nullptr, argv.data(), environ) != 0) {
+    *why = "cannot start " + std::string(python);
+    return -1;
+  }
+  return pid;
 }
 
 pid_t start_pass_report(const std::string& dir, const std::string& html, bool quiet, std::string* why) {
@@ -172,26 +193,13 @@ pid_t start_pass_report(const std::string& dir, const std::string& html, bool qu
     *why = "scripts/pass_report not found beside the sources (" CATENARY_SIM_SOURCE_DIR ") or in the share path";
     return -1;
   }
-  const char* python = "/usr/bin/python3";
-  if (::access(python, X_OK) != 0) {
-    *why = "/usr/bin/python3 is missing: install python3, python3-numpy and python3-matplotlib (scripts/setup)";
-    return -1;
-  }
-  std::vector<std::string> args{python, script, dir};
+  std::vector<std::string> args{dir};
   if (!html.empty()) {
     args.push_back("--html");
     args.push_back(html);
   }
   if (quiet) args.push_back("--quiet");
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, python, nullptr, nullptr, argv.data(), environ) != 0) {
-    *why = "cannot start " + std::string(python);
-    return -1;
-  }
-  return pid;
+  return start_python_script(script, args, why);
 }
 
 int pass_report_status(pid_t pid, bool block) {

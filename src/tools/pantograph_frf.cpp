@@ -4,32 +4,19 @@
 // contact, eq. 22), as DIR/frf.csv and a Bode plot DIR/frf.png (scripts/plot_frf).
 //   pantograph_frf SCENE --pantograph NAME --out DIR [--fmin HZ] [--fmax HZ] [--points N] [--dt S]
 #include <CLI/CLI.hpp>
-#include <cerrno>
 #include <cmath>
 #include <iostream>
 #include <memory>
-#include <spawn.h>
 #include <sstream>
 #include <string>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <vector>
 
 #include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/core/pantograph_frf.hpp"
+#include "catenary_sim/core/pass_files.hpp"
 #include "cli_checks.hpp"
 
-extern char** environ;
-
 using namespace catenary_sim;
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR ""
-#endif
-#ifndef CATENARY_SIM_SHARE_DIR
-#define CATENARY_SIM_SHARE_DIR ""
-#endif
 
 namespace {
 
@@ -37,35 +24,13 @@ constexpr double kPi = 3.14159265358979323846;
 
 // Runs /usr/bin/python3 scripts/plot_frf CSV PNG; returns its exit status (or -1, message in *why).
 int run_plot(const std::string& csv, const std::string& png, const std::string& title, std::string* why) {
-  std::string script;
-  for (const std::string& dir : {std::string(CATENARY_SIM_SOURCE_DIR), std::string(CATENARY_SIM_SHARE_DIR)}) {
-    struct stat st;
-    if (!dir.empty() && ::stat((dir + "/scripts/plot_frf").c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
-      script = dir + "/scripts/plot_frf";
-      break;
-    }
-  }
+  const std::string script = find_script("plot_frf");
   if (script.empty()) {
     *why = "scripts/plot_frf not found beside the sources or in the share path";
     return -1;
   }
-  const char* python = "/usr/bin/python3";
-  std::vector<std::string> args{python, script, csv, png, title};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, python, nullptr, nullptr, argv.data(), environ) != 0) {
-    *why = "cannot start /usr/bin/python3 (install python3-matplotlib: scripts/setup)";
-    return -1;
-  }
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) {
-      *why = "waitpid failed";
-      return -1;
-    }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+  const pid_t pid = start_python_script(script, {csv, png, title}, why);
+  return pid < 0 ? -1 : pass_report_status(pid, true);
 }
 
 double deg(std::complex<double> z) { return std::arg(z) * 180.0 / kPi; }

@@ -39,9 +39,14 @@ void write_pass_files(const std::string& dir, const Model& model, const State& s
                       const RunInfo& run, const LateralRecorder* lateral = nullptr,
                       bool stopped_by_dewirement = false);
 
-// scripts/pass_report beside the sources this was built from, or in the installed share path;
-// empty if neither has it.
+// scripts/NAME beside the sources this was built from, or in the installed share path; empty if
+// neither has it.
+std::string find_script(const std::string& name);
 std::string find_pass_report_script();
+
+// Starts /usr/bin/python3 SCRIPT ARGS... with its output going to ours; returns its pid, or -1
+// with the reason in *why. Wait for it with pass_report_status(pid, true).
+pid_t start_python_script(const std::string& script, const std::vector<std::string>& args, std::string* why);
 
 // Starts /usr/bin/python3 scripts/pass_report DIR [--html HTML] [--quiet] with its output going to
 // ours; returns its pid, or -1 with the reason in *why.
