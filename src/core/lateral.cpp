@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <random>
 #include <sstream>
 
 #include "catenary_sim/core/beam.hpp"
 #include "catenary_sim/core/state.hpp"
+#include "normal_errors.hpp"
 #include "wire_lanes.hpp"
 
 namespace catenary_sim {
@@ -228,12 +228,8 @@ std::vector<double> stagger_errors(const Model& m) {
   std::uint64_t z = im.seed + 0x9E3779B97F4A7C15ull;
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  std::mt19937_64 gen(im.stagger_seed ? *im.stagger_seed : z ^ (z >> 31));
-  auto unit = [&] { return (static_cast<double>(gen() >> 11) + 0.5) * 0x1.0p-53; };  // (0, 1)
-  for (double& v : e) {
-    const double u1 = unit(), u2 = unit();
-    v = im.stagger_std * std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);  // Box-Muller
-  }
+  NormalErrors gen(im.stagger_seed ? *im.stagger_seed : z ^ (z >> 31));
+  for (double& v : e) v = gen.next(im.stagger_std);
   return e;
 }
 

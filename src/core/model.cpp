@@ -7,7 +7,6 @@
 #include <cmath>
 #include <numeric>
 #include <limits>
-#include <random>
 #include <sstream>
 
 #include "catenary_sim/core/beam.hpp"
@@ -16,6 +15,7 @@
 #include "catenary_sim/core/stability.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statics.hpp"
+#include "normal_errors.hpp"
 #include "window.hpp"
 #include "wire_lanes.hpp"
 
@@ -377,22 +377,6 @@ std::string speed_warning(const Model& m, double speed) {
 }
 
 namespace {
-
-// Normal errors from one generator, reproducible everywhere: mt19937_64 is fully specified by the
-// standard, and Box-Muller is written out (std::normal_distribution differs between libraries).
-class NormalErrors {
- public:
-  explicit NormalErrors(std::uint64_t seed) : gen_(seed) {}
-  double uniform() { return (static_cast<double>(gen_() >> 11) + 0.5) * 0x1.0p-53; }  // (0, 1)
-  double next(double std_dev) {
-    const double u1 = (static_cast<double>(gen_() >> 11) + 0.5) * 0x1.0p-53;  // (0, 1)
-    const double u2 = (static_cast<double>(gen_() >> 11) + 0.5) * 0x1.0p-53;
-    return std_dev * std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-  }
-
- private:
-  std::mt19937_64 gen_;
-};
 
 // Spectral representation of a random profile (Shinozuka): sum_j a_j cos(k_j x + phi_j) with the
 // one-sided power-law spectrum S(k) ~ k^-n shared among kHarmonics bands equally spaced in log k
