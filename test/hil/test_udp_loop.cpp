@@ -41,63 +41,59 @@ using namespace hil_test;
 
 namespace {
 
-// The loop and the rig period by period without a clock (as test_ros_hil_loop's replay, with the
-// ROS-free frame): the force of period i is the rig's answer to the contact point of step
-// `measurement_step[i]` (null: the last one, no delay).
+// The loop and the rig period by period, with the ROS-free frame the UDP loop sends.
 bool replay(double dt, int k, const std::vector<std::uint64_t>* measurement_step, Series& out, std::string& error) {
-  Simulation sim(scene_with_dt("reference_55m_hil.yaml", dt));
-  const Model& m = sim.model();
-  const int p = external_pantographs(m).at(0);
-  const Scene lumped = load_scene_file(kDir + "/config/reference_55m.yaml");
-  RigPantograph rig(lumped_spec(lumped, m.pantographs[p].name), lumped.contact.stiffness);
   PointFrame frame;
-  compute_frame(m, sim.state(), k, frame);
-  std::vector<WirePoint> wire = wire_points(frame.pantographs[0]);
-  rig.reset(wire, frame.speed);
-  double speed = frame.speed;
-  std::map<std::uint64_t, double> answers{{frame.step, rig.contact_force(wire)}};
-  std::uint64_t rig_step = frame.step;
-  std::string err;
-  for (std::size_t i = 0; !sim.finished(); ++i) {
-    std::uint64_t used = rig_step;
-    if (measurement_step) {
-      if (i >= measurement_step->size()) {
-        error = "the live pass had " + std::to_string(i) + " periods, the replay has more";
-        return false;
-      }
-      used = (*measurement_step)[i];
-    }
-    const auto a = answers.find(used);
-    if (a == answers.end()) {
-      error = "period " + std::to_string(i) + " used the answer to step " + std::to_string(used) +
-              ", which is not a contact point sent before it";
-      return false;
-    }
-    sim.set_external_force(p, a->second, &err);
-    sim.set_external_force(p, std::clamp(sim.state().external_force[p], 0.0, Simulation::kMaxExternalForce), &err);
-    for (int j = 0; j < k && !sim.finished(); ++j)
-      if (sim.step() != StepStatus::kOk) {
-        error = "the replay diverged: " + sim.status_message();
-        return false;
-      }
-    compute_frame(m, sim.state(), k, frame);
-    out.step.push_back(frame.step);
-    out.x.push_back(frame.pantographs[0].position);
-    out.f.push_back(frame.pantographs[0].applied_force);
-    for (std::uint64_t s = rig_step; s < frame.step; ++s)
-      rig.step(dt, rig.contact_force(wire, static_cast<double>(s - rig_step) * dt), speed);
-    rig_step = frame.step;
-    wire = wire_points(frame.pantographs[0]);
-    speed = frame.speed;
-    answers[rig_step] = rig.contact_force(wire);
-  }
-  return true;
+  return hil_test::replay(dt, k, measurement_step, out, error, [&frame](const Model& m, const State& s, int steps) {
+    compute_frame(m, s, steps, frame);
+    return Observed{frame.step, frame.speed, frame.pantographs[0].position, frame.pantographs[0].applied_force,
+                    wire_points(frame.pantographs[0])};
+  });
 }
 
 std::string summary_text(const char* what, const ForceStatistics& s) {
   char b[128];
   std::snprintf(b, sizeof b, "%s mean %.3f N std %.3f N", what, s.mean, s.std_dev);
   return b;
+}
+
+// The UDP loop of config/reference_55m_hil.yaml on a loopback port of its own, running in a thread
+// until stop() (or the end of the test), and a rig socket to talk to it.
+struct RunningUdpLoop {
+  explicit RunningUdpLoop(const LoopOptions& lo)
+      : loop(scene_with_dt("reference_55m_hil.yaml", 0.0), lo), skin(loop, loopback()) {
+    skin.set_running([this] { return !done.load(); });
+    skin.set_log([](LogLevel, const std::string&) {});
+    to = udp_address("127.0.0.1", skin.port(), "simulator");
+    runner = std::thread([this] { loop.run(); });
+  }
+  ~RunningUdpLoop() { stop(); }
+  void stop() {
+    done = true;
+    if (runner.joinable()) runner.join();
+  }
+  static UdpLoopOptions loopback() {
+    UdpLoopOptions uo;
+    uo.bind_address = "127.0.0.1";
+    uo.port = 0;
+    return uo;
+  }
+  HilLoop loop;
+  UdpLoopSkin skin;
+  std::atomic<bool> done{false};
+  UdpSocket rig{"127.0.0.1", 0, "rig"};
+  sockaddr_in to{};
+  std::thread runner;
+};
+
+// A measurement packet of one pantograph (a negative force: none, the rig's hello).
+csim_udp_measurement measurement(std::uint32_t seq, double f) {
+  csim_udp_measurement m;
+  std::memset(&m, 0, sizeof m);
+  udp::fill_header(m.header, CSIM_UDP_KIND_MEASUREMENT, CSIM_UDP_MEASUREMENT_SIZE, seq, monotonic_ns());
+  m.pantographs = f < 0.0 ? 0 : 1;
+  m.force[0] = f;
+  return m;
 }
 
 }  // namespace
@@ -238,28 +234,11 @@ TEST(UdpLoop, BadLostReorderedAndDuplicatedPacketsAreCountedAndChangeNothing) {
   lo.rate = 1000.0;
   lo.timeout = 5.0;
   lo.who = "test_udp_loop";
-  HilLoop loop(scene_with_dt("reference_55m_hil.yaml", 0.0), lo);
-  UdpLoopOptions uo;
-  uo.bind_address = "127.0.0.1";
-  uo.port = 0;
-  UdpLoopSkin skin(loop, uo);
-  std::atomic<bool> done{false};
-  skin.set_running([&] { return !done.load(); });
-  skin.set_log([](LogLevel, const std::string&) {});
-  std::thread runner([&] { loop.run(); });
-
-  UdpSocket rig("127.0.0.1", 0, "rig");
-  const sockaddr_in to = udp_address("127.0.0.1", skin.port(), "simulator");
-  auto measurement = [](std::uint32_t seq, double f) {
-    csim_udp_measurement m;
-    std::memset(&m, 0, sizeof m);
-    udp::fill_header(m.header, CSIM_UDP_KIND_MEASUREMENT, CSIM_UDP_MEASUREMENT_SIZE, seq, monotonic_ns());
-    m.pantographs = f < 0.0 ? 0 : 1;
-    m.force[0] = f;
-    return m;
-  };
+  RunningUdpLoop run(lo);
+  HilLoop& loop = run.loop;
+  UdpLoopSkin& skin = run.skin;
   auto send = [&](const csim_udp_measurement& m, std::size_t size = sizeof(csim_udp_measurement)) {
-    ASSERT_TRUE(rig.send(&m, size, to));
+    ASSERT_TRUE(run.rig.send(&m, size, run.to));
     std::this_thread::sleep_for(std::chrono::milliseconds(30));  // (one at a time through the loop)
   };
   send(measurement(1, -1.0));   // hello
@@ -270,8 +249,7 @@ TEST(UdpLoop, BadLostReorderedAndDuplicatedPacketsAreCountedAndChangeNothing) {
   send(measurement(5, std::nan("")));
   send(measurement(6, 150.0), 40);  // short
   send(measurement(7, 5000.0));     // out of range (the loop's check, shared with ROS)
-  done = true;
-  runner.join();
+  run.stop();
   const auto& seq = skin.sequence();
   EXPECT_EQ(seq.duplicates(), 1u);
   EXPECT_EQ(seq.reordered(), 1u);
@@ -297,23 +275,11 @@ TEST(UdpLoop, ARigThatFallsSilentPutsTheLineIntoTheSafeHold) {
   lo.timeout = 0.1;
   lo.hold_ramp = 0.1;
   lo.who = "test_udp_loop";
-  HilLoop loop(scene_with_dt("reference_55m_hil.yaml", 0.0), lo);
-  UdpLoopOptions uo;
-  uo.bind_address = "127.0.0.1";
-  uo.port = 0;
-  UdpLoopSkin skin(loop, uo);
-  std::atomic<bool> done{false};
-  skin.set_running([&] { return !done.load(); });
-  skin.set_log([](LogLevel, const std::string&) {});
-  std::thread runner([&] { loop.run(); });
-  UdpSocket rig("127.0.0.1", 0, "rig");
-  const sockaddr_in to = udp_address("127.0.0.1", skin.port(), "simulator");
-  csim_udp_measurement m;
-  std::memset(&m, 0, sizeof m);
-  udp::fill_header(m.header, CSIM_UDP_KIND_MEASUREMENT, CSIM_UDP_MEASUREMENT_SIZE, 1, monotonic_ns());
-  m.pantographs = 1;
-  m.force[0] = 120.0;
-  ASSERT_TRUE(rig.send(&m, sizeof m, to));
+  RunningUdpLoop run(lo);
+  HilLoop& loop = run.loop;
+  UdpSocket& rig = run.rig;
+  const csim_udp_measurement m = measurement(1, 120.0);
+  ASSERT_TRUE(rig.send(&m, sizeof m, run.to));
   // Then silent. Read the contact points until one says SAFE_HOLD (at most 10 s: the timeout is
   // 0.1 s), then for 0.3 s more: they keep coming, finite (decoded), all in the hold.
   alignas(8) std::uint8_t buf[2048];
@@ -337,8 +303,7 @@ TEST(UdpLoop, ARigThatFallsSilentPutsTheLineIntoTheSafeHold) {
     }
     if (holding) (hold ? in_hold : not_hold_after)++;
   }
-  done = true;
-  runner.join();
+  run.stop();
   ASSERT_TRUE(holding) << "no SAFE_HOLD contact point within 10 s of silence";
   EXPECT_GE(in_hold, 10u);  // (one a period: about 300 in 0.3 s; 10 tolerates a loaded machine)
   EXPECT_EQ(not_hold_after, 0u);

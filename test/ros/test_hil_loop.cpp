@@ -26,7 +26,6 @@
 // the summary property.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -34,7 +33,6 @@
 #include <cstdio>
 #include <map>
 #include <mutex>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -44,13 +42,11 @@
 #include "catenary_sim/core/statistics.hpp"
 #include "catenary_sim/ros/hil.hpp"
 #include "catenary_sim/ros/virtual_rig.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../hil/hil_test_support.hpp"
 
 using namespace catenary_sim;
 using namespace catenary_sim::ros_layer;
+using namespace hil_test;
 
 namespace {
 
@@ -70,91 +66,14 @@ void on_measurement(const MeasuredContactForce::ConstPtr& m) {
   measurement_frames.push_back(m->header.frame_id);
 }
 
-const std::string kDir = CATENARY_SIM_SOURCE_DIR;
-
-Scene scene_with_dt(const std::string& file, double dt) {
-  YAML::Node root = YAML::LoadFile(kDir + "/config/" + file);
-  root["numerics"]["dt"] = dt;
-  std::stringstream yaml;
-  yaml << root;
-  return load_scene_string(yaml.str());
-}
-
-// The contact point of each period: step, position and applied force of the first pantograph.
-struct Series {
-  std::vector<std::uint64_t> step;
-  std::vector<double> x, f;
-};
-
-// The loop of catenary_sim_hil_node (config/reference_55m_hil.yaml, `dt`, `k` steps a period, the
-// newest measurement held) and virtual_rig (the lumped pantograph of the same name in
-// config/reference_55m.yaml, stepped up to each contact point against the previous one's wire
-// extrapolated along its path velocity, answering with its contact force), period by period
-// without a clock. The force of period i is the rig's answer to the contact point of step
-// `measurement_step[i]` (null: to the last one, no delay). Returns false with `error` set when a
-// period names a step that was not published before it.
+// The loop replayed offline (hil_test_support.hpp) with the contact points as the node publishes them.
 bool replay(double dt, int k, const std::vector<std::uint64_t>* measurement_step, Series& out, std::string& error) {
-  Simulation sim(scene_with_dt("reference_55m_hil.yaml", dt));
-  const Model& m = sim.model();
-  const std::vector<int> external = external_pantographs(m);
-  if (external.size() != 1) {
-    error = "reference_55m_hil.yaml has " + std::to_string(external.size()) + " external pantographs, 1 expected";
-    return false;
-  }
-  const int p = external[0];
-  const Scene lumped = load_scene_file(kDir + "/config/reference_55m.yaml");
-  const PantographSpec* spec = nullptr;
-  for (const PantographSpec& ps : lumped.pantographs)
-    if (ps.name == m.pantographs[p].name) spec = &ps;
-  if (!spec) {
-    error = "no pantograph '" + m.pantographs[p].name + "' in reference_55m.yaml";
-    return false;
-  }
-  RigPantograph rig(*spec, lumped.contact.stiffness);
   std::vector<ContactPointMotion> scratch;
-  ContactPointArray msg = to_contact_points(m, sim.state(), ros::Time(1), "line", k, scratch);
-  std::vector<WirePoint> wire = wire_points(msg.pantographs[0]);
-  rig.reset(wire, msg.speed);
-  double speed = msg.speed;
-  std::map<std::uint64_t, double> answers{{msg.step, rig.contact_force(wire)}};
-  std::uint64_t rig_step = msg.step;
-  std::string err;
-  for (std::size_t i = 0; !sim.finished(); ++i) {
-    std::uint64_t used = rig_step;
-    if (measurement_step) {
-      if (i >= measurement_step->size()) {
-        error = "the live pass had " + std::to_string(i) + " periods, the replay has more";
-        return false;
-      }
-      used = (*measurement_step)[i];
-    }
-    const auto a = answers.find(used);
-    if (a == answers.end()) {
-      error = "period " + std::to_string(i) + " used the answer to step " + std::to_string(used) +
-              ", which is not a contact point published before it (last: " + std::to_string(rig_step) + ")";
-      return false;
-    }
-    // As the node: the measurement goes through the core's check, is held and clamped.
-    sim.set_external_force(p, a->second, &err);
-    sim.set_external_force(p, std::clamp(sim.state().external_force[p], 0.0, Simulation::kMaxExternalForce), &err);
-    for (int j = 0; j < k && !sim.finished(); ++j)
-      if (sim.step() != StepStatus::kOk) {
-        error = "the replay diverged: " + sim.status_message();
-        return false;
-      }
-    msg = to_contact_points(m, sim.state(), ros::Time(1), "line", k, scratch);
-    out.step.push_back(msg.step);
-    out.x.push_back(msg.pantographs[0].position);
-    out.f.push_back(msg.pantographs[0].applied_force);
-    // As virtual_rig::on_point, then send().
-    for (std::uint64_t s = rig_step; s < msg.step; ++s)
-      rig.step(dt, rig.contact_force(wire, static_cast<double>(s - rig_step) * dt), speed);
-    rig_step = msg.step;
-    wire = wire_points(msg.pantographs[0]);
-    speed = msg.speed;
-    answers[rig_step] = rig.contact_force(wire);
-  }
-  return true;
+  return hil_test::replay(dt, k, measurement_step, out, error, [&scratch](const Model& m, const State& s, int steps) {
+    const ContactPointArray msg = to_contact_points(m, s, ros::Time(1), "line", steps, scratch);
+    return Observed{msg.step, msg.speed, msg.pantographs[0].position, msg.pantographs[0].applied_force,
+                    wire_points(msg.pantographs[0])};
+  });
 }
 
 }  // namespace
@@ -238,23 +157,10 @@ TEST(HilLoop, LiveLoopIsItsOwnReplayAndWithoutDelayTheInternalPantograph) {
   // 2. Without the delay the loop is the internal pantograph.
   ASSERT_TRUE(replay(dt, k, nullptr, prompt, error)) << error;
   Simulation internal(scene_with_dt("reference_55m.yaml", dt));
-  const Model& m = internal.model();
   ASSERT_NEAR(internal.state().speed, run.back()->speed, 1e-9);
-  Series in;
-  while (!internal.finished()) {
-    for (int j = 0; j < k; ++j) internal.step();
-    in.x.push_back(pantograph_position(m, internal.state(), 0));
-    in.f.push_back(total_contact_force(m, internal.state(), 0));
-  }
-  const double x0 = m.support_x[m.scene.analysis_first()], x1 = m.support_x[m.scene.analysis_last()];
-  auto stats = [&](const Series& s) {
-    const std::vector<double> filtered = lowpass_zero_phase(s.f, rate, m.scene.output.filter_cutoff);
-    std::vector<double> sec;
-    for (std::size_t i = 0; i < s.f.size(); ++i)
-      if (s.x[i] >= x0 && s.x[i] <= x1) sec.push_back(filtered[i]);
-    return force_statistics(sec);
-  };
-  const ForceStatistics sl = stats(live), sp = stats(prompt), si = stats(in);
+  const Model& m = internal.model();
+  auto stats = [&](const Series& s) { return section_stats(m, s, rate); };
+  const ForceStatistics sl = stats(live), sp = stats(prompt), si = stats(internal_series(dt, k));
   // test_hil.cpp, ClosedLoop.DelayOfOneOrTwoPeriodsChangesTheStatisticsLittle (1 kHz) and
   // WithoutDelayTheLoopIsTheInternalPantograph (2 kHz: equal but for round-off).
   EXPECT_NEAR(sp.mean, si.mean, 0.1);

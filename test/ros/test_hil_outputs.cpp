@@ -23,10 +23,13 @@
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/WireShapeArray.h"
 #include "catenary_sim/ros/hil.hpp"
+#include "ros_test_support.hpp"
 
 using namespace catenary_sim;
 
 namespace {
+
+bool wait_for(const std::function<bool()>& cond, double timeout_s) { return ros_test::wait_for(cond, timeout_s, 0.005); }
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kWireHeight = 5.3;  // m, contact_wire_height of the reference line
@@ -68,15 +71,6 @@ void send(double fz, double tx = 0.0) {
   value.force.x = 3.0;  // (ignored: only force.z is the contact force)
   value.force.z = fz;
   value.torque.x = tx;
-}
-
-bool wait_for(const std::function<bool()>& cond, double timeout_s) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (cond()) return true;
-    ros::WallDuration(0.005).sleep();
-  }
-  return cond();
 }
 
 ContactPointArray last_point() {

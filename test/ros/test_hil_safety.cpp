@@ -20,10 +20,13 @@
 #include "catenary_sim/ContactPointArray.h"
 #include "catenary_sim/MeasuredContactForce.h"
 #include "catenary_sim/ros/hil.hpp"
+#include "ros_test_support.hpp"
 
 using namespace catenary_sim;
 
 namespace {
+
+bool wait_for(const std::function<bool()>& cond, double timeout_s) { return ros_test::wait_for(cond, timeout_s, 0.005); }
 
 constexpr double kStatic = 100.0;  // N, static_uplift of reference_55m_hil.yaml
 
@@ -60,15 +63,6 @@ void rig_thread() {
 void send(std::vector<double> v) {
   std::lock_guard<std::mutex> l(values_mu);
   values = std::move(v);
-}
-
-bool wait_for(const std::function<bool()>& cond, double timeout_s) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (cond()) return true;
-    ros::WallDuration(0.005).sleep();
-  }
-  return cond();
 }
 
 ContactPointArray last_point() {

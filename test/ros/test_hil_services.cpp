@@ -30,10 +30,13 @@
 #include "catenary_sim/ContactPointArray.h"
 #include "catenary_sim/MeasuredContactForce.h"
 #include "catenary_sim/ros/hil.hpp"
+#include "ros_test_support.hpp"
 
 using namespace catenary_sim;
 
 namespace {
+
+bool wait_for(const std::function<bool()>& cond, double timeout_s) { return ros_test::wait_for(cond, timeout_s, 0.005); }
 
 constexpr double kForce = 120.0;     // N, what the rig measures (static uplift 100 N)
 
@@ -55,15 +58,6 @@ void rig_thread() {
     m.force = {kForce};
     pub.publish(m);
   }
-}
-
-bool wait_for(const std::function<bool()>& cond, double timeout_s) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (cond()) return true;
-    ros::WallDuration(0.005).sleep();
-  }
-  return cond();
 }
 
 ContactPointArray point() {

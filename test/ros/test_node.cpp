@@ -22,45 +22,14 @@
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/Step.h"
 #include "catenary_sim/WireShapeArray.h"
+#include "ros_test_support.hpp"
 
 using namespace catenary_sim;
 
+using ros_test::Recorder;
+using ros_test::wait_for;
+
 namespace {
-
-// Collects the messages of one topic.
-template <class M>
-struct Recorder {
-  explicit Recorder(const std::string& topic) {
-    sub = ros::NodeHandle().subscribe<M>(topic, 100, [this](const typename M::ConstPtr& m) {
-      std::lock_guard<std::mutex> l(mu);
-      msgs.push_back(*m);
-    });
-  }
-  std::vector<M> take() {
-    std::lock_guard<std::mutex> l(mu);
-    return msgs;
-  }
-  void clear() {
-    std::lock_guard<std::mutex> l(mu);
-    msgs.clear();
-  }
-  std::size_t size() {
-    std::lock_guard<std::mutex> l(mu);
-    return msgs.size();
-  }
-  ros::Subscriber sub;
-  std::mutex mu;
-  std::vector<M> msgs;
-};
-
-bool wait_for(const std::function<bool()>& cond, double timeout_s) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (cond()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return cond();
-}
 
 PantographStateArray latest_state(Recorder<PantographStateArray>& r) {
   r.clear();

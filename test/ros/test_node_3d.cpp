@@ -12,40 +12,14 @@
 
 #include "catenary_sim/LateralContactArray.h"
 #include "catenary_sim/WireShapeArray.h"
+#include "ros_test_support.hpp"
 
 using namespace catenary_sim;
 
+using ros_test::Recorder;
+using ros_test::wait_for;
+
 namespace {
-
-template <class M>
-struct Recorder {
-  explicit Recorder(const std::string& topic) {
-    sub = ros::NodeHandle().subscribe<M>(topic, 1000, [this](const typename M::ConstPtr& m) {
-      std::lock_guard<std::mutex> l(mu);
-      msgs.push_back(*m);
-    });
-  }
-  std::vector<M> take() {
-    std::lock_guard<std::mutex> l(mu);
-    return msgs;
-  }
-  std::size_t size() {
-    std::lock_guard<std::mutex> l(mu);
-    return msgs.size();
-  }
-  ros::Subscriber sub;
-  std::mutex mu;
-  std::vector<M> msgs;
-};
-
-bool wait_for(const std::function<bool()>& cond, double timeout_s) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (cond()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return cond();
-}
 
 double interpolate(const std::vector<double>& xs, const std::vector<double>& ys, double x) {
   const std::size_t k = std::upper_bound(xs.begin(), xs.end(), x) - xs.begin();
@@ -62,9 +36,9 @@ constexpr double kSpan = 55.0, kStagger = 0.3;
 // The contact point across the strip, stamped in simulated time, sweeping the zigzag; the same
 // position as the wire's shape at the collector's station.
 TEST(Node3d, PublishesTheLateralContactPositionAndA3dWireShape) {
-  Recorder<LateralContactArray> lateral("lateral_contact");
-  Recorder<WireShapeArray> shape("wire_shape");
-  Recorder<visualization_msgs::MarkerArray> markers("markers");
+  Recorder<LateralContactArray> lateral("lateral_contact", 1000);
+  Recorder<WireShapeArray> shape("wire_shape", 1000);
+  Recorder<visualization_msgs::MarkerArray> markers("markers", 1000);
   // A span at 300 km/h is 0.66 s simulated, 1.3 s wall at real_time_factor 0.5: 4 s sees three.
   ASSERT_TRUE(wait_for([&] { return lateral.size() > 0 && shape.size() > 0 && markers.size() > 0; }, 60.0));
   ros::WallDuration(4.0).sleep();

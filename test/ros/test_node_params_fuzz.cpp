@@ -106,6 +106,26 @@ class NodeParamsFuzz : public ::testing::Test {
     return c.wait(limit);
   }
 
+  // The node `name` runs a short pass (`source_scene` cut to six spans of 0.5 m elements, written
+  // into `out`) at full speed with ~report_file `out`/pass_report.html, and exits at its end.
+  ChildRun report_pass(const std::string& source_scene, const std::string& out, const std::string& name) {
+    mkdir(out.c_str(), 0755);
+    std::string text = slurp(source_scene);  // the node takes no --set
+    const auto set = [&](const std::string& from, const std::string& to) {
+      const std::size_t at = text.find(from);
+      EXPECT_NE(at, std::string::npos) << from;
+      if (at != std::string::npos) text.replace(at, from.size(), to);
+    };
+    set("span_count: 10", "span_count: 6");
+    set("preset: accurate", "preset: accurate\n  element_length: 0.5");
+    const std::string scene = out + "/short.yaml";
+    std::ofstream(scene) << text;
+    return Child({kNode, "__name:=" + name, "_scene:=" + scene, "_speed_kmh:=250", "_real_time_factor:=0",
+                  "_at_end:=exit", "_publish_clock:=false", "_report_file:=" + out + "/pass_report.html"},
+                 dir_ + "/" + name + ".log", env_)
+        .wait(300.0);
+  }
+
   static std::string dir_;
   static int port_;
   static std::vector<std::string> env_;
@@ -321,22 +341,8 @@ TEST_F(NodeParamsFuzz, StatsFileThatFailsAtTheEndFailsTheExitCode) {
 // A short pass (six spans, 0.5 m elements) at full speed; the page's checks are test_pass_report's.
 TEST_F(NodeParamsFuzz, ReportFileIsWrittenAtTheEndOfThePass) {
   const std::string out = dir_ + "/report";
-  mkdir(out.c_str(), 0755);
-  const std::string scene = out + "/short.yaml";
-  std::string text = slurp(kScene);  // the reference scene, shortened (the node takes no --set)
-  const auto set = [&](const std::string& from, const std::string& to) {
-    const std::size_t at = text.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    text.replace(at, from.size(), to);
-  };
-  set("span_count: 10", "span_count: 6");
-  set("preset: accurate", "preset: accurate\n  element_length: 0.5");
-  std::ofstream(scene) << text;
+  const ChildRun r = report_pass(kScene, out, "reporting");
   const std::string html = out + "/pass_report.html";
-  const ChildRun r = Child({kNode, "__name:=reporting", "_scene:=" + scene, "_speed_kmh:=250", "_real_time_factor:=0",
-                            "_at_end:=exit", "_publish_clock:=false", "_report_file:=" + html},
-                           dir_ + "/reporting.log", env_)
-                         .wait(300.0);
   ASSERT_FALSE(r.hung) << r.out;
   EXPECT_EQ(r.signal, 0);
   ASSERT_EQ(r.exit_code, 0) << r.out;
@@ -366,22 +372,7 @@ TEST_F(NodeParamsFuzz, ReportFileIsWrittenAtTheEndOfThePass) {
 // and stats.json its "lateral" object (the contact point across the strip, blow-off per span).
 TEST_F(NodeParamsFuzz, ReportFileOfA3dLineHasTheLateralFiles) {
   const std::string out = dir_ + "/report3d";
-  mkdir(out.c_str(), 0755);
-  const std::string scene = out + "/short.yaml";
-  std::string text = slurp(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml");
-  const auto set = [&](const std::string& from, const std::string& to) {
-    const std::size_t at = text.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    text.replace(at, from.size(), to);
-  };
-  set("span_count: 10", "span_count: 6");
-  set("preset: accurate", "preset: accurate\n  element_length: 0.5");
-  std::ofstream(scene) << text;
-  const std::string html = out + "/pass_report.html";
-  const ChildRun r = Child({kNode, "__name:=reporting3d", "_scene:=" + scene, "_speed_kmh:=250", "_real_time_factor:=0",
-                            "_at_end:=exit", "_publish_clock:=false", "_report_file:=" + html},
-                           dir_ + "/reporting3d.log", env_)
-                         .wait(300.0);
+  const ChildRun r = report_pass(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml", out, "reporting3d");
   ASSERT_FALSE(r.hung) << r.out;
   EXPECT_EQ(r.signal, 0);
   ASSERT_EQ(r.exit_code, 0) << r.out;

@@ -23,6 +23,7 @@
 
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/WireShapeArray.h"
+#include "ros_test_support.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."
@@ -33,21 +34,14 @@
 
 namespace {
 
+bool wait_for(const std::function<bool()>& cond, double timeout_s) { return ros_test::wait_for(cond, timeout_s, 0.1); }
+
 std::mutex mu;
 std::vector<visualization_msgs::MarkerArray> received;
 
 void on_markers(const visualization_msgs::MarkerArray::ConstPtr& m) {
   std::lock_guard<std::mutex> l(mu);
   received.push_back(*m);
-}
-
-bool wait_for(const std::function<bool()>& cond, double seconds) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (cond()) return true;
-    ros::WallDuration(0.1).sleep();
-  }
-  return cond();
 }
 
 std::string sh(const std::string& cmd) { return "bash -c '" + cmd + "'"; }
