@@ -28,13 +28,11 @@ everything started here is stopped on exit. Build first: SKIP_SETUP=1 scripts/bu
 (CATENARY_SIM_WS=DIR: a catkin workspace other than .ws/).
 """
 import argparse
-import atexit
 import json
 import os
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
@@ -151,14 +149,7 @@ def main():
         if not os.access(os.path.join(LIB, exe), os.R_OK):
             sys.exit(f"bench_hil_latency: {LIB}/{exe} missing: run SKIP_SETUP=1 scripts/build first")
 
-    atexit.register(bn.cleanup)
-    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
-        signal.signal(s, bn.on_signal)
-    bn._tmp = tempfile.mkdtemp(prefix="bench_hil_")
-    port = bn.free_port()
-    env = bn.ros_env(bn._tmp, port)
-    bn.start_roscore(env, port, bn._tmp)
-    bn.log(f"roscore on localhost:{port}, logs in {bn._tmp}")
+    env = bn.private_roscore("bench_hil_")
 
     results = []
     for rate, duration in zip(rates, durations):

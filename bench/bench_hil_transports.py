@@ -19,13 +19,11 @@ Uses bench_hil_latency.py's run_rate for the two ROS transports (a private rosco
 port); everything started here is stopped on exit. Build first: SKIP_SETUP=1 scripts/build.
 """
 import argparse
-import atexit
 import json
 import os
 import signal
 import subprocess
 import sys
-import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
 import bench_hil_latency as hl  # noqa: E402
@@ -79,10 +77,6 @@ def timer_jitter(rate, seconds):
     return out
 
 
-def us(x):
-    return f"{1e6 * x:.0f}" if x is not None else "-"
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rates", default="1000,5000,10000", help="Hz, comma separated")
@@ -92,14 +86,7 @@ def main():
     for exe in ("catenary_sim_hil_udp", "udp_rig_client", "catenary_sim_hil_node", "virtual_rig", "bench_timer_jitter"):
         if not os.access(os.path.join(LIB, exe), os.X_OK):
             sys.exit(f"bench_hil_transports: {LIB}/{exe} missing: run SKIP_SETUP=1 scripts/build first")
-    atexit.register(bn.cleanup)
-    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
-        signal.signal(s, bn.on_signal)
-    bn._tmp = tempfile.mkdtemp(prefix="bench_hil_transports_")
-    port = bn.free_port()
-    env = bn.ros_env(bn._tmp, port)
-    bn.start_roscore(env, port, bn._tmp)
-    bn.log(f"roscore on localhost:{port}, logs in {bn._tmp}")
+    env = bn.private_roscore("bench_hil_transports_")
     rows = []
     for rate in rates:
         for transport in ("udp", "tcpros", "inprocess"):
@@ -124,8 +111,8 @@ def main():
         held = n["periods_held"] / n["periods"] if n["periods"] else float("nan")
         p99[(rate, transport)] = lat["p99_s"]
         print(f"| {rate:g} Hz | {transport} | {n['periods']} | {n['overruns']} | {100 * held:.2f} % | "
-              f"{us(lat['p50_s'])} / {us(lat['p99_s'])} / {us(lat['max_s'])} | "
-              f"{us(jit.get('p99_s'))} / {us(jit.get('max_s'))} | {r['load']} |")
+              f"{hl.us(lat['p50_s'])} / {hl.us(lat['p99_s'])} / {hl.us(lat['max_s'])} | "
+              f"{hl.us(jit.get('p99_s'))} / {hl.us(jit.get('max_s'))} | {r['load']} |")
     print()
     for rate in rates:
         u, t, i = (p99.get((rate, k)) for k in ("udp", "tcpros", "inprocess"))

@@ -149,6 +149,21 @@ def start_roscore(env, port, tmp, timeout=30.0):
     raise RuntimeError(f"roscore on port {port} not up within {timeout:.0f} s")
 
 
+def private_roscore(prefix):
+    """A roscore on a free loopback port, its logs in a new temporary directory, stopped (with
+    every process started here) at exit or on a signal. Returns the environment to run nodes in."""
+    global _tmp
+    atexit.register(cleanup)
+    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(s, on_signal)
+    _tmp = tempfile.mkdtemp(prefix=prefix)
+    port = free_port()
+    env = ros_env(_tmp, port)
+    start_roscore(env, port, _tmp)
+    log(f"roscore on localhost:{port}, logs in {_tmp}")
+    return env
+
+
 def run(cmd, env, timeout, logname):
     with open(logname, "w") as f:
         try:
@@ -185,7 +200,6 @@ def node(args, env, tmp, label, rtf, timeout):
 
 
 def main():
-    global _tmp
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scene", default=os.path.join(ROOT, "config", "reference_55m.yaml"))
     ap.add_argument("--speed", type=float, default=300.0, help="km/h")
@@ -199,14 +213,7 @@ def main():
         if not os.access(os.path.join(LIB, exe), os.X_OK):
             sys.exit(f"bench_node: {LIB}/{exe} missing: run SKIP_SETUP=1 scripts/build first")
 
-    atexit.register(cleanup)
-    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
-        signal.signal(s, on_signal)
-    _tmp = tempfile.mkdtemp(prefix="bench_node_")
-    port = free_port()
-    env = ros_env(_tmp, port)
-    start_roscore(env, port, _tmp)
-    log(f"roscore on localhost:{port}, logs in {_tmp}")
+    env = private_roscore("bench_node_")
 
     off, fast = [], []
     for i in range(args.reps):
