@@ -464,10 +464,10 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
     const bool several = !pg.heads.empty();
     const double half_width = 0.5 * m.scene.pantograph_head.working_width;
     const double horn = std::max(0.05, 0.5 * (m.scene.pantograph_head.horn_width - m.scene.pantograph_head.working_width));
-    Marker strips = marker(h, "pantograph_strips", id, Marker::CUBE_LIST);
-    strips.scale.x = 0.035;  // strip width along the track
-    strips.scale.y = 2.0 * half_width;
-    strips.scale.z = 0.03;
+    // Each strip a segment across the track over its own working width (strips of one head may
+    // differ: collectors[].working_width), drawn as thick as a strip is wide along the track.
+    Marker strips = marker(h, "pantograph_strips", id, Marker::LINE_LIST);
+    strips.scale.x = 0.035;
     strips.color = contact ? color(0.05f, 0.05f, 0.05f) : color(1.0f, 0.1f, 0.1f);
     Marker horns = marker(h, "pantograph_horns", id, Marker::LINE_LIST);
     horns.scale.x = 0.03;
@@ -507,8 +507,11 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
       out.markers.push_back(head);
       if (point_force) continue;
       for (int ci : pg.collectors)
-        if (!several || m.collectors[ci].head == hd)
-          strips.points.push_back(point(x + m.collectors[ci].offset, yh, zh - 0.015));
+        if (!several || m.collectors[ci].head == hd) {
+          const double hw = m.collectors[ci].half_working_width > 0.0 ? m.collectors[ci].half_working_width : half_width;
+          strips.points.push_back(point(x + m.collectors[ci].offset, yh - hw, zh - 0.015));
+          strips.points.push_back(point(x + m.collectors[ci].offset, yh + hw, zh - 0.015));
+        }
       for (double side : {-1.0, 1.0}) {  // from the strip's end out and down: a quarter arc in 4 pieces
         double py = yh + side * half_width, pz = zh - 0.03;
         for (int i = 1; i <= 4; ++i) {

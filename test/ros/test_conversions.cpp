@@ -290,7 +290,10 @@ TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
   const auto* horns = find_marker(arr, "pantograph_horns", 0);
   const auto* links = find_marker(arr, "pantograph_suspension", 0);
   ASSERT_TRUE(wire && strips && horns && links);
-  ASSERT_EQ(strips->points.size(), 2u);
+  // One segment across the track per strip, over its working width.
+  ASSERT_EQ(strips->points.size(), 4u);
+  EXPECT_EQ(strips->type, visualization_msgs::Marker::LINE_LIST);
+  EXPECT_NEAR(strips->points[1].y - strips->points[0].y, m.scene.pantograph_head.working_width, 1e-12);
   // Two heads x two sides x a quarter arc of 4 segments, 2 points each.
   EXPECT_EQ(horns->points.size(), 32u);
   EXPECT_EQ(links->points.size(), 4u);
@@ -301,14 +304,14 @@ TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
     ASSERT_TRUE(head) << "head " << h;
     EXPECT_NEAR(head->pose.position.x, xh, 1e-9);
     EXPECT_NEAR(head->scale.x, 0.3, 1e-12);  // the head's length
-    const auto& strip = strips->points[h];
+    const auto& strip = strips->points[2 * h];  // (its segment's first end)
     EXPECT_NEAR(strip.x, xh, 1e-9);
     // Its strip's top on the wire over it, k x that strip's contact-spring compression above.
     double f = 0.0;
     for (int ci : pg.heads[h].collectors)
       for (std::size_t w = 0; w < nw; ++w) f += s.contact_force[ci * nw + w];
     ASSERT_GT(f, 0.0);
-    const double top = strip.z + 0.5 * strips->scale.z;
+    const double top = strip.z + 0.015;  // (a strip 30 mm high, drawn along its centre line)
     EXPECT_NEAR(top - strip_z(*wire, xh), k * f / m.contact_stiffness, 0.02) << "head " << h;
     EXPECT_NEAR(top, drawn_head_height(m, s, 0, h, k), 1e-12);
     // Its horns at its own station, reaching the scene's horn width.
@@ -321,6 +324,28 @@ TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
 
 // In the overlap of calpe_example the collectors are under both contact wires: the head is drawn
 // on the lower one and the label gives the force on each.
+TEST(Markers, EachStripIsDrawnOverItsOwnWorkingWidth) {
+  // Two strips of one head with working widths of 1.2 m and 0.5 m (collectors[].working_width):
+  // each drawn across the track over its own width, centred on the head, at its own offset.
+  Simulation sim(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m.yaml",
+                                 {"stagger.contact_wire=[0.3,-0.3]", "pantographs.0.collectors=[{offset: 0.3, "
+                                  "working_width: 1.2}, {offset: -0.3, working_width: 0.5}]"}));
+  const Model& m = sim.model();
+  const auto arr = to_markers(m, sim.state(), ros::Time(1.0), MarkerOptions());
+  const auto* strips = find_marker(arr, "pantograph_strips", 0);
+  ASSERT_TRUE(strips);
+  ASSERT_EQ(strips->points.size(), 4u);
+  const double x = pantograph_position(m, sim.state(), 0);
+  const double widths[2] = {1.2, 0.5}, offsets[2] = {0.3, -0.3};
+  for (int c = 0; c < 2; ++c) {
+    const geometry_msgs::Point &a = strips->points[2 * c], &b = strips->points[2 * c + 1];
+    EXPECT_NEAR(b.y - a.y, widths[c], 1e-12) << "strip " << c;
+    EXPECT_NEAR(0.5 * (a.y + b.y), sim.state().lateral.pantograph_lateral[0], 1e-12) << "strip " << c;
+    EXPECT_NEAR(a.x, x + offsets[c], 1e-9) << "strip " << c;
+    EXPECT_EQ(a.x, b.x);
+  }
+}
+
 TEST(Markers, OverlapLabelGivesTheForcePerContactWire) {
   Simulation sim(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/calpe_example.yaml"));
   const Model& m = sim.model();
@@ -619,8 +644,8 @@ TEST(Markers, ThreeDimensionalLineIsDrawnAcrossTheTrackAndStretchedAlike) {
       EXPECT_NEAR(y.scale.y, 7.0 * x.scale.y, 1e-12);
       dot = true;
     }
-    if (x.ns == "pantograph_strips") {
-      EXPECT_NEAR(x.points[0].y, s.lateral.pantograph_lateral[0], 1e-12);
+    if (x.ns == "pantograph_strips") {  // centred on the pantograph (its sway)
+      EXPECT_NEAR(0.5 * (x.points[0].y + x.points[1].y), s.lateral.pantograph_lateral[0], 1e-12);
     }
     if (x.ns == "wires" && x.id == 0) {
       // At the supports (rigid registration in plan here: springs of 2e5 N/m, within a few mm).
