@@ -7,6 +7,7 @@
 namespace catenary_sim {
 
 double AlignmentSpec::curvature(double x) const {
+  if (radius != 0.0) return 1.0 / radius;
   for (const CurveSpec& c : curves) {
     const double s = x - c.start;
     if (s < 0.0 || s > c.length) continue;
@@ -21,7 +22,9 @@ double AlignmentSpec::curvature(double x) const {
 }
 
 double AlignmentSpec::heading(double x) const {
-  // Integral of the curvature from 0 to x (trapezoids are exact on the linear pieces).
+  // Integral of the curvature from 0 to x (trapezoids are exact on the linear pieces); an
+  // endless line on one radius keeps its heading (AlignmentSpec::radius).
+  if (radius != 0.0) return 0.0;
   double psi = 0.0;
   for (const CurveSpec& c : curves) {
     if (x <= c.start) break;

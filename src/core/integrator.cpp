@@ -22,11 +22,10 @@ namespace {
 // penetration while compressive (eq. 22, 25), spread on the wire with the same weights.
 // Writes state.contact_force and state.collector_height; adds the forces to f unless f is null.
 void contact_forces(const Model& m, State& s, const double* u, double* f) {
-  const double v2 = s.speed * s.speed;
   const std::size_t nw = m.contact_wires.size();
   for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
     const Pantograph& p = m.pantographs[pi];
-    const double uplift = s.uplift[pi] + p.aero_coefficient * v2;
+    const double uplift = s.uplift[pi] + p.aero_coefficient * air_speed_squared(s, pi);
     const double x_ref = s.front - p.position;
     for (int ci : p.collectors) {
       const Collector& col = m.collectors[ci];
@@ -123,6 +122,7 @@ State make_state(const Model& m) {
   s.uplift.resize(m.pantographs.size());
   for (std::size_t i = 0; i < m.pantographs.size(); ++i) s.uplift[i] = m.pantographs[i].static_uplift;
   s.external_force = s.uplift;
+  s.head_wind.assign(m.pantographs.size(), 0.0);
   s.front = m.train_start;
   s.line_offset = m.initial_line_offset;
   s.speed = s.target_speed = m.scene.train_speed;
@@ -205,7 +205,11 @@ double head_height(const Model& m, const State& s, int p, int head) {
 double head_aero_uplift(const Model& m, const State& s, int p, int head) {
   const Pantograph& pg = m.pantographs[p];
   if (pg.moving_force || pg.heads.empty()) return 0.0;
-  return pg.heads[head].aero_coefficient * s.speed * s.speed;
+  return pg.heads[head].aero_coefficient * air_speed_squared(s, p);
+}
+
+double frame_aero_uplift(const Model& m, const State& s, int p) {
+  return m.pantographs[p].aero_coefficient * air_speed_squared(s, p);
 }
 
 double total_contact_force(const Model& m, const State& s, int p) {
@@ -279,9 +283,9 @@ void add_wire_point_forces(const Model& m, State& s, const double* u, const doub
 // Pantographs: lumped chains (eq. 9), uplift on the lowest mass; then the contact.
 void add_pantograph_forces(const Model& m, State& s, const double* u, const double* v, double* f) {
   for (int i = m.n_catenary_dof; i < m.n_dof; ++i) f[i] = 0.0;
-  const double v2 = s.speed * s.speed;
   for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
     const Pantograph& p = m.pantographs[pi];
+    const double v2 = air_speed_squared(s, pi);
     const double uplift = s.uplift[pi] + p.aero_coefficient * v2;
     if (!p.moving_force) {
       const int nm = p.masses_count(), a0 = p.first_dof;

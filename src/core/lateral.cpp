@@ -402,6 +402,25 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   return lat;
 }
 
+void update_head_wind(const Model& m, State& s, const double* field_points) {
+  const LateralModel& lat = *m.lateral;
+  if (!lat.windy) return;
+  const double phi = m.scene.wind->direction * M_PI / 180.0;
+  const WindField& fd = lat.field;
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    const double x = s.front - m.pantographs[p].position + s.line_offset;  // station along the line
+    double along_wind = lat.wind_speed;  // the along-wind speed U + u' (wind.hpp)
+    if (field_points && !fd.empty()) {
+      const double q = (x - fd.x0) / fd.dx;
+      const int j = std::clamp(static_cast<int>(std::floor(q)), 0, fd.points - 2);
+      const double a = std::clamp(q - j, 0.0, 1.0);
+      along_wind += (1.0 - a) * field_points[j] + a * field_points[j + 1];
+    }
+    // Its component along the track, against the direction of travel (+x).
+    s.head_wind[p] = -along_wind * std::cos(phi - m.scene.alignment.heading(x));
+  }
+}
+
 LateralState make_lateral_state(const Model& m) {
   const LateralModel& lat = *m.lateral;
   LateralState s;
@@ -658,6 +677,7 @@ StepStatus lateral_step(const Model& m, State& s) {
       return s.status;
     }
   }
+  update_head_wind(m, s, ls.wind_points.data());
   const bool left = contact_points(m, s, true);
   if (left && m.scene.pantograph_head.on_dewirement == DewirementAction::kStop) {
     ls.dewired_stop = true;

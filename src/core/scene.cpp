@@ -560,8 +560,17 @@ void read_lateral_parts(Reader& top, Scene& s) {
   }
   if (top.has("alignment")) {
     Reader r(top.child("alignment"), "alignment");
-    const YAML::Node cs = r.child("curves");
-    if (!cs || !cs.IsSequence()) fail("alignment.curves", "(missing or not a list)", "a list of {start, length, radius[, transition]}");
+    if (r.has("radius")) {
+      // The whole line on one radius: what an endless line can repeat (every span alike).
+      if (r.has("curves"))
+        fail("alignment.radius", "(given with alignment.curves)", "one of the two: curves placed by station, or radius for the whole line");
+      s.alignment.radius = r.number("radius", -1e6, 1e6);
+      if (std::fabs(s.alignment.radius) < 100.0)
+        fail("alignment.radius", fmt(s.alignment.radius), "|radius| of at least 100 m (+ to the left, - to the right)");
+    }
+    const YAML::Node cs = r.has("radius") ? YAML::Node(YAML::NodeType::Sequence) : r.child("curves");
+    if (!cs || !cs.IsSequence())
+      fail("alignment.curves", "(missing or not a list)", "a list of {start, length, radius[, transition]}, or alignment.radius");
     for (std::size_t i = 0; i < cs.size(); ++i) {
       Reader q(cs[i], "alignment.curves[" + std::to_string(i) + "]");
       CurveSpec c;
@@ -909,6 +918,11 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   }
   read_lateral_parts(top, s);
   top.finish();
+  // On a finite line one radius is one curve over the whole line (heading from station 0).
+  if (!s.endless && s.alignment.radius != 0.0) {
+    s.alignment.curves = {CurveSpec{0.0, s.line_length(), s.alignment.radius, 0.0}};
+    s.alignment.radius = 0.0;
+  }
   validate(s);
   return s;
 }
@@ -997,10 +1011,11 @@ void validate(const Scene& s) {
         check_strips(s.pantographs[i].heads[h].collectors, pf + ".heads[" + std::to_string(h) + "].collectors");
     }
     // An endless line repeats its block of spans: a stagger pattern repeats with it (the block
-    // moves by whole patterns), a curve placed by station or a list per support does not.
-    if (s.endless && s.alignment.any())
+    // moves by whole patterns), and so does one radius for the whole line; a curve placed by
+    // station or a list per support does not.
+    if (s.endless && !s.alignment.curves.empty())
       fail("alignment.curves", "(given with line.endless: true)",
-           "a finite line: curves are placed by station and the endless line repeats one straight span");
+           "a finite line: curves are placed by station; an endless line takes alignment.radius (every span on one curve)");
     if (s.endless && s.stagger && s.stagger->per_support)
       fail("stagger.per_support", "true (with line.endless: true)",
            "false on an endless line: give the stagger as a pattern repeated over the supports");

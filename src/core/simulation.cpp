@@ -10,6 +10,14 @@ namespace catenary_sim {
 
 Simulation::Simulation(const Scene& scene) : model_(build_model(scene)) {
   initial_ = make_state(model_);
+  if (model_.lateral && !model_.lateral->field.empty()) {
+    // The pass starts in the wind of t = 0: the pantograph's aerodynamic uplift too.
+    std::vector<double> points(static_cast<std::size_t>(model_.lateral->field.points));
+    model_.lateral->field.at_time(0.0, points.data());
+    update_head_wind(model_, initial_, points.data());
+  } else if (model_.lateral) {
+    update_head_wind(model_, initial_, nullptr);
+  }
   solve_initial_state(model_, initial_);
   observe(model_, initial_);
   if (model_.lateral) {

@@ -120,7 +120,7 @@ void solve_initial_state(const Model& m, State& st, bool roof_springs) {
     }
     for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
       const Pantograph& p = m.pantographs[pi];
-      const double uplift = st.uplift[pi] + p.aero_coefficient * st.speed * st.speed;
+      const double uplift = st.uplift[pi] + p.aero_coefficient * air_speed_squared(st, pi);
       if (!p.moving_force) {
         for (int i = 0; i < p.masses_count(); ++i) {
           const bool roof = i + 1 == p.masses_count();
@@ -131,7 +131,7 @@ void solve_initial_state(const Model& m, State& st, bool roof_springs) {
         // Heads on their suspensions, with their own aerodynamic uplift.
         for (const Head& h : p.heads) {
           add_spring(t, r, h.dof, p.first_dof, h.stiffness, h.preload);
-          r[h.dof] += h.aero_coefficient * st.speed * st.speed;
+          r[h.dof] += h.aero_coefficient * air_speed_squared(st, pi);
         }
       }
       for (std::size_t cj = 0; cj < p.collectors.size(); ++cj) {

@@ -180,7 +180,7 @@ void PassRecorder::record(const Model& m, const State& s) {
       if (pg.heads.empty()) {
         const double stretch = (nm > 1 ? s.u[a0 + 1] : 0.0) - s.u[a0];
         double fe = pg.spring_preload[0] + pg.stiffness[0] * stretch;
-        if (nm == 1) fe += s.uplift[p] + pg.aero_coefficient * s.speed * s.speed;
+        if (nm == 1) fe += s.uplift[p] + pg.aero_coefficient * air_speed_squared(s, p);
         head_u_[p].push_back(s.u[a0]);
         suspension_stretch_[p].push_back(stretch);
         suspension_force_[p].push_back(fe);
@@ -191,7 +191,7 @@ void PassRecorder::record(const Model& m, const State& s) {
           const double stretch = s.u[a0] - s.u[h.dof];
           head_u_[p].push_back(s.u[h.dof]);
           suspension_stretch_[p].push_back(stretch);
-          suspension_force_[p].push_back(h.preload + h.stiffness * stretch + h.aero_coefficient * s.speed * s.speed);
+          suspension_force_[p].push_back(h.preload + h.stiffness * stretch + h.aero_coefficient * air_speed_squared(s, p));
         }
       }
     }

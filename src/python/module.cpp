@@ -215,6 +215,8 @@ PYBIND11_MODULE(_core, m) {
         d["contact_force_N"] = total_contact_force(m, st, i);
         d["head_height_m"] = head_height(m, st, i);
         d["uplift_N"] = st.uplift[i];
+        d["aero_uplift_N"] = frame_aero_uplift(m, st, i);  // on the frame, at the speed through the air
+        d["head_wind_m_s"] = st.head_wind[i];               // the wind against the direction of travel
         // Every head (several on their own suspensions; a chain's first mass; none for a moving
         // force): its height, the force on its strips and its own aero uplift.
         const Pantograph& pg = m.pantographs[i];

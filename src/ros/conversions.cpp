@@ -213,7 +213,7 @@ PantographStateArray to_pantograph_state(const Model& m, const State& s, const r
       }
     }
     ps.uplift = p < s.uplift.size() ? s.uplift[p] : 0.0;
-    ps.aero_uplift = pg.aero_coefficient * s.speed * s.speed;
+    ps.aero_uplift = frame_aero_uplift(m, s, static_cast<int>(p));
     ps.head_count = head_count(m, static_cast<int>(p));
     for (int hd = 0; hd < ps.head_count; ++hd) {
       ps.head_heights.push_back(head_height(m, s, static_cast<int>(p), hd));

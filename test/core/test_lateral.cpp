@@ -406,6 +406,13 @@ TEST(Lateral, BadInputNamesTheField) {
                 .find("stagger.contact_wire"),
             std::string::npos);
   EXPECT_EQ(endless_error({"stagger.contact_wire=[0.2,-0.2]", "wind.speed=15"}), "(no error)");
+  // One radius for the whole line: the endless line's curve; not both, not a tight one.
+  EXPECT_EQ(endless_error({"alignment.radius=-1200"}), "(no error)");
+  const std::string both = endless_error({"alignment={radius: 1000, curves: []}"});
+  EXPECT_NE(both.find("alignment.radius"), std::string::npos) << both;
+  const std::string tight = endless_error({"alignment.radius=50"});
+  EXPECT_NE(tight.find("alignment.radius"), std::string::npos) << tight;
+  EXPECT_NE(tight.find("100 m"), std::string::npos) << tight;
 }
 
 namespace {
@@ -475,6 +482,69 @@ TEST(Lateral, EndlessLineGivesTheFiniteLinesContactPoint) {
   EXPECT_LT(worst, kSameContactPoint);
   // The vertical results are untouched by the block's larger moves: the same contact force.
   EXPECT_NEAR(total_contact_force(a.model(), a.state(), 0), total_contact_force(b.model(), b.state(), 0), 1e-3);
+}
+
+TEST(Lateral, EndlessLineOnOneRadiusHasTheCurvesPullOff) {
+  // The endless reference line all on a left curve of R = 1000 m, both wires staggered +-0.3 m
+  // alike (the droppers hang plumb, so each wire is its own chord polygon). As in
+  // CurvePullOffIsTensionTimesTheAngleBetweenChords: each wire pulls on a support with
+  // T [2 (s_next - s) / L + L / R], T times the angle between its chords; 1 % for the bending.
+  const double L = 55.0, R = 1000.0;
+  const Model m = build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml",
+                                              {"alignment.radius=1000", "stagger.contact_wire=[0.3,-0.3]",
+                                               "stagger.messenger=[0.3,-0.3]"}));
+  ASSERT_TRUE(m.endless);
+  ASSERT_TRUE(m.lateral);
+  const double x0 = m.support_x.front(), x1 = m.support_x.back();
+  int checked = 0;
+  for (const LateralSupport& sp : m.lateral->supports) {
+    // The block's far supports sit next to its ends, where the block is cut: two spans in.
+    if (sp.anchor || sp.x < x0 + 2 * L - 1e-6 || sp.x > x1 - 2 * L + 1e-6) continue;
+    const double T = m.wires[sp.wire].spec.tension, s = sp.stagger;
+    const double expected = T * (2.0 * (-s - s) / L + L / R);
+    EXPECT_NEAR(sp.pull_off, expected, 0.01 * std::fabs(expected)) << "wire " << sp.wire << ", support at " << sp.x;
+    ++checked;
+  }
+  EXPECT_GE(checked, 4);
+}
+
+TEST(Lateral, EndlessLineOnOneRadiusGivesTheFiniteLinesContactPoint) {
+  // As EndlessLineGivesTheFiniteLinesContactPoint, now all on a right curve of R = 1500 m (the
+  // finite line: one curve over its whole length), without wind (on the endless line the wind
+  // keeps its angle to the track; on the finite one it would turn with the track).
+  const std::vector<std::string> pass = {"train.start=1650", "train.end=2750", "numerics.preset=balanced",
+                                         "stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]",
+                                         "stagger.steady_arm_stiffness=2.0e5", "alignment.radius=-1500",
+                                         "pantograph_head.sway.amplitude=0.03", "pantograph_head.sway.frequency=0.8"};
+  std::vector<std::string> finite = pass;
+  finite.insert(finite.end(), {"line.span_count=60", "numerics.window=auto"});
+  Simulation a(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml", pass)),
+      b(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", finite));
+  ASSERT_TRUE(a.model().endless);
+  ASSERT_EQ(b.model().scene.alignment.curves.size(), 1u);
+  int compared = 0;
+  const double worst = worst_lateral_difference(a, b, &compared);
+  EXPECT_GT(a.state().line_offset - a.model().initial_line_offset, 15 * 55.0);
+  EXPECT_GT(compared, 5000);
+  // The block's ends reflect the lateral waves the pantograph sends ahead, where the finite line
+  // lets them run on: 2 mm, 1/10 of the wear histogram's 2 cm bin, still 100x below a block out of
+  // step with the stagger (0.6 m) or a curve lost on the way (the versine, 0.25 m).
+  EXPECT_LT(worst, 2.0 * kSameContactPoint);
+  // And the curve is there: the chords lie inside the arc, so mid-span the contact point is
+  // L^2 / (8 R) = 0.25 m off the straight line's (checked on the model's static state).
+  std::vector<std::string> straight_pass = pass;
+  straight_pass.erase(std::find(straight_pass.begin(), straight_pass.end(), "alignment.radius=-1500"));
+  const Model straight =
+      build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml", straight_pass));
+  const Model& curved = a.model();
+  const Wire& w = curved.lateral->wires[0];
+  ASSERT_TRUE(w.is_contact_wire);
+  double largest = 0.0;
+  for (int i = 0; i < w.nodes(); ++i)
+    largest = std::max(largest, std::fabs(curved.lateral->calm[w.w_dof + i] - straight.lateral->calm[w.w_dof + i]));
+  // Less the tensioned beam's rounding at the supports and the droppers' pull toward the messenger
+  // (also curved): 10 %.
+  EXPECT_NEAR(largest, 55.0 * 55.0 / (8.0 * 1500.0), 0.1 * 55.0 * 55.0 / (8.0 * 1500.0));
 }
 
 TEST(Lateral, TurbulentWindOnTheEndlessLineFollowsTheStations) {
@@ -752,4 +822,62 @@ TEST(Lateral, EachStripHasItsOwnWorkingWidth) {
   } catch (const SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("pantographs[0].collectors[0].working_width"), std::string::npos) << e.what();
   }
+}
+
+TEST(Lateral, HeadWindAddsToThePantographsAerodynamicUplift) {
+  // The aerodynamic uplift a v^2 (EN 50206-1's still-air coefficient) takes the pantograph's speed
+  // through the air: v + the wind's component against the direction of travel. A steady 15 m/s
+  // wind from ahead (direction 180 deg: blowing toward -x), from behind (0 deg) and across (90 deg)
+  // at 300 km/h, a = 0.01 N s^2/m^2 (70 N at 300 km/h in still air).
+  const double a = 0.01, v = 300.0 / 3.6, U = 15.0;
+  auto scene = [&](const std::string& direction) {
+    return load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+                           {"line.span_count=6", "output.analysis_spans=[1,5]", "pantographs.0.aero_coefficient=0.01",
+                            "wind.speed=15", "wind.direction=" + direction});
+  };
+  for (const auto& [direction, head] : std::vector<std::pair<std::string, double>>{{"180", U}, {"0", -U}, {"90", 0.0}}) {
+    Simulation sim(scene(direction));
+    EXPECT_NEAR(sim.state().head_wind[0], head, 1e-12) << direction;
+    EXPECT_NEAR(frame_aero_uplift(sim.model(), sim.state(), 0), a * (v + head) * (v + head), 1e-9) << direction;
+    sim.step();
+    EXPECT_NEAR(frame_aero_uplift(sim.model(), sim.state(), 0), a * (v + head) * (v + head), 1e-9) << direction;
+  }
+  // And the pantograph feels it: momentum of the lumped chain over the pass (eq. 9 summed over
+  // its masses; the springs and dampers between them cancel), step by step as the explicit scheme
+  // takes it (eq. 20): sum m_i (v_i,N - v_i,0) = dt sum_n [C + F_aero - k_roof u_n - c_roof v_n - F_c,n],
+  // C the static uplift, the roof spring's preload and the weights. The same pass in still air
+  // and with the head wind: the difference gives the aerodynamic uplift the pantograph received,
+  // which must be a ((v + U)^2 - v^2) = 27.3 N; what is left is the round-off of sums over 20000
+  // steps (1e-9 relative), checked at 1e-6 N.
+  auto received = [&](const std::string& direction, double* impulse_per_step, long* steps) {
+    Simulation sim(direction.empty() ? load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+                                                       {"line.span_count=6", "output.analysis_spans=[1,5]",
+                                                        "pantographs.0.aero_coefficient=0.01", "stagger.contact_wire=[0.0]"})
+                                     : scene(direction));
+    const Model& m = sim.model();
+    const Pantograph& p = m.pantographs[0];
+    const int nm = p.masses_count(), low = p.first_dof + nm - 1;
+    auto momentum = [&] {
+      double q = 0.0;
+      for (int i = 0; i < nm; ++i) q += p.masses[i] * sim.state().v[p.first_dof + i];
+      return q;
+    };
+    const double q0 = momentum();
+    double sum = 0.0;
+    *steps = 0;
+    while (!sim.finished()) {
+      const State& st = sim.state();
+      sum += p.stiffness[nm - 1] * st.u[low] + p.damping[nm - 1] * st.v[low] + total_contact_force(m, st, 0);
+      ASSERT_EQ(sim.step(), StepStatus::kOk);
+      ++*steps;
+    }
+    // per step: F_aero + C = (momentum change) / dt / N + mean of the rest
+    *impulse_per_step = (momentum() - q0) / m.dt / static_cast<double>(*steps) + sum / static_cast<double>(*steps);
+  };
+  double calm = 0.0, windy = 0.0;
+  long n_calm = 0, n_windy = 0;
+  received("", &calm, &n_calm);
+  received("180", &windy, &n_windy);
+  ASSERT_EQ(n_calm, n_windy);
+  EXPECT_NEAR(windy - calm, a * ((v + U) * (v + U) - v * v), 1e-6);
 }

@@ -121,6 +121,20 @@ def test_pantograph_state_gives_every_head():
     assert one["head_aero_uplift_N"] == [0.0]
 
 
+def test_a_head_wind_adds_to_the_aerodynamic_uplift():
+    # a v^2 is a still-air coefficient: a 15 m/s wind from ahead (direction 180 deg) makes the
+    # pantograph's speed through the air v + 15 m/s (test_lateral: the momentum balance).
+    sim = cs.Simulation(REFERENCE, overrides=["pantographs.0.aero_coefficient=0.01", "wind.speed=15",
+                                              "wind.direction=180"])
+    sim.step(10)
+    st = sim.pantograph_state(0)
+    v = 300.0 / 3.6
+    assert st["head_wind_m_s"] == pytest.approx(15.0, abs=1e-12)
+    assert st["aero_uplift_N"] == pytest.approx(0.01 * (v + 15.0) ** 2, rel=1e-12)
+    calm = cs.Simulation(REFERENCE, overrides=["pantographs.0.aero_coefficient=0.01"]).pantograph_state(0)
+    assert calm["head_wind_m_s"] == 0.0 and calm["aero_uplift_N"] == pytest.approx(0.01 * v * v, rel=1e-12)
+
+
 def test_a_pass_from_python_equals_simulate_pass():
     # The module adds no physics: the same scene gives the same statistics, bit for bit, as the
     # offline runner (the same core and the same fixed dt; only the skin differs).

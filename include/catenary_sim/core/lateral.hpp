@@ -130,6 +130,10 @@ struct LateralState {
 };
 
 LateralState make_lateral_state(const Model& model);
+// State::head_wind of every pantograph: the wind's component against the direction of travel at
+// its station, from the mean wind and `field_points` (the turbulent field at one time, WindField
+// ::at_time; null: the mean wind alone). The lateral step calls it with its latest refresh.
+void update_head_wind(const Model& model, State& state, const double* field_points);
 // Contact point positions of the current state (no step).
 void lateral_observe(const Model& model, State& state);
 // One lateral step of the model's dt (its substeps), after the vertical step moved the state to

@@ -283,7 +283,11 @@ struct CurveSpec {
 };
 struct AlignmentSpec {
   std::vector<CurveSpec> curves;  // in order of station, not overlapping
-  bool any() const { return !curves.empty(); }
+  // m, an endless line on one curve (0: none; a finite line's becomes one curve over the line).
+  // The endless line has no station 0 to turn from: there the track's heading is taken as 0
+  // everywhere, so the wind keeps its direction to the track (a steady cross wind on the curve).
+  double radius = 0.0;
+  bool any() const { return !curves.empty() || radius != 0.0; }
   double curvature(double x) const;  // 1/m at station x
   double heading(double x) const;    // rad, track direction at x relative to its direction at station 0
 };

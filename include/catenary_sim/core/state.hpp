@@ -46,6 +46,10 @@ struct State {
   double max_acceleration = 0.0;  // m/s^2, |dv/dt| limit toward target_speed (0: jump)
   std::vector<double> uplift;     // N, static uplift in effect per pantograph (eq. 9 thrust F)
   std::vector<double> external_force;  // N, force of an external (hardware-in-the-loop) pantograph
+  // m/s per pantograph, the wind against the direction of travel at the pantograph (3-D line with
+  // wind: mean plus turbulence, set by the lateral step; else 0). The aerodynamic uplift a v^2 is
+  // measured in still air: with wind it takes the speed through the air, v + head wind.
+  std::vector<double> head_wind;
 
   // q of eq. 21 as displacements from the design state, and q_dot_{n-1/2} (eq. 20, 26); with the
   // implicit integrator v is the velocity at the state's time.
@@ -135,9 +139,17 @@ double head_height(const Model& model, const State& state, int pantograph);
 int head_count(const Model& model, int pantograph);
 // Absolute height (m) of one head, 0 <= head < head_count; NaN for a moving force.
 double head_height(const Model& model, const State& state, int pantograph, int head);
-// The head's own aerodynamic uplift at the state's speed (N): a_h v^2 for the knee direction; 0
-// for a chain without `heads` (its aero acts on the frame) and for a moving force.
+// The pantograph's speed through the air, squared (m^2/s^2): (v + head wind)^2, the v^2 of every
+// aerodynamic uplift a v^2.
+inline double air_speed_squared(const State& state, std::size_t pantograph) {
+  const double v = state.speed + state.head_wind[pantograph];
+  return v * v;
+}
+// The head's own aerodynamic uplift at the state's air speed (N): a_h v^2 for the knee direction;
+// 0 for a chain without `heads` (its aero acts on the frame) and for a moving force.
 double head_aero_uplift(const Model& model, const State& state, int pantograph, int head);
+// The aerodynamic uplift on the frame (N): a v^2 for the knee direction, at the state's air speed.
+double frame_aero_uplift(const Model& model, const State& state, int pantograph);
 // Position of a pantograph's reference point along the line (m).
 double pantograph_position(const Model& model, const State& state, int pantograph);
 // Sum of the contact forces of one pantograph over its collectors and the contact wires (N).
