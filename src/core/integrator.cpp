@@ -238,24 +238,41 @@ void advance_train(const Model& m, State& s, double dt) {
   contact_forces(m, s, s.u.data(), nullptr);
 }
 
-template <class ForceAt, class ZAt>
+// A 3-D line whose state has its lateral plane (make_state alone gives none: the vertical plane
+// then steps alone, as before the lateral plane acted on it).
+bool leaning(const Model& m, const State& s) { return m.lateral && !s.lateral.dropper_stretch.empty(); }
+
+// kLean (a 3-D line, Model::lateral): every dropper's stretch has its lean's share too, averaged
+// over the last lateral step (LateralState::dropper_stretch, lateral.hpp). It is added to the
+// elastic stretch of u + beta v undamped: the lean's Rayleigh share beta k dy dy'/l is second
+// order in the lateral motion, and the vertical step then reads no lateral velocity. The 2-D
+// line (kLean false) does exactly the work it did before.
+template <bool kLean, class ForceAt, class ZAt>
 void add_wire_point_forces(const Model& m, State& s, const double* u, const double* v, ForceAt f, ZAt z,
                            bool given_slack) {
+  const double* lean = kLean ? s.lateral.dropper_stretch.data() : nullptr;
   auto dropper = [&](std::size_t k) {
     // Droppers work only in tension; the switch is decided on the elastic stretch.
     const Dropper& d = m.droppers[k];
+    auto z_stretch = [&] {
+      double e = z(d.messenger_dof) - z(d.contact_dof);
+      if constexpr (kLean) e += lean[k];
+      return e;
+    };
     if (given_slack) {
+      // (The implicit scheme: the lean enters lagged, as an explicit force.)
       if (s.dropper_slack[k]) return;
-      const double t = d.static_tension + d.stiffness * (z(d.messenger_dof) - z(d.contact_dof));
+      const double t = d.static_tension + d.stiffness * z_stretch();
       f(d.contact_dof) += t;
       f(d.messenger_dof) -= t;
       return;
     }
-    const double stretch = u[d.messenger_dof] - u[d.contact_dof];
+    double stretch = u[d.messenger_dof] - u[d.contact_dof];
+    if constexpr (kLean) stretch += lean[k];
     const bool taut = d.static_tension + d.stiffness * stretch > 0.0;
     s.dropper_slack[k] = !taut;
     if (!taut) return;
-    const double t = std::max(0.0, d.static_tension + d.stiffness * (z(d.messenger_dof) - z(d.contact_dof)));
+    const double t = std::max(0.0, d.static_tension + d.stiffness * z_stretch());
     f(d.contact_dof) += t;
     f(d.messenger_dof) -= t;
   };
@@ -317,8 +334,10 @@ void add_pantograph_forces(const Model& m, State& s, const double* u, const doub
 // matrix, so that the force and the corrected matrix describe the same active set.
 void add_point_forces(const Model& m, State& s, const double* u, const double* v, const double* z, double* f,
                       bool given_slack) {
-  add_wire_point_forces(
-      m, s, u, v, [f](int i) -> double& { return f[i]; }, [z](int i) { return z[i]; }, given_slack);
+  auto force_at = [f](int i) -> double& { return f[i]; };
+  auto z_at = [z](int i) { return z[i]; };
+  if (leaning(m, s)) add_wire_point_forces<true>(m, s, u, v, force_at, z_at, given_slack);
+  else add_wire_point_forces<false>(m, s, u, v, force_at, z_at, given_slack);
   add_pantograph_forces(m, s, u, v, f);
 }
 
@@ -461,9 +480,10 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
   double* rec = s.sweep.data();
   const int* f_at = m.dof_sweep_force.data();
   const int* z_at = m.dof_sweep_z.data();
-  add_wire_point_forces(
-      m, s, u, v, [rec, f_at](int i) -> double& { return rec[f_at[i]]; }, [rec, z_at](int i) { return rec[z_at[i]]; },
-      false);
+  auto force_at = [rec, f_at](int i) -> double& { return rec[f_at[i]]; };
+  auto z_rec = [rec, z_at](int i) { return rec[z_at[i]]; };
+  if (leaning(m, s)) add_wire_point_forces<true>(m, s, u, v, force_at, z_rec, false);
+  else add_wire_point_forces<false>(m, s, u, v, force_at, z_rec, false);
   for (int q = 0; q < contacts; ++q) f[contact_node[q]] = rec[f_at[contact_node[q]]];
   add_pantograph_forces(m, s, u, v, f);
   const double* im = m.inv_mass.data();
@@ -759,9 +779,11 @@ StepStatus step(const Model& m, State& s) {
       woodbury(s, count, n, m.max_contact_nodes + 1, f);
       // The droppers' elastic tension at t_{n+1} decides the set (as in the explicit scheme).
       bool changed = false;
+      const double* lean = leaning(m, s) ? s.lateral.dropper_stretch.data() : nullptr;
       for (std::size_t k = 0; k < m.droppers.size(); ++k) {
         const Dropper& d = m.droppers[k];
-        const double stretch = up[d.messenger_dof] + bdt2 * f[d.messenger_dof] - up[d.contact_dof] - bdt2 * f[d.contact_dof];
+        double stretch = up[d.messenger_dof] + bdt2 * f[d.messenger_dof] - up[d.contact_dof] - bdt2 * f[d.contact_dof];
+        if (lean) stretch += lean[k];  // (lagged, lateral.hpp)
         const std::uint8_t slack = !(d.static_tension + d.stiffness * stretch > 0.0);
         if (slack != s.dropper_slack[k]) {
           s.dropper_slack[k] = slack;

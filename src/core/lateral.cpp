@@ -319,6 +319,7 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
     p.dropper = static_cast<int>(k);
     // A dropper shorter than 5 cm would be a lateral clamp, not a pendulum: held at 5 cm.
     p.inv_length = 1.0 / std::max(0.05, d.length);
+    p.half_inv_length = 0.5 * p.inv_length;  // the same l as the pendulum: one potential (lateral.hpp)
     lat->pendulums.push_back(p);
   }
   // Wind: the normal component of the mean wind on each node's wire, following the track's heading.
@@ -376,6 +377,12 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   std::vector<double> calm_force, wind_force;
   solve_lateral_statics(m, *lat, false, &lat->calm, &calm_force);
   solve_lateral_statics(m, *lat, true, &lat->initial, &wind_force);
+  // The built lean under the mean wind: the droppers' reference (lateral.hpp), so that the pass
+  // starts with every dropper at its design stretch.
+  for (LateralPendulum& p : lat->pendulums) {
+    const double dy0 = lat->initial[p.messenger] - lat->initial[p.contact];
+    p.lean0_sq = dy0 * dy0;
+  }
   for (std::size_t k = 0; k < lat->supports.size(); ++k) {
     lat->supports[k].pull_off = calm_force[k];
     lat->supports[k].pull_off_wind = wind_force[k];
@@ -443,6 +450,9 @@ LateralState make_lateral_state(const Model& m) {
   s.pantograph_lateral.assign(m.pantographs.size(), 0.0);
   s.off_strip.assign(m.collectors.size(), 0);
   s.events.reserve(kMaxDewirementEvents);
+  s.dropper_stretch.assign(m.droppers.size(), 0.0);
+  s.lean_weight.assign(m.droppers.size(), 1.0);
+  for (const LateralPendulum& p : lat.pendulums) s.dropper_stretch[p.dropper] = lean_stretch(p, s.y.data());  // 0: y is initial
   return s;
 }
 
@@ -556,9 +566,15 @@ bool fused_substep(const Model& m, State& s) {
   for (std::size_t q = 0; q < np; ++q) f[lat.point_nodes[q]] = rec[lat.point_record[q]];
   for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * (y[sp.dof] + beta * v[sp.dof]);
   const double* u = s.u.data();
+  double* stretch = ls.dropper_stretch.data();
+  const double* w = ls.lean_weight.data();
   for (const LateralPendulum& p : lat.pendulums) {
     const Dropper& d = m.droppers[p.dropper];
-    const double tension = d.static_tension + d.stiffness * (u[d.messenger_dof] - u[d.contact_dof]);
+    // The dropper's tension with its lean's share (two-way coupling, lateral.hpp); summed for the
+    // next vertical step.
+    const double lean = lean_stretch(p, y);
+    stretch[p.dropper] += lean;
+    const double tension = d.static_tension + d.stiffness * ((u[d.messenger_dof] - u[d.contact_dof]) + lean * w[p.dropper]);
     const double k = std::max(0.0, tension) * p.inv_length;
     const double df = k * ((y[p.messenger] + beta * v[p.messenger]) - (y[p.contact] + beta * v[p.contact]));
     f[p.contact] += df;
@@ -599,6 +615,16 @@ StepStatus lateral_step(const Model& m, State& s) {
   const double limit = m.scene.numerics.divergence_limit;
   const double* u = s.u.data();
   const double t0 = s.time - m.dt;  // the vertical step has already moved the clock on
+  // The droppers' lean over this step's substeps (all at this u), for the next vertical step.
+  for (double& e : ls.dropper_stretch) e = 0.0;
+  if (m.scene.numerics.windowed()) {
+    // Outside the vertical plane's window the droppers' ends are held vertically (the window does
+    // not move them), so a lean there would load the dropper with k delta against rigid wires,
+    // where the free line gives way (delta / (1/k + f_c + f_m), some 1/300 of it): the lean acts on
+    // the tension only inside the window, as in the vertical step.
+    for (double& x : ls.lean_weight) x = 0.0;
+    for (int j = 0; j < s.window_dropper_count; ++j) ls.lean_weight[s.window_droppers[j]] = 1.0;
+  }
   for (int sub = 0; sub < lat.substeps; ++sub) {
     const double t = t0 + sub * h;
     if (lat.windy && !lat.field.empty() && t + 1e-12 >= ls.next_wind_update) {
@@ -655,10 +681,15 @@ StepStatus lateral_step(const Model& m, State& s) {
     }
     for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, ls.theta.data());
     for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
-    // Pendulums at the droppers' tension now (the one-way coupling): 0 when slack.
+    // Pendulums at the droppers' tension now, their lean's stretch included (lateral.hpp): 0 when
+    // slack. The lean is summed for the next vertical step.
+    double* stretch = ls.dropper_stretch.data();
+    const double* w = ls.lean_weight.data();
     for (const LateralPendulum& p : lat.pendulums) {
       const Dropper& d = m.droppers[p.dropper];
-      const double tension = d.static_tension + d.stiffness * (u[d.messenger_dof] - u[d.contact_dof]);
+      const double lean = lean_stretch(p, y);
+      stretch[p.dropper] += lean;
+      const double tension = d.static_tension + d.stiffness * ((u[d.messenger_dof] - u[d.contact_dof]) + lean * w[p.dropper]);
       const double k = std::max(0.0, tension) * p.inv_length;
       const double df = k * (z[p.messenger] - z[p.contact]);
       f[p.contact] += df;
@@ -677,6 +708,8 @@ StepStatus lateral_step(const Model& m, State& s) {
       return s.status;
     }
   }
+  const double per_substep = 1.0 / lat.substeps;
+  for (double& e : ls.dropper_stretch) e *= per_substep;
   update_head_wind(m, s, ls.wind_points.data());
   const bool left = contact_points(m, s, true);
   if (left && m.scene.pantograph_head.on_dewirement == DewirementAction::kStop) {
@@ -707,18 +740,71 @@ void shift_lateral_block(const Model& m, State& s) {
         ls.v[o + i] = 0.0;
       }
   }
+  set_dropper_stretch(m, s);  // the droppers' lean moved with the block
 }
 
-double lateral_energy(const Model& m, const State& s) {
+void set_dropper_stretch(const Model& m, State& s) {
+  for (const LateralPendulum& p : m.lateral->pendulums)
+    s.lateral.dropper_stretch[p.dropper] = lean_stretch(p, s.lateral.y.data());
+}
+
+namespace {
+
+// V(e) = S0 e + k e^2 / 2 while taut, S0 + k e > 0; constant (its value at the switch) when slack.
+double dropper_potential(const Dropper& d, double e) {
+  if (!(d.stiffness > 0.0)) return d.static_tension * e;
+  e = std::max(e, -d.static_tension / d.stiffness);
+  return d.static_tension * e + 0.5 * d.stiffness * e * e;
+}
+
+// The lateral plane's energy without the droppers: kinetic, wires and supports, less the loads.
+double lateral_wire_energy(const Model& m, const State& s) {
   const LateralModel& lat = *m.lateral;
   const int n = lat.n;
   Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
   std::vector<double> theta(n);
-  elastic_force(m, lat, nullptr, s.lateral.y.data(), f.data(), theta.data());  // f = -K y
+  const double* y = s.lateral.y.data();
+  for (const Wire& w : lat.wires) wire_elastic_force(w, y, f.data(), theta.data());  // f = -K y
+  for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * y[sp.dof];
   double e = 0.0;
   for (int i = 0; i < n; ++i)
-    e += 0.5 * lat.mass[i] * s.lateral.v[i] * s.lateral.v[i] * (lat.inv_mass[i] > 0.0) - 0.5 * s.lateral.y[i] * f[i] -
-         lat.load[i] * s.lateral.y[i];
+    e += 0.5 * lat.mass[i] * s.lateral.v[i] * s.lateral.v[i] * (lat.inv_mass[i] > 0.0) - 0.5 * y[i] * f[i] -
+         lat.load[i] * y[i];
+  return e;
+}
+
+}  // namespace
+
+double lateral_energy(const Model& m, const State& s) {
+  double e = lateral_wire_energy(m, s);
+  const double* u = s.u.data();
+  for (const LateralPendulum& p : m.lateral->pendulums) {
+    const Dropper& d = m.droppers[p.dropper];
+    const double ez = u[d.messenger_dof] - u[d.contact_dof];
+    e += dropper_potential(d, ez + lean_stretch(p, s.lateral.y.data())) - dropper_potential(d, ez);
+  }
+  return e;
+}
+
+double line_energy(const Model& m, const State& s) {
+  // The vertical plane: 0.5 v M v + 0.5 u K u - load . u over the wires (rotations as DOFs or
+  // condensed) and their supports; the droppers' V(e) with the lean's share when 3-D.
+  const int nc = m.n_catenary_dof;
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(m.n_dof);
+  int longest = 1;
+  for (const Wire& w : m.wires) longest = std::max(longest, w.nodes());
+  std::vector<double> theta(longest);
+  const double* u = s.u.data();
+  for (const Wire& w : m.wires) wire_elastic_force(w, u, f.data(), theta.data());  // f = -K u
+  for (const SupportSpring& sp : m.springs) f[sp.dof] -= sp.stiffness * u[sp.dof];
+  double e = 0.0;
+  for (int i = 0; i < nc; ++i)
+    e += 0.5 * m.mass[i] * s.v[i] * s.v[i] * (m.inv_mass[i] > 0.0) - 0.5 * u[i] * f[i] - m.load[i] * u[i];
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+    const Dropper& d = m.droppers[k];
+    e += dropper_potential(d, u[d.messenger_dof] - u[d.contact_dof]);
+  }
+  if (m.lateral) e += lateral_energy(m, s);
   return e;
 }
 

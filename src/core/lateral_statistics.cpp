@@ -134,7 +134,7 @@ std::string lateral_statistics_json(const Model& m, const LateralStatistics& st)
   const Scene& sc = m.scene;
   j["working_width_m"] = sc.pantograph_head.working_width;
   j["horn_width_m"] = sc.pantograph_head.horn_width;
-  j["coupling"] = "one-way: dropper tensions set the lateral pendulums; the lateral motion does not act on the vertical plane";
+  j["coupling"] = "two-way through the droppers: their tension sets the lateral pendulums, their lean's stretch (dy^2 - dy0^2) / (2 l) their vertical force";
   j["lateral_dofs"] = lat.n;
   j["lateral_substeps"] = lat.substeps;
   Json contacts = Json::array();

@@ -120,10 +120,14 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
         s->contact_force[pg.collectors[j] * nw + k] = c.wire_forces[j * nw + k];
   }
 
-  // Droppers: slack where the core's criterion says so (no tension at the elastic stretch).
+  // Droppers: slack where the core's criterion says so (no tension at the elastic stretch, on a
+  // 3-D line with the lean's share from the recorded lateral positions: lateral.hpp).
+  const bool leaning = m.lateral && s->lateral.y.size() == m.lateral->n && !s->lateral.dropper_stretch.empty();
+  if (leaning) set_dropper_stretch(m, *s);
   for (std::size_t d = 0; d < m.droppers.size(); ++d) {
     const Dropper& dr = m.droppers[d];
-    const double stretch = s->u[dr.messenger_dof] - s->u[dr.contact_dof];
+    double stretch = s->u[dr.messenger_dof] - s->u[dr.contact_dof];
+    if (leaning) stretch += s->lateral.dropper_stretch[d];
     s->dropper_slack[d] = !(dr.static_tension + dr.stiffness * stretch > 0.0);
   }
   if (m.lateral && s->lateral.y.size() == m.lateral->n) lateral_observe(m, *s);  // the contact points across the strips and the sway (3-D line)

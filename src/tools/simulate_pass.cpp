@@ -313,7 +313,7 @@ int main(int argc, char** argv) {
                 << *scene.output.allowed_uplift * 1e3 << " mm\n";
     if (m.lateral) {
       const LateralStatistics ls = lateral.statistics(m, st);
-      std::cout << std::setprecision(3) << "3-D line (lateral plane, one-way coupling): working width +-"
+      std::cout << std::setprecision(3) << "3-D line (lateral plane, coupled through the droppers): working width +-"
                 << 0.5 * scene.pantograph_head.working_width << " m\n";
       for (const LateralContactStatistics& c : ls.contacts)
         std::cout << "  " << c.pantograph << " contact point across the strip: mean " << c.mean << " m, range " << c.min

@@ -12,9 +12,19 @@
 // stagger; anchors are rigid. Wind pushes each node with 0.5 rho Cd d h V|V|, V the wind's
 // speed normal to the wire less the node's lateral velocity (aerodynamic damping included).
 //
-// One-way coupling (a first model, docs/model_and_numerics.md): the vertical state sets the
-// droppers' pendulum stiffness (their tension now); the lateral motion does not act back on the
-// vertical equations, so the vertical results are bit-identical with and without a lateral plane.
+// Two-way coupling through the droppers' geometry (docs/model_and_numerics.md, "Coupling"): a
+// dropper of length l whose ends are dz apart vertically (from the design) and dy = y_m - y_c
+// laterally is stretched by sqrt((l + dz)^2 + dy^2) - l ~ dz + dy^2 / (2 l). The built line holds
+// the static lean dy0 (LateralModel::initial, under the mean wind), so the stretch is
+// e = dz + (dy^2 - dy0^2) / (2 l) and one potential V(e) = S0 e + k e^2 / 2 (0 force when slack,
+// S0 + k e <= 0) serves both planes: the vertical force is S = S0 + k e, the lateral one S dy / l
+// (the pendulum). At the pass start e is the vertical plane's design stretch, so its static state
+// stays the design statics'; the lean's change during the pass acts on the vertical plane.
+// Order: the vertical step takes each dropper's lean stretch averaged over the previous lateral
+// step's substeps (LateralState::dropper_stretch), which all read the u the vertical step starts
+// from; every kick of V is then taken at one configuration for both planes, which makes the
+// partitioned step symplectic (the undamped, windless energy line_energy stays bounded, no drift:
+// Lateral.CoupledEnergyIsConserved). Reading the lean at one instant instead makes it drift.
 #pragma once
 
 #include <Eigen/Core>
@@ -40,7 +50,15 @@ struct LateralPendulum {
   int contact = 0, messenger = 0;  // lateral indices
   int dropper = 0;                 // index into Model::droppers (its tension now sets S)
   double inv_length = 0.0;         // 1/m
+  double half_inv_length = 0.0;    // 1/m, 1 / (2 l): the lean's stretch (dy^2 - dy0^2) / (2 l)
+  double lean0_sq = 0.0;           // m^2, dy0^2: the lean in the static state under the mean wind
 };
+
+// The stretch a dropper gets from its lean (the header comment), y the lateral positions.
+inline double lean_stretch(const LateralPendulum& p, const double* y) {
+  const double dy = y[p.messenger] - y[p.contact];
+  return (dy * dy - p.lean0_sq) * p.half_inv_length;
+}
 
 // A support of a wire in plan, with its static lateral force (pull-off).
 struct LateralSupport {
@@ -110,6 +128,11 @@ constexpr std::size_t kMaxDewirementEvents = 1024;  // kept per pass; more are c
 
 struct LateralState {
   Eigen::VectorXd y, v;      // m, m/s (v at the half step, eq. 20)
+  // m, per dropper (Model::droppers): its lean's stretch averaged over the last lateral step's
+  // substeps, which the next vertical step adds to the dropper's vertical stretch.
+  std::vector<double> dropper_stretch;
+  // Per dropper: 1 where the lean acts on its tension, 0 outside the vertical plane's window.
+  std::vector<double> lean_weight;
   Eigen::VectorXd f, z;      // workspace
   Eigen::VectorXd y_next, v_next, accel;  // the fused step's new values
   std::vector<double> theta, wind_points;
@@ -145,8 +168,18 @@ StepStatus lateral_step(const Model& model, State& state);
 // start in the static state. No allocation.
 void shift_lateral_block(const Model& model, State& state);
 
-// Lateral energy without wind: 0.5 v M v + 0.5 y K y - load . y with the droppers at their static
-// tension (J); constant in an undamped, windless free motion.
+// Sets LateralState::dropper_stretch from the current y (after y was set by hand, or moved).
+void set_dropper_stretch(const Model& model, State& state);
+
+// Lateral energy without wind: 0.5 v M v + 0.5 y K y - load . y of the wires and lateral supports,
+// plus what the lean adds to the droppers' potential at the current vertical state,
+// V(e_z + e_lean) - V(e_z) (J); constant in an undamped, windless free motion of the lateral
+// plane alone (the vertical one held).
 double lateral_energy(const Model& model, const State& state);
+
+// Energy of the whole line, both planes, the droppers' shared potential V(e) counted once:
+// kinetic, the wires' and supports' strain, less the constant loads' work (J). Constant in an
+// undamped, windless free motion of a line without pantographs on the full line (no window).
+double line_energy(const Model& model, const State& state);
 
 }  // namespace catenary_sim
