@@ -7,11 +7,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <sstream>
 
 #include "catenary_sim/core/beam.hpp"
 #include "catenary_sim/core/state.hpp"
 #include "normal_errors.hpp"
+#include "window.hpp"
 #include "wire_lanes.hpp"
 
 namespace catenary_sim {
@@ -20,6 +22,11 @@ namespace {
 // Share of the turbulent field's sample time between refreshes of the wind on the nodes.
 constexpr double kWindUpdate = 0.1;
 
+// Moving window: nodes from each cut inward that take the static force of the elements left out.
+// The window's condensed stiffness differs from the line's only through the rotation at the cut,
+// whose influence on K_theta_theta^-1 falls by about off-diagonal / diagonal (0.2-0.3 at 0.1-1 m
+// elements of the reference wires) per element: after 32 nodes by under 1e-16.
+constexpr int kCutLayer = 32;
 
 // Index of the support at station xs in Model::support_x (supports shared by an overlap's two
 // sections are one support along the line).
@@ -79,7 +86,7 @@ double lateral_omega_max(const Model& m, const LateralModel& lat) {
 void build_lateral_packs(const Model& m, LateralModel& lat) {
   lat.planes.clear();
   lat.point_nodes.clear();
-  lat.point_record.clear();
+  lat.sweep_force_at.clear();
   if (m.wire_packs.empty()) return;  // the vertical step is not fused: neither is this one
   for (const WireLanes& p : m.wire_packs) {
     const int L = p.lanes;
@@ -101,18 +108,15 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
   }
   // The band force of lateral node i of wire wi lies where the vertical sweep leaves that of the
   // wire's vertical node i.
+  lat.sweep_force_at.assign(lat.n, 0);
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi)
+    for (int i = 0; i < lat.wires[wi].nodes(); ++i)
+      lat.sweep_force_at[lat.wires[wi].w_dof + i] = m.dof_sweep_force[m.wires[wi].w_dof + i];
   std::vector<char> listed(lat.n, 0);
   auto add = [&](int i) {
     if (listed[i]) return;
     listed[i] = 1;
-    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
-      const Wire& w = lat.wires[wi];
-      if (i >= w.w_dof && i < w.w_dof + w.nodes()) {
-        lat.point_nodes.push_back(i);
-        lat.point_record.push_back(m.dof_sweep_force[m.wires[wi].w_dof + i - w.w_dof]);
-        return;
-      }
-    }
+    lat.point_nodes.push_back(i);
   };
   for (const LateralSpring& sp : lat.springs) add(sp.dof);
   for (const LateralPendulum& p : lat.pendulums) {
@@ -406,6 +410,18 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
                      " s; allowed at most 1000: lower the lateral support stiffnesses");
   lat->dt = m.dt / lat->substeps;
   build_lateral_packs(m, *lat);
+  // For the moving window: the wires' elastic force in the static state, and the springs in line order.
+  lat->static_elastic_force = Eigen::VectorXd::Zero(n);
+  {
+    std::vector<double> theta(n);
+    for (const Wire& w : lat->wires) wire_elastic_force(w, lat->initial.data(), lat->static_elastic_force.data(), theta.data());
+  }
+  lat->spring_order.resize(lat->springs.size());
+  std::iota(lat->spring_order.begin(), lat->spring_order.end(), 0);
+  std::stable_sort(lat->spring_order.begin(), lat->spring_order.end(), [&](int a, int b) {
+    return lat->node_x[lat->springs[a].dof] < lat->node_x[lat->springs[b].dof];
+  });
+  for (int k : lat->spring_order) lat->spring_order_x.push_back(lat->node_x[lat->springs[k].dof]);
   return lat;
 }
 
@@ -453,6 +469,12 @@ LateralState make_lateral_state(const Model& m) {
   s.dropper_stretch.assign(m.droppers.size(), 0.0);
   s.lean_weight.assign(m.droppers.size(), 1.0);
   for (const LateralPendulum& p : lat.pendulums) s.dropper_stretch[p.dropper] = lean_stretch(p, s.y.data());  // 0: y is initial
+  s.window_lo.assign(m.wires.size(), 0);
+  s.window_hi.assign(m.wires.size(), -1);
+  s.window_springs.assign(lat.springs.size(), 0);
+  s.cut_node.assign(2 * kCutLayer * m.wires.size(), 0);
+  s.cut_force.assign(s.cut_node.size(), 0.0);
+  s.window_points.assign(s.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size(), 0);
   return s;
 }
 
@@ -511,16 +533,158 @@ void lateral_observe(const Model& m, State& s) {
 
 namespace {
 
+// The wind's speed normal to nodes i0..i1-1 of the field's last sample (LateralState::wind_points;
+// zero before the first refresh: the mean wind).
+void refresh_wind(const Model& m, State& s, int i0, int i1) {
+  const LateralModel& lat = *m.lateral;
+  const double* wp = s.lateral.wind_points.data();
+  const double U = lat.wind_speed;
+  const double* sn = lat.wind_normal.data();
+  double* W = s.lateral.wind_speed.data();
+  if (m.endless) {
+    // The block's nodes at their stations along the line now.
+    const WindField& fd = lat.field;
+    for (int i = i0; i < i1; ++i) {
+      const double q = (lat.node_x[i] + s.line_offset - fd.x0) / fd.dx;
+      const int j = std::clamp(static_cast<int>(std::floor(q)), 0, fd.points - 2);
+      const double a = std::clamp(q - j, 0.0, 1.0);
+      W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
+    }
+  } else {
+    for (int i = i0; i < i1; ++i) {
+      const int j = lat.field_index[i];
+      const double a = lat.field_weight[i];
+      W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
+    }
+  }
+}
+
+// Calls body(i0, i1) on the lateral DOFs stepped: each wire's window, or the whole line.
+template <class Body>
+void over_stepped(const Model& m, const State& s, bool windowed, Body&& body) {
+  if (!windowed) {
+    body(0, m.lateral->n);
+    return;
+  }
+  const LateralState& ls = s.lateral;
+  for (std::size_t wi = 0; wi < m.lateral->wires.size(); ++wi)
+    if (ls.window_hi[wi] >= ls.window_lo[wi]) {
+      const int o = m.lateral->wires[wi].w_dof;
+      body(o + ls.window_lo[wi], o + ls.window_hi[wi] + 1);
+    }
+}
+
+// The moving window (numerics.window): the lateral plane steps the vertical plane's window
+// (State::window, which update_window moved before this step; the lateral waves run at the same
+// sqrt(T/rhoA), so the same window holds their echoes). When it moved, the nodes that left it
+// return to the static state under the mean wind at rest (as the vertical plane's to u = 0), the
+// nodes that entered (already there) get the wind of the last refresh, and the lists are rebuilt:
+// springs and pendulums in the window, and at each cut the static force of the elements left out
+// (-K initial of the whole line less the window's), so that the static state stays at rest in the
+// window as outside it. Costs what the window holds (bisection for the springs), not the line.
+void sync_window(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  bool moved = ls.window_dirty;
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi)
+    moved |= ls.window_lo[wi] != s.window[wi].lo || ls.window_hi[wi] != s.window[wi].hi;
+  if (!moved) return;
+  ls.window_dirty = false;
+  const bool turbulent = lat.windy && !lat.field.empty();
+  double* y = ls.y.data();
+  double* v = ls.v.data();
+  double* f = ls.f.data();
+  ls.cut_count = 0;
+  ls.window_fused = !lat.planes.empty();
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    const Wire& w = lat.wires[wi];
+    const WireWindow& ww = s.window[wi];
+    const int o = w.w_dof, lo = ww.lo, hi = ww.hi, old_lo = ls.window_lo[wi], old_hi = ls.window_hi[wi];
+    for (int i = old_lo; i <= old_hi; ++i)
+      if (i < lo || i > hi) {
+        y[o + i] = lat.initial[o + i];
+        v[o + i] = 0.0;
+      }
+    if (turbulent)
+      for (int i = lo; i <= hi; ++i)
+        if (i < old_lo || i > old_hi) refresh_wind(m, s, o + i, o + i + 1);
+    ls.window_lo[wi] = lo;
+    ls.window_hi[wi] = hi;
+    if (hi < lo) continue;
+    if (hi == lo) ls.window_fused = false;  // (as the vertical step: the sweep needs two nodes)
+    if (!ww.cut_lo && !ww.cut_hi) continue;
+    for (int i = lo; i <= hi; ++i) f[o + i] = 0.0;
+    wire_elastic_force_window(w, ww, lat.initial.data(), f, ls.theta.data());
+    auto add_cut = [&](int i) {
+      ls.cut_node[ls.cut_count] = o + i;
+      ls.cut_force[ls.cut_count++] = lat.static_elastic_force[o + i] - f[o + i];
+    };
+    const int lo_end = ww.cut_lo ? std::min(hi, lo + kCutLayer - 1) : lo - 1;
+    for (int i = lo; i <= lo_end; ++i) add_cut(i);
+    if (ww.cut_hi)
+      for (int i = std::max(lo_end + 1, hi - kCutLayer + 1); i <= hi; ++i) add_cut(i);
+  }
+  for (const WireLanes& p : m.wire_packs)
+    if (p.lanes == 2 && (s.window[p.wire[0]].lo != s.window[p.wire[1]].lo || s.window[p.wire[0]].hi != s.window[p.wire[1]].hi))
+      ls.window_fused = false;
+  // Springs between the window's end supports whose node it holds.
+  ls.window_spring_count = 0;
+  if (s.window_first_support >= 0) {
+    const double a = m.support_x[s.window_first_support], b = m.support_x[s.window_last_support];
+    const std::vector<double>& xs = lat.spring_order_x;
+    for (std::size_t j = std::lower_bound(xs.begin(), xs.end(), a - 1e-6) - xs.begin(); j < xs.size() && xs[j] <= b + 1e-6;
+         ++j) {
+      const int k = lat.spring_order[j], dof = lat.springs[k].dof;
+      for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+        const int i = dof - lat.wires[wi].w_dof;
+        if (i >= 0 && i < lat.wires[wi].nodes()) {
+          if (i >= ls.window_lo[wi] && i <= ls.window_hi[wi]) ls.window_springs[ls.window_spring_count++] = k;
+          break;
+        }
+      }
+    }
+  }
+  // The fused step's nodes with point forces: the cut layers, springs, pendulums (one per dropper
+  // in the window: State::window_droppers).
+  int q = 0;
+  for (int j = 0; j < ls.cut_count; ++j) ls.window_points[q++] = ls.cut_node[j];
+  for (int j = 0; j < ls.window_spring_count; ++j) ls.window_points[q++] = lat.springs[ls.window_springs[j]].dof;
+  for (int j = 0; j < s.window_dropper_count; ++j) {
+    const LateralPendulum& p = lat.pendulums[s.window_droppers[j]];
+    ls.window_points[q++] = p.contact;
+    ls.window_points[q++] = p.messenger;
+  }
+  ls.window_point_count = q;
+}
+
+// The window's own point forces, first after the band: the cut layers' static force and, at the
+// cuts, a dashpot of the wire's impedance sqrt(T rhoA) that lets the outgoing waves leave (the
+// vertical plane's, add_wire_point_forces).
+void add_window_forces(const Model& m, const State& s, const double* v, double* f) {
+  const LateralModel& lat = *m.lateral;
+  const LateralState& ls = s.lateral;
+  for (int j = 0; j < ls.cut_count; ++j) f[ls.cut_node[j]] += ls.cut_force[j];
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    const WireWindow& ww = s.window[wi];
+    if (ww.hi < ww.lo) continue;
+    const Wire& w = lat.wires[wi];
+    const double c = std::sqrt(w.spec.tension * w.spec.linear_mass);
+    if (ww.cut_lo) f[w.w_dof + ww.lo] -= c * v[w.w_dof + ww.lo];
+    if (ww.cut_hi) f[w.w_dof + ww.hi] -= c * v[w.w_dof + ww.hi];
+  }
+}
+
 // One lateral substep fused as the vertical plane's (wire_lanes.hpp): per pack one sweep pair for
 // z, the condensed rotations, the band force with the load, damping and the wind's drag, and the
 // update; then the nodes with point forces (steady arms and
 // messenger supports as springs, droppers as pendulums) are updated again with theirs, in the
 // generic step's order. The new values go to y_next, v_next and are swapped in when all are
 // inside the divergence limit (else the state keeps the last good substep and this returns true).
-bool fused_substep(const Model& m, State& s) {
+// Windowed: over the window's nodes (the vertical plane's factors of it), the window's forces
+// first among the point forces, the new values copied back in the window.
+bool fused_substep(const Model& m, State& s, bool windowed) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
-  const int n = lat.n;
   const double h = lat.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
   const double* y = ls.y.data();
   const double* v = ls.v.data();
@@ -533,18 +697,22 @@ bool fused_substep(const Model& m, State& s) {
   bool outside = false;
   for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
     const WireLanes& p = m.wire_packs[pk];
+    const WireWindow& ww0 = s.window[p.wire[0]];
     PackSweep a;
     a.pack = &p;
     a.plane = lat.planes[pk].data();
-    a.lo = 0;
-    a.hi = p.nodes - 1;
-    a.factors = p.factors.data();
+    a.lo = windowed ? ww0.lo : 0;
+    a.hi = windowed ? ww0.hi : p.nodes - 1;
+    if (a.hi < a.lo) continue;
+    a.factors = windowed ? s.sweep_factors.data() + 2 * p.offset : p.factors.data();
     for (int k = 0; k < p.lanes; ++k) {
       const Wire& w = lat.wires[p.wire[k]];
-      a.ww_lo[k] = w.d_ww[a.lo] - 0.0;  // no cut ends (condensed_band_force's kNone)
-      a.wt_lo[k] = w.d_wt[a.lo] - 0.0;
-      a.ww_hi[k] = w.d_ww[a.hi] - 0.0;
-      a.wt_hi[k] = w.d_wt[a.hi] - 0.0;
+      const WireWindow& ww = s.window[p.wire[k]];
+      // condensed_band_force's ends: less the cut's share in a window (x - 0.0 is x without one)
+      a.ww_lo[k] = w.d_ww[a.lo] - (windowed ? ww.lo_ww : 0.0);
+      a.wt_lo[k] = w.d_wt[a.lo] - (windowed ? ww.lo_wt : 0.0);
+      a.ww_hi[k] = w.d_ww[a.hi] - (windowed ? ww.hi_ww : 0.0);
+      a.wt_hi[k] = w.d_wt[a.hi] - (windowed ? ww.hi_wt : 0.0);
       a.u[k] = y + w.w_dof;
       a.v[k] = v + w.w_dof;
       a.u_next[k] = yn + w.w_dof;
@@ -562,13 +730,22 @@ bool fused_substep(const Model& m, State& s) {
   // Point forces on the band forces the sweep left in its records, as the generic step adds them.
   double* f = ls.f.data();
   const double* rec = s.sweep.data();
-  const std::size_t np = lat.point_nodes.size();
-  for (std::size_t q = 0; q < np; ++q) f[lat.point_nodes[q]] = rec[lat.point_record[q]];
-  for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * (y[sp.dof] + beta * v[sp.dof]);
+  const int* at = lat.sweep_force_at.data();
+  const int* points = windowed ? ls.window_points.data() : lat.point_nodes.data();
+  const int np = windowed ? ls.window_point_count : static_cast<int>(lat.point_nodes.size());
+  for (int q = 0; q < np; ++q) f[points[q]] = rec[at[points[q]]];
+  if (windowed) add_window_forces(m, s, v, f);
+  const int n_springs = windowed ? ls.window_spring_count : static_cast<int>(lat.springs.size());
+  for (int j = 0; j < n_springs; ++j) {
+    const LateralSpring& sp = lat.springs[windowed ? ls.window_springs[j] : j];
+    f[sp.dof] -= sp.stiffness * (y[sp.dof] + beta * v[sp.dof]);
+  }
   const double* u = s.u.data();
   double* stretch = ls.dropper_stretch.data();
   const double* w = ls.lean_weight.data();
-  for (const LateralPendulum& p : lat.pendulums) {
+  const int n_pendulums = windowed ? s.window_dropper_count : static_cast<int>(lat.pendulums.size());
+  for (int j = 0; j < n_pendulums; ++j) {
+    const LateralPendulum& p = lat.pendulums[windowed ? s.window_droppers[j] : j];
     const Dropper& d = m.droppers[p.dropper];
     // The dropper's tension with its lean's share (two-way coupling, lateral.hpp); summed for the
     // next vertical step.
@@ -581,8 +758,8 @@ bool fused_substep(const Model& m, State& s) {
     f[p.messenger] -= df;
   }
   const double* im = lat.inv_mass.data();
-  for (std::size_t q = 0; q < np; ++q) {
-    const int i = lat.point_nodes[q];
+  for (int q = 0; q < np; ++q) {
+    const int i = points[q];
     acc[i] = im[i] * f[i];
     vn[i] = v[i] + h * acc[i];
     yn[i] = y[i] + h * vn[i];
@@ -590,8 +767,21 @@ bool fused_substep(const Model& m, State& s) {
   }
   if (outside) {  // the sweeps' flag is a hint (they saw the point nodes before their forces)
     int bad = 0;
-    for (int i = 0; i < n; ++i) bad |= !(std::fabs(yn[i]) <= limit);
+    over_stepped(m, s, windowed, [&](int i0, int i1) {
+      for (int i = i0; i < i1; ++i) bad |= !(std::fabs(yn[i]) <= limit);
+    });
     if (bad) return true;
+  }
+  if (windowed) {  // outside the window the new buffers hold nothing current: copy the window back
+    double* yw = ls.y.data();
+    double* vw = ls.v.data();
+    over_stepped(m, s, true, [&](int i0, int i1) {
+      for (int i = i0; i < i1; ++i) {
+        yw[i] = yn[i];
+        vw[i] = vn[i];
+      }
+    });
+    return false;
   }
   ls.y.swap(ls.y_next);  // O(1)
   ls.v.swap(ls.v_next);
@@ -603,7 +793,6 @@ bool fused_substep(const Model& m, State& s) {
 StepStatus lateral_step(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
-  const int n = lat.n;
   const double h = lat.dt, beta = m.beta, alpha = m.alpha;
   const double* load = lat.load.data();
   const double* mass = lat.mass.data();
@@ -625,6 +814,8 @@ StepStatus lateral_step(const Model& m, State& s) {
     for (double& x : ls.lean_weight) x = 0.0;
     for (int j = 0; j < s.window_dropper_count; ++j) ls.lean_weight[s.window_droppers[j]] = 1.0;
   }
+  const bool windowed = m.scene.numerics.windowed();
+  if (windowed) sync_window(m, s);
   for (int sub = 0; sub < lat.substeps; ++sub) {
     const double t = t0 + sub * h;
     if (lat.windy && !lat.field.empty() && t + 1e-12 >= ls.next_wind_update) {
@@ -633,29 +824,10 @@ StepStatus lateral_step(const Model& m, State& s) {
       // default 5 Hz); the drag on the moving wire is taken every step.
       ls.next_wind_update = t + kWindUpdate * lat.field.dt;
       lat.field.at_time(t, ls.wind_points.data());
-      const double* wp = ls.wind_points.data();
-      const double U = lat.wind_speed;
-      const double* sn = lat.wind_normal.data();
-      double* W = ls.wind_speed.data();
-      if (m.endless) {
-        // The block's nodes at their stations along the line now.
-        const WindField& fd = lat.field;
-        for (int i = 0; i < n; ++i) {
-          const double q = (lat.node_x[i] + s.line_offset - fd.x0) / fd.dx;
-          const int j = std::clamp(static_cast<int>(std::floor(q)), 0, fd.points - 2);
-          const double a = std::clamp(q - j, 0.0, 1.0);
-          W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
-        }
-      } else {
-        for (int i = 0; i < n; ++i) {
-          const int j = lat.field_index[i];
-          const double a = lat.field_weight[i];
-          W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
-        }
-      }
+      over_stepped(m, s, windowed, [&](int i0, int i1) { refresh_wind(m, s, i0, i1); });  // (only where stepped)
     }
-    if (!lat.planes.empty()) {
-      if (fused_substep(m, s)) {
+    if (!lat.planes.empty() && (!windowed || ls.window_fused)) {
+      if (fused_substep(m, s, windowed)) {
         ls.diverged = true;
         s.status = StepStatus::kDiverged;
         return s.status;
@@ -665,27 +837,40 @@ StepStatus lateral_step(const Model& m, State& s) {
     // The generic step (what the fused one computes, bit for bit: test_lateral).
     y = ls.y.data();
     v = ls.v.data();
-    if (lat.windy) {
-      const double* cw = lat.wind_coefficient.data();
-      const double* W = ls.wind_speed.data();
-      for (int i = 0; i < n; ++i) {
-        z[i] = y[i] + beta * v[i];
-        const double vn = W[i] - v[i];  // relative to the moving wire: aerodynamic damping
-        f[i] = load[i] - alpha * mass[i] * v[i] + cw[i] * vn * std::fabs(vn);
+    over_stepped(m, s, windowed, [&](int i0, int i1) {
+      if (lat.windy) {
+        const double* cw = lat.wind_coefficient.data();
+        const double* W = ls.wind_speed.data();
+        for (int i = i0; i < i1; ++i) {
+          z[i] = y[i] + beta * v[i];
+          const double vn = W[i] - v[i];  // relative to the moving wire: aerodynamic damping
+          f[i] = load[i] - alpha * mass[i] * v[i] + cw[i] * vn * std::fabs(vn);
+        }
+      } else {
+        for (int i = i0; i < i1; ++i) {
+          z[i] = y[i] + beta * v[i];
+          f[i] = load[i] - alpha * mass[i] * v[i];
+        }
       }
+    });
+    if (windowed) {
+      for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) wire_elastic_force_window(lat.wires[wi], s.window[wi], z, f, ls.theta.data());
+      add_window_forces(m, s, v, f);
     } else {
-      for (int i = 0; i < n; ++i) {
-        z[i] = y[i] + beta * v[i];
-        f[i] = load[i] - alpha * mass[i] * v[i];
-      }
+      for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, ls.theta.data());
     }
-    for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, ls.theta.data());
-    for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * z[sp.dof];
+    const int n_springs = windowed ? ls.window_spring_count : static_cast<int>(lat.springs.size());
+    for (int j = 0; j < n_springs; ++j) {
+      const LateralSpring& sp = lat.springs[windowed ? ls.window_springs[j] : j];
+      f[sp.dof] -= sp.stiffness * z[sp.dof];
+    }
     // Pendulums at the droppers' tension now, their lean's stretch included (lateral.hpp): 0 when
     // slack. The lean is summed for the next vertical step.
     double* stretch = ls.dropper_stretch.data();
     const double* w = ls.lean_weight.data();
-    for (const LateralPendulum& p : lat.pendulums) {
+    const int n_pendulums = windowed ? s.window_dropper_count : static_cast<int>(lat.pendulums.size());
+    for (int j = 0; j < n_pendulums; ++j) {
+      const LateralPendulum& p = lat.pendulums[windowed ? s.window_droppers[j] : j];
       const Dropper& d = m.droppers[p.dropper];
       const double lean = lean_stretch(p, y);
       stretch[p.dropper] += lean;
@@ -696,12 +881,14 @@ StepStatus lateral_step(const Model& m, State& s) {
       f[p.messenger] -= df;
     }
     int out = 0;  // an integer OR vectorises where a max over doubles (NaN rules) does not
-    for (int i = 0; i < n; ++i) {
-      const double a = inv_mass[i] * f[i];  // eq. 20-21, in the fused sweep's order
-      v[i] += h * a;
-      y[i] += h * v[i];
-      out |= !(std::fabs(y[i]) <= limit);  // also NaN
-    }
+    over_stepped(m, s, windowed, [&](int i0, int i1) {
+      for (int i = i0; i < i1; ++i) {
+        const double a = inv_mass[i] * f[i];  // eq. 20-21, in the fused sweep's order
+        v[i] += h * a;
+        y[i] += h * v[i];
+        out |= !(std::fabs(y[i]) <= limit);  // also NaN
+      }
+    });
     if (out) {
       ls.diverged = true;
       s.status = StepStatus::kDiverged;
@@ -722,24 +909,37 @@ StepStatus lateral_step(const Model& m, State& s) {
 void shift_lateral_block(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
+  const bool windowed = m.scene.numerics.windowed();  // (an endless line always is)
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     const Wire& w = lat.wires[wi];
     const int ns = m.endless_shift_spans * m.span_nodes[wi], o = w.w_dof, nn = w.nodes();
+    // The nodes stepped: the window (outside it they are in the static state), as the vertical
+    // plane moves its window (shift_endless_block).
+    const int lo = windowed ? ls.window_lo[wi] : 0, hi = windowed ? ls.window_hi[wi] : nn - 1;
+    if (hi < lo) continue;
     // Upward, the destination below the source. Held nodes (supports at the stagger, which
-    // repeats with the block's move) keep their value.
-    for (int i = ns; i < nn; ++i)
+    // repeats with the block's move) keep their value. The wind moves along: a node's station
+    // along the line is the one the node ns above had.
+    for (int i = std::max(lo, ns); i <= hi; ++i) {
       if (lat.inv_mass[o + i - ns] > 0.0) {
         ls.y[o + i - ns] = ls.y[o + i];
         ls.v[o + i - ns] = ls.v[o + i];
       }
-    // The spans that enter at the block's far end start at rest in the static state under the
-    // mean wind, as the vertical plane's start at u = 0 (they are beyond the window ahead).
-    for (int i = std::max(0, nn - ns); i < nn; ++i)
+      if (lat.windy) ls.wind_speed[o + i - ns] = ls.wind_speed[o + i];
+    }
+    // The nodes the move leaves (the spans entering at the far end of the block or window) are
+    // at rest in the static state under the mean wind, as the vertical plane's at u = 0.
+    for (int i = std::max({0, lo, hi - ns + 1}); i <= hi; ++i)
       if (lat.inv_mass[o + i] > 0.0) {
         ls.y[o + i] = lat.initial[o + i];
         ls.v[o + i] = 0.0;
       }
+    if (windowed) {
+      ls.window_lo[wi] = std::max(0, lo - ns);
+      ls.window_hi[wi] = hi - ns;
+    }
   }
+  ls.window_dirty = true;  // the lists hold the old DOFs
   set_dropper_stretch(m, s);  // the droppers' lean moved with the block
 }
 

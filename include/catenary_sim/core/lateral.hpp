@@ -106,7 +106,15 @@ struct LateralModel {
   // point forces (springs, pendulums) with where the sweep leaves their band force. No planes
   // (the vertical step not fused: implicit, or rotations as DOFs): the generic step.
   std::vector<std::vector<double>> planes;
-  std::vector<int> point_nodes, point_record;
+  std::vector<int> point_nodes;
+  std::vector<int> sweep_force_at;  // per lateral DOF: where the sweep leaves its band force (fused step)
+  // Moving window (numerics.window; the vertical plane's window, State::window: the lateral waves
+  // run at the same sqrt(T/rhoA)): -K initial over the whole line, so that the window's cut ends
+  // get the force of the elements left out in the static state (outside, the wires stay there);
+  // the springs in line order, for the window to find its own by bisection.
+  Eigen::VectorXd static_elastic_force;
+  std::vector<int> spring_order;
+  std::vector<double> spring_order_x;
 };
 
 // Builds the lateral plane of a model whose scene asks for one (Scene::lateral()); throws SceneError.
@@ -150,6 +158,21 @@ struct LateralState {
   std::vector<DewirementEvent> events;     // capacity reserved: never allocates in step
   std::int64_t events_total = 0;
   bool diverged = false, dewired_stop = false;
+  // Moving window: the node range per wire the lateral plane steps (it follows State::window at
+  // each step; outside, the nodes stay in the static state under the mean wind, at rest), the
+  // springs in it (first window_spring_count entries; the pendulums are State::window_droppers',
+  // pendulum k being dropper k), the static force of the left-out elements on the nodes near the
+  // cuts, and the nodes with point forces for the fused step. Sized once: no allocation.
+  std::vector<int> window_lo, window_hi;
+  bool window_dirty = true;  // lists to rebuild (the endless block moved)
+  std::vector<int> window_springs;
+  int window_spring_count = 0;
+  std::vector<int> cut_node;
+  std::vector<double> cut_force;
+  int cut_count = 0;
+  std::vector<int> window_points;
+  int window_point_count = 0;
+  bool window_fused = false;  // the fused step can take the window (every wire's range two nodes or more)
 };
 
 LateralState make_lateral_state(const Model& model);
