@@ -22,7 +22,20 @@ LateralRecorder::LateralRecorder(const Model& m, double sample_rate_hz)
     columns_.push_back(name + "_station_m");
     columns_.push_back(name + "_lateral_m");
   }
-  if (m.lateral) max_blow_off_.assign(m.lateral->spans, 0.0);
+  if (!m.lateral) return;
+  const LateralModel& lat = *m.lateral;
+  max_blow_off_.assign(lat.spans, 0.0);
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    const int o = lat.wires[wi].w_dof, nn = lat.wires[wi].nodes();
+    for (int i = 0; i < nn; ++i) {
+      const int span = lat.node_span[o + i];
+      if (span < 0) continue;
+      if (blow_off_ranges_.empty() || blow_off_ranges_.back().wire != static_cast<int>(wi) ||
+          blow_off_ranges_.back().span != span || blow_off_ranges_.back().end != i)
+        blow_off_ranges_.push_back(BlowOffRange{static_cast<int>(wi), span, i, i});
+      blow_off_ranges_.back().end = i + 1;
+    }
+  }
 }
 
 void LateralRecorder::record(const Model& m, const State& s) {
@@ -41,15 +54,28 @@ void LateralRecorder::record(const Model& m, const State& s) {
   }
   if (s.time + 1e-12 >= next_blow_off_) {
     next_blow_off_ = s.time + kBlowOffPeriod;
-    for (int i = 0; i < lat.n; ++i) {
-      const int span = lat.node_span[i];
-      if (span < 0) continue;
-      max_blow_off_[span] = std::max(max_blow_off_[span], std::fabs(s.lateral.y[i] - lat.calm[i]));
+    const bool windowed = m.scene.numerics.windowed() && !s.lateral.window_lo.empty();
+    const double* y = s.lateral.y.data();
+    const double* calm = lat.calm.data();
+    for (const BlowOffRange& r : blow_off_ranges_) {
+      int b = r.begin, e = r.end;
+      if (windowed) {
+        b = std::max(b, s.lateral.window_lo[r.wire]);
+        e = std::min(e, s.lateral.window_hi[r.wire] + 1);
+      }
+      const int o = lat.wires[r.wire].w_dof;
+      double most = max_blow_off_[r.span];
+      for (int i = o + b; i < o + e; ++i) {
+        const double d = std::fabs(y[i] - calm[i]);
+        most = d > most ? d : most;
+      }
+      max_blow_off_[r.span] = most;
     }
   }
   if (sample_period_ > 0.0 && s.time + 1e-12 < next_sample_) return;
   next_sample_ += sample_period_;
   PassRecorder::Row r{s.time, {}};
+  r.values.reserve(2 * m.collectors.size());
   for (std::size_t c = 0; c < m.collectors.size(); ++c) {
     r.values.push_back(station_[c].back());
     r.values.push_back(lateral_[c].back());

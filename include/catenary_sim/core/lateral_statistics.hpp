@@ -59,6 +59,13 @@ class LateralRecorder {
   std::vector<std::vector<double>> station_, lateral_;  // per collector, every step
   std::vector<std::vector<char>> contact_;             // per collector, every step: force on it
   std::vector<double> max_blow_off_;                   // per span
+  // The contact wires' nodes by span (node ranges [begin, end) of lateral wire `wire`), scanned for
+  // the blow-off every kBlowOffPeriod: a max over each range, within the window if there is one
+  // (outside it the wires are in the static state, whose blow-off the statistics take anyway).
+  struct BlowOffRange {
+    int wire = 0, span = 0, begin = 0, end = 0;
+  };
+  std::vector<BlowOffRange> blow_off_ranges_;
 };
 
 // The "lateral" object of stats.json (JSON text).
