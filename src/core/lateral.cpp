@@ -369,6 +369,9 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
           const int j = std::clamp(static_cast<int>(std::floor(s)), 0, lat->field.points - 2);
           lat->field_index[a] = j;
           lat->field_weight[a] = std::clamp(s - j, 0.0, 1.0);
+          if (lat->field_runs.empty() || lat->field_runs.back().point != j || lat->field_runs.back().end != a)
+            lat->field_runs.push_back(LateralModel::FieldRun{a, a, j});
+          lat->field_runs.back().end = a + 1;
         }
       }
     }
@@ -551,10 +554,20 @@ void refresh_wind(const Model& m, State& s, int i0, int i1) {
       W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
     }
   } else {
-    for (int i = i0; i < i1; ++i) {
-      const int j = lat.field_index[i];
-      const double a = lat.field_weight[i];
-      W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
+    // Per run of nodes between two field points (the same operations as per node).
+    const std::vector<LateralModel::FieldRun>& runs = lat.field_runs;
+    std::size_t k = std::upper_bound(runs.begin(), runs.end(), i0,
+                                     [](int i, const LateralModel::FieldRun& r) { return i < r.begin; }) -
+                    runs.begin();
+    k = k > 0 ? k - 1 : 0;
+    const double* weight = lat.field_weight.data();
+    for (; k < runs.size() && runs[k].begin < i1; ++k) {
+      const double p0 = wp[runs[k].point], p1 = wp[runs[k].point + 1];
+      const int b = std::max(i0, runs[k].begin), e = std::min(i1, runs[k].end);
+      for (int i = b; i < e; ++i) {
+        const double a = weight[i];
+        W[i] = (U + (1.0 - a) * p0 + a * p1) * sn[i];
+      }
     }
   }
 }

@@ -775,6 +775,40 @@ TEST(Lateral, TurbulentWindOnTheEndlessLineFollowsTheStations) {
   EXPECT_LT(worst, 1e-9);
 }
 
+TEST(Lateral, TurbulentWindOnTheNodesIsTheFieldAtTheirStations) {
+  // On a finite line the refresh takes the nodes between two field points together: every node
+  // in the window (and on the whole line without one) must still get the field linear between
+  // the points around its station, at the last refresh, to the bit.
+  for (const std::string window : {"", "numerics.window=auto"}) {
+    std::vector<std::string> ov = {"numerics.preset=fast", "line.span_count=12"};
+    if (!window.empty()) ov.push_back(window);
+    Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml", ov));
+    const Model& m = sim.model();
+    ASSERT_TRUE(m.lateral);
+    const LateralModel& lat = *m.lateral;
+    ASSERT_FALSE(lat.field.empty());
+    for (int i = 0; i < 3000; ++i) ASSERT_EQ(sim.step(), StepStatus::kOk);
+    const State& s = sim.state();
+    std::vector<double> pts(lat.field.points);
+    lat.field.at_time(s.lateral.next_wind_update - 0.1 * lat.field.dt, pts.data());
+    const bool windowed = m.scene.numerics.windowed();
+    int checked = 0, wrong = 0;
+    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+      const int o = lat.wires[wi].w_dof;
+      const int lo = windowed ? s.window[wi].lo : 0, hi = windowed ? s.window[wi].hi : lat.wires[wi].nodes() - 1;
+      for (int i = o + lo; i <= o + hi; ++i, ++checked) {
+        const double q = (lat.node_x[i] - lat.field.x0) / lat.field.dx;
+        const int j = std::clamp(static_cast<int>(std::floor(q)), 0, lat.field.points - 2);
+        const double a = std::clamp(q - j, 0.0, 1.0);
+        wrong += s.lateral.wind_speed[i] != (lat.wind_speed + (1.0 - a) * pts[j] + a * pts[j + 1]) * lat.wind_normal[i];
+      }
+    }
+    EXPECT_GT(checked, 300) << window;  // (1 m elements: about 470 nodes in the window)
+    EXPECT_EQ(wrong, 0) << window;
+    if (windowed) EXPECT_GT(s.window[0].lo, 0);  // the window moved on: nodes entered it since
+  }
+}
+
 TEST(Lateral, SwayMovesTheContactPointAcrossTheStrip) {
   // As StaggerChordsUnderThePantograph (the same closed form of the wire under the strip), the
   // pantograph now swaying with the car body: the contact point on the strip is the wire's

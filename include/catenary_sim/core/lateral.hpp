@@ -90,6 +90,13 @@ struct LateralModel {
   WindField field;                 // turbulence (empty: steady wind)
   std::vector<int> field_index;    // per node: the field point at or before it
   std::vector<double> field_weight;  // per node: linear weight of the next point
+  // The nodes between two field points as runs of DOFs [begin, end) at field point `point` (a
+  // wire's nodes are in station order): the refresh interpolates a run with the two points' values
+  // at hand, a loop that vectorises where a gather per node does not. Finite lines only.
+  struct FieldRun {
+    int begin = 0, end = 0, point = 0;
+  };
+  std::vector<FieldRun> field_runs;
   double omega_max = 0.0;          // rad/s, highest lateral eigenfrequency
   int substeps = 1;                // lateral steps per vertical step
   double dt = 0.0;                 // s, lateral step
