@@ -2,7 +2,11 @@
 // as the 2-D model and with a lateral plane (stagger alone; stagger with a turbulent cross wind,
 // as config/reference_55m_3d.yaml), bare and with the recorders simulate_pass runs, in one
 // process with the repetitions interleaved, so the real-time factors compare as ratios.
-//   bench_lateral [repetitions=5]
+// Then the moving window on a long line: the same 2-D and 3-D (stagger + turbulent wind) passes
+// with numerics.window=auto on `long_spans` spans and on 20, bare step, interleaved: the 3-D
+// window's cost per simulated second must not grow with the line (its lateral plane is windowed
+// as the vertical one) and compares with the 2-D window's as a ratio. long_spans 0 skips it.
+//   bench_lateral [repetitions=5] [long_spans=100]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -20,8 +24,60 @@
 
 using namespace catenary_sim;
 
+namespace {
+
+// 2-D and 3-D windowed passes on `spans` spans and on 20, the repetitions interleaved.
+void run_windowed(int reps, int spans, const std::vector<std::string>& windy) {
+  const std::string path = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  struct Variant {
+    std::string label;
+    int spans;
+    bool lateral;
+  };
+  const std::vector<Variant> variants{{"2-D window", spans, false},
+                                      {"3-D stagger + wind, window", spans, true},
+                                      {"2-D window", 20, false},
+                                      {"3-D stagger + wind, window", 20, true}};
+  std::vector<Scene> scenes;
+  for (const Variant& v : variants) {
+    std::vector<std::string> ov{"line.span_count=" + std::to_string(v.spans), "numerics.window=auto"};
+    if (v.lateral) ov.insert(ov.end(), windy.begin(), windy.end());
+    scenes.push_back(load_scene_file(path, ov));
+  }
+  std::vector<std::vector<double>> walls(variants.size());
+  std::vector<double> sim_time(variants.size());
+  std::vector<int> dofs(variants.size());
+  for (int r = 0; r < reps; ++r)
+    for (std::size_t i = 0; i < variants.size(); ++i) {
+      Simulation sim(scenes[i]);
+      const auto t0 = std::chrono::steady_clock::now();
+      while (sim.step() == StepStatus::kOk) {
+      }
+      walls[i].push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      sim_time[i] = sim.state().time;
+      dofs[i] = sim.model().n_dof + (sim.model().lateral ? sim.model().lateral->n : 0);
+    }
+  std::printf("\nmoving window (numerics.window=auto), bare step\n");
+  std::printf("%-34s %6s %6s %9s %10s %10s %8s %12s %10s\n", "variant", "spans", "DOFs", "sim_s", "wall_med_s", "wall_min_s",
+              "RTF_med", "ms/sim_s_med", "RTF/2-D");
+  std::vector<double> ms(variants.size());
+  double base_rtf = 0.0;
+  for (std::size_t i = 0; i < variants.size(); ++i) {
+    std::sort(walls[i].begin(), walls[i].end());
+    const double med = walls[i][walls[i].size() / 2], rtf = sim_time[i] / med;
+    if (!variants[i].lateral) base_rtf = rtf;  // the 2-D row just above: same line
+    ms[i] = 1e3 * med / sim_time[i];
+    std::printf("%-34s %6d %6d %9.2f %10.4f %10.4f %8.1f %12.3f %10.3f\n", variants[i].label.c_str(), variants[i].spans,
+                dofs[i], sim_time[i], med, walls[i].front(), rtf, ms[i], rtf / base_rtf);
+  }
+  std::printf("cost per simulated second, %d spans against 20: 2-D %.3f, 3-D %.3f\n", spans, ms[0] / ms[2], ms[1] / ms[3]);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
+  const int long_spans = argc > 2 ? std::max(0, std::atoi(argv[2])) : 100;
   const std::string path = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
   struct Variant {
     std::string label;
@@ -79,5 +135,6 @@ int main(int argc, char** argv) {
     std::printf("%-34s %6d %9.4f %10.4f %10.4f %8.1f %10.3f\n", variants[i].label.c_str(), dofs[i], dt[i] * 1e3, med,
                 walls[i].front(), rtf, rtf / (variants[i].record ? base_rec_rtf : base_rtf));
   }
+  if (long_spans > 0) run_windowed(reps, long_spans, windy);
   return 0;
 }
