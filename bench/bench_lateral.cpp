@@ -6,9 +6,14 @@
 // with numerics.window=auto on `long_spans` spans and on 20, bare step, interleaved: the 3-D
 // window's cost per simulated second must not grow with the line (its lateral plane is windowed
 // as the vertical one) and compares with the 2-D window's as a ratio. long_spans 0 skips it.
-//   bench_lateral [repetitions=5] [long_spans=100]
+// Then, for `seeds` seeds of the turbulent wind (0 skips it), what the window changes in the
+// contact point's turbulent motion (its position in the turbulent wind less that in the steady
+// mean wind) on 40 spans, balanced preset: outside the window the wind is not stepped, so the
+// spans enter it without the motion the gusts built up.
+//   bench_lateral [repetitions=5] [long_spans=100] [seeds=0]
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -71,6 +76,36 @@ void run_windowed(int reps, int spans, const std::vector<std::string>& windy) {
                 dofs[i], sim_time[i], med, walls[i].front(), rtf, ms[i], rtf / base_rtf);
   }
   std::printf("cost per simulated second, %d spans against 20: 2-D %.3f, 3-D %.3f\n", spans, ms[0] / ms[2], ms[1] / ms[3]);
+}
+
+// The contact point's turbulent motion (position in the turbulent wind less in the steady mean
+// wind) on the full line and with the window, over spans 4 to 36 of 40.
+void turbulent_motion(int seed, std::vector<std::string> windy) {
+  const std::string path = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  windy.insert(windy.end(), {"numerics.preset=balanced", "line.span_count=40"});
+  std::vector<std::string> full = windy, steady = windy, window = windy;
+  full.push_back("wind.turbulence.seed=" + std::to_string(seed));
+  window.insert(window.end(), {"wind.turbulence.seed=" + std::to_string(seed), "numerics.window=auto"});
+  steady.push_back("wind.turbulence=null");
+  Simulation a(load_scene_file(path, full)), b(load_scene_file(path, window)), c(load_scene_file(path, steady));
+  double sa = 0, sb = 0, sd = 0, ma = 0, mb = 0;
+  long n = 0;
+  while (a.step() == StepStatus::kOk && b.step() == StepStatus::kOk && c.step() == StepStatus::kOk) {
+    const double ya = a.state().lateral.collector_lateral[0], yb = b.state().lateral.collector_lateral[0],
+                 yc = c.state().lateral.collector_lateral[0], x = a.state().front;
+    if (x < 4 * 55.0 || x > 36 * 55.0 || !std::isfinite(ya) || !std::isfinite(yb) || !std::isfinite(yc)) continue;
+    sa += (ya - yc) * (ya - yc);
+    sb += (yb - yc) * (yb - yc);
+    sd += (yb - ya) * (yb - ya);
+    ma = std::max(ma, std::fabs(ya - yc));
+    mb = std::max(mb, std::fabs(yb - yc));
+    ++n;
+  }
+  if (seed == 1)
+    std::printf("\ncontact point's turbulent motion (mm), 40 spans, balanced: rms full / window, max full / window, "
+                "rms of window - full\n");
+  std::printf("seed %d: rms %.2f / %.2f, max %.2f / %.2f, rms difference %.2f (%ld steps)\n", seed, 1e3 * std::sqrt(sa / n),
+              1e3 * std::sqrt(sb / n), 1e3 * ma, 1e3 * mb, 1e3 * std::sqrt(sd / n), n);
 }
 
 }  // namespace
@@ -136,5 +171,6 @@ int main(int argc, char** argv) {
                 walls[i].front(), rtf, rtf / (variants[i].record ? base_rec_rtf : base_rtf));
   }
   if (long_spans > 0) run_windowed(reps, long_spans, windy);
+  for (int seed = 1; seed <= (argc > 3 ? std::atoi(argv[3]) : 0); ++seed) turbulent_motion(seed, windy);
   return 0;
 }
