@@ -805,7 +805,9 @@ TEST(Lateral, TurbulentWindOnTheNodesIsTheFieldAtTheirStations) {
     }
     EXPECT_GT(checked, 300) << window;  // (1 m elements: about 470 nodes in the window)
     EXPECT_EQ(wrong, 0) << window;
-    if (windowed) EXPECT_GT(s.window[0].lo, 0);  // the window moved on: nodes entered it since
+    if (windowed) {
+      EXPECT_GT(s.window[0].lo, 0);  // the window moved on: nodes entered it since
+    }
   }
 }
 
