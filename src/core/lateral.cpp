@@ -376,6 +376,7 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
       }
     }
   }
+  lat->windowed = sc.numerics.windowed() && (m.endless || lat->field.empty());
   const PantographHeadSpec& head = sc.pantograph_head;
   lat->half_working_width = 0.5 * head.working_width;
   lat->half_horn_width = 0.5 * head.horn_width;
@@ -827,7 +828,7 @@ StepStatus lateral_step(const Model& m, State& s) {
     for (double& x : ls.lean_weight) x = 0.0;
     for (int j = 0; j < s.window_dropper_count; ++j) ls.lean_weight[s.window_droppers[j]] = 1.0;
   }
-  const bool windowed = m.scene.numerics.windowed();
+  const bool windowed = lat.windowed;
   if (windowed) sync_window(m, s);
   for (int sub = 0; sub < lat.substeps; ++sub) {
     const double t = t0 + sub * h;
@@ -922,7 +923,7 @@ StepStatus lateral_step(const Model& m, State& s) {
 void shift_lateral_block(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
-  const bool windowed = m.scene.numerics.windowed();  // (an endless line always is)
+  const bool windowed = lat.windowed;  // (an endless line always is)
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     const Wire& w = lat.wires[wi];
     const int ns = m.endless_shift_spans * m.span_nodes[wi], o = w.w_dof, nn = w.nodes();

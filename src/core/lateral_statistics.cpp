@@ -54,7 +54,7 @@ void LateralRecorder::record(const Model& m, const State& s) {
   }
   if (s.time + 1e-12 >= next_blow_off_) {
     next_blow_off_ = s.time + kBlowOffPeriod;
-    const bool windowed = m.scene.numerics.windowed() && !s.lateral.window_lo.empty();
+    const bool windowed = lat.windowed && !s.lateral.window_lo.empty();
     const double* y = s.lateral.y.data();
     const double* calm = lat.calm.data();
     for (const BlowOffRange& r : blow_off_ranges_) {

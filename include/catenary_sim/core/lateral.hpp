@@ -85,6 +85,12 @@ struct LateralModel {
   Eigen::VectorXd initial;  // m, static under the mean wind (the pass starts here)
   // Wind: per node 0.5 rho Cd d h (kg/m) and the sine of the wind's angle to the wire.
   bool windy = false;
+  // The lateral plane steps only the moving window (numerics.window), except in a turbulent wind on
+  // a finite line: there it steps the whole line, because a span entering the window at rest in the
+  // mean wind would lack the motion the gusts built up over the lateral modes' decay (about 9 s,
+  // against the window's lead of 1-2 s: 9-16 % less rms across the strip, BENCHMARKS.md). An
+  // endless line is always windowed (docs/model_and_numerics.md says what that costs in gusts).
+  bool windowed = false;
   double wind_speed = 0.0;
   Eigen::VectorXd wind_coefficient, wind_normal;
   WindField field;                 // turbulence (empty: steady wind)
