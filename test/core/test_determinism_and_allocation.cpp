@@ -85,3 +85,44 @@ TEST(Allocation, StepNeverAllocates) {
   EXPECT_EQ(g_allocations.load(), 0) << "step() allocated on the endless line";
   EXPECT_GE(endless.state().line_offset - offset0, 2 * 55.0);
 }
+
+// The 3-D line's paths: a turbulent wind on the whole line, the moving window (which keeps a
+// turbulent wind's lateral plane whole, and windows a steady wind's), the two-way dropper coupling,
+// sway, the wind in the uplift, and the endless line moving its block: no allocation in step(),
+// and two passes of one scene give the same bits, lateral state included.
+TEST(Allocation, ThreeDimensionalStepNeverAllocatesAndRepeatsItsBits) {
+  const std::string three_d = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml";
+  const std::vector<std::string> sway = {"pantograph_head.sway.amplitude=0.03", "pantograph_head.sway.frequency=0.8",
+                                         "pantographs.0.aero_coefficient=0.005"};
+  struct Case {
+    std::string file;
+    std::vector<std::string> overrides;
+  };
+  std::vector<Case> cases = {{three_d, {}}, {three_d, {"numerics.window=auto"}},
+                             {three_d, {"numerics.window=auto", "wind.turbulence=null"}},
+                             {CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml",
+                              {"stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]", "wind.speed=20",
+                               "wind.turbulence.intensity=0.15", "alignment.radius=1200"}}};
+  for (Case& c : cases) {
+    c.overrides.insert(c.overrides.end(), sway.begin(), sway.end());
+    const Scene scene = load_scene_file(c.file, c.overrides);
+    Simulation a(scene), b(scene);
+    ASSERT_TRUE(a.model().lateral);
+    a.step();
+    b.step();
+    g_allocations = 0;
+    g_counting = true;
+    for (int i = 0; i < 2000; ++i) a.step();
+    g_counting = false;
+    EXPECT_EQ(g_allocations.load(), 0) << "step() allocated on " << c.file << " with " << c.overrides.size()
+                                       << " overrides";
+    for (int i = 0; i < 2000; ++i) b.step();
+    ASSERT_EQ(a.state().status, StepStatus::kOk);
+    ASSERT_EQ(a.state().lateral.y.size(), b.state().lateral.y.size());
+    EXPECT_EQ(0, std::memcmp(a.state().u.data(), b.state().u.data(), sizeof(double) * a.state().u.size()));
+    EXPECT_EQ(0, std::memcmp(a.state().lateral.y.data(), b.state().lateral.y.data(),
+                             sizeof(double) * a.state().lateral.y.size()));
+    EXPECT_EQ(0, std::memcmp(a.state().lateral.v.data(), b.state().lateral.v.data(),
+                             sizeof(double) * a.state().lateral.v.size()));
+  }
+}
