@@ -396,30 +396,8 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
   }
   bool outside = false;
   for (const WireLanes& p : m.wire_packs) {
-    const WireWindow& ww0 = s.window[p.wire[0]];
     PackSweep a;
-    a.pack = &p;
-    a.lo = windowed ? ww0.lo : 0;
-    a.hi = windowed ? ww0.hi : p.nodes - 1;
-    if (a.hi < a.lo) continue;
-    a.factors = windowed ? s.sweep_factors.data() + 2 * p.offset : p.factors.data();
-    for (int k = 0; k < p.lanes; ++k) {
-      const Wire& w = m.wires[p.wire[k]];
-      const WireWindow& ww = s.window[p.wire[k]];
-      const double c[4] = {windowed ? ww.lo_ww : 0.0, windowed ? ww.lo_wt : 0.0, windowed ? ww.hi_ww : 0.0,
-                           windowed ? ww.hi_wt : 0.0};
-      // condensed_band_force's dww_at/dwt_at at the ends (x - 0.0 is x: no change without a cut)
-      a.ww_lo[k] = w.d_ww[a.lo] - c[0];
-      a.wt_lo[k] = w.d_wt[a.lo] - c[1];
-      a.ww_hi[k] = w.d_ww[a.hi] - c[2];
-      a.wt_hi[k] = w.d_wt[a.hi] - c[3];
-      a.u[k] = u + w.w_dof;
-      a.v[k] = v + w.w_dof;
-      a.u_next[k] = un + w.w_dof;
-      a.v_next[k] = vn + w.w_dof;
-      a.accel[k] = acc + w.w_dof;
-    }
-    a.record = s.sweep.data() + kSweepRecord * p.offset;
+    if (!setup_pack_sweep(p, m.wires, s, windowed, u, v, un, vn, acc, a)) continue;
     a.beta = beta;
     a.dt = dt;
     a.limit = limit;

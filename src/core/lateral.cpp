@@ -365,10 +365,9 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
         const Wire& w = m.wires[wi];
         for (int i = 0; i < w.nodes(); ++i) {
           const int a = lat->wires[wi].w_dof + i;
-          const double s = (w.x[i] - lat->field.x0) / lat->field.dx;
-          const int j = std::clamp(static_cast<int>(std::floor(s)), 0, lat->field.points - 2);
+          int j = 0;
+          lat->field.locate(w.x[i], &j, &lat->field_weight[a]);
           lat->field_index[a] = j;
-          lat->field_weight[a] = std::clamp(s - j, 0.0, 1.0);
           if (lat->field_runs.empty() || lat->field_runs.back().point != j || lat->field_runs.back().end != a)
             lat->field_runs.push_back(LateralModel::FieldRun{a, a, j});
           lat->field_runs.back().end = a + 1;
@@ -437,12 +436,7 @@ void update_head_wind(const Model& m, State& s, const double* field_points) {
   for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
     const double x = s.front - m.pantographs[p].position + s.line_offset;  // station along the line
     double along_wind = lat.wind_speed;  // the along-wind speed U + u' (wind.hpp)
-    if (field_points && !fd.empty()) {
-      const double q = (x - fd.x0) / fd.dx;
-      const int j = std::clamp(static_cast<int>(std::floor(q)), 0, fd.points - 2);
-      const double a = std::clamp(q - j, 0.0, 1.0);
-      along_wind += (1.0 - a) * field_points[j] + a * field_points[j + 1];
-    }
+    if (field_points && !fd.empty()) along_wind += fd.at(field_points, x);
     // Its component along the track, against the direction of travel (+x).
     s.head_wind[p] = -along_wind * std::cos(phi - m.scene.alignment.heading(x));
   }
@@ -549,9 +543,9 @@ void refresh_wind(const Model& m, State& s, int i0, int i1) {
     // The block's nodes at their stations along the line now.
     const WindField& fd = lat.field;
     for (int i = i0; i < i1; ++i) {
-      const double q = (lat.node_x[i] + s.line_offset - fd.x0) / fd.dx;
-      const int j = std::clamp(static_cast<int>(std::floor(q)), 0, fd.points - 2);
-      const double a = std::clamp(q - j, 0.0, 1.0);
+      int j = 0;
+      double a = 0.0;
+      fd.locate(lat.node_x[i] + s.line_offset, &j, &a);
       W[i] = (U + (1.0 - a) * wp[j] + a * wp[j + 1]) * sn[i];
     }
   } else {
@@ -688,6 +682,37 @@ void add_window_forces(const Model& m, const State& s, const double* v, double* 
   }
 }
 
+// The springs (steady arms, messenger supports) and the droppers' pendulums on f, at
+// z = y + beta v (`z_at`), over the window's lists or the whole line: the pendulums at the
+// droppers' tension now with their lean's share (two-way coupling, lateral.hpp), 0 when slack, and
+// each lean summed into dropper_stretch for the next vertical step. The fused and the generic
+// step share it, so they do the same operations.
+template <class ZAt>
+void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const double* y, ZAt z_at, double* f) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const int n_springs = windowed ? ls.window_spring_count : static_cast<int>(lat.springs.size());
+  for (int j = 0; j < n_springs; ++j) {
+    const LateralSpring& sp = lat.springs[windowed ? ls.window_springs[j] : j];
+    f[sp.dof] -= sp.stiffness * z_at(sp.dof);
+  }
+  const double* u = s.u.data();
+  double* stretch = ls.dropper_stretch.data();
+  const double* w = ls.lean_weight.data();
+  const int n_pendulums = windowed ? s.window_dropper_count : static_cast<int>(lat.pendulums.size());
+  for (int j = 0; j < n_pendulums; ++j) {
+    const LateralPendulum& p = lat.pendulums[windowed ? s.window_droppers[j] : j];
+    const Dropper& d = m.droppers[p.dropper];
+    const double lean = lean_stretch(p, y);
+    stretch[p.dropper] += lean;
+    const double tension = d.static_tension + d.stiffness * ((u[d.messenger_dof] - u[d.contact_dof]) + lean * w[p.dropper]);
+    const double k = std::max(0.0, tension) * p.inv_length;
+    const double df = k * (z_at(p.messenger) - z_at(p.contact));
+    f[p.contact] += df;
+    f[p.messenger] -= df;
+  }
+}
+
 // One lateral substep fused as the vertical plane's (wire_lanes.hpp): per pack one sweep pair for
 // z, the condensed rotations, the band force with the load, damping and the wind's drag, and the
 // update; then the nodes with point forces (steady arms and
@@ -711,31 +736,15 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
   bool outside = false;
   for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
     const WireLanes& p = m.wire_packs[pk];
-    const WireWindow& ww0 = s.window[p.wire[0]];
     PackSweep a;
-    a.pack = &p;
+    // (the records in the vertical step's scratch)
+    if (!setup_pack_sweep(p, lat.wires, s, windowed, y, v, yn, vn, acc, a)) continue;
     a.plane = lat.planes[pk].data();
-    a.lo = windowed ? ww0.lo : 0;
-    a.hi = windowed ? ww0.hi : p.nodes - 1;
-    if (a.hi < a.lo) continue;
-    a.factors = windowed ? s.sweep_factors.data() + 2 * p.offset : p.factors.data();
     for (int k = 0; k < p.lanes; ++k) {
-      const Wire& w = lat.wires[p.wire[k]];
-      const WireWindow& ww = s.window[p.wire[k]];
-      // condensed_band_force's ends: less the cut's share in a window (x - 0.0 is x without one)
-      a.ww_lo[k] = w.d_ww[a.lo] - (windowed ? ww.lo_ww : 0.0);
-      a.wt_lo[k] = w.d_wt[a.lo] - (windowed ? ww.lo_wt : 0.0);
-      a.ww_hi[k] = w.d_ww[a.hi] - (windowed ? ww.hi_ww : 0.0);
-      a.wt_hi[k] = w.d_wt[a.hi] - (windowed ? ww.hi_wt : 0.0);
-      a.u[k] = y + w.w_dof;
-      a.v[k] = v + w.w_dof;
-      a.u_next[k] = yn + w.w_dof;
-      a.v_next[k] = vn + w.w_dof;
-      a.accel[k] = acc + w.w_dof;
-      a.wind[k] = W ? W + w.w_dof : nullptr;
-      a.drag_coefficient[k] = cw ? cw + w.w_dof : nullptr;
+      const int o = lat.wires[p.wire[k]].w_dof;
+      a.wind[k] = W ? W + o : nullptr;
+      a.drag_coefficient[k] = cw ? cw + o : nullptr;
     }
-    a.record = s.sweep.data() + kSweepRecord * p.offset;  // the vertical step's scratch
     a.beta = beta;
     a.dt = h;
     a.limit = limit;
@@ -749,28 +758,7 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
   const int np = windowed ? ls.window_point_count : static_cast<int>(lat.point_nodes.size());
   for (int q = 0; q < np; ++q) f[points[q]] = rec[at[points[q]]];
   if (windowed) add_window_forces(m, s, v, f);
-  const int n_springs = windowed ? ls.window_spring_count : static_cast<int>(lat.springs.size());
-  for (int j = 0; j < n_springs; ++j) {
-    const LateralSpring& sp = lat.springs[windowed ? ls.window_springs[j] : j];
-    f[sp.dof] -= sp.stiffness * (y[sp.dof] + beta * v[sp.dof]);
-  }
-  const double* u = s.u.data();
-  double* stretch = ls.dropper_stretch.data();
-  const double* w = ls.lean_weight.data();
-  const int n_pendulums = windowed ? s.window_dropper_count : static_cast<int>(lat.pendulums.size());
-  for (int j = 0; j < n_pendulums; ++j) {
-    const LateralPendulum& p = lat.pendulums[windowed ? s.window_droppers[j] : j];
-    const Dropper& d = m.droppers[p.dropper];
-    // The dropper's tension with its lean's share (two-way coupling, lateral.hpp); summed for the
-    // next vertical step.
-    const double lean = lean_stretch(p, y);
-    stretch[p.dropper] += lean;
-    const double tension = d.static_tension + d.stiffness * ((u[d.messenger_dof] - u[d.contact_dof]) + lean * w[p.dropper]);
-    const double k = std::max(0.0, tension) * p.inv_length;
-    const double df = k * ((y[p.messenger] + beta * v[p.messenger]) - (y[p.contact] + beta * v[p.contact]));
-    f[p.contact] += df;
-    f[p.messenger] -= df;
-  }
+  add_springs_and_pendulums(m, s, windowed, y, [y, v, beta](int i) { return y[i] + beta * v[i]; }, f);
   const double* im = lat.inv_mass.data();
   for (int q = 0; q < np; ++q) {
     const int i = points[q];
@@ -816,7 +804,6 @@ StepStatus lateral_step(const Model& m, State& s) {
   double* f = ls.f.data();
   double* z = ls.z.data();
   const double limit = m.scene.numerics.divergence_limit;
-  const double* u = s.u.data();
   const double t0 = s.time - m.dt;  // the vertical step has already moved the clock on
   // The droppers' lean over this step's substeps (all at this u), for the next vertical step.
   for (double& e : ls.dropper_stretch) e = 0.0;
@@ -873,27 +860,7 @@ StepStatus lateral_step(const Model& m, State& s) {
     } else {
       for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, ls.theta.data());
     }
-    const int n_springs = windowed ? ls.window_spring_count : static_cast<int>(lat.springs.size());
-    for (int j = 0; j < n_springs; ++j) {
-      const LateralSpring& sp = lat.springs[windowed ? ls.window_springs[j] : j];
-      f[sp.dof] -= sp.stiffness * z[sp.dof];
-    }
-    // Pendulums at the droppers' tension now, their lean's stretch included (lateral.hpp): 0 when
-    // slack. The lean is summed for the next vertical step.
-    double* stretch = ls.dropper_stretch.data();
-    const double* w = ls.lean_weight.data();
-    const int n_pendulums = windowed ? s.window_dropper_count : static_cast<int>(lat.pendulums.size());
-    for (int j = 0; j < n_pendulums; ++j) {
-      const LateralPendulum& p = lat.pendulums[windowed ? s.window_droppers[j] : j];
-      const Dropper& d = m.droppers[p.dropper];
-      const double lean = lean_stretch(p, y);
-      stretch[p.dropper] += lean;
-      const double tension = d.static_tension + d.stiffness * ((u[d.messenger_dof] - u[d.contact_dof]) + lean * w[p.dropper]);
-      const double k = std::max(0.0, tension) * p.inv_length;
-      const double df = k * (z[p.messenger] - z[p.contact]);
-      f[p.contact] += df;
-      f[p.messenger] -= df;
-    }
+    add_springs_and_pendulums(m, s, windowed, y, [z](int i) { return z[i]; }, f);
     int out = 0;  // an integer OR vectorises where a max over doubles (NaN rules) does not
     over_stepped(m, s, windowed, [&](int i0, int i1) {
       for (int i = i0; i < i1; ++i) {

@@ -346,4 +346,30 @@ const char* sweep_pack_isa() {
   return "default";
 }
 
+bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, State& s, bool windowed, const double* x,
+                      const double* v, double* x_next, double* v_next, double* accel, PackSweep& a) {
+  const WireWindow& ww0 = s.window[p.wire[0]];
+  a.pack = &p;
+  a.lo = windowed ? ww0.lo : 0;
+  a.hi = windowed ? ww0.hi : p.nodes - 1;
+  if (a.hi < a.lo) return false;
+  a.factors = windowed ? s.sweep_factors.data() + 2 * p.offset : p.factors.data();
+  for (int k = 0; k < p.lanes; ++k) {
+    const Wire& w = wires[p.wire[k]];
+    const WireWindow& ww = s.window[p.wire[k]];
+    // condensed_band_force's dww_at/dwt_at at the ends (x - 0.0 is x: no change without a cut)
+    a.ww_lo[k] = w.d_ww[a.lo] - (windowed ? ww.lo_ww : 0.0);
+    a.wt_lo[k] = w.d_wt[a.lo] - (windowed ? ww.lo_wt : 0.0);
+    a.ww_hi[k] = w.d_ww[a.hi] - (windowed ? ww.hi_ww : 0.0);
+    a.wt_hi[k] = w.d_wt[a.hi] - (windowed ? ww.hi_wt : 0.0);
+    a.u[k] = x + w.w_dof;
+    a.v[k] = v + w.w_dof;
+    a.u_next[k] = x_next + w.w_dof;
+    a.v_next[k] = v_next + w.w_dof;
+    a.accel[k] = accel + w.w_dof;
+  }
+  a.record = s.sweep.data() + kSweepRecord * p.offset;
+  return true;
+}
+
 }  // namespace catenary_sim

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "catenary_sim/core/model.hpp"
+#include "catenary_sim/core/state.hpp"
 
 namespace catenary_sim {
 
@@ -48,6 +49,14 @@ struct PackSweep {
 // Runtime dispatch (GCC target_clones): x86-64-v4 (AVX-512), x86-64-v3 (AVX2) or the portable
 // x86-64 baseline.
 bool sweep_pack(const PackSweep& sweep);
+
+// Sets up pack p's sweep over the window (State::window, the whole wires without one) on the state
+// arrays x, v, x_next, v_next and accel, indexed by `wires`' w_dof (the vertical plane's
+// Model::wires, or the lateral plane's, whose band is the same), its records in State::sweep.
+// The ends take off the cut's share of the band (condensed_band_force's). False when the window
+// holds no node of the pack.
+bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, State& s, bool windowed, const double* x,
+                      const double* v, double* x_next, double* v_next, double* accel, PackSweep& a);
 
 
 }  // namespace catenary_sim

@@ -15,6 +15,8 @@
 // to cover the pass; points between the grid's are linear in x and t.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -35,6 +37,19 @@ struct WindField {
   bool empty() const { return points == 0; }
   // Values at all points at time t (out: `points` entries).
   void at_time(double t, double* out) const;
+  // Station x between points j and j + 1 with the linear weight a of j + 1 (clamped to the field).
+  void locate(double x, int* j, double* a) const {
+    const double q = (x - x0) / dx;
+    *j = std::clamp(static_cast<int>(std::floor(q)), 0, points - 2);
+    *a = std::clamp(q - *j, 0.0, 1.0);
+  }
+  // The field at station x from its values at all points at one time (at_time's out).
+  double at(const double* values, double x) const {
+    int j = 0;
+    double a = 0.0;
+    locate(x, &j, &a);
+    return (1.0 - a) * values[j] + a * values[j + 1];
+  }
 };
 
 // The field over [x_begin, x_end] for at least `duration` s (at least 60 s, at most 2^16 samples).
