@@ -508,7 +508,7 @@ visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const
       if (point_force) continue;
       for (int ci : pg.collectors)
         if (!several || m.collectors[ci].head == hd) {
-          const double hw = m.collectors[ci].half_working_width > 0.0 ? m.collectors[ci].half_working_width : half_width;
+          const double hw = m.collectors[ci].half_working_width;
           strips.points.push_back(point(x + m.collectors[ci].offset, yh - hw, zh - 0.015));
           strips.points.push_back(point(x + m.collectors[ci].offset, yh + hw, zh - 0.015));
         }
