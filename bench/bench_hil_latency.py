@@ -30,7 +30,6 @@ everything started here is stopped on exit. Build first: SKIP_SETUP=1 scripts/bu
 import argparse
 import json
 import os
-import signal
 import subprocess
 import sys
 import time
@@ -104,18 +103,7 @@ def run_rate(rate, duration, env, tmp, chrt, spin_wait, inprocess, watch):
     finally:
         # The node first: a rig stopping first would put it into the safe hold (in-process: the
         # manager, which ends both loops and writes both reports, then the loaders).
-        for p in procs:
-            if p.poll() is None:
-                p.send_signal(signal.SIGINT)
-            try:
-                p.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait(timeout=5)
-            if p in bn._started:
-                bn._started.remove(p)
-        for log in logs:
-            log.close()
+        bn.stop_processes(procs, logs)
     with open(node_report) as f:
         node = json.load(f)
     with open(rig_report) as f:

@@ -21,7 +21,6 @@ port); everything started here is stopped on exit. Build first: SKIP_SETUP=1 scr
 import argparse
 import json
 import os
-import signal
 import subprocess
 import sys
 
@@ -55,18 +54,7 @@ def run_udp(rate, duration, tmp):
             raise RuntimeError(f"catenary_sim_hil_udp exited with {procs[0].returncode}; see {tmp}")
         load1 = hl.loadavg()
     finally:
-        for p in reversed(procs):
-            if p.poll() is None:
-                p.send_signal(signal.SIGINT)
-            try:
-                p.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait(timeout=5)
-            if p in bn._started:
-                bn._started.remove(p)
-        for log in logs:
-            log.close()
+        bn.stop_processes(list(reversed(procs)), logs)
     with open(report) as f:
         return {"node": json.load(f), "load": f"{load0} -> {load1}"}
 

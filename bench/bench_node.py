@@ -164,6 +164,22 @@ def private_roscore(prefix):
     return env
 
 
+def stop_processes(procs, logs=()):
+    """Stops `procs` in their order (SIGINT, then kill after 20 s) and closes `logs`."""
+    for p in procs:
+        if p.poll() is None:
+            p.send_signal(signal.SIGINT)
+        try:
+            p.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait(timeout=5)
+        if p in _started:
+            _started.remove(p)
+    for log in logs:
+        log.close()
+
+
 def run(cmd, env, timeout, logname):
     with open(logname, "w") as f:
         try:
