@@ -47,20 +47,25 @@ WindField make_wind_field(const WindSpec& wind, double x_begin, double x_end, do
   std::mt19937_64 gen(t.seed);
   // Uniform phase in [0, 2 pi) from 53 random bits (the same on every machine).
   auto phase = [&gen]() { return 2.0 * M_PI * static_cast<double>(gen() >> 11) * (1.0 / 9007199254740992.0); };
-  // Coefficients per point, frequency by frequency (the autoregression runs along the line).
+  // Coefficients per point, the autoregression running along the line for every frequency. The
+  // phases are drawn point by point (all frequencies of point 0, then of point 1, ...), so that a
+  // field over a longer stretch from the same first point, with the same time grid, extends a
+  // shorter one: an endless line's field and a finite line's agree where both reach.
   std::vector<std::complex<double>> c(static_cast<std::size_t>(w.points) * (nf + 1), 0.0);
+  std::vector<double> amplitude(nf, 0.0), rho(nf, 0.0), innovation(nf, 0.0);
   double var = 0.0;
   for (int k = 1; k < nf; ++k) {
     const double f = k * df;
-    const double a = std::sqrt(2.0 * von_karman_spectrum(f, U, sigma, t.length_scale) * df);
-    var += 0.5 * a * a;
-    const double rho = std::exp(-t.coherence_decay * f * w.dx / U), s = std::sqrt(1.0 - rho * rho);
-    std::complex<double> prev = std::polar(a, phase());
-    c[k] = prev;
-    for (int j = 1; j < w.points; ++j) {
-      prev = rho * prev + s * std::polar(a, phase());
-      c[static_cast<std::size_t>(j) * (nf + 1) + k] = prev;
-    }
+    amplitude[k] = std::sqrt(2.0 * von_karman_spectrum(f, U, sigma, t.length_scale) * df);
+    var += 0.5 * amplitude[k] * amplitude[k];
+    rho[k] = std::exp(-t.coherence_decay * f * w.dx / U);
+    innovation[k] = std::sqrt(1.0 - rho[k] * rho[k]);
+  }
+  for (int k = 1; k < nf; ++k) c[k] = std::polar(amplitude[k], phase());
+  for (int j = 1; j < w.points; ++j) {
+    const std::complex<double>* prev = c.data() + static_cast<std::size_t>(j - 1) * (nf + 1);
+    std::complex<double>* cj = c.data() + static_cast<std::size_t>(j) * (nf + 1);
+    for (int k = 1; k < nf; ++k) cj[k] = rho[k] * prev[k] + innovation[k] * std::polar(amplitude[k], phase());
   }
   w.sigma_target = std::sqrt(var);
   // Re sum_k c_k e^{i 2 pi k n / N}: Eigen's unscaled half-spectrum inverse gives
