@@ -397,7 +397,8 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
   bool outside = false;
   for (const WireLanes& p : m.wire_packs) {
     PackSweep a;
-    if (!setup_pack_sweep(p, m.wires, s, windowed, u, v, un, vn, acc, a)) continue;
+    if (!setup_pack_sweep(p, m.wires, windowed ? &s.window : nullptr, s.sweep_factors.data(), s.sweep.data(), u, v, un, vn,
+                          acc, a)) continue;
     a.beta = beta;
     a.dt = dt;
     a.limit = limit;

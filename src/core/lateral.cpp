@@ -237,6 +237,23 @@ std::vector<double> stagger_errors(const Model& m) {
   return e;
 }
 
+double gust_lead_time(const Scene& sc) {
+  if (!sc.wind || !sc.wind->turbulence || !(sc.wind->speed > 0.0) || !sc.numerics.windowed()) return 0.0;
+  if (sc.numerics.gust_lead) return *sc.numerics.gust_lead;
+  if (!sc.endless) return 0.0;
+  // A span entering the window at rest lacks the resonant motion the gusts build up; what is left
+  // of that start decays as exp(-sigma t), so after 2 / sigma its share of the rms is some 5 % of
+  // the resonant part's, and the rms itself is short by a fraction of a percent (BENCHMARKS.md).
+  const WindSpec& w = *sc.wind;
+  const double normal = w.speed * std::fabs(std::sin(w.direction * M_PI / 180.0 - sc.alignment.heading(0.0)));
+  auto sigma = [&](const WireDragSpec& d, double linear_mass) {
+    return w.air_density * d.drag_coefficient * d.diameter * normal / (2.0 * linear_mass) + 0.5 * sc.rayleigh_alpha;
+  };
+  double slowest = sigma(w.contact_wire, sc.contact_wire.linear_mass);
+  if (sc.messenger) slowest = std::min(slowest, sigma(w.messenger, sc.messenger->linear_mass));
+  return slowest > kGustLeadDecays / kAutoGustLeadMax ? kGustLeadDecays / slowest : kAutoGustLeadMax;
+}
+
 std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   const Scene& sc = m.scene;
   const std::vector<double> stagger_error = stagger_errors(m);
@@ -375,7 +392,8 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
       }
     }
   }
-  lat->windowed = sc.numerics.windowed() && (m.endless || lat->field.empty());
+  lat->windowed = sc.numerics.windowed() && (m.endless || lat->field.empty() || sc.numerics.gust_lead.has_value());
+  lat->gust_lead = lat->windowed ? gust_lead_time(sc) : 0.0;
   const PantographHeadSpec& head = sc.pantograph_head;
   lat->half_working_width = 0.5 * head.working_width;
   lat->half_horn_width = 0.5 * head.horn_width;
@@ -467,9 +485,14 @@ LateralState make_lateral_state(const Model& m) {
   s.dropper_stretch.assign(m.droppers.size(), 0.0);
   s.lean_weight.assign(m.droppers.size(), 1.0);
   for (const LateralPendulum& p : lat.pendulums) s.dropper_stretch[p.dropper] = lean_stretch(p, s.y.data());  // 0: y is initial
-  s.window_lo.assign(m.wires.size(), 0);
-  s.window_hi.assign(m.wires.size(), -1);
+  s.window.resize(lat.wires.size());
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    s.window[wi].tt_lower.assign(lat.wires[wi].nodes(), 0.0);
+    s.window[wi].tt_inv_pivot.assign(lat.wires[wi].nodes(), 0.0);
+  }
+  if (lat.windowed && !lat.planes.empty()) s.sweep_factors.assign(2 * m.sweep_size, 0.0);
   s.window_springs.assign(lat.springs.size(), 0);
+  s.window_droppers.assign(lat.pendulums.size(), 0);
   s.cut_node.assign(2 * kCutLayer * m.wires.size(), 0);
   s.cut_force.assign(s.cut_node.size(), 0.0);
   s.window_points.assign(s.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size(), 0);
@@ -576,38 +599,55 @@ void over_stepped(const Model& m, const State& s, bool windowed, Body&& body) {
   }
   const LateralState& ls = s.lateral;
   for (std::size_t wi = 0; wi < m.lateral->wires.size(); ++wi)
-    if (ls.window_hi[wi] >= ls.window_lo[wi]) {
+    if (ls.window[wi].hi >= ls.window[wi].lo) {
       const int o = m.lateral->wires[wi].w_dof;
-      body(o + ls.window_lo[wi], o + ls.window_hi[wi] + 1);
+      body(o + ls.window[wi].lo, o + ls.window[wi].hi + 1);
     }
 }
 
 // The moving window (numerics.window): the lateral plane steps the vertical plane's window
 // (State::window, which update_window moved before this step; the lateral waves run at the same
-// sqrt(T/rhoA), so the same window holds their echoes). When it moved, the nodes that left it
-// return to the static state under the mean wind at rest (as the vertical plane's to u = 0), the
-// nodes that entered (already there) get the wind of the last refresh, and the lists are rebuilt:
-// springs and pendulums in the window, and at each cut the static force of the elements left out
-// (-K initial of the whole line less the window's), so that the static state stays at rest in the
-// window as outside it. Costs what the window holds (bisection for the springs), not the line.
+// sqrt(T/rhoA), so the same window holds their echoes) and, in a turbulent wind, a lead of
+// LateralModel::gust_lead seconds of travel further ahead, so that a span has felt the gusts that
+// long when the pantograph reaches it. When it moved, the nodes that left it return to the static
+// state under the mean wind at rest (as the vertical plane's to u = 0), the nodes that entered
+// get the wind of the last refresh, and the lists are rebuilt: springs and pendulums in the
+// window, and at each cut the static force of the elements left out (-K initial of the whole line
+// less the window's), so that the static state stays at rest in the window as outside it. Costs
+// what the window holds (bisection for the springs and droppers), not the line.
 void sync_window(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
-  bool moved = ls.window_dirty;
-  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi)
-    moved |= ls.window_lo[wi] != s.window[wi].lo || ls.window_hi[wi] != s.window[wi].hi;
-  if (!moved) return;
+  const std::vector<double>& sx = m.support_x;
+  const int first = s.window_first_support;
+  int last = s.window_last_support;
+  if (first >= 0 && lat.gust_lead > 0.0) {
+    const double hi_x = sx[last] + lat.gust_lead * std::fabs(s.speed);  // the lead, snapped outward to a support
+    last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x - 1e-6) - sx.begin());
+    last = std::min(last, static_cast<int>(sx.size()) - 1);
+  }
+  if (first == ls.window_first_support && last == ls.window_last_support && !ls.window_dirty) return;
   ls.window_dirty = false;
+  ls.window_first_support = first;
+  ls.window_last_support = last;
   const bool turbulent = lat.windy && !lat.field.empty();
   double* y = ls.y.data();
   double* v = ls.v.data();
   double* f = ls.f.data();
   ls.cut_count = 0;
   ls.window_fused = !lat.planes.empty();
+  const double xa = first >= 0 ? sx[first] : 0.0, xb = first >= 0 ? sx[last] : -1.0;
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     const Wire& w = lat.wires[wi];
-    const WireWindow& ww = s.window[wi];
-    const int o = w.w_dof, lo = ww.lo, hi = ww.hi, old_lo = ls.window_lo[wi], old_hi = ls.window_hi[wi];
+    WireWindow& ww = ls.window[wi];
+    const int o = w.w_dof, old_lo = ww.lo, old_hi = ww.hi;
+    if (first >= 0) {
+      set_wire_window(w, xa, xb, ww);
+    } else {
+      ww.lo = 0;
+      ww.hi = -1;
+    }
+    const int lo = ww.lo, hi = ww.hi;
     for (int i = old_lo; i <= old_hi; ++i)
       if (i < lo || i > hi) {
         y[o + i] = lat.initial[o + i];
@@ -616,8 +656,6 @@ void sync_window(const Model& m, State& s) {
     if (turbulent)
       for (int i = lo; i <= hi; ++i)
         if (i < old_lo || i > old_hi) refresh_wind(m, s, o + i, o + i + 1);
-    ls.window_lo[wi] = lo;
-    ls.window_hi[wi] = hi;
     if (hi < lo) continue;
     if (hi == lo) ls.window_fused = false;  // (as the vertical step: the sweep needs two nodes)
     if (!ww.cut_lo && !ww.cut_hi) continue;
@@ -633,32 +671,37 @@ void sync_window(const Model& m, State& s) {
       for (int i = std::max(lo_end + 1, hi - kCutLayer + 1); i <= hi; ++i) add_cut(i);
   }
   for (const WireLanes& p : m.wire_packs)
-    if (p.lanes == 2 && (s.window[p.wire[0]].lo != s.window[p.wire[1]].lo || s.window[p.wire[0]].hi != s.window[p.wire[1]].hi))
+    if (p.lanes == 2 && (ls.window[p.wire[0]].lo != ls.window[p.wire[1]].lo || ls.window[p.wire[0]].hi != ls.window[p.wire[1]].hi))
       ls.window_fused = false;
-  // Springs between the window's end supports whose node it holds.
+  if (ls.window_fused) interleave_window_factors(m.wire_packs, ls.window, ls.sweep_factors.data());
+  auto inside = [&](int dof) {  // a lateral DOF in the window
+    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+      const int i = dof - lat.wires[wi].w_dof;
+      if (i >= 0 && i < lat.wires[wi].nodes()) return i >= ls.window[wi].lo && i <= ls.window[wi].hi;
+    }
+    return false;
+  };
+  // Springs and pendulums (droppers) between the window's end supports whose nodes it holds.
   ls.window_spring_count = 0;
-  if (s.window_first_support >= 0) {
-    const double a = m.support_x[s.window_first_support], b = m.support_x[s.window_last_support];
+  ls.window_dropper_count = 0;
+  if (first >= 0) {
     const std::vector<double>& xs = lat.spring_order_x;
-    for (std::size_t j = std::lower_bound(xs.begin(), xs.end(), a - 1e-6) - xs.begin(); j < xs.size() && xs[j] <= b + 1e-6;
+    for (std::size_t j = std::lower_bound(xs.begin(), xs.end(), xa - 1e-6) - xs.begin(); j < xs.size() && xs[j] <= xb + 1e-6;
+         ++j)
+      if (inside(lat.springs[lat.spring_order[j]].dof)) ls.window_springs[ls.window_spring_count++] = lat.spring_order[j];
+    const std::vector<double>& dx = m.dropper_order_x;
+    for (std::size_t j = std::lower_bound(dx.begin(), dx.end(), xa - 1e-6) - dx.begin(); j < dx.size() && dx[j] <= xb + 1e-6;
          ++j) {
-      const int k = lat.spring_order[j], dof = lat.springs[k].dof;
-      for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
-        const int i = dof - lat.wires[wi].w_dof;
-        if (i >= 0 && i < lat.wires[wi].nodes()) {
-          if (i >= ls.window_lo[wi] && i <= ls.window_hi[wi]) ls.window_springs[ls.window_spring_count++] = k;
-          break;
-        }
-      }
+      const LateralPendulum& p = lat.pendulums[m.dropper_order[j]];
+      if (inside(p.contact) && inside(p.messenger)) ls.window_droppers[ls.window_dropper_count++] = m.dropper_order[j];
     }
   }
-  // The fused step's nodes with point forces: the cut layers, springs, pendulums (one per dropper
-  // in the window: State::window_droppers).
+  // The fused step's nodes with point forces: the cut layers, springs, pendulums.
   int q = 0;
   for (int j = 0; j < ls.cut_count; ++j) ls.window_points[q++] = ls.cut_node[j];
   for (int j = 0; j < ls.window_spring_count; ++j) ls.window_points[q++] = lat.springs[ls.window_springs[j]].dof;
-  for (int j = 0; j < s.window_dropper_count; ++j) {
-    const LateralPendulum& p = lat.pendulums[s.window_droppers[j]];
+  for (int j = 0; j < ls.window_dropper_count; ++j) {
+    const LateralPendulum& p = lat.pendulums[ls.window_droppers[j]];
     ls.window_points[q++] = p.contact;
     ls.window_points[q++] = p.messenger;
   }
@@ -673,7 +716,7 @@ void add_window_forces(const Model& m, const State& s, const double* v, double* 
   const LateralState& ls = s.lateral;
   for (int j = 0; j < ls.cut_count; ++j) f[ls.cut_node[j]] += ls.cut_force[j];
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
-    const WireWindow& ww = s.window[wi];
+    const WireWindow& ww = ls.window[wi];
     if (ww.hi < ww.lo) continue;
     const Wire& w = lat.wires[wi];
     const double c = std::sqrt(w.spec.tension * w.spec.linear_mass);
@@ -699,9 +742,9 @@ void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const do
   const double* u = s.u.data();
   double* stretch = ls.dropper_stretch.data();
   const double* w = ls.lean_weight.data();
-  const int n_pendulums = windowed ? s.window_dropper_count : static_cast<int>(lat.pendulums.size());
+  const int n_pendulums = windowed ? ls.window_dropper_count : static_cast<int>(lat.pendulums.size());
   for (int j = 0; j < n_pendulums; ++j) {
-    const LateralPendulum& p = lat.pendulums[windowed ? s.window_droppers[j] : j];
+    const LateralPendulum& p = lat.pendulums[windowed ? ls.window_droppers[j] : j];
     const Dropper& d = m.droppers[p.dropper];
     const double lean = lean_stretch(p, y);
     stretch[p.dropper] += lean;
@@ -738,7 +781,9 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
     const WireLanes& p = m.wire_packs[pk];
     PackSweep a;
     // (the records in the vertical step's scratch)
-    if (!setup_pack_sweep(p, lat.wires, s, windowed, y, v, yn, vn, acc, a)) continue;
+    if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, ls.sweep_factors.data(), s.sweep.data(), y, v, yn,
+                          vn, acc, a))
+      continue;
     a.plane = lat.planes[pk].data();
     for (int k = 0; k < p.lanes; ++k) {
       const int o = lat.wires[p.wire[k]].w_dof;
@@ -855,7 +900,7 @@ StepStatus lateral_step(const Model& m, State& s) {
       }
     });
     if (windowed) {
-      for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) wire_elastic_force_window(lat.wires[wi], s.window[wi], z, f, ls.theta.data());
+      for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) wire_elastic_force_window(lat.wires[wi], ls.window[wi], z, f, ls.theta.data());
       add_window_forces(m, s, v, f);
     } else {
       for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, ls.theta.data());
@@ -896,7 +941,7 @@ void shift_lateral_block(const Model& m, State& s) {
     const int ns = m.endless_shift_spans * m.span_nodes[wi], o = w.w_dof, nn = w.nodes();
     // The nodes stepped: the window (outside it they are in the static state), as the vertical
     // plane moves its window (shift_endless_block).
-    const int lo = windowed ? ls.window_lo[wi] : 0, hi = windowed ? ls.window_hi[wi] : nn - 1;
+    const int lo = windowed ? ls.window[wi].lo : 0, hi = windowed ? ls.window[wi].hi : nn - 1;
     if (hi < lo) continue;
     // Upward, the destination below the source. Held nodes (supports at the stagger, which
     // repeats with the block's move) keep their value. The wind moves along: a node's station
@@ -916,11 +961,11 @@ void shift_lateral_block(const Model& m, State& s) {
         ls.v[o + i] = 0.0;
       }
     if (windowed) {
-      ls.window_lo[wi] = std::max(0, lo - ns);
-      ls.window_hi[wi] = hi - ns;
+      ls.window[wi].lo = std::max(0, lo - ns);
+      ls.window[wi].hi = hi - ns;
     }
   }
-  ls.window_dirty = true;  // the lists hold the old DOFs
+  ls.window_dirty = true;  // the lists and factors hold the old DOFs (the node ranges already match)
   set_dropper_stretch(m, s);  // the droppers' lean moved with the block
 }
 

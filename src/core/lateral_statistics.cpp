@@ -54,14 +54,14 @@ void LateralRecorder::record(const Model& m, const State& s) {
   }
   if (s.time + 1e-12 >= next_blow_off_) {
     next_blow_off_ = s.time + kBlowOffPeriod;
-    const bool windowed = lat.windowed && !s.lateral.window_lo.empty();
+    const bool windowed = lat.windowed && !s.lateral.window.empty();
     const double* y = s.lateral.y.data();
     const double* calm = lat.calm.data();
     for (const BlowOffRange& r : blow_off_ranges_) {
       int b = r.begin, e = r.end;
       if (windowed) {
-        b = std::max(b, s.lateral.window_lo[r.wire]);
-        e = std::min(e, s.lateral.window_hi[r.wire] + 1);
+        b = std::max(b, s.lateral.window[r.wire].lo);
+        e = std::min(e, s.lateral.window[r.wire].hi + 1);
       }
       const int o = lat.wires[r.wire].w_dof;
       double most = max_blow_off_[r.span];

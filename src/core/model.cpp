@@ -515,7 +515,11 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
     collector_extent(scene, &lead, &rear);
     auto spans_for = [&](double length) { return static_cast<int>(std::ceil(length / span - 1e-9)); };
     const int margin = kEndlessMargin, behind = spans_for(std::max(behind_slow, behind_fast)) + 1;
-    const int ahead = spans_for(std::max(ahead_slow, ahead_fast)) + 1, train = spans_for(lead - rear);
+    // In a turbulent wind the lateral plane's window reaches a gust lead further (lateral.hpp),
+    // snapped outward to a support once more.
+    const double gusts = gust_lead_time(scene) * std::max(scene.train_speed, Simulation::kMaxSpeed);
+    const int ahead = spans_for(std::max(ahead_slow, ahead_fast) + gusts) + (gusts > 0.0 ? 2 : 1);
+    const int train = spans_for(lead - rear);
     // A 3-D line's stagger pattern repeats after `period` supports: the block moves by that many
     // spans (the rearmost collector stays within [home, home + period) spans).
     int period = 1;

@@ -814,6 +814,22 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
         w.finish();
       }
     }
+    if (r.has("gust_lead")) {
+      const YAML::Node n = r.child("gust_lead");
+      const std::string raw = n.IsScalar() ? n.as<std::string>() : "(not a scalar)";
+      if (raw != "auto") {
+        double v = std::nan("");
+        if (n.IsScalar()) {
+          try {
+            v = n.as<double>();
+          } catch (const YAML::Exception&) {
+          }
+        }
+        if (!(v >= 0.0 && v <= kMaxGustLead))
+          fail("numerics.gust_lead", raw, "auto, or seconds of travel in [0, " + fmt(kMaxGustLead) + "]");
+        s.numerics.gust_lead = v;
+      }
+    }
     r.finish();
   }
   if (top.has("imperfections")) {

@@ -67,6 +67,57 @@ void shift_endless_block(const Model& m, State& s) {
   s.window_first_support = s.window_last_support = -1;
 }
 
+void set_wire_window(const Wire& w, double a, double b, WireWindow& ww) {
+  const int n = w.nodes();
+  ww.lo = static_cast<int>(std::lower_bound(w.x.begin(), w.x.end(), a - 1e-9) - w.x.begin());
+  ww.hi = static_cast<int>(std::upper_bound(w.x.begin(), w.x.end(), b + 1e-9) - w.x.begin()) - 1;
+  if (ww.hi < ww.lo) return;
+  ww.cut_lo = ww.lo > 0;
+  ww.cut_hi = ww.hi < n - 1;
+  ww.lo_ww = ww.lo_wt = ww.lo_tt = ww.hi_ww = ww.hi_wt = ww.hi_tt = 0.0;
+  if (ww.cut_lo) {
+    const Matrix4 k = beam_stiffness(w.x[ww.lo] - w.x[ww.lo - 1], w.spec.bending_stiffness, w.spec.tension);
+    ww.lo_ww = k[2][2];
+    ww.lo_wt = k[2][3];
+    ww.lo_tt = k[3][3];
+  }
+  if (ww.cut_hi) {
+    const Matrix4 k = beam_stiffness(w.x[ww.hi + 1] - w.x[ww.hi], w.spec.bending_stiffness, w.spec.tension);
+    ww.hi_ww = k[0][0];
+    ww.hi_wt = k[0][1];
+    ww.hi_tt = k[1][1];
+  }
+  // LDL^T of the window's tridiagonal K_theta_theta (free rotations at the cut ends).
+  double d = 0.0;
+  for (int i = ww.lo; i <= ww.hi; ++i) {
+    double diag = w.d_tt[i];
+    if (i == ww.lo) diag -= ww.lo_tt;
+    if (i == ww.hi) diag -= ww.hi_tt;
+    if (i == ww.lo) {
+      d = diag;
+      ww.tt_lower[i] = 0.0;
+    } else {
+      const double l = w.e_tt[i - 1] / d;
+      d = diag - l * w.e_tt[i - 1];
+      ww.tt_lower[i] = l;
+    }
+    ww.tt_inv_pivot[i] = 1.0 / d;
+  }
+}
+
+void interleave_window_factors(const std::vector<WireLanes>& packs, const std::vector<WireWindow>& windows,
+                               double* sweep_factors) {
+  for (const WireLanes& p : packs)
+    for (int k = 0; k < p.lanes; ++k) {
+      const WireWindow& ww = windows[p.wire[k]];
+      double* f = sweep_factors + 2 * p.offset;
+      for (int i = ww.lo; i <= ww.hi; ++i) {
+        f[(2 * static_cast<std::size_t>(i) + 0) * p.lanes + k] = ww.tt_lower[i];
+        f[(2 * static_cast<std::size_t>(i) + 1) * p.lanes + k] = ww.tt_inv_pivot[i];
+      }
+    }
+}
+
 void update_window(const Model& m, State& s) {
   double x_min = 1e300, x_max = -1e300;
   for (const Pantograph& p : m.pantographs) {
@@ -93,58 +144,15 @@ void update_window(const Model& m, State& s) {
     const Wire& w = m.wires[wi];
     WireWindow& ww = s.window[wi];
     const int old_lo = ww.lo, old_hi = ww.hi;
-    const int n = w.nodes();
-    ww.lo = static_cast<int>(std::lower_bound(w.x.begin(), w.x.end(), a - 1e-9) - w.x.begin());
-    ww.hi = static_cast<int>(std::upper_bound(w.x.begin(), w.x.end(), b + 1e-9) - w.x.begin()) - 1;
+    set_wire_window(w, a, b, ww);
     // Nodes that left the window return to the static state.
     for (int i = old_lo; i <= old_hi; ++i)
       if (i < ww.lo || i > ww.hi) {
         s.u[w.w_dof + i] = 0.0;
         s.v[w.w_dof + i] = 0.0;
       }
-    if (ww.hi < ww.lo) continue;
-    ww.cut_lo = ww.lo > 0;
-    ww.cut_hi = ww.hi < n - 1;
-    ww.lo_ww = ww.lo_wt = ww.lo_tt = ww.hi_ww = ww.hi_wt = ww.hi_tt = 0.0;
-    if (ww.cut_lo) {
-      const Matrix4 k = beam_stiffness(w.x[ww.lo] - w.x[ww.lo - 1], w.spec.bending_stiffness, w.spec.tension);
-      ww.lo_ww = k[2][2];
-      ww.lo_wt = k[2][3];
-      ww.lo_tt = k[3][3];
-    }
-    if (ww.cut_hi) {
-      const Matrix4 k = beam_stiffness(w.x[ww.hi + 1] - w.x[ww.hi], w.spec.bending_stiffness, w.spec.tension);
-      ww.hi_ww = k[0][0];
-      ww.hi_wt = k[0][1];
-      ww.hi_tt = k[1][1];
-    }
-    // LDL^T of the window's tridiagonal K_theta_theta (free rotations at the cut ends).
-    double d = 0.0;
-    for (int i = ww.lo; i <= ww.hi; ++i) {
-      double diag = w.d_tt[i];
-      if (i == ww.lo) diag -= ww.lo_tt;
-      if (i == ww.hi) diag -= ww.hi_tt;
-      if (i == ww.lo) {
-        d = diag;
-        ww.tt_lower[i] = 0.0;
-      } else {
-        const double l = w.e_tt[i - 1] / d;
-        d = diag - l * w.e_tt[i - 1];
-        ww.tt_lower[i] = l;
-      }
-      ww.tt_inv_pivot[i] = 1.0 / d;
-    }
   }
-  // The factors interleaved for the fused step (both lanes of a pack share the node range).
-  for (const WireLanes& p : m.wire_packs)
-    for (int k = 0; k < p.lanes; ++k) {
-      const WireWindow& ww = s.window[p.wire[k]];
-      double* f = s.sweep_factors.data() + 2 * p.offset;
-      for (int i = ww.lo; i <= ww.hi; ++i) {
-        f[(2 * static_cast<std::size_t>(i) + 0) * p.lanes + k] = ww.tt_lower[i];
-        f[(2 * static_cast<std::size_t>(i) + 1) * p.lanes + k] = ww.tt_inv_pivot[i];
-      }
-    }
+  interleave_window_factors(m.wire_packs, s.window, s.sweep_factors.data());
   auto inside = [&](int dof) {
     for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
       const Wire& w = m.wires[wi];

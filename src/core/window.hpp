@@ -11,6 +11,16 @@ namespace catenary_sim {
 void window_lengths_for(const NumericsSpec& numerics, double wave_speed, double span, double speed, double* ahead,
                         double* behind);
 
+// One wire's window over the supports at stations a <= b: its node range, the cut ends' share of
+// the band and the LDL^T factors of its K_theta_theta (the vertical plane's window, and the lateral
+// plane's, which may reach further ahead: lateral.cpp).
+void set_wire_window(const Wire& wire, double a, double b, WireWindow& window);
+
+// The windows' factors interleaved per pack for the fused step (both lanes of a pack share the
+// node range), laid out as WireLanes::factors at the pack's offset.
+void interleave_window_factors(const std::vector<WireLanes>& packs, const std::vector<WireWindow>& windows,
+                               double* sweep_factors);
+
 // Moves the window to the pantographs if they crossed into another span; no allocation.
 void update_window(const Model& model, State& state);
 

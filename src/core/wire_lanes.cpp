@@ -346,17 +346,20 @@ const char* sweep_pack_isa() {
   return "default";
 }
 
-bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, State& s, bool windowed, const double* x,
-                      const double* v, double* x_next, double* v_next, double* accel, PackSweep& a) {
-  const WireWindow& ww0 = s.window[p.wire[0]];
+bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const std::vector<WireWindow>* windows,
+                      const double* window_factors, double* records, const double* x, const double* v, double* x_next,
+                      double* v_next, double* accel, PackSweep& a) {
+  const bool windowed = windows != nullptr;
+  const WireWindow none;
+  const WireWindow& ww0 = windowed ? (*windows)[p.wire[0]] : none;
   a.pack = &p;
   a.lo = windowed ? ww0.lo : 0;
   a.hi = windowed ? ww0.hi : p.nodes - 1;
   if (a.hi < a.lo) return false;
-  a.factors = windowed ? s.sweep_factors.data() + 2 * p.offset : p.factors.data();
+  a.factors = windowed ? window_factors + 2 * p.offset : p.factors.data();
   for (int k = 0; k < p.lanes; ++k) {
     const Wire& w = wires[p.wire[k]];
-    const WireWindow& ww = s.window[p.wire[k]];
+    const WireWindow& ww = windowed ? (*windows)[p.wire[k]] : none;
     // condensed_band_force's dww_at/dwt_at at the ends (x - 0.0 is x: no change without a cut)
     a.ww_lo[k] = w.d_ww[a.lo] - (windowed ? ww.lo_ww : 0.0);
     a.wt_lo[k] = w.d_wt[a.lo] - (windowed ? ww.lo_wt : 0.0);
@@ -368,7 +371,7 @@ bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, State&
     a.v_next[k] = v_next + w.w_dof;
     a.accel[k] = accel + w.w_dof;
   }
-  a.record = s.sweep.data() + kSweepRecord * p.offset;
+  a.record = records + kSweepRecord * p.offset;
   return true;
 }
 

@@ -50,13 +50,15 @@ struct PackSweep {
 // x86-64 baseline.
 bool sweep_pack(const PackSweep& sweep);
 
-// Sets up pack p's sweep over the window (State::window, the whole wires without one) on the state
-// arrays x, v, x_next, v_next and accel, indexed by `wires`' w_dof (the vertical plane's
-// Model::wires, or the lateral plane's, whose band is the same), its records in State::sweep.
-// The ends take off the cut's share of the band (condensed_band_force's). False when the window
-// holds no node of the pack.
-bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, State& s, bool windowed, const double* x,
-                      const double* v, double* x_next, double* v_next, double* accel, PackSweep& a);
+// Sets up pack p's sweep over `windows` (per wire of `wires`, their factors interleaved in
+// `window_factors`: the vertical plane's State::window or the lateral plane's own; null: the whole
+// wires) on the state arrays x, v, x_next, v_next and accel, indexed by `wires`' w_dof (the
+// vertical plane's Model::wires, or the lateral plane's, whose band is the same), its records in
+// `records` (State::sweep). The ends take off the cut's share of the band (condensed_band_force's).
+// False when the window holds no node of the pack.
+bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const std::vector<WireWindow>* windows,
+                      const double* window_factors, double* records, const double* x, const double* v, double* x_next,
+                      double* v_next, double* accel, PackSweep& a);
 
 
 }  // namespace catenary_sim

@@ -543,6 +543,11 @@ TEST(Lateral, BadInputNamesTheField) {
   EXPECT_NE(error_of("wind: {speed: 20, turbulence: {intensity: 0.1, seed: 1.5}}\n").find("wind.turbulence.seed"),
             std::string::npos);
   EXPECT_NE(error_of("pantograph_head: {on_dewirement: maybe}\n").find("pantograph_head.on_dewirement"), std::string::npos);
+  for (const char* lead : {"-1", "61", "soon", "[1, 2]"}) {
+    const std::string e = error_of(std::string("numerics: {window: auto, gust_lead: ") + lead + "}\n");
+    EXPECT_NE(e.find("numerics.gust_lead"), std::string::npos) << e;
+    EXPECT_NE(e.find("auto, or seconds"), std::string::npos) << e;
+  }
   EXPECT_NE(error_of("pantograph_head: {working_width: 1.5, horn_width: 1.0}\n").find("pantograph_head.horn_width"),
             std::string::npos);
   EXPECT_NE(error_of("stagger: {contact_wire: [0.2], steady_arm_stiffness: -5}\n").find("stagger.steady_arm_stiffness"),
@@ -662,9 +667,9 @@ TEST(Lateral, WindowGivesTheFullLinesContactPoint) {
   const State& s = b.state();
   int outside = 0;
   for (std::size_t wi = 0; wi < m.lateral->wires.size(); ++wi) {
-    ASSERT_LT(s.window[wi].lo, s.window[wi].hi);
+    ASSERT_LT(s.lateral.window[wi].lo, s.lateral.window[wi].hi);
     const int o = m.lateral->wires[wi].w_dof;
-    for (int i = 0; i < s.window[wi].lo; ++i, ++outside) {
+    for (int i = 0; i < s.lateral.window[wi].lo; ++i, ++outside) {
       ASSERT_EQ(s.lateral.y[o + i], m.lateral->initial[o + i]) << "wire " << wi << " node " << i;
       ASSERT_EQ(s.lateral.v[o + i], 0.0) << "wire " << wi << " node " << i;
     }
@@ -712,6 +717,74 @@ TEST(Lateral, EndlessLineGivesTheFiniteLinesContactPoint) {
   // a lateral difference under 1 mm, a tenth of that or less, bounds it by 0.6 N (a block out of
   // step with the stagger puts the wires 0.6 m off and the leans' stretch by centimetres).
   EXPECT_NEAR(total_contact_force(a.model(), a.state(), 0), total_contact_force(b.model(), b.state(), 0), 0.6);
+}
+
+TEST(Lateral, GustLeadGivesTheEndlessLineTheFiniteLinesTurbulentMotion) {
+  // The endless reference line against a finite 66-span one, staggered and swaying as in
+  // EndlessAndFinite, in the same turbulent 20 m/s cross wind: both fields start at station 0
+  // with the same time grid, so they are one realisation where both reach (make_wind_field draws
+  // point by point). The block starts at station 0: with the train front at 500 m the collector
+  // is in span 9, the block's home at the balanced preset (asserted through the offset).
+  const std::vector<std::string> common = {"train.start=500", "train.end=3300", "wind.speed=20",
+                                           "wind.turbulence.intensity=0.15", "wind.turbulence.seed=3"};
+  auto endless_scene = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> ov = common;
+    ov.insert(ov.end(), extra.begin(), extra.end());
+    return load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml", EndlessAndFinite::pass(ov));
+  };
+  auto finite_scene = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> ov = common;
+    ov.insert(ov.end(), extra.begin(), extra.end());
+    std::vector<std::string> p = EndlessAndFinite::finite_pass(ov);
+    p.push_back("line.span_count=66");  // (the later key wins: 3630 m, beyond the pass's window)
+    return load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", p);
+  };
+  Simulation endless(endless_scene({})), no_lead(endless_scene({"numerics.gust_lead=0"}));
+  Simulation finite(finite_scene({})), steady(finite_scene({"wind.turbulence=null"}));
+  const LateralModel& lat = *endless.model().lateral;
+  ASSERT_EQ(endless.model().initial_line_offset, 0.0);
+  ASSERT_FALSE(finite.model().lateral->windowed);  // a finite line in a turbulent wind: its whole lateral plane
+  ASSERT_EQ(lat.field.x0, finite.model().lateral->field.x0);
+  ASSERT_EQ(lat.field.samples, finite.model().lateral->field.samples);
+  // The auto lead: two decay times of the contact wire's lateral motion (the slower wire here),
+  // sigma = rho Cd d U / (2 m') + alpha / 2 (the default drag: Cd 1.0, d 12 mm).
+  const double sigma = 1.225 * 1.0 * 0.012 * 20.0 / (2.0 * 1.35) + 0.5 * 0.0125;
+  EXPECT_NEAR(lat.gust_lead, 2.0 / sigma, 1e-9);
+  EXPECT_EQ(no_lead.model().lateral->gust_lead, 0.0);
+  // Compared where the lead has run its course: a span reached within the lead's time was in the
+  // lateral window from the start, as on the finite line.
+  const double from = 500.0 + lat.gust_lead * endless.state().speed + 110.0;
+  double motion = 0.0, with_lead = 0.0, without = 0.0;
+  long n = 0;
+  while (true) {
+    const StepStatus a = endless.step(), b = no_lead.step(), c = finite.step(), d = steady.step();
+    ASSERT_TRUE(a == b && b == c && c == d) << endless.status_message() << finite.status_message();
+    if (a != StepStatus::kOk) break;
+    const double ya = endless.state().lateral.collector_lateral[0], yb = no_lead.state().lateral.collector_lateral[0],
+                 yc = finite.state().lateral.collector_lateral[0], yd = steady.state().lateral.collector_lateral[0];
+    if (finite.state().front < from || !std::isfinite(ya + yb + yc + yd)) continue;
+    motion += (yc - yd) * (yc - yd);
+    with_lead += (ya - yc) * (ya - yc);
+    without += (yb - yc) * (yb - yc);
+    ++n;
+  }
+  ASSERT_GT(n, 5000);
+  motion = std::sqrt(motion / n);
+  with_lead = std::sqrt(with_lead / n);
+  without = std::sqrt(without / n);
+  // Why this bound: a span enters the lateral window at rest in the mean wind, where the finite
+  // line has the motion the gusts built up in it; that difference is free motion of the lateral
+  // modes, damped at sigma or faster (the messenger's drag, beta K), so after the lead it is at
+  // most exp(-sigma lead) = exp(-2) of the entering motion, which is at most the turbulent motion
+  // itself. The window's own differences (cuts, echoes) are those of a steady wind, within
+  // kSameContactPoint (WindowGivesTheFullLinesContactPoint).
+  const double bound = std::exp(-2.0) * motion + kSameContactPoint;
+  EXPECT_GT(motion, 3e-3);  // gusts that move the contact point by millimetres (about 1 cm rms)
+  EXPECT_LT(with_lead, bound) << "turbulent motion " << motion << " m rms";
+  std::printf("turbulent motion %.2f mm rms; endless line - finite line: %.2f mm rms with the lead, %.2f mm without\n",
+              1e3 * motion, 1e3 * with_lead, 1e3 * without);
+  // Without the lead the spans enter with 1-2 s of gusts: a difference of the motion's order.
+  EXPECT_GT(without, bound) << "turbulent motion " << motion << " m rms";
 }
 
 TEST(Lateral, EndlessLineOnOneRadiusHasTheCurvesPullOff) {
@@ -789,7 +862,7 @@ TEST(Lateral, TurbulentWindOnTheEndlessLineFollowsTheStations) {
   double worst = 0.0;
   int checked = 0;
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi)
-    for (int i = lat.wires[wi].w_dof + s.window[wi].lo; i <= lat.wires[wi].w_dof + s.window[wi].hi; i += 7) {
+    for (int i = lat.wires[wi].w_dof + s.lateral.window[wi].lo; i <= lat.wires[wi].w_dof + s.lateral.window[wi].hi; i += 7) {
       const double q = (lat.node_x[i] + s.line_offset - f.x0) / f.dx;
       const int j = std::clamp(static_cast<int>(std::floor(q)), 0, f.points - 2);
       const double a = q - j;
@@ -821,7 +894,7 @@ TEST(Lateral, TurbulentWindOnTheNodesIsTheFieldAtTheirStations) {
     int checked = 0, wrong = 0;
     for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
       const int o = lat.wires[wi].w_dof;
-      const int lo = windowed ? s.window[wi].lo : 0, hi = windowed ? s.window[wi].hi : lat.wires[wi].nodes() - 1;
+      const int lo = windowed ? s.lateral.window[wi].lo : 0, hi = windowed ? s.lateral.window[wi].hi : lat.wires[wi].nodes() - 1;
       for (int i = o + lo; i <= o + hi; ++i, ++checked) {
         const double q = (lat.node_x[i] - lat.field.x0) / lat.field.dx;
         const int j = std::clamp(static_cast<int>(std::floor(q)), 0, lat.field.points - 2);
@@ -832,7 +905,7 @@ TEST(Lateral, TurbulentWindOnTheNodesIsTheFieldAtTheirStations) {
     EXPECT_GT(checked, 300) << window;  // (1 m elements: about 470 nodes in the window)
     EXPECT_EQ(wrong, 0) << window;
     if (windowed) {
-      EXPECT_GT(s.window[0].lo, 0);  // the window moved on: nodes entered it since
+      EXPECT_GT(s.lateral.window[0].lo, 0);  // the window moved on: nodes entered it since
     }
   }
 }

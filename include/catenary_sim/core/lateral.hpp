@@ -34,6 +34,7 @@
 
 #include "catenary_sim/core/model.hpp"
 #include "catenary_sim/core/wind.hpp"
+#include "catenary_sim/core/wire_window.hpp"
 
 namespace catenary_sim {
 
@@ -86,11 +87,14 @@ struct LateralModel {
   // Wind: per node 0.5 rho Cd d h (kg/m) and the sine of the wind's angle to the wire.
   bool windy = false;
   // The lateral plane steps only the moving window (numerics.window), except in a turbulent wind on
-  // a finite line: there it steps the whole line, because a span entering the window at rest in the
-  // mean wind would lack the motion the gusts built up over the lateral modes' decay (about 9 s,
-  // against the window's lead of 1-2 s: 9-16 % less rms across the strip, BENCHMARKS.md). An
-  // endless line is always windowed (docs/model_and_numerics.md says what that costs in gusts).
+  // a finite line without numerics.gust_lead: there it steps the whole line, because a span
+  // entering the window at rest in the mean wind would lack the motion the gusts built up over the
+  // lateral modes' decay (about 9 s, against the window's lead of 1-2 s: 9-16 % less rms across the
+  // strip, BENCHMARKS.md). An endless line is always windowed, with a gust lead in a turbulent wind.
   bool windowed = false;
+  // s: in a turbulent wind, how long ahead of the vertical window's front the lateral window
+  // reaches, as time of travel at the train's speed (numerics.gust_lead; 0 otherwise).
+  double gust_lead = 0.0;
   double wind_speed = 0.0;
   Eigen::VectorXd wind_coefficient, wind_normal;
   WindField field;                 // turbulence (empty: steady wind)
@@ -129,6 +133,14 @@ struct LateralModel {
   std::vector<int> spring_order;
   std::vector<double> spring_order_x;
 };
+
+// s: how far ahead of the vertical window the lateral plane's window reaches, as time of travel
+// (LateralModel::gust_lead): 0 without a turbulent wind or a window; numerics.gust_lead when given;
+// auto on an endless line two decay times 1 / sigma of the slowest wire's lateral motion,
+// sigma = rho Cd d U_n / (2 m') + alpha / 2 (the drag's aerodynamic damping and eq. 5's mass term),
+// at most kAutoGustLeadMax; auto on a finite line 0 (its whole lateral plane is stepped).
+double gust_lead_time(const Scene& scene);
+constexpr double kGustLeadDecays = 2.0, kAutoGustLeadMax = 30.0;  // s
 
 // Builds the lateral plane of a model whose scene asks for one (Scene::lateral()); throws SceneError.
 std::shared_ptr<const LateralModel> build_lateral(const Model& model);
@@ -171,15 +183,19 @@ struct LateralState {
   std::vector<DewirementEvent> events;     // capacity reserved: never allocates in step
   std::int64_t events_total = 0;
   bool diverged = false, dewired_stop = false;
-  // Moving window: the node range per wire the lateral plane steps (it follows State::window at
-  // each step; outside, the nodes stay in the static state under the mean wind, at rest), the
-  // springs in it (first window_spring_count entries; the pendulums are State::window_droppers',
-  // pendulum k being dropper k), the static force of the left-out elements on the nodes near the
-  // cuts, and the nodes with point forces for the fused step. Sized once: no allocation.
-  std::vector<int> window_lo, window_hi;
-  bool window_dirty = true;  // lists to rebuild (the endless block moved)
-  std::vector<int> window_springs;
-  int window_spring_count = 0;
+  // Moving window: the part of each wire the lateral plane steps, from the vertical plane's
+  // window's first support to its last or, with a gust lead (LateralModel::gust_lead), a support
+  // further ahead (outside, the nodes stay in the static state under the mean wind, at rest); the
+  // factors interleaved for the fused step; the springs and the droppers' pendulums in it (first
+  // *_count entries; pendulum k is dropper k), the static force of the left-out elements on the
+  // nodes near the cuts, and the nodes with point forces for the fused step. Sized once: no
+  // allocation.
+  std::vector<WireWindow> window;
+  int window_first_support = -1, window_last_support = -1;
+  bool window_dirty = true;  // lists and factors to rebuild (the endless block moved)
+  std::vector<double> sweep_factors;
+  std::vector<int> window_springs, window_droppers;
+  int window_spring_count = 0, window_dropper_count = 0;
   std::vector<int> cut_node;
   std::vector<double> cut_force;
   int cut_count = 0;

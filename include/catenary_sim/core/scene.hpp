@@ -151,6 +151,8 @@ struct OverlapSpec {
 enum class RotaryInertia { kCondensed, kLumped };
 enum class Integrator { kExplicit, kImplicit };
 
+constexpr double kMaxGustLead = 60.0;  // s, numerics.gust_lead
+
 struct NumericsSpec {
   std::string preset;            // "", fast, balanced, accurate, reference: defaults for the fields below
   double element_length = 0.25;  // m, target; segments between supports and droppers are split evenly
@@ -168,6 +170,12 @@ struct NumericsSpec {
   double window_ahead = 0.0, window_behind = 0.0;
   bool window_auto = false;
   bool windowed() const { return window_auto || window_ahead > 0.0; }
+  // 3-D line in a turbulent wind with the window: the lateral plane's window reaches this many
+  // seconds of travel further ahead than the vertical one, so that a span has felt the gusts that
+  // long when the pantograph reaches it (lateral.hpp, gust_lead_time). Empty: auto, which on an
+  // endless line is two decay times of the slowest wire's lateral motion, and on a finite line
+  // the whole line (no lateral window).
+  std::optional<double> gust_lead;
 };
 
 struct OutputSpec {

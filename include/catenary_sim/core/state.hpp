@@ -10,6 +10,7 @@
 
 #include "catenary_sim/core/lateral.hpp"
 #include "catenary_sim/core/model.hpp"
+#include "catenary_sim/core/wire_window.hpp"
 
 namespace catenary_sim {
 
@@ -19,16 +20,6 @@ enum class StepStatus {
                // stopped and the state keeps the last good step
   kFinished,   // the train front reached the end of the pass; step() does nothing more
   kDewired,    // a contact point left the strip's working width and the scene says stop (3-D line)
-};
-
-// The part of one wire a moving window integrates: nodes lo..hi (empty when hi < lo). Where the
-// window cuts the wire (not at its anchors) the element outside is left out and a dashpot of the
-// wire's impedance sqrt(T rhoA) absorbs the waves that leave.
-struct WireWindow {
-  int lo = 0, hi = -1;
-  bool cut_lo = false, cut_hi = false;
-  double lo_ww = 0, lo_wt = 0, lo_tt = 0, hi_ww = 0, hi_wt = 0, hi_tt = 0;  // outside element's share of the end blocks
-  std::vector<double> tt_lower, tt_inv_pivot;  // LDL^T of the window's K_theta_theta
 };
 
 // Implicit integrator: slack droppers it can take out of its matrix at once (each keeps a column
