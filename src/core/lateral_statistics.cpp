@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace catenary_sim {
 
@@ -24,6 +25,31 @@ LateralRecorder::LateralRecorder(const Model& m, double sample_rate_hz)
   }
   if (!m.lateral) return;
   const LateralModel& lat = *m.lateral;
+  if (m.endless) {
+    // The block's spans, each a contact wire's nodes from its support to the next; a block span
+    // stands for the line's span at its station now (the block moves by whole spans: record()).
+    // The line's spans are those the collectors pass over, from the rearmost one's start to the
+    // front's end of the pass.
+    endless_span_ = m.endless_span;
+    first_line_span_ = static_cast<long>(
+        std::floor((m.train_start + m.initial_line_offset + m.rear_collector_offset) / endless_span_ + 1e-9));
+    const long last = static_cast<long>(std::ceil(m.train_end / endless_span_ - 1e-9));
+    const std::size_t count = static_cast<std::size_t>(std::max(0L, last - first_line_span_));
+    max_blow_off_.assign(count, 0.0);
+    line_static_blow_off_.assign(count, std::nan(""));  // NaN: the span was never in the window
+    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+      const Wire& w = lat.wires[wi];
+      if (!w.is_contact_wire) continue;
+      for (std::size_t j = 0; j + 1 < w.support_nodes.size(); ++j) {
+        const BlowOffRange r{static_cast<int>(wi), static_cast<int>(j), w.support_nodes[j], w.support_nodes[j + 1]};
+        if (block_static_blow_off_.size() <= j) block_static_blow_off_.resize(j + 1, 0.0);
+        for (int i = w.w_dof + r.begin; i < w.w_dof + r.end; ++i)
+          block_static_blow_off_[j] = std::max(block_static_blow_off_[j], std::fabs(lat.initial[i] - lat.calm[i]));
+        blow_off_ranges_.push_back(r);
+      }
+    }
+    return;
+  }
   max_blow_off_.assign(lat.spans, 0.0);
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     const int o = lat.wires[wi].w_dof, nn = lat.wires[wi].nodes();
@@ -57,19 +83,24 @@ void LateralRecorder::record(const Model& m, const State& s) {
     const bool windowed = lat.windowed && !s.lateral.window.empty();
     const double* y = s.lateral.y.data();
     const double* calm = lat.calm.data();
+    // On an endless line, block span j is the line's span j + the spans the block has moved.
+    const long moved = m.endless ? std::lround(s.line_offset / endless_span_) - first_line_span_ : 0;
     for (const BlowOffRange& r : blow_off_ranges_) {
       int b = r.begin, e = r.end;
       if (windowed) {
         b = std::max(b, s.lateral.window[r.wire].lo);
         e = std::min(e, s.lateral.window[r.wire].hi + 1);
       }
+      const long k = r.span + moved;
+      if (b >= e || k < 0 || k >= static_cast<long>(max_blow_off_.size())) continue;
       const int o = lat.wires[r.wire].w_dof;
-      double most = max_blow_off_[r.span];
+      double most = max_blow_off_[k];
       for (int i = o + b; i < o + e; ++i) {
         const double d = std::fabs(y[i] - calm[i]);
         most = d > most ? d : most;
       }
-      max_blow_off_[r.span] = most;
+      max_blow_off_[k] = most;
+      if (m.endless) line_static_blow_off_[k] = block_static_blow_off_[r.span];
     }
   }
   if (sample_period_ > 0.0 && s.time + 1e-12 < next_sample_) return;
@@ -136,15 +167,24 @@ LateralStatistics LateralRecorder::statistics(const Model& m, const State& s) co
       for (double& h : st.histogram_percent) h *= 100.0 / st.contact_samples;
     out.contacts.push_back(std::move(st));
   }
-  const std::optional<double> limit = m.scene.wind ? m.scene.wind->blow_off_limit : std::nullopt;
-  for (int k = 0; k < lat.spans; ++k) {
+  const double limit = m.scene.wind && m.scene.wind->blow_off_limit ? *m.scene.wind->blow_off_limit
+                                                                     : std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < max_blow_off_.size(); ++k) {
     SpanBlowOff b;
-    b.span = k;
-    b.start = m.support_x[k] + s.line_offset;
-    b.end = m.support_x[k + 1] + s.line_offset;
-    b.static_m = lat.static_blow_off[k];
+    if (m.endless) {
+      if (std::isnan(line_static_blow_off_[k])) continue;  // (never reached by the window)
+      b.span = static_cast<int>(first_line_span_ + static_cast<long>(k));
+      b.start = b.span * endless_span_;
+      b.end = b.start + endless_span_;
+      b.static_m = line_static_blow_off_[k];
+    } else {
+      b.span = static_cast<int>(k);
+      b.start = m.support_x[k];
+      b.end = m.support_x[k + 1];
+      b.static_m = lat.static_blow_off[k];
+    }
     b.max_m = std::max(max_blow_off_[k], b.static_m);
-    b.exceeded = limit && b.max_m > *limit;
+    b.exceeded = b.max_m > limit;
     out.spans.push_back(b);
   }
   out.events = s.lateral.events;

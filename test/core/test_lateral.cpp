@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include "catenary_sim/core/lateral.hpp"
@@ -785,6 +786,61 @@ TEST(Lateral, GustLeadGivesTheEndlessLineTheFiniteLinesTurbulentMotion) {
               1e3 * motion, 1e3 * with_lead, 1e3 * without);
   // Without the lead the spans enter with 1-2 s of gusts: a difference of the motion's order.
   EXPECT_GT(without, bound) << "turbulent motion " << motion << " m rms";
+}
+
+TEST(Lateral, EndlessLineReportsTheBlowOffPerSpanByStation) {
+  // In a turbulent wind, each span's blow-off varies with its gusts: the recorder must give the
+  // line's span k (stations 55k to 55(k+1)) the largest |y - calm| of the contact wire's nodes at
+  // those stations, whichever block span holds them as the block moves. Computed here from the
+  // nodes' stations at the recorder's own sampling times (every 5 ms).
+  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml",
+                                 EndlessAndFinite::pass({"train.start=0", "train.end=1500", "numerics.preset=fast",
+                                                         "wind.speed=25", "wind.turbulence.intensity=0.2",
+                                                         "wind.turbulence.seed=5"})));
+  const Model& m = sim.model();
+  const LateralModel& lat = *m.lateral;
+  LateralRecorder rec(m);
+  rec.record(m, sim.state());
+  std::map<long, double> largest, static_of;
+  double next = 0.0;
+  auto observe = [&](const State& s) {
+    if (!(s.time + 1e-12 >= next)) return;
+    next = s.time + 0.005;
+    for (const Wire& w : lat.wires) {
+      if (!w.is_contact_wire) continue;
+      const std::size_t wi = &w - lat.wires.data();
+      for (int i = s.lateral.window[wi].lo; i <= s.lateral.window[wi].hi; ++i) {
+        const int a = w.w_dof + i;
+        const long k = static_cast<long>(std::floor((lat.node_x[a] + s.line_offset) / 55.0 + 1e-9));
+        largest[k] = std::max(largest[k], std::fabs(s.lateral.y[a] - lat.calm[a]));
+        static_of[k] = std::max(static_of[k], std::fabs(lat.initial[a] - lat.calm[a]));
+      }
+    }
+  };
+  observe(sim.state());
+  while (sim.step() == StepStatus::kOk) {
+    rec.record(m, sim.state());
+    observe(sim.state());
+  }
+  ASSERT_EQ(sim.state().status, StepStatus::kFinished);
+  EXPECT_GT(sim.state().line_offset - m.initial_line_offset, 10 * 55.0);  // the block moved along
+  const LateralStatistics st = rec.statistics(m, sim.state());
+  // The spans the collector passes over: from station 0 to the pass's end at 1500 m.
+  ASSERT_EQ(st.spans.size(), 28u);
+  double lo = 1e9, hi = 0.0;
+  for (const SpanBlowOff& b : st.spans) {
+    ASSERT_TRUE(largest.count(b.span)) << "span " << b.span;
+    EXPECT_EQ(b.start, 55.0 * b.span);
+    // (1 um: the block's spans are identical to that, check_endless_block, not to the bit; a span
+    // mapped to the wrong station is off by the gusts' millimetres, below.)
+    EXPECT_NEAR(b.static_m, static_of[b.span], 1e-6) << "span " << b.span;
+    EXPECT_NEAR(b.max_m, std::max(largest[b.span], static_of[b.span]), 1e-6) << "span " << b.span;
+    lo = std::min(lo, b.max_m - b.static_m);
+    hi = std::max(hi, b.max_m - b.static_m);
+  }
+  EXPECT_EQ(st.spans.front().span, 0);
+  // The gusts differ from span to span (else the mapping would not be tested): by millimetres.
+  EXPECT_GT(hi - lo, 2e-3);
 }
 
 TEST(Lateral, EndlessLineOnOneRadiusHasTheCurvesPullOff) {

@@ -30,7 +30,8 @@ struct SpanBlowOff {
   int span = 0;
   double start = 0.0, end = 0.0;  // m
   double static_m = 0.0;  // m, under the mean wind (largest |y - calm| on the contact wire)
-  double max_m = 0.0;     // m, over the pass (turbulence included), sampled every 5 ms
+  double max_m = 0.0;     // m, over the pass (turbulence included), sampled every 5 ms; on an
+                          // endless line while the span is in the lateral window (gust lead included)
   bool exceeded = false;  // max_m above wind.blow_off_limit
 };
 
@@ -58,7 +59,12 @@ class LateralRecorder {
   std::vector<double> time_;
   std::vector<std::vector<double>> station_, lateral_;  // per collector, every step
   std::vector<std::vector<char>> contact_;             // per collector, every step: force on it
-  std::vector<double> max_blow_off_;                   // per span
+  std::vector<double> max_blow_off_;                   // per span (of the line's spans the pass covers, when endless)
+  // Endless line: the span length, the first line span reported, the static blow-off per block
+  // span, and per line span the one of the block span it was last recorded on (NaN: never).
+  double endless_span_ = 0.0;
+  long first_line_span_ = 0;
+  std::vector<double> block_static_blow_off_, line_static_blow_off_;
   // The contact wires' nodes by span (node ranges [begin, end) of lateral wire `wire`), scanned for
   // the blow-off every kBlowOffPeriod: a max over each range, within the window if there is one
   // (outside it the wires are in the static state, whose blow-off the statistics take anyway).
