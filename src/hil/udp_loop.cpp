@@ -327,12 +327,7 @@ int UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_end
     }
     drain();
     send_measurement();
-    next += period;
-    const double now = steady_now();
-    if (now > next) {  // late by more than a period: skip the missed ticks
-      ++missed_;
-      next += std::ceil((now - next) / period) * period;
-    }
+    next = next_rig_tick(next, period, steady_now(), missed_);
   }
   return 0;
 }

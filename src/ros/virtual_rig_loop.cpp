@@ -119,12 +119,7 @@ int VirtualRig::run() {
       queue_.callAvailable(ros::WallDuration(next - now));
     queue_.callAvailable(ros::WallDuration(0.0));
     send();
-    next += period;
-    const double now = mono_now();
-    if (now > next) {  // late by more than a period: skip the missed ticks
-      ++missed_;
-      next += std::ceil((now - next) / period) * period;
-    }
+    next = hil::next_rig_tick(next, period, mono_now(), missed_);
   }
   const double wall = mono_now() - start;
   std::printf("virtual_rig: %llu measurements in %.1f s, %llu missed ticks; round trip (sent -> contact point "

@@ -13,6 +13,7 @@
 #include <netinet/in.h>
 
 #include <array>
+#include <cmath>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -147,6 +148,18 @@ struct UdpRigOptions {
   double rate = 0.0;
   bool extrapolate = true;
 };
+
+// A rig's next measurement tick: `next` moved on by `period`; when the rig is late by more than a
+// period (`now`, s on the same clock, beyond it) it skips the ticks it missed, counting them in
+// `missed`, rather than sending them in a burst (UdpVirtualRig, and the ROS virtual_rig).
+inline double next_rig_tick(double next, double period, double now, std::uint64_t& missed) {
+  next += period;
+  if (now > next) {
+    ++missed;
+    next += std::ceil((now - next) / period) * period;
+  }
+  return next;
+}
 
 class UdpVirtualRig {
  public:
