@@ -17,19 +17,15 @@
 
 #include "pass_errors.hpp"
 
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
-
 using bench::PassResult;
 using bench::run_pass;
 
 int main(int argc, char** argv) {
-  const std::string path = argc > 1 ? argv[1] : CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string path = argc > 1 ? argv[1] : bench::kReferenceScene;
   const std::string csv_path = argc > 2 ? argv[2] : "reference_rung.csv";
   const std::string finest_h = argc > 3 ? argv[3] : "0.03125";
   std::ofstream csv(csv_path);
-  csv << "speed_kmh,variant,dofs,dt_s,wall_s,rtf,err_mean_pct,err_std_pct,err_max_pct,err_min_pct,err_max200_pct\n";
+  csv << bench::kCsvHeader;
   // The first five were measured first (BENCHMARKS.md); the rest refine the explicit scheme's dt
   // at h = 0.125 m and try h = 0.1 m. Give `all` as 4th argument for the first five too.
   const bool all = argc > 4 && std::string(argv[4]) == "all";
@@ -98,8 +94,7 @@ int main(int argc, char** argv) {
       std::printf("%-30s %6d %8.4f %8.2f %8.2f | %7.3f %7.3f %7.3f %7.3f | %8.3f\n", label.c_str(), r.dofs, r.dt * 1e3,
                   r.wall, r.rtf, e.mean, e.std_dev, e.max, e.min, e.max200);
       std::fflush(stdout);
-      csv << kmh << "," << label << "," << r.dofs << "," << r.dt << "," << r.wall << "," << r.rtf << "," << e.mean << ","
-          << e.std_dev << "," << e.max << "," << e.min << "," << e.max200 << "\n";
+      bench::csv_row(csv, kmh, label, r.dofs, r.dt, r.wall, r.rtf, e);
     }
     for (const auto& [ha, hb] : richardson ? pairs : std::vector<std::pair<double, double>>{}) {
       std::ostringstream label;
@@ -119,8 +114,7 @@ int main(int argc, char** argv) {
       std::printf("%-30s %6d %8.4f %8.2f %8.2f | %7.4f %7.4f %7.4f %7.4f | %8.4f\n", label.str().c_str(), a.dofs + b.dofs,
                   a.dt * 1e3, wall, a.rtf * a.wall / wall, e.mean, e.std_dev, e.max, e.min, e.max200);
       std::fflush(stdout);
-      csv << kmh << "," << label.str() << "," << a.dofs + b.dofs << "," << a.dt << "," << wall << "," << a.rtf * a.wall / wall
-          << "," << e.mean << "," << e.std_dev << "," << e.max << "," << e.min << "," << e.max200 << "\n";
+      bench::csv_row(csv, kmh, label.str(), a.dofs + b.dofs, a.dt, wall, a.rtf * a.wall / wall, e);
     }
   }
   std::printf("\nwrote %s\n", csv_path.c_str());

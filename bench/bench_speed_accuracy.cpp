@@ -12,18 +12,14 @@
 
 #include "pass_errors.hpp"
 
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
-
 using bench::PassResult;
 using bench::run_pass;
 
 int main(int argc, char** argv) {
-  const std::string path = argc > 1 ? argv[1] : CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string path = argc > 1 ? argv[1] : bench::kReferenceScene;
   const std::string csv_path = argc > 2 ? argv[2] : "speed_accuracy.csv";
   std::ofstream csv(csv_path);
-  csv << "speed_kmh,variant,dofs,dt_s,wall_s,rtf,err_mean_pct,err_std_pct,err_max_pct,err_min_pct,err_max200_pct\n";
+  csv << bench::kCsvHeader;
   for (double kmh : {250.0, 300.0}) {
     const PassResult ref = run_pass(path, {"numerics.preset=reference"}, kmh);
     const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {
@@ -46,8 +42,7 @@ int main(int argc, char** argv) {
       const bench::StatErrors e = bench::stat_errors(r, ref);
       std::printf("%-26s %6d %8.4f %8.4f %8.1f | %7.2f %7.2f %7.2f %7.2f | %8.2f\n", label.c_str(), r.dofs, r.dt * 1e3,
                   r.wall, r.rtf, e.mean, e.std_dev, e.max, e.min, e.max200);
-      csv << kmh << "," << label << "," << r.dofs << "," << r.dt << "," << r.wall << "," << r.rtf << "," << e.mean << ","
-          << e.std_dev << "," << e.max << "," << e.min << "," << e.max200 << "\n";
+      bench::csv_row(csv, kmh, label, r.dofs, r.dt, r.wall, r.rtf, e);
     }
   }
   std::printf("\nwrote %s\n", csv_path.c_str());

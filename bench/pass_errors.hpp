@@ -6,13 +6,21 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ostream>
 #include <string>
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
 
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+
 namespace bench {
+
+// The scene both benches measure unless given another.
+inline const std::string kReferenceScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
 
 struct PassResult {
   int dofs = 0;
@@ -65,6 +73,16 @@ inline StatErrors stat_errors(const PassResult& r, const PassResult& ref) {
   e.min = 100.0 * std::fabs(r.s20.filtered.min - ref.s20.filtered.min) / ref.s20.filtered.mean;
   e.max200 = rel(r.s200.filtered.max, ref.s200.filtered.max);
   return e;
+}
+
+// The CSV both benches write: a header, then a row a variant.
+inline const char* const kCsvHeader =
+    "speed_kmh,variant,dofs,dt_s,wall_s,rtf,err_mean_pct,err_std_pct,err_max_pct,err_min_pct,err_max200_pct\n";
+
+inline void csv_row(std::ostream& csv, double kmh, const std::string& variant, int dofs, double dt, double wall, double rtf,
+                    const StatErrors& e) {
+  csv << kmh << "," << variant << "," << dofs << "," << dt << "," << wall << "," << rtf << "," << e.mean << ","
+      << e.std_dev << "," << e.max << "," << e.min << "," << e.max200 << "\n";
 }
 
 }  // namespace bench
