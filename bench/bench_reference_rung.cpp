@@ -6,62 +6,26 @@
 // Errors as in bench_speed_accuracy: relative to the finest value (the min relative to the mean).
 // The finest runs take about 10 minutes each: their statistics are kept in <csv>.finest and reused
 // when that file exists (delete it after changing the scene or the model).
-#include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "pass_errors.hpp"
 
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
-
-using namespace catenary_sim;
-
-namespace {
-
-struct Result {
-  int dofs = 0;
-  double dt = 0.0, wall = 0.0, rtf = 0.0;
-  PantographStatistics s20, s200;
-};
-
-Result run(const std::string& path, std::vector<std::string> overrides, double kmh) {
-  overrides.push_back("train.speed_kmh=" + std::to_string(kmh));
-  const Scene scene = load_scene_file(path, overrides);
-  Result r;
-  Simulation sim(scene);
-  const Model& m = sim.model();
-  PassRecorder rec(m);
-  rec.record(m, sim.state());
-  const auto t0 = std::chrono::steady_clock::now();
-  while (sim.step() == StepStatus::kOk) rec.record(m, sim.state());
-  r.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  r.dofs = m.n_dof;
-  r.dt = m.dt;
-  r.s20 = rec.statistics(m, 20.0)[0];
-  r.s200 = rec.statistics(m, 200.0)[0];
-  r.rtf = sim.state().time / r.wall;
-  return r;
-}
-
-double rel(double a, double ref) { return 100.0 * std::fabs(a - ref) / std::fabs(ref); }
-
-}  // namespace
+using bench::PassResult;
+using bench::run_pass;
 
 int main(int argc, char** argv) {
-  const std::string path = argc > 1 ? argv[1] : CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string path = argc > 1 ? argv[1] : bench::kReferenceScene;
   const std::string csv_path = argc > 2 ? argv[2] : "reference_rung.csv";
   const std::string finest_h = argc > 3 ? argv[3] : "0.03125";
   std::ofstream csv(csv_path);
-  csv << "speed_kmh,variant,dofs,dt_s,wall_s,rtf,err_mean_pct,err_std_pct,err_max_pct,err_min_pct,err_max200_pct\n";
+  csv << bench::kCsvHeader;
   // The first five were measured first (BENCHMARKS.md); the rest refine the explicit scheme's dt
   // at h = 0.125 m and try h = 0.1 m. Give `all` as 4th argument for the first five too.
   const bool all = argc > 4 && std::string(argv[4]) == "all";
@@ -100,7 +64,7 @@ int main(int argc, char** argv) {
   const std::vector<std::pair<double, double>> pairs = {{0.125, 0.25}, {0.1, 0.2}, {0.1, 0.125}, {0.0625, 0.125}};
   if (richardson) candidates.clear();
   for (double kmh : {250.0, 300.0}) {
-    Result fine;
+    PassResult fine;
     if (kept.count(kmh)) {
       const std::vector<double>& k = kept[kmh];
       fine.s20.filtered.mean = k[0];
@@ -112,7 +76,7 @@ int main(int argc, char** argv) {
       fine.dt = k[6];
       fine.wall = k[7];
     } else {
-      fine = run(path, {"numerics.element_length=" + finest_h}, kmh);
+      fine = run_pass(path, {"numerics.element_length=" + finest_h}, kmh);
       std::ofstream out(csv_path + ".finest", std::ios::app);
       out.precision(17);
       out << kmh << "," << fine.s20.filtered.mean << "," << fine.s20.filtered.std_dev << "," << fine.s20.filtered.max << ","
@@ -125,37 +89,32 @@ int main(int argc, char** argv) {
     std::printf("%-30s %6s %8s %8s %8s | %7s %7s %7s %7s | %8s\n", "candidate", "DOFs", "dt_ms", "wall_s", "RTF", "mean%",
                 "std%", "max%", "min%", "max200%");
     for (const auto& [label, ov] : candidates) {
-      const Result r = run(path, ov, kmh);
-      const double em = rel(r.s20.filtered.mean, fine.s20.filtered.mean);
-      const double es = rel(r.s20.filtered.std_dev, fine.s20.filtered.std_dev);
-      const double ex = rel(r.s20.filtered.max, fine.s20.filtered.max);
-      const double en = 100.0 * std::fabs(r.s20.filtered.min - fine.s20.filtered.min) / fine.s20.filtered.mean;
-      const double e200 = rel(r.s200.filtered.max, fine.s200.filtered.max);
+      const PassResult r = run_pass(path, ov, kmh);
+      const bench::StatErrors e = bench::stat_errors(r, fine);
       std::printf("%-30s %6d %8.4f %8.2f %8.2f | %7.3f %7.3f %7.3f %7.3f | %8.3f\n", label.c_str(), r.dofs, r.dt * 1e3,
-                  r.wall, r.rtf, em, es, ex, en, e200);
+                  r.wall, r.rtf, e.mean, e.std_dev, e.max, e.min, e.max200);
       std::fflush(stdout);
-      csv << kmh << "," << label << "," << r.dofs << "," << r.dt << "," << r.wall << "," << r.rtf << "," << em << "," << es
-          << "," << ex << "," << en << "," << e200 << "\n";
+      bench::csv_row(csv, kmh, label, r.dofs, r.dt, r.wall, r.rtf, e);
     }
     for (const auto& [ha, hb] : richardson ? pairs : std::vector<std::pair<double, double>>{}) {
       std::ostringstream label;
       label << "richardson h=" << ha << "+" << hb;
-      const Result a = run(path, {"numerics.element_length=" + std::to_string(ha)}, kmh);
-      const Result b = run(path, {"numerics.element_length=" + std::to_string(hb)}, kmh);
+      const PassResult a = run_pass(path, {"numerics.element_length=" + std::to_string(ha)}, kmh);
+      const PassResult b = run_pass(path, {"numerics.element_length=" + std::to_string(hb)}, kmh);
       const double q = 1.0 / ((hb / ha) * (hb / ha) - 1.0);
       auto ex = [&](double sa, double sb) { return sa + (sa - sb) * q; };
-      const double mean = ex(a.s20.filtered.mean, b.s20.filtered.mean);
-      const double em = rel(mean, fine.s20.filtered.mean);
-      const double es = rel(ex(a.s20.filtered.std_dev, b.s20.filtered.std_dev), fine.s20.filtered.std_dev);
-      const double emx = rel(ex(a.s20.filtered.max, b.s20.filtered.max), fine.s20.filtered.max);
-      const double en = 100.0 * std::fabs(ex(a.s20.filtered.min, b.s20.filtered.min) - fine.s20.filtered.min) / fine.s20.filtered.mean;
-      const double e200 = rel(ex(a.s200.filtered.max, b.s200.filtered.max), fine.s200.filtered.max);
+      PassResult x;  // the extrapolated statistics
+      x.s20.filtered.mean = ex(a.s20.filtered.mean, b.s20.filtered.mean);
+      x.s20.filtered.std_dev = ex(a.s20.filtered.std_dev, b.s20.filtered.std_dev);
+      x.s20.filtered.max = ex(a.s20.filtered.max, b.s20.filtered.max);
+      x.s20.filtered.min = ex(a.s20.filtered.min, b.s20.filtered.min);
+      x.s200.filtered.max = ex(a.s200.filtered.max, b.s200.filtered.max);
+      const bench::StatErrors e = bench::stat_errors(x, fine);
       const double wall = a.wall + b.wall;
       std::printf("%-30s %6d %8.4f %8.2f %8.2f | %7.4f %7.4f %7.4f %7.4f | %8.4f\n", label.str().c_str(), a.dofs + b.dofs,
-                  a.dt * 1e3, wall, a.rtf * a.wall / wall, em, es, emx, en, e200);
+                  a.dt * 1e3, wall, a.rtf * a.wall / wall, e.mean, e.std_dev, e.max, e.min, e.max200);
       std::fflush(stdout);
-      csv << kmh << "," << label.str() << "," << a.dofs + b.dofs << "," << a.dt << "," << wall << "," << a.rtf * a.wall / wall
-          << "," << em << "," << es << "," << emx << "," << en << "," << e200 << "\n";
+      bench::csv_row(csv, kmh, label.str(), a.dofs + b.dofs, a.dt, wall, a.rtf * a.wall / wall, e);
     }
   }
   std::printf("\nwrote %s\n", csv_path.c_str());

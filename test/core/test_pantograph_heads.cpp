@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
@@ -48,6 +49,18 @@ YAML::Node two_half_heads(double offset_a, double offset_b, double k_a, double k
   return p;
 }
 
+// The paper's scene twice: with its one-head pantograph carrying two strips at its station, and
+// with that pantograph as two half heads at the same station (the same sum).
+std::pair<YAML::Node, YAML::Node> one_head_and_two_halves() {
+  YAML::Node one = calpe();
+  YAML::Node strips;
+  for (int i = 0; i < 2; ++i) strips.push_back(YAML::Load("{offset: 0.0}"));
+  one["pantographs"][0]["collectors"] = strips;
+  YAML::Node two = calpe();
+  two["pantographs"][0] = two_half_heads(0.0, 0.0, 2100.0, 2100.0);
+  return {one, two};
+}
+
 std::vector<PantographStatistics> run(const Scene& scene) {
   Simulation sim(scene);
   PassRecorder rec(sim.model());
@@ -73,12 +86,7 @@ std::string error_of(const YAML::Node& root) {
 // that station. The models are the same algebra summed in another order; round-off (1e-16 per
 // operation) carried through ~1e5 steps of a stable system stays many orders below 1e-9.
 TEST(PantographHeads, TwoIdenticalHeadsTogetherAreTheOneHeadModel) {
-  YAML::Node one = calpe();
-  YAML::Node strips;
-  for (int i = 0; i < 2; ++i) strips.push_back(YAML::Load("{offset: 0.0}"));
-  one["pantographs"][0]["collectors"] = strips;
-  YAML::Node two = calpe();
-  two["pantographs"][0] = two_half_heads(0.0, 0.0, 2100.0, 2100.0);
+  auto [one, two] = one_head_and_two_halves();
   // The same step for both (the automatic one bounds each contact by its own head mass).
   one["numerics"]["dt"] = two["numerics"]["dt"] = 2e-5;
   const auto a = run(load(one)), b = run(load(two));
@@ -93,12 +101,7 @@ TEST(PantographHeads, TwoIdenticalHeadsTogetherAreTheOneHeadModel) {
 // The same with the implicit integrator (the heads' suspensions in its Newmark matrix, each strip
 // a rank-1 correction): the same reduction, to the same round-off.
 TEST(PantographHeads, ImplicitIntegratorReducesAlike) {
-  YAML::Node one = calpe();
-  YAML::Node strips;
-  for (int i = 0; i < 2; ++i) strips.push_back(YAML::Load("{offset: 0.0}"));
-  one["pantographs"][0]["collectors"] = strips;
-  YAML::Node two = calpe();
-  two["pantographs"][0] = two_half_heads(0.0, 0.0, 2100.0, 2100.0);
+  auto [one, two] = one_head_and_two_halves();
   for (YAML::Node* r : {&one, &two}) (*r)["numerics"]["integrator"] = "implicit";
   const auto a = run(load(one)), b = run(load(two));
   EXPECT_NEAR(b[0].filtered.mean, a[0].filtered.mean, 1e-9 * a[0].filtered.mean);

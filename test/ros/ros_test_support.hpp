@@ -1,31 +1,56 @@
-// Helpers of the rostest companions (test/ros): a topic recorder and a wall-clock wait.
+// Helpers of the rostest companions (test/ros): a topic recorder, a recorder of a node's log lines
+// and a wall-clock wait.
 #pragma once
 
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
 
+#include <cstdint>
 #include <functional>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ros_test {
 
-// Collects the messages of one topic (relative names resolve in the test's namespace).
+// Collects the messages of one topic (relative names resolve in the test's namespace), each with
+// the wall time it arrived at.
 template <class M>
 struct Recorder {
-  explicit Recorder(const std::string& topic, std::uint32_t queue = 100) {
-    sub = ros::NodeHandle().subscribe<M>(topic, queue, [this](const typename M::ConstPtr& m) {
-      std::lock_guard<std::mutex> l(mu);
-      msgs.push_back(*m);
-    });
+  explicit Recorder(const std::string& topic, std::uint32_t queue = 100,
+                    const ros::TransportHints& hints = ros::TransportHints()) {
+    sub = ros::NodeHandle().subscribe<M>(
+        topic, queue,
+        [this](const typename M::ConstPtr& m) {
+          const ros::WallTime now = ros::WallTime::now();
+          std::lock_guard<std::mutex> l(mu);
+          msgs.push_back(*m);
+          arrivals.push_back(now);
+        },
+        ros::VoidConstPtr(), hints);
   }
   std::vector<M> take() {
     std::lock_guard<std::mutex> l(mu);
     return msgs;
   }
+  // The messages and their arrival times, taken together (the same length).
+  std::pair<std::vector<M>, std::vector<ros::WallTime>> take_with_arrivals() {
+    std::lock_guard<std::mutex> l(mu);
+    return {msgs, arrivals};
+  }
+  // The newest message (a default one before the first).
+  M last() { return last_with_arrival().first; }
+  // The newest message and when it arrived (a default message at time 0 before the first).
+  std::pair<M, ros::WallTime> last_with_arrival() {
+    std::lock_guard<std::mutex> l(mu);
+    if (msgs.empty()) return {M(), ros::WallTime()};
+    return {msgs.back(), arrivals.back()};
+  }
   void clear() {
     std::lock_guard<std::mutex> l(mu);
     msgs.clear();
+    arrivals.clear();
   }
   std::size_t size() {
     std::lock_guard<std::mutex> l(mu);
@@ -34,6 +59,41 @@ struct Recorder {
   ros::Subscriber sub;
   std::mutex mu;
   std::vector<M> msgs;
+  std::vector<ros::WallTime> arrivals;
+};
+
+// The lines on /rosout of the nodes whose name contains `node`, at `min_level` or above.
+struct NodeLog {
+  explicit NodeLog(const std::string& node, std::uint8_t min_level = rosgraph_msgs::Log::ERROR) {
+    sub = ros::NodeHandle().subscribe<rosgraph_msgs::Log>(
+        "/rosout", 1000, [this, node, min_level](const rosgraph_msgs::Log::ConstPtr& m) {
+          if (m->name.find(node) != std::string::npos && m->level >= min_level) {
+            std::lock_guard<std::mutex> l(mu);
+            lines.push_back(m->msg);
+          }
+        },
+        ros::VoidConstPtr());
+  }
+  // Whether one line holds every one of `parts`.
+  bool has(const std::vector<std::string>& parts) {
+    std::lock_guard<std::mutex> l(mu);
+    for (const std::string& line : lines) {
+      bool all = true;
+      for (const std::string& p : parts) all = all && line.find(p) != std::string::npos;
+      if (all) return true;
+    }
+    return false;
+  }
+  // How many lines hold `part`.
+  int count(const std::string& part) {
+    std::lock_guard<std::mutex> l(mu);
+    int n = 0;
+    for (const std::string& line : lines) n += line.find(part) != std::string::npos ? 1 : 0;
+    return n;
+  }
+  ros::Subscriber sub;
+  std::mutex mu;
+  std::vector<std::string> lines;
 };
 
 // Polls `cond` every `poll_s` of wall time until it holds or `timeout_s` has passed.

@@ -2,42 +2,20 @@
 // offline runner's for the same scene and inputs: the same numbers, bit for bit, at every
 // instant the node published. Both run the same core with the same fixed dt; only pacing differs.
 #include <gtest/gtest.h>
-#include <netinet/in.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <map>
 #include <string>
 
+#include "../support/child_process.hpp"
 #include "catenary_sim/ContactForceArray.h"
 
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
-#ifndef CATENARY_SIM_DEVEL_LIB
-#define CATENARY_SIM_DEVEL_LIB "."
-#endif
+using catenary_sim_test::free_port;
+using catenary_sim_test::temp_dir;
 
 namespace {
-
-int free_port() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  socklen_t len = sizeof a;
-  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 || getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
-    close(fd);
-    return 11391;
-  }
-  const int port = ntohs(a.sin_port);
-  close(fd);
-  return port;
-}
 
 std::map<double, catenary_sim::ContactForce> read_forces(const std::string& path) {
   std::map<double, catenary_sim::ContactForce> out;  // keyed by pantograph position
@@ -52,13 +30,14 @@ std::map<double, catenary_sim::ContactForce> read_forces(const std::string& path
 }  // namespace
 
 TEST(BagEquality, LiveRecordingEqualsOfflineRunner) {
-  char dir_template[] = "/tmp/catenary_sim_bag_XXXXXX";
-  const std::string dir = mkdtemp(dir_template);
+  const std::string dir = temp_dir("catenary_sim_bag_");
   const std::string scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
   const std::string live = dir + "/live.bag", offline = dir + "/offline.bag";
   // A master of its own on a free loopback port. roslaunch stops everything when the node
   // (required) exits at the end of the pass, and rosbag record closes the bag.
-  const std::string port = std::to_string(free_port());
+  const int free = free_port();
+  ASSERT_NE(free, 0) << "no free port on the loopback interface";
+  const std::string port = std::to_string(free);
   const std::string env = "ROS_MASTER_URI=http://localhost:" + port + " ROS_HOME=" + dir;
   const std::string core = env + " timeout -k 5 300 roscore -p " + port + " > " + dir + "/roscore.log 2>&1 & echo $! > " +
                            dir + "/roscore.pid";

@@ -8,61 +8,51 @@
 #include <geometry_msgs/WrenchStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
-#include <rosgraph_msgs/Log.h>
 
 #include <atomic>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "catenary_sim/ContactPointArray.h"
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/WireShapeArray.h"
 #include "catenary_sim/ros/hil.hpp"
+#include "hil_rig.hpp"
 #include "ros_test_support.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
-bool wait_for(const std::function<bool()>& cond, double timeout_s) { return ros_test::wait_for(cond, timeout_s, 0.005); }
+using hil_rostest::wait_for;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kWireHeight = 5.3;  // m, contact_wire_height of the reference line
 
-std::mutex mu;
-std::vector<ContactPointArray> points;
-std::vector<PantographStateArray> states;
-std::vector<WireShapeArray> shapes;
-std::vector<ros::WallTime> state_wall, shape_wall;
-std::vector<std::string> errors;  // the node's ERROR log lines
+// What the test hears of the node (made in main, after ros::init).
+struct Heard {
+  ros::NodeHandle nh;  // (first: the end of the last handle would shut ROS down)
+  ros_test::Recorder<ContactPointArray> points{"hil/contact_point", 100000, ros::TransportHints().tcpNoDelay()};
+  ros_test::Recorder<PantographStateArray> states{"pantograph_state", 1000};
+  ros_test::Recorder<WireShapeArray> shapes{"wire_shape", 100};
+  ros_test::NodeLog errors{"catenary_sim_hil"};  // the node's ERROR log lines
+};
+Heard* heard = nullptr;
 
-// The rig: publishes the wrench `value` at 1 kHz while `sending`.
-std::atomic<bool> sending{false}, quit{false};
+// The rig: sends the wrench `value` while `sending`.
+std::atomic<bool> sending{false};
 std::mutex values_mu;
 geometry_msgs::Wrench value;
 
-void rig_thread() {
-  ros::NodeHandle nh;
-  ros::Publisher pub = nh.advertise<geometry_msgs::WrenchStamped>("hil/contact_wrench", 10);
-  ros::WallTime next = ros::WallTime::now();
-  while (!quit && ros::ok()) {
-    next += ros::WallDuration(0.001);
-    ros::WallTime::sleepUntil(next);
-    if (!sending) continue;
-    geometry_msgs::WrenchStamped m;
-    m.header.stamp = ros::Time::now();
-    m.header.frame_id = "load_cell";
-    {
-      std::lock_guard<std::mutex> l(values_mu);
-      m.wrench = value;
-    }
-    pub.publish(m);
-  }
+bool measure(geometry_msgs::WrenchStamped& m) {
+  if (!sending) return false;
+  m.header.frame_id = "load_cell";
+  std::lock_guard<std::mutex> l(values_mu);
+  m.wrench = value;
+  return true;
 }
 
 void send(double fz, double tx = 0.0) {
@@ -73,20 +63,9 @@ void send(double fz, double tx = 0.0) {
   value.torque.x = tx;
 }
 
-ContactPointArray last_point() {
-  std::lock_guard<std::mutex> l(mu);
-  return points.empty() ? ContactPointArray() : points.back();
-}
+ContactPointArray last_point() { return heard->points.last(); }
 
-bool logged(const std::vector<std::string>& parts) {
-  std::lock_guard<std::mutex> l(mu);
-  for (const std::string& e : errors) {
-    bool all = true;
-    for (const std::string& p : parts) all = all && e.find(p) != std::string::npos;
-    if (all) return true;
-  }
-  return false;
-}
+bool logged(const std::vector<std::string>& parts) { return heard->errors.has(parts); }
 
 }  // namespace
 
@@ -129,19 +108,17 @@ TEST(HilOutputs, WrenchInputPantographStateAndWireShape) {
   ros::WallDuration(0.05).sleep();
   sending = false;
   EXPECT_DOUBLE_EQ(last_point().pantographs[0].applied_force, 110.0);
-  {
-    std::lock_guard<std::mutex> l(mu);
-    for (const ContactPointArray& p : points) {
-      ASSERT_TRUE(ros_layer::all_finite(p)) << "step " << p.step;
-      if (p.step <= r.step) continue;
-      EXPECT_EQ(p.mode, ContactPointArray::RUNNING) << "step " << p.step << ": a rejected wrench stopped the input";
-      const double f = p.pantographs[0].applied_force;
-      EXPECT_TRUE(f == 120.0 || f == 110.0) << "step " << p.step << ": " << f;
-    }
+  for (const ContactPointArray& p : heard->points.take()) {
+    ASSERT_TRUE(ros_layer::all_finite(p)) << "step " << p.step;
+    if (p.step <= r.step) continue;
+    EXPECT_EQ(p.mode, ContactPointArray::RUNNING) << "step " << p.step << ": a rejected wrench stopped the input";
+    const double f = p.pantographs[0].applied_force;
+    EXPECT_TRUE(f == 120.0 || f == 110.0) << "step " << p.step << ": " << f;
   }
 
   // 5. pantograph_state and wire_shape: decimated, increasing stamps, finite and sane.
-  std::lock_guard<std::mutex> l(mu);
+  const auto [states, state_wall] = heard->states.take_with_arrivals();
+  const auto [shapes, shape_wall] = heard->shapes.take_with_arrivals();
   ASSERT_GT(states.size(), 20u);
   ASSERT_GT(shapes.size(), 3u);
   const double state_s = (state_wall.back() - state_wall.front()).toSec();
@@ -190,37 +167,7 @@ TEST(HilOutputs, WrenchInputPantographStateAndWireShape) {
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_hil_outputs");
-  ros::NodeHandle nh;
-  ros::Subscriber s1 = nh.subscribe<ContactPointArray>(
-      "hil/contact_point", 100000,
-      [](const ContactPointArray::ConstPtr& m) {
-        std::lock_guard<std::mutex> l(mu);
-        points.push_back(*m);
-      },
-      ros::VoidPtr(), ros::TransportHints().tcpNoDelay());
-  ros::Subscriber s2 = nh.subscribe<PantographStateArray>("pantograph_state", 1000, [](const PantographStateArray::ConstPtr& m) {
-    std::lock_guard<std::mutex> l(mu);
-    states.push_back(*m);
-    state_wall.push_back(ros::WallTime::now());
-  }, ros::VoidPtr());
-  ros::Subscriber s3 = nh.subscribe<WireShapeArray>("wire_shape", 100, [](const WireShapeArray::ConstPtr& m) {
-    std::lock_guard<std::mutex> l(mu);
-    shapes.push_back(*m);
-    shape_wall.push_back(ros::WallTime::now());
-  }, ros::VoidPtr());
-  ros::Subscriber s4 = nh.subscribe<rosgraph_msgs::Log>("/rosout", 1000, [](const rosgraph_msgs::Log::ConstPtr& m) {
-    if (m->name.find("catenary_sim_hil") != std::string::npos && m->level >= rosgraph_msgs::Log::ERROR) {
-      std::lock_guard<std::mutex> l(mu);
-      errors.push_back(m->msg);
-    }
-  }, ros::VoidPtr());
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  std::thread rig(rig_thread);
-  const int rc = RUN_ALL_TESTS();
-  quit = true;
-  rig.join();
-  spinner.stop();
-  ros::shutdown();
-  return rc;
+  Heard h;
+  heard = &h;
+  return hil_rostest::run_with_rig<geometry_msgs::WrenchStamped>("hil/contact_wrench", measure);
 }

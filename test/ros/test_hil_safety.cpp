@@ -10,54 +10,51 @@
 
 #include <atomic>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <mutex>
-#include <thread>
 #include <vector>
 
 #include "catenary_sim/ContactForceArray.h"
 #include "catenary_sim/ContactPointArray.h"
 #include "catenary_sim/MeasuredContactForce.h"
 #include "catenary_sim/ros/hil.hpp"
+#include "hil_rig.hpp"
 #include "ros_test_support.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
-bool wait_for(const std::function<bool()>& cond, double timeout_s) { return ros_test::wait_for(cond, timeout_s, 0.005); }
+using hil_rostest::wait_for;
 
 constexpr double kStatic = 100.0;  // N, static_uplift of reference_55m_hil.yaml
 
+// What the test hears of the node (made in main, after ros::init).
+struct Heard {
+  ros::NodeHandle nh;  // (first: the end of the last handle would shut ROS down)
+  ros_test::Recorder<ContactPointArray> points{"hil/contact_point", 100000, ros::TransportHints().tcpNoDelay()};
+  ros_test::Recorder<ContactForceArray> forces{"contact_force", 1000};
+  ros_test::NodeLog log{"catenary_sim_hil", rosgraph_msgs::Log::DEBUG};  // every line of the node
+};
+Heard* heard = nullptr;
+
+// The node's diagnostics statuses, each with the wall time it arrived at.
 std::mutex mu;
-std::vector<ContactPointArray> points;
-std::vector<ContactForceArray> forces;
 std::vector<diagnostic_msgs::DiagnosticStatus> diags;
 std::vector<ros::WallTime> diag_wall;
-int rejected_logs = 0;
 
-// The rig: publishes `values` at 1 kHz while `sending`.
-std::atomic<bool> sending{false}, quit{false};
+int rejected_logs() { return heard->log.count("rejected"); }
+
+// The rig: sends `values` while `sending`.
+std::atomic<bool> sending{false};
 std::mutex values_mu;
 std::vector<double> values{kStatic};
 
-void rig_thread() {
-  ros::NodeHandle nh;
-  ros::Publisher pub = nh.advertise<MeasuredContactForce>("hil/contact_force", 10);
-  ros::WallTime next = ros::WallTime::now();
-  while (!quit && ros::ok()) {
-    next += ros::WallDuration(0.001);
-    ros::WallTime::sleepUntil(next);
-    if (!sending) continue;
-    MeasuredContactForce m;
-    m.header.stamp = ros::Time::now();
-    {
-      std::lock_guard<std::mutex> l(values_mu);
-      m.force = values;
-    }
-    pub.publish(m);
-  }
+bool measure(MeasuredContactForce& m) {
+  if (!sending) return false;
+  std::lock_guard<std::mutex> l(values_mu);
+  m.force = values;
+  return true;
 }
 
 void send(std::vector<double> v) {
@@ -65,10 +62,7 @@ void send(std::vector<double> v) {
   values = std::move(v);
 }
 
-ContactPointArray last_point() {
-  std::lock_guard<std::mutex> l(mu);
-  return points.empty() ? ContactPointArray() : points.back();
-}
+ContactPointArray last_point() { return heard->points.last(); }
 
 // The newest diagnostics status of the node received after `since`.
 bool diag_after(const ros::WallTime& since, diagnostic_msgs::DiagnosticStatus* out) {
@@ -143,9 +137,8 @@ TEST(HilSafety, WaitingRunningSafeHoldRejectionAndRecovery) {
   EXPECT_GT(h2.pantographs[0].measurement_age, 1.0);
   // The ramp: from 120 N down to 100 N, never outside.
   {
-    std::lock_guard<std::mutex> l(mu);
     bool ramped = false;
-    for (const ContactPointArray& p : points)
+    for (const ContactPointArray& p : heard->points.take())
       if (p.mode == ContactPointArray::SAFE_HOLD) {
         const double f = p.pantographs[0].applied_force;
         EXPECT_GE(f, kStatic - 1e-9);
@@ -156,11 +149,7 @@ TEST(HilSafety, WaitingRunningSafeHoldRejectionAndRecovery) {
   }
 
   // 4. Bad measurements do not end the safe hold, change nothing and are logged throttled.
-  int logs_before;
-  {
-    std::lock_guard<std::mutex> l(mu);
-    logs_before = rejected_logs;
-  }
+  const int logs_before = rejected_logs();
   const ros::WallTime bad_start = ros::WallTime::now();
   for (const std::vector<double>& bad : std::vector<std::vector<double>>{
            {std::numeric_limits<double>::quiet_NaN()}, {std::numeric_limits<double>::infinity()}, {-100.0}, {5000.0},
@@ -179,12 +168,9 @@ TEST(HilSafety, WaitingRunningSafeHoldRejectionAndRecovery) {
   ASSERT_TRUE(wait_for([&] { return diag_after(after_bad, &d); }, 2.0));
   EXPECT_EQ(d.level, diagnostic_msgs::DiagnosticStatus::ERROR) << d.message;
   EXPECT_GE(std::stoll(value_of(d, "measurements rejected")), 1000) << value_of(d, "measurements rejected");
-  {
-    std::lock_guard<std::mutex> l(mu);
-    const int logs = rejected_logs - logs_before;
-    EXPECT_GE(logs, 1);
-    EXPECT_LE(logs, static_cast<int>(bad_s) + 3) << "rejections not throttled: " << logs << " in " << bad_s << " s";
-  }
+  const int logs = rejected_logs() - logs_before;
+  EXPECT_GE(logs, 1);
+  EXPECT_LE(logs, static_cast<int>(bad_s) + 3) << "rejections not throttled: " << logs << " in " << bad_s << " s";
 
   // 5. Fresh valid measurements end the safe hold; the train accelerates back.
   send({110.0});
@@ -211,7 +197,8 @@ TEST(HilSafety, WaitingRunningSafeHoldRejectionAndRecovery) {
   ros::WallDuration(0.02).sleep();
 
   // Never a NaN (or inf) in anything the node published.
-  std::lock_guard<std::mutex> l(mu);
+  const std::vector<ContactPointArray> points = heard->points.take();
+  const std::vector<ContactForceArray> forces = heard->forces.take();
   EXPECT_GT(points.size(), 3000u);
   for (const ContactPointArray& p : points) {
     ASSERT_TRUE(ros_layer::all_finite(p)) << "step " << p.step;
@@ -231,19 +218,9 @@ TEST(HilSafety, WaitingRunningSafeHoldRejectionAndRecovery) {
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_hil_safety");
-  ros::NodeHandle nh;
-  ros::Subscriber s1 = nh.subscribe<ContactPointArray>(
-      "hil/contact_point", 100000,
-      [](const ContactPointArray::ConstPtr& m) {
-        std::lock_guard<std::mutex> l(mu);
-        points.push_back(*m);
-      },
-      ros::VoidPtr(), ros::TransportHints().tcpNoDelay());
-  ros::Subscriber s2 = nh.subscribe<ContactForceArray>("contact_force", 1000, [](const ContactForceArray::ConstPtr& m) {
-    std::lock_guard<std::mutex> l(mu);
-    forces.push_back(*m);
-  }, ros::VoidPtr());
-  ros::Subscriber s3 = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+  Heard h;
+  heard = &h;
+  ros::Subscriber diag_sub = h.nh.subscribe<diagnostic_msgs::DiagnosticArray>(
       "/diagnostics", 100, [](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
         std::lock_guard<std::mutex> l(mu);
         for (const auto& s : m->status)
@@ -252,20 +229,6 @@ int main(int argc, char** argv) {
             diag_wall.push_back(ros::WallTime::now());
           }
       },
-      ros::VoidPtr());
-  ros::Subscriber s4 = nh.subscribe<rosgraph_msgs::Log>("/rosout", 1000, [](const rosgraph_msgs::Log::ConstPtr& m) {
-    if (m->name.find("catenary_sim_hil") != std::string::npos && m->msg.find("rejected") != std::string::npos) {
-      std::lock_guard<std::mutex> l(mu);
-      ++rejected_logs;
-    }
-  }, ros::VoidPtr());
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  std::thread rig(rig_thread);
-  const int rc = RUN_ALL_TESTS();
-  quit = true;
-  rig.join();
-  spinner.stop();
-  ros::shutdown();
-  return rc;
+      ros::VoidConstPtr());
+  return hil_rostest::run_with_rig<MeasuredContactForce>("hil/contact_force", measure);
 }

@@ -9,20 +9,15 @@
 // waits for effects, it never times them.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
-#include <rosgraph_msgs/Log.h>
 #include <std_msgs/Float64.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <functional>
-#include <mutex>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -30,48 +25,38 @@
 #include "catenary_sim/ContactPointArray.h"
 #include "catenary_sim/MeasuredContactForce.h"
 #include "catenary_sim/ros/hil.hpp"
+#include "hil_rig.hpp"
 #include "ros_test_support.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
-bool wait_for(const std::function<bool()>& cond, double timeout_s) { return ros_test::wait_for(cond, timeout_s, 0.005); }
+using hil_rostest::wait_for;
 
 constexpr double kForce = 120.0;     // N, what the rig measures (static uplift 100 N)
 
-std::mutex mu;
-ContactPointArray last;               // newest contact point
-ros::WallTime last_wall;              // when it arrived
-std::vector<std::string> errors;      // the node's ERROR lines on /rosout
-std::atomic<bool> quit{false};
+// What the test hears of the node (made in main, after ros::init).
+struct Heard {
+  ros::NodeHandle nh;  // (first: the end of the last handle would shut ROS down)
+  ros_test::Recorder<ContactPointArray> points{"hil/contact_point", 100, ros::TransportHints().tcpNoDelay()};
+  ros_test::NodeLog errors{"catenary_sim_hil"};  // the node's ERROR lines on /rosout
+};
+Heard* heard = nullptr;
 
-void rig_thread() {
-  ros::NodeHandle nh;
-  ros::Publisher pub = nh.advertise<MeasuredContactForce>("hil/contact_force", 10);
-  ros::WallTime next = ros::WallTime::now();
-  while (!quit && ros::ok()) {
-    next += ros::WallDuration(0.001);
-    ros::WallTime::sleepUntil(next);
-    MeasuredContactForce m;
-    m.header.stamp = ros::Time::now();
-    m.force = {kForce};
-    pub.publish(m);
-  }
+// The rig: measures kForce all along.
+bool measure(MeasuredContactForce& m) {
+  m.force = {kForce};
+  return true;
 }
 
-ContactPointArray point() {
-  std::lock_guard<std::mutex> l(mu);
-  return last;
-}
+// The newest contact point.
+ContactPointArray point() { return heard->points.last(); }
 
 // A contact point that arrived after now (the node has run a period since).
 ContactPointArray next_point() {
   const ros::WallTime since = ros::WallTime::now();
-  EXPECT_TRUE(wait_for([&] {
-    std::lock_guard<std::mutex> l(mu);
-    return last_wall > since;
-  }, 10.0)) << "no contact point for 10 s";
+  EXPECT_TRUE(wait_for([&] { return heard->points.last_with_arrival().second > since; }, 10.0)) << "no contact point for 10 s";
   return point();
 }
 
@@ -160,7 +145,7 @@ TEST(HilServices, ArmPauseSpeedResetStopAndArmAgain) {
   // within a second of being stamped (a generous bound for a loaded machine; the simulation time
   // started at 0, decades before the wall clock's epoch-based seconds).
   {
-    std::lock_guard<std::mutex> l(mu);
+    const auto [last, last_wall] = heard->points.last_with_arrival();
     EXPECT_LT(std::fabs((last_wall - ros::WallTime(last.header.stamp.sec, last.header.stamp.nsec)).toSec()), 1.0);
     EXPECT_NEAR(last.simulation_time, static_cast<double>(last.step) * last.dt, 1e-6);
   }
@@ -173,12 +158,7 @@ TEST(HilServices, ArmPauseSpeedResetStopAndArmAgain) {
   v.data = 200.0;
   speed_pub.publish(v);
   ASSERT_TRUE(wait_for([] {
-    std::lock_guard<std::mutex> l(mu);
-    for (const std::string& e : errors)
-      if (e.find("cmd/train_speed = 200 m/s rejected: allowed 0 to 150 m/s (540 km/h); command ignored") !=
-          std::string::npos)
-        return true;
-    return false;
+    return heard->errors.has({"cmd/train_speed = 200 m/s rejected: allowed 0 to 150 m/s (540 km/h); command ignored"});
   }, 10.0)) << "no rejection logged";
   ros::WallDuration(0.5).sleep();
   EXPECT_EQ(next_point().speed, 10.0);
@@ -269,29 +249,7 @@ TEST(HilServices, ArmPauseSpeedResetStopAndArmAgain) {
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_hil_services");
-  ros::NodeHandle nh;
-  ros::Subscriber s1 = nh.subscribe<ContactPointArray>(
-      "hil/contact_point", 100,
-      [](const ContactPointArray::ConstPtr& m) {
-        const ros::WallTime now = ros::WallTime::now();
-        std::lock_guard<std::mutex> l(mu);
-        last = *m;
-        last_wall = now;
-      },
-      ros::VoidPtr(), ros::TransportHints().tcpNoDelay());
-  ros::Subscriber s2 = nh.subscribe<rosgraph_msgs::Log>("/rosout", 1000, [](const rosgraph_msgs::Log::ConstPtr& m) {
-    if (m->name.find("catenary_sim_hil") != std::string::npos && m->level >= rosgraph_msgs::Log::ERROR) {
-      std::lock_guard<std::mutex> l(mu);
-      errors.push_back(m->msg);
-    }
-  }, ros::VoidPtr());
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  std::thread rig(rig_thread);
-  const int rc = RUN_ALL_TESTS();
-  quit = true;
-  rig.join();
-  spinner.stop();
-  ros::shutdown();
-  return rc;
+  Heard h;
+  heard = &h;
+  return hil_rostest::run_with_rig<MeasuredContactForce>("hil/contact_force", measure);
 }

@@ -14,10 +14,8 @@
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -33,13 +31,6 @@
 
 #include <nlohmann/json.hpp>
 
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
-#ifndef CATENARY_SIM_DEVEL_LIB
-#define CATENARY_SIM_DEVEL_LIB "."
-#endif
-
 #include "../support/child_process.hpp"
 
 using namespace catenary_sim_test;
@@ -51,19 +42,6 @@ const std::string kHilNode = CATENARY_SIM_DEVEL_LIB "/catenary_sim_hil_node";
 const std::string kRig = CATENARY_SIM_DEVEL_LIB "/virtual_rig";
 const std::string kScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
 const std::string kHilScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_hil.yaml";
-
-int free_port() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof a;
-  int port = 0;
-  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 && getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0)
-    port = ntohs(a.sin_port);
-  close(fd);
-  return port;
-}
 
 bool port_open(int port) {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -80,8 +58,7 @@ bool port_open(int port) {
 class NodeParamsFuzz : public ::testing::Test {
  public:
   static void SetUpTestSuite() {
-    char t[] = "/tmp/catenary_sim_params_XXXXXX";
-    dir_ = mkdtemp(t);
+    dir_ = temp_dir("catenary_sim_params_");
     port_ = free_port();
     env_ = {"ROS_MASTER_URI=http://localhost:" + std::to_string(port_), "ROS_HOME=" + dir_,
             "ROS_LOG_DIR=" + dir_ + "/log", "ROSCONSOLE_FORMAT=[${severity}] ${message}",

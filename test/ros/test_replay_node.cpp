@@ -23,14 +23,8 @@
 
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/WireShapeArray.h"
+#include "../support/child_process.hpp"
 #include "ros_test_support.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
-#ifndef CATENARY_SIM_DEVEL_LIB
-#define CATENARY_SIM_DEVEL_LIB "."
-#endif
 
 namespace {
 
@@ -49,8 +43,7 @@ std::string sh(const std::string& cmd) { return "bash -c '" + cmd + "'"; }
 }  // namespace
 
 TEST(Replay, RecordedPassIsDrawnAndPlotted) {
-  char dir_template[] = "/tmp/catenary_sim_replay_XXXXXX";
-  const std::string dir = mkdtemp(dir_template);
+  const std::string dir = catenary_sim_test::temp_dir("catenary_sim_replay_");
   const std::string scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
   const std::string bag = dir + "/pass.bag", png = dir + "/plot.png";
   // The whole reference pass (550 m, 6.6 s at 300 km/h): state topics at 200 Hz, wire_shape at 10 Hz.

@@ -1,21 +1,37 @@
 // Child processes for the tests that run the tools and nodes as a user would (fuzz of bad input,
-// the pass report): spawn with stdout and stderr to a log file, wait with a time limit, kill a
-// hung child, and report how it ended. Header-only; POSIX.
+// the pass report, bags and replays): spawn with stdout and stderr to a log file, wait with a time
+// limit, kill a hung child, and report how it ended; a scratch directory and a free port for a
+// master of the test's own. Header-only; POSIX.
 #pragma once
 
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
+
+// Where the programs under test are built and where the source tree is: the build defines both
+// for the tests that include this header.
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+#ifndef CATENARY_SIM_DEVEL_LIB
+#define CATENARY_SIM_DEVEL_LIB "."
+#endif
 
 extern char** environ;
 
@@ -31,6 +47,27 @@ inline std::string slurp(const std::string& path) {
 inline bool exists(const std::string& path) {
   struct stat st {};
   return stat(path.c_str(), &st) == 0;
+}
+
+// A new directory of the test's own, /tmp/<prefix>XXXXXX.
+inline std::string temp_dir(const std::string& prefix) {
+  std::string t = "/tmp/" + prefix + "XXXXXX";
+  if (!mkdtemp(&t[0])) throw std::runtime_error("cannot make " + t + ": " + std::strerror(errno));
+  return t;
+}
+
+// A TCP port free on the loopback interface (for a master of the test's own), 0 if none.
+inline int free_port() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof a;
+  int port = 0;
+  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 && getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0)
+    port = ntohs(a.sin_port);
+  close(fd);
+  return port;
 }
 
 struct ChildRun {

@@ -8,29 +8,15 @@
 // and a scalar in its place, and the YAML text is corrupted in the ways the fuzz found.
 // Deterministic (fixed seed): a failure is reproducible, never by chance.
 #include <gtest/gtest.h>
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
-#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <random>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
-#ifndef CATENARY_SIM_DEVEL_LIB
-#define CATENARY_SIM_DEVEL_LIB "."
-#endif
 
 #include "../support/child_process.hpp"
 
@@ -41,11 +27,6 @@ namespace {
 const std::string kReference = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
 const std::string kSimulatePass = CATENARY_SIM_DEVEL_LIB "/simulate_pass";
 const std::string kElasticity = CATENARY_SIM_DEVEL_LIB "/elasticity_curve";
-
-std::string temp_dir() {
-  char t[] = "/tmp/catenary_sim_fuzz_XXXXXX";
-  return mkdtemp(t);
-}
 
 // Runs argv to its end (at most `limit` s) with its output in dir/output.txt.
 ChildRun run(const std::vector<std::string>& args, const std::string& dir, double limit = 10.0) {
@@ -106,7 +87,7 @@ void collect(const YAML::Node& n, const std::string& key, const std::string& msg
 }  // namespace
 
 TEST(FuzzBadInput, SetOverridesOfEveryField) {
-  const std::string dir = temp_dir();
+  const std::string dir = temp_dir("catenary_sim_fuzz_");
   const YAML::Node root = YAML::LoadFile(kReference);
   std::vector<Field> numeric, maps;
   collect(root, "", "", &numeric, &maps);
@@ -133,7 +114,7 @@ TEST(FuzzBadInput, SetOverridesOfEveryField) {
 }
 
 TEST(FuzzBadInput, OverridePathsAndValues) {
-  const std::string dir = temp_dir();
+  const std::string dir = temp_dir("catenary_sim_fuzz_");
   int count = 0;
   std::vector<Case> cases = {
       {"through a value", {"--set", "name.foo=1"}, {"name"}},
@@ -199,7 +180,7 @@ TEST(FuzzBadInput, OverridePathsAndValues) {
 }
 
 TEST(FuzzBadInput, CorruptedSceneFiles) {
-  const std::string dir = temp_dir();
+  const std::string dir = temp_dir("catenary_sim_fuzz_");
   const std::string text = slurp(kReference);
   std::mt19937 rng(20261123);  // fixed: the same files every run
   int count = 0;

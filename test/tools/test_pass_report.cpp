@@ -2,28 +2,14 @@
 // HTML holds every section with its picture embedded, the limits are marked, and the report
 // fails with a clear message on a directory without a pass. Runs the tools as child processes.
 #include <gtest/gtest.h>
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <chrono>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
-#ifndef CATENARY_SIM_DEVEL_LIB
-#define CATENARY_SIM_DEVEL_LIB "."
-#endif
 
 #include "../support/child_process.hpp"
 
@@ -33,17 +19,9 @@ namespace {
 
 const std::string kSimulatePass = CATENARY_SIM_DEVEL_LIB "/simulate_pass";
 
-// Runs argv to its end (at most `limit` s) with its output in `log`.
-ChildRun run(const std::vector<std::string>& args, const std::string& log, double limit) {
-  return run_child(args, log, limit);
-}
-
 class PassReport : public ::testing::Test {
  protected:
-  void SetUp() override {
-    char t[] = "/tmp/catenary_sim_report_XXXXXX";
-    dir_ = mkdtemp(t);
-  }
+  void SetUp() override { dir_ = temp_dir("catenary_sim_report_"); }
   void TearDown() override {
     if (!HasFailure()) std::system(("rm -rf '" + dir_ + "'").c_str());
   }
@@ -55,7 +33,7 @@ class PassReport : public ::testing::Test {
 // The limits are set so that some pass and one fails: 1 mm of uplift is far below any pass's.
 TEST_F(PassReport, ShortPassBuildsEverySection) {
   const std::string out = dir_ + "/out";
-  const ChildRun r = run({kSimulatePass, "--scene", CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", "--out", out,
+  const ChildRun r = run_child({kSimulatePass, "--scene", CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", "--out", out,
                           "--speed", "250", "--set", "line.span_count=6", "--set", "numerics.element_length=0.5",
                           "--set", "output.allowed_uplift=0.001", "--set", "output.max_stat_force=400", "--set",
                           "output.min_stat_force=0", "--set", "output.max_contact_loss_percent=0", "--set",
@@ -105,7 +83,7 @@ TEST_F(PassReport, ShortPassBuildsEverySection) {
 // The 3-D line's section: its files written and drawn, the page one picture longer.
 TEST_F(PassReport, ThreeDimensionalLineAddsTheLateralSection) {
   const std::string out = dir_ + "/out";
-  const ChildRun r = run({kSimulatePass, "--scene", CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", "--out", out,
+  const ChildRun r = run_child({kSimulatePass, "--scene", CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", "--out", out,
                           "--speed", "250", "--set", "line.span_count=6", "--set", "numerics.element_length=0.5",
                           "--set", "stagger.contact_wire=[0.3,-0.3]", "--report", "--no-progress"},
                          dir_ + "/log.txt", 300.0);
@@ -124,7 +102,7 @@ TEST_F(PassReport, ThreeDimensionalLineAddsTheLateralSection) {
 }
 
 TEST_F(PassReport, ReportOfAnEmptyDirectoryFailsNamingTheFile) {
-  const ChildRun r = run({"/usr/bin/python3", CATENARY_SIM_SOURCE_DIR "/scripts/pass_report", dir_},
+  const ChildRun r = run_child({"/usr/bin/python3", CATENARY_SIM_SOURCE_DIR "/scripts/pass_report", dir_},
                          dir_ + "/log.txt", 60.0);
   ASSERT_FALSE(r.hung);
   EXPECT_EQ(r.exit_code, 2) << r.out;
