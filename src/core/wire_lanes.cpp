@@ -261,8 +261,8 @@ struct OnePlane {
   static bool inside(Mask m) { return V::ok(m); }
 };
 
-// One pack's sweep (eq. 19-21 with the rotations condensed) on what A reads and writes, as the
-// steps the driver below takes along the nodes.
+// One pack's sweep (eq. 19-21 with the rotations condensed) on what Access reads and writes
+// (OnePlane, TwoPlanes), as the steps the driver below takes along the nodes.
 template <class Access>
 struct Sweeper : Access {
   using T = typename Access::T;
