@@ -6,8 +6,9 @@
 //       -o /tmp/bench_pass_hash_base
 // (the flags of the package's Release build).
 //   bench_pass_hash SCENE [--set-style overrides...]
-// Prints the steps, the FNV-1a hash of u, v and the contact forces over every step, and the wall
-// time of the stepping (model building and statics not included).
+// Prints the steps, the FNV-1a hash of u, v and the contact forces over every step (and, with a
+// lateral plane, of its y and v: a 2-D scene's hash is what it was before the 3-D line), and the
+// wall time of the stepping (model building and statics not included).
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -41,6 +42,10 @@ int main(int argc, char** argv) {
     mix(s.u.data(), s.u.size());
     mix(s.v.data(), s.v.size());
     mix(s.contact_force.data(), s.contact_force.size());
+    if (again.model().lateral) {
+      mix(s.lateral.y.data(), s.lateral.y.size());
+      mix(s.lateral.v.data(), s.lateral.v.size());
+    }
   }
   std::printf("%ld steps, %d DOFs, wall %.4f s, %.3f ns per DOF and step, hash %016llx\n", steps, sim.model().n_dof, wall,
               wall / steps / sim.model().n_dof * 1e9, static_cast<unsigned long long>(hash));

@@ -395,14 +395,30 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
     if (!done) return -1;
   }
   bool outside = false;
-  for (const WireLanes& p : m.wire_packs) {
-    PackSweep a;
-    if (!setup_pack_sweep(p, m.wires, windowed ? &s.window : nullptr, s.sweep_factors.data(), s.sweep.data(), u, v, un, vn,
-                          acc, a)) continue;
+  // The lateral step's band sweep taken along (step_both_planes): both planes' records then in the
+  // joint layout (LateralState::sweep, joint_record_index).
+  const bool join = m.lateral && s.lateral.join;
+  bool lateral_outside = false;
+  for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
+    PackSweep a, b;
+    if (!setup_pack_sweep(m.wire_packs[pk], m.wires, windowed ? &s.window : nullptr, s.sweep_factors.data(), s.sweep.data(), u, v,
+                          un, vn, acc, a))
+      continue;
     a.beta = beta;
     a.dt = dt;
     a.limit = limit;
-    outside |= sweep_pack(a);
+    if (join && setup_lateral_sweep(m, s, pk, false, b)) {
+      bool b_outside = false;
+      outside |= sweep_pack_pair(a, b, s.lateral.sweep.data() + 2 * kSweepRecord * m.wire_packs[pk].offset, &b_outside);
+      lateral_outside |= b_outside;
+    } else {
+      outside |= sweep_pack(a);
+    }
+  }
+  if (join) {
+    s.lateral.joined = true;
+    s.lateral.joined_outside = lateral_outside;
+    ++s.lateral.joined_steps;
   }
 
   // The nodes with point forces: the contact wire's nodes under every collector (contact_forces'
@@ -456,14 +472,15 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
   // Supports, droppers and the window's dashpots act straight on the band forces the sweep left in
   // its records (where z is too), in the generic step's order; the contact nodes then take their
   // force so far into the force vector, where the pantographs' contact adds to it.
-  double* rec = s.sweep.data();
+  double* rec = join ? s.lateral.sweep.data() : s.sweep.data();
   const int* f_at = m.dof_sweep_force.data();
   const int* z_at = m.dof_sweep_z.data();
-  auto force_at = [rec, f_at](int i) -> double& { return rec[f_at[i]]; };
-  auto z_rec = [rec, z_at](int i) { return rec[z_at[i]]; };
+  const int joint = join;
+  auto force_at = [rec, f_at, joint](int i) -> double& { return rec[joint_record_index(f_at[i], joint, false)]; };
+  auto z_rec = [rec, z_at, joint](int i) { return rec[joint_record_index(z_at[i], joint, false)]; };
   if (leaning(m, s)) add_wire_point_forces<true>(m, s, u, v, force_at, z_rec, false);
   else add_wire_point_forces<false>(m, s, u, v, force_at, z_rec, false);
-  for (int q = 0; q < contacts; ++q) f[contact_node[q]] = rec[f_at[contact_node[q]]];
+  for (int q = 0; q < contacts; ++q) f[contact_node[q]] = force_at(contact_node[q]);
   add_pantograph_forces(m, s, u, v, f);
   const double* im = m.inv_mass.data();
   auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
@@ -473,7 +490,7 @@ int explicit_fused_update(const Model& m, State& s, bool windowed, bool& done) {
     un[i] = u[i] + dt * vn[i];
     outside |= beyond(i);
   };
-  for_each_point([&](int i) { update(i, rec[f_at[i]]); });  // the contact nodes last: theirs has the contact
+  for_each_point([&](int i) { update(i, force_at(i)); });  // the contact nodes last: theirs has the contact
   for (int q = 0; q < contacts; ++q) update(contact_node[q], f[contact_node[q]]);
   for (int i = m.n_catenary_dof; i < m.n_dof; ++i) update(i, f[i]);
   // The displacement check: the sweeps' flag is only a hint (they saw the nodes before the point

@@ -82,7 +82,8 @@ double lateral_omega_max(const Model& m, const LateralModel& lat) {
 }
 
 // The fused step's planes: per vertical pack (Model::wire_packs, wires on the same stations side
-// by side), the lateral plane's load, alpha m and 1/m in the pack's layout; and the point nodes.
+// by side), the lateral plane's load, alpha m, 1/m and wind drag coefficient in the pack's layout
+// (PackSweep::plane); and the point nodes.
 void build_lateral_packs(const Model& m, LateralModel& lat) {
   lat.planes.clear();
   lat.point_nodes.clear();
@@ -90,7 +91,7 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
   if (m.wire_packs.empty()) return;  // the vertical step is not fused: neither is this one
   for (const WireLanes& p : m.wire_packs) {
     const int L = p.lanes;
-    std::vector<double> plane(static_cast<std::size_t>(p.nodes) * 3 * L, 0.0);
+    std::vector<double> plane(static_cast<std::size_t>(p.nodes) * kPlaneValues * L, 0.0);
     for (int k = 0; k < L; ++k) {
       const Wire& w = lat.wires[p.wire[k]];
       if (w.nodes() != p.nodes) {  // (never: the lateral wires are the vertical ones' copies)
@@ -98,10 +99,11 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
         return;
       }
       for (int i = 0; i < p.nodes; ++i) {
-        double* c = plane.data() + static_cast<std::size_t>(i) * 3 * L + k;
-        c[0 * L] = lat.load[w.w_dof + i];
-        c[1 * L] = m.alpha * lat.mass[w.w_dof + i];
-        c[2 * L] = lat.inv_mass[w.w_dof + i];
+        double* c = plane.data() + static_cast<std::size_t>(i) * kPlaneValues * L + k;
+        c[kPlaneLoad * L] = lat.load[w.w_dof + i];
+        c[kPlaneDamping * L] = m.alpha * lat.mass[w.w_dof + i];
+        c[kPlaneInvMass * L] = lat.inv_mass[w.w_dof + i];
+        c[kPlaneDrag * L] = lat.windy ? lat.wind_coefficient[w.w_dof + i] : 0.0;
       }
     }
     lat.planes.push_back(std::move(plane));
@@ -470,6 +472,7 @@ LateralState make_lateral_state(const Model& m) {
   s.y_next = s.y;
   s.v_next = Eigen::VectorXd::Zero(lat.n);
   s.accel = Eigen::VectorXd::Zero(lat.n);
+  s.sweep.assign(2 * kSweepRecord * m.sweep_size, 0.0);  // (both planes' records when joint)
   int longest = 0;
   for (const Wire& w : lat.wires) longest = std::max(longest, w.nodes());
   s.theta.assign(longest, 0.0);
@@ -605,6 +608,19 @@ void over_stepped(const Model& m, const State& s, bool windowed, Body&& body) {
     }
 }
 
+// The turbulent wind on the nodes stepped at time t, if a refresh is due: the wind's speed normal
+// to each node's wire, W = (U + u') sin(angle), is refreshed every kWindUpdate of the field's
+// sample time (it is linear between samples 0.1 s apart at the default 5 Hz); the drag on the
+// moving wire is taken every step.
+void refresh_wind_if_due(const Model& m, State& s, double t, bool windowed) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  if (!lat.windy || lat.field.empty() || !(t + 1e-12 >= ls.next_wind_update)) return;
+  ls.next_wind_update = t + kWindUpdate * lat.field.dt;
+  lat.field.at_time(t, ls.wind_points.data());
+  over_stepped(m, s, windowed, [&](int i0, int i1) { refresh_wind(m, s, i0, i1); });  // (only where stepped)
+}
+
 // The moving window (numerics.window): the lateral plane steps the vertical plane's window
 // (State::window, which update_window moved before this step; the lateral waves run at the same
 // sqrt(T/rhoA), so the same window holds their echoes) and, in a turbulent wind, a lead of
@@ -725,6 +741,27 @@ void add_window_forces(const Model& m, const State& s, const double* v, double* 
   }
 }
 
+}  // namespace
+
+bool setup_lateral_sweep(const Model& m, State& s, std::size_t pack, bool windowed, PackSweep& a) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const WireLanes& p = m.wire_packs[pack];
+  if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, ls.sweep_factors.data(), s.sweep.data(), ls.y.data(),
+                        ls.v.data(), ls.y_next.data(), ls.v_next.data(), ls.accel.data(), a))
+    return false;
+  // (the records in the vertical step's scratch, State::sweep; sweep_pack_pair puts them elsewhere)
+  a.plane = lat.planes[pack].data();
+  // The wind's drag is taken in the sweep (PackSweep::wind), on the velocity it reads anyway.
+  for (int k = 0; k < p.lanes; ++k) a.wind[k] = lat.windy ? ls.wind_speed.data() + lat.wires[p.wire[k]].w_dof : nullptr;
+  a.beta = m.beta;
+  a.dt = lat.dt;
+  a.limit = m.scene.numerics.divergence_limit;
+  return true;
+}
+
+namespace {
+
 // The springs (steady arms, messenger supports) and the droppers' pendulums on f, at
 // z = y + beta v (`z_at`), over the window's lists or the whole line: the pendulums at the
 // droppers' tension now with their lean's share (two-way coupling, lateral.hpp), 0 when slack, and
@@ -773,35 +810,22 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
   double* yn = ls.y_next.data();
   double* vn = ls.v_next.data();
   double* acc = ls.accel.data();
-  // The wind's drag is taken in the sweep (PackSweep::wind), on the velocity it reads anyway.
-  const double* W = lat.windy ? ls.wind_speed.data() : nullptr;
-  const double* cw = lat.windy ? lat.wind_coefficient.data() : nullptr;
-  bool outside = false;
-  for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
-    const WireLanes& p = m.wire_packs[pk];
-    PackSweep a;
-    // (the records in the vertical step's scratch)
-    if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, ls.sweep_factors.data(), s.sweep.data(), y, v, yn,
-                          vn, acc, a))
-      continue;
-    a.plane = lat.planes[pk].data();
-    for (int k = 0; k < p.lanes; ++k) {
-      const int o = lat.wires[p.wire[k]].w_dof;
-      a.wind[k] = W ? W + o : nullptr;
-      a.drag_coefficient[k] = cw ? cw + o : nullptr;
+  // The band sweeps: taken along by this step's vertical sweeps (step_both_planes), else here.
+  const int joined = ls.joined;  // (its records then in the joint layout: joint_record_index)
+  bool outside = joined && ls.joined_outside;
+  if (!joined)
+    for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
+      PackSweep a;
+      if (setup_lateral_sweep(m, s, pk, windowed, a)) outside |= sweep_pack(a);
     }
-    a.beta = beta;
-    a.dt = h;
-    a.limit = limit;
-    outside |= sweep_pack(a);
-  }
+  ls.joined = false;
   // Point forces on the band forces the sweep left in its records, as the generic step adds them.
   double* f = ls.f.data();
-  const double* rec = s.sweep.data();
+  const double* rec = joined ? ls.sweep.data() : s.sweep.data();
   const int* at = lat.sweep_force_at.data();
   const int* points = windowed ? ls.window_points.data() : lat.point_nodes.data();
   const int np = windowed ? ls.window_point_count : static_cast<int>(lat.point_nodes.size());
-  for (int q = 0; q < np; ++q) f[points[q]] = rec[at[points[q]]];
+  for (int q = 0; q < np; ++q) f[points[q]] = rec[joint_record_index(at[points[q]], joined, true)];
   if (windowed) add_window_forces(m, s, v, f);
   add_springs_and_pendulums(m, s, windowed, y, [y, v, beta](int i) { return y[i] + beta * v[i]; }, f);
   const double* im = lat.inv_mass.data();
@@ -863,15 +887,7 @@ StepStatus lateral_step(const Model& m, State& s) {
   const bool windowed = lat.windowed;
   if (windowed) sync_window(m, s);
   for (int sub = 0; sub < lat.substeps; ++sub) {
-    const double t = t0 + sub * h;
-    if (lat.windy && !lat.field.empty() && t + 1e-12 >= ls.next_wind_update) {
-      // The wind's speed normal to each node's wire, W = (U + u') sin(angle), is refreshed every
-      // kWindUpdate of the field's sample time (it is linear between samples 0.1 s apart at the
-      // default 5 Hz); the drag on the moving wire is taken every step.
-      ls.next_wind_update = t + kWindUpdate * lat.field.dt;
-      lat.field.at_time(t, ls.wind_points.data());
-      over_stepped(m, s, windowed, [&](int i0, int i1) { refresh_wind(m, s, i0, i1); });  // (only where stepped)
-    }
+    refresh_wind_if_due(m, s, t0 + sub * h, windowed);
     if (!lat.planes.empty() && (!windowed || ls.window_fused)) {
       if (fused_substep(m, s, windowed)) {
         ls.diverged = true;
@@ -930,6 +946,28 @@ StepStatus lateral_step(const Model& m, State& s) {
     s.status = StepStatus::kDewired;
   }
   return s.status;
+}
+
+StepStatus step_both_planes(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  // Both planes sweep every node of the same packs: no window, one lateral step a vertical one,
+  // both fused, and the step will be taken (not the pass's end).
+  bool two_wire_packs = true;  // (sweep_pack_pair's four lanes)
+  for (const WireLanes& p : m.wire_packs) two_wire_packs &= p.lanes == 2;
+  ls.join = !lat.planes.empty() && two_wire_packs && lat.substeps == 1 && !m.scene.numerics.windowed() &&
+            s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty();
+  // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
+  // the vertical step's s.time += dt), refreshed now for the sweep (lateral_step then finds it
+  // done: the same values, once).
+  if (ls.join) refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
+  const StepStatus st = step(m, s);
+  ls.join = false;
+  if (st != StepStatus::kOk) {
+    ls.joined = false;
+    return st;
+  }
+  return lateral_step(m, s);
 }
 
 void shift_lateral_block(const Model& m, State& s) {

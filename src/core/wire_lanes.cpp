@@ -77,6 +77,7 @@ namespace {
 
 typedef double Double2 __attribute__((vector_size(16)));
 typedef long Long2 __attribute__((vector_size(16)));
+typedef double Double4 __attribute__((vector_size(32)));
 
 template <int L>
 struct Lane;
@@ -189,97 +190,142 @@ struct Lane<2> {
   }
 };
 
+// Where one pack's sweep reads and writes: one plane, L lanes (PackSweep: the vertical plane's
+// pack, or the lateral plane's on the same band with its own load, damping, inverse mass and wind).
 template <int L, bool Plane, bool Drag>
-__attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
+struct OnePlane {
   using V = Lane<L>;
   using T = typename V::T;
-  using W = WireLanes;
-  constexpr int NC = W::kCoefficients, NR = kSweepRecord;
+  using Mask = typename V::Mask;
+  static constexpr int NC = WireLanes::kCoefficients, NR = kSweepRecord;
   // Few base pointers (one coefficient record per node, one sweep record per node, the second
-  // wire at an offset in the state's arrays), all in restrict locals, so that they stay in
-  // registers and no store can be taken to change them.
-  const double* __restrict coef = a.pack->coef.data();
-  const double* __restrict fac = a.factors;
-  double* __restrict rec = a.record;
-  const double *__restrict u = a.u[0], *__restrict v = a.v[0];
-  double *__restrict un = a.u_next[0], *__restrict vn = a.v_next[0], *__restrict acc = a.accel[0];
-  const std::ptrdiff_t d = L == 2 ? a.u[1] - a.u[0] : 0;
-  // The wind's arrays: second lanes as far from the first as the state's (per-wire rows of one
+  // wire at an offset in the state's arrays), so that they stay in registers.
+  const double* coef;
+  const double* fac;
+  double* rec;
+  const double *u, *v;
+  double *un, *vn, *acc;
+  std::ptrdiff_t d;
+  // The wind's speed: second lane as far from the first as the state's (per-wire rows of one
   // array of the lateral plane's DOFs).
-  const double* __restrict wind = a.wind[0];
-  const double* __restrict cw = a.drag_coefficient[0];
-  const double* __restrict plane = a.plane;
-  auto c = [&](int i, int k) __attribute__((always_inline)) { return V::at(coef, static_cast<std::ptrdiff_t>(i) * NC + k); };
-  // The load, alpha m and 1/m of node i: the pack's, or the lateral plane's own.
-  auto load = [&](int i) __attribute__((always_inline)) {
-    if constexpr (Plane) return V::at(plane, static_cast<std::ptrdiff_t>(i) * 3 + 0);
-    else return c(i, W::kLoad);
-  };
-  auto damping = [&](int i) __attribute__((always_inline)) {
-    if constexpr (Plane) return V::at(plane, static_cast<std::ptrdiff_t>(i) * 3 + 1);
-    else return c(i, W::kDampingMass);
-  };
-  auto inv_mass = [&](int i) __attribute__((always_inline)) {
-    if constexpr (Plane) return V::at(plane, static_cast<std::ptrdiff_t>(i) * 3 + 2);
-    else return c(i, W::kInvMass);
-  };
-  auto lower = [&](int i) __attribute__((always_inline)) { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i)); };
-  auto ip = [&](int i) __attribute__((always_inline)) { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i) + 1); };
-  auto get = [&](int i, int k) __attribute__((always_inline)) { return V::at(rec, static_cast<std::ptrdiff_t>(i) * NR + k); };
-  auto set = [&](int i, int k, T x) __attribute__((always_inline)) { V::put(rec, static_cast<std::ptrdiff_t>(i) * NR + k, x); };
-  const T beta = V::splat(a.beta), dt = V::splat(a.dt);
-  const int lo = a.lo, hi = a.hi;
-  const T ww_lo = V::pair(a.ww_lo), wt_lo = V::pair(a.wt_lo), ww_hi = V::pair(a.ww_hi), wt_hi = V::pair(a.wt_hi);
+  const double *wind, *plane;
+  T beta, dt, ww_lo, wt_lo, ww_hi, wt_hi, above, below;
+  int lo, hi;
 
-  // Forward: z = u + beta v and the load less the mass-proportional damping, load - alpha m v
-  // (assemble_force's init), kept for the backward sweep; and K_tt theta = -K_tw z, the L of
-  // LDL^T (condensed_band_force's first loop).
-  auto start = [&](int i, T ui, T vi) __attribute__((always_inline)) {
-    const T z = ui + beta * vi;
-    set(i, kRecZ, z);
+  explicit OnePlane(const PackSweep& a)
+      : coef(a.pack->coef.data()), fac(a.factors), rec(a.record), u(a.u[0]), v(a.v[0]), un(a.u_next[0]),
+        vn(a.v_next[0]), acc(a.accel[0]), d(L == 2 ? a.u[1] - a.u[0] : 0), wind(a.wind[0]),
+        plane(a.plane), beta(V::splat(a.beta)), dt(V::splat(a.dt)),
+        ww_lo(V::pair(a.ww_lo)), wt_lo(V::pair(a.wt_lo)), ww_hi(V::pair(a.ww_hi)), wt_hi(V::pair(a.wt_hi)),
+        above(V::splat(a.limit)), below(V::splat(-a.limit)), lo(a.lo), hi(a.hi) {}
+
+  __attribute__((always_inline)) T c(int i, int k) const { return V::at(coef, static_cast<std::ptrdiff_t>(i) * NC + k); }
+  __attribute__((always_inline)) T lower(int i) const { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i)); }
+  __attribute__((always_inline)) T ip(int i) const { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i) + 1); }
+  __attribute__((always_inline)) T get(int i, int k) const { return V::at(rec, static_cast<std::ptrdiff_t>(i) * NR + k); }
+  __attribute__((always_inline)) void set(int i, int k, T x) { V::put(rec, static_cast<std::ptrdiff_t>(i) * NR + k, x); }
+  // The load, alpha m and 1/m of node i: the pack's, or the lateral plane's own.
+  __attribute__((always_inline)) T plane_value(int i, int k, int own) const {
+    if constexpr (Plane) return V::at(plane, static_cast<std::ptrdiff_t>(i) * kPlaneValues + own);
+    else return c(i, k);
+  }
+  __attribute__((always_inline)) T inv_mass(int i) const { return plane_value(i, WireLanes::kInvMass, kPlaneInvMass); }
+  // The load less the mass-proportional damping, load - alpha m v (assemble_force's init), and
+  // with wind its drag: (load - alpha m v) + (cw (W - v)) |W - v|.
+  __attribute__((always_inline)) T init(int i, T vi) const {
+    const T f = plane_value(i, WireLanes::kLoad, kPlaneLoad) - plane_value(i, WireLanes::kDampingMass, kPlaneDamping) * vi;
     if constexpr (Drag) {
       const T vr = V::gather(wind, d, i) - vi;
-      set(i, kRecInit, (load(i) - damping(i) * vi) + V::gather(cw, d, i) * vr * V::abs(vr));
+      return f + V::at(plane, static_cast<std::ptrdiff_t>(i) * kPlaneValues + kPlaneDrag) * vr * V::abs(vr);
     } else {
-      set(i, kRecInit, load(i) - damping(i) * vi);
+      return f;
     }
+  }
+  __attribute__((always_inline)) void state(int i, T& ui, T& vi) const {
+    ui = V::gather(u, d, i);
+    vi = V::gather(v, d, i);
+  }
+  // Nodes i and i + 1: u, v of both wires loaded as blocks.
+  __attribute__((always_inline)) void state2(int i, T& u0, T& u1, T& v0, T& v1) const {
+    V::gather2(u, d, i, u0, u1);
+    V::gather2(v, d, i, v0, v1);
+  }
+  // Eq. 20-21 at node i, and at nodes i and i + 1 as a block.
+  __attribute__((always_inline)) void update(int i, T a, Mask& ok) {
+    V::template update<!Plane>(u, v, un, vn, acc, d, i, a, dt, ok, above, below);
+  }
+  __attribute__((always_inline)) void update2(int i, T a0, T a1, Mask& ok) {
+    V::template update2<!Plane>(u, v, un, vn, acc, d, i, a0, a1, dt, ok, above, below);
+  }
+  static Mask all() { return V::all(); }
+  static bool inside(Mask m) { return V::ok(m); }
+};
+
+// One pack's sweep (eq. 19-21 with the rotations condensed) on what Access reads and writes
+// (OnePlane, TwoPlanes), as the steps the driver below takes along the nodes.
+template <class Access>
+struct Sweeper : Access {
+  using T = typename Access::T;
+  using W = WireLanes;
+  using Access::c;
+  using Access::get;
+  using Access::ip;
+  using Access::lower;
+  using Access::set;
+  T zp, zc, y;              // forward: z at the last two nodes, the L sweep's value
+  T th1, th2, z1, z2;       // backward: theta and z at the two nodes after the current one
+  typename Access::Mask ok;  // every new displacement inside the limit so far
+
+  using Access::Access;
+
+  // Forward: z = u + beta v and the load less the damping (init), kept for the backward sweep;
+  // and K_tt theta = -K_tw z, the L of LDL^T (condensed_band_force's first loop).
+  __attribute__((always_inline)) T start(int i, T ui, T vi) {
+    const T z = ui + this->beta * vi;
+    set(i, kRecZ, z);
+    set(i, kRecInit, this->init(i, vi));
     return z;
-  };
-  T zp = start(lo, V::gather(u, d, lo), V::gather(v, d, lo));
-  T zc = start(lo + 1, V::gather(u, d, lo + 1), V::gather(v, d, lo + 1));
-  T y = -wt_lo * zp - c(lo, W::kEtw) * zc;
-  set(lo, kRecTheta, y);
-  auto forward = [&](int i, T zn) __attribute__((always_inline)) {
+  }
+  __attribute__((always_inline)) void forward(int i, T zn) {
     const T r = (-c(i, W::kDwt) * zc - c(i, W::kEtw) * zn) - c(i - 1, W::kEwt) * zp;
     y = r - lower(i) * y;
     set(i, kRecTheta, y);
     zp = zc;
     zc = zn;
-  };
-  int i = lo + 1;
-  for (; i + 1 < hi; i += 2) {  // two nodes a turn: u, v of both wires loaded as blocks
+  }
+  __attribute__((always_inline)) void forward_begin() {
+    const int lo = this->lo;
+    T u0, v0, u1, v1;
+    this->state(lo, u0, v0);
+    this->state(lo + 1, u1, v1);
+    zp = start(lo, u0, v0);
+    zc = start(lo + 1, u1, v1);
+    y = -this->wt_lo * zp - c(lo, W::kEtw) * zc;
+    set(lo, kRecTheta, y);
+  }
+  __attribute__((always_inline)) void forward_two(int i) {
     T u0, u1, v0, v1;
-    V::gather2(u, d, i + 1, u0, u1);
-    V::gather2(v, d, i + 1, v0, v1);
+    this->state2(i + 1, u0, u1, v0, v1);
     forward(i, start(i + 1, u0, v0));
     forward(i + 1, start(i + 2, u1, v1));
   }
-  if (i < hi) forward(i, start(i + 1, V::gather(u, d, i + 1), V::gather(v, d, i + 1)));
-  y = (-wt_hi * zc - c(hi - 1, W::kEwt) * zp) - lower(hi) * y;
+  __attribute__((always_inline)) void forward_one(int i) {
+    T ui, vi;
+    this->state(i + 1, ui, vi);
+    forward(i, start(i + 1, ui, vi));
+  }
+  __attribute__((always_inline)) void forward_end() {
+    y = (-this->wt_hi * zc - c(this->hi - 1, W::kEwt) * zp) - lower(this->hi) * y;
+  }
 
   // Backward: D^-1 and L^T, and behind it node j = i + 1 is complete: its band force
   // f_j = (load - alpha m v - A_j) - B_j (band_w_rows' order), kept for the nodes with point
   // forces, its acceleration, and the update of eq. 20-21.
-  typename V::Mask ok = V::all();
-  const T above = V::splat(a.limit), below = V::splat(-a.limit);
-  T th1 = y * ip(hi);  // theta_{i+1}, theta_{i+2}, z likewise
-  set(hi, kRecTheta, th1);
-  T z1 = get(hi, kRecZ), th2, z2;
-  auto accel = [&](int j, T f) __attribute__((always_inline)) {
+  __attribute__((always_inline)) T accel(int j, T f) {
     set(j, kRecForce, f);
-    return inv_mass(j) * f;
-  };
-  auto backward = [&](int i) __attribute__((always_inline)) {
+    return this->inv_mass(j) * f;
+  }
+  __attribute__((always_inline)) T backward(int i) {
     const T th0 = get(i, kRecTheta) * ip(i) - lower(i + 1) * th1;
     set(i, kRecTheta, th0);
     const T z0 = get(i, kRecZ);
@@ -292,30 +338,146 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
     z2 = z1;
     z1 = z0;
     return accel(j, f);
-  };
-  {
-    const int i = hi - 1;
+  }
+  __attribute__((always_inline)) void backward_begin() {
+    const int hi = this->hi, i = hi - 1;
+    ok = Access::all();
+    th1 = y * ip(hi);  // theta_{i+1}, theta_{i+2}, z likewise
+    set(hi, kRecTheta, th1);
+    z1 = get(hi, kRecZ);
     const T th0 = get(i, kRecTheta) * ip(i) - lower(i + 1) * th1;
     set(i, kRecTheta, th0);
     const T z0 = get(i, kRecZ);
-    const T A = ((ww_hi * z1 + wt_hi * th1) + c(i, W::kEww) * z0) + c(i, W::kEtw) * th0;
-    V::template update<!Plane>(u, v, un, vn, acc, d, hi, accel(hi, get(hi, kRecInit) - A), dt, ok, above, below);
+    const T A = ((this->ww_hi * z1 + this->wt_hi * th1) + c(i, W::kEww) * z0) + c(i, W::kEtw) * th0;
+    this->update(hi, accel(hi, get(hi, kRecInit) - A), ok);
     th2 = th1;
     th1 = th0;
     z2 = z1;
     z1 = z0;
   }
-  i = hi - 2;
-  for (; i - 1 >= lo; i -= 2) {  // nodes i + 1 and i complete: updated as a block
+  // Nodes i + 1 and i complete: updated as a block.
+  __attribute__((always_inline)) void backward_two(int i) {
     const T a1 = backward(i);
     const T a0 = backward(i - 1);
-    V::template update2<!Plane>(u, v, un, vn, acc, d, i, a0, a1, dt, ok, above, below);
+    this->update2(i, a0, a1, ok);
   }
-  if (i == lo) V::template update<!Plane>(u, v, un, vn, acc, d, lo + 1, backward(lo), dt, ok, above, below);
-  const T A = ww_lo * z1 + wt_lo * th1;
-  const T B = c(lo, W::kEww) * z2 + c(lo, W::kEwt) * th2;
-  V::template update<!Plane>(u, v, un, vn, acc, d, lo, accel(lo, (get(lo, kRecInit) - A) - B), dt, ok, above, below);
-  return !V::ok(ok);
+  __attribute__((always_inline)) void backward_one() { this->update(this->lo + 1, backward(this->lo), ok); }
+  // Node lo (then `ok` tells whether every new displacement is inside the limit).
+  __attribute__((always_inline)) void backward_end() {
+    const int lo = this->lo;
+    const T A = this->ww_lo * z1 + this->wt_lo * th1;
+    const T B = c(lo, W::kEww) * z2 + c(lo, W::kEwt) * th2;
+    this->update(lo, accel(lo, (get(lo, kRecInit) - A) - B), ok);
+  }
+};
+
+// Runs a sweep over nodes lo..hi (hi >= lo + 1).
+template <class S>
+__attribute__((always_inline)) inline void drive(S& s) {
+  const int lo = s.lo, hi = s.hi;
+  s.forward_begin();
+  int i = lo + 1;
+  for (; i + 1 < hi; i += 2) s.forward_two(i);
+  if (i < hi) s.forward_one(i);
+  s.forward_end();
+  s.backward_begin();
+  i = hi - 2;
+  for (; i - 1 >= lo; i -= 2) s.backward_two(i);
+  if (i == lo) s.backward_one();
+  s.backward_end();
+}
+
+template <int L, bool Plane, bool Drag>
+__attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
+  Sweeper<OnePlane<L, Plane, Drag>> s(a);
+  drive(s);
+  return !OnePlane<L, Plane, Drag>::inside(s.ok);  // some new displacement beyond the limit or NaN
+}
+
+// Both planes of a two-wire pack in four lanes, [vertical: wire 0, wire 1; lateral: wire 0,
+// wire 1]: the band and its factors are the same both ways (a round wire bends alike), so each
+// coefficient is loaded once for both and every band operation does both planes at once; each
+// plane's state, load, damping, inverse mass and wind are its own (OnePlane's, in halves), the
+// records interleaved per node [value][4 lanes] (joint_record_index).
+template <bool Drag>
+struct TwoPlanes {
+  using T = Double4;
+  using Half = Lane<2>::T;
+  struct Mask {
+    Lane<2>::Mask vertical, lateral;
+  };
+  static constexpr int NR = kSweepRecord;
+  OnePlane<2, false, false> vp;
+  OnePlane<2, true, Drag> lp;
+  double* rec;
+  T beta, dt, ww_lo, wt_lo, ww_hi, wt_hi;
+  int lo, hi;
+
+  static T both(Half a, Half b) { return __builtin_shufflevector(a, b, 0, 1, 2, 3); }
+  static Half low(T x) { return __builtin_shufflevector(x, x, 0, 1); }
+  static Half high(T x) { return __builtin_shufflevector(x, x, 2, 3); }
+  TwoPlanes(const PackSweep& a, const PackSweep& b, double* joint_record)
+      : vp(a), lp(b), rec(joint_record), beta(both(vp.beta, lp.beta)), dt(both(vp.dt, lp.dt)),
+        ww_lo(both(vp.ww_lo, lp.ww_lo)), wt_lo(both(vp.wt_lo, lp.wt_lo)), ww_hi(both(vp.ww_hi, lp.ww_hi)),
+        wt_hi(both(vp.wt_hi, lp.wt_hi)), lo(a.lo), hi(a.hi) {}
+
+  __attribute__((always_inline)) T c(int i, int k) const {
+    const Half x = vp.c(i, k);
+    return both(x, x);
+  }
+  __attribute__((always_inline)) T lower(int i) const {
+    const Half x = vp.lower(i);
+    return both(x, x);
+  }
+  __attribute__((always_inline)) T ip(int i) const {
+    const Half x = vp.ip(i);
+    return both(x, x);
+  }
+  __attribute__((always_inline)) T get(int i, int k) const {
+    T x;
+    std::memcpy(&x, rec + (static_cast<std::ptrdiff_t>(i) * NR + k) * 4, sizeof x);
+    return x;
+  }
+  __attribute__((always_inline)) void set(int i, int k, T x) {
+    std::memcpy(rec + (static_cast<std::ptrdiff_t>(i) * NR + k) * 4, &x, sizeof x);
+  }
+  __attribute__((always_inline)) T inv_mass(int i) const { return both(vp.inv_mass(i), lp.inv_mass(i)); }
+  __attribute__((always_inline)) T init(int i, T vi) const { return both(vp.init(i, low(vi)), lp.init(i, high(vi))); }
+  __attribute__((always_inline)) void state(int i, T& ui, T& vi) const {
+    Half a, b, c, d;
+    vp.state(i, a, b);
+    lp.state(i, c, d);
+    ui = both(a, c);
+    vi = both(b, d);
+  }
+  __attribute__((always_inline)) void state2(int i, T& u0, T& u1, T& v0, T& v1) const {
+    Half a0, a1, b0, b1, c0, c1, d0, d1;
+    vp.state2(i, a0, a1, b0, b1);
+    lp.state2(i, c0, c1, d0, d1);
+    u0 = both(a0, c0);
+    u1 = both(a1, c1);
+    v0 = both(b0, d0);
+    v1 = both(b1, d1);
+  }
+  __attribute__((always_inline)) void update(int i, T a, Mask& ok) {
+    vp.update(i, low(a), ok.vertical);
+    lp.update(i, high(a), ok.lateral);
+  }
+  __attribute__((always_inline)) void update2(int i, T a0, T a1, Mask& ok) {
+    vp.update2(i, low(a0), low(a1), ok.vertical);
+    lp.update2(i, high(a0), high(a1), ok.lateral);
+  }
+  static Mask all() { return Mask{Lane<2>::all(), Lane<2>::all()}; }
+};
+
+// The vertical plane's sweep `a` and the lateral plane's `b` on the same two-wire pack and nodes.
+template <bool Drag>
+__attribute__((always_inline)) inline bool sweep_pair(const PackSweep& a, const PackSweep& b, double* joint_record,
+                                                      bool* b_outside) {
+  Sweeper<TwoPlanes<Drag>> s(a, b, joint_record);
+  drive(s);
+  *b_outside = !Lane<2>::ok(s.ok.lateral);
+  return !Lane<2>::ok(s.ok.vertical);
 }
 
 }  // namespace
@@ -332,6 +494,10 @@ CATENARY_SIM_CLONES bool sweep_pack(const PackSweep& a) {
     return a.pack->lanes == 2 ? sweep<2, true, false>(a) : sweep<1, true, false>(a);
   }
   return a.pack->lanes == 2 ? sweep<2, false, false>(a) : sweep<1, false, false>(a);
+}
+
+CATENARY_SIM_CLONES bool sweep_pack_pair(const PackSweep& a, const PackSweep& b, double* joint_record, bool* b_outside) {
+  return b.wind[0] ? sweep_pair<true>(a, b, joint_record, b_outside) : sweep_pair<false>(a, b, joint_record, b_outside);
 }
 
 // GCC's resolver takes the clone of the highest priority the CPU supports: x86-64-v4 (AVX-512

@@ -1145,7 +1145,8 @@ TEST(Lateral, StaggerErrorsBadInputNamesTheField) {
 namespace {
 
 // Steps a pass with the fused lateral step and a copy of the model without its planes (the
-// generic step) side by side; every lateral value must agree to the bit. Returns the steps taken.
+// generic step) side by side; every lateral value must agree to the bit, and every vertical one
+// (Simulation::step may sweep both planes at once: step_both_planes). Returns the steps taken.
 int expect_fused_is_generic(const std::vector<std::string>& overrides, int* windowed_fused_steps) {
   Simulation a(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml", overrides));
   EXPECT_TRUE(a.model().lateral);
@@ -1170,6 +1171,13 @@ int expect_fused_is_generic(const std::vector<std::string>& overrides, int* wind
     ++steps;
     *windowed_fused_steps += a.state().lateral.window_fused;
     EXPECT_EQ(a.state().lateral.y.size(), g.lateral.y.size());
+    for (int i = 0; i < generic.n_dof; ++i) {
+      if (a.state().u[i] != g.u[i] || a.state().v[i] != g.v[i]) {
+        ADD_FAILURE() << "DOF " << i << " step " << steps << ": u " << a.state().u[i] << " / " << g.u[i] << ", v "
+                      << a.state().v[i] << " / " << g.v[i];
+        return steps;
+      }
+    }
     for (int i = 0; i < lat->n; ++i) {
       if (a.state().lateral.y[i] != g.lateral.y[i] || a.state().lateral.v[i] != g.lateral.v[i]) {
         ADD_FAILURE() << "node " << i << " step " << steps << ": y " << a.state().lateral.y[i] << " / " << g.lateral.y[i]
@@ -1193,7 +1201,12 @@ TEST(Lateral, FusedStepIsTheGenericStepBitForBit) {
   std::vector<std::string> line = pass;
   line.push_back("line.span_count=4");
   int windowed_fused = 0;
+  Simulation joint(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml", line));
   EXPECT_GT(expect_fused_is_generic(line, &windowed_fused), 1000);
+  // Without a window both planes are swept at once (sweep_pack_pair) at every step.
+  while (joint.step() == StepStatus::kOk) {
+  }
+  EXPECT_EQ(joint.state().lateral.joined_steps, joint.state().steps);
   // And with the moving window on 12 spans (about 5 in the window: both ends cut, the window
   // moved span by span, the cut layers' static force and the dashpots in the point forces), in a
   // steady wind (in a turbulent one a finite line's lateral plane is not windowed).

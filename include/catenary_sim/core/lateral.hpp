@@ -118,8 +118,9 @@ struct LateralModel {
   std::vector<double> static_blow_off;  // m, per span: largest |initial - calm| on the contact wire(s)
   // The fused step (wire_lanes.hpp): the vertical plane's packs (Model::wire_packs: the same
   // band and factors, a round wire bends alike both ways) swept with the lateral plane's own load,
-  // damping and inverse mass (per pack [node][load, alpha m, 1/m][lane]) and the wind's drag, the
-  // records in the vertical step's scratch (State::sweep, free between steps); the nodes with
+  // damping, inverse mass and wind drag coefficient (per pack [node][value][lane]: PackSweep::
+  // plane) and the wind's drag, the records in the vertical step's scratch (State::sweep, free
+  // between steps, or LateralState::sweep when the vertical step takes it along); the nodes with
   // point forces (springs, pendulums) with where the sweep leaves their band force. No planes
   // (the vertical step not fused: implicit, or rotations as DOFs): the generic step.
   std::vector<std::vector<double>> planes;
@@ -168,6 +169,12 @@ struct LateralState {
   std::vector<double> lean_weight;
   Eigen::VectorXd f, z;      // workspace
   Eigen::VectorXd y_next, v_next, accel;  // the fused step's new values
+  // Both planes' sweep records when the vertical step takes the lateral sweep along
+  // (step_both_planes, sweep_pack_pair's joint layout), and that hand-over: `join` while the
+  // vertical step may take it, `joined` when it did, with the lateral sweep's divergence hint.
+  std::vector<double> sweep;
+  bool join = false, joined = false, joined_outside = false;
+  std::int64_t joined_steps = 0;  // steps whose lateral sweep the vertical step took along
   std::vector<double> theta, wind_points;
   Eigen::VectorXd wind_speed;    // m/s, per node: the wind's speed normal to the wire now
   double next_wind_update = 0.0;  // s
@@ -214,6 +221,14 @@ void lateral_observe(const Model& model, State& state);
 // One lateral step of the model's dt (its substeps), after the vertical step moved the state to
 // its new time. Never allocates. Returns kDiverged or kDewired (on_dewirement: stop), else kOk.
 StepStatus lateral_step(const Model& model, State& state);
+// The vertical step, then the lateral one (Simulation::step on a 3-D line). Where both planes
+// sweep every node of the same two-wire packs (no window, one lateral substep, both fused), the
+// vertical step runs the lateral step's band sweep with its own, both planes in four lanes
+// (sweep_pack_pair: the band and its factors are the same both ways, loaded once, and each band
+// operation does both planes). The lateral sweep reads nothing the vertical step changes (the
+// lateral state, the wind of the step's start, the shared band and factors), and each lane does
+// its own plane's operations, so the results are those of step then lateral_step, to the bit.
+StepStatus step_both_planes(const Model& model, State& state);
 
 // Endless line: moves the lateral state back Model::endless_shift_spans spans with the block
 // (called by shift_endless_block before it moves the train); the spans entering at the far end
