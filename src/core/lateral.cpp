@@ -690,27 +690,17 @@ void sync_window(const Model& m, State& s) {
     if (p.lanes == 2 && (ls.window[p.wire[0]].lo != ls.window[p.wire[1]].lo || ls.window[p.wire[0]].hi != ls.window[p.wire[1]].hi))
       ls.window_fused = false;
   if (ls.window_fused) interleave_window_factors(m.wire_packs, ls.window, ls.sweep_factors.data());
-  auto inside = [&](int dof) {  // a lateral DOF in the window
-    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
-      const int i = dof - lat.wires[wi].w_dof;
-      if (i >= 0 && i < lat.wires[wi].nodes()) return i >= ls.window[wi].lo && i <= ls.window[wi].hi;
-    }
-    return false;
-  };
   // Springs and pendulums (droppers) between the window's end supports whose nodes it holds.
-  ls.window_spring_count = 0;
-  ls.window_dropper_count = 0;
+  auto inside = [&](int dof) { return in_windows(lat.wires, ls.window, dof); };
+  ls.window_spring_count = ls.window_dropper_count = 0;
   if (first >= 0) {
-    const std::vector<double>& xs = lat.spring_order_x;
-    for (std::size_t j = std::lower_bound(xs.begin(), xs.end(), xa - 1e-6) - xs.begin(); j < xs.size() && xs[j] <= xb + 1e-6;
-         ++j)
-      if (inside(lat.springs[lat.spring_order[j]].dof)) ls.window_springs[ls.window_spring_count++] = lat.spring_order[j];
-    const std::vector<double>& dx = m.dropper_order_x;
-    for (std::size_t j = std::lower_bound(dx.begin(), dx.end(), xa - 1e-6) - dx.begin(); j < dx.size() && dx[j] <= xb + 1e-6;
-         ++j) {
-      const LateralPendulum& p = lat.pendulums[m.dropper_order[j]];
-      if (inside(p.contact) && inside(p.messenger)) ls.window_droppers[ls.window_dropper_count++] = m.dropper_order[j];
-    }
+    ls.window_spring_count = select_between(
+        lat.spring_order, lat.spring_order_x, xa, xb, [&](int k) { return inside(lat.springs[k].dof); },
+        ls.window_springs.data());
+    ls.window_dropper_count = select_between(
+        m.dropper_order, m.dropper_order_x, xa, xb,
+        [&](int k) { return inside(lat.pendulums[k].contact) && inside(lat.pendulums[k].messenger); },
+        ls.window_droppers.data());
   }
   // The fused step's nodes with point forces: the cut layers, springs, pendulums.
   int q = 0;

@@ -153,30 +153,24 @@ void update_window(const Model& m, State& s) {
       }
   }
   interleave_window_factors(m.wire_packs, s.window, s.sweep_factors.data());
-  auto inside = [&](int dof) {
-    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
-      const Wire& w = m.wires[wi];
-      if (dof >= w.w_dof && dof < w.w_dof + w.nodes()) {
-        const int i = dof - w.w_dof;
-        return i >= s.window[wi].lo && i <= s.window[wi].hi;
-      }
-    }
-    return false;
-  };
   // Index lists sized once in make_state (a copied State keeps their size): no allocation. Only
-  // the droppers and supports between the window's ends are looked at (bisection on the line
-  // order), so moving the window costs what the window holds, not the line.
-  const auto from = [&](const std::vector<double>& xs) {
-    return static_cast<std::size_t>(std::lower_bound(xs.begin(), xs.end(), a - 1e-6) - xs.begin());
-  };
-  s.window_dropper_count = 0;
-  for (std::size_t j = from(m.dropper_order_x); j < m.dropper_order.size() && m.dropper_order_x[j] <= b + 1e-6; ++j) {
-    const Dropper& d = m.droppers[m.dropper_order[j]];
-    if (inside(d.contact_dof) && inside(d.messenger_dof)) s.window_droppers[s.window_dropper_count++] = m.dropper_order[j];
+  // the droppers and supports between the window's ends are looked at, so moving the window costs
+  // what the window holds, not the line.
+  auto inside = [&](int dof) { return in_windows(m.wires, s.window, dof); };
+  s.window_dropper_count = select_between(
+      m.dropper_order, m.dropper_order_x, a, b,
+      [&](int k) { return inside(m.droppers[k].contact_dof) && inside(m.droppers[k].messenger_dof); },
+      s.window_droppers.data());
+  s.window_spring_count = select_between(
+      m.spring_order, m.spring_order_x, a, b, [&](int k) { return inside(m.springs[k].dof); }, s.window_springs.data());
+}
+
+bool in_windows(const std::vector<Wire>& wires, const std::vector<WireWindow>& windows, int dof) {
+  for (std::size_t wi = 0; wi < wires.size(); ++wi) {
+    const int i = dof - wires[wi].w_dof;
+    if (i >= 0 && i < wires[wi].nodes()) return i >= windows[wi].lo && i <= windows[wi].hi;
   }
-  s.window_spring_count = 0;
-  for (std::size_t j = from(m.spring_order_x); j < m.spring_order.size() && m.spring_order_x[j] <= b + 1e-6; ++j)
-    if (inside(m.springs[m.spring_order[j]].dof)) s.window_springs[s.window_spring_count++] = m.spring_order[j];
+  return false;
 }
 
 void wire_elastic_force_window(const Wire& wire, const WireWindow& ww, const double* z, double* f, double* theta) {

@@ -1,6 +1,9 @@
 // Moving window internals (see window.cpp).
 #pragma once
 
+#include <algorithm>
+#include <vector>
+
 #include "catenary_sim/core/model.hpp"
 #include "catenary_sim/core/state.hpp"
 
@@ -20,6 +23,22 @@ void set_wire_window(const Wire& wire, double a, double b, WireWindow& window);
 // node range), laid out as WireLanes::factors at the pack's offset.
 void interleave_window_factors(const std::vector<WireLanes>& packs, const std::vector<WireWindow>& windows,
                                double* sweep_factors);
+
+// Whether DOF `dof` (numbered by `wires`' w_dof) lies in its wire's window.
+bool in_windows(const std::vector<Wire>& wires, const std::vector<WireWindow>& windows, int dof);
+
+// The entries of `order` (indices in line order, at stations `order_x`) between stations a and b
+// that `keep(index)` accepts, written to `list` in that order; returns how many. Bisection to a:
+// costs what lies between a and b, not the line. No allocation.
+template <class Keep>
+int select_between(const std::vector<int>& order, const std::vector<double>& order_x, double a, double b, Keep&& keep,
+                   int* list) {
+  int count = 0;
+  for (std::size_t j = std::lower_bound(order_x.begin(), order_x.end(), a - 1e-6) - order_x.begin();
+       j < order.size() && order_x[j] <= b + 1e-6; ++j)
+    if (keep(order[j])) list[count++] = order[j];
+  return count;
+}
 
 // Moves the window to the pantographs if they crossed into another span; no allocation.
 void update_window(const Model& model, State& state);
