@@ -4,7 +4,8 @@
 //   g++ -O3 -DNDEBUG -std=c++17 -ffp-contract=off -I/tmp/base/include -I/usr/include/eigen3
 //       bench/bench_pass_hash.cpp /tmp/base/.ws/devel/lib/libcatenary_sim_core.a -lyaml-cpp
 //       -o /tmp/bench_pass_hash_base
-// (the flags of the package's Release build).
+// (the flags of the package's Release build; add -DBENCH_PASS_HASH_2D_ONLY for a checkout older
+// than the 3-D line, e.g. 25f35a6).
 //   bench_pass_hash SCENE [--set-style overrides...]
 // Prints the steps, the FNV-1a hash of u, v and the contact forces over every step (and, with a
 // lateral plane, of its y and v: a 2-D scene's hash is what it was before the 3-D line), and the
@@ -42,10 +43,12 @@ int main(int argc, char** argv) {
     mix(s.u.data(), s.u.size());
     mix(s.v.data(), s.v.size());
     mix(s.contact_force.data(), s.contact_force.size());
+#ifndef BENCH_PASS_HASH_2D_ONLY  // (for a checkout older than the 3-D line: -DBENCH_PASS_HASH_2D_ONLY)
     if (again.model().lateral) {
       mix(s.lateral.y.data(), s.lateral.y.size());
       mix(s.lateral.v.data(), s.lateral.v.size());
     }
+#endif
   }
   std::printf("%ld steps, %d DOFs, wall %.4f s, %.3f ns per DOF and step, hash %016llx\n", steps, sim.model().n_dof, wall,
               wall / steps / sim.model().n_dof * 1e9, static_cast<unsigned long long>(hash));

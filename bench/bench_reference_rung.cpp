@@ -2,7 +2,7 @@
 // the explicit scheme at h = 0.03125 m (automatic dt: the stability limit falls with h, so dt is
 // refined with it); every candidate's 0-20 Hz statistics (mean, std, max, min) and 0-200 Hz max are
 // compared with it, with its wall time, on the reference scene at 250 and 300 km/h.
-//   bench_reference_rung [scene=config/reference_55m.yaml] [csv=reference_rung.csv] [finest_h=0.03125] [all]
+//   bench_reference_rung [scene=config/reference_55m.yaml] [csv=reference_rung.csv] [finest_h=0.03125] [all|centred|richardson]
 // Errors as in bench_speed_accuracy: relative to the finest value (the min relative to the mean).
 // The finest runs take about 10 minutes each: their statistics are kept in <csv>.finest and reused
 // when that file exists (delete it after changing the scene or the model).
@@ -27,8 +27,11 @@ int main(int argc, char** argv) {
   std::ofstream csv(csv_path);
   csv << bench::kCsvHeader;
   // The first five were measured first (BENCHMARKS.md); the rest refine the explicit scheme's dt
-  // at h = 0.125 m and try h = 0.1 m. Give `all` as 4th argument for the first five too.
-  const bool all = argc > 4 && std::string(argv[4]) == "all";
+  // at h = 0.125 m and try h = 0.1 m. Give `all` as 4th argument for the first five too, or
+  // `centred` for the explicit step with centred damping (numerics.damping) beside the half-step
+  // rungs it replaces.
+  const std::string mode = argc > 4 ? argv[4] : "";
+  const bool all = mode == "all";
   std::vector<std::pair<std::string, std::vector<std::string>>> candidates = {
       {"explicit h=0.125", {"numerics.element_length=0.125"}},
       {"explicit h=0.125 dt=auto/2", {"numerics.element_length=0.125", "numerics.safety_factor=0.45"}},
@@ -44,6 +47,16 @@ int main(int argc, char** argv) {
          {"implicit h=0.125 dt=0.5ms", {"numerics.integrator=implicit", "numerics.element_length=0.125", "numerics.dt=0.0005"}},
          {"implicit h=0.0625 dt=0.5ms",
           {"numerics.integrator=implicit", "numerics.element_length=0.0625", "numerics.dt=0.0005"}}});
+  if (mode == "centred")
+    candidates = {
+        {"half-step h=0.0625 (the rung of 25f35a6)", {"numerics.element_length=0.0625", "numerics.damping=half_step"}},
+        {"half-step h=0.1 (the rung before)", {"numerics.element_length=0.1", "numerics.damping=half_step"}},
+        {"centred h=0.1", {"numerics.element_length=0.1", "numerics.damping=centred"}},
+        {"centred h=0.08", {"numerics.element_length=0.08", "numerics.damping=centred"}},
+        {"centred h=0.07", {"numerics.element_length=0.07", "numerics.damping=centred"}},
+        {"centred h=0.0625 (the new rung)", {"numerics.element_length=0.0625", "numerics.damping=centred"}},
+        {"centred h=0.0625 dt=auto/2", {"numerics.element_length=0.0625", "numerics.damping=centred", "numerics.safety_factor=0.45"}},
+    };
   // Finest statistics kept from an earlier run: kmh -> mean, std, max, min, max200, dofs, dt, wall.
   std::map<double, std::vector<double>> kept;
   {
@@ -76,7 +89,7 @@ int main(int argc, char** argv) {
       fine.dt = k[6];
       fine.wall = k[7];
     } else {
-      fine = run_pass(path, {"numerics.element_length=" + finest_h}, kmh);
+      fine = run_pass(path, {"numerics.element_length=" + finest_h, "numerics.damping=half_step"}, kmh);
       std::ofstream out(csv_path + ".finest", std::ios::app);
       out.precision(17);
       out << kmh << "," << fine.s20.filtered.mean << "," << fine.s20.filtered.std_dev << "," << fine.s20.filtered.max << ","

@@ -10,6 +10,7 @@
 
 #include "catenary_sim/core/implicit.hpp"
 #include "catenary_sim/core/state.hpp"
+#include "centred_damping.hpp"
 #include "window.hpp"
 #include "wire_lanes.hpp"
 
@@ -95,7 +96,9 @@ State make_state(const Model& m) {
     s.correction_small.assign(corrections * corrections + corrections, 0.0);
   }
   s.z = Eigen::VectorXd::Zero(m.n_dof);
-  if (!m.wire_packs.empty()) {
+  // The centred damping step keeps the load in the wires' force entries (clear_point_forces).
+  if (m.scene.numerics.damping == DampingStep::kCentred) s.force.head(m.n_catenary_dof) = m.load.head(m.n_catenary_dof);
+  if (!m.wire_packs.empty() || m.scene.numerics.damping == DampingStep::kCentred) {
     s.u_next = Eigen::VectorXd::Zero(m.n_dof);
     s.v_next = Eigen::VectorXd::Zero(m.n_dof);
     s.sweep.assign(kSweepRecord * m.sweep_size, 0.0);
@@ -633,6 +636,72 @@ void woodbury(State& s, int count, int n, int stride, double* x) {
   }
 }
 
+// Back to the load the wires' entries add_wire_point_forces and contact_forces wrote (the centred
+// step keeps the load in the wires' part of f between steps, its sweep reading load and point
+// forces together).
+void clear_point_forces(const Model& m, State& s, double* f) {
+  const double* load = m.load.data();
+  for (const SupportSpring& sp : m.springs) f[sp.dof] = load[sp.dof];
+  for (const Dropper& d : m.droppers) {
+    f[d.contact_dof] = load[d.contact_dof];
+    f[d.messenger_dof] = load[d.messenger_dof];
+  }
+  for (const Pantograph& p : m.pantographs)
+    for (int ci : p.collectors) {
+      const double xc = s.front - p.position + m.collectors[ci].offset;
+      for (int wi : m.contact_wires) {
+        const Wire& w = m.wires[wi];
+        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
+        for (int a = 0; a < cnt; ++a) f[w.w_dof + s.weight_node[a]] = load[w.w_dof + s.weight_node[a]];
+      }
+    }
+}
+
+// The explicit step with centred damping (centred_damping.hpp): the point forces on z = u + beta v
+// as in the half-step scheme, then per wire pack the block-tridiagonal solve for zeta and the
+// update (centred_sweep_pack; build_model gives such a model its packs), then the pantographs.
+StepStatus centred_damping_step(const Model& m, State& s) {
+  const int n = m.n_dof, nc = m.n_catenary_dof;
+  double* u = s.u.data();
+  double* v = s.v.data();
+  double* f = s.force.data();
+  double* acc = s.accel.data();
+  const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
+  // The wires' entries of f hold the load here (make_state, clear_point_forces); the point forces
+  // are added to it. The supports and droppers read z = u + beta v at their DOFs only.
+  auto force_at = [f](int i) -> double& { return f[i]; };
+  auto z_at = [u, v, beta](int i) { return u[i] + beta * v[i]; };
+  if (leaning(m, s)) add_wire_point_forces<true>(m, s, u, v, force_at, z_at, false);
+  else add_wire_point_forces<false>(m, s, u, v, force_at, z_at, false);
+  add_pantograph_forces(m, s, u, v, f);
+  for (int d : m.centred_fixed_dofs) f[d] = 0.0;  // a fixed node's row is zeta = u (a contact may reach it; load 0)
+  double* un = s.u_next.data();
+  double* vn = s.v_next.data();
+  bool out = false;
+  for (const WireLanes& p : m.wire_packs) out |= centred_sweep_pack(m, p, s);
+  clear_point_forces(m, s, f);
+  const double* im = m.inv_mass.data();
+  for (int i = nc; i < n; ++i) {
+    acc[i] = im[i] * f[i];
+    vn[i] = v[i] + dt * acc[i];
+    un[i] = u[i] + dt * vn[i];
+    out |= !(std::fabs(un[i]) <= limit);
+  }
+  if (out) {
+    for (int i = 0; i < n; ++i)
+      if (!(std::fabs(un[i]) <= limit)) {
+        s.status = StepStatus::kDiverged;
+        s.diverged_dof = i;
+        break;
+      }
+    return s.status;
+  }
+  s.u.swap(s.u_next);
+  s.v.swap(s.v_next);
+  advance_train(m, s, dt);
+  return s.status;
+}
+
 }  // namespace
 
 StepStatus step(const Model& m, State& s) {
@@ -650,6 +719,7 @@ StepStatus step(const Model& m, State& s) {
   double* acc = s.accel.data();
   const double limit = m.scene.numerics.divergence_limit;
   int bad = -1;
+  if (!m.implicit && m.scene.numerics.damping == DampingStep::kCentred) return centred_damping_step(m, s);
   if (!m.implicit) {
     const bool windowed = m.scene.numerics.windowed();
     if (m.endless) shift_endless_block(m, s);

@@ -17,6 +17,7 @@
 #include "catenary_sim/core/statics.hpp"
 #include "normal_errors.hpp"
 #include "window.hpp"
+#include "centred_damping.hpp"
 #include "wire_lanes.hpp"
 
 namespace catenary_sim {
@@ -963,6 +964,16 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
       (scene.numerics.integrator != Integrator::kExplicit || scene.numerics.rotary_inertia != RotaryInertia::kCondensed))
     throw SceneError("numerics.window: needs numerics.integrator explicit with rotary_inertia condensed (the window "
                      "integrates node ranges of the condensed band)");
+  if (scene.numerics.damping == DampingStep::kCentred) {
+    // The centred step solves each whole wire's band with the rotations condensed, for u + beta v.
+    std::string why;
+    if (scene.numerics.integrator != Integrator::kExplicit) why = "numerics.integrator explicit";
+    else if (scene.numerics.rotary_inertia != RotaryInertia::kCondensed) why = "numerics.rotary_inertia condensed";
+    else if (scene.numerics.windowed()) why = "no numerics.window (nor an endless line): it solves whole wires";
+    else if (scene.lateral()) why = "a 2-D line (no stagger, curve or wind): the lateral plane steps with half_step";
+    else if (!(m.beta > 0.0)) why = "damping.beta > 0 (it solves for u + beta v; with beta 0 half_step has the same limit)";
+    if (!why.empty()) throw SceneError("numerics.damping = 'centred': needs " + why + "; allowed otherwise: half_step");
+  }
   if (scene.numerics.integrator == Integrator::kImplicit) {
     // Newmark average acceleration is unconditionally stable for the linear part, and nothing is
     // taken explicitly: slack droppers and contacts are rank-1 corrections of the factorised
@@ -992,6 +1003,11 @@ Model build_model(const Scene& scene, const BuildOptions& options) {
   Model m = build_model_unchecked(scene, options);
   build_wire_packs(m);
   if (!options.stability) return m;
+  if (scene.numerics.damping == DampingStep::kCentred) {
+    if (m.wire_packs.empty())  // (condensed rotations on every wire node give packs)
+      throw SceneError("numerics.damping = 'centred': needs the wires' rotations condensed; allowed otherwise: half_step");
+    factor_centred_damping(m);
+  }
   // The statistics filter runs at the step rate: a cutoff at or above its Nyquist frequency would
   // be no filter at all (lowpass_zero_phase returns the input unchanged).
   const double nyquist = 0.5 / m.dt;

@@ -664,6 +664,7 @@ void read_lateral_parts(Reader& top, Scene& s) {
 }  // namespace
 
 Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
+  bool reference_defaults = false;  // preset reference, element length and damping its own
   if (!root || !root.IsMap()) throw SceneError("scene: the document must be a YAML map of sections (line, contact_wire, ...)");
   Reader top(root, "");
   Scene s;
@@ -768,10 +769,10 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
     double h = 0.25;
     // Element lengths measured in bench/speed_accuracy (BENCHMARKS.md): all explicit, because on
     // these lines the condensed explicit scheme is the fastest at every accuracy level. The
-    // reference rung chosen in bench_reference_rung against h = 0.03125 m: h = 0.1 m keeps its
-    // 0-20 Hz statistics within 0.1 % and its 0-200 Hz max within 0.2 % of that finer solution at
-    // a tenth of the former h = 0.0625 m rung's cost (whose explicit dt fell with h^3 there, the
-    // stiffness-proportional damping of the shortest mesh modes setting the limit).
+    // reference rung chosen in bench_reference_rung against h = 0.03125 m: h = 0.0625 m with the
+    // centred damping keeps every statistic within 0.05 % of that finer solution, its dt the
+    // undamped limit (with the half-step damping, the stiffness-proportional damping of the
+    // shortest mesh modes cut it 2.6x; where the centred step does not go, h = 0.1 m below).
     if (preset == "fast") {
       h = 1.0;
     } else if (preset == "balanced") {
@@ -779,11 +780,12 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
     } else if (preset == "accurate" || preset.empty()) {
       h = 0.25;
     } else if (preset == "reference") {
-      h = 0.1;
+      h = 0.0625;
     } else {
       fail("numerics.preset", "'" + preset + "'", "one of: fast, balanced, accurate, reference");
     }
     s.numerics.preset = preset;
+    reference_defaults = preset == "reference" && !r.has("element_length") && !r.has("damping");
     s.numerics.element_length = r.number("element_length", 0.01, 10.0, h);
     if (r.has("dt")) {
       const YAML::Node n = r.child("dt");
@@ -801,6 +803,10 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
     else fail("numerics.rotary_inertia", "'" + rt + "'", "one of: condensed (massless rotations, statically condensed), lumped (HRZ rotary inertia)");
     if (s.numerics.integrator == Integrator::kImplicit && s.numerics.rotary_inertia == RotaryInertia::kCondensed)
       fail("numerics.rotary_inertia", "'condensed'", "lumped with the implicit integrator (its matrix holds the rotations as DOFs)");
+    const std::string dmp = r.text("damping", preset == "reference" ? "centred" : "half_step");
+    if (dmp == "half_step") s.numerics.damping = DampingStep::kHalfStep;
+    else if (dmp == "centred") s.numerics.damping = DampingStep::kCentred;
+    else fail("numerics.damping", "'" + dmp + "'", "one of: half_step (C v at v_{n-1/2}, eq. 19-21), centred (C v at (v_{n+1/2} + v_{n-1/2}) / 2)");
     s.numerics.divergence_limit = r.number("divergence_limit", 0.0, 1000.0, 5.0, true);
     if (r.has("window")) {
       const YAML::Node wn = r.child("window");
@@ -934,6 +940,16 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   }
   read_lateral_parts(top, s);
   top.finish();
+  // The reference rung's centred damping steps a whole 2-D line with the explicit scheme and beta
+  // > 0 (NumericsSpec::damping); elsewhere (a window, an endless line, a 3-D line) the rung is
+  // h = 0.1 m with the half-step damping, the finest its explicit dt allows at a reference's cost
+  // (BENCHMARKS.md, "Choosing the reference rung").
+  if (reference_defaults && (s.numerics.windowed() || s.endless || s.lateral() || !(s.rayleigh_beta > 0.0) ||
+                             s.numerics.integrator != Integrator::kExplicit ||
+                             s.numerics.rotary_inertia != RotaryInertia::kCondensed)) {
+    s.numerics.element_length = 0.1;
+    s.numerics.damping = DampingStep::kHalfStep;
+  }
   // On a finite line one radius is one curve over the whole line (heading from station 0).
   if (!s.endless && s.alignment.radius != 0.0) {
     s.alignment.curves = {CurveSpec{0.0, s.line_length(), s.alignment.radius, 0.0}};

@@ -64,7 +64,10 @@ void compute_stability_limit(Model& m) {
     if (!p.moving_force) contact += m.contact_stiffness * (m.inv_mass[c.dof] + lightest) * m.contact_wires.size();
   }
   m.omega_max = std::sqrt(m.omega_max * m.omega_max + contact);
-  m.dt_critical = critical_time_step(m.omega_max, m.alpha, m.beta);
+  // Centred damping (NumericsSpec::damping) leaves the wires' band the undamped limit; the
+  // supports' and droppers' springs keep their explicit share beta k (below).
+  const bool centred = m.scene.numerics.damping == DampingStep::kCentred;
+  m.dt_critical = centred ? critical_time_step(m.omega_max, 0.0, 0.0) : critical_time_step(m.omega_max, m.alpha, m.beta);
   // The pantographs' dampers are not Rayleigh damping: the half-step velocity of eq. 19-21 takes
   // them explicitly, and a damper c on a light mass m needs dt < 2 m / c even without a spring.
   // Each mass with its own springs and dampers as one DOF (w^2 = k/m, mass-proportional damping
@@ -76,6 +79,13 @@ void compute_stability_limit(Model& m) {
     const double dt = w > 0.0 ? critical_time_step(w, c / mass, 0.0) : 2.0 * mass / c;
     m.dt_critical = std::min(m.dt_critical, dt);
   };
+  if (centred) {
+    for (const SupportSpring& sp : m.springs)
+      if (m.mass[sp.dof] > 0.0) limit_by(sp.stiffness, m.beta * sp.stiffness, m.mass[sp.dof]);
+    for (const Dropper& d : m.droppers)
+      for (int dof : {d.contact_dof, d.messenger_dof})
+        if (m.mass[dof] > 0.0) limit_by(d.stiffness, m.beta * d.stiffness, m.mass[dof]);
+  }
   for (const Pantograph& p : m.pantographs) {
     if (p.moving_force) continue;
     for (int i = 0; i < p.masses_count(); ++i) {

@@ -154,8 +154,10 @@ TEST(FusedStep, MatchesThePlainStepBitForBitOverAPass) {
 
 // The fused step against the library's generic step (the same model with its packs removed) on
 // the other ways a pass runs: the moving window, the endless line, two pantographs, two sections
-// (an overlap: two packs), the coarsest and finest rungs, and a twin contact wire (a pack of one
-// wire beside one of two), with and without a window.
+// (an overlap: two packs), the coarsest rung and the half-step's finest (the reference rung's
+// h = 0.1 m where the centred damping does not go; the centred step has its own tests,
+// test_centred_damping.cpp), and a twin contact wire (a pack of one wire beside one of two), with
+// and without a window.
 TEST(FusedStep, MatchesTheGenericStepBitForBit) {
   struct Case {
     std::string file;
@@ -168,7 +170,7 @@ TEST(FusedStep, MatchesTheGenericStepBitForBit) {
       {"reference_55m_two_pantographs.yaml", {}, 3000},
       {"reference_55m_two_sections.yaml", {}, 3000},
       {"reference_55m.yaml", {"numerics.preset=fast", "train.speed_kmh=250"}, 2000},
-      {"reference_55m.yaml", {"numerics.preset=reference"}, 1500},
+      {"reference_55m.yaml", {"numerics.element_length=0.1"}, 1500},
       {"twin", {}, 2000},
       {"twin", {"numerics.window=auto", "train.speed_kmh=250"}, 3000},
   };

@@ -150,6 +150,10 @@ struct OverlapSpec {
 
 enum class RotaryInertia { kCondensed, kLumped };
 enum class Integrator { kExplicit, kImplicit };
+// The explicit scheme's Rayleigh damping of the wires' bending and tension (C = alpha M + beta K,
+// eq. 5): kHalfStep takes it on v_{n-1/2} (eq. 19-21), so beta K on the shortest mesh modes sets
+// dt; kCentred on (v_{n+1/2} + v_{n-1/2}) / 2, a banded solve per step and the undamped limit.
+enum class DampingStep { kHalfStep, kCentred };
 
 constexpr double kMaxGustLead = 60.0;  // s, numerics.gust_lead
 
@@ -162,6 +166,7 @@ struct NumericsSpec {
   std::optional<double> dt;      // s; empty = automatic (safety_factor times the stability limit)
   double safety_factor = 0.9;    // for automatic dt
   RotaryInertia rotary_inertia = RotaryInertia::kCondensed;
+  DampingStep damping = DampingStep::kHalfStep;
   double divergence_limit = 5.0;  // m: any displacement beyond this stops the run as diverged
   // Moving window: only the spans from `window_behind` m behind the rearmost pantograph to
   // `window_ahead` m ahead of the foremost are integrated (snapped outward to supports); the rest
