@@ -382,8 +382,10 @@ __attribute__((always_inline)) inline bool sweep(const WireLanes& p, const Centr
 
 }  // namespace
 
+// Runtime dispatch (GCC target_clones): the four lanes in one AVX2 register (x86-64-v3), or the
+// portable baseline in two SSE2 halves; the same IEEE operations either way (no FMA contraction).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define CATENARY_SIM_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#define CATENARY_SIM_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
 #define CATENARY_SIM_CLONES
 #endif
