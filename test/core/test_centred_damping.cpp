@@ -16,10 +16,9 @@
 #include <string>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
-
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statics.hpp"
+#include "../support/scenes.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."
@@ -42,24 +41,10 @@ Model damped_wire(const std::string& damping, double alpha, double beta, double 
   return build_model(load_scene_string(y.str()));
 }
 
-// The reference catenary as one 6-span section with a twin contact wire: three wires on the same
-// stations, packed as two lanes and one.
-Scene twin_contact_wire(const std::vector<std::string>& overrides) {
-  YAML::Node root = YAML::LoadFile(kDir + "reference_55m.yaml");
-  root["line"].remove("span_length");
-  root["line"].remove("span_count");
-  YAML::Node sec;
-  sec["span_length"] = 55.0;
-  sec["span_count"] = 6;
-  sec["contact_wire_count"] = 2;
-  root["sections"].push_back(sec);
-  std::stringstream s;
-  s << root;
-  return load_scene_string(s.str(), overrides);
-}
+Scene twin_contact_wire(const std::vector<std::string>& overrides) { return test_scenes::twin_contact_wire(kDir, overrides); }
 
 // The first pantograph's contact force at every step of `seconds` of a pass.
-std::vector<double> contact_history(const Scene& scene, double seconds, int* steps_per_ms = nullptr) {
+std::vector<double> contact_history(const Scene& scene, double seconds) {
   Model m = build_model(scene);
   State s = make_state(m);
   solve_initial_state(m, s);
@@ -70,7 +55,6 @@ std::vector<double> contact_history(const Scene& scene, double seconds, int* ste
     if (s.status != StepStatus::kOk) break;
     f.push_back(total_contact_force(m, s, 0));
   }
-  if (steps_per_ms) *steps_per_ms = static_cast<int>(std::lround(1e-3 / m.dt));
   return f;
 }
 

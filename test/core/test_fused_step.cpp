@@ -20,12 +20,9 @@
 #include <string>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
-
-#include <sstream>
-
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statics.hpp"
+#include "../support/scenes.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."
@@ -37,21 +34,7 @@ namespace {
 
 const std::string kDir = CATENARY_SIM_SOURCE_DIR "/config/";
 
-// The reference catenary as one 6-span section with a twin contact wire: three wires on the same
-// stations, packed as two lanes and one.
-Scene twin_contact_wire(const std::vector<std::string>& overrides) {
-  YAML::Node root = YAML::LoadFile(kDir + "reference_55m.yaml");
-  root["line"].remove("span_length");
-  root["line"].remove("span_count");
-  YAML::Node sec;
-  sec["span_length"] = 55.0;
-  sec["span_count"] = 6;
-  sec["contact_wire_count"] = 2;
-  root["sections"].push_back(sec);
-  std::stringstream s;
-  s << root;
-  return load_scene_string(s.str(), overrides);
-}
+Scene twin_contact_wire(const std::vector<std::string>& overrides) { return test_scenes::twin_contact_wire(kDir, overrides); }
 
 bool same_bits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;
