@@ -192,7 +192,7 @@ struct LaneOps {
   }
   static void put(double* p, T x) { std::memcpy(p, &x, sizeof x); }
   static M within(T x, T limit) {
-    const M bits = reinterpret_cast<M>(x) & ~reinterpret_cast<M>(T{} - 0.0);  // |x|: the sign bit off
+    const M bits = reinterpret_cast<M>(x) & ~reinterpret_cast<M>(-T{});  // |x|: the sign bit (of -0.0) off
     return reinterpret_cast<T>(bits) <= limit;  // false for NaN
   }
   static bool all(M ok) {

@@ -177,6 +177,33 @@ TEST(CentredDamping, RunsAtTheUndampedLimitWhereTheHalfStepDiverges) {
   EXPECT_LT(largest, 0.2);
 }
 
+// A displacement beyond numerics.divergence_limit, of either sign, stops the run as diverged and
+// the state keeps its last good step (nothing diverged is passed on). A wire released from 1.5 m
+// below its design shape (limit 1 m) must stop at the first step, in every lane of the kernel:
+// the pinned wire alone (a pack of one wire, pairs in two lanes) and the reference catenary (two
+// wires, pairs in four lanes), once downward and once upward.
+TEST(CentredDamping, StopsAtADisplacementBeyondTheLimitOfEitherSign) {
+  for (double sign : {-1.0, 1.0}) {
+    for (const char* line : {"wire", "catenary"}) {
+      SCOPED_TRACE(std::string(line) + (sign < 0 ? " downward" : " upward"));
+      const Model m = std::string(line) == "wire"
+                          ? damped_wire("centred", 0.5, 2e-4, 0.25)
+                          : build_model(load_scene_file(kDir + "reference_55m.yaml",
+                                                        {"numerics.element_length=0.25", "numerics.damping=centred"}));
+      Model limited = m;
+      limited.scene.numerics.divergence_limit = 1.0;
+      State s = make_state(limited);
+      for (int i = 0; i < limited.n_catenary_dof; ++i)
+        if (limited.inv_mass[i] != 0.0) s.u[i] = 1.5 * sign;
+      const Eigen::VectorXd before = s.u;
+      EXPECT_EQ(step(limited, s), StepStatus::kDiverged);
+      EXPECT_GE(s.diverged_dof, 0);
+      EXPECT_TRUE(s.u == before);
+      EXPECT_EQ(s.steps, 0);
+    }
+  }
+}
+
 // (c) Convergence on lines packed differently. The centred scheme is second order: the distance of
 // its contact force at dt, dt/2, dt/4 to the one at dt/16 must fall by at least 3x per halving (4x
 // asymptotically; 3 leaves room for the O(dt^3) remainder and for the dt/16 solution's own
