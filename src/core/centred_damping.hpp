@@ -15,7 +15,7 @@
 
 namespace catenary_sim {
 
-// Per node and lane of the solve (Wire::centred, and WireLanes::centred_* in the twisted order),
+// Per node and lane of the solve (WireLanes::centred_*, in the twisted order),
 // eliminated from both ends toward the meeting node k = centred_meeting_node(n) (a twisted
 // factorisation: two independent recurrences per wire), as a recurrence on c_i = S_i y_i (S_i the
 // inverse pivot block): c_i = s_i r_i - G_i c_prev, with s_i the first column of S_i (the rotation
@@ -26,7 +26,7 @@ namespace catenary_sim {
 enum { kCdG, kCdS = 4, kCdP = 6, kCdU = 10, kCdValues };
 int centred_meeting_node(int nodes);
 
-// Fills Wire::centred (and the packs' WireLanes::centred, if packed) for m.dt; needs beta > 0.
+// Fills the packs' WireLanes::centred_* (every wire is in a pack) for m.dt; needs beta > 0.
 void factor_centred_damping(Model& m);
 
 // One wire pack's solve and update (both wires in lanes): reads u, v and the point forces in

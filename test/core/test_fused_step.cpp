@@ -24,17 +24,12 @@
 #include "catenary_sim/core/statics.hpp"
 #include "../support/scenes.hpp"
 
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
-
 using namespace catenary_sim;
 
 namespace {
 
-const std::string kDir = CATENARY_SIM_SOURCE_DIR "/config/";
-
-Scene twin_contact_wire(const std::vector<std::string>& overrides) { return test_scenes::twin_contact_wire(kDir, overrides); }
+const std::string& kDir = test_scenes::kConfigDir;
+using test_scenes::twin_contact_wire;
 
 bool same_bits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;

@@ -9,12 +9,20 @@
 
 #include "catenary_sim/core/scene.hpp"
 
+// The source tree: the build defines it for the tests.
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR "."
+#endif
+
 namespace test_scenes {
 
-// The reference catenary (dir + "reference_55m.yaml") as one 6-span section with a twin contact
-// wire: three wires on the same stations, packed as two lanes and one.
-inline catenary_sim::Scene twin_contact_wire(const std::string& dir, const std::vector<std::string>& overrides) {
-  YAML::Node root = YAML::LoadFile(dir + "reference_55m.yaml");
+// The shipped scenes.
+inline const std::string kConfigDir = CATENARY_SIM_SOURCE_DIR "/config/";
+
+// The reference catenary as one 6-span section with a twin contact wire: three wires on the same
+// stations, packed as two lanes and one.
+inline catenary_sim::Scene twin_contact_wire(const std::vector<std::string>& overrides) {
+  YAML::Node root = YAML::LoadFile(kConfigDir + "reference_55m.yaml");
   root["line"].remove("span_length");
   root["line"].remove("span_count");
   YAML::Node sec;

@@ -34,9 +34,6 @@ struct Wire {
   std::vector<double> e_ww, e_wt, e_tw, e_tt;  // size nodes-1; e_wt = K(w_e, theta_e+1), e_tw = K(theta_e, w_e+1)
   // Condensed rotations: LDL^T factors of the tridiagonal K_theta_theta, reused every step.
   std::vector<double> tt_inv_pivot, tt_lower;
-  // Centred damping (NumericsSpec::damping): the factors of the step's block-tridiagonal solve,
-  // kCdValues per node (src/core/centred_damping.hpp). Empty with the half-step damping.
-  std::vector<double> centred;
   std::vector<int> support_nodes;  // node index of each support of its section, in order
 
   int nodes() const { return static_cast<int>(x.size()); }
@@ -134,8 +131,9 @@ struct WireLanes {
   enum { kDww, kDwt, kEww, kEwt, kEtw, kLoad, kDampingMass, kInvMass, kCoefficients };  // kDampingMass: alpha m (eq. 5)
   std::vector<double> coef;
   std::vector<double> factors;  // LDL^T of K_theta_theta: [node][lower, inv_pivot][lane]
-  // Centred damping: Wire::centred of the lanes in the twisted order (centred_damping.cpp):
-  // [pair][value][2 lanes], and the meeting and extra nodes' [value][lane].
+  // Centred damping: the factors of the step's block-tridiagonal solve for the lanes' wires in
+  // the twisted order (src/core/centred_damping.hpp): [pair][value][2 lanes], and the meeting and
+  // extra nodes' [value][lane]. Empty with the half-step damping.
   std::vector<double> centred_twin, centred_single;
 };
 
