@@ -323,7 +323,7 @@ void UdpLoopSkin::send(const PointFrame& f) {
     if (have_peer_) say(LogLevel::kInfo, "UDP rig " + address_text(peer_) + " released (~arm): the next sender is the rig");
     have_peer_ = false;
     end_sent_ = false;
-    tracker_.restart();
+    tracker_.restart(false);
     if (!fixed_rig_) have_rig_ = false;
   }
   last_mode_ = f.mode;

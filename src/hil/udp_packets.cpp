@@ -274,11 +274,11 @@ SequenceTracker::Verdict SequenceTracker::observe(std::uint32_t seq) {
   return Verdict::kReordered;
 }
 
-void SequenceTracker::restart() {
+void SequenceTracker::restart(bool counted) {
   if (!any_) return;
   any_ = false;
   run_ = 0;
-  ++restarts_;
+  if (counted) ++restarts_;
 }
 
 }  // namespace udp

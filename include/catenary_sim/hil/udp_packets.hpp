@@ -69,8 +69,9 @@ class SequenceTracker {
   enum class Verdict { kFirst, kInOrder, kGap, kReordered, kDuplicate, kRestart };
   Verdict observe(std::uint32_t sequence);
   // The sender starts numbering again (a hello after its restart): the next number is taken as
-  // the first; the counts are kept, and the restart counted.
-  void restart();
+  // the first; the counts are kept, and the restart counted unless `counted` is false (a new
+  // pass's rig).
+  void restart(bool counted = true);
   // True when `sequence` is not newer than the newest taken (a sender numbering again).
   bool behind(std::uint32_t sequence) const {
     return any_ && static_cast<std::int32_t>(sequence - newest_) <= 0;
