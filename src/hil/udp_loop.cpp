@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -32,6 +33,62 @@ sockaddr_in udp_address(const std::string& address, int port, const std::string&
   if (inet_pton(AF_INET, address.c_str(), &a.sin_addr) != 1)
     throw HilError(name + " = '" + address + "' rejected: allowed a numeric IPv4 address, e.g. 127.0.0.1 or 0.0.0.0");
   return a;
+}
+
+std::pair<std::string, int> parse_host_port(const std::string& text, const std::string& name) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size())
+    throw HilError(name + " = '" + text + "' rejected: allowed HOST:PORT with a numeric IPv4 HOST and a port 1 to "
+                   "65535, e.g. 127.0.0.1:47801");
+  const std::string host = text.substr(0, colon), digits = text.substr(colon + 1);
+  int port = -1;
+  if (digits.size() <= 5 && digits.find_first_not_of("0123456789") == std::string::npos) port = std::stoi(digits);
+  if (port < 1 || port > 65535)
+    throw HilError(name + " = '" + text + "' rejected: the port '" + digits + "' is not allowed: allowed 1 to 65535");
+  in_addr a{};
+  if (inet_pton(AF_INET, host.c_str(), &a) != 1)
+    throw HilError(name + " = '" + text + "' rejected: the host '" + host +
+                   "' is not allowed: allowed a numeric IPv4 address, e.g. 127.0.0.1 (no names, no IPv6)");
+  const std::uint32_t h = ntohl(a.s_addr);
+  if (h == INADDR_ANY || h == INADDR_BROADCAST || (h >> 28) == 0xE)
+    throw HilError(name + " = '" + text + "' rejected: the host '" + host +
+                   "' is not one machine: allowed a unicast IPv4 address (not 0.0.0.0, broadcast or multicast)");
+  return {host, port};
+}
+
+std::string address_text(const sockaddr_in& a) {
+  char b[INET_ADDRSTRLEN] = "?";
+  inet_ntop(AF_INET, &a.sin_addr, b, sizeof b);
+  return std::string(b) + ":" + std::to_string(ntohs(a.sin_port));
+}
+
+std::vector<AllowedSender> parse_allow_list(const std::string& text, const std::string& name) {
+  std::vector<AllowedSender> out;
+  std::size_t i = 0;
+  while (i <= text.size() && !text.empty()) {
+    const std::size_t comma = std::min(text.find(',', i), text.size());
+    const std::string entry = text.substr(i, comma - i);
+    AllowedSender s;
+    const auto colon = entry.find(':');
+    std::string host = entry;
+    bool ok = !entry.empty();
+    if (ok && colon != std::string::npos) {
+      host = entry.substr(0, colon);
+      const std::string digits = entry.substr(colon + 1);
+      ok = !digits.empty() && digits.size() <= 5 && digits.find_first_not_of("0123456789") == std::string::npos;
+      const int port = ok ? std::stoi(digits) : 0;
+      ok = ok && port >= 1 && port <= 65535;
+      s.port = static_cast<std::uint16_t>(port);
+    }
+    in_addr a{};
+    if (!ok || inet_pton(AF_INET, host.c_str(), &a) != 1)
+      throw HilError(name + " entry '" + entry + "' rejected: allowed a numeric IPv4 address with an optional port "
+                     "1 to 65535 (10.0.0.2 or 10.0.0.2:47801), several separated by commas");
+    s.address = a.s_addr;
+    out.push_back(s);
+    i = comma + 1;
+  }
+  return out;
 }
 
 UdpSocket::UdpSocket(const std::string& address, int port, const std::string& name) {
@@ -90,11 +147,27 @@ UdpLoopSkin::UdpLoopSkin(HilLoop& loop, const UdpLoopOptions& o, MonitorRing* mo
   if (const std::string e = udp::check_fits(loop.model()); !e.empty()) throw HilError("~scene: " + e);
   if (!o.rig_address.empty()) {
     if (o.rig_port <= 0 || o.rig_port > 65535)
-      throw HilError("--rig-port = " + std::to_string(o.rig_port) + " rejected: allowed 1 to 65535 with --rig");
+      throw HilError("--rig port = " + std::to_string(o.rig_port) + " rejected: allowed 1 to 65535");
     rig_ = udp_address(o.rig_address, o.rig_port, "--rig");
     fixed_rig_ = have_rig_ = true;
+    if (!allowed(rig_))
+      throw HilError("--rig = " + address_text(rig_) + " is not on the allow-list (--allow): it could never be the rig");
   }
   loop_.attach(this);
+}
+
+bool UdpLoopSkin::throttle(int slot) {
+  const double now = steady_now();
+  if (now < throttle_until_[slot]) return false;
+  throttle_until_[slot] = now + 1.0;
+  return true;
+}
+
+bool UdpLoopSkin::allowed(const sockaddr_in& from) const {
+  if (opt_.allow.empty()) return true;
+  for (const AllowedSender& a : opt_.allow)
+    if (a.address == from.sin_addr.s_addr && (a.port == 0 || a.port == ntohs(from.sin_port))) return true;
+  return false;
 }
 
 void UdpLoopSkin::log(LogLevel level, const std::string& text) {
@@ -121,23 +194,82 @@ void UdpLoopSkin::receive(double until) {
 }
 
 void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_in& from, double arrival) {
+  enum { kSlotForeign, kSlotRefused, kSlotUnusable };
+  if (!allowed(from)) {
+    ++refused_;
+    if (throttle(kSlotRefused))
+      say(LogLevel::kWarn, "UDP packet from " + address_text(from) + " refused: not on the allow-list (" +
+                               std::to_string(refused_) + " refused so far)");
+    return;
+  }
+  const bool same_address = have_peer_ ? from.sin_addr.s_addr == peer_.sin_addr.s_addr
+                                       : !fixed_rig_ || from.sin_addr.s_addr == rig_.sin_addr.s_addr;
+  const bool from_peer = have_peer_ && same_address && from.sin_port == peer_.sin_port;
+  auto foreign = [&](const char* why) {
+    ++foreign_;
+    if (throttle(kSlotForeign))
+      say(LogLevel::kWarn, "UDP packet from " + address_text(from) + " ignored: " + why + " (" +
+                               std::to_string(foreign_) + " foreign packets so far)");
+  };
+  if (!same_address) {
+    foreign(have_peer_ ? ("the loop follows the rig at " + address_text(peer_)).c_str()
+                       : ("only the rig at --rig " + address_text(rig_) + " may send").c_str());
+    return;
+  }
   csim_udp_measurement m;
   udp::Reject why;
   std::string reason;
   if (!udp::decode_measurement(data, n, static_cast<std::uint32_t>(loop_.external().size()), m, why, reason)) {
+    if (have_peer_ && !from_peer) {
+      foreign(("the loop follows the rig at " + address_text(peer_)).c_str());
+      return;
+    }
     ++rejected_[static_cast<int>(why)];
     loop_.reject("UDP " + reason);
     return;
   }
-  if (!udp::SequenceTracker::usable(tracker_.observe(m.header.sequence))) {
-    ++unusable_;  // older than one already taken (reordered) or a duplicate: counted, not used
+  const bool hello = m.pantographs == 0;
+  if (!have_peer_ || (!from_peer && hello)) {
+    // The rig: the first valid sender, or the rig's own address on a new port saying hello (a
+    // restarted controller with a new socket). Its numbering starts again.
+    if (have_peer_) {
+      ++rig_moves_;
+      say(LogLevel::kWarn, "UDP rig moved from " + address_text(peer_) + " to " + address_text(from) +
+                               " (a hello from the rig's address: a restarted rig)");
+      tracker_.restart();
+    } else {
+      say(LogLevel::kInfo, "UDP rig at " + address_text(from) + (hello ? " (hello)" : ""));
+    }
+    peer_ = from;
+    have_peer_ = true;
+  } else if (!from_peer) {
+    foreign(("the loop follows the rig at " + address_text(peer_) + "; a restarted rig says hello first").c_str());
     return;
+  } else if (hello && tracker_.behind(m.header.sequence)) {
+    tracker_.restart();  // a hello numbered below what the rig sent before: it started numbering again
   }
   if (!fixed_rig_) {
     rig_ = from;
     have_rig_ = true;
   }
-  if (m.pantographs == 0) return;  // a hello: the rig's address, no measurement
+  const auto verdict = tracker_.observe(m.header.sequence);
+  if (hello) return;  // a hello: the rig's address, no measurement
+  if (!udp::SequenceTracker::usable(verdict)) {
+    ++unusable_;  // older than one already taken (reordered) or a duplicate: counted, not used
+    if (throttle(kSlotUnusable))
+      say(LogLevel::kWarn, "UDP measurement " + std::to_string(m.header.sequence) + " from the rig ignored: " +
+                               (verdict == udp::SequenceTracker::Verdict::kDuplicate ? "a duplicate" : "older than ") +
+                               (verdict == udp::SequenceTracker::Verdict::kDuplicate
+                                    ? std::string()
+                                    : std::to_string(tracker_.newest()) + ", already taken") +
+                               " (" + std::to_string(unusable_) + " reordered or duplicated so far; " +
+                               std::to_string(udp::SequenceTracker::kResyncRun) +
+                               " in a row from lower numbers are taken as a restart)");
+    return;
+  }
+  if (verdict == udp::SequenceTracker::Verdict::kRestart)
+    say(LogLevel::kWarn, "UDP rig " + address_text(from) + " numbers its packets again from " +
+                             std::to_string(m.header.sequence) + ": followed");
   for (std::uint32_t i = 0; i < m.pantographs; ++i) force_[i] = m.force[i];
   const double measured = m.measured_time_ns > 0 ? 1e-9 * static_cast<double>(m.measured_time_ns) : 0.0;
   if (!loop_.accept(force_.data(), m.pantographs, arrival, measured, m.answers_step, "UDP measurement.force", true))
@@ -147,6 +279,32 @@ void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_i
     const double transport = arrival - 1e-9 * static_cast<double>(m.header.send_time_ns);
     if (transport >= 0.0 && transport < 1.0) loop_.add_transport(transport);
   }
+}
+
+void UdpLoopSkin::send_end(std::uint32_t reason, const PointFrame* f) {
+  end_sent_ = true;
+  end_sent_pass_ = loop_.pass_count();
+  if (!have_rig_) return;
+  csim_udp_end e;
+  std::memset(&e, 0, sizeof e);
+  e.step = f ? f->step : 0;
+  e.pass_count = loop_.pass_count();
+  e.reason = reason;
+  e.simulation_time = loop_.state().time;
+  // Three copies: a rig that loses one still stops at once rather than after its own timeout.
+  for (int i = 0; i < 3; ++i) {
+    udp::fill_header(e.header, CSIM_UDP_KIND_END, CSIM_UDP_END_SIZE, ++sequence_, monotonic_ns());
+    if (socket_.send(&e, sizeof e, rig_)) ++ends_sent_;
+    else ++send_errors_;
+  }
+  say(LogLevel::kInfo, std::string("UDP end sent to the rig at ") + address_text(rig_) + ": " +
+                           udp::end_reason_name(reason));
+}
+
+void UdpLoopSkin::finish() {
+  if (end_sent_ && end_sent_pass_ == loop_.pass_count()) return;
+  const bool ended = loop_.mode() == Mode::kEnded;
+  send_end(!ended ? CSIM_UDP_END_SHUTDOWN : loop_.diverged() ? CSIM_UDP_END_DIVERGED : CSIM_UDP_END_FINISHED, nullptr);
 }
 
 void UdpLoopSkin::send(const PointFrame& f) {
@@ -160,11 +318,22 @@ void UdpLoopSkin::send(const PointFrame& f) {
   last_held_ = c.held;
   last_overruns_ = c.overruns;
   if (loop_.options().delay_compensation > 0.0) flags |= CSIM_UDP_FLAG_COMPENSATED;
+  if (last_mode_ == Mode::kEnded && f.mode == Mode::kWaiting) {
+    // ~arm after the end: the next pass takes the first allowed sender as its rig.
+    if (have_peer_) say(LogLevel::kInfo, "UDP rig " + address_text(peer_) + " released (~arm): the next sender is the rig");
+    have_peer_ = false;
+    end_sent_ = false;
+    tracker_.restart(false);
+    if (!fixed_rig_) have_rig_ = false;
+  }
+  last_mode_ = f.mode;
   if (have_rig_) {
     udp::encode_contact_point(f, ++sequence_, monotonic_ns(), in_effect_sequence_, flags, packet_);  // (fits: checked)
     if (socket_.send(&packet_, sizeof packet_, rig_)) ++sent_;
     else ++send_errors_;
   }
+  if (f.mode == Mode::kEnded && !(end_sent_ && end_sent_pass_ == f.pass_count))
+    send_end(loop_.diverged() ? CSIM_UDP_END_DIVERGED : CSIM_UDP_END_FINISHED, &f);
   if (monitor_) {
     MonitorSample s;
     s.wall = steady_now();
@@ -192,6 +361,8 @@ void UdpLoopSkin::send(const PointFrame& f) {
     s.packets_lost = tracker_.lost();
     s.packets_reordered = tracker_.reordered();
     s.packets_duplicated = tracker_.duplicates();
+    s.packets_foreign = foreign_;
+    s.packets_refused = refused_;
     s.latency_p99 = loop_.latency_quantiles()[1];
     s.jitter_p50 = loop_.jitter_summary().p50;
     s.jitter_p99 = loop_.jitter_summary().p99;
@@ -214,7 +385,12 @@ void UdpLoopSkin::add_report(nlohmann::ordered_json& j) const {
   for (int i = 0; i < static_cast<int>(udp::Reject::kNumReasons); ++i)
     r[udp::reject_name(static_cast<udp::Reject>(i))] = rejected_[i];
   u["packets_rejected"] = r;
+  u["packets_foreign"] = foreign_;
+  u["packets_refused"] = refused_;
+  u["rig_moves"] = rig_moves_;
+  if (have_peer_) u["rig"] = address_text(peer_);
   u["contact_points_sent"] = sent_;
+  u["ends_sent"] = ends_sent_;
   u["send_errors"] = send_errors_;
   if (monitor_) u["monitor_dropped"] = monitor_->dropped();
   j["udp"] = u;
@@ -227,17 +403,36 @@ UdpVirtualRig::UdpVirtualRig(const Scene& scene, const UdpRigOptions& o)
   simulator_ = udp_address(o.simulator_address, o.simulator_port, "--simulator");
   if (!std::isfinite(o.rate) || !(o.rate == 0.0 || (o.rate >= 1.0 && o.rate <= 20000.0)))
     throw HilError("--rate = " + format_value(o.rate) + " rejected: allowed 0 (the simulator's loop rate) or [1, 20000] Hz");
-  for (const PantographSpec& ps : scene_.pantographs)
-    if (!ps.moving_force && !ps.external && !ps.masses.empty()) rigs_.emplace_back(ps, scene_.contact.stiffness);
+  if (!std::isfinite(o.contact_timeout) || o.contact_timeout < 0.0 || o.contact_timeout > 3600.0)
+    throw HilError("--timeout = " + format_value(o.contact_timeout) + " rejected: allowed 0 (never) or up to 3600 s");
+  if (!std::isfinite(o.connect_timeout) || o.connect_timeout < 0.0 || o.connect_timeout > 3600.0)
+    throw HilError("--connect-timeout = " + format_value(o.connect_timeout) +
+                   " rejected: allowed 0 (wait for ever) or up to 3600 s");
+  for (const PantographSpec& ps : scene_.pantographs) {
+    if (ps.moving_force || ps.external || ps.masses.empty()) continue;
+    try {
+      rigs_.emplace_back(ps, scene_.contact.stiffness);
+    } catch (const std::invalid_argument& e) {
+      throw HilError(std::string("--pantograph-scene: ") + e.what());
+    }
+  }
   if (rigs_.empty()) throw HilError("--pantograph-scene: no lumped pantograph (type lumped) in the scene");
+  if (rigs_.size() > CSIM_UDP_MAX_PANTOGRAPHS)  // (a packet carries no more)
+    rigs_.erase(rigs_.begin() + CSIM_UDP_MAX_PANTOGRAPHS, rigs_.end());
 }
 
 void UdpVirtualRig::on_point(const csim_udp_contact_point& msg) {
   if (!(msg.dt > 0.0 && msg.dt < 1.0) || msg.steps_per_period == 0) return;
   if (msg.pantographs > rigs_.size()) {
     ++rejected_;
+    if (!cannot_serve_)
+      message_ = "the simulator has " + std::to_string(msg.pantographs) + " external pantographs; --pantograph-scene "
+                 "has " + std::to_string(rigs_.size()) + " lumped one(s): allowed a scene with at least one lumped "
+                 "pantograph per external one, in scene order";
+    cannot_serve_ = true;
     return;
   }
+  last_point_ = steady_now();
   if (observer_) observer_(msg);
   ended_ = (msg.state_flags & CSIM_UDP_MODE_MASK) == CSIM_UDP_MODE_ENDED;
   auto points_of = [](const csim_udp_pantograph_point& p) {
@@ -287,16 +482,36 @@ void UdpVirtualRig::send_measurement() {
   }
 }
 
-int UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_ended) {
+RigEnd UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_ended) {
+  const double started = steady_now();
   auto stopped = [&] { return !keep_running(); };
   alignas(8) std::uint8_t buf[2048];
   csim_udp_contact_point p;
+  csim_udp_end e;
+  const bool any_source = simulator_.sin_addr.s_addr == htonl(INADDR_ANY);
   auto drain = [&] {
     sockaddr_in from{};
     long n;
     while ((n = socket_.receive(buf, sizeof buf, &from)) >= 0) {
+      // Only the simulator's packets (a stray sender must not move the rig's actuator).
+      if (from.sin_port != simulator_.sin_port || (!any_source && from.sin_addr.s_addr != simulator_.sin_addr.s_addr)) {
+        ++foreign_;
+        continue;
+      }
       udp::Reject why;
       std::string reason;
+      if (udp::kind_of(buf, static_cast<std::size_t>(n)) == CSIM_UDP_KIND_END) {
+        if (!udp::decode_end(buf, static_cast<std::size_t>(n), e, why, reason)) {
+          ++rejected_;
+          continue;
+        }
+        if (!end_received_ || end_reason_ != e.reason)
+          message_ = std::string("the simulator sent the end of pass ") + std::to_string(e.pass_count) + ": " +
+                     udp::end_reason_name(e.reason);
+        end_received_ = true;
+        end_reason_ = e.reason;
+        continue;
+      }
       if (!udp::decode_contact_point(buf, static_cast<std::size_t>(n), p, why, reason)) {
         ++rejected_;
         continue;
@@ -305,9 +520,27 @@ int UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_end
       on_point(p);
     }
   };
+  // The simulator ends the rig's run with an end packet: always when it stops, for a pass that
+  // ended only with `until_ended` (else the rig waits for the next pass).
+  auto over = [&]() -> std::optional<RigEnd> {
+    if (cannot_serve_) return RigEnd::kCannotServe;
+    if (end_received_ && (until_ended || end_reason_ == CSIM_UDP_END_SHUTDOWN)) return RigEnd::kEnded;
+    if (until_ended && ended_) {
+      if (message_.empty()) message_ = "the simulator reports the pass ENDED";
+      return RigEnd::kEnded;
+    }
+    if (stopped()) return RigEnd::kStopped;
+    return std::nullopt;
+  };
   // Until the first contact point: a hello every 50 ms (a measurement of no pantographs), from
   // which the simulator learns where to send (unless it was given --rig).
-  while (!stopped() && !have_) {
+  while (!have_) {
+    if (auto r = over()) return *r;
+    if (opt_.connect_timeout > 0.0 && steady_now() - started > opt_.connect_timeout) {
+      message_ = "no contact point from the simulator at " + address_text(simulator_) + " within --connect-timeout = " +
+                 format_value(opt_.connect_timeout) + " s (is it running, on that address and port?)";
+      return RigEnd::kConnectTimeout;
+    }
     csim_udp_measurement hello;
     std::memset(&hello, 0, sizeof hello);
     udp::fill_header(hello.header, CSIM_UDP_KIND_MEASUREMENT, CSIM_UDP_MEASUREMENT_SIZE, ++sequence_, monotonic_ns());
@@ -318,7 +551,13 @@ int UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_end
   const double period0 = dt_ * steps_per_period_;
   const double period = opt_.rate > 0.0 ? 1.0 / opt_.rate : period0;
   double next = steady_now() + 0.25 * period;
-  while (!stopped() && !(until_ended && ended_)) {
+  while (true) {
+    if (auto r = over()) return *r;
+    if (opt_.contact_timeout > 0.0 && steady_now() - last_point_ > opt_.contact_timeout) {
+      message_ = "no contact point from the simulator for --timeout = " + format_value(opt_.contact_timeout) +
+                 " s: the simulator stopped or the link broke";
+      return RigEnd::kContactTimeout;
+    }
     // Take contact points as they come (stepping the pantograph up to each at once) until the
     // tick, then send the contact force: the measurement, as a rig samples its load cell.
     for (double now = steady_now(); now < next && !stopped(); now = steady_now()) {
@@ -326,10 +565,10 @@ int UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_end
       drain();
     }
     drain();
+    if (over()) continue;
     send_measurement();
     next = next_rig_tick(next, period, steady_now(), missed_);
   }
-  return 0;
 }
 
 }  // namespace hil

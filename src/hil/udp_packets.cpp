@@ -137,6 +137,32 @@ bool decode_contact_point(const void* data, std::size_t size, csim_udp_contact_p
   return true;
 }
 
+std::uint16_t kind_of(const void* data, std::size_t size) {
+  if (size < sizeof(csim_udp_header)) return 0;
+  csim_udp_header h;
+  std::memcpy(&h, data, sizeof h);
+  return h.kind;
+}
+
+const char* end_reason_name(std::uint32_t reason) {
+  switch (reason) {
+    case CSIM_UDP_END_FINISHED: return "the pass ended";
+    case CSIM_UDP_END_DIVERGED: return "the simulation diverged";
+    case CSIM_UDP_END_SHUTDOWN: return "the simulator stopped";
+    default: return "unknown";
+  }
+}
+
+bool decode_end(const void* data, std::size_t size, csim_udp_end& out, Reject& why, std::string& reason) {
+  csim_udp_header h;
+  if (!check_header(data, size, CSIM_UDP_KIND_END, CSIM_UDP_END_SIZE, "end", h, why, reason)) return false;
+  std::memcpy(&out, data, sizeof out);
+  if (out.reason < CSIM_UDP_END_FINISHED || out.reason > CSIM_UDP_END_SHUTDOWN)
+    return fail(Reject::kFlags, why, reason,
+                "end.reason = " + std::to_string(out.reason) + " rejected: allowed 1 to 3 (CSIM_UDP_END_*)");
+  return finite_field(out.simulation_time, "end.simulation_time", why, reason);
+}
+
 std::string check_fits(const Model& m) {
   const std::vector<int> ext = external_pantographs(m);
   if (ext.size() > CSIM_UDP_MAX_PANTOGRAPHS)
@@ -214,10 +240,21 @@ SequenceTracker::Verdict SequenceTracker::observe(std::uint32_t seq) {
     return Verdict::kRestart;
   }
   if (d > 0) {
+    run_ = 0;
     lost_ += static_cast<std::uint64_t>(d - 1);
     seen_ = d >= 64 ? 1 : ((seen_ << d) | 1);
     newest_ = seq;
     return d == 1 ? Verdict::kInOrder : Verdict::kGap;
+  }
+  // Older than the newest: the start of the sender's numbering again, when kResyncRun in a row.
+  run_ = run_ > 0 && seq == run_next_ ? run_ + 1 : 1;
+  run_next_ = seq + 1;
+  if (run_ >= kResyncRun) {
+    ++restarts_;
+    newest_ = seq;
+    seen_ = 1;
+    run_ = 0;
+    return Verdict::kRestart;
   }
   if (d == 0) {
     ++duplicates_;
@@ -235,6 +272,13 @@ SequenceTracker::Verdict SequenceTracker::observe(std::uint32_t seq) {
   }
   ++reordered_;
   return Verdict::kReordered;
+}
+
+void SequenceTracker::restart(bool counted) {
+  if (!any_) return;
+  any_ = false;
+  run_ = 0;
+  if (counted) ++restarts_;
 }
 
 }  // namespace udp

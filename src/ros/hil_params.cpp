@@ -82,7 +82,7 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
                  "hil/hold_deceleration", "hil/report_file", "hil/realtime_priority", "hil/spin_wait", "hil/auto_start", "at_end",
                  "stats_file", "line_frame", "publish_rate", "marker_rate", "start_delay", "shape_rate",
                  "shape_resolution", "diagnostic_period", "hil/lock_memory", "hil/cpus", "hil/delay_compensation",
-                 "hil/udp_bind", "hil/udp_port", "hil/udp_rig"});  // (the last read by diagnostic_updater)
+                 "hil/udp_bind", "hil/udp_port", "hil/udp_rig", "hil/udp_allow"});  // (the last read by diagnostic_updater)
   HilParams p;
   // (the ranges are checked by validate_hil_params; the type errors name them too)
   r.text("scene", p.scene, "the path of a scene YAML file");
@@ -106,6 +106,7 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
   r.text("hil/udp_bind", p.udp_bind, "a numeric IPv4 address");
   r.integer("hil/udp_port", p.udp_port, "an integer in [0, 65535]");
   r.text("hil/udp_rig", p.udp_rig, "HOST:PORT (empty: the source of the rig's measurements)");
+  r.text("hil/udp_allow", p.udp_allow, "IPv4 addresses with optional :PORT, separated by commas (empty: any sender)");
   r.text("hil/report_file", p.report_file, "a file path (empty: none)");
   r.text("stats_file", p.stats_file, "a file path (empty: none)");
   r.text("line_frame", p.line_frame, "a frame id");

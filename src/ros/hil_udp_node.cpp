@@ -26,17 +26,11 @@ HilUdpNode::HilUdpNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   hil::UdpLoopOptions u;
   u.bind_address = params_.udp_bind;
   u.port = params_.udp_port;
-  if (!params_.udp_rig.empty()) {
-    const auto colon = params_.udp_rig.rfind(':');
-    int port = -1;
-    try {
-      if (colon != std::string::npos) port = std::stoi(params_.udp_rig.substr(colon + 1));
-    } catch (const std::exception&) {
-    }
-    if (colon == std::string::npos || colon == 0 || port < 1 || port > 65535)
-      throw ParamError("parameter ~hil/udp_rig = '" + params_.udp_rig + "' rejected: allowed HOST:PORT, e.g. 10.0.0.2:47801");
-    u.rig_address = params_.udp_rig.substr(0, colon);
-    u.rig_port = port;
+  try {
+    if (!params_.udp_rig.empty()) std::tie(u.rig_address, u.rig_port) = hil::parse_host_port(params_.udp_rig, "~hil/udp_rig");
+    u.allow = hil::parse_allow_list(params_.udp_allow, "~hil/udp_allow");
+  } catch (const hil::HilError& e) {
+    throw ParamError(std::string("parameter ") + e.what());
   }
   try {
     loop_ = std::make_unique<hil::HilLoop>(scene, o);
@@ -170,6 +164,8 @@ void HilUdpNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("packets lost", s.packets_lost);
   stat.add("packets reordered", s.packets_reordered);
   stat.add("packets duplicated", s.packets_duplicated);
+  stat.add("packets from other senders", s.packets_foreign);
+  stat.add("packets refused (~hil/udp_allow)", s.packets_refused);
   stat.add("latency p99 [s]", s.latency_p99);
   stat.add("jitter p50 [s]", s.jitter_p50);
   stat.add("jitter p99 [s]", s.jitter_p99);
@@ -187,6 +183,7 @@ int HilUdpNode::run() {
     return 2;
   }
   int rc = loop_->run();
+  skin_->finish();  // the rig is told that the pass ended (or that the node stops)
   stop_publisher_ = true;
   if (publisher_.joinable()) publisher_.join();
   std::printf("catenary_sim_hil_udp: %s\n", hil::loop_summary(*loop_).c_str());

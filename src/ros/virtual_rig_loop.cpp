@@ -84,6 +84,10 @@ int VirtualRig::run_udp() {
   o.simulator_port = port;
   o.rate = rate_;
   o.extrapolate = extrapolate_;
+  // A ROS node: it runs until the launch stops it (a new pass may come after the end), not until
+  // a timeout of its own.
+  o.contact_timeout = 0.0;
+  o.connect_timeout = 0.0;
   try {
     hil::UdpVirtualRig rig(scene_, o);
     ROS_INFO("virtual_rig: over UDP to %s (local port %d)", simulator_.c_str(), rig.port());

@@ -31,23 +31,6 @@ extern "C" void on_signal(int) {
   if (g_skin) g_skin->stop();  // (an atomic store: async-signal-safe)
 }
 
-// "HOST:PORT" -> (host, port); throws CLI::ValidationError naming `flag`.
-std::pair<std::string, int> host_port(const std::string& text, const std::string& flag) {
-  const auto colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size())
-    throw CLI::ValidationError(flag, "'" + text + "' rejected: allowed HOST:PORT, e.g. 127.0.0.1:47801");
-  int port = -1;
-  try {
-    std::size_t used = 0;
-    port = std::stoi(text.substr(colon + 1), &used);
-    if (used != text.size() - colon - 1) port = -1;
-  } catch (const std::exception&) {
-  }
-  if (port < 1 || port > 65535)
-    throw CLI::ValidationError(flag, "'" + text + "' rejected: the port must be 1 to 65535");
-  return {text.substr(0, colon), port};
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -80,6 +63,9 @@ int main(int argc, char** argv) {
   app.add_option("--bind", uo.bind_address, "local IPv4 address to receive on")->capture_default_str();
   app.add_option("--port", uo.port, "local UDP port to receive on")->check(CLI::Range(0, 65535))->capture_default_str();
   app.add_option("--rig", rig, "HOST:PORT of the rig (default: the source of its newest valid measurement)");
+  std::string allow;
+  app.add_option("--allow", allow, "senders that may be the rig: IPv4 addresses, each with an optional :PORT, "
+                 "separated by commas (default: any; the rig is the first valid sender)");
   app.add_flag("--same-clock", uo.same_clock, "the rig's send_time_ns is this machine's CLOCK_MONOTONIC (transport measured)");
   app.add_option("--report", report_file, "JSON at exit: latency, jitter, overruns, packets, coupling energy")->type_name("FILE");
   app.add_option("--stats", stats_file, "the pass statistics JSON (as simulate_pass)")->type_name("FILE");
@@ -91,9 +77,10 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    if (!rig.empty()) std::tie(uo.rig_address, uo.rig_port) = host_port(rig, "--rig");
+    if (!rig.empty()) std::tie(uo.rig_address, uo.rig_port) = hil::parse_host_port(rig, "--rig");
+    uo.allow = hil::parse_allow_list(allow, "--allow");
     if (cpus) rt.cpus = hil::parse_cpu_list(*cpus, "--cpus");
-  } catch (const CLI::ValidationError& e) {
+  } catch (const hil::HilError& e) {
     std::fprintf(stderr, "catenary_sim_hil_udp: %s\n", e.what());
     return 2;
   } catch (const std::invalid_argument& e) {
@@ -120,11 +107,14 @@ int main(int argc, char** argv) {
                  uo.bind_address.c_str(), skin.port(), rig.empty() ? "" : (", sending to " + rig).c_str());
     const int rc = loop.run();
     g_skin = nullptr;
+    skin.finish();  // the rig is told that the pass ended (or that the simulator stops)
     std::printf("catenary_sim_hil_udp: %s\n", hil::loop_summary(loop).c_str());
     const auto& seq = skin.sequence();
-    std::printf("catenary_sim_hil_udp: packets: %llu received, %llu lost, %llu reordered, %llu duplicated, %llu sent\n",
+    std::printf("catenary_sim_hil_udp: packets: %llu received, %llu lost, %llu reordered, %llu duplicated, %llu from "
+                "other senders, %llu refused (--allow), %llu sent\n",
                 static_cast<unsigned long long>(seq.received()), static_cast<unsigned long long>(seq.lost()),
                 static_cast<unsigned long long>(seq.reordered()), static_cast<unsigned long long>(seq.duplicates()),
+                static_cast<unsigned long long>(skin.foreign()), static_cast<unsigned long long>(skin.refused()),
                 static_cast<unsigned long long>(skin.sent()));
     const hil::CouplingEnergy& en = loop.energy();
     std::printf("catenary_sim_hil_udp: coupling: %.4g J of work on the line at the interface, %.4g J of it added by "
@@ -156,5 +146,8 @@ int main(int argc, char** argv) {
   } catch (const OutputError& e) {
     std::fprintf(stderr, "catenary_sim_hil_udp: %s\n", e.what());
     return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "catenary_sim_hil_udp: %s\n", e.what());
+    return 2;
   }
 }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <string>
 #include <thread>
 #include <vector>
@@ -71,6 +72,33 @@ TEST(HilUdpCli, BadOptionsAreRefusedNamingTheOption) {
   expect_refused({kRig, "--pantograph-scene", kLumped, "--simulator", "127.0.0.1"}, {"--simulator", "HOST:PORT"});
   expect_refused({kRig, "--pantograph-scene", kHil, "--simulator", "127.0.0.1:47800"}, {"lumped"});
   expect_refused({kRig, "--pantograph-scene", kLumped, "--rate", "-1"}, {"--rate"});
+  // A scene the rig cannot take: a pantograph with heads on their own suspensions.
+  expect_refused({kRig, "--pantograph-scene", CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_heads.yaml"},
+                 {"--pantograph-scene", "two_heads", "heads", "allowed"});
+  expect_refused({kRig, "--pantograph-scene", kLumped, "--simulator", "0.0.0.0:47800"}, {"--simulator", "unicast"});
+  expect_refused({kRig, "--pantograph-scene", kLumped, "--simulator", "127.0.0.1:65536"}, {"--simulator", "1 to 65535"});
+  expect_refused({kRig, "--pantograph-scene", kLumped, "--timeout", "-1"}, {"--timeout", "-1"});
+  expect_refused({kRig, "--pantograph-scene", kLumped, "--connect-timeout", "nan"}, {"--connect-timeout", "nan"});
+  expect_refused(with({"--rig", "255.255.255.255:47801"}), {"--rig", "unicast"});
+  expect_refused(with({"--allow", "10.0.0.2:0"}), {"--allow", "10.0.0.2:0", "allowed"});
+  expect_refused(with({"--allow", "10.0.0.2", "--rig", "10.0.0.3:47801"}), {"--rig", "allow"});
+}
+
+TEST(HilUdpCli, TheDocsPairEndsTogether) {
+  // docs/hil.md's ROS-free pair: the simulator runs the pass and exits, and tells the rig, which
+  // exits too (by itself: the 60 s limit of run_child is never reached on a 6.6 s pass).
+  const int port = free_port();
+  ASSERT_GT(port, 0);
+  ChildRun sim;
+  std::thread t([&] { sim = run({kSim, "--scene", kHil, "--port", std::to_string(port), "--bind", "127.0.0.1"}); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const ChildRun rig = run({kRig, "--pantograph-scene", kLumped, "--simulator", "127.0.0.1:" + std::to_string(port)});
+  t.join();
+  EXPECT_FALSE(rig.hung) << rig.out;
+  EXPECT_EQ(rig.exit_code, 0) << rig.out;
+  EXPECT_NE(rig.out.find("the pass ended"), std::string::npos) << rig.out;
+  EXPECT_FALSE(sim.hung) << sim.out;
+  EXPECT_EQ(sim.exit_code, 0) << sim.out;
 }
 
 TEST(HilUdpCli, RealTimeRefusedWithoutTheRightNamesTheOption) {

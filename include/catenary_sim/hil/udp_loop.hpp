@@ -2,10 +2,15 @@
 // exchanging the fixed packets of udp_packets.h with a rig controller, and a simulated rig
 // (UdpVirtualRig: the scene's lumped pantograph, as virtual_rig) that closes the loop over UDP.
 //
-// The simulator binds a UDP port; every valid measurement that is newer than the ones before
-// (sequence numbers) is handed to the loop, which answers each period with a contact point sent
-// to the rig's address (given, or the source of the newest valid measurement). Bad packets are
-// counted per reason and rejected whole; lost, reordered and duplicated ones are counted.
+// The simulator binds a UDP port and follows one rig: the source (address and port) of the first
+// valid packet from an allowed sender (UdpLoopOptions::allow, and the --rig address if given).
+// Every valid measurement of that rig that is newer than the ones before (sequence numbers) is
+// handed to the loop, which answers each period with a contact point sent to the rig (--rig, or
+// its source). Packets from other senders are counted (foreign; refused when not on the
+// allow-list), logged at most once a second and ignored. A hello from the rig's address on a new
+// port follows a restarted rig there; an ~arm after the end releases the rig. Bad packets are
+// counted per reason and rejected whole; lost, reordered and duplicated ones are counted. When
+// the pass ends, or at finish(), an end packet tells the rig to stop.
 // Monitoring (ROS topics, a recorder) takes MonitorSamples from a lock-free SPSC ring on a thread
 // of its own: sending them never blocks the loop (a full ring drops and counts).
 #pragma once
@@ -19,6 +24,8 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -52,6 +59,20 @@ class UdpSocket {
 };
 // Resolves a numeric IPv4 address; throws HilError naming `name`.
 sockaddr_in udp_address(const std::string& address, int port, const std::string& name);
+// "HOST:PORT" with a numeric IPv4 HOST and a port in [1, 65535]; throws HilError naming `name`,
+// the value and what is allowed.
+std::pair<std::string, int> parse_host_port(const std::string& text, const std::string& name);
+// "A:P" as text.
+std::string address_text(const sockaddr_in& a);
+
+// One entry of the allow-list: a numeric IPv4 address, with a port or any (0).
+struct AllowedSender {
+  std::uint32_t address = 0;  // network byte order
+  std::uint16_t port = 0;     // host byte order, 0: any
+};
+// "10.0.0.2" or "10.0.0.2:47801", several separated by commas (empty: none); throws HilError
+// naming `name`, the entry and what is allowed.
+std::vector<AllowedSender> parse_allow_list(const std::string& text, const std::string& name);
 std::int64_t monotonic_ns();
 
 // What the monitoring thread gets of each contact point (fixed size: it goes through the ring).
@@ -65,7 +86,8 @@ struct MonitorSample {
       measurement_age{};
   // The loop's figures at that period (copied: the monitoring thread never reads the loop's own).
   std::int64_t periods = 0, overruns = 0, held = 0, holds = 0, rejected = 0;
-  std::uint64_t packets_lost = 0, packets_reordered = 0, packets_duplicated = 0;
+  std::uint64_t packets_lost = 0, packets_reordered = 0, packets_duplicated = 0, packets_foreign = 0,
+                packets_refused = 0;
   double latency_p99 = 0.0, jitter_p50 = 0.0, jitter_p99 = 0.0, jitter_max = 0.0, delay_energy = 0.0;
   std::array<std::uint64_t, 8> jitter_counts{};  // JitterSummary::counts
 };
@@ -74,8 +96,9 @@ using MonitorRing = SpscRing<MonitorSample, 4096>;  // 4 s at 1 kHz
 struct UdpLoopOptions {
   std::string bind_address = "0.0.0.0";
   int port = 47800;
-  std::string rig_address;  // empty: answer the source of the newest valid measurement
+  std::string rig_address;  // empty: answer the rig's source; else only this address is the rig
   int rig_port = 0;
+  std::vector<AllowedSender> allow;  // empty: any sender may become the rig
   bool same_clock = false;  // the rig's send_time_ns is on this machine's CLOCK_MONOTONIC: transport measured
 };
 
@@ -89,6 +112,9 @@ class UdpLoopSkin : public LoopSkin {
   void set_running(std::function<bool()> f) { running_fn_ = std::move(f); }
   void stop() { stop_ = true; }
   int port() const { return socket_.port(); }
+  // After the loop has returned: tells the rig that the pass ended (or, before its end, that the
+  // simulator stops), unless an end packet for this pass was already sent.
+  void finish();
 
   bool running() override { return !stop_ && (!running_fn_ || running_fn_()); }
   void receive(double until) override;
@@ -109,11 +135,22 @@ class UdpLoopSkin : public LoopSkin {
   std::uint64_t sent() const { return sent_; }
   std::uint64_t send_errors() const { return send_errors_; }
   std::uint64_t unusable() const { return unusable_; }  // reordered or duplicated: dropped
+  std::uint64_t foreign() const { return foreign_; }    // from another sender than the rig: ignored
+  std::uint64_t refused() const { return refused_; }    // from a sender not on the allow-list
+  std::uint64_t rig_moves() const { return rig_moves_; }  // the rig followed to a new port (hello)
+  std::uint64_t ends_sent() const { return ends_sent_; }
+  bool has_rig() const { return have_peer_; }
+  const sockaddr_in& rig() const { return peer_; }
   // The packet figures as JSON fields of the report.
   void add_report(nlohmann::ordered_json& j) const;
 
  private:
   void take(const std::uint8_t* data, std::size_t n, const sockaddr_in& from, double arrival);
+  bool allowed(const sockaddr_in& from) const;
+  void send_end(std::uint32_t reason, const PointFrame* f);
+  // At most once per second per `slot`: true when the line may be logged now.
+  bool throttle(int slot);
+  void say(LogLevel level, const std::string& text) { log(level, loop_.options().who + ": " + text); }
 
   HilLoop& loop_;
   UdpLoopOptions opt_;
@@ -121,6 +158,13 @@ class UdpLoopSkin : public LoopSkin {
   MonitorRing* monitor_ = nullptr;
   bool fixed_rig_ = false, have_rig_ = false;
   sockaddr_in rig_{};
+  bool have_peer_ = false;  // the rig whose measurements are taken (address and port)
+  sockaddr_in peer_{};
+  std::uint64_t foreign_ = 0, refused_ = 0, rig_moves_ = 0, ends_sent_ = 0;
+  std::uint32_t end_sent_pass_ = 0;
+  bool end_sent_ = false;
+  Mode last_mode_ = Mode::kWaiting;
+  std::array<double, 4> throttle_until_{};
   std::atomic<bool> stop_{false};
   std::function<bool()> running_fn_;
   std::function<void(LogLevel, const std::string&)> log_sink_;
@@ -147,6 +191,20 @@ struct UdpRigOptions {
   int port = 0;  // 0: any
   double rate = 0.0;
   bool extrapolate = true;
+  // s without a contact point, once one came, after which the rig stops (the simulator died or
+  // the link broke); 0: never.
+  double contact_timeout = 2.0;
+  // s to wait for the first contact point (hellos every 50 ms meanwhile); 0: for ever.
+  double connect_timeout = 30.0;
+};
+
+// How UdpVirtualRig::run ended.
+enum class RigEnd {
+  kStopped,         // keep_running() turned false
+  kEnded,           // the simulator reported the end (an end packet, or ENDED with until_ended)
+  kContactTimeout,  // no contact point for contact_timeout
+  kConnectTimeout,  // no first contact point within connect_timeout
+  kCannotServe      // the simulator has more external pantographs than the scene lumped ones
 };
 
 // A rig's next measurement tick: `next` moved on by `period`; when the rig is late by more than a
@@ -164,8 +222,13 @@ inline double next_rig_tick(double next, double period, double now, std::uint64_
 class UdpVirtualRig {
  public:
   UdpVirtualRig(const Scene& pantograph_scene, const UdpRigOptions& o);
-  // Runs while `keep_running()` (and, with `until_ended`, until the simulator reports ENDED).
-  int run(const std::function<bool()>& keep_running, bool until_ended = false);
+  // Runs while `keep_running()`, until the simulator sends an end packet (with `until_ended`
+  // also until a contact point says ENDED; without it an end packet of a pass that ended is
+  // noted and the rig keeps running for a new pass, one of a simulator that stops still ends it),
+  // or until a timeout of UdpRigOptions. message() says why it returned.
+  RigEnd run(const std::function<bool()>& keep_running, bool until_ended = false);
+  const std::string& message() const { return message_; }
+  std::uint64_t foreign() const { return foreign_; }  // datagrams from another source than the simulator
   const udp::SequenceTracker& sequence() const { return tracker_; }
   std::uint64_t sent() const { return sent_; }
   std::uint64_t missed_ticks() const { return missed_; }
@@ -190,7 +253,11 @@ class UdpVirtualRig {
   std::uint64_t step_ = 0;
   double dt_ = 0.0;
   std::uint32_t steps_per_period_ = 1;
-  std::uint64_t sent_ = 0, missed_ = 0, rejected_ = 0;
+  std::uint64_t sent_ = 0, missed_ = 0, rejected_ = 0, foreign_ = 0;
+  bool end_received_ = false, cannot_serve_ = false;
+  std::uint32_t end_reason_ = 0;
+  double last_point_ = 0.0;  // steady s of the newest contact point taken
+  std::string message_;
   std::array<std::pair<std::uint64_t, double>, 256> sent_at_{};  // (step, steady s), a ring
   LatencyHistogram round_trip_;
   udp::SequenceTracker tracker_;

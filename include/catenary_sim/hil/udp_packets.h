@@ -1,8 +1,9 @@
 /* catenary_sim hardware in the loop over UDP: the packets, for rig controllers (plain C99).
  *
- * Two packets, each one UDP datagram of fixed size (no fragmentation: both fit an Ethernet MTU):
+ * Three packets, each one UDP datagram of fixed size (no fragmentation: all fit an Ethernet MTU):
  *   rig -> simulator  csim_udp_measurement    the contact force measured on each pantograph
  *   simulator -> rig  csim_udp_contact_point  the motion of the wire under each pantograph
+ *   simulator -> rig  csim_udp_end            the pass has ended or the simulator stops: stop
  *
  * Byte order: every field is LITTLE-ENDIAN (x86, ARM and most PowerPC rig targets in their usual
  * mode: the structs can be sent and received as they are; a big-endian target swaps each field).
@@ -14,12 +15,26 @@
  *
  * Sequence numbers: each sender numbers its packets 1, 2, 3, ... (uint32, wrapping to 0 after
  * 2^32 - 1 is allowed); the receiver counts lost, reordered and duplicated packets from them.
- * A measurement answers a contact point by naming its `step` (0: the newest the rig has).
+ * A measurement answers a contact point by naming its `step` (0: the newest the rig has). A
+ * sender that starts numbering again (a restarted rig) is followed again after a hello, or after
+ * 8 consecutive numbers from it that are older than the newest taken.
  *
  * Start: the simulator sends contact points to the rig's address given on its command line, or
  * else to the source of the newest valid measurement. A rig that has no contact point yet (so no
  * force to send) sends a hello: a measurement with pantographs = 0, every 50 ms until the first
  * contact point arrives. The pass starts with the first measurement with forces.
+ *
+ * The rig: the simulator follows one rig, the source (address and port) of the first valid
+ * packet it takes (from the address given with --rig, if any, and on the allow-list, if any).
+ * Packets from any other source are counted as foreign, logged and ignored, and get no contact
+ * points. A hello from the rig's address on another port moves the simulator to that port (a
+ * restarted controller with a new socket); an explicit re-arm after the end of a pass (~arm)
+ * releases the rig. UDP carries no authentication: this keeps a misconfigured second sender out,
+ * not an attacker on the rig network (docs/hil.md, "UDP": isolate the rig network).
+ *
+ * End: when the pass ends (its end, ~stop, a divergence) or the simulator stops (a signal, its
+ * --duration), it sends csim_udp_end (3 copies, for a lost datagram) to the rig. A rig stops on
+ * it; a rig should also stop after a time without contact points (the simulator died).
  *
  * Validation by the simulator: magic, version, kind, size, count of pantographs (the scene's
  * number of external pantographs), finite values, forces in [-50, 2000] N (readings in [-50, 0)
@@ -35,6 +50,7 @@
 #define CSIM_UDP_VERSION 1u
 #define CSIM_UDP_KIND_MEASUREMENT 1u
 #define CSIM_UDP_KIND_CONTACT_POINT 2u
+#define CSIM_UDP_KIND_END 3u
 #define CSIM_UDP_MAX_PANTOGRAPHS 4u /* external pantographs in one packet */
 #define CSIM_UDP_MAX_WIRE_POINTS 8u /* collectors x contact wires of one pantograph */
 
@@ -51,6 +67,11 @@
 #define CSIM_UDP_FLAG_HELD 0x100u       /* this period ran without a fresh measurement (held/extrapolated) */
 #define CSIM_UDP_FLAG_OVERRUN 0x200u    /* the loop has fallen behind since the last packet (periods dropped) */
 #define CSIM_UDP_FLAG_COMPENSATED 0x400u /* heights are predicted over the loop delay (delay compensation) */
+
+/* csim_udp_end.reason */
+#define CSIM_UDP_END_FINISHED 1u /* the pass ended (the end of the line, or ~stop once the line settled) */
+#define CSIM_UDP_END_DIVERGED 2u /* the simulation diverged: the pass ended */
+#define CSIM_UDP_END_SHUTDOWN 3u /* the simulator stops before the pass ended (a signal, --duration) */
 
 #pragma pack(push, 1)
 
@@ -107,9 +128,19 @@ typedef struct {
   csim_udp_pantograph_point pantograph[CSIM_UDP_MAX_PANTOGRAPHS];
 } csim_udp_contact_point;
 
+/* simulator -> rig, at the end (3 copies with consecutive sequence numbers) */
+typedef struct {
+  csim_udp_header header;  /* kind CSIM_UDP_KIND_END */
+  uint64_t step;           /* core steps at the end */
+  uint32_t pass_count;     /* the pass that ended */
+  uint32_t reason;         /* CSIM_UDP_END_* */
+  double simulation_time;  /* s */
+} csim_udp_end;            /* 48 bytes */
+
 #pragma pack(pop)
 
 #define CSIM_UDP_MEASUREMENT_SIZE 112u
 #define CSIM_UDP_CONTACT_POINT_SIZE 1384u
+#define CSIM_UDP_END_SIZE 48u
 
 #endif /* CATENARY_SIM_HIL_UDP_PACKETS_H */

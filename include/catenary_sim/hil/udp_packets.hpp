@@ -19,6 +19,7 @@ static_assert(sizeof(csim_udp_header) == 24, "udp_packets.h: header layout");
 static_assert(sizeof(csim_udp_measurement) == CSIM_UDP_MEASUREMENT_SIZE, "udp_packets.h: measurement layout");
 static_assert(sizeof(csim_udp_pantograph_point) == 324, "udp_packets.h: pantograph point layout");
 static_assert(sizeof(csim_udp_contact_point) == CSIM_UDP_CONTACT_POINT_SIZE, "udp_packets.h: contact point layout");
+static_assert(sizeof(csim_udp_end) == CSIM_UDP_END_SIZE, "udp_packets.h: end layout");
 // The packets are little-endian and copied as they are: this build serves little-endian hosts.
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the UDP packets are little-endian: port encode/decode");
 
@@ -40,6 +41,13 @@ bool decode_measurement(const void* data, std::size_t size, std::uint32_t pantog
 bool decode_contact_point(const void* data, std::size_t size, csim_udp_contact_point& out, Reject& why,
                           std::string& reason);
 
+// The same for an end packet (a rig's side): the reason one of CSIM_UDP_END_*.
+bool decode_end(const void* data, std::size_t size, csim_udp_end& out, Reject& why, std::string& reason);
+// The kind of a datagram that carries a header (0: too short for one).
+std::uint16_t kind_of(const void* data, std::size_t size);
+// "the pass ended", "the simulation diverged", "the simulator stopped" for CSIM_UDP_END_*.
+const char* end_reason_name(std::uint32_t reason);
+
 // The contact point packet of a loop frame. Fails (false, `reason`) when the frame does not fit
 // (more than CSIM_UDP_MAX_PANTOGRAPHS pantographs or CSIM_UDP_MAX_WIRE_POINTS wire points).
 bool encode_contact_point(const PointFrame& f, std::uint32_t sequence, std::int64_t send_time_ns,
@@ -50,11 +58,24 @@ std::string check_fits(const Model& m);
 
 // Lost, reordered and duplicated packets of one sender, from their sequence numbers. A packet is
 // `usable` when it is newer than every one before (the loop uses only the newest measurement: an
-// older one that arrives late is counted and dropped).
+// older one that arrives late is counted and dropped). A sender that numbers again from lower
+// down (it restarted, or one packet jumped far ahead) would otherwise be dropped until it passes
+// its old newest number: kResyncRun consecutive numbers, each older than the newest, are taken as
+// the sender's numbering from then on (a restart). Reordering in a network delays single packets
+// or short bursts behind newer ones; 8 consecutive late ones in a row are not that.
 class SequenceTracker {
  public:
+  static constexpr int kResyncRun = 8;
   enum class Verdict { kFirst, kInOrder, kGap, kReordered, kDuplicate, kRestart };
   Verdict observe(std::uint32_t sequence);
+  // The sender starts numbering again (a hello after its restart): the next number is taken as
+  // the first; the counts are kept, and the restart counted unless `counted` is false (a new
+  // pass's rig).
+  void restart(bool counted = true);
+  // True when `sequence` is not newer than the newest taken (a sender numbering again).
+  bool behind(std::uint32_t sequence) const {
+    return any_ && static_cast<std::int32_t>(sequence - newest_) <= 0;
+  }
   static bool usable(Verdict v) { return v != Verdict::kReordered && v != Verdict::kDuplicate; }
   std::uint64_t received() const { return received_; }
   std::uint64_t lost() const { return lost_; }          // skipped and not arrived since (within 64)
@@ -68,6 +89,8 @@ class SequenceTracker {
   bool any_ = false;
   std::uint32_t newest_ = 0;
   std::uint64_t seen_ = 0;  // bit i: newest_ - i arrived
+  int run_ = 0;               // consecutive numbers older than newest_, ending at run_next_ - 1
+  std::uint32_t run_next_ = 0;
   std::uint64_t received_ = 0, lost_ = 0, reordered_ = 0, duplicates_ = 0, restarts_ = 0;
 };
 

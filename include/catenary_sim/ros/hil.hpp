@@ -66,6 +66,7 @@ struct HilParams {
   int udp_port = 47800;             // ~hil/udp_port: local UDP port, [0, 65535]
   std::string udp_rig;              // ~hil/udp_rig: HOST:PORT of the rig (empty: the source of its
                                     //   newest valid measurement)
+  std::string udp_allow;            // ~hil/udp_allow: senders that may be the rig, "A[:P],..." (empty: any)
 };
 
 // The real-time options of the parameters, named as parameters in errors.
