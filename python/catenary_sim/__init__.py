@@ -201,7 +201,7 @@ def _override_list(overrides):
         return out
     if isinstance(overrides, (list, tuple)):
         for i, o in enumerate(overrides):
-            if not isinstance(o, str):
+            if not isinstance(o, str) or not o.split("=", 1)[0].strip() or "=" not in o:
                 _refuse(f"overrides[{i}]", o, "a 'dotted.key=value' string")
         return list(overrides)
     _refuse("overrides", overrides, "a dict {'dotted.key': value} or a list of 'dotted.key=value' strings")

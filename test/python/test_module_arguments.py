@@ -422,6 +422,29 @@ def test_fuzz_of_every_argument_raises_scene_error_naming_it():
                 else:
                     if (name, repr(v)) not in valid:
                         wrong.append([name, repr(v), "accepted"])
+        # Overrides as simulate_pass --set takes them: non-finite, huge, negative, of another type.
+        for text in (".nan", "nan", ".inf", "-.inf", "1e999", "-1e999", "1e300", "-3", "[1]", "{{a: 1}}", "true", "'x'"):
+            for key, field in (("train.speed_kmh", "train.speed_kmh"), ("pantographs.0.static_uplift",
+                               "pantographs[0].static_uplift"), ("line.span_count", "line.span_count")):
+                try:
+                    cs.Simulation(ref, overrides=short + [f"{{key}}={{text}}"])
+                except cs.SceneError as e:
+                    if e.field != field or not e.allowed:
+                        wrong.append([key, text, "field", e.field, str(e)[:300]])
+                except BaseException as e:
+                    wrong.append([key, text, type(e).__name__, str(e)[:300]])
+                else:
+                    wrong.append([key, text, "accepted"])
+        for i, o in enumerate((["train.speed_kmh"], [3], ["=3"])):
+            try:
+                cs.Simulation(ref, overrides=o)
+            except cs.SceneError as e:
+                if not e.field or not e.allowed:
+                    wrong.append([repr(o), "field", e.field, str(e)[:300]])
+            except BaseException as e:
+                wrong.append([repr(o), type(e).__name__, str(e)[:300]])
+            else:
+                wrong.append([repr(o), "accepted"])
         assert state() == before, "a refused call changed the state"
         print(json.dumps(wrong))
     """, timeout=300)
