@@ -76,6 +76,9 @@ class PySimulation {
   // Called without the GIL.
   long long run(double max_steps) {
     std::lock_guard<std::mutex> lock(mutex_);
+    // An infinite bound would let a pass at speed 0 run for ever.
+    if (!std::isfinite(max_steps))
+      throw py::value_error("run(): max_steps = " + fmt(max_steps) + " rejected: allowed a finite number");
     const State& st = sim_.state();
     const double left = st.speed > 0.0 ? (sim_.model().train_end - st.front - st.line_offset) / st.speed / sim_.model().dt
                                        : std::numeric_limits<double>::infinity();

@@ -361,7 +361,7 @@ def test_fuzz_of_every_argument_raises_scene_error_naming_it():
     # Every number argument with values of the wrong type, non-finite, huge or negative, on one
     # object (and the constructor's, overrides and a scene's value): each must raise SceneError
     # naming the argument or field, no crash (a child process), no hang (its timeout), and the
-    # object must be as it was afterwards.
+    # object must be as it was afterwards. (run(max_steps=inf) on a pass at speed 0 never ended.)
     r = run_child(f"""
         import json
         import numpy as np
