@@ -103,6 +103,9 @@ void LateralRecorder::record(const Model& m, const State& s) {
       if (m.endless) line_static_blow_off_[k] = block_static_blow_off_[r.span];
     }
   }
+  // The samples run from the first recorded state: a recorder started after a reset that kept the
+  // clock running samples at its rate from there, not every step until it reaches the clock.
+  if (rows_.empty()) next_sample_ = s.time;
   if (sample_period_ > 0.0 && s.time + 1e-12 < next_sample_) return;
   next_sample_ += sample_period_;
   PassRecorder::Row r{s.time, {}};

@@ -1,5 +1,7 @@
 #include "catenary_sim/core/simulation.hpp"
 
+#include "format.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -110,7 +112,7 @@ void Simulation::reset(bool keep_time) {
 
 bool Simulation::set_target_speed(double v, std::string* error) {
   if (!std::isfinite(v) || v < 0.0 || v > kMaxSpeed) {
-    if (error) *error = "train speed " + std::to_string(v) + " m/s rejected: allowed 0 to " + std::to_string(kMaxSpeed) + " m/s";
+    if (error) *error = "train speed " + fmt(v) + " m/s rejected: allowed 0 to " + fmt(kMaxSpeed) + " m/s";
     return false;
   }
   state_.target_speed = v;
@@ -119,7 +121,7 @@ bool Simulation::set_target_speed(double v, std::string* error) {
 
 bool Simulation::set_max_acceleration(double a, std::string* error) {
   if (!std::isfinite(a) || a < 0.0 || a > 20.0) {
-    if (error) *error = "max acceleration " + std::to_string(a) + " m/s^2 rejected: allowed 0 (no limit) to 20 m/s^2";
+    if (error) *error = "max acceleration " + fmt(a) + " m/s^2 rejected: allowed 0 (no limit) to 20 m/s^2";
     return false;
   }
   state_.max_acceleration = a;
@@ -133,7 +135,7 @@ bool Simulation::set_uplift(int p, double f, std::string* error) {
     return false;
   }
   if (!std::isfinite(f) || f < 0.0 || f > kMaxUplift) {
-    if (error) *error = "uplift force " + std::to_string(f) + " N rejected: allowed 0 to " + std::to_string(kMaxUplift) + " N";
+    if (error) *error = "uplift force " + fmt(f) + " N rejected: allowed 0 to " + fmt(kMaxUplift) + " N";
     return false;
   }
   if (p < 0) {

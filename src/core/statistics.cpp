@@ -217,6 +217,9 @@ void PassRecorder::record(const Model& m, const State& s) {
       else it->second = std::max(it->second, s.u[sp.dof]);
     }
   }
+  // The samples run from the first recorded state: a recorder started after a reset that kept the
+  // clock running samples at its rate from there, not every step until it reaches the clock.
+  if (rows_.empty()) next_sample_ = s.time;
   if (sample_period_ > 0.0 && s.time + 1e-12 < next_sample_) return;
   next_sample_ += sample_period_;
   row_index_.push_back(time_.size() - 1);

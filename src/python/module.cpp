@@ -8,8 +8,11 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
+
+#include "../core/format.hpp"
 
 #include "catenary_sim/core/output_files.hpp"
 #include "catenary_sim/core/pass_files.hpp"
@@ -34,15 +37,31 @@ class PySimulation {
   // sample_rate < 0: the scene's output.sample_rate.
   PySimulation(const Scene& scene, double sample_rate)
       : sim_(scene),
-        recorder_(sim_.model(), sample_rate < 0.0 ? scene.output.sample_rate : sample_rate),
-        lateral_(sim_.model(), sample_rate < 0.0 ? scene.output.sample_rate : sample_rate) {
+        sample_rate_(sample_rate < 0.0 ? scene.output.sample_rate : sample_rate),
+        recorder_(sim_.model(), sample_rate_),
+        lateral_(sim_.model(), sample_rate_) {
     recorder_.record(sim_.model(), sim_.state());
     lateral_.record(sim_.model(), sim_.state());
   }
 
+  // A new pass from the start, recorded at the same sample rate as the first.
+  void reset() {
+    sim_.reset(true);
+    recorder_ = PassRecorder(sim_.model(), sample_rate_);
+    recorder_.record(sim_.model(), sim_.state());
+    lateral_ = LateralRecorder(sim_.model(), sample_rate_);
+    lateral_.record(sim_.model(), sim_.state());
+  }
+
   // Steps up to n times; stops at the end of the pass or a divergence. Returns the steps taken.
+  // Called without the GIL: takes the object's lock itself.
   long long step(long long n) {
-    if (n < 0) throw py::value_error("step(n): n = " + std::to_string(n) + ": allowed n >= 0");
+    std::lock_guard<std::mutex> lock(mutex_);
+    return step_locked(n);
+  }
+
+  long long step_locked(long long n) {
+    if (n < 0) throw py::value_error("step(n): n = " + std::to_string(n) + " rejected: allowed n >= 0");
     long long done = 0;
     for (; done < n && !sim_.finished(); ++done) {
       if (sim_.step() != StepStatus::kOk) break;
@@ -54,15 +73,20 @@ class PySimulation {
   }
 
   // To the end of the pass, refused when it would not end within max_steps (speed 0, a crawl).
+  // Called without the GIL.
   long long run(double max_steps) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    // An infinite bound would let a pass at speed 0 run for ever.
+    if (!std::isfinite(max_steps))
+      throw py::value_error("run(): max_steps = " + fmt(max_steps) + " rejected: allowed a finite number");
     const State& st = sim_.state();
     const double left = st.speed > 0.0 ? (sim_.model().train_end - st.front - st.line_offset) / st.speed / sim_.model().dt
                                        : std::numeric_limits<double>::infinity();
     if (!(left <= max_steps))
-      throw py::value_error("run(): the rest of the pass would take " + std::to_string(left) + " steps at " +
-                            std::to_string(st.speed) + " m/s, more than max_steps = " + std::to_string(max_steps) +
-                            "; set a speed, or step(n) yourself");
-    return step(std::numeric_limits<long long>::max());
+      throw py::value_error("run(): max_steps = " + fmt(max_steps) + " rejected: the rest of the pass would take " +
+                            fmt(std::ceil(left)) + " steps at " + fmt(st.speed) +
+                            " m/s; allowed max_steps at least that (set a speed, or step(n) yourself)");
+    return step_locked(std::numeric_limits<long long>::max());
   }
 
   std::string statistics_json(double wall_s) const {
@@ -107,15 +131,45 @@ class PySimulation {
   }
 
   Simulation sim_;
+  double sample_rate_;  // Hz of the recorded series (0: every step)
   PassRecorder recorder_;
   LateralRecorder lateral_;  // records nothing on a 2-D line
+  // step() and run() release the GIL, so other Python threads may call into the same object
+  // meanwhile: every call holds this lock while it touches the pass.
+  mutable std::mutex mutex_;
 };
+
+// Takes a simulation's lock for a call that holds the GIL. Waits for it without the GIL: the
+// holder may be a call like this one, which took the lock and now waits for the GIL (a deadlock if
+// the GIL were kept while waiting), or a step() that runs for long (other threads run meanwhile).
+class Locked {
+ public:
+  explicit Locked(const PySimulation& s) : lock_(s.mutex_, std::defer_lock) {
+    if (!lock_.try_lock()) {
+      py::gil_scoped_release nogil;
+      lock_.lock();
+    }
+  }
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+};
+
+void check_sample_rate(double sample_rate) {
+  if (!std::isfinite(sample_rate) || (sample_rate < 0.0 && sample_rate != -1.0))
+    throw py::value_error("sample_rate = " + fmt(sample_rate) + " rejected: allowed >= 0 Hz (0: every step)");
+}
 
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "catenary_sim core (pybind11): scenes, passes, stepping; see catenary_sim.__doc__";
   py::register_exception<SceneError>(m, "_SceneError", PyExc_ValueError);
+  // The commands' ranges (the core's), for the Python side's messages about arguments of a wrong type.
+  m.attr("_MAX_SPEED") = Simulation::kMaxSpeed;
+  m.attr("_MAX_UPLIFT") = Simulation::kMaxUplift;
+  m.attr("_MIN_EXTERNAL_FORCE") = Simulation::kMinExternalForce;
+  m.attr("_MAX_EXTERNAL_FORCE") = Simulation::kMaxExternalForce;
 
   m.def(
       "_check_scene_string",
@@ -123,42 +177,43 @@ PYBIND11_MODULE(_core, m) {
         load_scene_string(yaml, overrides, base_dir);
       },
       py::arg("yaml"), py::arg("overrides"), py::arg("base_dir") = "");
+  m.def(
+      "_check_scene_file",
+      [](const std::string& path, const std::vector<std::string>& overrides) { load_scene_file(path, overrides); },
+      py::arg("path"), py::arg("overrides"));
 
   py::class_<PySimulation>(m, "_Simulation")
       .def(py::init([](const std::string& yaml, const std::vector<std::string>& overrides, double sample_rate) {
-             if (!std::isfinite(sample_rate) || sample_rate < -1.0 || (sample_rate < 0.0 && sample_rate != -1.0))
-               throw py::value_error("sample_rate = " + std::to_string(sample_rate) + ": allowed >= 0 Hz (0: every step)");
+             check_sample_rate(sample_rate);
              return std::make_unique<PySimulation>(load_scene_string(yaml, overrides), sample_rate);
            }),
            py::arg("yaml"), py::arg("overrides"), py::arg("sample_rate"))
       .def_static("from_file", [](const std::string& path, const std::vector<std::string>& overrides, double sample_rate) {
-             if (!std::isfinite(sample_rate) || sample_rate < -1.0 || (sample_rate < 0.0 && sample_rate != -1.0))
-               throw py::value_error("sample_rate = " + std::to_string(sample_rate) + ": allowed >= 0 Hz (0: every step)");
+             check_sample_rate(sample_rate);
              return std::make_unique<PySimulation>(load_scene_file(path, overrides), sample_rate);
            },
            py::arg("path"), py::arg("overrides"), py::arg("sample_rate"))
       .def("step", &PySimulation::step, py::arg("n") = 1, py::call_guard<py::gil_scoped_release>())
       // The whole pass without the GIL: other Python threads (a Dask worker's heartbeats) run meanwhile.
       .def("run", &PySimulation::run, py::arg("max_steps") = 2e7, py::call_guard<py::gil_scoped_release>())
-      .def("statistics_json", &PySimulation::statistics_json, py::arg("wall_s") = 0.0)
-      .def("write_pass_files", &PySimulation::write_pass_files, py::arg("dir"), py::arg("wall_s") = 0.0)
-      .def("series", &PySimulation::series)
-      .def("finished", [](const PySimulation& s) { return s.sim_.finished(); })
-      .def("reset", [](PySimulation& s) {
-        s.sim_.reset(true);
-        s.recorder_ = PassRecorder(s.sim_.model(), 0.0);
-        s.recorder_.record(s.sim_.model(), s.sim_.state());
-        s.lateral_ = LateralRecorder(s.sim_.model(), 0.0);
-        s.lateral_.record(s.sim_.model(), s.sim_.state());
-      })
-      .def_property_readonly("time", [](const PySimulation& s) { return s.sim_.state().time; })
-      .def_property_readonly("steps", [](const PySimulation& s) { return static_cast<long long>(s.sim_.state().steps); })
-      .def_property_readonly("dt", [](const PySimulation& s) { return s.sim_.model().dt; })
-      .def_property_readonly("dofs", [](const PySimulation& s) { return s.sim_.model().n_dof; })
-      .def_property_readonly("speed", [](const PySimulation& s) { return s.sim_.state().speed; })
-      .def_property_readonly("front", [](const PySimulation& s) { return s.sim_.state().front + s.sim_.state().line_offset; })
-      .def_property_readonly("status", [](const PySimulation& s) { return s.sim_.status_message(); })
+      .def("statistics_json", [](const PySimulation& s, double wall_s) { Locked l(s); return s.statistics_json(wall_s); },
+           py::arg("wall_s") = 0.0)
+      .def("write_pass_files", [](const PySimulation& s, const std::string& dir, double wall_s) {
+             Locked l(s);
+             s.write_pass_files(dir, wall_s);
+           }, py::arg("dir"), py::arg("wall_s") = 0.0)
+      .def("series", [](const PySimulation& s) { Locked l(s); return s.series(); })
+      .def("finished", [](const PySimulation& s) { Locked l(s); return s.sim_.finished(); })
+      .def("reset", [](PySimulation& s) { Locked l(s); s.reset(); })
+      .def_property_readonly("time", [](const PySimulation& s) { Locked l(s); return s.sim_.state().time; })
+      .def_property_readonly("steps", [](const PySimulation& s) { Locked l(s); return static_cast<long long>(s.sim_.state().steps); })
+      .def_property_readonly("dt", [](const PySimulation& s) { Locked l(s); return s.sim_.model().dt; })
+      .def_property_readonly("dofs", [](const PySimulation& s) { Locked l(s); return s.sim_.model().n_dof; })
+      .def_property_readonly("speed", [](const PySimulation& s) { Locked l(s); return s.sim_.state().speed; })
+      .def_property_readonly("front", [](const PySimulation& s) { Locked l(s); return s.sim_.state().front + s.sim_.state().line_offset; })
+      .def_property_readonly("status", [](const PySimulation& s) { Locked l(s); return s.sim_.status_message(); })
       .def_property_readonly("pantograph_names", [](const PySimulation& s) {
+        Locked l(s);
         std::vector<std::string> n;
         for (const Pantograph& p : s.sim_.model().pantographs) n.push_back(p.name);
         return n;
@@ -167,6 +222,7 @@ PYBIND11_MODULE(_core, m) {
       // contact wire, the station in the model's stations (on an endless line add the line offset:
       // a wire_shape's stations[0] minus wire_start_m), the design height and the wire's first station.
       .def_property_readonly("steady_arms", [](const PySimulation& s) {
+        Locked l(s);
         const Model& m = s.sim_.model();
         py::list out;
         for (const SupportSpring& sp : m.springs) {
@@ -183,7 +239,15 @@ PYBIND11_MODULE(_core, m) {
         }
         return out;
       })
+      .def_property_readonly("external_pantographs", [](const PySimulation& s) {
+        Locked l(s);
+        std::vector<int> n;
+        for (std::size_t i = 0; i < s.sim_.model().pantographs.size(); ++i)
+          if (s.sim_.model().pantographs[i].external) n.push_back(static_cast<int>(i));
+        return n;
+      })
       .def_property_readonly("contact_wire_names", [](const PySimulation& s) {
+        Locked l(s);
         std::vector<std::string> n;
         for (int w : s.sim_.model().contact_wires) n.push_back(s.sim_.model().wires[w].name);
         return n;
@@ -191,23 +255,28 @@ PYBIND11_MODULE(_core, m) {
       // Views (read-only, no copy) of the state: they change as the simulation steps.
       .def_property_readonly("displacements", [](py::object self) {
         const PySimulation& s = self.cast<const PySimulation&>();
+        Locked l(s);
         return view(s.sim_.state().u.data(), static_cast<std::size_t>(s.sim_.state().u.size()), self);
       })
       .def_property_readonly("velocities", [](py::object self) {
         const PySimulation& s = self.cast<const PySimulation&>();
+        Locked l(s);
         return view(s.sim_.state().v.data(), static_cast<std::size_t>(s.sim_.state().v.size()), self);
       })
       .def_property_readonly("contact_forces", [](py::object self) {
         const PySimulation& s = self.cast<const PySimulation&>();
+        Locked l(s);
         const auto& f = s.sim_.state().contact_force;
         py::array_t<double> a = view(f.data(), f.size(), self);
         const std::size_t nw = s.sim_.model().contact_wires.size();
         return a.reshape({static_cast<py::ssize_t>(f.size() / nw), static_cast<py::ssize_t>(nw)});
       })
       .def("pantograph_state", [](const PySimulation& s, int i) {
+        Locked l(s);
         const Model& m = s.sim_.model();
         if (i < 0 || i >= static_cast<int>(m.pantographs.size()))
-          throw py::index_error("pantograph " + std::to_string(i) + ": allowed 0.." + std::to_string(m.pantographs.size() - 1));
+          throw py::index_error("pantograph index " + std::to_string(i) + " rejected: allowed 0 to " +
+                                std::to_string(m.pantographs.size() - 1));
         const State& st = s.sim_.state();
         py::dict d;
         d["name"] = m.pantographs[i].name;
@@ -238,18 +307,28 @@ PYBIND11_MODULE(_core, m) {
         return d;
       }, py::arg("index") = 0)
       .def("set_speed", [](PySimulation& s, double v) {
+        Locked l(s);
         std::string e;
         s.command(s.sim_.set_target_speed(v, &e), e);
       }, py::arg("speed_mps"))
       .def("set_max_acceleration", [](PySimulation& s, double a) {
+        Locked l(s);
         std::string e;
         s.command(s.sim_.set_max_acceleration(a, &e), e);
       }, py::arg("accel_mps2"))
+      // pantograph -1: every pantograph. Other negative indexes are refused: the core would take any
+      // of them as every pantograph, and -2 is no such wish.
       .def("set_uplift", [](PySimulation& s, double f, int i) {
+        Locked l(s);
+        const int np = static_cast<int>(s.sim_.model().pantographs.size());
+        if (i < -1 || i >= np)
+          throw py::value_error("pantograph index " + std::to_string(i) + " rejected: allowed 0 to " +
+                                std::to_string(np - 1) + ", or -1 for every pantograph");
         std::string e;
         s.command(s.sim_.set_uplift(i, f, &e), e);
       }, py::arg("force_n"), py::arg("pantograph") = -1)
       .def("set_external_force", [](PySimulation& s, double f, int i) {
+        Locked l(s);
         std::string e;
         s.command(s.sim_.set_external_force(i, f, &e), e);
       }, py::arg("force_n"), py::arg("pantograph") = 0);
