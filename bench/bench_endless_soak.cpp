@@ -4,7 +4,7 @@
 // recorder in bounded memory the bytes and the statistics' time are flat after the warm-up.
 //   bench_endless_soak [--hours H] [--report S] [--scene FILE] [field=value ...]
 // Defaults: 2 h simulated of config/reference_55m_endless.yaml on the fast rung at 300 km/h,
-// every 600 s. The time series at 0.001 Hz (as the node), so the rows add nothing.
+// every 600 s. The time series at 0.001 Hz (a node that asks for few rows): the rows add nothing.
 // Against another checkout's core (no memory_bytes() there; the RSS column still tells):
 //   g++ -O3 -DNDEBUG -std=c++17 -DBENCH_SOAK_NO_ACCESSOR -I/tmp/base/include -I/usr/include/eigen3
 //       bench/bench_endless_soak.cpp /tmp/base/.ws/devel/lib/libcatenary_sim_core.a -lyaml-cpp

@@ -129,9 +129,10 @@ std::string statistics_json(const Model& model, const State& state, const std::v
 //   runs on blocks with kFilterSettling/cutoff seconds of overlap on each side, past which the
 //   4th-order Butterworth's slowest pole (decay 2 pi fc sin(pi/8)) has decayed to 2e-17: the
 //   filtered force is the whole-record filtfilt's to rounding;
-// - windowed: the spectrum over the last kSpectrumWindow s in the section; the time series rows
-//   (rows(), processed_rows(), dropper none) the last kMaxRows; the loss events and steady arms
-//   listed the first (events) and last (arms) kMaxListed.
+// - windowed: the spectrum over the last kSpectrumWindow s in the section (and the filtered
+//   statistics at a cutoff other than output.filter_cutoff); the time series (rows(),
+//   processed_rows()) the last kMaxRows rows; of the loss events the first kMaxListed listed, of
+//   the steady arms the last kMaxListed.
 // memory_bytes() reports what it holds.
 class PassRecorder {
  public:
@@ -148,7 +149,8 @@ class PassRecorder {
   // The initial state, then the state after each successful step().
   void record(const Model& model, const State& state);
   std::vector<PantographStatistics> statistics(const Model& model) const;
-  // The same with another low-pass cutoff (Hz), e.g. 200 Hz for the extremes of EN 50317.
+  // The same with another low-pass cutoff (Hz), e.g. 200 Hz for the extremes of EN 50317 (on an
+  // endless line over the spectrum's window: only the scene's cutoff is filtered as the pass runs).
   std::vector<PantographStatistics> statistics(const Model& model, double cutoff_hz) const;
 
   // Time series at the output sample rate (every step when 0).
