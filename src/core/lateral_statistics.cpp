@@ -13,10 +13,14 @@ constexpr double kBlowOffPeriod = 0.005;  // s: the wind moves the wires at a fe
 }
 
 LateralRecorder::LateralRecorder(const Model& m, double sample_rate_hz)
-    : sample_period_(sample_rate_hz > 0.0 ? 1.0 / sample_rate_hz : 0.0) {
-  station_.resize(m.collectors.size());
-  lateral_.resize(m.collectors.size());
-  contact_.resize(m.collectors.size());
+    : sample_period_(sample_rate_hz > 0.0 ? 1.0 / sample_rate_hz : 0.0), endless_(m.endless) {
+  analysis_section(m, &x0_, &x1_);
+  hist_bin_ = m.scene.pantograph_head.histogram_bin;
+  hist_bins_ = std::max(1, static_cast<int>(std::ceil(m.scene.pantograph_head.horn_width / hist_bin_ - 1e-9)));
+  hist_from_ = -0.5 * hist_bins_ * hist_bin_;
+  contacts_.resize(m.collectors.size());
+  if (m.lateral)
+    for (ContactTrack& t : contacts_) t.histogram.assign(hist_bins_, 0.0);
   for (std::size_t c = 0; c < m.collectors.size(); ++c) {
     const std::string name = m.pantographs[m.collectors[c].pantograph].name +
                              (m.pantographs[m.collectors[c].pantograph].collectors.size() > 1 ? "_" + std::to_string(c) : "");
@@ -68,15 +72,41 @@ void LateralRecorder::record(const Model& m, const State& s) {
   if (!m.lateral) return;
   const LateralModel& lat = *m.lateral;
   const std::size_t nw = m.contact_wires.size();
-  time_.push_back(s.time);
   for (std::size_t c = 0; c < m.collectors.size(); ++c) {
     const Collector& col = m.collectors[c];
+    ContactTrack& t = contacts_[c];
     const double x = s.front + s.line_offset - m.pantographs[col.pantograph].position + col.offset;
-    station_[c].push_back(x);
-    lateral_[c].push_back(s.lateral.collector_lateral[c]);
+    const double y = s.lateral.collector_lateral[c];
     double f = 0.0;
     for (std::size_t k = 0; k < nw; ++k) f += s.contact_force[c * nw + k];
-    contact_[c].push_back(f > 0.0);
+    if (!(x < x0_ || x > x1_ || std::isnan(y))) {
+      if (t.samples == 0) {
+        t.min = std::numeric_limits<double>::infinity();
+        t.max = -t.min;
+      }
+      ++t.samples;
+      t.sum += y;
+      t.sum2 += y * y;
+      t.min = std::min(t.min, y);
+      t.max = std::max(t.max, y);
+      t.outside += std::fabs(y) > col.half_working_width;
+      if (t.any && !std::isnan(t.prev_y) && s.time > t.prev_t) {
+        const double v = std::fabs(y - t.prev_y) / (s.time - t.prev_t);
+        t.sweep += v;
+        t.sweep_max = std::max(t.sweep_max, v);
+        ++t.sweeps;
+      }
+      if (f > 0.0) {
+        ++t.contact_samples;
+        const int b = static_cast<int>(std::floor((y - hist_from_) / hist_bin_));
+        if (b >= 0 && b < hist_bins_) t.histogram[b] += 1.0;
+      }
+    }
+    t.any = true;
+    t.prev_t = s.time;
+    t.prev_y = y;
+    t.station = x;
+    t.lateral = y;
   }
   if (s.time + 1e-12 >= next_blow_off_) {
     next_blow_off_ = s.time + kBlowOffPeriod;
@@ -111,61 +141,48 @@ void LateralRecorder::record(const Model& m, const State& s) {
   PassRecorder::Row r{s.time, {}};
   r.values.reserve(2 * m.collectors.size());
   for (std::size_t c = 0; c < m.collectors.size(); ++c) {
-    r.values.push_back(station_[c].back());
-    r.values.push_back(lateral_[c].back());
+    r.values.push_back(contacts_[c].station);
+    r.values.push_back(contacts_[c].lateral);
   }
   rows_.push_back(std::move(r));
+  if (endless_ && rows_.size() > PassRecorder::kMaxRows) rows_.pop_front();
+}
+
+std::size_t LateralRecorder::memory_bytes() const {
+  std::size_t b = 0;
+  for (const PassRecorder::Row& r : rows_) b += sizeof(PassRecorder::Row) + r.values.capacity() * sizeof(double);
+  for (const ContactTrack& t : contacts_) b += sizeof(ContactTrack) + t.histogram.capacity() * sizeof(double);
+  b += (max_blow_off_.capacity() + block_static_blow_off_.capacity() + line_static_blow_off_.capacity()) * sizeof(double);
+  b += blow_off_ranges_.capacity() * sizeof(BlowOffRange);
+  return b;
 }
 
 LateralStatistics LateralRecorder::statistics(const Model& m, const State& s) const {
   LateralStatistics out;
   if (!m.lateral) return out;
   const LateralModel& lat = *m.lateral;
-  const PantographHeadSpec& head = m.scene.pantograph_head;
-  double x0 = 0.0, x1 = 0.0;
-  analysis_section(m, &x0, &x1);
   for (std::size_t c = 0; c < m.collectors.size(); ++c) {
+    const ContactTrack& t = contacts_[c];
     LateralContactStatistics st;
     st.pantograph = m.pantographs[m.collectors[c].pantograph].name;
     st.collector = static_cast<int>(c);
-    st.bin = head.histogram_bin;
-    const int bins = std::max(1, static_cast<int>(std::ceil(head.horn_width / st.bin - 1e-9)));
-    st.from = -0.5 * bins * st.bin;
-    st.histogram_percent.assign(bins, 0.0);
-    double sum = 0.0, sum2 = 0.0, sweep = 0.0;
-    st.min = std::numeric_limits<double>::infinity();
-    st.max = -st.min;
-    std::size_t outside = 0, sweeps = 0;
-    for (std::size_t k = 0; k < time_.size(); ++k) {
-      const double x = station_[c][k], y = lateral_[c][k];
-      if (x < x0 || x > x1 || std::isnan(y)) continue;
-      ++st.samples;
-      sum += y;
-      sum2 += y * y;
-      st.min = std::min(st.min, y);
-      st.max = std::max(st.max, y);
-      outside += std::fabs(y) > m.collectors[c].half_working_width;
-      if (k > 0 && !std::isnan(lateral_[c][k - 1]) && time_[k] > time_[k - 1]) {
-        const double v = std::fabs(y - lateral_[c][k - 1]) / (time_[k] - time_[k - 1]);
-        sweep += v;
-        st.sweep_max = std::max(st.sweep_max, v);
-        ++sweeps;
-      }
-      if (contact_[c][k]) {
-        ++st.contact_samples;
-        const int b = static_cast<int>(std::floor((y - st.from) / st.bin));
-        if (b >= 0 && b < bins) st.histogram_percent[b] += 1.0;
-      }
-    }
+    st.bin = hist_bin_;
+    st.from = hist_from_;
+    st.histogram_percent = t.histogram;
+    st.samples = t.samples;
+    st.contact_samples = t.contact_samples;
+    st.sweep_max = t.sweep_max;
     if (st.samples) {
       const double n = static_cast<double>(st.samples);
-      st.mean = sum / n;
-      st.std_dev = std::sqrt(std::max(0.0, sum2 / n - st.mean * st.mean));
-      st.outside_working_percent = 100.0 * outside / n;
+      st.min = t.min;
+      st.max = t.max;
+      st.mean = t.sum / n;
+      st.std_dev = std::sqrt(std::max(0.0, t.sum2 / n - st.mean * st.mean));
+      st.outside_working_percent = 100.0 * t.outside / n;
     } else {
       st.min = st.max = std::nan("");
     }
-    if (sweeps) st.sweep_mean = sweep / sweeps;
+    if (t.sweeps) st.sweep_mean = t.sweep / t.sweeps;
     if (st.contact_samples)
       for (double& h : st.histogram_percent) h *= 100.0 / st.contact_samples;
     out.contacts.push_back(std::move(st));

@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
+#include <deque>
 #include <iomanip>
 #include <memory>
 #include <sstream>
@@ -28,8 +30,9 @@ namespace catenary_sim {
 
 namespace {
 
-// A CSV of rows (time first), written in pieces of about 1 MiB.
-void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const std::vector<PassRecorder::Row>& rows) {
+// A CSV of rows (time first), written in pieces of about 1 MiB. A value that does not exist (NaN)
+// is an empty field, as RFC 4180 readers take a missing value, never the text "nan".
+void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const std::deque<PassRecorder::Row>& rows) {
   std::ostringstream c;
   c << "time_s";
   for (const std::string& col : columns) c << "," << csv_field(col);
@@ -37,7 +40,10 @@ void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const st
   c << std::setprecision(9);
   for (const auto& row : rows) {
     c << row.time;
-    for (double v : row.values) c << "," << v;
+    for (double v : row.values) {
+      c << ",";
+      if (std::isfinite(v)) c << v;
+    }
     c << "\n";
     if (c.tellp() > (1 << 20)) {
       f.write(c.str());

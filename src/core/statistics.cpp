@@ -134,6 +134,55 @@ PassRecorder::PassRecorder(const Model& m, double sample_rate_hz, bool record_dr
   if (!m.endless)
     for (int k : steady_arm_springs_)
       columns_.push_back("uplift_steady_arm" + std::to_string(m.springs[k].span_index) + "_m");
+  analysis_section(m, &x0_, &x1_);
+  running_ = m.endless;
+  if (!running_) return;
+  const double fs = 1.0 / m.dt;
+  run_.resize(np);
+  for (Running& r : run_) {
+    r.wire_sum.assign(nw, 0.0);
+    r.wire_max.assign(nw, 0.0);
+    r.wire_on.assign(nw, 0);
+  }
+  buf_.x.resize(np);
+  buf_.force.resize(np);
+  buf_.measured.resize(np);
+  head_history_.resize(np);
+  // The overlap of the filter's blocks: kFilterSettling time constants of the lowest cutoff that
+  // filters at all (lowpass_zero_phase passes a cutoff at or above Nyquist through).
+  double fc = m.scene.output.filter_cutoff < 0.5 * fs ? m.scene.output.filter_cutoff : 0.0;
+  for (std::size_t p = 0; p < np; ++p) {
+    const Pantograph& pg = m.pantographs[p];
+    if (pg.moving_force) continue;
+    head_history_[p].assign(9 * (pg.heads.empty() ? 1 : pg.heads.size()), 0.0);
+    const double bw = m.scene.output.sensor_bandwidth;
+    if (bw < 0.5 * fs && (fc == 0.0 || bw < fc)) fc = bw;
+  }
+  margin_ = fc > 0.0 ? static_cast<std::size_t>(std::ceil(kFilterSettling * fs / fc)) : 4;
+  block_ = std::max<std::size_t>(margin_, 256);
+  window_steps_ = static_cast<std::size_t>(std::ceil(kSpectrumWindow * fs));
+}
+
+void PassRecorder::Moments::add(double v) {
+  if (n == 0) min = max = v;
+  ++n;
+  const double d = v - mean;
+  mean += d / static_cast<double>(n);
+  m2 += d * (v - mean);
+  min = std::min(min, v);
+  max = std::max(max, v);
+}
+
+ForceStatistics PassRecorder::Moments::statistics() const {
+  if (n == 0) return force_statistics({});
+  ForceStatistics s;
+  s.mean = mean;
+  s.std_dev = std::sqrt(std::max(0.0, m2 / static_cast<double>(n)));
+  s.max = max;
+  s.min = min;
+  s.stat_max = s.mean + 3.0 * s.std_dev;
+  s.stat_min = s.mean - 3.0 * s.std_dev;
+  return s;
 }
 
 namespace {
@@ -161,8 +210,45 @@ double section_speed(const std::vector<double>& t, const std::vector<double>& x,
 
 void PassRecorder::record(const Model& m, const State& s) {
   const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
-  time_.push_back(s.time);
   ++steps_;
+  if (running_) {
+    record_running(m, s);
+  } else {
+    time_.push_back(s.time);
+    record_whole(m, s);
+  }
+  // The samples run from the first recorded state: a recorder started after a reset that kept the
+  // clock running samples at its rate from there, not every step until it reaches the clock.
+  if (steps_ == 1) next_sample_ = s.time;
+  if (sample_period_ > 0.0 && s.time + 1e-12 < next_sample_) return;
+  next_sample_ += sample_period_;
+  if (running_) pending_rows_.push_back(steps_ - 1);
+  else row_index_.push_back(time_.size() - 1);
+  if (m.scene.output.dropper_series && !droppers_.empty()) {
+    Row dr{s.time, {}};
+    dr.values.reserve(droppers_.size());
+    bool slack = false;
+    for (const DropperTrack& t : droppers_) dr.values.push_back(dropper_force(m.droppers[t.index], s, &slack));
+    dropper_rows_.push_back(std::move(dr));
+  }
+  Row row{s.time, {}};
+  row.values.reserve(columns_.size());
+  for (std::size_t p = 0; p < np; ++p) {
+    const Pantograph& pg = m.pantographs[p];
+    row.values.push_back(s.front - pg.position + s.line_offset + 0.0);  // + 0.0: no "-0" in the CSV
+    for (int ci : pg.collectors)
+      for (std::size_t w = 0; w < nw; ++w) row.values.push_back(s.contact_force[ci * nw + w]);
+    row.values.push_back(total_contact_force(m, s, static_cast<int>(p)));
+    row.values.push_back(pg.moving_force ? 0.0 : s.u[pg.first_dof]);
+  }
+  if (!m.endless)
+    for (int k : steady_arm_springs_) row.values.push_back(s.u[m.springs[k].dof]);
+  rows_.push_back(std::move(row));
+  if (running_ && rows_.size() > kMaxRows) rows_.pop_front();
+}
+
+void PassRecorder::record_whole(const Model& m, const State& s) {
+  const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
   for (DropperTrack& t : droppers_) {
     bool slack = false;
     const double f = dropper_force(m.droppers[t.index], s, &slack);
@@ -217,39 +303,297 @@ void PassRecorder::record(const Model& m, const State& s) {
       else it->second = std::max(it->second, s.u[sp.dof]);
     }
   }
-  // The samples run from the first recorded state: a recorder started after a reset that kept the
-  // clock running samples at its rate from there, not every step until it reaches the clock.
-  if (rows_.empty()) next_sample_ = s.time;
-  if (sample_period_ > 0.0 && s.time + 1e-12 < next_sample_) return;
-  next_sample_ += sample_period_;
-  row_index_.push_back(time_.size() - 1);
-  if (m.scene.output.dropper_series && !droppers_.empty()) {
-    Row dr{s.time, {}};
-    dr.values.reserve(droppers_.size());
-    bool slack = false;
-    for (const DropperTrack& t : droppers_) dr.values.push_back(dropper_force(m.droppers[t.index], s, &slack));
-    dropper_rows_.push_back(std::move(dr));
-  }
-  Row row{s.time, {}};
-  row.values.reserve(columns_.size());
-  for (std::size_t p = 0; p < np; ++p) {
-    const Pantograph& pg = m.pantographs[p];
-    row.values.push_back(position_[p].back() + 0.0);  // + 0.0: no "-0" in the CSV
-    for (int ci : pg.collectors)
-      for (std::size_t w = 0; w < nw; ++w) row.values.push_back(s.contact_force[ci * nw + w]);
-    row.values.push_back(force_[p].back());
-    row.values.push_back(pg.moving_force ? 0.0 : s.u[pg.first_dof]);
-  }
-  if (!m.endless)
-    for (int k : steady_arm_springs_) row.values.push_back(s.u[m.springs[k].dof]);
-  rows_.push_back(std::move(row));
 }
 
 std::vector<PantographStatistics> PassRecorder::statistics(const Model& m) const {
   return statistics(m, m.scene.output.filter_cutoff);
 }
 
+namespace {
+
+// The measuring pantograph's force at the middle of three steps (slots a, b, c of a head history
+// of u, stretch and force per head): PassRecorder::measured_force's sum, one step at a time.
+double measured_at(const Pantograph& pg, const std::vector<double>& h, std::size_t a, std::size_t b, std::size_t c,
+                   double dt) {
+  const std::size_t heads = pg.heads.empty() ? 1 : pg.heads.size();
+  double f = 0.0;
+  for (std::size_t k = 0; k < heads; ++k) {
+    const double mass = pg.heads.empty() ? pg.masses[0] : pg.heads[k].mass;
+    const double damping = pg.heads.empty() ? pg.damping[0] : pg.heads[k].damping;
+    auto at = [&](std::size_t slot, int what) { return h[(slot * heads + k) * 3 + what]; };
+    const double vel = (at(c, 1) - at(a, 1)) / (2.0 * dt);
+    const double acc = (at(c, 0) - 2.0 * at(b, 0) + at(a, 0)) / (dt * dt);
+    f += at(b, 2) + damping * vel - mass * acc;
+  }
+  return f;
+}
+
+void close_loss(double t_end, double x_end, ContactLossEvent* ev, std::size_t* events,
+                double* longest, std::vector<ContactLossEvent>* listed) {
+  ev->duration = t_end - ev->start_time;
+  ev->length = x_end - ev->station;
+  ++*events;
+  *longest = std::max(*longest, ev->duration);
+  if (listed->size() < PassRecorder::kMaxListed) listed->push_back(*ev);
+}
+
+}  // namespace
+
+void PassRecorder::record_running(const Model& m, const State& s) {
+  const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
+  const std::size_t i = steps_ - 1;  // this step
+  const bool has_prev = !buf_.time.empty();
+  const double t_prev = has_prev ? buf_.time.back() : 0.0;
+  buf_.time.push_back(s.time);
+  for (std::size_t p = 0; p < np; ++p) {
+    const Pantograph& pg = m.pantographs[p];
+    Running& r = run_[p];
+    const double xp = s.front - pg.position, x = xp + s.line_offset;
+    const double f = total_contact_force(m, s, static_cast<int>(p));
+    const double x_prev = has_prev ? buf_.x[p].back() : 0.0;
+    buf_.x[p].push_back(x);
+    buf_.force[p].push_back(f);
+    if (!pg.moving_force) {
+      // The head's suspension as record_whole() keeps it, for the last three steps.
+      std::vector<double>& h = head_history_[p];
+      const std::size_t heads = pg.heads.empty() ? 1 : pg.heads.size(), slot = i % 3;
+      const int a0 = pg.first_dof, nm = pg.masses_count();
+      for (std::size_t k = 0; k < heads; ++k) {
+        double* e = &h[(slot * heads + k) * 3];
+        if (pg.heads.empty()) {
+          const double stretch = (nm > 1 ? s.u[a0 + 1] : 0.0) - s.u[a0];
+          double fe = pg.spring_preload[0] + pg.stiffness[0] * stretch;
+          if (nm == 1) fe += s.uplift[p] + pg.aero_coefficient * air_speed_squared(s, p);
+          e[0] = s.u[a0];
+          e[1] = stretch;
+          e[2] = fe;
+        } else {
+          const Head& hd = pg.heads[k];
+          const double stretch = s.u[a0] - s.u[hd.dof];
+          e[0] = s.u[hd.dof];
+          e[1] = stretch;
+          e[2] = hd.preload + hd.stiffness * stretch + hd.aero_coefficient * air_speed_squared(s, p);
+        }
+      }
+      if (i >= 2) {
+        const double fm = measured_at(pg, h, (i - 2) % 3, (i - 1) % 3, slot, m.dt);
+        if (i == 2) buf_.measured[p].push_back(fm);  // the first step takes the second's (as measured_force)
+        buf_.measured[p].push_back(fm);
+      }
+    }
+    if (x < x0_ || x > x1_) {
+      if (r.open) {
+        // Leaving the section cuts a running loss at this step.
+        close_loss(s.time, x, &r.event, &r.events, &r.longest, &r.listed);
+        r.open = false;
+      }
+    } else {
+      if (!r.any_in) {
+        r.first_t = s.time;
+        r.first_x = x;
+      }
+      r.any_in = true;
+      r.in_dt = has_prev ? s.time - t_prev : 0.0;
+      r.in_dx = has_prev ? x - x_prev : 0.0;
+      r.in_t = s.time;
+      r.in_x = x;
+      r.unfiltered.add(f);
+      r.lost += f <= 0.0;
+      for (std::size_t w = 0; w < nw; ++w) {
+        double fw = 0.0;
+        for (int ci : pg.collectors) fw += s.contact_force[ci * nw + w];
+        r.wire_sum[w] += fw;
+        r.wire_max[w] = std::max(r.wire_max[w], fw);
+        r.wire_on[w] += fw > 0.0;
+      }
+      const bool lost = !(f > 0.0);
+      if (lost && !r.open) {
+        r.event = ContactLossEvent{};
+        r.event.start_time = s.time;
+        r.event.station = x;
+        r.open = true;
+      } else if (!lost && r.open) {
+        close_loss(s.time, x, &r.event, &r.events, &r.longest, &r.listed);
+        r.open = false;
+      }
+      r.window.push_back(f);
+      if (r.window.size() > window_steps_) r.window.pop_front();
+    }
+    // Steady arms within half a span, as record_whole() finds them; the line's arms by station.
+    const auto first = std::lower_bound(steady_arm_x_.begin(), steady_arm_x_.end(), xp - longest_span_);
+    for (std::size_t k = first - steady_arm_x_.begin(); k < steady_arm_x_.size() && steady_arm_x_[k] <= xp + longest_span_; ++k) {
+      const SupportSpring& sp = m.springs[steady_arm_springs_[k]];
+      const int span = sp.span_index;
+      const double reach = 0.5 * std::min(m.scene.spans[span - 1], m.scene.spans[span]);
+      if (std::fabs(xp - sp.x) > reach) continue;
+      const long long key = std::llround(1e3 * (sp.x + s.line_offset));
+      const double up = s.u[sp.dof], xs = 1e-3 * key;
+      if (xs >= x0_ - 1e-6 && xs <= x1_ + 1e-6) r.uplift = std::max(r.uplift, up);
+      const auto it = arms_.find(key);
+      if (it == arms_.end()) arms_.emplace(key, up);
+      else it->second = std::max(it->second, up);
+    }
+  }
+  while (arms_.size() > kMaxListed) arms_.erase(arms_.begin());  // the oldest: the train runs forward
+  // A block is settled once kFilterSettling time constants follow it (one more step for the
+  // measured force's central difference).
+  if (steps_ >= committed_ + block_ + margin_ + 2) {
+    const std::size_t end = committed_ + block_;
+    commit(m, end, false, &run_, &processed_, &pending_rows_);
+    committed_ = end;
+    const std::size_t drop = committed_ - margin_ - first_;  // keep a margin before the next block
+    auto trim = [drop](std::vector<double>& v) { v.erase(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(std::min(drop, v.size()))); };
+    trim(buf_.time);
+    for (std::size_t p = 0; p < np; ++p) {
+      trim(buf_.x[p]);
+      trim(buf_.force[p]);
+      trim(buf_.measured[p]);
+    }
+    first_ += drop;
+  }
+}
+
+void PassRecorder::commit(const Model& m, std::size_t end, bool final, std::vector<Running>* run, std::deque<Row>* processed,
+                          std::deque<std::size_t>* pending) const {
+  const std::size_t np = m.pantographs.size();
+  const double fs = 1.0 / m.dt;
+  std::vector<std::vector<double>> filtered(np), measured(np);
+  for (std::size_t p = 0; p < np; ++p) {
+    filtered[p] = lowpass_zero_phase(buf_.force[p], fs, m.scene.output.filter_cutoff);
+    if (m.pantographs[p].moving_force || steps_ < 3) continue;
+    std::vector<double> raw = buf_.measured[p];
+    if (final) raw.push_back(raw.back());  // the last step takes the one before (as measured_force)
+    measured[p] = lowpass_zero_phase(raw, fs, m.scene.output.sensor_bandwidth);
+  }
+  for (std::size_t p = 0; p < np && run; ++p) {
+    Running& r = (*run)[p];
+    for (std::size_t j = committed_; j < end; ++j) {
+      const std::size_t k = j - first_;
+      const double x = buf_.x[p][k];
+      if (x < x0_ || x > x1_) continue;
+      r.filtered.add(filtered[p][k]);
+      if (k >= measured[p].size()) continue;
+      r.measured.add(measured[p][k]);
+      const double diff = measured[p][k] - filtered[p][k];
+      r.diff_sq += diff * diff;
+      r.diff_max = std::max(r.diff_max, std::fabs(diff));
+    }
+  }
+  while (processed && pending && !pending->empty() && pending->front() < end) {
+    const std::size_t k = pending->front() - first_;
+    pending->pop_front();
+    Row row{buf_.time[k], {}};
+    for (std::size_t p = 0; p < np; ++p) {
+      row.values.push_back(buf_.x[p][k] + 0.0);
+      row.values.push_back(filtered[p][k]);
+      // A moving force has no head: what it applies is what a load cell under it would read.
+      row.values.push_back(m.pantographs[p].moving_force ? buf_.force[p][k]
+                                                         : k < measured[p].size() ? measured[p][k] : std::nan(""));
+    }
+    processed->push_back(std::move(row));
+    if (processed->size() > kMaxRows) processed->pop_front();
+  }
+}
+
+std::vector<PantographStatistics> PassRecorder::running_statistics(const Model& m, double cutoff_hz) const {
+  std::vector<Running> run = run_;
+  commit(m, first_ + buf_.time.size(), true, &run, nullptr, nullptr);
+  const double fs = 1.0 / m.dt;
+  std::vector<PantographStatistics> out;
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    Running& r = run[p];
+    PantographStatistics st;
+    st.name = m.pantographs[p].name;
+    st.samples = r.unfiltered.n;
+    st.unfiltered = r.unfiltered.statistics();
+    if (cutoff_hz == m.scene.output.filter_cutoff) {
+      st.filtered = r.filtered.statistics();
+    } else {
+      // Another cutoff than the one filtered as the pass ran: over the spectrum's window.
+      const std::vector<double> w(r.window.begin(), r.window.end());
+      st.filtered = force_statistics(lowpass_zero_phase(w, fs, cutoff_hz));
+    }
+    const double n = static_cast<double>(r.unfiltered.n);
+    st.contact_loss_percent = r.unfiltered.n ? 100.0 * r.lost / n : std::nan("");
+    st.max_uplift_at_support_m = r.uplift > -1e300 ? r.uplift : std::nan("");
+    for (std::size_t w = 0; w < m.contact_wires.size(); ++w) {
+      WireContactStatistics ws;
+      ws.wire = m.wires[m.contact_wires[w]].name;
+      ws.mean_force = r.unfiltered.n ? r.wire_sum[w] / n : std::nan("");
+      ws.max_force = r.wire_max[w];
+      ws.contact_percent = r.unfiltered.n ? 100.0 * r.wire_on[w] / n : std::nan("");
+      st.wires.push_back(ws);
+    }
+    if (r.open) {
+      // Still lost at the last step in the section: it stands for one step.
+      close_loss(r.in_t + r.in_dt, r.in_x + r.in_dx, &r.event, &r.events, &r.longest, &r.listed);
+      r.open = false;
+    }
+    st.loss_events = r.listed;
+    st.loss_events_total = r.events;
+    // Per km run in the section so far (the section's length once the pass is through it).
+    const double run_km = (r.in_x - r.first_x) / 1000.0;
+    st.loss_events_per_km = r.any_in && run_km > 0.0 ? r.events / run_km : std::nan("");
+    st.longest_loss_s = r.longest;
+    const double v = r.any_in && r.in_t > r.first_t ? (r.in_x - r.first_x) / (r.in_t - r.first_t) : std::nan("");
+    st.spectrum = spectrum_summary(m, v, spectrum(m, p));
+    if (!m.pantographs[p].moving_force && r.measured.n) {
+      st.measured.available = true;
+      st.measured.force = r.measured.statistics();
+      st.measured.rms_difference = std::sqrt(r.diff_sq / static_cast<double>(r.measured.n));
+      st.measured.max_abs_difference = r.diff_max;
+    }
+    st.measured.bandwidth_hz = m.scene.output.sensor_bandwidth;
+    const std::optional<TargetMeanForce>& target = m.scene.pantographs[p].target_mean_force;
+    if (target && std::isfinite(v) && std::isfinite(st.filtered.mean)) {
+      PantographStatistics::TargetMean t;
+      t.speed_mps = v;
+      t.target = target->at(v);
+      t.difference = st.filtered.mean - t.target;
+      t.tolerance = target->tolerance;
+      t.within = !t.tolerance || std::fabs(t.difference) <= *t.tolerance;
+      st.target_mean = t;
+    }
+    out.push_back(st);
+  }
+  return out;
+}
+
+std::size_t PassRecorder::memory_bytes() const {
+  std::size_t b = 0;
+  auto vec = [&](const std::vector<double>& v) { b += v.capacity() * sizeof(double); };
+  auto vecs = [&](const std::vector<std::vector<double>>& v) {
+    for (const auto& x : v) vec(x);
+  };
+  auto rows = [&](const std::deque<Row>& d) {
+    for (const Row& r : d) b += sizeof(Row) + r.values.capacity() * sizeof(double);
+  };
+  vec(time_);
+  vecs(position_);
+  vecs(force_);
+  for (const auto& w : wire_force_) vecs(w);
+  vecs(head_u_);
+  vecs(suspension_stretch_);
+  vecs(suspension_force_);
+  for (const auto& a : max_uplift_) b += a.size() * (sizeof(long long) + sizeof(double) + 32);
+  for (const DropperTrack& t : droppers_) b += t.reversals.points().capacity() * sizeof(double);
+  b += row_index_.capacity() * sizeof(std::size_t);
+  rows(rows_);
+  rows(dropper_rows_);
+  rows(processed_);
+  vec(buf_.time);
+  vecs(buf_.x);
+  vecs(buf_.force);
+  vecs(buf_.measured);
+  vecs(head_history_);
+  b += pending_rows_.size() * sizeof(std::size_t);
+  b += arms_.size() * (sizeof(long long) + sizeof(double) + 32);
+  for (const Running& r : run_) b += r.window.size() * sizeof(double) + r.listed.capacity() * sizeof(ContactLossEvent);
+  return b;
+}
+
 std::vector<PantographStatistics> PassRecorder::statistics(const Model& m, double cutoff_hz) const {
+  if (running_) return running_statistics(m, cutoff_hz);
   std::vector<PantographStatistics> out;
   double x0 = 0.0, x1 = 0.0;
   analysis_section(m, &x0, &x1);
@@ -295,10 +639,11 @@ std::vector<PantographStatistics> PassRecorder::statistics(const Model& m, doubl
       st.wires.push_back(ws);
     }
     st.loss_events = contact_loss_events(time_, position_[p], force_[p], x0, x1);
+    st.loss_events_total = st.loss_events.size();
     st.loss_events_per_km = x1 > x0 ? st.loss_events.size() / ((x1 - x0) / 1000.0) : std::nan("");
     st.longest_loss_s = 0.0;
     for (const ContactLossEvent& e : st.loss_events) st.longest_loss_s = std::max(st.longest_loss_s, e.duration);
-    st.spectrum = spectrum_summary(m, p, spectrum(m, p));
+    st.spectrum = spectrum_summary(m, section_speed(time_, position_[p], x0, x1), spectrum(m, p));
     measured_statistics(m, p, x0, x1, filtered, &st.measured);
     const std::optional<TargetMeanForce>& target = m.scene.pantographs[p].target_mean_force;
     const double v = section_speed(time_, position_[p], x0, x1);
@@ -404,12 +749,19 @@ Spectrum PassRecorder::spectrum(const Model& m, std::size_t p) const {
   double x0 = 0.0, x1 = 0.0;
   analysis_section(m, &x0, &x1);
   std::vector<double> in;
-  for (std::size_t i = 0; i < force_[p].size(); ++i)
-    if (position_[p][i] >= x0 && position_[p][i] <= x1) in.push_back(force_[p][i]);
+  double v = 0.0;
+  if (running_) {
+    const Running& r = run_[p];
+    in.assign(r.window.begin(), r.window.end());
+    v = r.any_in && r.in_t > r.first_t ? (r.in_x - r.first_x) / (r.in_t - r.first_t) : std::nan("");
+  } else {
+    for (std::size_t i = 0; i < force_[p].size(); ++i)
+      if (position_[p][i] >= x0 && position_[p][i] <= x1) in.push_back(force_[p][i]);
+    v = section_speed(time_, position_[p], x0, x1);
+  }
   const double fs = 1.0 / m.dt;
   // Segments of 8 span-passing periods (a resolution of 1/8 of the span-passing frequency), or the
   // whole section when it is shorter.
-  const double v = section_speed(time_, position_[p], x0, x1);
   std::size_t seg = in.size();
   if (v > 0.0) seg = std::min(seg, static_cast<std::size_t>(std::ceil(8.0 * mean_span(m, x0, x1) / v * fs)));
   return welch_psd(in, fs, seg);
@@ -421,11 +773,10 @@ std::vector<Spectrum> PassRecorder::spectra(const Model& m) const {
   return out;
 }
 
-SpectrumSummary PassRecorder::spectrum_summary(const Model& m, std::size_t p, const Spectrum& sp) const {
+SpectrumSummary PassRecorder::spectrum_summary(const Model& m, double v, const Spectrum& sp) const {
   double x0 = 0.0, x1 = 0.0;
   analysis_section(m, &x0, &x1);
   SpectrumSummary s;
-  const double v = section_speed(time_, position_[p], x0, x1);
   s.span_passing_hz = v / mean_span(m, x0, x1);
   s.dropper_passing_hz = v / dropper_spacing(m, x0, x1);
   s.resolution_hz = sp.resolution;
@@ -463,7 +814,7 @@ LineStatistics PassRecorder::line_statistics(const Model& m) const {
   // Steady arms: the largest uplift of each over all pantographs, in the analysis section.
   double x0 = 0.0, x1 = 0.0;
   analysis_section(m, &x0, &x1);
-  std::map<long long, double> arms;
+  std::map<long long, double> arms = arms_;  // (an endless pass's, already over all pantographs)
   for (const auto& per : max_uplift_)
     for (const auto& [key, up] : per) {
       const auto it = arms.find(key);
@@ -502,21 +853,30 @@ std::vector<std::string> PassRecorder::dropper_columns() const {
   return c;
 }
 
-std::vector<PassRecorder::Row> PassRecorder::processed_rows(const Model& m) const {
+std::deque<PassRecorder::Row> PassRecorder::processed_rows(const Model& m) const {
+  if (running_) {
+    std::deque<Row> out = processed_;
+    std::deque<std::size_t> pending = pending_rows_;
+    commit(m, first_ + buf_.time.size(), true, nullptr, &out, &pending);
+    while (out.size() > rows_.size()) out.pop_front();  // the same rows as rows() keeps
+    return out;
+  }
   const std::size_t np = m.pantographs.size();
   std::vector<std::vector<double>> filtered(np), measured(np);
   for (std::size_t p = 0; p < np; ++p) {
     filtered[p] = lowpass_zero_phase(force_[p], 1.0 / m.dt, m.scene.output.filter_cutoff);
     measured[p] = measured_force(m, p);
   }
-  std::vector<Row> out;
-  out.reserve(row_index_.size());
+  std::deque<Row> out;
   for (std::size_t i : row_index_) {
     Row r{time_[i], {}};
     for (std::size_t p = 0; p < np; ++p) {
       r.values.push_back(position_[p][i] + 0.0);
       r.values.push_back(filtered[p][i]);
-      r.values.push_back(measured[p].size() > i ? measured[p][i] : std::nan(""));
+      // A moving force has no head: what it applies is what a load cell under it would read.
+      r.values.push_back(m.pantographs[p].moving_force ? force_[p][i]
+                         : measured[p].size() > i  ? measured[p][i]
+                                                   : std::nan(""));
     }
     out.push_back(std::move(r));
   }
@@ -577,7 +937,7 @@ std::string statistics_json(const Model& m, const State& s, const std::vector<Pa
                            {"contact_percent", w.contact_percent}});
     pj["contact_wires"] = wires;
     Json losses;
-    losses["count"] = p.loss_events.size();
+    losses["count"] = p.loss_events_total;
     losses["per_km"] = p.loss_events_per_km;
     losses["longest_s"] = p.longest_loss_s;
     Json events = Json::array();
@@ -588,7 +948,7 @@ std::string statistics_json(const Model& m, const State& s, const std::vector<Pa
                             {"length_m", e.length}});
     }
     losses["events"] = events;
-    losses["events_truncated"] = p.loss_events.size() > kMaxEvents;
+    losses["events_truncated"] = p.loss_events_total > events.size();
     pj["contact_loss_events"] = losses;
     Json sp;
     sp["span_passing_hz"] = p.spectrum.span_passing_hz;
@@ -665,6 +1025,8 @@ std::string statistics_json(const Model& m, const State& s, const std::vector<Pa
       loss = std::max(loss, p.contact_loss_percent);
     }
     for (const SteadyArmStatistics& a : line->steady_arms) uplift = std::max(uplift, a.max_uplift);
+    // (the same value on a finite line; an endless one lists only its last arms)
+    for (const PantographStatistics& p : stats) uplift = std::max(uplift, p.max_uplift_at_support_m);
     mark("stat_max_force_N", o.max_stat_force, true, stat_max);
     mark("stat_min_force_N", o.min_stat_force, false, stat_min);
     mark("contact_loss_percent", o.max_contact_loss_percent, true, loss);

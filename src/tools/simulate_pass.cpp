@@ -166,11 +166,21 @@ int main(int argc, char** argv) {
   // pass (a full or read-only target is found now, not after the pass).
   std::unique_ptr<DirectoryLock> lock;
   const std::string stats_path = out_dir + "/stats.json", csv_path = out_dir + "/timeseries.csv";
+  std::string bag_target;  // bag_path with its links followed
   try {
     make_directories(out_dir);
     lock = std::make_unique<DirectoryLock>(out_dir);
     check_pass_files_writable(out_dir, m);
-    if (!bag_path.empty()) check_writable(bag_path);
+    if (!bag_path.empty()) {
+      // rosbag seeks back to write its header and index: it needs a regular file (a link to one
+      // is kept and its target written).
+      const OutputTarget target = output_target(bag_path);
+      bag_target = target.path;
+      if (target.stream)
+        throw OutputError("--bag '" + bag_path + "': a rosbag needs a regular file (it seeks back to write its index), "
+                          "not a FIFO or device");
+      check_writable(bag_path);
+    }
   } catch (const OutputError& e) {
     std::cerr << "simulate_pass: " << e.what() << "\n";
     return kBadInput;
@@ -194,7 +204,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<ros_layer::PassBag> bag;
   // The bag is written under a temporary name and renamed when complete (rosbag writes its index
   // at close), so a failed pass never leaves a half bag under the asked name.
-  const std::string bag_tmp = bag_path.empty() ? "" : bag_path + ".partial";
+  const std::string bag_tmp = bag_path.empty() ? "" : bag_target + ".partial";
   try {
     if (!bag_path.empty()) {
       bag = std::make_unique<ros_layer::PassBag>(bag_tmp, bag_options);
@@ -248,7 +258,7 @@ int main(int argc, char** argv) {
     run.wall_time_s = wall;
     run.build_time_s = build_s;
     write_pass_files(out_dir, m, st, recorder, run, &lateral, status == StepStatus::kDewired);
-    if (!bag_tmp.empty() && std::rename(bag_tmp.c_str(), bag_path.c_str()) != 0)
+    if (!bag_tmp.empty() && std::rename(bag_tmp.c_str(), bag_target.c_str()) != 0)
       throw OutputError("cannot write '" + bag_path + "': rename failed");
   } catch (const OutputError& e) {
     std::cerr << "simulate_pass: " << e.what() << "\n";
@@ -282,7 +292,7 @@ int main(int argc, char** argv) {
         for (const WireContactStatistics& w : s.wires)
           std::cout << "      on " << w.wire << ": mean " << w.mean_force << " N, max " << w.max_force << " N, in contact "
                     << w.contact_percent << " % of the time\n";
-      std::cout << std::setprecision(2) << "      contact losses: " << s.loss_events.size() << " (" << s.loss_events_per_km
+      std::cout << std::setprecision(2) << "      contact losses: " << s.loss_events_total << " (" << s.loss_events_per_km
                 << " per km), longest " << s.longest_loss_s * 1e3 << " ms\n";
       std::cout << "      spectrum: span passing " << s.spectrum.span_passing_hz << " Hz, dropper passing "
                 << s.spectrum.dropper_passing_hz << " Hz; peaks";

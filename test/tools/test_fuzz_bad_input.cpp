@@ -239,3 +239,49 @@ TEST(FuzzBadInput, CorruptedSceneFiles) {
   RecordProperty("cases", count);
   std::system(("rm -rf '" + dir + "'").c_str());
 }
+
+TEST(FuzzBadInput, OutputTargetsThatAreNotRegularFiles) {
+  // The tools' single-file outputs onto what is not a regular file (output_files.hpp): a FIFO is
+  // written through (elasticity_curve) or refused before the pass (--bag: a rosbag seeks), never
+  // renamed over; a link to a file stays a link. In a scratch directory: no system file touched.
+  const std::string dir = temp_dir("catenary_sim_targets_");
+  auto mode = [](const std::string& p) {
+    struct stat st {};
+    return ::lstat(p.c_str(), &st) == 0 ? st.st_mode : mode_t{0};
+  };
+  const std::string fifo = dir + "/pipe";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // A reader on the FIFO (non-blocking open: no writer needed) that takes the curve afterwards.
+  const int rd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(rd, 0);
+  const ChildRun e = run({kElasticity, "--scene", kReference, "--step", "5", "--out", fifo}, dir);
+  EXPECT_EQ(e.exit_code, 0) << e.out;
+  EXPECT_TRUE(S_ISFIFO(mode(fifo))) << "elasticity_curve replaced the FIFO";
+  std::string got;
+  char buf[4096];
+  for (ssize_t n; (n = ::read(rd, buf, sizeof buf)) > 0;) got.append(buf, static_cast<std::size_t>(n));
+  ::close(rd);
+  EXPECT_EQ(got.rfind("x_m,", 0), 0u) << got.substr(0, 80);
+  // No reader: refused at once, the FIFO kept.
+  const ChildRun nr = run({kElasticity, "--scene", kReference, "--step", "5", "--out", fifo}, dir);
+  EXPECT_NE(nr.exit_code, 0);
+  EXPECT_FALSE(nr.hung);
+  EXPECT_NE(nr.out.find("no reader"), std::string::npos) << nr.out;
+  EXPECT_TRUE(S_ISFIFO(mode(fifo)));
+  // --bag onto a FIFO: refused before the pass, naming the flag.
+  const ChildRun b = run({kSimulatePass, "--scene", kReference, "--set", "numerics.preset=fast", "--out", dir + "/out",
+                          "--bag", fifo, "--quiet"},
+                         dir, 60.0);
+  EXPECT_EQ(b.exit_code, 2) << b.out;
+  EXPECT_NE(b.out.find("--bag"), std::string::npos) << b.out;
+  EXPECT_TRUE(S_ISFIFO(mode(fifo)));
+  // A link to a regular file: the link stays, the file gets the curve.
+  const std::string file = dir + "/curve.csv", link = dir + "/link.csv";
+  std::ofstream(file) << "old\n";
+  ASSERT_EQ(::symlink("curve.csv", link.c_str()), 0);
+  const ChildRun l = run({kElasticity, "--scene", kReference, "--step", "5", "--out", link}, dir);
+  EXPECT_EQ(l.exit_code, 0) << l.out;
+  EXPECT_TRUE(S_ISLNK(mode(link)));
+  EXPECT_EQ(slurp(file).rfind("x_m,", 0), 0u);
+  std::system(("rm -rf '" + dir + "'").c_str());
+}

@@ -3,6 +3,7 @@
 // against wind.blow_off_limit, the supports' pull-off forces and the dewirement events.
 #pragma once
 
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -49,16 +50,29 @@ class LateralRecorder {
   void record(const Model& model, const State& state);
   LateralStatistics statistics(const Model& model, const State& state) const;
   // Time series at the output sample rate: per collector its station and lateral position.
+  // (On an endless line the last PassRecorder::kMaxRows.)
   std::vector<std::string> columns() const { return columns_; }
-  const std::vector<PassRecorder::Row>& rows() const { return rows_; }
+  const std::deque<PassRecorder::Row>& rows() const { return rows_; }
+  // Bytes held for the pass: the rows and the blow-off per span; the contact point's statistics
+  // are running sums (exactly the sums over the recorded steps, in their order).
+  std::size_t memory_bytes() const;
 
  private:
   double sample_period_ = 0.0, next_sample_ = 0.0, next_blow_off_ = 0.0;
+  bool endless_ = false;
   std::vector<std::string> columns_;
-  std::vector<PassRecorder::Row> rows_;
-  std::vector<double> time_;
-  std::vector<std::vector<double>> station_, lateral_;  // per collector, every step
-  std::vector<std::vector<char>> contact_;             // per collector, every step: force on it
+  std::deque<PassRecorder::Row> rows_;
+  // Per collector over the analysis section, as the steps come.
+  struct ContactTrack {
+    std::size_t samples = 0, contact_samples = 0, outside = 0, sweeps = 0;
+    double sum = 0.0, sum2 = 0.0, sweep = 0.0, sweep_max = 0.0, min = 0.0, max = 0.0;
+    std::vector<double> histogram;  // steps with contact per bin
+    bool any = false;               // a step recorded (prev_* valid)
+    double prev_t = 0.0, prev_y = 0.0, station = 0.0, lateral = 0.0;  // the last step's
+  };
+  std::vector<ContactTrack> contacts_;
+  double x0_ = 0.0, x1_ = 0.0, hist_from_ = 0.0, hist_bin_ = 0.0;
+  int hist_bins_ = 0;
   std::vector<double> max_blow_off_;                   // per span (of the line's spans the pass covers, when endless)
   // Endless line: the span length, the first line span reported, the static blow-off per block
   // span, and per line span the one of the block span it was last recorded on (NaN: never).

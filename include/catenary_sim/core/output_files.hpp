@@ -2,6 +2,16 @@
 // everything is written to a temporary file in the same directory and renamed into place, which
 // POSIX makes atomic. A failed write (full disk, no permission) is an OutputError naming the file
 // and the system's reason, never a silent success.
+//
+// What the path already is decides how (never is anything renamed over what is not a regular file):
+// - nothing, or a regular file: the temporary file is renamed onto it;
+// - a symbolic link (or a chain of them): followed; the link stays and what it finally names is
+//   written as above, or as below when that is not a regular file;
+// - a FIFO or a character device (a pipe to another program, /dev/stdout, /dev/null, a terminal):
+//   written through, in place, as the text comes (a stream has no "whole file" to replace); a FIFO
+//   without a reader is refused at once rather than waited for;
+// - a directory, a block device or a socket: refused with an OutputError naming the path and what
+//   it is (a CSV over a disk or a socket is never what was meant).
 #pragma once
 
 #include <cstdio>
@@ -20,15 +30,27 @@ class OutputError : public std::runtime_error {
 void write_file_atomically(const std::string& path, const std::string& content);
 
 // Checks at start-up that `path` can be written later: the directory exists and accepts a new file
-// (created and removed again), and `path` itself is not a directory. Throws OutputError naming the
+// (created and removed again), and `path` itself is not a directory (nor a block device or socket;
+// a FIFO or character device must be writable, opened only when written). Throws OutputError naming the
 // path and the reason. Leaves nothing behind.
 void check_writable(const std::string& path);
+
+// Where output for `path` goes: the path with its symbolic links followed (dangling: the file the
+// link names, to be created) and whether it is written through as a stream (FIFO, character
+// device) rather than renamed into place. Throws OutputError for a directory, a block device, a
+// socket, or a link loop.
+struct OutputTarget {
+  std::string path;
+  bool stream = false;
+};
+OutputTarget output_target(const std::string& path);
 
 // Creates `dir` and its parents (mkdir -p). Throws OutputError.
 void make_directories(const std::string& dir);
 
 // A file being written: text goes to DIR/.NAME.tmp.XXXXXX; commit() flushes, fsyncs and renames it
-// to `path`. Destroyed without commit() (an error, an exception) it removes the temporary file.
+// to `path` (to what a link at `path` names). Destroyed without commit() (an error, an exception) it
+// removes the temporary file. A stream target (output_target()) is written directly instead.
 class AtomicFile {
  public:
   explicit AtomicFile(const std::string& path);  // throws OutputError
@@ -42,8 +64,9 @@ class AtomicFile {
   const std::string& path() const { return path_; }
 
  private:
-  std::string path_, tmp_;
+  std::string path_, tmp_, target_;
   std::FILE* file_ = nullptr;
+  bool stream_ = false;
 };
 
 // An exclusive advisory lock (flock) on DIR/.catenary_sim.lock, held while the object lives, so two
