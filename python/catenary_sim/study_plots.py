@@ -100,7 +100,7 @@ def plot_study(study, table, out):
             if any_failed:  # below the first map (constrained layout makes room for it)
                 axes.flat[0].legend(handles=[Rectangle((0, 0), 1, 1, facecolor="0.92", edgecolor="0.45", hatch="xx",
                                                        label="case failed (message in results.csv)")],
-                                    loc="upper left", bbox_to_anchor=(0.0, -0.12), fontsize=8, frameon=False)
+                                    loc="upper left", bbox_to_anchor=(0.0, -0.2), fontsize=8, frameon=False)
             if len(keys) == 3:
                 fig.suptitle(f"{study['name']}: {o}")
         elif study["sampling"] == "grid" and len(keys) == 1:
