@@ -81,19 +81,22 @@ class _StrictLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
             return None
         # An alias is the same node met twice in the graph (the parser shares it): looked for
         # without recursion, so a self-reference ends here too.
-        seen, stack = set(), [node]
+        seen, stack = set(), [(node, 0)]
         while stack:
-            n = stack.pop()
+            n, depth = stack.pop()
+            if depth > 64:  # a plan is a few levels deep; thousands overflow Python's recursion
+                raise StudyError(f"study file '{self.name}' line {n.start_mark.line + 1}: nested more than 64 levels "
+                                 "deep; a study file is a few levels of maps and lists")
             if id(n) in seen:
                 raise StudyError(f"study file '{self.name}' line {n.start_mark.line + 1}: this value is used again "
                                  "through an alias (*name): aliases and anchors are not allowed in a study file; "
                                  "write the value out")
             seen.add(id(n))
             if isinstance(n, yaml.SequenceNode):
-                stack.extend(n.value)
+                stack.extend((v, depth + 1) for v in n.value)
             elif isinstance(n, yaml.MappingNode):
                 for k, v in n.value:
-                    stack.extend((k, v))
+                    stack.extend(((k, depth + 1), (v, depth + 1)))
         return self.construct_document(node)
 
     def construct_mapping(self, node, deep=False):
