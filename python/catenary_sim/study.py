@@ -49,6 +49,15 @@ from . import SceneError
 SAMPLINGS = ("grid", "random", "lhs", "sobol", "saltelli")
 DISTRIBUTIONS = ("uniform", "normal", "truncated_normal", "integers")
 
+# A study file is read whole; beyond this it is refused (a study file is a page of YAML; a grid of
+# 100,000 values is about 1 MiB).
+MAX_STUDY_BYTES = 64 << 20
+# The plan is held in memory (a dict per case, about 1 kB with its record) and written to
+# plan.json; 100,000 passes are days of a cluster's time. Counted before the cases are made.
+MAX_CASES = 100_000
+# scipy's Sobol sequence has at most 21,201 dimensions (saltelli draws 2 per parameter).
+MAX_PARAMETERS = 1000
+
 
 class StudyError(ValueError):
     """A study file that cannot be run: names the field, the value and what is allowed."""
@@ -61,14 +70,75 @@ def _fail(field, value, allowed):
 # --------------------------------------------------------------------------------------------
 # The study file
 # --------------------------------------------------------------------------------------------
+class _StrictLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
+    """YAML as safe_load reads it (libyaml's parser where present: a 100,000-value grid in seconds),
+    but a key given twice in one map is refused (not last-wins) and aliases are refused (a
+    self-referencing or exponentially expanding one cannot be a plan)."""
+
+    def get_single_data(self):
+        node = self.get_single_node()
+        if node is None:
+            return None
+        # An alias is the same node met twice in the graph (the parser shares it): looked for
+        # without recursion, so a self-reference ends here too.
+        seen, stack = set(), [(node, 0)]
+        while stack:
+            n, depth = stack.pop()
+            if depth > 64:  # a plan is a few levels deep; thousands overflow Python's recursion
+                raise StudyError(f"study file '{self.name}' line {n.start_mark.line + 1}: nested more than 64 levels "
+                                 "deep; a study file is a few levels of maps and lists")
+            if id(n) in seen:
+                raise StudyError(f"study file '{self.name}' line {n.start_mark.line + 1}: this value is used again "
+                                 "through an alias (*name): aliases and anchors are not allowed in a study file; "
+                                 "write the value out")
+            seen.add(id(n))
+            if isinstance(n, yaml.SequenceNode):
+                stack.extend((v, depth + 1) for v in n.value)
+            elif isinstance(n, yaml.MappingNode):
+                for k, v in n.value:
+                    stack.extend(((k, depth + 1), (v, depth + 1)))
+        return self.construct_document(node)
+
+    def construct_mapping(self, node, deep=False):
+        seen = {}
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            try:
+                hash(key)
+            except TypeError:
+                raise StudyError(f"study file '{self.name}' line {key_node.start_mark.line + 1}: a key that is a "
+                                 "list or map; allowed text or number keys") from None
+            if key in seen:
+                raise StudyError(f"study file '{self.name}' line {key_node.start_mark.line + 1}: key '{key}' is given "
+                                 f"twice in one map (first on line {seen[key] + 1}); allowed each key once")
+            seen[key] = key_node.start_mark.line
+        return super().construct_mapping(node, deep)
+
+
 def load_study(path):
     """Reads and checks a study file; returns a dict with absolute paths. Raises StudyError."""
+    if os.path.isdir(path):
+        raise StudyError(f"study file '{path}' is a directory; expected a YAML file")
     with open(path, "rb") as f:
-        raw = f.read(1 << 20)
+        raw = f.read(MAX_STUDY_BYTES + 1)
+    if len(raw) > MAX_STUDY_BYTES:
+        raise StudyError(f"study file '{path}' is larger than {MAX_STUDY_BYTES >> 20} MiB: allowed at most "
+                         f"{MAX_STUDY_BYTES >> 20} MiB (a study is a page of YAML)")
     try:
-        doc = yaml.safe_load(raw)
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise StudyError(f"study file '{path}': not UTF-8 text ({e.reason} at byte {e.start})") from None
+    try:
+        loader = _StrictLoader(text)
+        loader.name = path  # for the messages
+        try:
+            doc = loader.get_single_data()
+        finally:
+            loader.dispose()
     except yaml.YAMLError as e:
         raise StudyError(f"study file '{path}': not valid YAML: {e}") from None
+    except RecursionError:
+        raise StudyError(f"study file '{path}': nested too deeply") from None
     if not isinstance(doc, dict):
         raise StudyError(f"study file '{path}': expected a map of fields (name, scene, parameters, ...)")
     known = {"name", "scene", "overrides", "sampling", "samples", "seed", "parameters", "outputs", "bootstrap", "report"}
@@ -93,6 +163,8 @@ def load_study(path):
     params = doc.get("parameters")
     if not isinstance(params, list) or not params:
         _fail("parameters", params, "a non-empty list of {key, values} or {key, distribution}")
+    if len(params) > MAX_PARAMETERS:
+        _fail("parameters", f"a list of {len(params)}", f"at most {MAX_PARAMETERS} parameters")
     s["parameters"] = []
     seen = set()
     for i, p in enumerate(params):
@@ -142,7 +214,26 @@ def load_study(path):
     if not isinstance(report, bool):
         _fail("report", report, "true or false (true: a pass report per case)")
     s["report"] = report
+    n = case_count(s)
+    if n > MAX_CASES:
+        field = "parameters" if s["sampling"] == "grid" else "samples"
+        how = (" x ".join(str(len(p["values"])) for p in s["parameters"]) + " grid values" if s["sampling"] == "grid"
+               else f"{s['samples']} samples" + (f" x ({len(s['parameters'])} parameters + 2)"
+                                                 if s["sampling"] == "saltelli" else ""))
+        _fail(field, f"{how} = {n} cases", f"at most {MAX_CASES} cases in one study (split it, or sample)")
+    try:
+        json.dumps(s, allow_nan=False)
+    except (TypeError, ValueError) as e:  # a date, a set, inf in a value: not writable to plan.json
+        raise StudyError(f"study file '{path}': a value that cannot be written to plan.json ({e}); allowed "
+                         "numbers, text, true/false, null, lists and maps") from None
     return s
+
+
+def case_count(study):
+    """The number of cases of a checked study, known before they are made."""
+    if study["sampling"] == "grid":
+        return math.prod(len(p["values"]) for p in study["parameters"])
+    return study["samples"] * (len(study["parameters"]) + 2 if study["sampling"] == "saltelli" else 1)
 
 
 def _label(value):
@@ -311,6 +402,41 @@ def _case_path(out, i):
     return os.path.join(out, "cases", f"{i:06d}.json")
 
 
+def _read_case(out, i, n_outputs, warn=False):
+    """A case's record, or None when it is missing or damaged (emptied, cut, not a record): such
+    a case is run again, with a word when it was there but unreadable."""
+    path = _case_path(out, i)
+    if not os.path.exists(path):
+        return None
+    try:
+        with open(path, encoding="utf-8") as f:
+            r = json.load(f)
+        ok = (isinstance(r, dict) and isinstance(r.get("parameters"), dict) and isinstance(r.get("outputs"), dict)
+              and len(r["outputs"]) == n_outputs and r.get("status") in ("ok", "failed")
+              and isinstance(r.get("message"), str) and isinstance(r.get("wall_time_s"), (int, float)))
+        why = "" if ok else "not a case record (parameters, outputs, status, message, wall_time_s)"
+    except (ValueError, OSError) as e:
+        ok, why = False, str(e)
+    if ok:
+        return r
+    if warn:
+        print(f"catenary_sim_study: case file '{path}' is damaged ({why}); the case runs again", flush=True)
+    return None
+
+
+def _plan_difference(old, new):
+    """Says which part of two plans differs, for the refusal message."""
+    new = json.loads(json.dumps(new))
+    if not isinstance(old, dict) or not isinstance(old.get("study"), dict):
+        return "its plan.json is not a plan"
+    for k in sorted(set(old["study"]) | set(new["study"])):
+        if old["study"].get(k) != new["study"].get(k):
+            return f"the study field '{k}' differs"
+    if len(old.get("cases") or []) != len(new["cases"]):
+        return f"{len(old.get('cases') or [])} cases against {len(new['cases'])}"
+    return "the cases differ"
+
+
 def _report_dir(out, i):
     # absolute: the workers of a cluster write it too (a shared file system, as for the scene)
     return os.path.join(os.path.abspath(out), "cases", f"{i:06d}")
@@ -339,17 +465,32 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
     plan = {"study": study, "cases": cases}
     plan_path = os.path.join(out, "plan.json")
     if os.path.exists(plan_path):
-        with open(plan_path) as f:
-            if json.load(f) != json.loads(json.dumps(plan)):
-                raise StudyError(f"'{out}' holds another study's cases (plan.json differs); use a new --out to start afresh")
+        try:
+            with open(plan_path, encoding="utf-8") as f:
+                old = json.load(f)
+        except ValueError as e:
+            raise StudyError(f"'{plan_path}' is damaged (not the JSON this tool writes: {e}); the cases in "
+                             f"'{out}' cannot be matched to a plan: use a new --out, or delete '{out}' to start "
+                             "afresh") from None
+        if old != json.loads(json.dumps(plan)):
+            raise StudyError(f"'{out}' holds the cases of another plan ({_plan_difference(old, plan)}); its cases are "
+                             "numbered by that plan and cannot be reused: run the changed study with a new --out "
+                             f"(or delete '{out}' to start afresh)")
     else:
         _write_atomically(plan_path, json.dumps(plan, indent=1))
-    todo = [i for i in range(len(cases)) if not os.path.exists(_case_path(out, i))]
+    todo = []
+    for i in range(len(cases)):
+        if _read_case(out, i, len(study["outputs"]), warn=True) is None:
+            todo.append(i)
 
     if todo:
         own = None
         if scheduler:
-            client = Client(scheduler)
+            try:
+                client = Client(scheduler, timeout=10)
+            except Exception as e:  # a bad address or no scheduler there: dask raises several kinds
+                raise StudyError(f"--scheduler {scheduler!r}: cannot reach a Dask scheduler ({type(e).__name__}: "
+                                 f"{e}); allowed the address of a running dask-scheduler, e.g. tcp://host:8786") from None
         else:
             # Without the workers' statistical profiler: it samples every 10 ms a thread that sits in
             # one C++ call, learns nothing, and takes CPU from the other worker on a 2-core machine
@@ -377,8 +518,10 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
 
     rows = []
     for i in range(len(cases)):
-        with open(_case_path(out, i)) as f:
-            r = json.load(f)
+        r = _read_case(out, i, len(study["outputs"]))
+        if r is None:
+            raise StudyError(f"case file '{_case_path(out, i)}' is missing or damaged after the run; run the "
+                             "study again on the same --out to redo it")
         shown = dict(r["parameters"])
         if study["sampling"] == "grid":  # a list or null value shows as its label
             for p in study["parameters"]:
@@ -471,6 +614,7 @@ def sobol_indices_from_table(table, study):
 
 def main(argv=None):
     import argparse
+    import sys
     ap = argparse.ArgumentParser(prog="catenary_sim_study", description="Run (or resume) a study of many passes on Dask.")
     ap.add_argument("study", help="study YAML (see catenary_sim.study)")
     ap.add_argument("--out", required=True, help="output directory (cases/, results.csv, plots)")
@@ -481,8 +625,16 @@ def main(argv=None):
     a = ap.parse_args(argv)
     try:
         table = run_study(a.study, a.out, a.scheduler, a.workers, not a.no_progress, not a.no_plots)
-    except (StudyError, SceneError, OSError) as e:
-        print(f"catenary_sim_study: {e}", flush=True)
+    except (StudyError, SceneError) as e:
+        print(f"catenary_sim_study: {e}", file=sys.stderr, flush=True)
+        return 2
+    except OSError as e:
+        where = f" '{e.filename}'" if e.filename else ""
+        print(f"catenary_sim_study:{where} {e.strerror or e}", file=sys.stderr, flush=True)
+        return 2
+    except MemoryError:
+        print("catenary_sim_study: out of memory building the plan; allowed fewer cases (a smaller grid or "
+              "fewer samples)", file=sys.stderr, flush=True)
         return 2
     failed = int((table["status"] != "ok").sum())
     print(f"catenary_sim_study: {len(table)} cases, {failed} failed; {os.path.join(a.out, 'results.csv')}")

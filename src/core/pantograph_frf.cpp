@@ -148,6 +148,34 @@ Scene frf_rig_scene(const Scene& scene, int pi, double dt) {
   return s;
 }
 
+namespace {
+
+// Where the measurement window of one frequency starts and how long it is, in steps: after the
+// ramp and the settling of the slowest free mode (sigma, 1/s), in whole periods.
+void frf_window(double f, double sigma, double dt, const FrfMeasurement& how, double* t0, long long* start,
+                long long* count) {
+  const double period = 1.0 / f;
+  const double ramp = how.ramp_periods * period;
+  const double settle = std::min(how.max_settle_time, sigma > 0.0 ? std::log(1.0 / how.settle_tolerance) / sigma : how.max_settle_time);
+  *t0 = ramp + std::ceil(settle / period) * period;
+  *start = std::llround(*t0 / dt);
+  *count = std::llround(how.window_periods * period / dt);
+}
+
+}  // namespace
+
+long long frf_steps(const Model& rig, const std::vector<double>& frequencies, const FrfMeasurement& how) {
+  const double sigma = slowest_decay_rate(rig, 0);
+  long long total = 0;
+  for (double f : frequencies) {
+    double t0 = 0.0;
+    long long start = 0, count = 0;
+    frf_window(f, sigma, rig.dt, how, &t0, &start, &count);
+    total += start + count;
+  }
+  return total;
+}
+
 std::vector<FrfPoint> measured_frf(const Model& rig, const std::vector<double>& frequencies, const FrfMeasurement& how) {
   const int pi = 0;
   const Pantograph& p = rig.pantographs.at(pi);
@@ -169,6 +197,8 @@ std::vector<FrfPoint> measured_frf(const Model& rig, const std::vector<double>& 
   const Eigen::VectorXd x_eq = kc.ldlt().solve(r);
 
   std::vector<FrfPoint> out;
+  const long long total = how.progress ? frf_steps(rig, frequencies, how) : 0;
+  long long done = 0;
   for (std::size_t k = 0; k < frequencies.size(); ++k) {
     const double f = frequencies[k], w = 2.0 * kPi * f, period = 1.0 / f;
     // Drive amplitude: the dynamic contact force stays a share of the static uplift (no loss of contact).
@@ -180,16 +210,17 @@ std::vector<FrfPoint> measured_frf(const Model& rig, const std::vector<double>& 
     for (int c : sys.contact) f1 += rig.contact_stiffness * (x1[c] - 1.0);
     const double amplitude = how.force_share * p.static_uplift / std::abs(f1);
     const double ramp = how.ramp_periods * period;
-    const double settle = std::min(how.max_settle_time, sigma > 0.0 ? std::log(1.0 / how.settle_tolerance) / sigma : how.max_settle_time);
-    const double t0 = ramp + std::ceil(settle / period) * period;
-    const long start = std::lround(t0 / dt), count = std::lround(how.window_periods * period / dt);
+    double t0 = 0.0;
+    long long start = 0, count = 0;
+    frf_window(f, sigma, dt, how, &t0, &start, &count);
 
     State s = make_state(rig);
     for (int i = 0; i < n; ++i) s.u[p.first_dof + i] = x_eq[i];
     // Least squares of x and F on (1, cos, sin) over the window: sums of the normal equations.
     Eigen::Matrix3d nn = Eigen::Matrix3d::Zero();
     Eigen::Vector3d bx = Eigen::Vector3d::Zero(), bf = Eigen::Vector3d::Zero();
-    for (long step_i = 0; step_i < start + count; ++step_i) {
+    for (long long step_i = 0; step_i < start + count; ++step_i) {
+      if (how.progress && (done + step_i) % how.progress_every == 0) how.progress(done + step_i, total);
       const double t = step_i * dt;
       const double env = t < ramp ? 0.5 * (1.0 - std::cos(kPi * t / ramp)) : 1.0;
       const double denv = t < ramp ? 0.5 * kPi / ramp * std::sin(kPi * t / ramp) : 0.0;
@@ -234,6 +265,7 @@ std::vector<FrfPoint> measured_frf(const Model& rig, const std::vector<double>& 
     pt.drive_amplitude = amplitude;
     pt.settle_time = t0;
     out.push_back(pt);
+    done += start + count;
   }
   return out;
 }

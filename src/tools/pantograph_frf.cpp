@@ -3,7 +3,9 @@
 // (the pantograph alone under a rigid wire driven by stepped sines, the force read from the
 // contact, eq. 22), as DIR/frf.csv and a Bode plot DIR/frf.png (scripts/plot_frf).
 //   pantograph_frf SCENE --pantograph NAME --out DIR [--fmin HZ] [--fmax HZ] [--points N] [--dt S]
+//                  [--max-steps N]
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -45,6 +47,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   double fmin = 0.5, fmax = 20.0, dt = 1e-4, share = 0.5;
   int points = 30;
+  // About 6 minutes of the rig at about 1.3e6 steps/s (3.7e10 steps at --dt 1e-7, the default
+  // 30 points, were estimated at 8 hours); the default run at dt 1e-4 takes 3.7e7.
+  double max_steps = 5e8;
   bool no_plot = false;
   app.add_option("scene", scene_path, "scene YAML")->required()->type_name("SCENE");
   app.add_option("--pantograph", name, "name of the pantograph in the scene")->required();
@@ -54,6 +59,9 @@ int main(int argc, char** argv) {
   app.add_option("--points", points, "measured frequencies (log spaced)")->check(CLI::Range(1, 400))->capture_default_str();
   app.add_option("--dt", dt, "largest time step of the simulated rig, s (smaller if its stability limit asks)")
       ->check(kFinite & CLI::Range(1e-7, 1e-2))
+      ->capture_default_str();
+  app.add_option("--max-steps", max_steps, "refuse a measurement that would take more rig steps than this")
+      ->check(kFinite & CLI::Range(1.0, 1e12))
       ->capture_default_str();
   app.add_option("--force-share", share, "dynamic contact force amplitude as a share of the static uplift")
       ->check(kFinite & CLI::Range(0.01, 0.9))
@@ -105,6 +113,26 @@ int main(int argc, char** argv) {
     FrfMeasurement how;
     how.dt = rig.dt;
     how.force_share = share;
+    // Known before running: the steps grow as 1/dt, and a tiny --dt runs for hours without a word.
+    const long long steps = frf_steps(rig, freqs, how);
+    if (static_cast<double>(steps) > max_steps) {
+      const double smallest = rig.dt * static_cast<double>(steps) / max_steps;
+      std::cerr << "pantograph_frf: --dt " << dt << " s: the rig would take " << static_cast<double>(steps)
+                << " steps for these " << freqs.size() << " frequencies, more than --max-steps " << max_steps
+                << "; allowed: --dt >= " << smallest
+                << " s here (or fewer --points, a higher --fmin, or a larger --max-steps)\n";
+      return 2;
+    }
+    // A line per tenth of a long run (several million steps): seconds to minutes each.
+    int shown = 0;
+    if (steps > 20000000LL)
+      how.progress = [&shown](long long done, long long total) {
+        const int tenth = static_cast<int>(10 * done / std::max(1LL, total));
+        if (tenth > shown) {
+          shown = tenth;
+          std::cerr << "pantograph_frf: " << 10 * tenth << " % of " << static_cast<double>(total) << " rig steps\n";
+        }
+      };
     const std::vector<FrfPoint> model = analytic_frf(rig, 0, freqs);
     const std::vector<FrfPoint> measured = measured_frf(rig, freqs, how);
 

@@ -132,3 +132,86 @@ def test_heads_need_a_frame_below_them():
     from catenary_sim.pantograph_fit import scene_snippet
     with pytest.raises(ValueError, match="heads = 0.5"):
         scene_snippet(fit, heads=0.5)
+
+
+def write_frf(path, f, h):
+    pd.DataFrame({"frequency_hz": f, "receptance_re_m_per_n": h.real, "receptance_im_m_per_n": h.imag}).to_csv(
+        path, index=False)
+    return str(path)
+
+
+@pytest.mark.parametrize("name", ['a: "b', "it's", "x # y", "- z", "{q}", "naïve: [1]"])
+def test_snippet_reads_back_for_any_name(tmp_path, name):
+    # The snippet is YAML written by a YAML library: a name with a quote, a colon, a '#' or a
+    # flow character reads back as given (pasted into text, it broke the file).
+    f, h = noisy_frf(CHAINS[0], 0.0, seed=0)
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, FIT_CLI, write_frf(tmp_path / "frf.csv", f, h), "--out", str(out), "--name", name],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    p = yaml.safe_load((out / "pantograph_fit.yaml").read_text(encoding="utf-8"))["pantographs"][0]
+    assert p["name"] == name
+    np.testing.assert_allclose(p["masses"], CHAINS[0][0], rtol=1e-5)
+
+
+def test_a_nan_row_is_refused_by_row(tmp_path):
+    f, h = noisy_frf(CHAINS[0], 0.0, seed=0)
+    h[7] = complex(np.nan, h[7].imag)
+    with pytest.raises(ValueError, match=r"data row 8 .*receptance_re_m_per_n"):
+        read_frf_csv(write_frf(tmp_path / "frf.csv", f, h))
+
+
+def test_rows_at_one_frequency_are_too_few(tmp_path):
+    # 12 rows at one frequency fix one complex value, not 6 parameters: refused (a "fit" with
+    # std 0 before).
+    f, h = noisy_frf(CHAINS[0], 0.0, seed=0)
+    with pytest.raises(ValueError, match="1 distinct frequency .*12 rows.*at least 7 distinct"):
+        fit_chain(np.full(12, f[3]), np.full(12, h[3]), masses=2)
+
+
+def test_a_huge_frf_is_refused_not_left_to_run(tmp_path):
+    # 240,000 rows ran for hours; refused at once with the bound.
+    f = np.geomspace(0.5, 20.0, 240_000)
+    h = chain_receptance(f, *CHAINS[0])
+    r = subprocess.run([sys.executable, FIT_CLI, write_frf(tmp_path / "frf.csv", f, h), "--out", str(tmp_path / "o")],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "at most 20000" in r.stderr, r.stderr
+
+
+def test_a_damper_the_frf_cannot_see_is_not_given_a_deviation(tmp_path):
+    # A chain without a roof damper: the fit drives that damper towards 0, where the FRF no longer
+    # depends on it, and the pseudo-inverse gave it a "std" of 1e-25 on a value of 1e-13. It is
+    # said to be not identifiable; the others, which the FRF fixes, keep their deviations.
+    chain = ([7.2, 15.0], [4200.0, 50.0], [10.0, 0.0])
+    f, h = noisy_frf(chain, 0.0, seed=0)
+    fit = fit_chain(f, h, masses=2)
+    assert list(fit.identifiable["damping"]) == [True, False]
+    assert fit.identifiable["masses"].all() and fit.identifiable["stiffness"].all()
+    r = subprocess.run([sys.executable, FIT_CLI, write_frf(tmp_path / "frf.csv", f, h), "--out", str(tmp_path / "o")],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    line = [x for x in r.stdout.splitlines() if x.startswith("damping:")][0]
+    first, second = line.split(":", 1)[1].split(",")
+    assert "+-" in first and "not identifiable" in second and "+-" not in second
+    assert "not identifiable from this FRF" in (tmp_path / "o" / "pantograph_fit.yaml").read_text()
+
+
+def test_pantograph_frf_refuses_a_step_that_would_run_for_hours(tmp_path):
+    # --dt 1e-7 is in the allowed range but takes about 3e10 steps of the rig (hours): refused at
+    # once, naming --dt and the smallest step the step budget allows; a run within it prints its
+    # progress.
+    frf_bin = os.path.join(os.environ.get("CATENARY_SIM_DEVEL_LIB", os.path.join(ROOT, ".ws/devel/lib/catenary_sim")),
+                           "pantograph_frf")
+    scene = os.path.join(ROOT, "config", "reference_55m.yaml")
+    r = subprocess.run([frf_bin, scene, "--pantograph", "leading", "--out", str(tmp_path / "frf"), "--dt", "1e-7",
+                        "--no-plot"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2, r.stderr
+    assert "--dt 1e-07" in r.stderr and "--max-steps" in r.stderr and "allowed: --dt >=" in r.stderr
+    smallest = float(r.stderr.split("allowed: --dt >=")[1].split()[0])
+    assert 1e-7 < smallest < 1e-4
+    assert not os.path.exists(tmp_path / "frf" / "frf.csv")
+    # With a budget below the default run's steps the default dt is refused too: the bound is the
+    # budget, not a fixed dt.
+    r = subprocess.run([frf_bin, scene, "--pantograph", "leading", "--out", str(tmp_path / "frf"), "--max-steps", "1000",
+                        "--no-plot"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "--max-steps 1000" in r.stderr, r.stderr

@@ -163,3 +163,120 @@ def test_a_study_links_a_report_per_case(tmp_path):
         assert stats["pantographs"][0]["std_force_N"] == row["pantographs.0.std_force_N"]
     with pytest.raises(study.StudyError, match="report"):
         study.load_study(write_study(str(tmp_path / "b.yaml"), report="yes", parameters=[{"key": "a", "values": [1]}]))
+
+
+def test_a_study_file_is_read_whole(tmp_path):
+    # An `overrides:` after 1 MiB of comments is part of the study, and a grid of 100,000 values
+    # has 100,000 values (a reader that stops at a fixed size loses both without a word).
+    path = tmp_path / "long.yaml"
+    doc = yaml.safe_dump({"name": "t", "scene": REFERENCE, "outputs": ["pantographs.0.std_force_N"],
+                          "parameters": [{"key": "train.speed_kmh", "values": list(range(100_000))}]})
+    path.write_text(doc + "# " + "x" * 78 + "\n" * 1 + ("# " + "y" * 78 + "\n") * 14000
+                    + "overrides: {numerics.preset: balanced}\n")
+    assert path.stat().st_size > (1 << 20) + 100
+    s = study.load_study(str(path))
+    assert s["overrides"] == {"numerics.preset": "balanced"}
+    assert len(s["parameters"][0]["values"]) == 100_000
+    # beyond the stated bound: refused with the bound, not cut
+    big = tmp_path / "big.yaml"
+    with open(big, "w") as f:
+        f.write("# " + "z" * 1000 + "\n")
+        f.seek(study.MAX_STUDY_BYTES + 10)
+        f.write("\n")
+    with pytest.raises(study.StudyError, match="larger than"):
+        study.load_study(str(big))
+
+
+def test_a_key_given_twice_is_refused_by_name(tmp_path):
+    path = tmp_path / "dup.yaml"
+    path.write_text(f"name: t\nscene: {REFERENCE}\noutputs: [pantographs.0.std_force_N]\n"
+                    "parameters:\n  - key: train.speed_kmh\n    values: [200, 250]\n    values: [300]\n")
+    with pytest.raises(study.StudyError, match=r"line 7: key 'values' is given twice.*first on line 6"):
+        study.load_study(str(path))
+    path.write_text(f"name: t\nscene: {REFERENCE}\nseed: 1\nseed: 2\noutputs: [a]\n"
+                    "parameters: [{key: a, values: [1]}]\n")
+    with pytest.raises(study.StudyError, match="key 'seed' is given twice"):
+        study.load_study(str(path))
+    path.write_text(f"name: &a [*a]\nscene: {REFERENCE}\noutputs: [a]\nparameters: [{{key: a, values: [1]}}]\n")
+    with pytest.raises(study.StudyError, match="alias"):
+        study.load_study(str(path))
+
+
+def test_a_plan_too_large_is_refused_before_it_is_made(tmp_path):
+    # 10 parameters of 10 values: 1e10 cases, some terabytes of plan; refused from the counts.
+    grid = [{"key": f"p{i}", "values": list(range(10))} for i in range(10)]
+    with pytest.raises(study.StudyError, match=r"10000000000 cases.*at most 100000"):
+        study.load_study(write_study(str(tmp_path / "g.yaml"), sampling="grid", parameters=grid))
+    sampled = [{"key": f"p{i}", "distribution": {"type": "uniform", "low": 0, "high": 1}} for i in range(20)]
+    with pytest.raises(study.StudyError, match=r"samples.*1000000 samples x \(20 parameters \+ 2\)"):
+        study.load_study(write_study(str(tmp_path / "s.yaml"), sampling="saltelli", samples=1_000_000,
+                                     parameters=sampled))
+
+
+def run_cli_err(args, timeout=120):
+    return subprocess.run([sys.executable, STUDY_CLI, *args, "--no-progress", "--no-plots"], capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def test_a_damaged_output_directory_is_named_or_redone(tmp_path):
+    # Cases that fail at once (an uplift the scene refuses) keep it quick; what is checked is the
+    # directory's handling, not the passes.
+    spec = write_study(str(tmp_path / "s.yaml"), sampling="grid",
+                       parameters=[{"key": "pantographs.0.static_uplift", "values": [-5, -6]}])
+    out = tmp_path / "out"
+    r = run_cli_err([spec, "--out", str(out)], timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    # An emptied case file: that case runs again, with a word naming it.
+    (out / "cases" / "000001.json").write_text("")
+    r = run_cli_err([spec, "--out", str(out)], timeout=300)
+    assert r.returncode == 0 and "Traceback" not in r.stderr, r.stdout + r.stderr
+    assert "000001.json" in r.stdout and "runs again" in r.stdout
+    assert len(pd.read_csv(out / "results.csv")) == 2
+    # A damaged plan.json: named, with what to do.
+    (out / "plan.json").write_text('{"study": ')
+    r = run_cli_err([spec, "--out", str(out)])
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert "plan.json" in r.stderr and "new --out" in r.stderr
+    # A changed plan on the same --out: refused, saying what differs and what to do.
+    (out / "plan.json").unlink()
+    r = run_cli_err([spec, "--out", str(out)], timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    changed = write_study(str(tmp_path / "s2.yaml"), sampling="grid",
+                          parameters=[{"key": "pantographs.0.static_uplift", "values": [-5, -6, -7]}])
+    r = run_cli_err([changed, "--out", str(out)])
+    assert r.returncode == 2 and "'parameters' differs" in r.stderr and "new --out" in r.stderr, r.stderr
+
+
+def test_a_bad_scheduler_address_is_named(tmp_path):
+    spec = write_study(str(tmp_path / "s.yaml"), sampling="grid", parameters=[{"key": "train.speed_kmh",
+                                                                             "values": [200]}])
+    for address in ("not an address", "tcp://127.0.0.1:1"):
+        r = run_cli_err([spec, "--out", str(tmp_path / "out"), "--scheduler", address], timeout=120)
+        assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+        assert "--scheduler" in r.stderr and address in r.stderr
+
+
+def test_a_map_draws_a_grid_value_whose_cases_all_failed(tmp_path, monkeypatch):
+    # The overlap study's rises [eq. 6-8, 0.15, 0.50] at two speeds, every 0.50 case failed: the
+    # map keeps the 0.50 column, its cells hatched as failed, with a legend entry saying so.
+    from matplotlib.patches import Rectangle
+    from catenary_sim import study_plots
+    s = {"name": "overlap", "sampling": "grid", "outputs": ["pantographs.0.std_force_N"],
+         "parameters": [{"key": "overlap.support_rise", "values": [None, 0.15, 0.5], "labels": ["eq. 6-8", 0.15, 0.5]},
+                        {"key": "train.speed_kmh", "values": [120, 160], "labels": [120, 160]}]}
+    rows = []
+    for rise in ["eq. 6-8", 0.15, 0.5]:
+        for v in (120, 160):
+            failed = rise == 0.5
+            rows.append({"overlap.support_rise": rise, "train.speed_kmh": v,
+                         "pantographs.0.std_force_N": math.nan if failed else 20.0 + v / 100,
+                         "status": "failed" if failed else "ok", "message": "diverged" if failed else ""})
+    figs = []
+    monkeypatch.setattr(study_plots, "_save", lambda fig, path: figs.append(fig))
+    study_plots.plot_study(s, pd.DataFrame(rows), str(tmp_path))
+    ax = figs[0].axes[0]
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["eq. 6-8", "0.15", "0.5"]
+    hatched = [p for p in ax.patches if isinstance(p, Rectangle) and p.get_hatch()]
+    assert sorted((p.get_x(), p.get_y()) for p in hatched) == [(2, 0), (2, 1)]
+    legend = ax.get_legend()
+    assert legend is not None and "failed" in legend.get_texts()[0].get_text()

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <complex>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -44,7 +45,15 @@ struct FrfMeasurement {
   int ramp_periods = 3;             // raised-cosine ramp of the drive amplitude
   int window_periods = 4;           // periods fitted (least squares: mean, cosine, sine)
   double max_settle_time = 120.0;   // s, per frequency
+  // Called now and then during the run with the steps done and the steps of the whole
+  // measurement (frf_steps), for a progress line: a small --dt runs for hours.
+  std::function<void(long long done, long long total)> progress;
+  long long progress_every = 1LL << 22;  // steps between calls
 };
+
+// The steps measured_frf takes for these frequencies (ramp, settling and window of each), known
+// before running it: lets a tool refuse a --dt that would run for hours.
+long long frf_steps(const Model& rig, const std::vector<double>& frequencies, const FrfMeasurement& how);
 
 // The rig: a copy of `scene` with only `pantograph` (at position 0), under a short single contact
 // wire at speed 0; the contact (stiffness, rub length) is the scene's.
