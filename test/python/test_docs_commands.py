@@ -35,8 +35,15 @@ Another block.
 
 
 def run_checker(*args, timeout):
-    return subprocess.run(["/usr/bin/python3", CHECKER] + list(args), cwd=ROOT, timeout=timeout,
-                          capture_output=True, text=True)
+    proc = subprocess.Popen(["/usr/bin/python3", CHECKER] + list(args), cwd=ROOT,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        proc.terminate()   # the checker stops the commands it started on SIGTERM
+        out, err = proc.communicate()
+        pytest.fail("check_docs_commands took more than %d s:\n%s" % (timeout, out[-6000:]))
+    return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
 
 
 def test_commands_are_found_in_code_blocks_with_their_lines(tmp_path):
