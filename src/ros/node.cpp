@@ -573,7 +573,12 @@ void SimulationNode::publish(bool force) {
         // The label has a third line with several contact wires (force on each) or on a 3-D line
         // (the contact point on the strip), one line higher: the panel goes up by as much as that
         // line spans seen from the default camera, so that the heads-up line stays clear of it.
-        if (m.contact_wires.size() > 1 || m.lateral) co.z_bottom += kThirdLabelLineLift;
+        // It also moves left by as much, clear of the label's wider lines.
+        if (m.contact_wires.size() > 1 || m.lateral) {
+          co.z_bottom += kThirdLabelLineLift;
+          co.origin_x -= kThirdLabelLineLift * co.dir_x;
+          co.origin_y -= kThirdLabelLineLift * co.dir_y;
+        }
         const visualization_msgs::MarkerArray chart = to_strip_chart(chart_, stamp, co);
         arr.markers.insert(arr.markers.end(), chart.markers.begin(), chart.markers.end());
       }

@@ -382,7 +382,10 @@ TEST_F(NodeParamsFuzz, ReportFileIntoANewDirectoryCreatesIt) {
 // found in the package; one found nowhere is refused with that hint.
 TEST_F(NodeParamsFuzz, RelativeSceneIsLookedForInThePackage) {
   const auto in_ros_home = [&](const std::string& args) {
-    return std::vector<std::string>{"/bin/sh", "-c", "cd '" + dir_ + "' && exec " + kNode + " " + args};
+    // (the shell keeps the last of duplicate variables, the inherited ones: env_ set again after it)
+    std::string set;
+    for (const std::string& e : env_) set += " '" + e + "'";
+    return std::vector<std::string>{"/bin/sh", "-c", "cd '" + dir_ + "' && exec env" + set + " " + kNode + " " + args};
   };
   // Paused: it loads the scene and then holds until killed at the limit.
   const ChildRun found = Child(in_ros_home("__name:=relative_scene _scene:=config/reference_55m.yaml _paused:=true"),
