@@ -1,15 +1,18 @@
 // replay_markers: the rviz markers of a recorded pass. A bag recorded with pass.launch record:=true
 // (or written by simulate_pass --bag) has no markers; played back (launch/replay.launch), this node
 // rebuilds them from the recorded wire_shape, pantograph_state and contact_force with the live
-// node's own to_markers() (state_from_messages: no physics here). The scene gives the constant
-// geometry (masts, steady arms, droppers): it must be the scene of the recording.
+// node's own to_markers() (state_from_messages: no physics here). The constant geometry (masts,
+// steady arms, droppers) comes from the scene the recording carries (the node's latched
+// /catenary_sim/scene_yaml, recorded with the pass), or from ~scene when given.
 //
-// Parameters: ~scene (required), ~vertical_scale (10, as the live default), ~shape_resolution
-// (1 m between line-strip points, 0: every node), ~publish_view_frame (true: send line ->
-// train_view with each marker message, as the live node does, unless the bag has it already).
-// Markers are drawn for every recorded wire_shape (the live node's ~shape_rate, 10 Hz), with the
-// pantograph_state and contact_force of the same stamp.
+// Parameters: ~scene (optional: a scene YAML file, which then must be the scene of the recording),
+// ~scene_topic (/catenary_sim/scene_yaml), ~vertical_scale (10, as the live default),
+// ~shape_resolution (1 m between line-strip points, 0: every node), ~publish_view_frame (true:
+// send line -> train_view with each marker message, as the live node does, unless the bag has it
+// already). Markers are drawn for every recorded wire_shape (the live node's ~shape_rate, 10 Hz),
+// with the pantograph_state and contact_force of the same stamp.
 #include <ros/ros.h>
+#include <std_msgs/String.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -55,16 +58,20 @@ double number_param(const ros::NodeHandle& pnh, const char* name, double fallbac
 class ReplayMarkers {
  public:
   ReplayMarkers(ros::NodeHandle nh, ros::NodeHandle pnh) {
-    std::string scene;
-    if (!pnh.getParam("scene", scene) || scene.empty())
-      throw std::runtime_error("parameter ~scene is required: the scene YAML file of the recording");
-    try {
-      model_ = std::make_unique<Model>(build_model(load_scene_file(scene)));
-    } catch (const SceneError& e) {
-      throw std::runtime_error("parameter ~scene = '" + scene + "': " + e.what());
+    std::string scene, scene_topic = "/catenary_sim/scene_yaml";
+    if (pnh.hasParam("scene") && !pnh.getParam("scene", scene))
+      throw std::runtime_error("parameter ~scene must be a file path (empty: the recording's scene)");
+    if (pnh.hasParam("scene_topic") && (!pnh.getParam("scene_topic", scene_topic) || scene_topic.empty()))
+      throw std::runtime_error("parameter ~scene_topic must be a topic name");
+    if (!scene.empty()) {
+      try {
+        use_scene(load_scene_file(scene));
+      } catch (const SceneError& e) {
+        throw std::runtime_error("parameter ~scene = '" + scene + "': " + e.what());
+      }
+    } else {
+      subs_.push_back(nh.subscribe(scene_topic, 1, &ReplayMarkers::on_scene, this));
     }
-    state_ = make_state(*model_);
-    if (model_->lateral) state_.lateral = make_lateral_state(*model_);  // a 3-D line: wires drawn at their lateral positions
     options_.vertical_scale = number_param(pnh, "vertical_scale", 10.0, 1e-9, 10000.0, "");
     options_.shape_resolution = number_param(pnh, "shape_resolution", 1.0, 0.0, 100.0, "m (0: every node)");
     pnh.param("publish_view_frame", view_, true);
@@ -73,8 +80,8 @@ class ReplayMarkers {
     subs_.push_back(nh.subscribe("pantograph_state", 500, &ReplayMarkers::on_state, this));
     subs_.push_back(nh.subscribe("contact_force", 500, &ReplayMarkers::on_force, this));
     if (view_) subs_.push_back(nh.subscribe("/tf", 100, &ReplayMarkers::on_tf, this));
-    ROS_INFO("replay_markers: scene %s; drawing %s from %s, %s and %s", scene.c_str(), pub_.getTopic().c_str(),
-             subs_[0].getTopic().c_str(), subs_[1].getTopic().c_str(), subs_[2].getTopic().c_str());
+    ROS_INFO("replay_markers: scene %s; drawing %s from wire_shape, pantograph_state and contact_force",
+             scene.empty() ? ("of the recording (" + scene_topic + ")").c_str() : scene.c_str(), pub_.getTopic().c_str());
   }
 
  private:
@@ -93,6 +100,25 @@ class ReplayMarkers {
     states_.clear();
     forces_.clear();
     last_drawn_ = ros::Time();
+  }
+
+  void use_scene(const Scene& scene) {
+    model_ = std::make_unique<Model>(build_model(scene));
+    state_ = make_state(*model_);
+    if (model_->lateral) state_.lateral = make_lateral_state(*model_);  // a 3-D line: wires drawn at their lateral positions
+    last_drawn_ = ros::Time();
+    drawn_any_ = false;
+  }
+
+  void on_scene(const std_msgs::String::ConstPtr& m) {
+    if (m->data == scene_text_) return;
+    try {
+      use_scene(scene_from_message(m->data));
+      scene_text_ = m->data;
+      ROS_INFO("replay_markers: scene %s from the recording", model_->scene.name.c_str());
+    } catch (const std::exception& e) {
+      ROS_ERROR("replay_markers: the recording's scene cannot be used: %s", e.what());
+    }
   }
 
   void on_shape(const WireShapeArray::ConstPtr& m) { keep(shapes_, *m); draw(); }
@@ -127,6 +153,12 @@ class ReplayMarkers {
   void draw() {
     // The newest shape not drawn yet, with the state and force of its stamp.
     if (shapes_.empty()) return;
+    if (!model_) {
+      ROS_WARN_THROTTLE(10.0, "replay_markers: no scene to draw with: the recording has no %s (recorded before the "
+                        "node published it, or another recorder's topic list); give the scene of the recording: "
+                        "replay.launch scene:=FILE", subs_.empty() ? "scene" : subs_[0].getTopic().c_str());
+      return;
+    }
     const WireShapeArray& shape = shapes_.back();
     const ros::Time t = shape.header.stamp;
     if (t == last_drawn_ && drawn_any_) return;
@@ -142,11 +174,12 @@ class ReplayMarkers {
     }
     options_.frame = shape.header.frame_id.empty() ? "line" : shape.header.frame_id;
     // The transform first, so that rviz may know the line frame before the markers arrive.
-    if (view_) tf_.sendTransform(to_view_transform(state_, t, options_.frame));
+    if (view_) tf_.sendTransform(to_view_transforms(*model_, state_, t, options_.frame));
     pub_.publish(to_markers(*model_, state_, t, options_));
   }
 
-  std::unique_ptr<Model> model_;
+  std::unique_ptr<Model> model_;   // null until the scene is known
+  std::string scene_text_;         // the recording's scene message in use
   State state_;
   MarkerOptions options_;
   bool view_ = true;

@@ -86,6 +86,21 @@ std::string add_lateral_statistics(const std::string& stats_json, const Model& m
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
+namespace {
+std::string stats_document(const Model& m, const State& st, const std::vector<PantographStatistics>& stats,
+                           const LineStatistics& line, const RunInfo& run, const LateralStatistics& lateral,
+                           bool stopped_by_dewirement) {
+  return add_lateral_statistics(statistics_json(m, st, stats, run, &line), m, lateral, stopped_by_dewirement);
+}
+}  // namespace
+
+std::string pass_statistics_json(const Model& m, const State& st, const PassRecorder& recorder, const RunInfo& run,
+                                 const LateralRecorder* lateral, bool stopped_by_dewirement) {
+  const LateralStatistics lateral_stats = m.lateral && lateral ? lateral->statistics(m, st) : LateralStatistics{};
+  return stats_document(m, st, recorder.statistics(m), recorder.line_statistics(m), run, lateral_stats,
+                        stopped_by_dewirement);
+}
+
 void write_pass_files(const std::string& dir, const Model& m, const State& st, const PassRecorder& recorder,
                       const RunInfo& run, const LateralRecorder* lateral, bool stopped_by_dewirement) {
   const std::vector<PantographStatistics> stats = recorder.statistics(m);
@@ -98,8 +113,7 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
   write_rows(add("timeseries.csv"), recorder.columns(), recorder.rows());
   const bool three_d = m.lateral && lateral;
   const LateralStatistics lateral_stats = three_d ? lateral->statistics(m, st) : LateralStatistics{};
-  add("stats.json").write(add_lateral_statistics(statistics_json(m, st, stats, run, &line), m, lateral_stats,
-                                                  stopped_by_dewirement));
+  add("stats.json").write(stats_document(m, st, stats, line, run, lateral_stats, stopped_by_dewirement));
   write_rows(add("force_processed.csv"), recorder.processed_columns(), recorder.processed_rows(m));
   {
     std::ostringstream c;
@@ -162,15 +176,17 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
   for (auto& f : files) f->commit();
 }
 
-std::string find_script(const std::string& name) {
+std::string find_package_file(const std::string& relative) {
   for (const std::string& dir : {std::string(CATENARY_SIM_SOURCE_DIR), std::string(CATENARY_SIM_SHARE_DIR)}) {
     if (dir.empty()) continue;
-    const std::string path = dir + "/scripts/" + name;
+    const std::string path = dir + "/" + relative;
     struct stat st {};
     if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return path;
   }
   return "";
 }
+
+std::string find_script(const std::string& name) { return find_package_file("scripts/" + name); }
 
 std::string find_pass_report_script() { return find_script("pass_report"); }
 

@@ -786,6 +786,16 @@ SpectrumSummary PassRecorder::spectrum_summary(const Model& m, double v, const S
   return s;
 }
 
+double PassRecorder::max_steady_arm_uplift(double station) const {
+  const long long key = std::llround(1e3 * station);  // the key of record()
+  double up = std::nan("");
+  for (const auto& per : max_uplift_) {
+    const auto it = per.find(key);
+    if (it != per.end()) up = std::isnan(up) ? it->second : std::max(up, it->second);
+  }
+  return up;
+}
+
 LineStatistics PassRecorder::line_statistics(const Model& m) const {
   LineStatistics ls;
   constexpr int kBins = 20;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -316,6 +318,78 @@ geometry_msgs::TransformStamped to_view_transform(const State& s, const ros::Tim
   t.transform.translation.x = s.front + s.line_offset;
   t.transform.rotation.w = 1.0;
   return t;
+}
+
+namespace {
+constexpr const char* kScenePathLine = "# catenary_sim scene: ";
+constexpr const char* kSceneSetLine = "# catenary_sim set: ";
+}  // namespace
+
+std::string scene_yaml_message(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError("cannot read scene file '" + path + "'");
+  std::ostringstream text;
+  char* real = ::realpath(path.c_str(), nullptr);
+  text << kScenePathLine << (real ? real : path) << "\n";
+  std::free(real);
+  for (const std::string& o : overrides) text << kSceneSetLine << o << "\n";
+  text << in.rdbuf();
+  return text.str();
+}
+
+Scene scene_from_message(const std::string& text) {
+  std::string base_dir;
+  std::vector<std::string> overrides;
+  std::istringstream lines(text);
+  const std::string head(kScenePathLine), set(kSceneSetLine);
+  for (std::string line; std::getline(lines, line) && line.rfind("# catenary_sim ", 0) == 0;) {
+    if (line.compare(0, head.size(), head) == 0) {
+      const std::string path = line.substr(head.size());
+      const std::size_t slash = path.rfind('/');
+      if (slash != std::string::npos) base_dir = slash == 0 ? "/" : path.substr(0, slash);
+    } else if (line.compare(0, set.size(), set) == 0) {
+      overrides.push_back(line.substr(set.size()));
+    }
+  }
+  return load_scene_string(text, overrides, base_dir);
+}
+
+LineState to_line_state(const Model& m, const State& s, const PassRecorder& recorder, const ros::Time& stamp,
+                        const std::string& frame) {
+  LineState ls;
+  ls.header.stamp = stamp;
+  ls.header.frame_id = frame;
+  ls.sim_time = s.time;
+  for (std::uint8_t d : s.dropper_slack) ls.slack_droppers += d;
+  analysis_section(m, &ls.analysis_start, &ls.analysis_end);
+  const double reach = m.longest_span;
+  for (const SupportSpring& sp : m.springs) {
+    if (!sp.steady_arm) continue;
+    bool near = false;
+    for (const Pantograph& p : m.pantographs) near = near || std::fabs(sp.x - (s.front - p.position)) <= reach;
+    if (!near) continue;
+    const double station = sp.x + s.line_offset;
+    const double most = recorder.max_steady_arm_uplift(station);
+    ls.steady_arm_station.push_back(station);
+    ls.steady_arm_uplift.push_back(s.u[sp.dof]);
+    // The recorder's value (stats.json's, every step while a pantograph is within half a span);
+    // before a pantograph comes that close, the uplift now.
+    ls.steady_arm_max_uplift.push_back(std::isnan(most) ? s.u[sp.dof] : most);
+  }
+  return ls;
+}
+
+std::vector<geometry_msgs::TransformStamped> to_view_transforms(const Model& m, const State& s, const ros::Time& stamp,
+                                                                const std::string& line_frame) {
+  std::vector<geometry_msgs::TransformStamped> out{to_view_transform(s, stamp, line_frame)};
+  if (m.pantographs.size() < 2) return out;
+  for (const Pantograph& p : m.pantographs) {
+    geometry_msgs::TransformStamped t = out.front();
+    t.child_frame_id = view_frame_id() + "_" + p.name;
+    t.transform.translation.x -= p.position;
+    out.push_back(t);
+  }
+  return out;
 }
 
 std::string head_frame_id(const Model& m, int p) { return "pantograph_" + m.pantographs[p].name; }

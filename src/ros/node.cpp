@@ -2,6 +2,7 @@
 
 #include <rosgraph_msgs/Clock.h>
 #include <std_msgs/String.h>
+#include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cmath>
@@ -41,6 +42,13 @@ std::string report_directory(const std::string& html) {
   return slash == std::string::npos ? "." : slash == 0 ? "/" : html.substr(0, slash);
 }
 
+// m the strip chart's panel rises for a label of three lines (ChartOptions::z_bottom): a 0.6 m
+// line at the label, 16 m from the camera, spans about as much as 1 m at the panel, farther away.
+constexpr double kThirdLabelLineLift = 1.0;
+
+// The answer of set_paused false and step once the pass has ended (pass_status "ended").
+constexpr const char* kEndedMessage = "the pass has ended; reset to run again";
+
 // At real_time_factor > 0, a tick may take this many times its nominal share of steps before the
 // backlog is dropped (counted as an overrun) instead of trying to catch up.
 constexpr double kCatchUp = 2.0;
@@ -48,6 +56,7 @@ constexpr double kCatchUp = 2.0;
 
 SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), params_(load_params(pnh)), updater_(nh, pnh) {
+  params_.scene = resolve_scene_path(params_.scene);
   const Scene scene = load_scene(params_);
   try {
     sim_ = std::make_unique<Simulation>(scene);
@@ -72,8 +81,16 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   pantograph_pub_ = nh_.advertise<PantographStateArray>("pantograph_state", 10);
   shape_pub_ = nh_.advertise<WireShapeArray>("wire_shape", 2);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
+  // (the broadcaster's own topic, advertised again for the connect callback: one publication)
+  tf_hold_pub_ = nh_.advertise<tf2_msgs::TFMessage>(
+      "/tf", 100, [this](const ros::SingleSubscriberPublisher& pub) { on_tf_subscriber(pub); });
   if (params_.publish_clock) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   status_pub_ = nh_.advertise<std_msgs::String>("pass_status", 1, true);
+  // The scene itself, latched, so that a recording carries it and its replay needs no scene file.
+  scene_pub_ = pnh_.advertise<std_msgs::String>("scene_yaml", 1, true);
+  std_msgs::String text;
+  text.data = scene_yaml_message(params_.scene);
+  scene_pub_.publish(text);
   events_pub_ = nh_.advertise<PassEvent>("events", 100);
   line_state_pub_ = nh_.advertise<LineState>("line_state", 10);
   // A 3-D line (stagger, curve, wind or sway) also says where each strip meets the wire across it.
@@ -110,7 +127,6 @@ void SimulationNode::restart_recording() {
   lateral_recorder_ = std::make_unique<LateralRecorder>(sim_->model(), rows);  // records nothing on a 2-D line
   lateral_recorder_->record(sim_->model(), sim_->state());
   running_.assign(sim_->model().pantographs.size(), Running{});
-  arm_max_uplift_.assign(sim_->model().springs.size(), 0.0);
   chart_ = ChartData{};
   last_chart_time_ = -1.0;
 }
@@ -154,31 +170,10 @@ void SimulationNode::sample_chart() {
     chart_.time.erase(chart_.time.begin(), chart_.time.begin() + drop);
     for (ChartSeries& c : chart_.series) c.force.erase(c.force.begin(), c.force.begin() + drop);
   }
-  for (std::size_t k = 0; k < m.springs.size(); ++k)
-    if (m.springs[k].steady_arm) arm_max_uplift_[k] = std::max(arm_max_uplift_[k], s.u[m.springs[k].dof]);
 }
 
 void SimulationNode::publish_line_state(const ros::Time& stamp) {
-  const Model& m = sim_->model();
-  const State& s = sim_->state();
-  LineState ls;
-  ls.header.stamp = stamp;
-  ls.header.frame_id = params_.line_frame;
-  ls.sim_time = s.time;
-  for (std::uint8_t d : s.dropper_slack) ls.slack_droppers += d;
-  const double reach = m.longest_span;
-  for (std::size_t k = 0; k < m.springs.size(); ++k) {
-    const SupportSpring& sp = m.springs[k];
-    if (!sp.steady_arm) continue;
-    bool near = false;
-    for (std::size_t p = 0; p < m.pantographs.size(); ++p)
-      near = near || std::fabs(sp.x - (s.front - m.pantographs[p].position)) <= reach;
-    if (!near) continue;
-    ls.steady_arm_station.push_back(sp.x + s.line_offset);
-    ls.steady_arm_uplift.push_back(s.u[sp.dof]);
-    ls.steady_arm_max_uplift.push_back(arm_max_uplift_[k]);
-  }
-  line_state_pub_.publish(ls);
+  line_state_pub_.publish(to_line_state(sim_->model(), sim_->state(), *recorder_, stamp, params_.line_frame));
 }
 
 void SimulationNode::reanchor() {
@@ -299,6 +294,24 @@ void SimulationNode::track_contact_loss() {
       loss_since_[p] = std::nan("");
     }
   }
+}
+
+bool SimulationNode::holding() const {
+  return paused_ || ended_ || waiting_ || sim_->finished() || sim_->state().status != StepStatus::kOk;
+}
+
+void SimulationNode::on_tf_subscriber(const ros::SingleSubscriberPublisher& pub) {
+  // While running, the next tick broadcasts a new time; sending it here as well could give the new
+  // listener the same stamp twice.
+  if (!holding() || last_published_time_ != sim_->state().time) return;
+  const State& s = sim_->state();
+  const ros::Time stamp = sim_stamp(s.time, 0.0);
+  tf2_msgs::TFMessage msg;
+  msg.transforms = to_transforms(sim_->model(), s, stamp, params_.line_frame);
+  // train_view only once the markers of the hold have broadcast it (else they will, to everyone).
+  if (view_sent_ && last_view_stamp_ == stamp)
+    for (const auto& t : to_view_transforms(sim_->model(), s, stamp, params_.line_frame)) msg.transforms.push_back(t);
+  pub.publish(msg);
 }
 
 void SimulationNode::on_reconfigure(NodeConfig& c, uint32_t) {
@@ -429,8 +442,10 @@ void SimulationNode::report_statistics() {
   }
   write_report();
   if (params_.stats_file.empty()) return;
+  // The same document as simulate_pass's stats.json and the report's (one code path).
   const std::string json =
-      statistics_json(m, sim_->state(), stats, RunInfo{(ros::WallTime::now() - wall_start_).toSec(), -1.0, overruns_});
+      pass_statistics_json(m, sim_->state(), *recorder_, RunInfo{(ros::WallTime::now() - wall_start_).toSec(), -1.0, overruns_},
+                           lateral_recorder_.get(), sim_->state().status == StepStatus::kDewired);
   // Whole or not at all (checked writable at start-up; a full disk is still possible): a failure
   // is an error and the node's exit code becomes 1, whenever it exits.
   try {
@@ -555,15 +570,25 @@ void SimulationNode::publish(bool force) {
         }
         ChartOptions co;
         co.window = params_.chart_window;
+        // The label has a third line with several contact wires (force on each) or on a 3-D line
+        // (the contact point on the strip), one line higher: the panel goes up by as much as that
+        // line spans seen from the default camera, so that the heads-up line stays clear of it.
+        // It also moves left by as much, clear of the label's wider lines.
+        if (m.contact_wires.size() > 1 || m.lateral) {
+          co.z_bottom += kThirdLabelLineLift;
+          co.origin_x -= kThirdLabelLineLift * co.dir_x;
+          co.origin_y -= kThirdLabelLineLift * co.dir_y;
+        }
         const visualization_msgs::MarkerArray chart = to_strip_chart(chart_, stamp, co);
         arr.markers.insert(arr.markers.end(), chart.markers.begin(), chart.markers.end());
       }
       marker_pub_.publish(arr);
       // The camera's frame moves with the markers, same stamp. A repeated stamp (holding) is not
       // sent again: tf2 would warn TF_REPEATED_DATA, and the last transform stays in effect.
-      if (stamp != last_view_stamp_) {
-        tf_.sendTransform(to_view_transform(s, stamp, params_.line_frame));
+      if (!view_sent_ || stamp != last_view_stamp_) {
+        tf_.sendTransform(to_view_transforms(m, s, stamp, params_.line_frame));
         last_view_stamp_ = stamp;
+        view_sent_ = true;
       }
       last_marker_time_ = s.time;
     }
@@ -636,10 +661,19 @@ bool SimulationNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Re
 }
 
 bool SimulationNode::on_set_paused(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
+  // After the end (at_end stop, or a divergence) nothing runs until ~reset, whatever the pause
+  // says: the answer agrees with pass_status.
+  if (ended_ && !req.data) {
+    res.success = false;
+    res.message = kEndedMessage;
+    return true;
+  }
   if (!req.data && paused_) reanchor();
   paused_ = req.data;
   res.success = true;
-  res.message = paused_ ? "paused" : "running";
+  res.message = paused_ ? (ended_ ? std::string("paused (the pass has ended; a reset starts the next pass paused)")
+                                  : std::string("paused"))
+                        : "running";
   return true;
 }
 
@@ -647,6 +681,11 @@ bool SimulationNode::on_step(Step::Request& req, Step::Response& res) {
   res.total_steps = sim_->state().steps;
   res.sim_time = sim_->state().time;
   res.steps_advanced = 0;
+  if (ended_) {
+    res.success = false;
+    res.message = std::string("rejected: ") + kEndedMessage;
+    return true;
+  }
   if (!paused_) {
     res.success = false;
     res.message = "rejected: the simulation is running; call ~set_paused true first";

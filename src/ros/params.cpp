@@ -1,13 +1,19 @@
 #include "catenary_sim/ros/params.hpp"
 
+#include <ros/console.h>
 #include <ros/node_handle.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/pass_files.hpp"
 #include "catenary_sim/core/scene.hpp"
 
 namespace catenary_sim {
@@ -291,13 +297,40 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   r.number("chart_window", p.chart_window, kChartWindow.text());
   validate(p);
   check_output_param("stats_file", p.stats_file);
+  if (!p.report_file.empty()) {
+    // The report's directory holds its data files too: created, as simulate_pass --out is.
+    const std::size_t slash = p.report_file.rfind('/');
+    try {
+      if (slash != std::string::npos && slash > 0) make_directories(p.report_file.substr(0, slash));
+    } catch (const OutputError& e) {
+      throw ParamError("parameter ~report_file = '" + p.report_file + "' rejected: " + e.what());
+    }
+  }
   check_output_param("report_file", p.report_file);
   return p;
 }
 
+std::string resolve_scene_path(const std::string& scene) {
+  struct stat st {};
+  if (scene.empty() || scene[0] == '/' || ::stat(scene.c_str(), &st) == 0) return scene;
+  // roslaunch runs nodes in ROS_HOME: a path relative to the package (config/...) is looked for
+  // there too.
+  char cwd[4096] = "?";
+  if (!::getcwd(cwd, sizeof cwd)) std::snprintf(cwd, sizeof cwd, "?");
+  const std::string path = find_package_file(scene);
+  if (path.empty())
+    throw ParamError("parameter ~scene = '" + scene + "': no such file in the node's working directory " + cwd +
+                     " (roslaunch runs nodes in ROS_HOME) nor in the package; give an absolute path, e.g. "
+                     "scene:=$(rospack find catenary_sim)/config/reference_55m.yaml");
+  ROS_INFO("catenary_sim: ~scene '%s' is not in the working directory %s: using the package's %s", scene.c_str(), cwd,
+           path.c_str());
+  return path;
+}
+
 Scene load_scene(const NodeParams& p) {
+  const std::string path = resolve_scene_path(p.scene);
   try {
-    Scene scene = load_scene_file(p.scene);
+    Scene scene = load_scene_file(path);
     if (p.speed_kmh) {
       scene.train_speed = *p.speed_kmh / 3.6;
       validate(scene);

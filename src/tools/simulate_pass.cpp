@@ -28,6 +28,7 @@
 #include "catenary_sim/core/pass_files.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/ros/pass_bag.hpp"
 #include "cli_checks.hpp"
 
@@ -206,17 +207,18 @@ int main(int argc, char** argv) {
   // at close), so a failed pass never leaves a half bag under the asked name.
   const std::string bag_tmp = bag_path.empty() ? "" : bag_target + ".partial";
   try {
-    if (!bag_path.empty()) {
-      bag = std::make_unique<ros_layer::PassBag>(bag_tmp, bag_options);
-      bag->write(m, sim->state());
-    }
-    Progress progress(steps_needed, !quiet && !no_progress);
     recorder.record(m, sim->state());
     lateral.record(m, sim->state());
+    if (!bag_path.empty()) {
+      bag = std::make_unique<ros_layer::PassBag>(bag_tmp, bag_options);
+      bag->write_scene(ros_layer::scene_yaml_message(scene_path, overrides));
+      bag->write(m, sim->state(), &recorder);
+    }
+    Progress progress(steps_needed, !quiet && !no_progress);
     while ((status = sim->step()) == StepStatus::kOk) {
       recorder.record(m, sim->state());
       lateral.record(m, sim->state());
-      if (bag) bag->write(m, sim->state());
+      if (bag) bag->write(m, sim->state(), &recorder);
       progress.update(sim->state().steps, sim->state().time);
     }
     progress.done();

@@ -6,6 +6,8 @@
 #include <rosbag/view.h>
 
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <string>
 
@@ -33,8 +35,8 @@ TEST(BagEquality, LiveRecordingEqualsOfflineRunner) {
   const std::string dir = temp_dir("catenary_sim_bag_");
   const std::string scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
   const std::string live = dir + "/live.bag", offline = dir + "/offline.bag";
-  // A master of its own on a free loopback port. roslaunch stops everything when the node
-  // (required) exits at the end of the pass, and rosbag record closes the bag.
+  // A master of its own on a free loopback port. The node exits at the end of the pass, the
+  // recorder closes the bag, and roslaunch ends with them.
   const int free = free_port();
   ASSERT_NE(free, 0) << "no free port on the loopback interface";
   const std::string port = std::to_string(free);
@@ -48,6 +50,13 @@ TEST(BagEquality, LiveRecordingEqualsOfflineRunner) {
   const int rc = std::system(("bash -c '" + launch + "'").c_str());
   (void)!std::system(("bash -c 'kill $(cat " + dir + "/roscore.pid) 2>/dev/null; sleep 1'").c_str());
   ASSERT_EQ(rc, 0) << "roslaunch failed; see " << dir << "/launch.log";
+  {
+    // A clean end, not roslaunch's red "REQUIRED process [...] has died!" banner.
+    std::ifstream in(dir + "/launch.log");
+    const std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(log.find("REQUIRED process"), std::string::npos) << "see " << dir << "/launch.log";
+    EXPECT_EQ(log.find("has died"), std::string::npos) << "see " << dir << "/launch.log";
+  }
   const std::string run = std::string(CATENARY_SIM_DEVEL_LIB) + "/simulate_pass --scene " + scene +
                           " --speed 250 --quiet --out " + dir + "/offline --bag " + offline + " --bag-rate 0";
   ASSERT_EQ(std::system(run.c_str()), 0);

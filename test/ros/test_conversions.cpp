@@ -393,6 +393,25 @@ TEST(Markers, ViewFrameFollowsTheTrainFront) {
   EXPECT_DOUBLE_EQ(t.transform.rotation.w, 1.0);
 }
 
+// With two pantographs (200 m apart in the scene) each has a view frame at its own station, so a
+// camera can follow the trailing one; train_view stays at the front. One pantograph: train_view only.
+TEST(Markers, EveryPantographHasAViewFrameOnATrainWithSeveral) {
+  Simulation two(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m_two_pantographs.yaml"));
+  const Model& m = two.model();
+  const State& s = two.state();
+  const auto v = to_view_transforms(m, s, ros::Time(5.0), "line");
+  ASSERT_EQ(v.size(), 3u);
+  EXPECT_EQ(v[0].child_frame_id, "train_view");
+  for (std::size_t p = 0; p < 2; ++p) {
+    EXPECT_EQ(v[p + 1].child_frame_id, "train_view_" + m.pantographs[p].name);
+    EXPECT_EQ(v[p + 1].header.stamp, ros::Time(5.0));
+    EXPECT_DOUBLE_EQ(v[p + 1].transform.translation.x, s.front + s.line_offset - m.pantographs[p].position);
+  }
+  EXPECT_DOUBLE_EQ(v[1].transform.translation.x - v[2].transform.translation.x, 200.0);
+  Simulation one(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m.yaml"));
+  EXPECT_EQ(to_view_transforms(one.model(), one.state(), ros::Time(5.0), "line").size(), 1u);
+}
+
 TEST(Pacing, StepsDueFollowWallClockTimesFactor) {
   EXPECT_EQ(steps_due(1.0, 1.0, 1e-3, 0.0), 1000);
   EXPECT_EQ(steps_due(1.0, 2.0, 1e-3, 0.0), 2000);

@@ -85,7 +85,8 @@ class NodeParamsFuzz : public ::testing::Test {
 
   // The node `name` runs a short pass (`source_scene` cut to six spans of 0.5 m elements, written
   // into `out`) at full speed with ~report_file `out`/pass_report.html, and exits at its end.
-  ChildRun report_pass(const std::string& source_scene, const std::string& out, const std::string& name) {
+  ChildRun report_pass(const std::string& source_scene, const std::string& out, const std::string& name,
+                       const std::string& html = "") {
     mkdir(out.c_str(), 0755);
     std::string text = slurp(source_scene);  // the node takes no --set
     const auto set = [&](const std::string& from, const std::string& to) {
@@ -98,7 +99,8 @@ class NodeParamsFuzz : public ::testing::Test {
     const std::string scene = out + "/short.yaml";
     std::ofstream(scene) << text;
     return Child({kNode, "__name:=" + name, "_scene:=" + scene, "_speed_kmh:=250", "_real_time_factor:=0",
-                  "_at_end:=exit", "_publish_clock:=false", "_report_file:=" + out + "/pass_report.html"},
+                  "_at_end:=exit", "_publish_clock:=false",
+                  "_report_file:=" + (html.empty() ? out + "/pass_report.html" : html)},
                  dir_ + "/" + name + ".log", env_)
         .wait(300.0);
   }
@@ -115,7 +117,7 @@ std::vector<std::string> NodeParamsFuzz::env_;
 Child* NodeParamsFuzz::master_ = nullptr;
 int NodeParamsFuzz::runs_ = 0;
 
-enum class Kind { kNumber, kRate, kRigRate, kInteger, kBool, kString, kPath, kFrame, kAtEnd, kScene };
+enum class Kind { kNumber, kRate, kRigRate, kInteger, kBool, kString, kPath, kReportPath, kFrame, kAtEnd, kScene };
 
 struct Param {
   std::string name;
@@ -141,6 +143,8 @@ std::vector<std::string> bad_values(Kind k, std::size_t i) {
     case Kind::kBool: return {"1", "0", "yes", "1.5", ""};
     case Kind::kString: return {"5", "1.5", "true"};
     case Kind::kPath: return {"5", "true", "/nonexistent_catenary_sim_dir/x.json", "/tmp"};
+    // (a report's missing directory is created: one that cannot be)
+    case Kind::kReportPath: return {"5", "true", "/proc/catenary_sim_dir/x.html", "/tmp"};
     case Kind::kFrame: return {"5", "true", "", "/line"};
     case Kind::kAtEnd: return {"1", "true", "", "rewind"};
     case Kind::kScene: return {"5", "", "/nonexistent_catenary_sim_dir/s.yaml"};
@@ -203,7 +207,7 @@ TEST_F(NodeParamsFuzz, NodeRejectsEveryBadValueNamingTheParameter) {
       {"shape_resolution", Kind::kNumber}, {"vertical_scale", Kind::kRate}, {"lateral_scale", Kind::kRate},  {"line_frame", Kind::kFrame},
       {"at_end", Kind::kAtEnd},          {"stats_file", Kind::kPath},        {"publish_clock", Kind::kBool},
       {"paused", Kind::kBool},           {"wait_for_viewer", Kind::kNumber}, {"max_acceleration", Kind::kNumber},
-      {"start_delay", Kind::kNumber},    {"report_file", Kind::kPath}};
+      {"start_delay", Kind::kNumber},    {"report_file", Kind::kReportPath}};
   int count = 0;
   fuzz(this, kNode, params, {{"scene", kScene}, {"stats_file", out + "/stats.json"}}, out, &count);
   EXPECT_GT(count, 60);
@@ -361,6 +365,39 @@ TEST_F(NodeParamsFuzz, ReportFileOfA3dLineHasTheLateralFiles) {
   // Over the analysed spans: the contact point sweeps the +-0.3 m zigzag.
   const nlohmann::json& c = j.at("lateral").at("contact_points").at(0);
   EXPECT_GT(c.at("max_m").get<double>() - c.at("min_m").get<double>(), 0.4) << c.dump();
+}
+
+// A report into a directory that does not exist yet: created with its parents, as simulate_pass
+// --out creates its directory, and the pass's files written into it.
+TEST_F(NodeParamsFuzz, ReportFileIntoANewDirectoryCreatesIt) {
+  const std::string out = dir_ + "/report_new", where = out + "/not/yet/there";
+  const ChildRun r = report_pass(kScene, out, "reporting_new", where + "/pass_report.html");
+  ASSERT_FALSE(r.hung) << r.out;
+  EXPECT_EQ(r.signal, 0);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  for (const char* f : {"pass_report.html", "stats.json", "timeseries.csv"}) EXPECT_TRUE(exists(where + "/" + f)) << f;
+}
+
+// roslaunch runs nodes in ROS_HOME: a scene path relative to the package (scene:=config/...) is
+// found in the package; one found nowhere is refused with that hint.
+TEST_F(NodeParamsFuzz, RelativeSceneIsLookedForInThePackage) {
+  const auto in_ros_home = [&](const std::string& args) {
+    // (the shell keeps the last of duplicate variables, the inherited ones: env_ set again after it)
+    std::string set;
+    for (const std::string& e : env_) set += " '" + e + "'";
+    return std::vector<std::string>{"/bin/sh", "-c", "cd '" + dir_ + "' && exec env" + set + " " + kNode + " " + args};
+  };
+  // Paused: it loads the scene and then holds until killed at the limit.
+  const ChildRun found = Child(in_ros_home("__name:=relative_scene _scene:=config/reference_55m.yaml _paused:=true"),
+                               dir_ + "/relative_scene.log", env_)
+                             .wait(8.0);
+  EXPECT_NE(found.out.find("scene reference_55m"), std::string::npos) << found.out;
+  EXPECT_NE(found.out.find("using the package's"), std::string::npos) << found.out;
+  const ChildRun missing =
+      Child(in_ros_home("__name:=missing_scene _scene:=config/no_such_scene.yaml"), dir_ + "/missing_scene.log", env_)
+          .wait(20.0);
+  expect_rejected(missing, "a relative scene found nowhere", "scene");
+  EXPECT_NE(missing.out.find("ROS_HOME"), std::string::npos) << missing.out;
 }
 
 // A report whose directory cannot take the pass's files is refused at start-up, naming ~report_file.

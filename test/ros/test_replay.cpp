@@ -179,3 +179,19 @@ TEST(Replay, RecordingOfAnotherSceneIsRefusedWithTheField) {
                                              to_contact_force(m2, pair.state(), stamp, "line"), &out2);
   EXPECT_NE(e2.find("pantograph_state has 1 pantographs, the scene 2"), std::string::npos) << e2;
 }
+
+// The scene a recording carries (the node's ~scene_yaml, simulate_pass's bag): the same model as
+// the file with its overrides, so that the replay draws without a scene argument. Here with a
+// --set that changes the geometry (6 spans instead of 10): the message must carry it.
+TEST(Replay, SceneMessageGivesTheSceneOfTheRecording) {
+  const std::string path = scene_path("reference_55m.yaml");
+  const std::vector<std::string> set{"line.span_count=6"};
+  const Model file = build_model(load_scene_file(path, set));
+  const Model carried = build_model(scene_from_message(scene_yaml_message(path, set)));
+  EXPECT_EQ(carried.scene.name, file.scene.name);
+  EXPECT_EQ(carried.n_dof, file.n_dof);
+  EXPECT_EQ(carried.support_x, file.support_x);
+  EXPECT_EQ(carried.support_x.size(), 7u);  // 6 spans
+  // A file that cannot be read is the scene's error, not an empty message.
+  EXPECT_THROW(scene_yaml_message("/nonexistent_catenary_sim_dir/s.yaml"), SceneError);
+}

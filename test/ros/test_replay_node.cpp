@@ -2,7 +2,8 @@
 // topics, no markers) is played back with rosbag play --clock; replay_markers must draw it: one
 // marker array per recorded wire_shape, every part of the scene in it, the pantograph head at the
 // recorded position of the same instant. plot_contact_force, started on the same playback, must
-// write its PNG when the pass ends.
+// write its PNG when the pass ends, and show the steady-arm uplift of stats.json (the pass's record
+// at every step, carried by line_state), not a sample of the 10 Hz wire shape.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
@@ -21,6 +22,9 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "catenary_sim/LineState.h"
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/WireShapeArray.h"
 #include "../support/child_process.hpp"
@@ -45,7 +49,7 @@ std::string sh(const std::string& cmd) { return "bash -c '" + cmd + "'"; }
 TEST(Replay, RecordedPassIsDrawnAndPlotted) {
   const std::string dir = catenary_sim_test::temp_dir("catenary_sim_replay_");
   const std::string scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
-  const std::string bag = dir + "/pass.bag", png = dir + "/plot.png";
+  const std::string bag = dir + "/pass.bag", png = dir + "/plot.png", csv = dir + "/uplift.csv";
   // The whole reference pass (550 m, 6.6 s at 300 km/h): state topics at 200 Hz, wire_shape at 10 Hz.
   ASSERT_EQ(std::system((std::string(CATENARY_SIM_DEVEL_LIB) + "/simulate_pass --scene " + scene + " --quiet --out " +
                          dir + "/offline --bag " + bag + " > " + dir + "/simulate_pass.log 2>&1").c_str()),
@@ -55,21 +59,38 @@ TEST(Replay, RecordedPassIsDrawnAndPlotted) {
   // What the bag holds: the pantograph position at every stamp, the stamps of the wire shapes.
   std::map<ros::Time, double> position;
   std::set<ros::Time> shape_stamps;
+  std::map<long long, double> bag_uplift;  // steady arm station (mm) -> last recorded largest uplift (m)
   {
     rosbag::Bag b(bag, rosbag::bagmode::Read);
     for (const rosbag::MessageInstance& mi : rosbag::View(b)) {
       if (const auto s = mi.instantiate<catenary_sim::PantographStateArray>())
         position[s->header.stamp] = s->pantographs.at(0).position;
       if (const auto w = mi.instantiate<catenary_sim::WireShapeArray>()) shape_stamps.insert(w->header.stamp);
+      if (const auto l = mi.instantiate<catenary_sim::LineState>())
+        for (std::size_t k = 0; k < l->steady_arm_station.size(); ++k)
+          bag_uplift[std::llround(1e3 * l->steady_arm_station[k])] = l->steady_arm_max_uplift[k];
     }
   }
   ASSERT_GT(shape_stamps.size(), 50u);
+  // The steady arms' largest uplift as stats.json has it (the pass's record at every step).
+  std::map<long long, double> stats_uplift;
+  {
+    std::ifstream in(dir + "/offline/stats.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    for (const auto& a : j.at("steady_arms")) stats_uplift[std::llround(1e3 * a.at("station_m").get<double>())] = a.at("max_uplift_m");
+  }
+  ASSERT_GE(stats_uplift.size(), 5u);
+  // The bag's line_state carries them (written by the same run, from the same record: equal).
+  for (const auto& [key, up] : stats_uplift) {
+    ASSERT_TRUE(bag_uplift.count(key)) << "no line_state for the steady arm at " << key << " mm";
+    EXPECT_EQ(bag_uplift[key], up) << "steady arm at " << key << " mm";
+  }
 
   ros::NodeHandle nh;
   ros::Publisher status = nh.advertise<std_msgs::String>("pass_status", 1, true);
   ros::Subscriber sub = nh.subscribe("markers", 1000, &on_markers);
   // plot_contact_force, headless, on the same playback (started here: the PNG goes to this test's directory).
-  ASSERT_EQ(std::system(sh(std::string(CATENARY_SIM_DEVEL_LIB) + "/plot_contact_force _scene:=" + scene + " _output_png:=" + png +
+  ASSERT_EQ(std::system(sh(std::string(CATENARY_SIM_DEVEL_LIB) + "/plot_contact_force _output_png:=" + png + " _output_csv:=" + csv +
                            " _headless:=true > " + dir + "/plot.log 2>&1 & echo $! > " + dir + "/plot.pid")
                             .c_str()),
             0);
@@ -131,6 +152,24 @@ TEST(Replay, RecordedPassIsDrawnAndPlotted) {
   const unsigned h = head[20] << 24 | head[21] << 16 | head[22] << 8 | head[23];
   EXPECT_EQ(w, 1100u);
   EXPECT_EQ(h, 650u);
+  // The uplift it plots is stats.json's at every steady arm of the analysis section. Exact: the
+  // values travel as doubles (line_state) and are written with repr. Sampling the 10 Hz wire shape
+  // instead reads up to a quarter less (the arm's peak falls between two shapes at 300 km/h).
+  std::ifstream table(csv);
+  ASSERT_TRUE(table.good()) << csv << " not written; see " << dir << "/plot.log";
+  std::map<long long, double> plotted;
+  std::string line;
+  std::getline(table, line);
+  EXPECT_EQ(line, "station_m,max_uplift_m,uplift_now_m");
+  while (std::getline(table, line)) {
+    const double x = std::stod(line.substr(0, line.find(',')));
+    const std::string rest = line.substr(line.find(',') + 1);
+    plotted[std::llround(1e3 * x)] = std::stod(rest.substr(0, rest.find(',')));
+  }
+  for (const auto& [key, up] : stats_uplift) {
+    ASSERT_TRUE(plotted.count(key)) << "the plot has no steady arm at " << key << " mm";
+    EXPECT_EQ(plotted[key], up) << "steady arm at " << key << " mm";
+  }
   if (!HasFailure()) (void)!std::system(("rm -rf " + dir).c_str());  // kept for a look when it failed
 }
 

@@ -32,6 +32,13 @@ void check_pass_files_writable(const std::string& dir, const Model& model);
 std::string add_lateral_statistics(const std::string& stats_json, const Model& model, const LateralStatistics& lateral,
                                    bool stopped_by_dewirement);
 
+// stats.json of a pass, the one document simulate_pass --out, the node's ~stats_file and its
+// ~report_file write: the pantographs' statistics, the line's (droppers, steady arms, limits,
+// stations) and on a 3-D line (model.lateral) with `lateral` the "lateral" object.
+std::string pass_statistics_json(const Model& model, const State& state, const PassRecorder& recorder,
+                                 const RunInfo& run, const LateralRecorder* lateral = nullptr,
+                                 bool stopped_by_dewirement = false);
+
 // Writes the pass's files into `dir`; throws OutputError (then none is renamed into place).
 // On a 3-D line (model.lateral) with `lateral`, also stats.json's "lateral" object and
 // lateral.csv, lateral_histogram.csv, blow_off.csv, pull_off.csv and dewirements.csv.
@@ -42,6 +49,9 @@ void write_pass_files(const std::string& dir, const Model& model, const State& s
 // scripts/NAME beside the sources this was built from, or in the installed share path; empty if
 // neither has it.
 std::string find_script(const std::string& name);
+// A file of the package by its path in it (e.g. config/reference_55m.yaml), beside the sources
+// this was built from or in the installed share path; empty if neither has it.
+std::string find_package_file(const std::string& relative);
 std::string find_pass_report_script();
 
 // Starts /usr/bin/python3 SCRIPT ARGS... with its output going to ours; returns its pid, or -1

@@ -168,6 +168,9 @@ class PassRecorder {
 
   // Droppers, steady arms, over the pass.
   LineStatistics line_statistics(const Model& model) const;
+  // The largest uplift so far (m, every step while a pantograph was within half a span) of the
+  // steady arm at `station` m along the line (s.line_offset included); NaN if none was recorded.
+  double max_steady_arm_uplift(double station) const;
   // Contact-force PSD per pantograph over the analysis section (unfiltered, every step).
   std::vector<Spectrum> spectra(const Model& model) const;
   // At the times of rows(): per pantograph its position, the contact force filtered at the

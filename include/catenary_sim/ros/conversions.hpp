@@ -12,9 +12,11 @@
 
 #include "catenary_sim/ContactForceArray.h"
 #include "catenary_sim/LateralContactArray.h"
+#include "catenary_sim/LineState.h"
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/WireShapeArray.h"
 #include "catenary_sim/core/model.hpp"
+#include "catenary_sim/core/scene.hpp"
 #include "catenary_sim/core/state.hpp"
 #include "catenary_sim/core/statistics.hpp"
 
@@ -37,6 +39,21 @@ PantographStateArray to_pantograph_state(const Model& m, const State& s, const r
 // Samples every wire at about `resolution` m (0: every node); the last node is always included.
 WireShapeArray to_wire_shape(const Model& m, const State& s, double resolution, const ros::Time& stamp,
                              const std::string& frame);
+
+// The scene of a pass as the node publishes it (latched ~scene_yaml, std_msgs/String, recorded
+// with the pass): a first line "# catenary_sim scene: PATH" (the file's absolute path, for the
+// files a scene names relative to itself), a line "# catenary_sim set: KEY=VALUE" per override
+// (simulate_pass --set), then the file's text. Throws SceneError if the file cannot be read.
+std::string scene_yaml_message(const std::string& path, const std::vector<std::string>& overrides = {});
+// The scene of such a message (its relative files looked up beside PATH, its overrides applied);
+// throws SceneError.
+Scene scene_from_message(const std::string& text);
+
+// Slack droppers and the steady arms within a span of a pantograph: their uplift now and the
+// largest so far, as the pass's recorder has it at every step (stats.json's steady_arms are the
+// same values over the analysis section).
+LineState to_line_state(const Model& m, const State& s, const PassRecorder& recorder, const ros::Time& stamp,
+                        const std::string& frame);
 
 // Per collector, where its strip meets the contact wire across the track (the contact point's
 // lateral position on the strip, the wire's and the pantograph's); no contacts on a 2-D line.
@@ -74,6 +91,11 @@ std::string view_frame_id();
 // it moves exactly when the markers do, not at the tf rate between two marker messages.
 geometry_msgs::TransformStamped to_view_transform(const State& s, const ros::Time& stamp,
                                                   const std::string& line_frame);
+// train_view and, on a train with several pantographs, line -> train_view_<name> at each
+// pantograph's station, sent the same way: an rviz camera whose Target Frame is one of them
+// follows that pantograph (train_view is the front, the leading one's).
+std::vector<geometry_msgs::TransformStamped> to_view_transforms(const Model& m, const State& s, const ros::Time& stamp,
+                                                                const std::string& line_frame);
 
 // line -> train (at the train front, on the rail) and train -> one frame per pantograph head (at
 // the head's true absolute height, not exaggerated; a moving force sits at the contact-wire

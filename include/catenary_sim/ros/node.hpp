@@ -70,6 +70,12 @@ class SimulationNode {
   void publish_line_state(const ros::Time& stamp);
   // Contact-loss events per pantograph (a physics result, on `events`, not on /diagnostics).
   void track_contact_loss();
+  // True while no step is taken (waiting, paused, ended, finished, diverged).
+  bool holding() const;
+  // A new /tf subscriber (rviz started during a pause) gets the held state's transforms, with the
+  // hold's stamp, once: tf is only broadcast for a new time, and a repeated stamp would make every
+  // other listener warn TF_REPEATED_DATA.
+  void on_tf_subscriber(const ros::SingleSubscriberPublisher& pub);
 
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
@@ -78,7 +84,7 @@ class SimulationNode {
   std::unique_ptr<LateralRecorder> lateral_recorder_;  // a 3-D line's contact positions, blow-off, dewirements
 
   ros::Publisher contact_pub_, pantograph_pub_, shape_pub_, marker_pub_, clock_pub_, status_pub_, events_pub_,
-      line_state_pub_, lateral_pub_;
+      line_state_pub_, lateral_pub_, tf_hold_pub_, scene_pub_;
   ros::Subscriber speed_sub_, uplift_sub_;
   ros::ServiceServer reset_srv_, pause_srv_, step_srv_;
   tf2_ros::TransformBroadcaster tf_;
@@ -96,7 +102,6 @@ class SimulationNode {
   std::vector<Running> running_;          // per pantograph
   double last_chart_time_ = -1.0;
   double achieved_rtf_ = 0.0;             // over the last diagnostics period (0 while holding)
-  std::vector<double> arm_max_uplift_;    // per steady arm (model spring index order), this pass
 
   // Stamps are simulated time, as gazebo_ros does (docs/user_guide.md, "Time"): no offset.
   bool paused_ = false;
@@ -117,6 +122,7 @@ class SimulationNode {
   ros::WallTime next_marker_wall_;   // markers are due at or after this wall time (marker_rate)
   double last_marker_time_ = -1.0;   // sim time of the last marker message
   ros::Time last_view_stamp_;        // stamp of the last train_view transform
+  bool view_sent_ = false;           // a train_view transform has been broadcast (stamp 0 is a stamp)
 
   // Diagnostics.
   ros::WallTime last_command_wall_;

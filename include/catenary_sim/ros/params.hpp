@@ -143,6 +143,9 @@ const char* to_string(AtEnd a);
 // Loads the scene file and applies the overrides (speed). Throws ParamError naming ~scene for a
 // scene that cannot be loaded (with the core's SceneError message).
 Scene load_scene(const NodeParams& p);
+// ~scene as a path to open: as given when it exists (roslaunch runs nodes in ROS_HOME), else a
+// relative path in the package (config/...); throws ParamError saying so when neither has it.
+std::string resolve_scene_path(const std::string& scene);
 
 }  // namespace ros_layer
 }  // namespace catenary_sim

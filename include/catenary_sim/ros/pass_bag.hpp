@@ -9,13 +9,14 @@
 
 #include "catenary_sim/core/model.hpp"
 #include "catenary_sim/core/state.hpp"
+#include "catenary_sim/core/statistics.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
 
 struct PassBagOptions {
   double rate = 200.0;        // Hz for /contact_force, /pantograph_state and /tf (0: every step)
-  double shape_rate = 10.0;   // Hz for /wire_shape
+  double shape_rate = 10.0;   // Hz for /wire_shape (and /line_state)
   double shape_resolution = 1.0;  // m
   double stamp_offset = 1.0;  // s added to simulation time in every stamp (ros::Time(0) means "latest" to tf)
   std::string line_frame = "line";
@@ -25,8 +26,12 @@ class PassBag {
  public:
   // Opens (truncates) the bag; throws rosbag::BagException naming the path if it cannot.
   PassBag(const std::string& path, const PassBagOptions& options);
-  // Call with the initial state and after every step; writes what is due at the rates.
-  void write(const Model& model, const State& state);
+  // Call with the initial state and after every step; writes what is due at the rates. With the
+  // pass's recorder (fed this state first), also /line_state at shape_rate, as the node does.
+  void write(const Model& model, const State& state, const PassRecorder* recorder = nullptr);
+  // The scene as the node publishes it (/catenary_sim/scene_yaml, latched on replay), at the
+  // first stamp: the replay then needs no scene file.
+  void write_scene(const std::string& scene_yaml);
   void close() { bag_.close(); }
   std::size_t messages() const { return messages_; }
 
