@@ -1006,6 +1006,10 @@ Model build_model(const Scene& scene, const BuildOptions& options) {
   if (scene.numerics.damping == DampingStep::kCentred) {
     if (m.wire_packs.empty())  // (condensed rotations on every wire node give packs)
       throw SceneError("numerics.damping = 'centred': needs the wires' rotations condensed; allowed otherwise: half_step");
+    if (scene.numerics.dt && *scene.numerics.dt > kCentredMaxSafetyFactor * m.dt_critical)
+      throw SceneError("numerics.dt = " + fmt(*scene.numerics.dt) + " s: with numerics.damping centred at most " +
+                       fmt(kCentredMaxSafetyFactor) + " of the stability estimate " + fmt(m.dt_critical) + " s, dt <= " +
+                       fmt(kCentredMaxSafetyFactor * m.dt_critical) + " (the estimate is not a bound for that step; see numerics.safety_factor)");
     factor_centred_damping(m);
   }
   // The statistics filter runs at the step rate: a cutoff at or above its Nyquist frequency would
@@ -1035,7 +1039,20 @@ double estimate_model_bytes(const Scene& scene) {
     const double wires = sec.contact_wire_count + (sec.messenger ? 1 : 0);
     nodes += wires * per_wire;
   }
-  return kModelBytesPerNode * nodes;
+  return kModelBytesPerNode * nodes + estimate_wind_field_bytes(scene);
+}
+
+double estimate_wind_field_bytes(const Scene& scene) {
+  const double points = wind_field_points(scene);
+  if (!(points > 0.0)) return 0.0;
+  // The field precomputed over the pass (make_wind_field): per point a float per time sample and
+  // a complex double per frequency (half as many), the samples a power of two covering the pass.
+  const TurbulenceSpec& t = *scene.wind->turbulence;
+  const double dt = 0.5 / t.max_frequency;
+  const double reach = points * t.spacing;
+  const double duration = std::max(60.0, scene.train_speed > 0.0 ? reach / scene.train_speed : 600.0);
+  const double samples = std::min(65536.0, std::max(64.0, std::exp2(std::ceil(std::log2(duration / dt)))));
+  return points * samples * (4.0 + 8.0);
 }
 
 void check_model_memory(const Scene& scene) {
@@ -1043,10 +1060,18 @@ void check_model_memory(const Scene& scene) {
   if (need > limit) {
     std::ostringstream s;
     s.precision(3);
+    const double wind = estimate_wind_field_bytes(scene);
     s << "scene: the model would need about " << need / (1ull << 30) << " GiB (" << scene.line_length() / 1000.0
-      << " km of line in " << scene.numerics.element_length << " m elements), more than the limit of "
-      << limit / (1ull << 30) << " GiB (half of this machine's memory); use a longer numerics.element_length, fewer "
-      << "or shorter spans (line.span_count, line.span_length), or line.endless with numerics.window";
+      << " km of line in " << scene.numerics.element_length << " m elements";
+    if (wind > 0.0)
+      s << ", " << wind / (1ull << 30) << " GiB of it the turbulent wind's " << wind_field_points(scene)
+        << " points, wind.turbulence.spacing " << scene.wind->turbulence->spacing << " m apart";
+    s << "), more than the limit of " << limit / (1ull << 30) << " GiB (half of this machine's memory); ";
+    if (wind > 0.5 * need)
+      s << "use a longer wind.turbulence.spacing or a lower wind.turbulence.max_frequency";
+    else
+      s << "use a longer numerics.element_length, fewer or shorter spans (line.span_count, line.span_length), or "
+           "line.endless with numerics.window";
     throw SceneError(s.str());
   }
 }

@@ -141,6 +141,10 @@ Scene frf_rig_scene(const Scene& scene, int pi, double dt) {
   PantographSpec p = scene.pantographs.at(pi);
   p.position = 0.0;
   p.aero_coefficient = 0.0;
+  // The rig is a 2-D line: the strips' widths across the track cannot act there.
+  for (CollectorSpec& c : p.collectors) c.working_width.reset();
+  for (HeadSpec& h : p.heads)
+    for (CollectorSpec& c : h.collectors) c.working_width.reset();
   s.pantographs = {p};
   s.contact = scene.contact;
   if (dt > 0.0) s.numerics.dt = dt;

@@ -1,6 +1,7 @@
 #include "catenary_sim/core/scene.hpp"
 
 #include <sys/stat.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cerrno>
@@ -22,6 +23,14 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 std::string fmt(double v) {
   std::ostringstream s;
   s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// 4 significant digits, for limits computed from the scene.
+std::string fmt4(double v) {
+  std::ostringstream s;
+  s.precision(4);
   s << v;
   return s.str();
 }
@@ -153,6 +162,118 @@ void check_document(const YAML::Node& n, const std::string& path) {
     }
   } else if (n.IsSequence()) {
     for (std::size_t i = 0; i < n.size(); ++i) check_document(n[i], path + "[" + std::to_string(i) + "]");
+  }
+}
+
+// The YAML text before it is built into nodes. yaml-cpp shares an aliased node instead of copying
+// it, so a tree walk visits it once per alias: an alias inside its own anchor is a cycle (the walk
+// never ends) and nested aliases multiply (9 levels of 9 aliases: 9^9 visits from 2.8 kB). Counts
+// every node as the walk will visit it (an alias adds its anchor's whole expanded size) and
+// refuses a cycle, an expansion beyond kMaxAliasExpansion, and a second document (YAML::Load
+// reads the first only, so the rest would be silently ignored).
+class DocumentShape : public YAML::EventHandler {
+ public:
+  explicit DocumentShape(std::string what) : what_(std::move(what)) {}
+  int documents = 0;
+
+  void OnDocumentStart(const YAML::Mark& mark) override {
+    start_ = mark;
+    content_ = false;
+  }
+  void OnDocumentEnd() override {
+    if (!content_) return;  // an empty document (a trailing '---') holds nothing to ignore
+    if (++documents > 1)
+      throw SceneError(what_ + ": a second YAML document" + at(start_) +
+                       "; a scene is one document (remove the '---' and what follows, or merge it into the first)");
+  }
+  void OnNull(const YAML::Mark&, YAML::anchor_t anchor) override {
+    if (stack_.empty() && anchor == YAML::NullAnchor) return;  // the empty document itself
+    node(anchor, 1);
+  }
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, const std::string&) override { node(anchor, 1); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    const std::string name = anchor < names_.size() && !names_[anchor].empty() ? names_[anchor] : std::to_string(anchor);
+    for (const Open& o : stack_)
+      if (o.anchor == anchor)
+        throw SceneError(what_ + ": the alias '*" + name + "'" + at(mark) + " lies inside its own anchor '&" + name +
+                         "': a node that contains itself, which no scene field can hold; write the value out");
+    const std::uint64_t size = anchor < sizes_.size() ? sizes_[anchor] : 1;
+    expanded_ += size;
+    if (expanded_ > kMaxAliasExpansion)
+      throw SceneError(what_ + ": the aliases expand to more than " + std::to_string(kMaxAliasExpansion) +
+                       " nodes (refused at '*" + name + "'" + at(mark) +
+                       "); anchors and aliases are allowed for repeated values, not for nesting repeats of repeats");
+    add(size);
+  }
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(anchor);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(anchor);
+  }
+  void OnMapEnd() override { close(); }
+  void OnAnchor(const YAML::Mark&, const std::string& name) override { pending_name_ = name; }
+
+ private:
+  struct Open {
+    YAML::anchor_t anchor;
+    std::uint64_t size;
+  };
+  static std::string at(const YAML::Mark& m) {
+    return m.line < 0 ? "" : " (line " + std::to_string(m.line + 1) + ", column " + std::to_string(m.column + 1) + ")";
+  }
+  void name(YAML::anchor_t anchor) {
+    if (anchor == YAML::NullAnchor) return;
+    if (names_.size() <= anchor) names_.resize(anchor + 1);
+    names_[anchor] = pending_name_;
+  }
+  void add(std::uint64_t size) {
+    content_ = true;
+    if (!stack_.empty()) stack_.back().size += size;
+  }
+  void node(YAML::anchor_t anchor, std::uint64_t size) {
+    name(anchor);
+    record(anchor, size);
+    add(size);
+  }
+  void record(YAML::anchor_t anchor, std::uint64_t size) {
+    if (anchor == YAML::NullAnchor) return;
+    if (sizes_.size() <= anchor) sizes_.resize(anchor + 1, 1);
+    sizes_[anchor] = size;
+  }
+  void open(YAML::anchor_t anchor) {
+    name(anchor);
+    content_ = true;
+    stack_.push_back({anchor, 1});
+  }
+  void close() {
+    const Open o = stack_.back();
+    stack_.pop_back();
+    record(o.anchor, o.size);
+    add(o.size);
+  }
+
+  std::string what_;
+  YAML::Mark start_;
+  bool content_ = false;
+  std::vector<Open> stack_;
+  std::vector<std::uint64_t> sizes_;
+  std::vector<std::string> names_;
+  std::string pending_name_;
+  std::uint64_t expanded_ = 0;
+};
+
+// Throws SceneError (naming `what`) for YAML that is not one acyclic document of bounded expansion.
+void check_yaml_shape(const std::string& text, const std::string& what) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  DocumentShape shape(what);
+  try {
+    while (parser.HandleNextDocument(shape)) {
+    }
+  } catch (const YAML::Exception& e) {
+    throw SceneError(what + ": not valid YAML: " + e.what());
   }
 }
 
@@ -417,6 +538,39 @@ double SectionSpec::length() const {
   return l;
 }
 
+std::string TrainSpeedLimit::text() const {
+  std::ostringstream s;
+  s.precision(4);
+  if (below_wave_speed)
+    s << "0 to below " << max << " m/s (" << max * 3.6 << " km/h), the contact wire's wave speed c = sqrt(T / rhoA): "
+      << "a faster pass is supercritical (the wire's wave cannot run ahead of the pantograph), outside what the model "
+         "covers; numerics.allow_supercritical: true runs it anyway";
+  else
+    s << "0 to " << max << " m/s (" << max * 3.6 << " km/h)";
+  return s.str();
+}
+
+TrainSpeedLimit train_speed_limit(const Scene& scene) {
+  TrainSpeedLimit l;
+  l.wave_speed = std::numeric_limits<double>::infinity();
+  for (const SectionSpec& sec : scene.sections)
+    if (sec.contact_wire.linear_mass > 0.0)
+      l.wave_speed = std::min(l.wave_speed, std::sqrt(sec.contact_wire.tension / sec.contact_wire.linear_mass));
+  l.below_wave_speed = !scene.numerics.allow_supercritical && l.wave_speed <= kMaxTrainSpeed;
+  l.max = l.below_wave_speed ? l.wave_speed : kMaxTrainSpeed;
+  return l;
+}
+
+double wind_field_points(const Scene& scene) {
+  if (!scene.wind || !scene.wind->turbulence) return 0.0;
+  // The stretch the field must cover: the line, or on an endless line the train's travel and a
+  // block of spans around it (the block's exact length is the model's).
+  double reach = scene.line_length();
+  if (scene.endless && scene.train_end)
+    reach = std::max(0.0, *scene.train_end - scene.train_start.value_or(0.0)) + 16.0 * scene.spans.front();
+  return std::ceil(reach / scene.wind->turbulence->spacing) + 1.0;
+}
+
 double Scene::line_length() const {
   double s = 0.0;
   for (double l : spans) s += l;
@@ -550,7 +704,15 @@ void read_lateral_parts(Reader& top, Scene& s) {
     StaggerSpec st;
     st.contact_wire = r.numbers("contact_wire", -1.0, 1.0);
     if (st.contact_wire.empty()) fail("stagger.contact_wire", "(empty list)", "at least one offset, m");
-    if (r.has("messenger")) st.messenger = r.numbers("messenger", -1.0, 1.0);
+    if (r.has("messenger")) {
+      st.messenger = r.numbers("messenger", -1.0, 1.0);
+      // An empty list reads as "no offsets": neither the contact wire's (what the field's absence
+      // gives) nor 0 is what it says, so it is asked for explicitly.
+      if (st.messenger.empty())
+        fail("stagger.messenger", "(empty list)",
+             "at least one offset, m ([0.0]: the messenger above the track centre); leave the field out for the "
+             "messenger above the contact wire (its stagger)");
+    }
     st.per_support = r.boolean("per_support", false);
     if (r.has("steady_arm_stiffness")) st.steady_arm_stiffness = r.number("steady_arm_stiffness", 0.0, 1e9, std::nullopt, true);
     if (r.has("messenger_support_stiffness"))
@@ -756,8 +918,9 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   if (top.has("train")) {
     Reader r(top.child("train"), "train");
     if (r.has("speed") && r.has("speed_kmh")) fail("train.speed", "(given with speed_kmh)", "give either speed (m/s) or speed_kmh");
-    if (r.has("speed_kmh")) s.train_speed = r.number("speed_kmh", 0.0, 1000.0) / 3.6;
-    else s.train_speed = r.number("speed", 0.0, 300.0, 0.0);
+    // Any finite speed >= 0 here; validate() applies the limit (train_speed_limit).
+    if (r.has("speed_kmh")) s.train_speed = r.number("speed_kmh", 0.0, kInf) / 3.6;
+    else s.train_speed = r.number("speed", 0.0, kInf, 0.0);
     if (r.has("start")) s.train_start = r.number("start", -kInf, kInf);
     if (r.has("end")) s.train_end = r.number("end", -kInf, kInf);
     r.finish();
@@ -808,6 +971,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
     else if (dmp == "centred") s.numerics.damping = DampingStep::kCentred;
     else fail("numerics.damping", "'" + dmp + "'", "one of: half_step (C v at v_{n-1/2}, eq. 19-21), centred (C v at (v_{n+1/2} + v_{n-1/2}) / 2)");
     s.numerics.divergence_limit = r.number("divergence_limit", 0.0, 1000.0, 5.0, true);
+    s.numerics.allow_supercritical = r.boolean("allow_supercritical", false);
     if (r.has("window")) {
       const YAML::Node wn = r.child("window");
       if (wn.IsScalar() && wn.as<std::string>() == "auto") {
@@ -985,6 +1149,52 @@ void validate(const Scene& s) {
       }
     }
   }
+  const TrainSpeedLimit speed = train_speed_limit(s);
+  if (!speed.allows(s.train_speed)) {
+    const double v = s.train_speed;
+    std::string value = fmt(v * 3.6) + " (" + fmt(v) + " m/s";
+    if (v >= speed.wave_speed) value += ", " + fmt4(v / speed.wave_speed) + " times the contact wire's wave speed";
+    fail("train.speed_kmh", value + ")", "allowed " + speed.text());
+  }
+  {
+    const PantographHeadSpec& h = s.pantograph_head;
+    if (!(h.histogram_bin > 0.0) || h.horn_width / h.histogram_bin > kMaxHistogramBins)
+      fail("pantograph_head.histogram_bin", fmt(h.histogram_bin),
+           "allowed [" + fmt4(h.horn_width / kMaxHistogramBins) + ", 1] m: at most " + fmt(kMaxHistogramBins) +
+               " bins across pantograph_head.horn_width = " + fmt(h.horn_width) + " m");
+  }
+  if (s.wind && s.wind->turbulence) {
+    const double points = wind_field_points(s);
+    if (!(points <= kMaxWindFieldPoints)) {
+      const double spacing = s.wind->turbulence->spacing, reach = (points - 1.0) * spacing;
+      fail("wind.turbulence.spacing", fmt(spacing),
+           "allowed [" + fmt4(reach / (kMaxWindFieldPoints - 1.0)) + ", 100] m here: at most " + fmt(kMaxWindFieldPoints) +
+               " field points over the " + fmt4(reach) + " m of line the pass covers (this spacing gives " + fmt4(points) + ")");
+    }
+  }
+  if (s.numerics.damping == DampingStep::kCentred && s.numerics.safety_factor > kCentredMaxSafetyFactor)
+    fail("numerics.safety_factor", fmt(s.numerics.safety_factor),
+         "at most " + fmt(kCentredMaxSafetyFactor) + " with numerics.damping: centred (its stability estimate is no bound "
+         "at the estimate itself; half_step takes up to 1)");
+  // Fields that could never act in this scene are refused rather than silently ignored.
+  if (s.numerics.gust_lead && !(s.wind && s.wind->turbulence && s.numerics.windowed()))
+    fail("numerics.gust_lead", fmt(*s.numerics.gust_lead),
+         "only with a turbulent wind (wind.turbulence) and the moving window (numerics.window): it is how much further "
+         "ahead the lateral window reaches; remove it here");
+  if (!s.lateral())
+    for (std::size_t i = 0; i < s.pantographs.size(); ++i) {
+      const PantographSpec& p = s.pantographs[i];
+      auto check = [&](const std::vector<CollectorSpec>& cs, const std::string& field) {
+        for (std::size_t j = 0; j < cs.size(); ++j)
+          if (cs[j].working_width)
+            fail(field + "[" + std::to_string(j) + "].working_width", fmt(*cs[j].working_width),
+                 "only on a 3-D line (stagger, alignment, wind or pantograph_head.sway): a 2-D line has no lateral "
+                 "contact point to keep on the strip; remove it here");
+      };
+      const std::string pf = "pantographs[" + std::to_string(i) + "]";
+      check(p.collectors, pf + ".collectors");
+      for (std::size_t h = 0; h < p.heads.size(); ++h) check(p.heads[h].collectors, pf + ".heads[" + std::to_string(h) + "].collectors");
+    }
   std::set<std::string> names;
   for (std::size_t i = 0; i < s.pantographs.size(); ++i) {
     const auto& p = s.pantographs[i];
@@ -1129,6 +1339,7 @@ void apply_override(YAML::Node root, const std::string& assignment) {
   } catch (const YAML::Exception& e) {
     throw bad(std::string("value is not valid YAML (") + e.what() + ")");
   }
+  check_yaml_shape(assignment.substr(eq + 1), "override '" + assignment + "'");
   std::vector<std::string> parts;
   std::stringstream ss(key);
   for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
@@ -1194,6 +1405,7 @@ Scene load_scene_string(const std::string& yaml, const std::vector<std::string>&
   } catch (const YAML::Exception& e) {
     throw SceneError(std::string("scene: not valid YAML: ") + e.what());
   }
+  check_yaml_shape(yaml, "scene");
   return load_from_node(root, overrides, base_dir);
 }
 

@@ -10,7 +10,24 @@
 
 namespace catenary_sim {
 
-Simulation::Simulation(const Scene& scene) : model_(build_model(scene)) {
+namespace {
+
+// A Scene changed in code after loading (a tool's --speed-kmh) meets the same limit as a file.
+const Scene& speed_checked(const Scene& scene) {
+  const TrainSpeedLimit limit = train_speed_limit(scene);
+  if (!limit.allows(scene.train_speed)) {
+    std::ostringstream s;
+    s.precision(10);
+    s << "scene field 'train.speed_kmh' = " << scene.train_speed * 3.6 << " (" << scene.train_speed
+      << " m/s): allowed " << limit.text();
+    throw SceneError(s.str());
+  }
+  return scene;
+}
+
+}  // namespace
+
+Simulation::Simulation(const Scene& scene) : model_(build_model(speed_checked(scene))) {
   initial_ = make_state(model_);
   if (model_.lateral && !model_.lateral->field.empty()) {
     // The pass starts in the wind of t = 0: the pantograph's aerodynamic uplift too.
@@ -77,16 +94,54 @@ std::string Simulation::status_message() const {
           where = "pantograph " + p.name + " head " + std::to_string(d - p.first_dof - p.masses_count());
       s << "diverged at t = " << state_.time << " s: displacement of " << where << " is "
         << state_.u[d] << " m (limit " << model_.scene.numerics.divergence_limit
-        << " m); the run was stopped. ";
-      if (model_.scene.numerics.dt)
-        s << "Reduce numerics.dt (" << model_.dt << " s; the stability estimate is " << model_.dt_critical
-          << " s) or check the scene";
-      else
-        s << "The automatic dt (" << model_.dt << " s) was below the stability estimate, so the scene is outside "
-          << "what the estimate covers: check its masses, stiffnesses and dampers, or use numerics.integrator implicit";
+        << " m); the run was stopped. " << divergence_cause();
       break;
     }
   }
+  return s.str();
+}
+
+// The likeliest cause of a divergence, from what the scene asks: a contact spring so soft that
+// the strips sink into the wire beyond the limit, a limit within the line's own displacements,
+// or the time step; dt is blamed only when it was near the stability estimate.
+std::string Simulation::divergence_cause() const {
+  std::ostringstream s;
+  s.precision(4);
+  const Scene& sc = model_.scene;
+  const double limit = sc.numerics.divergence_limit;
+  // The penalty contact spring: under the net uplift F a strip sinks F / k0 into the wire.
+  double sink = 0.0, force = 0.0;
+  for (std::size_t i = 0; i < model_.pantographs.size() && i < sc.pantographs.size(); ++i)
+    if (!model_.pantographs[i].moving_force) {
+      const PantographSpec& p = sc.pantographs[i];
+      const double static_uplift = i < state_.uplift.size() ? state_.uplift[i] : p.static_uplift;
+      const double f = static_uplift + p.net_uplift(state_.speed) - p.static_uplift;
+      if (f / model_.contact_stiffness > sink) sink = f / model_.contact_stiffness, force = f;
+    }
+  // A sink of centimetres is no contact (50000 N/m under 120 N: 2.4 mm).
+  if (sink > 0.5 * limit && sink > 0.01) {
+    s << "Likely cause: contact.stiffness = " << model_.contact_stiffness << " N/m is so low that the strips sink about "
+      << sink << " m into the wire under the uplift of " << force << " N (uplift / stiffness), beyond the divergence "
+      << "limit; the contact spring is a penalty that keeps them on the wire: use 1e4 to 1e5 N/m (50000 by default)";
+    return s.str();
+  }
+  const double moved = initial_.u.size() ? initial_.u.cwiseAbs().maxCoeff() : 0.0;
+  if (limit < 10.0 * moved) {
+    s << "Likely cause: numerics.divergence_limit = " << limit << " m is within the line's own displacements (its static "
+      << "state already reaches " << moved << " m): the limit stopped the run, not an instability; raise it (5 m by "
+      << "default)";
+    return s.str();
+  }
+  const double ratio = model_.dt / model_.dt_critical;
+  if (ratio > kStepNearEstimate) {
+    s << "Likely cause: dt (" << model_.dt << " s) is " << ratio << " of the stability estimate (" << model_.dt_critical
+      << " s), closer than the estimate guarantees; " << (sc.numerics.dt ? "reduce numerics.dt" : "reduce numerics.safety_factor")
+      << " (dt at 0.9 of the estimate by default)";
+    return s.str();
+  }
+  s << "dt (" << model_.dt << " s) was " << ratio << " of the stability estimate (" << model_.dt_critical
+    << " s), so the scene is outside what the estimate covers: check its masses, stiffnesses and dampers, or use "
+       "numerics.integrator implicit";
   return s.str();
 }
 
@@ -111,8 +166,9 @@ void Simulation::reset(bool keep_time) {
 }
 
 bool Simulation::set_target_speed(double v, std::string* error) {
-  if (!std::isfinite(v) || v < 0.0 || v > kMaxSpeed) {
-    if (error) *error = "train speed " + fmt(v) + " m/s rejected: allowed 0 to " + fmt(kMaxSpeed) + " m/s";
+  const TrainSpeedLimit limit = train_speed_limit(model_.scene);
+  if (!limit.allows(v)) {
+    if (error) *error = "train speed " + fmt(v) + " m/s rejected: allowed " + limit.text();
     return false;
   }
   state_.target_speed = v;

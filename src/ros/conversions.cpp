@@ -153,12 +153,12 @@ std::string label_wire_name(const std::string& name) {
 }
 
 
-std::string speed_command_error(double v) {
-  if (std::isfinite(v) && v >= 0.0 && v <= Simulation::kMaxSpeed) return "";
-  char what[160];
-  std::snprintf(what, sizeof what, "cmd/train_speed = %g m/s rejected: allowed 0 to %g m/s (%g km/h)", v,
-                Simulation::kMaxSpeed, Simulation::kMaxSpeed * 3.6);
-  return what;
+std::string speed_command_error(const Scene& scene, double v) {
+  const TrainSpeedLimit limit = train_speed_limit(scene);
+  if (limit.allows(v)) return "";
+  char what[64];
+  std::snprintf(what, sizeof what, "cmd/train_speed = %g m/s rejected: allowed ", v);
+  return what + limit.text();
 }
 
 ros::Time sim_stamp(double sim_time, double offset) { return ros::Time(sim_time + offset); }

@@ -171,7 +171,7 @@ void HilNode::pass_ended(std::unique_ptr<PassRecorder> recorder, const State& st
 
 void HilNode::on_speed(const std_msgs::Float64::ConstPtr& msg) {
   const double v = msg->data;
-  if (const std::string e = speed_command_error(v); !e.empty()) {
+  if (const std::string e = speed_command_error(loop_->model().scene, v); !e.empty()) {
     ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil: %s; command ignored", e.c_str());
     return;
   }

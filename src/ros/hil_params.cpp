@@ -15,7 +15,7 @@ namespace ros_layer {
 void validate_hil_params(const HilParams& p) {
   if (p.scene.empty())
     throw ParamError("parameter ~scene is required: path of a scene YAML file with a `type: external` pantograph");
-  if (p.speed_kmh) check_range("speed_kmh", *p.speed_kmh, 0.0, 540.0, false, "km/h");
+  if (p.speed_kmh) check_range("speed_kmh", *p.speed_kmh, 0.0, 3.6 * kMaxTrainSpeed, false, "km/h");
   check_range("hil/rate", p.rate, 1000.0, 10000.0, false, "Hz");
   const double period = 1.0 / p.rate;
   if (!std::isfinite(p.timeout) || p.timeout < 2.0 * period || p.timeout > 10.0)
@@ -86,7 +86,7 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
   HilParams p;
   // (the ranges are checked by validate_hil_params; the type errors name them too)
   r.text("scene", p.scene, "the path of a scene YAML file");
-  read_speed_kmh(r, nh, p.speed_kmh, "a number in [0, 540] km/h");
+  read_speed_kmh(r, nh, p.speed_kmh, "a number in " + range_text(0.0, 3.6 * kMaxTrainSpeed, false, "km/h"));
   r.number("hil/rate", p.rate, "a number in [1000, 10000] Hz");
   r.number("hil/timeout", p.timeout, "a number of seconds in [2 loop periods, 10]");
   r.number("hil/hold_ramp", p.hold_ramp, "a number in [0, 60] s");

@@ -72,7 +72,7 @@ HilUdpNode::HilUdpNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   ros::SubscribeOptions vo = ros::SubscribeOptions::create<std_msgs::Float64>(
       "cmd/train_speed", 10,
       [this](const std_msgs::Float64::ConstPtr& msg) {
-        if (const std::string e = speed_command_error(msg->data); !e.empty()) {
+        if (const std::string e = speed_command_error(loop_->model().scene, msg->data); !e.empty()) {
           ROS_ERROR_THROTTLE(1.0, "catenary_sim_hil_udp: %s; command ignored", e.c_str());
           return;
         }

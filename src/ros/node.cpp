@@ -599,7 +599,7 @@ void SimulationNode::on_speed(const std_msgs::Float64::ConstPtr& msg) {
   // The range is checked here too, for a message with %g numbers (the core's has std::to_string's
   // "200.000000"); the core's check stays the authority.
   const double v = msg->data;
-  if (const std::string e = speed_command_error(v); !e.empty()) {
+  if (const std::string e = speed_command_error(sim_->model().scene, v); !e.empty()) {
     ROS_ERROR_THROTTLE(1.0, "catenary_sim: %s; command ignored", e.c_str());
     return;
   }

@@ -222,7 +222,7 @@ struct Range {
   const char* unit;
   std::string text() const { return "a number in " + range_text(lo, hi, lo_open, unit); }
 };
-const Range kSpeed{0.0, 540.0, false, "km/h"};
+const Range kSpeed{0.0, 3.6 * kMaxTrainSpeed, false, "km/h"};  // the ceiling; the scene's wave speed in validate()
 const Range kRealTimeFactor{0.0, 1000.0, false, "(0: as fast as possible)"};
 const Range kPublishRate{kMinPublishRate, 10000.0, false, "Hz"};
 const Range kShapeRate{kMinShapeRate, 1000.0, false, "Hz"};

@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
   hil::RealtimeOptions rt;
   double duration = 0.0;
   app.add_option("--scene", scene_file, "scene YAML with at least one `type: external` pantograph")->required()->type_name("FILE");
-  app.add_option("--speed-kmh", speed_kmh, "train speed, km/h (default: the scene's)")->check(kFinite & CLI::Range(0.0, 540.0));
+  app.add_option("--speed-kmh", speed_kmh, "train speed, km/h (default: the scene's)")->check(kFinite & CLI::Range(0.0, 3.6 * kMaxTrainSpeed));
   app.add_option("--rate", lo.rate, "loop rate, Hz")->check(kFinite & CLI::Range(1000.0, 10000.0))->capture_default_str();
   app.add_option("--timeout", lo.timeout, "s without a valid measurement before the safe hold (>= 2 periods)")
       ->check(kFinite & CLI::Range(0.0002, 10.0))->capture_default_str();

@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
       ->required()
       ->type_name("DIR");
   app.add_option("--speed", speed_kmh, "train speed in km/h, overrides train.speed / train.speed_kmh")
-      ->check(kFinite & CLI::Range(0.0, 540.0))
+      ->check(kFinite & CLI::Range(0.0, 3.6 * kMaxTrainSpeed))
       ->type_name("KMH");
   app.add_option("--set", overrides, "override a scene field, e.g. --set numerics.element_length=0.125 (null removes it)")
       ->type_name("KEY=VALUE")
@@ -135,9 +135,23 @@ int main(int argc, char** argv) {
   try {
     scene = load_scene_file(scene_path, overrides);
     if (!std::isnan(speed_kmh)) {
+      // The scene's own limit (below the contact wire's wave speed), named as the flag.
+      if (const TrainSpeedLimit limit = train_speed_limit(scene); !limit.allows(speed_kmh / 3.6)) {
+        std::ostringstream s;
+        s.precision(10);
+        s << "--speed " << speed_kmh << " km/h: allowed " << limit.text();
+        throw SceneError(s.str());
+      }
       scene.train_speed = speed_kmh / 3.6;
       validate(scene);
     }
+    // An external pantograph's force is measured on a real pantograph; offline nothing measures
+    // it and it would stay a constant force.
+    for (std::size_t i = 0; i < scene.pantographs.size(); ++i)
+      if (scene.pantographs[i].external)
+        throw SceneError("scene field 'pantographs[" + std::to_string(i) + "].type' = 'external': needs a live rig that "
+                         "measures the contact force (catenary_sim_hil_udp, the HIL node, or Python's "
+                         "set_external_force); an offline pass takes lumped or moving_force");
     if (!(scene.train_speed > 0.0))
       throw SceneError("scene field 'train.speed_kmh' = 0: an offline pass needs a train speed > 0 (give "
                        "train.speed_kmh in the scene or --speed; the live node accepts 0 and waits for a speed command)");

@@ -178,3 +178,180 @@ TEST(Commands, RejectedCommandsLeaveTheStateAsItWas) {
   EXPECT_TRUE(sim.set_uplift(-1, 120.0, &err));
   EXPECT_EQ(sim.state().uplift[0], 120.0);
 }
+
+namespace {
+
+const std::string kReference3d = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml";
+
+std::string error_of_3d(const std::vector<std::string>& overrides) {
+  try {
+    Simulation sim(load_scene_file(kReference3d, overrides));
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The reference scene's text with `line` put in place of its first line ("name: ...").
+std::string reference_with_first_line(const std::string& line) {
+  std::ifstream in(kReference);
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  const std::size_t at = text.find("\nname:");
+  const std::size_t end = text.find('\n', at + 1);
+  return text.substr(0, at + 1) + line + text.substr(end);
+}
+
+}  // namespace
+
+// yaml-cpp shares an aliased node: an alias inside its own anchor is a node that contains itself,
+// and every walk over the tree would recurse without end (a stack overflow).
+TEST(SceneErrors, AnchorThatContainsItselfIsRefused) {
+  EXPECT_MENTIONS(error_of_yaml(reference_with_first_line("name: &r [*r]")), "'*r'", "its own anchor", "line ");
+  EXPECT_MENTIONS(error_of({"name=&a [*a]"}), "name=&a [*a]", "'*a'", "its own anchor");
+  EXPECT_MENTIONS(error_of({"numerics=&n {dt: *n}"}), "numerics", "'*n'", "its own anchor");
+}
+
+// Aliases of aliases multiply: 9 levels of 9 are 9^9 visits from a few hundred bytes.
+TEST(SceneErrors, AliasExpansionIsBounded) {
+  std::string bomb = "a0: &a0 [1, 2, 3, 4, 5, 6, 7, 8, 9]\n";
+  for (int i = 1; i < 10; ++i) {
+    bomb += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [";
+    for (int k = 0; k < 9; ++k) bomb += (k ? ", *a" : "*a") + std::to_string(i - 1);
+    bomb += "]\n";
+  }
+  const std::string budget = std::to_string(kMaxAliasExpansion);
+  EXPECT_MENTIONS(error_of_yaml(reference_with_first_line("name: bomb\n" + bomb)), "aliases expand to more than",
+                  budget.c_str());
+  // The same in an override's value: [&b0 [1..9], &b1 [*b0 x 9], ..., &b9 [*b8 x 9]].
+  std::string flow = "[&b0 [1, 2, 3, 4, 5, 6, 7, 8, 9]";
+  for (int i = 1; i < 10; ++i) {
+    flow += ", &b" + std::to_string(i) + " [";
+    for (int k = 0; k < 9; ++k) flow += (k ? ", *b" : "*b") + std::to_string(i - 1);
+    flow += "]";
+  }
+  EXPECT_MENTIONS(error_of({"name=" + flow + "]"}), "override 'name=", "aliases expand to more than");
+  // An anchor used for what it is for, a repeated value, reads as the value written out.
+  const std::string text = reference_with_first_line("name: reference_55m");
+  std::string aliased = text;
+  aliased.replace(aliased.find("  tension: 22000.0"), 18, "  tension: &t 22000.0");
+  aliased.replace(aliased.find("  tension: 16000.0"), 18, "  tension: *t");
+  const Scene a = load_scene_string(aliased), b = load_scene_string(text, {"messenger.tension=22000.0"});
+  EXPECT_EQ(a.messenger->tension, b.messenger->tension);
+  EXPECT_EQ(a.messenger->tension, a.contact_wire.tension);
+}
+
+TEST(SceneErrors, SecondDocumentIsRefused) {
+  const std::string text = reference_with_first_line("name: reference_55m");
+  EXPECT_MENTIONS(error_of_yaml(text + "---\ntrain: {speed_kmh: 100}\n"), "second YAML document", "line ");
+  EXPECT_EQ(error_of_yaml(text + "---\n"), "");  // an empty document after the scene holds nothing to ignore
+}
+
+// A bin far below the head's width asked for more bins than memory holds (1e-8 m: 2e8 bins, a
+// bad_alloc after the whole pass; 1e-300: an int overflow, one bin).
+TEST(SceneErrors, HistogramBinsAreBounded) {
+  for (const char* bin : {"1e-8", "1e-300"})
+    EXPECT_MENTIONS(error_of_3d({std::string("pantograph_head.histogram_bin=") + bin}), "pantograph_head.histogram_bin",
+                    "allowed [", "bins across pantograph_head.horn_width");
+  // At the bound: horn_width / bin = kMaxHistogramBins bins.
+  EXPECT_EQ(error_of_3d({"pantograph_head.histogram_bin=" + std::to_string(1.95 / kMaxHistogramBins)}), "");
+}
+
+// The turbulent field's points over the line: 550 m / 1e-9 m overflows the point count's int,
+// 550 m / 1e-6 m asks for far more than memory; both are refused naming the spacing.
+TEST(SceneErrors, TurbulencePointsAreBounded) {
+  for (const auto& [spacing, shown] : {std::pair{"1e-9", "1e-09"}, {"3e-9", "3e-09"}, {"1e-6", "1e-06"}})
+    EXPECT_MENTIONS(error_of_3d({std::string("wind.turbulence.spacing=") + spacing}), "wind.turbulence.spacing", shown,
+                    "field points over the");
+  const Scene s = load_scene_file(kReference3d);
+  // The field's memory is part of the model's estimate (it grows as the points).
+  Scene fine = s;
+  fine.wind->turbulence->spacing = 0.5;
+  EXPECT_GT(estimate_wind_field_bytes(s), 0.0);
+  EXPECT_NEAR(estimate_wind_field_bytes(fine) / estimate_wind_field_bytes(s), wind_field_points(fine) / wind_field_points(s), 1e-9);
+  EXPECT_EQ(estimate_model_bytes(fine) - estimate_model_bytes(s), estimate_wind_field_bytes(fine) - estimate_wind_field_bytes(s));
+}
+
+// The speed limit: below the contact wire's wave speed c = sqrt(T / rhoA), computed here from the
+// scene's own wire (22 kN on 1.35 kg/m: 127.66 m/s).
+TEST(SceneErrors, SupercriticalSpeedIsRefusedEverywhere) {
+  const double c = std::sqrt(22000.0 / 1.35);
+  const TrainSpeedLimit limit = train_speed_limit(load_scene_file(kReference));
+  EXPECT_NEAR(limit.wave_speed, c, 1e-9 * c);
+  EXPECT_TRUE(limit.below_wave_speed);
+  EXPECT_MENTIONS(error_of({"train.speed_kmh=800"}), "train.speed_kmh", "800", "wave speed", "allow_supercritical");
+  EXPECT_MENTIONS(error_of({"train.speed_kmh=null", "train.speed=" + std::to_string(1.0001 * c)}), "train.speed_kmh",
+                  "wave speed");
+  EXPECT_EQ(error_of({"train.speed_kmh=null", "train.speed=" + std::to_string(0.99 * c)}), "");
+  // Beyond the ceiling even with the opt-in.
+  EXPECT_MENTIONS(error_of({"train.speed_kmh=541", "numerics.allow_supercritical=true"}), "train.speed_kmh", "541",
+                  "0 to 150 m/s (540 km/h)");
+  // A Scene changed in code after loading meets the same limit when it is run.
+  Scene s = load_scene_file(kReference);
+  s.train_speed = 1.01 * c;
+  EXPECT_THROW(Simulation{s}, SceneError);
+  // The explicit opt-in runs it, up to the ceiling.
+  EXPECT_EQ(error_of({"train.speed_kmh=500", "numerics.allow_supercritical=true"}), "");
+  EXPECT_MENTIONS(error_of({"numerics.allow_supercritical=maybe"}), "numerics.allow_supercritical", "true or false");
+  // Commands: refused beyond the wave speed, the state as it was; accepted below it.
+  Simulation sim(load_scene_file(kReference));
+  for (int i = 0; i < 20; ++i) sim.step();
+  const State before = sim.state();
+  std::string err;
+  for (double v : {c, 1.2 * c, 149.0}) {
+    EXPECT_FALSE(sim.set_target_speed(v, &err)) << v;
+    EXPECT_NE(err.find("wave speed"), std::string::npos) << err;
+  }
+  EXPECT_EQ(sim.state().target_speed, before.target_speed);
+  EXPECT_TRUE(sim.set_target_speed(0.9 * c, &err)) << err;
+  Simulation super(load_scene_file(kReference, {"numerics.allow_supercritical=true"}));
+  EXPECT_TRUE(super.set_target_speed(1.1 * c, &err)) << err;
+  EXPECT_FALSE(super.set_target_speed(kMaxTrainSpeed * 1.0001, &err));
+}
+
+// Fields that can never act where they are given are refused, not silently ignored.
+TEST(SceneErrors, FieldsThatCannotActAreRefused) {
+  EXPECT_MENTIONS(error_of_3d({"stagger.messenger=[]"}), "stagger.messenger", "empty list", "leave the field out");
+  // gust_lead needs a turbulent wind and the moving window.
+  EXPECT_MENTIONS(error_of({"numerics.gust_lead=5"}), "numerics.gust_lead", "5", "wind.turbulence", "numerics.window");
+  EXPECT_MENTIONS(error_of_3d({"numerics.gust_lead=5"}), "numerics.gust_lead", "numerics.window");
+  EXPECT_EQ(error_of_3d({"numerics.gust_lead=5", "numerics.window=auto"}), "");
+  // A strip's working width needs a 3-D line.
+  EXPECT_MENTIONS(error_of({"pantographs.0.collectors=[{offset: 0.0, working_width: 1.0}]"}),
+                  "pantographs[0].collectors[0].working_width", "only on a 3-D line");
+  EXPECT_EQ(error_of_3d({"pantographs.0.collectors=[{offset: 0.0, working_width: 1.0}]"}), "");
+}
+
+// The centred step's estimate is no bound at the estimate itself (the reference diverged at a
+// safety factor of 0.99 with it): a dt that close is refused up front, not found by a divergence.
+TEST(SceneErrors, CentredStepKeepsItsMargin) {
+  EXPECT_MENTIONS(error_of({"numerics.damping=centred", "numerics.safety_factor=1"}), "numerics.safety_factor", "1",
+                  "numerics.damping: centred");
+  EXPECT_EQ(error_of({"numerics.damping=centred", "numerics.safety_factor=0.95"}), "");
+  EXPECT_EQ(error_of({"numerics.safety_factor=1"}), "");  // the half step's estimate holds at 1
+  const Simulation sim(load_scene_file(kReference, {"numerics.damping=centred"}));
+  const double at_estimate = sim.model().dt_critical;
+  EXPECT_MENTIONS(error_of({"numerics.damping=centred", "numerics.dt=" + std::to_string(0.99 * at_estimate)}), "numerics.dt",
+                  "centred");
+}
+
+// A divergence names its likely cause, and blames dt only when dt was near the estimate.
+TEST(SceneErrors, DivergenceNamesItsLikelyCause) {
+  auto message = [](const std::vector<std::string>& overrides) {
+    Simulation sim(load_scene_file(kReference, overrides));
+    for (int i = 0; i < 2000 && sim.step() == StepStatus::kOk; ++i) {
+    }
+    EXPECT_EQ(sim.state().status, StepStatus::kDiverged);
+    return sim.status_message();
+  };
+  // Static displacements are millimetres: a limit of 1e-9 m stops a sound run at once.
+  const std::string limit = message({"numerics.divergence_limit=1e-9"});
+  EXPECT_MENTIONS(limit, "numerics.divergence_limit");
+  EXPECT_EQ(limit.find("numerics.dt"), std::string::npos) << limit;
+  EXPECT_EQ(limit.find("stability estimate"), std::string::npos) << limit;
+  // 0.001 N/m under some 100 N: the strips would sink 1e5 m into the wire.
+  const std::string soft = message({"contact.stiffness=0.001"});
+  EXPECT_MENTIONS(soft, "contact.stiffness");
+  EXPECT_EQ(soft.find("stability estimate"), std::string::npos) << soft;
+}

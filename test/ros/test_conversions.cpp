@@ -425,16 +425,19 @@ TEST(Pacing, StepsDueFollowWallClockTimesFactor) {
 // The pass node and the HIL node reject cmd/train_speed with this message (the same range as the
 // core's set_target_speed, which stays the authority).
 TEST(Commands, SpeedCommandErrorNamesTopicValueAndRange) {
-  EXPECT_EQ(speed_command_error(0.0), "");
-  EXPECT_EQ(speed_command_error(Simulation::kMaxSpeed), "");
-  EXPECT_EQ(speed_command_error(200.0), "cmd/train_speed = 200 m/s rejected: allowed 0 to 150 m/s (540 km/h)");
-  EXPECT_NE(speed_command_error(-0.5).find("= -0.5 m/s rejected"), std::string::npos);
-  EXPECT_NE(speed_command_error(std::nan("")).find("= nan m/s rejected"), std::string::npos);
-  EXPECT_NE(speed_command_error(std::numeric_limits<double>::infinity()), "");
-  // Whatever it accepts the core accepts, and the other way round.
   Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml"));
-  for (double v : {-1e-9, 0.0, 75.0, 150.0, 150.0000001, std::nan("")})
-    EXPECT_EQ(speed_command_error(v).empty(), sim.set_target_speed(v, nullptr)) << v;
+  const Scene& scene = sim.model().scene;
+  const double c = std::sqrt(22000.0 / 1.35);  // the reference contact wire's wave speed, m/s
+  EXPECT_EQ(speed_command_error(scene, 0.0), "");
+  EXPECT_EQ(speed_command_error(scene, 0.99 * c), "");
+  EXPECT_EQ(speed_command_error(scene, 200.0).rfind("cmd/train_speed = 200 m/s rejected: allowed 0 to below ", 0), 0u);
+  EXPECT_NE(speed_command_error(scene, c).find("wave speed"), std::string::npos);
+  EXPECT_NE(speed_command_error(scene, -0.5).find("= -0.5 m/s rejected"), std::string::npos);
+  EXPECT_NE(speed_command_error(scene, std::nan("")).find("= nan m/s rejected"), std::string::npos);
+  EXPECT_NE(speed_command_error(scene, std::numeric_limits<double>::infinity()), "");
+  // Whatever it accepts the core accepts, and the other way round.
+  for (double v : {-1e-9, 0.0, 75.0, 0.99 * c, c, 150.0, 150.0000001, std::nan("")})
+    EXPECT_EQ(speed_command_error(scene, v).empty(), sim.set_target_speed(v, nullptr)) << v;
 }
 
 TEST(Stamps, OffsetAddsAndIsMonotonic) {

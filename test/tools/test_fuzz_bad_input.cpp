@@ -285,3 +285,101 @@ TEST(FuzzBadInput, OutputTargetsThatAreNotRegularFiles) {
   EXPECT_EQ(slurp(file).rfind("x_m,", 0), 0u);
   std::system(("rm -rf '" + dir + "'").c_str());
 }
+
+// The 3-D line's rooms, the pantograph heads and the YAML shapes (anchors, aliases, documents):
+// each refused cleanly, naming the field (or what is refused), by every tool that reads a scene.
+TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
+  const std::string dir = temp_dir("catenary_sim_fuzz_");
+  const std::string r3 = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml";
+  const std::string heads = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_heads.yaml";
+  int count = 0;
+  struct SetCase {
+    std::string scene, set;
+    std::vector<std::string> names;
+  };
+  const std::vector<SetCase> sets = {
+      // stagger
+      {r3, "stagger.contact_wire=[]", {"stagger.contact_wire"}},
+      {r3, "stagger.contact_wire=[0.7, -0.7]", {"stagger.contact_wire[0]"}},
+      {r3, "stagger.messenger=[]", {"stagger.messenger"}},
+      {r3, "stagger.per_support=true", {"stagger.contact_wire"}},
+      {r3, "stagger.per_support=sometimes", {"stagger.per_support"}},
+      {r3, "stagger.steady_arm_stiffness=-1", {"stagger.steady_arm_stiffness"}},
+      {r3, "stagger.messenger=[.nan]", {"stagger.messenger[0]"}},
+      // alignment
+      {r3, "alignment.radius=50", {"alignment.radius"}},
+      {r3, "alignment.curves=[{start: 0, length: 50, radius: 500, transition: 30}]", {"alignment.curves[0].transition"}},
+      {r3, "alignment.curves=[{start: 1e6, length: 50, radius: 500}]", {"alignment.curves[0].start"}},
+      {r3, "alignment.curves=5", {"alignment.curves"}},
+      // wind and turbulence
+      {r3, "wind.speed=90", {"wind.speed"}},
+      {r3, "wind.direction=.nan", {"wind.direction"}},
+      {r3, "wind.air_density=0", {"wind.air_density"}},
+      {r3, "wind.contact_wire.diameter=1", {"wind.contact_wire.diameter"}},
+      {r3, "wind.speed=0", {"wind.speed"}},
+      {r3, "wind.turbulence.spacing=1e-9", {"wind.turbulence.spacing"}},
+      {r3, "wind.turbulence.spacing=1e-6", {"wind.turbulence.spacing"}},
+      {r3, "wind.turbulence.intensity=0", {"wind.turbulence.intensity"}},
+      {r3, "wind.turbulence.max_frequency=1e9", {"wind.turbulence.max_frequency"}},
+      {r3, "wind.turbulence.seed=-1", {"wind.turbulence.seed"}},
+      {r3, "wind.blow_off_limit=0", {"wind.blow_off_limit"}},
+      // the pantograph head across the track
+      {r3, "pantograph_head.histogram_bin=1e-8", {"pantograph_head.histogram_bin"}},
+      {r3, "pantograph_head.histogram_bin=1e-300", {"pantograph_head.histogram_bin"}},
+      {r3, "pantograph_head.working_width=0", {"pantograph_head.working_width"}},
+      {r3, "pantograph_head.on_dewirement=maybe", {"pantograph_head.on_dewirement"}},
+      {r3, "pantograph_head.sway={times: [1, 0], lateral: [0, 0]}", {"pantograph_head.sway.times[1]"}},
+      {r3, "pantograph_head.sway={amplitude: 0.1, times: [0]}", {"pantograph_head.sway"}},
+      {r3, "numerics.gust_lead=5", {"numerics.gust_lead"}},
+      // heads
+      {heads, "pantographs.0.heads.0.stiffness=0", {"pantographs[0].heads[0].stiffness"}},
+      {heads, "pantographs.0.heads.0.collectors.0.offset=5", {"pantographs[0].heads[0].collectors[0].offset"}},
+      {heads, "pantographs.0.heads=[]", {"pantographs[0].heads"}},
+      {heads, "pantographs.0.heads.1.mass=.inf", {"pantographs[0].heads[1].mass"}},
+      {heads, "pantographs.0.heads.0.collectors.0.working_width=1", {"pantographs[0].heads[0].collectors[0].working_width"}},
+      {heads, "pantographs.0.heads.0.aero_coefficient=-1", {"pantographs[0].heads[0].aero_coefficient"}},
+      // where a field cannot act, the speed limit, the offline external pantograph
+      {kReference, "numerics.gust_lead=5", {"numerics.gust_lead"}},
+      {kReference, "pantographs.0.collectors=[{offset: 0, working_width: 1}]", {"pantographs[0].collectors[0].working_width"}},
+      {kReference, "train.speed_kmh=800", {"train.speed_kmh"}},
+      {kReference, "train={speed: 130}", {"train.speed_kmh"}},
+      {kReference, "pantographs=[{name: rig, type: external, static_uplift: 100}]", {"pantographs[0].type"}},
+      // YAML shapes in an override's value
+      {kReference, "name=&a [*a]", {"'*a'"}},
+      {kReference, "numerics=&n {dt: *n}", {"'*n'"}},
+  };
+  for (const SetCase& c : sets)
+    expect_rejected(kSimulatePass, {c.set, {"--scene", c.scene, "--out", "@OUT", "--set", c.set}, c.names}, dir, &count);
+  expect_rejected(kSimulatePass, {"--speed above the wave speed", {"--scene", kReference, "--out", "@OUT", "--speed", "500"}, {"--speed"}},
+                  dir, &count);
+  // YAML shapes in a scene file, through every reader of scene files.
+  const std::string text = slurp(kReference);
+  const std::size_t name_at = text.find("\nname:") + 1, name_end = text.find('\n', name_at);
+  auto with_name = [&](const std::string& line) { return text.substr(0, name_at) + line + text.substr(name_end); };
+  std::string bomb = "name: bomb\na0: &a0 [1, 2, 3, 4, 5, 6, 7, 8, 9]";
+  for (int i = 1; i < 10; ++i) {
+    bomb += "\na" + std::to_string(i) + ": &a" + std::to_string(i) + " [";
+    for (int k = 0; k < 9; ++k) bomb += (k ? ", *a" : "*a") + std::to_string(i - 1);
+    bomb += "]";
+  }
+  struct FileCase {
+    std::string what, body;
+    std::vector<std::string> names;
+  };
+  const std::vector<FileCase> files = {
+      {"anchor containing itself", with_name("name: &r [*r]"), {"'*r'"}},
+      {"alias bomb", with_name(bomb), {"aliases expand"}},
+      {"second document", text + "---\ntrain: {speed_kmh: 100}\n", {"second YAML document"}},
+  };
+  const std::string client = CATENARY_SIM_DEVEL_LIB "/udp_rig_client", hil = CATENARY_SIM_DEVEL_LIB "/catenary_sim_hil_udp";
+  for (const FileCase& f : files) {
+    const std::string path = dir + "/scene.yaml";
+    std::ofstream(path) << f.body;
+    expect_rejected(kSimulatePass, {f.what, {"--scene", path, "--out", "@OUT"}, f.names}, dir, &count);
+    expect_rejected(kElasticity, {"elasticity: " + f.what, {"--scene", path, "--out", "@OUT"}, f.names}, dir, &count);
+    expect_rejected(hil, {"hil_udp: " + f.what, {"--scene", path, "--duration", "1", "--stats", "@OUT"}, f.names}, dir, &count);
+    expect_rejected(client, {"udp_rig_client: " + f.what, {"--pantograph-scene", path}, f.names}, dir, &count);
+  }
+  RecordProperty("cases", count);
+  std::system(("rm -rf '" + dir + "'").c_str());
+}

@@ -211,6 +211,7 @@ constexpr double kModelBytesPerNode = 2048.0;
 // The model's size estimated from the scene before anything is allocated, and the limit (half the
 // machine's physical memory). check_model_memory throws SceneError with both, naming what to change.
 double estimate_model_bytes(const Scene& scene);
+double estimate_wind_field_bytes(const Scene& scene);  // its turbulent wind field's share (0 without)
 double model_memory_limit_bytes();
 void check_model_memory(const Scene& scene);
 

@@ -157,6 +157,11 @@ enum class DampingStep { kHalfStep, kCentred };
 
 constexpr double kMaxGustLead = 60.0;  // s, numerics.gust_lead
 
+// The centred step's dt estimate (stability.cpp) takes the supports' and droppers' explicit
+// damping one node at a time, not coupled with the wires' band, so it is no bound at the estimate
+// itself: the reference line diverged at 0.99 of it and ran at 0.98. Its dt stays below this share.
+constexpr double kCentredMaxSafetyFactor = 0.95;
+
 struct NumericsSpec {
   std::string preset;            // "", fast, balanced, accurate, reference: defaults for the fields below
   double element_length = 0.25;  // m, target; segments between supports and droppers are split evenly
@@ -181,6 +186,8 @@ struct NumericsSpec {
   // endless line is two decay times of the slowest wire's lateral motion, and on a finite line
   // the whole line (no lateral window).
   std::optional<double> gust_lead;
+  // A train faster than the contact wire's wave speed (train_speed_limit) runs only with this set.
+  bool allow_supercritical = false;
 };
 
 struct OutputSpec {
@@ -389,8 +396,35 @@ struct Scene {
   int analysis_last() const;
 };
 
+// The train-speed limit, one definition for the scene files, the tools' --speed, Simulation's
+// speed commands, the nodes and Python. Below the slowest contact wire's wave speed
+// c = sqrt(T / rhoA): at c the wave ahead of the pantograph cannot run away from it and the
+// steady uplift grows without bound; above it the pass is supercritical, outside what the model
+// is built and checked for (numerics.allow_supercritical opts in). Never above kMaxTrainSpeed.
+constexpr double kMaxTrainSpeed = 150.0;  // m/s (540 km/h)
+struct TrainSpeedLimit {
+  double wave_speed = 0.0;  // m/s, sqrt(T / rhoA) of the slowest contact wire
+  double max = 0.0;         // m/s, the largest speed allowed (excluded when below_wave_speed)
+  bool below_wave_speed = true;
+  bool allows(double v) const { return v >= 0.0 && (below_wave_speed ? v < max : v <= max); }  // false for NaN
+  std::string text() const;  // "0 to ... m/s (... km/h) ...", for messages
+};
+TrainSpeedLimit train_speed_limit(const Scene& scene);
+
+// The lateral contact histogram has at most this many bins across pantograph_head.horn_width.
+constexpr double kMaxHistogramBins = 10000.0;
+// The turbulent wind field has at most this many points along the line (wind.turbulence.spacing).
+constexpr double kMaxWindFieldPoints = 100000.0;
+// Points of the turbulent wind field over the stretch of line the pass covers; 0 without turbulence.
+double wind_field_points(const Scene& scene);
+
 // A scene is a few kB of YAML: a file above this is refused before it is read whole.
 constexpr std::size_t kMaxSceneFileBytes = std::size_t{16} << 20;
+
+// Anchors and aliases may repeat a value; the nodes they add (an alias counts its anchor's whole
+// subtree, nested aliases multiply) are limited to this many, and an alias inside its own anchor
+// is refused: either would make every reader walk without end.
+constexpr std::size_t kMaxAliasExpansion = 10000;
 
 // Loads and validates; throws SceneError. `overrides` are "dotted.key=value" pairs applied to the
 // YAML tree before validation (the same keys as the file, e.g. "numerics.element_length=0.125").

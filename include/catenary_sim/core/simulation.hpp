@@ -46,10 +46,14 @@ class Simulation {
 
   static constexpr double kMinExternalForce = -50.0;  // N
   static constexpr double kMaxExternalForce = 2000.0; // N
-  static constexpr double kMaxSpeed = 150.0;   // m/s (540 km/h)
+  static constexpr double kMaxSpeed = kMaxTrainSpeed;  // m/s, the ceiling; below it train_speed_limit (scene.hpp)
   static constexpr double kMaxUplift = 1000.0;  // N
 
+  // A dt above this share of the stability estimate is what a divergence message blames first.
+  static constexpr double kStepNearEstimate = 0.95;
+
  private:
+  std::string divergence_cause() const;
   Model model_;
   State initial_;
   State state_;

@@ -27,11 +27,12 @@ namespace ros_layer {
 // the node; the core keeps its clock running across resets, so stamps never go backwards.
 ros::Time sim_stamp(double sim_time, double offset);
 
-// A cmd/train_speed command (m/s), as both nodes check it before the core's set_target_speed:
-// empty when allowed, else the message naming the topic, the value and the range, e.g.
-// "cmd/train_speed = 200 m/s rejected: allowed 0 to 150 m/s (540 km/h)" (%g numbers; the core's
-// own message has std::to_string's "200.000000").
-std::string speed_command_error(double speed_mps);
+// A cmd/train_speed command (m/s), as the nodes check it before the core's set_target_speed:
+// empty when allowed (train_speed_limit of the scene), else the message naming the topic, the
+// value and the range, e.g. "cmd/train_speed = 200 m/s rejected: allowed 0 to below 127.7 m/s
+// (459.6 km/h), the contact wire's wave speed ..." (%g numbers; the core's own message has
+// std::to_string's "200.000000").
+std::string speed_command_error(const Scene& scene, double speed_mps);
 
 ContactForceArray to_contact_force(const Model& m, const State& s, const ros::Time& stamp, const std::string& frame);
 PantographStateArray to_pantograph_state(const Model& m, const State& s, const ros::Time& stamp,
