@@ -1035,7 +1035,11 @@ double estimate_model_bytes(const Scene& scene) {
     const double wires = sec.contact_wire_count + (sec.messenger ? 1 : 0);
     nodes += wires * per_wire;
   }
-  return kModelBytesPerNode * nodes;
+  // The turbulent wind's series (wind.hpp): a finite line's every point, once in the model; an
+  // endless line's block, in the pass's initial state and its running state.
+  double wind = 0.0;
+  if (scene.wind) wind = (scene.endless ? 2.0 : 1.0) * wind_field_bytes_estimate(*scene.wind, scene.line_length());
+  return kModelBytesPerNode * nodes + wind;
 }
 
 void check_model_memory(const Scene& scene) {
@@ -1047,6 +1051,11 @@ void check_model_memory(const Scene& scene) {
       << " km of line in " << scene.numerics.element_length << " m elements), more than the limit of "
       << limit / (1ull << 30) << " GiB (half of this machine's memory); use a longer numerics.element_length, fewer "
       << "or shorter spans (line.span_count, line.span_length), or line.endless with numerics.window";
+    if (scene.wind && scene.wind->turbulence) {
+      const double wind = wind_field_bytes_estimate(*scene.wind, scene.line_length());
+      s << "; of it the turbulent wind's field about " << wind / (1ull << 30) << " GiB (wind.turbulence.spacing "
+        << scene.wind->turbulence->spacing << " m, max_frequency " << scene.wind->turbulence->max_frequency << " Hz)";
+    }
     throw SceneError(s.str());
   }
 }
