@@ -1043,16 +1043,10 @@ double estimate_model_bytes(const Scene& scene) {
 }
 
 double estimate_wind_field_bytes(const Scene& scene) {
-  const double points = wind_field_points(scene);
-  if (!(points > 0.0)) return 0.0;
-  // The field precomputed over the pass (make_wind_field): per point a float per time sample and
-  // a complex double per frequency (half as many), the samples a power of two covering the pass.
-  const TurbulenceSpec& t = *scene.wind->turbulence;
-  const double dt = 0.5 / t.max_frequency;
-  const double reach = points * t.spacing;
-  const double duration = std::max(60.0, scene.train_speed > 0.0 ? reach / scene.train_speed : 600.0);
-  const double samples = std::min(65536.0, std::max(64.0, std::exp2(std::ceil(std::log2(duration / dt)))));
-  return points * samples * (4.0 + 8.0);
+  // The turbulent wind's series (wind.hpp): a finite line's every point, once in the model; an
+  // endless line's block, in the pass's initial state and its running state.
+  if (!scene.wind || !scene.wind->turbulence) return 0.0;
+  return (scene.endless ? 2.0 : 1.0) * wind_field_bytes_estimate(*scene.wind, scene.line_length());
 }
 
 void check_model_memory(const Scene& scene) {

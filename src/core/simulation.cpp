@@ -30,12 +30,17 @@ const Scene& speed_checked(const Scene& scene) {
 Simulation::Simulation(const Scene& scene) : model_(build_model(speed_checked(scene))) {
   initial_ = make_state(model_);
   if (model_.lateral && !model_.lateral->field.empty()) {
-    // The pass starts in the wind of t = 0: the pantograph's aerodynamic uplift too.
-    std::vector<double> points(static_cast<std::size_t>(model_.lateral->field.points));
-    model_.lateral->field.at_time(0.0, points.data());
-    update_head_wind(model_, initial_, points.data());
+    // The pass starts in the wind of t = 0: the pantograph's aerodynamic uplift too (an endless
+    // line's field: its first points, as its state's will be).
+    const LateralModel& lat = *model_.lateral;
+    WindFieldBuffer start;
+    if (model_.endless) start.reset(lat.field);
+    const WindFieldBuffer& values = model_.endless ? start : lat.field_values;
+    std::vector<double> points(static_cast<std::size_t>(lat.field.held));
+    values.at_time(lat.field, 0.0, points.data());
+    update_head_wind(model_, initial_, &values, points.data());
   } else if (model_.lateral) {
-    update_head_wind(model_, initial_, nullptr);
+    update_head_wind(model_, initial_, nullptr, nullptr);
   }
   solve_initial_state(model_, initial_);
   observe(model_, initial_);

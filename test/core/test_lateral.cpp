@@ -475,6 +475,9 @@ TEST(Lateral, TurbulentFieldMatchesItsSpectrumAndCoherence) {
   w.turbulence = t;
   const WindField f = make_wind_field(w, 0.0, 2000.0, 600.0);
   ASSERT_GT(f.points, 400);
+  ASSERT_EQ(f.held, f.points);
+  WindFieldBuffer values;
+  values.reset(f);
   // The spectrum's integral over the generated band: the target variance, and most of sigma_u^2
   // (the band 1/T..5 Hz leaves out the lowest frequencies' share and the tail above 5 Hz).
   const double sigma = t.intensity * w.speed;
@@ -482,25 +485,29 @@ TEST(Lateral, TurbulentFieldMatchesItsSpectrumAndCoherence) {
   EXPECT_LT(f.sigma_target, sigma);
   auto series = [&](int j) {
     std::vector<double> s(f.samples);
-    for (int n = 0; n < f.samples; ++n) s[n] = f.u[static_cast<std::size_t>(n) * f.points + j];
+    for (int n = 0; n < f.samples; ++n) s[n] = values.sample(f, n, j);
     return s;
   };
+  // The samples' variance: sum A_k^2 / 2, the amplitudes raised by the interpolation's
+  // compensation (wind.hpp; the field between samples has sigma_target, WindField's PSD test).
+  double sample_var = 0.0;
+  for (int k = 1; k < f.frequencies; ++k) sample_var += 0.5 * f.amplitude[k] * f.amplitude[k];
   auto var = [](const std::vector<double>& a) {
     double m = std::accumulate(a.begin(), a.end(), 0.0) / a.size(), v = 0.0;
     for (double x : a) v += (x - m) * (x - m);
     return v / a.size();
   };
-  // Point 0 has unit-modulus coefficients: its variance over one period is the target exactly
-  // (float storage: 1e-5 relative).
-  EXPECT_NEAR(var(series(0)), f.sigma_target * f.sigma_target, 1e-5 * f.sigma_target * f.sigma_target);
+  // Point 0's coefficients have the amplitudes' modulus: its variance over one period is the
+  // samples' exactly (float storage: 1e-5 relative).
+  EXPECT_NEAR(var(series(0)), sample_var, 1e-5 * sample_var);
   // Correlation at separations of 1 and 5 points, averaged over the line, against the coherence
   // weighted by the spectrum: sum S_k df exp(-C f_k dx / U) / sum S_k df. About 100 independent
   // pairs of 2^13 samples: the sample estimate's scatter is a few 1e-3; 0.03 absolute.
   for (int lag : {1, 5}) {
     double num = 0.0, den = 0.0;
     const double df = 1.0 / (f.samples * f.dt);
-    for (int k = 1; k < f.samples / 2; ++k) {
-      const double s = von_karman_spectrum(k * df, w.speed, sigma, t.length_scale) * df;
+    for (int k = 1; k < f.frequencies; ++k) {
+      const double s = 0.5 * f.amplitude[k] * f.amplitude[k];  // the samples' spectrum
       num += s * std::exp(-t.coherence_decay * k * df * lag * t.spacing / w.speed);
       den += s;
     }
@@ -910,10 +917,10 @@ TEST(Lateral, TurbulentWindOnTheEndlessLineFollowsTheStations) {
   const State& s = sim.state();
   const LateralModel& lat = *m.lateral;
   const WindField& f = lat.field;
-  // The refresh time: the last multiple of 0.1 field samples the step passed.
-  std::vector<double> pts(f.points);
-  const double t_refresh = s.lateral.next_wind_update - 0.1 * f.dt;
-  f.at_time(t_refresh, pts.data());
+  // At the last refresh, the points the state holds.
+  const WindFieldBuffer& held = s.lateral.wind_field;
+  std::vector<double> pts(f.held);
+  held.at_time(f, s.lateral.wind_time, pts.data());
   // Over the nodes the window steps (outside it the wind is not needed and not refreshed).
   double worst = 0.0;
   int checked = 0;
@@ -921,8 +928,11 @@ TEST(Lateral, TurbulentWindOnTheEndlessLineFollowsTheStations) {
     for (int i = lat.wires[wi].w_dof + s.lateral.window[wi].lo; i <= lat.wires[wi].w_dof + s.lateral.window[wi].hi; i += 7) {
       const double q = (lat.node_x[i] + s.line_offset - f.x0) / f.dx;
       const int j = std::clamp(static_cast<int>(std::floor(q)), 0, f.points - 2);
+      ASSERT_GE(j, held.first());
+      ASSERT_LT(j + 1, held.end());
       const double a = q - j;
-      const double expected = (lat.wind_speed + (1.0 - a) * pts[j] + a * pts[j + 1]) * lat.wind_normal[i];
+      const double expected =
+          (lat.wind_speed + (1.0 - a) * pts[j - held.first()] + a * pts[j + 1 - held.first()]) * lat.wind_normal[i];
       worst = std::max(worst, std::fabs(s.lateral.wind_speed[i] - expected));
       ++checked;
     }
@@ -945,7 +955,7 @@ TEST(Lateral, TurbulentWindOnTheNodesIsTheFieldAtTheirStations) {
     for (int i = 0; i < 3000; ++i) ASSERT_EQ(sim.step(), StepStatus::kOk);
     const State& s = sim.state();
     std::vector<double> pts(lat.field.points);
-    lat.field.at_time(s.lateral.next_wind_update - 0.1 * lat.field.dt, pts.data());
+    lat.field_values.at_time(lat.field, s.lateral.wind_time, pts.data());
     const bool windowed = lat.windowed;
     int checked = 0, wrong = 0;
     for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {

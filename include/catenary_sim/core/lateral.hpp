@@ -98,6 +98,10 @@ struct LateralModel {
   double wind_speed = 0.0;
   Eigen::VectorXd wind_coefficient, wind_normal;
   WindField field;                 // turbulence (empty: steady wind)
+  // A finite line's field: every point's series, made with the model (an endless line's state
+  // holds its block's points, LateralState::wind_field).
+  WindFieldBuffer field_values;
+  double field_block_end = 0.0;    // m, an endless line's last node in the block (before its offset)
   std::vector<int> field_index;    // per node: the field point at or before it
   std::vector<double> field_weight;  // per node: linear weight of the next point
   // The nodes between two field points as runs of DOFs [begin, end) at field point `point` (a
@@ -178,6 +182,10 @@ struct LateralState {
   std::vector<double> theta, wind_points;
   Eigen::VectorXd wind_speed;    // m/s, per node: the wind's speed normal to the wire now
   double next_wind_update = 0.0;  // s
+  double wind_time = 0.0;         // s, of the last refresh (wind_points' time)
+  // An endless line's turbulent field over its block: generated ahead as the block moves on,
+  // in buffers sized once (wind.hpp). wind_points holds its points' values from first().
+  WindFieldBuffer wind_field;
   std::vector<int> weight_node;
   std::vector<double> weight;
   // Per collector x contact wire: the contact point's lateral position on the strip (wire minus
@@ -213,9 +221,9 @@ struct LateralState {
 
 LateralState make_lateral_state(const Model& model);
 // State::head_wind of every pantograph: the wind's component against the direction of travel at
-// its station, from the mean wind and `field_points` (the turbulent field at one time, WindField
-// ::at_time; null: the mean wind alone). The lateral step calls it with its latest refresh.
-void update_head_wind(const Model& model, State& state, const double* field_points);
+// its station, from the mean wind and `field_points` (the turbulent field's held points at one
+// time, WindFieldBuffer::at_time; null: the mean wind alone). The lateral step calls it with its latest refresh.
+void update_head_wind(const Model& model, State& state, const WindFieldBuffer* field, const double* field_points);
 // Contact point positions of the current state (no step).
 void lateral_observe(const Model& model, State& state);
 // One lateral step of the model's dt (its substeps), after the vertical step moved the state to
