@@ -1,6 +1,6 @@
 // catenary_sim_hil_node: the catenary of a scene against real pantographs (hardware in the loop):
-// hil/contact_force (or hil/contact_wrench) in, hil/contact_point out (see README "Hardware in the
-// loop", launch/hil.launch). The same node runs in a nodelet manager as catenary_sim/HilNodelet.
+// hil/contact_force (or hil/contact_wrench) in, hil/contact_point out (see docs/hil.md,
+// launch/hil.launch). The same node runs in a nodelet manager as catenary_sim/HilNodelet.
 #include <sys/prctl.h>
 
 #include "catenary_sim/ros/hil_node.hpp"

@@ -27,7 +27,7 @@
 namespace catenary_sim {
 namespace ros_layer {
 
-// Private parameters of catenary_sim_hil_node (README "Hardware in the loop").
+// Private parameters of catenary_sim_hil_node (docs/hil.md).
 struct HilParams {
   std::string scene;                // ~scene: scene YAML with at least one `type: external` pantograph
   std::optional<double> speed_kmh;  // ~speed_kmh: overrides the scene's train speed, [0, 540] km/h

@@ -9,7 +9,7 @@
 // the window's end with the held measurement. The windows lock onto the arrivals of a rig that
 // sends on its own clock at the same rate (at most 0.2 % of a period per period); a late answer
 // that belongs to a period already run at its deadline starts nothing. Input older than
-// ~hil/timeout puts the line into the safe hold (README "Hardware in the loop").
+// ~hil/timeout puts the line into the safe hold (docs/hil.md).
 //
 // Slow publications (contact_force, pantograph_state, wire_shape, tf, markers, diagnostics, pass
 // statistics) run on a second thread from snapshots of the state, so that the loop's period holds
