@@ -188,8 +188,15 @@ ForceStatistics PassRecorder::Moments::statistics() const {
 namespace {
 
 // A dropper's force as the explicit integrator decides it: elastic tension, nothing when slack.
-inline double dropper_force(const Dropper& d, const State& s, bool* slack) {
-  const double t = d.static_tension + d.stiffness * (s.u[d.messenger_dof] - s.u[d.contact_dof]);
+// On a 3-D line the stretch has the lean's share (LateralState::dropper_stretch, lateral.hpp):
+// a leaning dropper is a stiff link along itself, so the vertical plane gives way to a change of
+// lean by about as much (u_m - u_c ~ -lean), and the vertical stretch alone would read k times
+// the lean's change (60 N per 0.3 mm) as force or slack the dropper does not have.
+inline double dropper_force(const Model& m, std::size_t k, const State& s, bool* slack) {
+  const Dropper& d = m.droppers[k];
+  double stretch = s.u[d.messenger_dof] - s.u[d.contact_dof];
+  if (m.lateral && !s.lateral.dropper_stretch.empty()) stretch += s.lateral.dropper_stretch[k];
+  const double t = d.static_tension + d.stiffness * stretch;
   *slack = !(t > 0.0);
   return *slack ? 0.0 : t;
 }
@@ -228,7 +235,7 @@ void PassRecorder::record(const Model& m, const State& s) {
     Row dr{s.time, {}};
     dr.values.reserve(droppers_.size());
     bool slack = false;
-    for (const DropperTrack& t : droppers_) dr.values.push_back(dropper_force(m.droppers[t.index], s, &slack));
+    for (const DropperTrack& t : droppers_) dr.values.push_back(dropper_force(m, t.index, s, &slack));
     dropper_rows_.push_back(std::move(dr));
   }
   Row row{s.time, {}};
@@ -251,7 +258,7 @@ void PassRecorder::record_whole(const Model& m, const State& s) {
   const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
   for (DropperTrack& t : droppers_) {
     bool slack = false;
-    const double f = dropper_force(m.droppers[t.index], s, &slack);
+    const double f = dropper_force(m, t.index, s, &slack);
     t.max = std::max(t.max, f);
     t.min = std::min(t.min, f);
     t.slack += slack;
