@@ -563,11 +563,12 @@ TrainSpeedLimit train_speed_limit(const Scene& scene) {
 
 double wind_field_points(const Scene& scene) {
   if (!scene.wind || !scene.wind->turbulence) return 0.0;
-  // The stretch the field must cover: the line, or on an endless line the train's travel and a
-  // block of spans around it (the block's exact length is the model's).
+  // The stretch whose points the field holds at once: a finite line's whole length; an endless
+  // line generates its points as the block moves and holds the block's only, a block of spans
+  // around the train and the lateral plane's gust lead, at most kMaxGustLead s of travel at the
+  // speed ceiling (the block's exact length is the model's).
   double reach = scene.line_length();
-  if (scene.endless && scene.train_end)
-    reach = std::max(0.0, *scene.train_end - scene.train_start.value_or(0.0)) + 16.0 * scene.spans.front();
+  if (scene.endless) reach = 16.0 * scene.spans.front() + kMaxGustLead * kMaxTrainSpeed;
   return std::ceil(reach / scene.wind->turbulence->spacing) + 1.0;
 }
 
@@ -1169,7 +1170,8 @@ void validate(const Scene& s) {
       const double spacing = s.wind->turbulence->spacing, reach = (points - 1.0) * spacing;
       fail("wind.turbulence.spacing", fmt(spacing),
            "allowed [" + fmt4(reach / (kMaxWindFieldPoints - 1.0)) + ", 100] m here: at most " + fmt(kMaxWindFieldPoints) +
-               " field points over the " + fmt4(reach) + " m of line the pass covers (this spacing gives " + fmt4(points) + ")");
+               " field points over the " + fmt4(reach) + " m of line the field holds at once (this spacing gives " + fmt4(points) +
+                   ")");
     }
   }
   if (s.numerics.damping == DampingStep::kCentred && s.numerics.safety_factor > kCentredMaxSafetyFactor)
