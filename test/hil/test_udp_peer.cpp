@@ -15,6 +15,7 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <random>
 #include <regex>
 #include <sstream>
 #include <thread>
@@ -186,6 +187,45 @@ TEST(UdpPeer, ASenderNotOnTheAllowListIsRefused) {
   EXPECT_TRUE(at_other.empty());
   EXPECT_EQ(l.loop.state().external_force[l.loop.external()[0]], 120.0);
   EXPECT_NE(l.log.find("allow-list"), std::string::npos) << l.log;
+}
+
+// Fuzz of sequences and senders (seeded, so every run sends the same packets): the armed rig's
+// numbering jumps ahead, falls back, repeats and restarts at random, while strangers on other
+// ports send measurements of 500 N with random sequence numbers, some just ahead of the rig's.
+// Whatever they send, no stranger gets a contact point or has its force applied, and after the
+// rig's last run of kResyncRun + 2 packets in order the force in effect is the rig's last.
+TEST(UdpPeer, FuzzedSequencesAndSendersNeverTakeTheLoop) {
+  const int run = udp::SequenceTracker::kResyncRun;
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    std::mt19937 rng(seed);
+    Loop l(Loop::loopback());
+    UdpSocket rig("127.0.0.1", 0, "rig"), s1("127.0.0.1", 0, "stranger"), s2("127.0.0.1", 0, "stranger");
+    UdpSocket* strangers[] = {&s1, &s2};
+    std::uint32_t seq = 1;
+    send(rig, l.to, seq, -1.0);  // armed with the rig's hello
+    for (int k = 0; k < 300; ++k) {
+      switch (rng() % 8) {
+        case 0: seq += 1 + rng() % 100000; break;   // a jump ahead
+        case 1: seq = 1 + rng() % (seq + 1); break;  // a fall back, or a restart from low numbers
+        case 2: break;                               // a repeat
+        default: ++seq;                              // in order
+      }
+      send(rig, l.to, seq, 120.0 + (k % 7));
+      if (rng() % 2) {
+        UdpSocket* s = strangers[rng() % 2];
+        const std::uint32_t sseq = (rng() % 3 == 0) ? seq + 1 : static_cast<std::uint32_t>(rng());
+        send(*s, l.to, sseq, 500.0);
+      }
+    }
+    double last = 0.0;
+    for (int k = 0; k < run + 2; ++k) send(rig, l.to, ++seq, last = 140.0 + k);
+    const auto at_rig = contact_points(rig, 0.0), at_s1 = contact_points(s1, 0.0), at_s2 = contact_points(s2);
+    l.stop();
+    EXPECT_TRUE(at_s1.empty() && at_s2.empty()) << "seed " << seed << ": a stranger got contact points";
+    for (const auto& p : at_rig) ASSERT_LT(p.pantograph[0].applied_force, 500.0) << "seed " << seed;
+    EXPECT_EQ(l.loop.state().external_force[l.loop.external()[0]], last) << "seed " << seed << "\n" << l.log;
+    EXPECT_GT(l.skin.foreign(), 0u) << "seed " << seed;
+  }
 }
 
 TEST(UdpPeer, AllowListEntriesAreCheckedNamingTheOption) {
