@@ -33,11 +33,19 @@ def sourced(cmd, setup):
 def install_space():
     if not os.path.isdir(os.path.join(WS, "build")):
         pytest.fail(".ws/build is missing: build first (scripts/build)")
-    r = subprocess.run(["make", "-C", os.path.join(WS, "build"), "install"], env=clean_env(),
-                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=1800)
-    assert r.returncode == 0, r.stdout[-4000:]
-    assert os.path.isfile(os.path.join(INSTALL, "setup.bash"))
-    return INSTALL
+    # The install space lies inside the package's own tree (.ws/install), where `rosrun
+    # catenary_sim TOOL` would then find each tool twice and refuse to choose: the test removes
+    # the install space it made once it is done.
+    made = not os.path.exists(INSTALL)
+    try:
+        r = subprocess.run(["make", "-C", os.path.join(WS, "build"), "install"], env=clean_env(),
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=1800)
+        assert r.returncode == 0, r.stdout[-4000:]
+        assert os.path.isfile(os.path.join(INSTALL, "setup.bash"))
+        yield INSTALL
+    finally:
+        if made:
+            shutil.rmtree(INSTALL, ignore_errors=True)
 
 
 def test_a_downstream_package_builds_against_the_install_space_and_runs_a_pass(install_space):
