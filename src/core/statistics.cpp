@@ -201,6 +201,20 @@ inline double dropper_force(const Model& m, std::size_t k, const State& s, bool*
   return *slack ? 0.0 : t;
 }
 
+// The standards' permissible mean force Fm(v) against the pass's (filtered) mean, at the section's
+// mean speed v; none without a target or with no mean.
+std::optional<PantographStatistics::TargetMean> target_mean(const Model& m, std::size_t p, double v, double mean) {
+  const std::optional<TargetMeanForce>& target = m.scene.pantographs[p].target_mean_force;
+  if (!target || !std::isfinite(v) || !std::isfinite(mean)) return std::nullopt;
+  PantographStatistics::TargetMean t;
+  t.speed_mps = v;
+  t.target = target->at(v);
+  t.difference = mean - t.target;
+  t.tolerance = target->tolerance;
+  t.within = !t.tolerance || std::fabs(t.difference) <= *t.tolerance;
+  return t;
+}
+
 // Mean train speed over the samples in the section (m/s).
 double section_speed(const std::vector<double>& t, const std::vector<double>& x, double x0, double x1) {
   std::size_t first = t.size(), last = 0;
@@ -551,16 +565,7 @@ std::vector<PantographStatistics> PassRecorder::running_statistics(const Model& 
       st.measured.max_abs_difference = r.diff_max;
     }
     st.measured.bandwidth_hz = m.scene.output.sensor_bandwidth;
-    const std::optional<TargetMeanForce>& target = m.scene.pantographs[p].target_mean_force;
-    if (target && std::isfinite(v) && std::isfinite(st.filtered.mean)) {
-      PantographStatistics::TargetMean t;
-      t.speed_mps = v;
-      t.target = target->at(v);
-      t.difference = st.filtered.mean - t.target;
-      t.tolerance = target->tolerance;
-      t.within = !t.tolerance || std::fabs(t.difference) <= *t.tolerance;
-      st.target_mean = t;
-    }
+    st.target_mean = target_mean(m, p, v, st.filtered.mean);
     out.push_back(st);
   }
   return out;
@@ -652,18 +657,7 @@ std::vector<PantographStatistics> PassRecorder::statistics(const Model& m, doubl
     for (const ContactLossEvent& e : st.loss_events) st.longest_loss_s = std::max(st.longest_loss_s, e.duration);
     st.spectrum = spectrum_summary(m, section_speed(time_, position_[p], x0, x1), spectrum(m, p));
     measured_statistics(m, p, x0, x1, filtered, &st.measured);
-    const std::optional<TargetMeanForce>& target = m.scene.pantographs[p].target_mean_force;
-    const double v = section_speed(time_, position_[p], x0, x1);
-    if (target && std::isfinite(v) && std::isfinite(st.filtered.mean)) {
-      // The standards' permissible mean force against the pass's (filtered) mean, at the mean speed.
-      PantographStatistics::TargetMean t;
-      t.speed_mps = v;
-      t.target = target->at(v);
-      t.difference = st.filtered.mean - t.target;
-      t.tolerance = target->tolerance;
-      t.within = !t.tolerance || std::fabs(t.difference) <= *t.tolerance;
-      st.target_mean = t;
-    }
+    st.target_mean = target_mean(m, p, section_speed(time_, position_[p], x0, x1), st.filtered.mean);
     out.push_back(st);
   }
   return out;

@@ -15,17 +15,14 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/statistics.hpp"
 #include "catenary_sim/core/wind.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
-const std::string kEndless = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml";
-const std::string kFinite = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+const std::string kEndless = test_scenes::kConfigDir + "reference_55m_endless.yaml";
+const std::string kFinite = test_scenes::kConfigDir + "reference_55m.yaml";
 
 // Resident set size of this process (bytes), from /proc/self/statm.
 double rss_bytes() {
