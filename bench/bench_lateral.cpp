@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "catenary_sim/core/lateral_statistics.hpp"
+#include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."

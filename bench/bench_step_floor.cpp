@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
-#include "../src/core/wire_lanes.hpp"  // the step's kernel, timed alone
+#include "../src/core/engine/wire_lanes.hpp"  // the step's kernel, timed alone
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."

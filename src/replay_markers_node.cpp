@@ -26,10 +26,10 @@
 #include "catenary_sim/ContactForceArray.h"
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/WireShapeArray.h"
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/ros/conversions.hpp"
-#include "catenary_sim/core/lateral.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/ros/replay.hpp"
 
 using namespace catenary_sim;

@@ -1,12 +1,12 @@
 #include "catenary_sim/core/simulation.hpp"
 
-#include "format.hpp"
+#include "util/format.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "catenary_sim/core/statics.hpp"
+#include "catenary_sim/core/model/statics.hpp"
 
 namespace catenary_sim {
 

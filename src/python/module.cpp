@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "../core/format.hpp"
+#include "../core/util/format.hpp"
 
-#include "catenary_sim/core/output_files.hpp"
-#include "catenary_sim/core/pass_files.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
+#include "catenary_sim/core/output/pass_files.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 
 namespace py = pybind11;
 using namespace catenary_sim;

@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "catenary_sim/ContactForceArray.h"
-#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/hil/report.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 

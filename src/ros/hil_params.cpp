@@ -5,7 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/ros/hil.hpp"
 #include "catenary_sim/ros/params.hpp"
 

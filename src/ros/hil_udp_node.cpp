@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "catenary_sim/ContactPointArray.h"
-#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/hil/report.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/ros/params.hpp"

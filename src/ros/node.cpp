@@ -17,8 +17,8 @@
 #include "catenary_sim/LineState.h"
 #include "catenary_sim/PassEvent.h"
 #include "catenary_sim/WireShapeArray.h"
-#include "catenary_sim/core/output_files.hpp"
-#include "catenary_sim/core/pass_files.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
+#include "catenary_sim/core/output/pass_files.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 
 namespace catenary_sim {

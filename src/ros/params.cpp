@@ -12,9 +12,9 @@
 #include <cstdio>
 #include <sstream>
 
-#include "catenary_sim/core/output_files.hpp"
-#include "catenary_sim/core/pass_files.hpp"
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
+#include "catenary_sim/core/output/pass_files.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {

@@ -1,6 +1,6 @@
 #include "catenary_sim/ros/replay.hpp"
 
-#include "catenary_sim/core/lateral.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "catenary_sim/MeasuredContactForce.h"
-#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/ros/params.hpp"
 #include "catenary_sim/hil/udp_loop.hpp"
 

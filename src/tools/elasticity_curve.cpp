@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/output_files.hpp"
-#include "catenary_sim/core/statics.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
+#include "catenary_sim/core/model/statics.hpp"
 #include "cli_checks.hpp"
 
 using namespace catenary_sim;

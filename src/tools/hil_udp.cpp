@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/hil/realtime.hpp"
 #include "catenary_sim/hil/report.hpp"

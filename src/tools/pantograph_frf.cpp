@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "catenary_sim/core/output_files.hpp"
-#include "catenary_sim/core/pantograph_frf.hpp"
-#include "catenary_sim/core/pass_files.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
+#include "catenary_sim/core/analysis/pantograph_frf.hpp"
+#include "catenary_sim/core/output/pass_files.hpp"
 #include "cli_checks.hpp"
 
 using namespace catenary_sim;

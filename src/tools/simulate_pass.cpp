@@ -23,11 +23,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "catenary_sim/core/lateral_statistics.hpp"
-#include "catenary_sim/core/output_files.hpp"
-#include "catenary_sim/core/pass_files.hpp"
+#include "catenary_sim/core/output/lateral_statistics.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
+#include "catenary_sim/core/output/pass_files.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/ros/pass_bag.hpp"
 #include "cli_checks.hpp"

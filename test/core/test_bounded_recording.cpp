@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "catenary_sim/core/lateral_statistics.hpp"
+#include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
-#include "catenary_sim/core/wind.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
+#include "catenary_sim/core/model/wind_field.hpp"
 #include "../support/scenes.hpp"
 
 using namespace catenary_sim;

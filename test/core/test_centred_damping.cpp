@@ -1,4 +1,4 @@
-// The explicit step with centred Rayleigh damping (numerics.damping: centred, src/core/centred_damping.hpp):
+// The explicit step with centred Rayleigh damping (numerics.damping: centred, src/core/engine/centred_damping.hpp):
 //   M (v_{n+1/2} - v_{n-1/2}) / dt = R_n - C (v_{n+1/2} + v_{n-1/2}) / 2 - K u_n,  C = alpha M + beta K,
 // where the paper's step (eq. 19-21, `half_step`) takes C v_{n-1/2}. Checked against:
 //  (a) the exact solution of the scheme on one mode of a pinned wire (the discrete recurrence);
@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statics.hpp"
+#include "catenary_sim/core/model/statics.hpp"
 #include "../support/scenes.hpp"
 
 using namespace catenary_sim;

@@ -118,7 +118,7 @@ TEST(Allocation, ThreeDimensionalStepNeverAllocatesAndRepeatsItsBits) {
     EXPECT_EQ(g_allocations.load(), 0) << "step() allocated on " << c.file << " with " << c.overrides.size()
                                        << " overrides";
     // The endless line's block moved in the steps counted: its turbulent field generated the
-    // points ahead (wind.hpp) in them.
+    // points ahead (wind_field.hpp) in them.
     if (a.model().endless) {
       EXPECT_GT(a.state().line_offset, offset);
     }

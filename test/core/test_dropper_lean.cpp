@@ -20,10 +20,10 @@
 #include <string>
 #include <vector>
 
-#include "catenary_sim/core/lateral.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statics.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 
 using namespace catenary_sim;
 
@@ -118,7 +118,7 @@ struct LeaningStatics {
   }
 };
 
-// The tension the integrator applies (integrator.cpp: the vertical stretch plus the lean's).
+// The tension the integrator applies (engine/step.cpp: the vertical stretch plus the lean's).
 double applied_tension(const Model& m, const State& s, int k) {
   const Dropper& d = m.droppers[k];
   const double e = s.u[d.messenger_dof] - s.u[d.contact_dof] + s.lateral.dropper_stretch[k];

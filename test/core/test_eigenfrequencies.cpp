@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/scene.hpp"
-#include "catenary_sim/core/stability.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
+#include "catenary_sim/core/model/stability.hpp"
 
 namespace cs = catenary_sim;
 

@@ -17,9 +17,9 @@
 #include <utility>
 #include <vector>
 
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/scene.hpp"
-#include "catenary_sim/core/state.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
+#include "catenary_sim/core/engine/state.hpp"
 
 namespace cs = catenary_sim;
 

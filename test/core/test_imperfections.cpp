@@ -9,9 +9,9 @@
 #include <sstream>
 #include <string>
 
-#include "catenary_sim/core/outputs.hpp"
+#include "catenary_sim/core/output/line_measures.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."

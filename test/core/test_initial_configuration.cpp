@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/state.hpp"
+#include "catenary_sim/core/engine/state.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "/work/main"

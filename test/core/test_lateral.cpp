@@ -1,4 +1,4 @@
-// The 3-D line (lateral.hpp, wind.hpp): static blow-off and lateral eigenfrequencies against the
+// The 3-D line (lateral.hpp, wind_field.hpp): static blow-off and lateral eigenfrequencies against the
 // tensioned-beam closed forms, the stagger's chords under the pantograph, pull-off on a curve,
 // dewirement where the static blow-off puts it, energy without damping, the turbulent field's
 // statistics against its spectrum and coherence, the 2-D results untouched, and bad input.
@@ -9,11 +9,11 @@
 #include <map>
 #include <numeric>
 
-#include "catenary_sim/core/lateral.hpp"
-#include "catenary_sim/core/lateral_statistics.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
+#include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statics.hpp"
-#include "catenary_sim/core/wind.hpp"
+#include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/model/wind_field.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."
@@ -489,7 +489,7 @@ TEST(Lateral, TurbulentFieldMatchesItsSpectrumAndCoherence) {
     return s;
   };
   // The samples' variance: sum A_k^2 / 2, the amplitudes raised by the interpolation's
-  // compensation (wind.hpp; the field between samples has sigma_target, WindField's PSD test).
+  // compensation (wind_field.hpp; the field between samples has sigma_target, WindField's PSD test).
   double sample_var = 0.0;
   for (int k = 1; k < f.frequencies; ++k) sample_var += 0.5 * f.amplitude[k] * f.amplitude[k];
   auto var = [](const std::vector<double>& a) {

@@ -17,8 +17,8 @@
 #include <tuple>
 #include <vector>
 
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
 
 namespace cs = catenary_sim;

@@ -15,7 +15,7 @@
 #include <sstream>
 #include <string>
 
-#include "catenary_sim/core/output_files.hpp"
+#include "catenary_sim/core/output/output_files.hpp"
 
 using namespace catenary_sim;
 

@@ -6,7 +6,7 @@
 #include <map>
 #include <vector>
 
-#include "catenary_sim/core/outputs.hpp"
+#include "catenary_sim/core/output/line_measures.hpp"
 
 using namespace catenary_sim;
 

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <complex>
 
-#include "catenary_sim/core/pantograph_frf.hpp"
+#include "catenary_sim/core/analysis/pantograph_frf.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."

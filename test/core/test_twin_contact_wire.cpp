@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statics.hpp"
+#include "catenary_sim/core/model/statics.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."

@@ -1,4 +1,4 @@
-// The turbulent wind field (wind.hpp): its spectrum as the wires feel it, and its memory on a
+// The turbulent wind field (wind_field.hpp): its spectrum as the wires feel it, and its memory on a
 // line that runs on.
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 #include <complex>
 #include <vector>
 
-#include "catenary_sim/core/lateral.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/wind.hpp"
+#include "catenary_sim/core/model/wind_field.hpp"
 
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."
@@ -126,7 +126,7 @@ TEST(WindField, EndlessLinesFieldHasABoundedSizeWhateverTheDistance) {
   const WindField& f = m.lateral->field;
   ASSERT_FALSE(f.empty());
   const WindFieldBuffer& held = sim.state().lateral.wind_field;
-  // The points held: the block's and those around its ends (wind.cpp), against the pass's.
+  // The points held: the block's and those around its ends (wind_field.cpp), against the pass's.
   EXPECT_LE(f.held, static_cast<int>(std::ceil(m.line_length / f.dx)) + 3);
   EXPECT_GT(f.points, 30 * f.held);
   const std::size_t bytes = held.bytes();

@@ -13,8 +13,8 @@
 #include <sstream>
 #include <string>
 
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 
 namespace cs = catenary_sim;
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/hil/rig_pantograph.hpp"
 

@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/hil/report.hpp"
 #include "catenary_sim/hil/udp_loop.hpp"

@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/ros/hil.hpp"
 #include "catenary_sim/ros/virtual_rig.hpp"
 

@@ -7,7 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 
 // The source tree: the build defines it for the tests.
 #ifndef CATENARY_SIM_SOURCE_DIR

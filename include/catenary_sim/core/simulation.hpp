@@ -4,9 +4,9 @@
 
 #include <string>
 
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/scene.hpp"
-#include "catenary_sim/core/state.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
+#include "catenary_sim/core/engine/state.hpp"
 
 namespace catenary_sim {
 

@@ -27,11 +27,11 @@
 #include <utility>
 #include <vector>
 
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/state.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/engine/state.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 
 namespace catenary_sim {
 namespace hil {

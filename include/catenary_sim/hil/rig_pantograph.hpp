@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 
 namespace catenary_sim {
 namespace hil {

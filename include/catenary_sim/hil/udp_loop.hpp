@@ -29,7 +29,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/hil/rig_pantograph.hpp"
 #include "catenary_sim/hil/spsc_ring.hpp"

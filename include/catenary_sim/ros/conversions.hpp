@@ -15,10 +15,10 @@
 #include "catenary_sim/LineState.h"
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/WireShapeArray.h"
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/scene.hpp"
-#include "catenary_sim/core/state.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
+#include "catenary_sim/core/engine/state.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {

@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "catenary_sim/ContactPointArray.h"
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/scene.hpp"
-#include "catenary_sim/core/state.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
+#include "catenary_sim/core/engine/state.hpp"
 #include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/hil/realtime.hpp"
 #include "catenary_sim/ros/params.hpp"

@@ -52,7 +52,7 @@
 #include "catenary_sim/ContactPointArray.h"
 #include "catenary_sim/MeasuredContactForce.h"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/ros/hil.hpp"
 

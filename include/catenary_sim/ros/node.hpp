@@ -18,9 +18,9 @@
 
 #include "catenary_sim/NodeConfig.h"
 #include "catenary_sim/Step.h"
-#include "catenary_sim/core/lateral_statistics.hpp"
+#include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/ros/params.hpp"
 

@@ -7,9 +7,9 @@
 
 #include <string>
 
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/state.hpp"
-#include "catenary_sim/core/statistics.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/engine/state.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {

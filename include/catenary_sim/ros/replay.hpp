@@ -8,8 +8,8 @@
 #include "catenary_sim/ContactForceArray.h"
 #include "catenary_sim/PantographStateArray.h"
 #include "catenary_sim/WireShapeArray.h"
-#include "catenary_sim/core/model.hpp"
-#include "catenary_sim/core/state.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/engine/state.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {

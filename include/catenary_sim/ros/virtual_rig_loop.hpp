@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "catenary_sim/ContactPointArray.h"
-#include "catenary_sim/core/scene.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/ros/hil.hpp"
 #include "catenary_sim/ros/virtual_rig.hpp"
 

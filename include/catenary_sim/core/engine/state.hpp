@@ -1,0 +1,149 @@
+// The mutable state of a pass (MuJoCo's mjData to the Model's mjModel): displacements, half-step
+// velocities, train kinematics, commands in effect, the contact and dropper activity of the last
+// step, and preallocated workspace so that step() never allocates.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "catenary_sim/core/model/lateral.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/engine/wire_window.hpp"
+
+namespace catenary_sim {
+
+enum class StepStatus {
+  kOk = 0,
+  kDiverged,   // a displacement would leave the divergence limit or become NaN/inf: the run is
+               // stopped and the state keeps the last good step
+  kFinished,   // the train front reached the end of the pass; step() does nothing more
+  kDewired,    // a contact point left the strip's working width and the scene says stop (3-D line)
+};
+
+// Implicit integrator: slack droppers it can take out of its matrix at once (each keeps a column
+// of n values); more stops the run with a message. Active-set passes per step at most.
+constexpr std::size_t kSlackDropperCapacity = 64;
+constexpr int kMaxActiveSetPasses = 4;
+
+struct State {
+  double time = 0.0;       // s, simulation time since the pass started
+  std::int64_t steps = 0;
+  double front = 0.0;      // m, train front position (a block station on an endless line)
+  double line_offset = 0.0;  // m, station along the line of the model's station 0 (endless line)
+  double speed = 0.0;      // m/s, train speed now
+  double target_speed = 0.0;      // m/s, commanded speed the train accelerates toward
+  double max_acceleration = 0.0;  // m/s^2, |dv/dt| limit toward target_speed (0: jump)
+  std::vector<double> uplift;     // N, static uplift in effect per pantograph (eq. 9 thrust F)
+  std::vector<double> external_force;  // N, force of an external (hardware-in-the-loop) pantograph
+  // m/s per pantograph, the wind against the direction of travel at the pantograph (3-D line with
+  // wind: mean plus turbulence, set by the lateral step; else 0). The aerodynamic uplift a v^2 is
+  // measured in still air: with wind it takes the speed through the air, v + head wind.
+  std::vector<double> head_wind;
+
+  // q of eq. 21 as displacements from the design state, and q_dot_{n-1/2} (eq. 20, 26); with the
+  // implicit integrator v is the velocity at the state's time.
+  Eigen::VectorXd u, v;
+  Eigen::VectorXd accel;  // q'' of the last step (at its start, t_n), for observers
+
+  // Observations of this state (time, front, u): filled by step() and observe().
+  std::vector<double> contact_force;     // N, >= 0, per collector x contact wire (eq. 22, 25)
+  std::vector<double> collector_height;  // m, weighted wire height under each collector (eq. 12)
+  std::vector<std::uint8_t> dropper_slack;  // 1 where the dropper carried no tension
+
+  StepStatus status = StepStatus::kOk;
+  int diverged_dof = -1;
+
+  // Moving window (numerics.window): the supports it spans and what it integrates.
+  int window_first_support = -1, window_last_support = -1;
+  std::vector<WireWindow> window;
+  std::vector<int> window_droppers, window_springs;  // the first *_count entries are in the window
+  int window_dropper_count = 0, window_spring_count = 0;
+
+  // Workspace, sized once by make_state().
+  Eigen::VectorXd force, z;
+  // Fused explicit step: the new displacements and velocities (swapped in, or copied back in the
+  // window, once all are good); per node and lane of every wire pack the sweep's record (rotation,
+  // z, load less damping, band force: src/core/engine/wire_lanes.hpp); the window's LDL^T factors laid
+  // out as WireLanes::factors; the contact wire's nodes under the collectors this step.
+  Eigen::VectorXd u_next, v_next;
+  std::vector<double> sweep, sweep_factors;
+  std::vector<int> point_node;
+  // Implicit integrator only: the prediction, and the rank-1 corrections of the factorised
+  // matrix A (contacts in touch add k0 g g^T, slack droppers take their stiffness out again),
+  // each with its sparse g, its stiffness factor and its column A^-1 g.
+  Eigen::VectorXd u_pred, v_pred, solve_tmp;
+  std::vector<double> contact_solve;           // A^-1 g per contact in touch (they move: every step)
+  std::vector<double> dropper_solve;           // A^-1 g per cache slot (A never changes: kept)
+  std::vector<int> dropper_slot;               // per dropper: its cache slot, -1 if none
+  std::vector<int> slot_dropper;               // per slot: its dropper, -1 if free
+  std::vector<std::int64_t> slot_used;         // per slot: the step that last used it
+  std::vector<int> correction_g_index, correction_g_count;
+  std::vector<double> correction_g_value, correction_factor, correction_small;
+  std::vector<const double*> correction_solve;
+  bool active_set_full = false;  // more droppers slack at once than the cache holds: run stopped
+  std::vector<double> theta;
+  std::vector<int> weight_node;
+  std::vector<double> weight;
+
+  // 3-D line (Model::lateral): the wires' lateral planes; empty without one.
+  LateralState lateral;
+};
+
+// A state sized for the model with zero displacement (the design state, no pantograph force).
+State make_state(const Model& model);
+
+// Advances one fixed dt with the explicit central differences of eq. 19-21 (half-step velocity).
+// Never reads a clock, never allocates, never logs. Returns the state's status.
+StepStatus step(const Model& model, State& state);
+
+// The instruction set the fused explicit step's runtime dispatch chose on this machine:
+// "x86-64-v4" (AVX-512), "x86-64-v3" (AVX2) or "default" (the x86-64 baseline). All give the
+// same bits.
+const char* sweep_pack_isa();
+
+// Fills the observations (contact forces, collector heights) for the current state without
+// advancing it, e.g. for the initial state.
+void observe(const Model& model, State& state);
+
+// Motion of the contact wire under one pantograph's collectors, per collector and contact wire:
+// what a hardware-in-the-loop rig must impose on a real pantograph (eq. 12 weights).
+struct ContactPointMotion {
+  int collector = 0, wire = 0;   // indices into Model::collectors and Model::contact_wires
+  bool on_wire = false;          // false: the collector is not under this wire
+  double height = 0.0;           // m, absolute
+  double velocity = 0.0;         // m/s, of the wire point under the collector, at the state's time
+                                 // (half-step velocity + dt/2 acceleration)
+  double acceleration = 0.0;     // m/s^2, of the wire point under the collector (last step)
+  double path_velocity = 0.0;    // m/s, rate of change of `height` seen by the moving pantograph:
+                                 // velocity + train speed x wire slope
+  double force = 0.0;            // N, contact force on this wire
+};
+void contact_point_motion(const Model& model, const State& state, int pantograph, std::vector<ContactPointMotion>& out);
+
+// Absolute height of a contact collector's pantograph head (m); NaN for a moving force. With
+// several heads: their mean.
+double head_height(const Model& model, const State& state, int pantograph);
+// Heads of a pantograph: 0 for a moving force, 1 for a chain without `heads` (its first mass),
+// else one per head on its own suspension.
+int head_count(const Model& model, int pantograph);
+// Absolute height (m) of one head, 0 <= head < head_count; NaN for a moving force.
+double head_height(const Model& model, const State& state, int pantograph, int head);
+// The pantograph's speed through the air, squared (m^2/s^2): (v + head wind)^2, the v^2 of every
+// aerodynamic uplift a v^2.
+inline double air_speed_squared(const State& state, std::size_t pantograph) {
+  const double v = state.speed + state.head_wind[pantograph];
+  return v * v;
+}
+// The head's own aerodynamic uplift at the state's air speed (N): a_h v^2 for the knee direction;
+// 0 for a chain without `heads` (its aero acts on the frame) and for a moving force.
+double head_aero_uplift(const Model& model, const State& state, int pantograph, int head);
+// The aerodynamic uplift on the frame (N): a v^2 for the knee direction, at the state's air speed.
+double frame_aero_uplift(const Model& model, const State& state, int pantograph);
+// Position of a pantograph's reference point along the line (m).
+double pantograph_position(const Model& model, const State& state, int pantograph);
+// Sum of the contact forces of one pantograph over its collectors and the contact wires (N).
+double total_contact_force(const Model& model, const State& state, int pantograph);
+
+}  // namespace catenary_sim

@@ -1,0 +1,264 @@
+// The constant model built from a scene: DOF layout, lumped masses, banded stiffness of the
+// wires, supports, droppers, pantographs and collectors, the design (static) geometry and the
+// stability limit. Like MuJoCo's mjModel it never changes during a pass; everything that
+// changes lives in State (state.hpp).
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/scene/scene.hpp"
+
+namespace catenary_sim {
+
+struct LateralModel;  // lateral.hpp: the 3-D line's lateral plane
+
+// One tensioned wire of a tension section, meshed with pre-stressed Euler-Bernoulli (Hermite)
+// beam elements (eq. 3). Its stiffness is stored as a block-tridiagonal band of 2x2 blocks
+// (w, theta per node): that is exactly the bandwidth of a beam, so a product costs O(nodes).
+struct Wire {
+  std::string name;
+  int section = 0;               // tension section it belongs to
+  bool is_contact_wire = false;
+  WireSpec spec;
+  std::vector<double> x;         // m, node stations along the line
+  std::vector<double> height;    // m, design height of each node (static shape, no pantograph)
+  std::vector<double> slope;     // rad, design rotation of each node
+  int w_dof = 0;                 // global index of node 0's vertical displacement
+  int theta_dof = -1;            // global index of node 0's rotation; -1: rotations condensed
+  // K band: diagonal blocks per node and the coupling block of element e (node e -> e+1).
+  std::vector<double> d_ww, d_wt, d_tt;        // size nodes
+  std::vector<double> e_ww, e_wt, e_tw, e_tt;  // size nodes-1; e_wt = K(w_e, theta_e+1), e_tw = K(theta_e, w_e+1)
+  // Condensed rotations: LDL^T factors of the tridiagonal K_theta_theta, reused every step.
+  std::vector<double> tt_inv_pivot, tt_lower;
+  std::vector<int> support_nodes;  // node index of each support of its section, in order
+
+  int nodes() const { return static_cast<int>(x.size()); }
+  // Index of the element containing station xs (clamped to the wire), by bisection.
+  int element_at(double xs) const;
+};
+
+// Tension-only dropper between a contact-wire node and a messenger node.
+struct Dropper {
+  int contact_dof = 0, messenger_dof = 0;
+  int section = 0, span = 0;    // tension section, span index within it
+  double x = 0.0;               // m
+  double stiffness = 0.0;       // N/m, EA / unstretched length
+  double static_tension = 0.0;  // N, in the design state
+  double length = 0.0;          // m, design (stretched) length
+  double unstretched_length = 0.0;
+};
+
+// An elastic support: steady arm on the contact wire (eq. 4) or messenger support spring.
+struct SupportSpring {
+  int dof = 0;
+  double stiffness = 0.0;     // N/m
+  double static_force = 0.0;  // N, f0 of eq. 4 (balanced in the constant load vector)
+  double x = 0.0;
+  int span_index = 0;         // index of the support along the line (Model::support_x); span i starts there
+  bool steady_arm = false;
+  int section_support = 0;    // index of the support within its tension section
+};
+
+// A tension section as built: its wires and the raised contact-wire supports of its transition
+// spans (d of eq. 8, 0 where the span is a current span).
+struct Section {
+  double start = 0.0, end = 0.0;       // m
+  double rise_first = 0.0, rise_last = 0.0;  // m, at its first and last support
+  std::vector<int> wires;              // indices into Model::wires
+  int messenger = -1;                  // index into Model::wires, -1 without a messenger
+};
+
+struct Collector {
+  int pantograph = 0;
+  double offset = 0.0;  // m along the track from the pantograph reference point
+  int head = -1;        // index into Pantograph::heads; -1: on the chain's first mass
+  int dof = -1;         // the mass it presses (eq. 22: k0 (y_dof - y_wire)); -1 for a moving force
+  double half_working_width = 0.0;  // m, half the strip's working width (3-D line: beyond it, a dewirement)
+};
+
+// A head on its own suspension to the top frame mass (HeadSpec).
+struct Head {
+  int dof = 0;
+  double mass = 0.0, stiffness = 0.0, damping = 0.0;
+  double aero_coefficient = 0.0;  // N s^2/m^2, for the pantograph's knee direction
+  double preload = 0.0;           // N: compression of the suspension at displacement 0 (its static share)
+  double reference_height = 0.0;  // m: absolute height at displacement 0
+  std::vector<int> collectors;    // indices into Model::collectors
+};
+
+struct Pantograph {
+  std::string name;
+  double position = 0.0;  // m behind the train front
+  bool moving_force = false;  // no masses: the force is given (uplift, or the rig's for external)
+  bool external = false;      // hardware-in-the-loop: the force comes from a real pantograph
+  int first_dof = -1;     // head DOF; masses follow down the chain
+  std::vector<double> masses, stiffness, damping;
+  double static_uplift = 0.0, aero_coefficient = 0.0;  // aero: the frame's, for the knee direction
+  std::vector<int> collectors;  // indices into Model::collectors
+  std::vector<Head> heads;      // empty: the first chain mass is the head (DOFs after the chain's)
+  double reference_height = 0.0;  // m: absolute head height at displacement 0
+  std::vector<double> spring_preload;  // N: compression of each spring at displacement 0
+  int masses_count() const { return static_cast<int>(masses.size()); }
+  int dof_count() const { return masses_count() + static_cast<int>(heads.size()); }
+  // Absolute height at displacement 0 of the mass collector `ci` presses.
+  double contact_reference(const Collector& c) const { return c.head < 0 ? reference_height : heads[c.head].reference_height; }
+};
+
+// The Newmark matrix M + dt/2 C + dt^2/4 K0, factorised once: L D L^T of P A P^T with L unit
+// lower triangular (strict part in compressed columns).
+struct ImplicitMatrix {
+  std::vector<int> perm;           // P as indices: (P b)[perm[i]] = b[i]
+  std::vector<int> col, row;       // CSC of the strict lower part of L
+  std::vector<double> val;
+  std::vector<double> inv_diag;    // 1 / D
+};
+
+// Wires packed for the fused explicit step (condensed rotations): one wire, or two on the same node
+// stations (a section's contact wire and messenger) side by side, so that their independent
+// recurrences (the condensation's tridiagonal sweeps) run in the two lanes of one vector register.
+// Node i of lane k is entry i * lanes + k. Copies of the wires' band, factors, load and masses.
+struct WireLanes {
+  int lanes = 1;
+  int wire[2] = {-1, -1};  // indices into Model::wires
+  int nodes = 0;
+  std::size_t offset = 0;  // of this pack, in node-lanes: its records start at State::sweep[4 * offset]
+  // One record per node: kCoefficients values, each for every lane ([node][value][lane]); the
+  // element values (e_*) belong to the element from the node to the next.
+  enum { kDww, kDwt, kEww, kEwt, kEtw, kLoad, kDampingMass, kInvMass, kCoefficients };  // kDampingMass: alpha m (eq. 5)
+  std::vector<double> coef;
+  std::vector<double> factors;  // LDL^T of K_theta_theta: [node][lower, inv_pivot][lane]
+  // Centred damping: the factors of the step's block-tridiagonal solve for the lanes' wires in
+  // the twisted order (src/core/engine/centred_damping.hpp): [pair][value][2 lanes], and the meeting and
+  // extra nodes' [value][lane]. Empty with the half-step damping.
+  std::vector<double> centred_twin, centred_single;
+};
+
+struct Model {
+  Scene scene;
+  std::vector<Section> sections;
+  std::vector<Wire> wires;            // per section: contact wire(s), then the messenger if any
+  std::vector<int> contact_wires;     // indices into wires that collectors touch
+  std::vector<Dropper> droppers;
+  std::vector<SupportSpring> springs;
+  std::vector<Pantograph> pantographs;
+  std::vector<Collector> collectors;
+  std::vector<double> support_x;      // m, station of every support along the line (all sections)
+
+  int n_dof = 0;
+  int n_catenary_dof = 0;       // catenary DOFs come first, pantograph DOFs after
+  Eigen::VectorXd mass;         // lumped, kg (or kg m^2 for lumped rotations); 0 on fixed DOFs
+  Eigen::VectorXd inv_mass;     // 0 on fixed (rigidly supported) DOFs, which therefore never move
+  Eigen::VectorXd load;         // constant load: gravity, support preloads and -K y_design (N)
+  double alpha = 0.0, beta = 0.0;  // Rayleigh, eq. 5 (catenary only)
+  double contact_stiffness = 0.0, rub_length = 0.0;
+  int max_contact_nodes = 2;    // nodes a distributed contact can touch (sizes the workspace)
+
+  double omega_max = 0.0;       // rad/s, highest eigenfrequency of the assembled system
+  double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction (inf: implicit)
+  double dt = 0.0;              // s, the step in use
+  std::shared_ptr<const ImplicitMatrix> implicit;  // set when the integrator is implicit
+  // Explicit with condensed rotations: the wires packed for the fused step (empty otherwise: the
+  // generic step). wire_pack[wi], wire_lane[wi]: where wire wi is.
+  std::vector<WireLanes> wire_packs;
+  std::vector<int> wire_pack, wire_lane;
+  std::vector<int> centred_fixed_dofs;  // the wires' fixed vertical DOFs (centred damping step)
+  double centred_v_ratio = 0.0;         // (2 / dt) / D_i per mass (centred damping step)
+  // Per catenary DOF: where the sweep leaves its band force and its z in State::sweep.
+  std::vector<int> dof_sweep_force, dof_sweep_z;
+  std::size_t sweep_size = 0;  // node-lanes of all packs (State::sweep holds 4 values for each)
+  double train_start = 0.0, train_end = 0.0;  // m, front of the train
+  double line_length = 0.0;
+  double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)
+  // Endless line (Scene::endless): the wires are a block of equal spans starting at station 0;
+  // whenever the rearmost collector runs a span past endless_home, step() moves the state back a
+  // span and adds it to State::line_offset (a station along the line = block station + offset).
+  // train_start is then in block stations, train_end along the line.
+  bool endless = false;
+  double endless_span = 0.0, endless_home = 0.0;  // m
+  double initial_line_offset = 0.0;               // m, a whole number of spans
+  double rear_collector_offset = 0.0;             // m, rearmost collector station - train front
+  std::vector<int> span_nodes;                    // per wire: nodes per span (endless)
+  // Spans the block moves by: 1, or a 3-D line's stagger pattern (its supports repeat only after
+  // a whole pattern), so that endless_home..endless_home + shift spans holds the rearmost collector.
+  int endless_shift_spans = 1;
+  double longest_span = 0.0;    // m
+  std::vector<int> dropper_order, spring_order;       // indices in line order (stable)
+  std::vector<double> dropper_order_x, spring_order_x;  // m, their stations
+  std::vector<std::string> warnings;  // what the scene asks that is outside design practice
+  // The wires' lateral planes (3-D line); null when the scene has no stagger, curve, wind or sway.
+  std::shared_ptr<const LateralModel> lateral;
+};
+
+// Builds the model, solves the design statics (dropper lengths for the presag) and the stability
+// limit. Throws SceneError for a scene that cannot be built (e.g. dt above the stability limit).
+Model build_model(const Scene& scene);
+
+struct BuildOptions {
+  bool stability = true;  // false: skip the stability limit (static probes)
+  // Raised supports per section (first, last, first, last, ...), m; empty: from the scene / eq. 6-8.
+  std::optional<std::vector<double>> support_rises;
+};
+Model build_model(const Scene& scene, const BuildOptions& options);
+
+// Memory per wire node (bytes) to build a model and solve its statics: measured as the peak
+// resident size of simulate_pass on the reference scene at 1.1e5-2.2e5 nodes (2026-11-23:
+// 1.2-1.3 kB a node over a 25 MB base), with a margin of 1.5 for other scenes.
+constexpr double kModelBytesPerNode = 2048.0;
+// The model's size estimated from the scene before anything is allocated, and the limit (half the
+// machine's physical memory). check_model_memory throws SceneError with both, naming what to change.
+double estimate_model_bytes(const Scene& scene);
+double estimate_wind_field_bytes(const Scene& scene);  // its turbulent wind field's share (0 without)
+double model_memory_limit_bytes();
+void check_model_memory(const Scene& scene);
+
+// Steps a whole pass takes at the scene's train speed (inf at speed 0): offline tools refuse a
+// pass above their bound unless asked for.
+double pass_step_count(const Model& model);
+
+// Lengths (m) the moving window integrates ahead of the foremost and behind the rearmost
+// pantograph at a train speed (m/s): the scene's, or for `window: auto` the distances the
+// contact wire's waves run from the pantograph in the time they take to fade (window.cpp).
+void window_lengths(const Model& model, double speed_mps, double* ahead, double* behind);
+
+// The statistics section along the line (m): output.analysis_spans, or by default all spans but
+// two at each end of the line (of the pass on an endless line).
+void analysis_section(const Model& model, double* x0, double* x1);
+
+// A warning (empty if none) for a train speed above 0.7 of the contact wire's wave speed.
+std::string speed_warning(const Model& model, double speed_mps);
+
+// Heights d (m) by which each section's contact wire support is raised at its first and last
+// support (0 where the end span is a current span): overlap.support_rise, or eq. 6-8 with
+// h = E F, E measured on the model at the middle of a current span of the section.
+std::vector<double> transition_support_rises(const Scene& scene);
+
+// y = K x for the linear part of the system with every dropper and contact active (the collectors
+// at the train position `front`): used for the stability limit and by tests. x and y have n_dof
+// entries; `scratch` must have room for the condensed rotations (max wire nodes).
+void apply_stiffness(const Model& model, double front, const double* x, double* y, double* scratch);
+
+// Stiffness-only internal force of one wire: f(w) -= K z over the wire's nodes (rotations
+// condensed or taken from z). `theta` is scratch (nodes entries) and returns the rotations used.
+void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta);
+
+// The condensed band's force on nodes lo..hi of a wire (f -= K z), given the LDL^T factors of
+// K_theta_theta over that range and the diagonal shares (ww, wt at lo, then at hi) of elements
+// left out at the ends. Shared by the whole wire and the moving window.
+void condensed_band_force(const Wire& wire, int lo, int hi, const double end_correction[4], const double* lower,
+                          const double* inv_pivot, const double* z, double* f, double* theta);
+
+// Design height (m) of the lowest contact wire under station xc (eq. 12 weights), the wire a
+// rising head meets first; +inf where no contact wire is. `wire` (if given) receives its index
+// into Model::contact_wires.
+double lowest_design_height(const Model& model, double xc, int* wire = nullptr);
+
+// Weights of the contact wire's nodes for a distributed contact centred at xc (eq. 10-13): the
+// collector height is sum w_i y_i (eq. 12) and its force is spread as F w_i. Returns the count,
+// at most model.max_contact_nodes; 0 if xc is off the wire.
+int contact_weights(const Wire& wire, double rub_length, double xc, int* node, double* weight);
+
+}  // namespace catenary_sim

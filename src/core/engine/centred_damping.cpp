@@ -1,0 +1,420 @@
+#include "engine/centred_damping.hpp"
+
+#include "engine/wire_lanes.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+namespace catenary_sim {
+
+namespace {
+
+typedef double Mat2[4];  // row-major
+
+void mul(const double* a, const double* b, double* out) {
+  out[0] = a[0] * b[0] + a[1] * b[2];
+  out[1] = a[0] * b[1] + a[1] * b[3];
+  out[2] = a[2] * b[0] + a[3] * b[2];
+  out[3] = a[2] * b[1] + a[3] * b[3];
+}
+
+void sub_mul(double* a, const double* b, const double* c) {  // a -= b c
+  Mat2 bc;
+  mul(b, c, bc);
+  for (int k = 0; k < 4; ++k) a[k] -= bc[k];
+}
+
+void invert(const double* a, double* out) {
+  const double det = a[0] * a[3] - a[1] * a[2];
+  out[0] = a[3] / det;
+  out[1] = -a[1] / det;
+  out[2] = -a[2] / det;
+  out[3] = a[0] / det;
+}
+
+}  // namespace
+
+int centred_meeting_node(int nodes) { return (nodes - 1) / 2; }
+
+namespace {
+
+// One wire's factors, kCdValues per node in line order (the packs take them in the twisted order);
+// its fixed vertical DOFs appended to `fixed_dofs`. D = shift M.
+std::vector<double> wire_factors(const Model& m, const Wire& w, double shift, std::vector<int>& fixed_dofs) {
+  std::vector<double> factors;
+  const int n = w.nodes(), k = centred_meeting_node(n);
+  factors.assign(static_cast<std::size_t>(n) * kCdValues, 0.0);
+  auto fixed = [&](int i) { return m.inv_mass[w.w_dof + i] == 0.0; };
+  auto at = [&](int i) { return factors.data() + static_cast<std::size_t>(i) * kCdValues; };
+  // Blocks of D + K: A_i on node i (a fixed node's vertical row the identity), U_i from node i to
+  // i + 1 and L_i from node i + 1 to i (the vertical row of a fixed node zero in both).
+  auto diag = [&](int i, double* a) {
+    const bool fx = fixed(i);
+    a[0] = fx ? 1.0 : shift * m.mass[w.w_dof + i] + w.d_ww[i];
+    a[1] = fx ? 0.0 : w.d_wt[i];
+    a[2] = w.d_wt[i];
+    a[3] = w.d_tt[i];
+  };
+  auto upper = [&](int i, double* u) {  // rows i, cols i + 1
+    const bool fx = fixed(i);
+    u[0] = fx ? 0.0 : w.e_ww[i];
+    u[1] = fx ? 0.0 : w.e_wt[i];
+    u[2] = w.e_tw[i];
+    u[3] = w.e_tt[i];
+  };
+  auto lower = [&](int i, double* l) {  // rows i + 1, cols i
+    const bool fx = fixed(i + 1);
+    l[0] = fx ? 0.0 : w.e_ww[i];
+    l[1] = fx ? 0.0 : w.e_tw[i];
+    l[2] = w.e_wt[i];
+    l[3] = w.e_tt[i];
+  };
+  // One side's elimination toward k: pivot a_i = A_i - M_i B (M_i = C S_prev, the coupling C
+  // into node i from its predecessor and B back), S_i = a_i^-1; in the node's places the
+  // recurrence on c_i = S_i y_i: c_i = s_i r_i - (S_i M_i a_prev) c_prev (s_i: S_i's first
+  // column, r's rotation entry being 0), and P_i = S_i N_i toward the next node (N_i its coupling).
+  Mat2 a{}, a_prev{}, s_prev{}, mm{}, tmp{}, cpl{}, back{};
+  auto side = [&](int i, bool first, const double* into, const double* out_back, const double* next) {
+    double* c = at(i);
+    diag(i, a);
+    if (!first) {
+      mul(into, s_prev, mm);  // M_i
+      sub_mul(a, mm, out_back);
+    }
+    Mat2 si;
+    invert(a, si);
+    if (!first) {
+      mul(si, mm, tmp);
+      mul(tmp, a_prev, c + kCdG);
+    }
+    c[kCdS] = si[0];
+    c[kCdS + 1] = si[2];
+    mul(si, next, c + kCdP);
+    std::copy(a, a + 4, a_prev);
+    std::copy(si, si + 4, s_prev);
+  };
+  for (int i = 0; i < k; ++i) {
+    if (i > 0) {
+      lower(i - 1, cpl);
+      upper(i - 1, back);
+    }
+    Mat2 nx;
+    upper(i, nx);
+    side(i, i == 0, cpl, back, nx);
+  }
+  Mat2 top_a, top_s;  // S~_{k-1} and S_{k-1}
+  std::copy(a_prev, a_prev + 4, top_a);
+  std::copy(s_prev, s_prev + 4, top_s);
+  for (int i = n - 1; i > k; --i) {
+    if (i < n - 1) {
+      upper(i, cpl);
+      lower(i, back);
+    }
+    Mat2 nx;
+    lower(i - 1, nx);
+    side(i, i == n - 1, cpl, back, nx);
+  }
+  // The meeting node: Z = A_k - G_k U_{k-1} - H_k L_k (G_k = L_{k-1} S_{k-1}, H_k = U_k T_{k+1});
+  // zeta_k = Z^-1 r_k - (Z^-1 G_k S~_{k-1}) c_{k-1} - (Z^-1 H_k T~_{k+1}) c'_{k+1}: in its G, P
+  // and S places.
+  double* c = at(k);
+  diag(k, a);
+  Mat2 g{}, h{}, zi{};
+  if (k > 0) {
+    lower(k - 1, cpl);
+    mul(cpl, top_s, g);
+    upper(k - 1, back);
+    sub_mul(a, g, back);
+  }
+  if (k + 1 < n) {
+    upper(k, cpl);
+    mul(cpl, s_prev, h);
+    lower(k, back);
+    sub_mul(a, h, back);
+  }
+  invert(a, zi);
+  if (k > 0) {
+    mul(zi, g, tmp);
+    mul(tmp, top_a, c + kCdG);
+  }
+  if (k + 1 < n) {
+    mul(zi, h, tmp);
+    mul(tmp, a_prev, c + kCdP);
+  }
+  c[kCdS] = zi[0];
+  c[kCdS + 1] = zi[2];
+  for (int i = 0; i < n; ++i) {
+    const bool fx = fixed(i);
+    if (fx) fixed_dofs.push_back(w.w_dof + i);
+    at(i)[kCdU] = fx ? 1.0 : shift * m.mass[w.w_dof + i];
+  }
+  return factors;
+}
+
+}  // namespace
+
+void factor_centred_damping(Model& m) {
+  const double shift = 2.0 / (m.beta * m.dt) + m.alpha / m.beta;
+  m.centred_fixed_dofs.clear();
+  m.centred_v_ratio = (2.0 / m.dt) / shift;
+  // The packs: pair j of the twisted order (top node j, bottom node n - 1 - (bottom - top) - j,
+  // both eliminated at step j and substituted at step top - 1 - j) in 2L lanes, the top's lanes
+  // first; the meeting node and the extra bottom node (when n is even) alone, in L lanes.
+  for (WireLanes& p : m.wire_packs) {
+    const int L = p.lanes, n = p.nodes, k = centred_meeting_node(n), top = k, extra = (n - 1 - k) - top;
+    p.centred_twin.assign(static_cast<std::size_t>(top) * kCdValues * 2 * L, 0.0);
+    p.centred_single.assign(2 * kCdValues * static_cast<std::size_t>(L), 0.0);
+    for (int lane = 0; lane < L; ++lane) {
+      const std::vector<double> factors = wire_factors(m, m.wires[p.wire[lane]], shift, m.centred_fixed_dofs);
+      auto value = [&](int i, int v) { return factors[static_cast<std::size_t>(i) * kCdValues + v]; };
+      for (int j = 0; j < top; ++j)
+        for (int v = 0; v < kCdValues; ++v) {
+          double* t = p.centred_twin.data() + (static_cast<std::size_t>(j) * kCdValues + v) * 2 * L;
+          t[lane] = value(j, v);
+          t[L + lane] = value(n - 1 - extra - j, v);
+        }
+      for (int v = 0; v < kCdValues; ++v) {
+        p.centred_single[v * L + lane] = value(k, v);
+        p.centred_single[(kCdValues + v) * L + lane] = extra ? value(n - 1, v) : 0.0;
+      }
+    }
+  }
+}
+
+namespace {
+
+typedef double Double2 __attribute__((vector_size(16)));
+typedef double Double4 __attribute__((vector_size(32)));
+
+// L wires' lanes at one node (Lanes<L>), or at the two nodes of a twisted pair (Lanes<2 L>, the
+// top node's lanes first): scalars or GCC vectors, the same IEEE operations per lane either way.
+typedef long Long2 __attribute__((vector_size(16)));
+typedef long Long4 __attribute__((vector_size(32)));
+
+template <class T, class M, int W>
+struct LaneOps {
+  typedef M Mask;  // all bits set in a lane: that lane's new displacement is within the limit
+  static T at(const double* p) {
+    T x;
+    std::memcpy(&x, p, sizeof x);
+    return x;
+  }
+  static void put(double* p, T x) { std::memcpy(p, &x, sizeof x); }
+  static M within(T x, T limit) {
+    const M bits = reinterpret_cast<M>(x) & ~reinterpret_cast<M>(-T{});  // |x|: the sign bit (of -0.0) off
+    return reinterpret_cast<T>(bits) <= limit;  // false for NaN
+  }
+  static bool all(M ok) {
+    bool b = true;
+    for (int k = 0; k < W; ++k) b &= ok[k] != 0;
+    return b;
+  }
+};
+template <int W>
+struct Lanes;
+template <>
+struct Lanes<1> {
+  typedef double T;
+  typedef bool Mask;
+  static T at(const double* p) { return *p; }
+  static void put(double* p, T x) { *p = x; }
+  static Mask within(T x, T limit) { return std::fabs(x) <= limit; }
+  static bool all(Mask ok) { return ok; }
+  // lanes of wires a[0..L) at node i (and, for a pair, at node ib)
+  static T gather(const double* const* a, int i, int) { return a[0][i]; }
+  static void scatter(double* const* a, int i, int, T x) { a[0][i] = x; }
+};
+template <>
+struct Lanes<2> : LaneOps<Double2, Long2, 2> {
+  typedef Double2 T;
+  // Two wires at node i, or one wire at the pair's nodes i and ib (`pair`).
+  template <bool pair>
+  static T gather(const double* const* a, int i, int ib) {
+    return pair ? T{a[0][i], a[0][ib]} : T{a[0][i], a[1][i]};
+  }
+  template <bool pair>
+  static void scatter(double* const* a, int i, int ib, T x) {
+    if (pair) {
+      a[0][i] = x[0];
+      a[0][ib] = x[1];
+    } else {
+      a[0][i] = x[0];
+      a[1][i] = x[1];
+    }
+  }
+};
+template <>
+struct Lanes<4> : LaneOps<Double4, Long4, 4> {
+  typedef Double4 T;
+  template <bool pair>
+  static T gather(const double* const* a, int i, int ib) {
+    return T{a[0][i], a[1][i], a[0][ib], a[1][ib]};
+  }
+  template <bool pair>
+  static void scatter(double* const* a, int i, int ib, T x) {
+    a[0][i] = x[0];
+    a[1][i] = x[1];
+    a[0][ib] = x[2];
+    a[1][ib] = x[3];
+  }
+};
+
+template <int W, bool pair, class T>
+__attribute__((always_inline)) inline T gather(const double* const* a, int i, int ib) {
+  if constexpr (W == 1) return Lanes<1>::gather(a, i, ib);
+  else return Lanes<W>::template gather<pair>(a, i, ib);
+}
+template <int W, bool pair, class T>
+__attribute__((always_inline)) inline void scatter(double* const* a, int i, int ib, T x) {
+  if constexpr (W == 1) Lanes<1>::scatter(a, i, ib, x);
+  else Lanes<W>::template scatter<pair>(a, i, ib, x);
+}
+
+struct CentredArgs {
+  const double* const* u;
+  const double* const* v;
+  double* const* f;
+  double* const* un;
+  double* const* vn;
+  double* const* acc;
+  double dt, v_ratio, two_by_beta, limit;
+};
+
+// The elimination and substitution steps in W lanes: one node of L wires (W = L, pair false) or a
+// twisted pair of nodes (W = 2 L, pair true), coefficients at `coef` ([value][W]); the record of a
+// step (4 W values: c = S y, then u and v) at `rec`.
+template <int W, bool pair>
+struct Steps {
+  typedef typename Lanes<W>::T T;
+  typedef typename Lanes<W>::Mask Mask;
+  const CentredArgs& a;
+  T zero, step, inv_step, ratio, kb, limit;
+  Mask ok;
+  explicit Steps(const CentredArgs& args) : a(args) {
+    zero = T{} * 0.0;
+    step = zero + a.dt;
+    inv_step = zero + 1.0 / a.dt;
+    ratio = zero + a.v_ratio;
+    kb = zero + a.two_by_beta;
+    limit = zero + a.limit;
+    ok = Lanes<W>::within(zero, limit);
+  }
+  static T c(const double* coef, int k) { return Lanes<W>::at(coef + k * W); }
+  // r's vertical entry: load and point forces (f) + a (u + ratio v), a = D_i (1 on a fixed node,
+  // where f and v are 0).
+  __attribute__((always_inline)) T rhs(const double* coef, T ui, T vi, T fi) const {
+    return fi + c(coef, kCdU) * (ui + ratio * vi);
+  }
+  // c = s r - G^ c_prev (G^ in place mplace).
+  __attribute__((always_inline)) void eliminate(const double* coef, int i, int ib, int mplace, T& yw, T& yt, double* rec) {
+    const T ui = gather<W, pair, T>(a.u, i, ib), vi = gather<W, pair, T>(a.v, i, ib), fi = gather<W, pair, T>(a.f, i, ib);
+    const T rw = rhs(coef, ui, vi, fi);
+    const T nw = c(coef, kCdS) * rw - (c(coef, mplace) * yw + c(coef, mplace + 1) * yt);
+    const T nt = c(coef, kCdS + 1) * rw - (c(coef, mplace + 2) * yw + c(coef, mplace + 3) * yt);
+    yw = nw;
+    yt = nt;
+    Lanes<W>::put(rec, yw);
+    Lanes<W>::put(rec + W, yt);
+    Lanes<W>::put(rec + 2 * W, ui);
+    Lanes<W>::put(rec + 3 * W, vi);
+  }
+  // v_{n+1/2} = 2 (zeta - u) / beta - v_{n-1/2} and u_{n+1}.
+  __attribute__((always_inline)) void update(int i, int ib, T zeta, T ui, T vi) {
+    const T vnew = kb * (zeta - ui) - vi;
+    const T unew = ui + step * vnew;
+    ok &= Lanes<W>::within(unew, limit);
+    scatter<W, pair, T>(a.vn, i, ib, vnew);
+    scatter<W, pair, T>(a.un, i, ib, unew);
+    scatter<W, pair, T>(a.acc, i, ib, (vnew - vi) * inv_step);
+  }
+  // zeta = c - P zeta_neighbour, then the update.
+  __attribute__((always_inline)) void substitute(const double* coef, int i, int ib, T& xw, T& xt, const double* rec) {
+    const T nw = Lanes<W>::at(rec) - (c(coef, kCdP) * xw + c(coef, kCdP + 1) * xt);
+    const T nt = Lanes<W>::at(rec + W) - (c(coef, kCdP + 2) * xw + c(coef, kCdP + 3) * xt);
+    xw = nw;
+    xt = nt;
+    update(i, ib, xw, Lanes<W>::at(rec + 2 * W), Lanes<W>::at(rec + 3 * W));
+  }
+};
+
+// Lanes of the pair's top (0..L) and bottom (L..2L) halves, and back.
+template <int L, class T2, class T>
+__attribute__((always_inline)) inline T2 join(T top, T bottom) {
+  if constexpr (L == 1) return T2{top, bottom};
+  else return T2{top[0], top[1], bottom[0], bottom[1]};
+}
+template <int L, class T, class T2>
+__attribute__((always_inline)) inline T half(T2 x, int h) {
+  if constexpr (L == 1) return x[h];
+  else return T{x[2 * h], x[2 * h + 1]};
+}
+
+// The pack's twisted block elimination: from both ends toward node k at once (pairs of nodes in
+// 2L lanes), the meeting node k, then outward from k in pairs.
+template <int L>
+__attribute__((always_inline)) inline bool sweep(const WireLanes& p, const CentredArgs& args, double* rec) {
+  typedef typename Lanes<L>::T T;
+  typedef typename Lanes<2 * L>::T T2;
+  Steps<L, false> one(args);
+  Steps<2 * L, true> two(args);
+  const int n = p.nodes, k = centred_meeting_node(n), top = k, extra = (n - 1 - k) - top;
+  const double* twin = p.centred_twin.data();
+  const double* single = p.centred_single.data();
+  double* rec_extra = rec + 8 * L * static_cast<std::size_t>(top);  // the extra bottom node's
+  auto pair_coef = [&](int j) { return twin + static_cast<std::size_t>(j) * kCdValues * 2 * L; };
+  auto pair_rec = [&](int j) { return rec + 8 * L * static_cast<std::size_t>(j); };
+  T bw = one.zero, bt = one.zero;
+  if (extra) one.eliminate(single + kCdValues * L, n - 1, n - 1, kCdG, bw, bt, rec_extra);
+  T2 yw = join<L, T2>(one.zero, bw), yt = join<L, T2>(one.zero, bt);
+  for (int j = 0; j < top; ++j) two.eliminate(pair_coef(j), j, n - 1 - extra - j, kCdG, yw, yt, pair_rec(j));
+  // The meeting node: zeta_k = z r_k - A c_{k-1} - B c'_{k+1} (A, B in its G and P places).
+  {
+    const T tw = half<L, T>(yw, 0), tt = half<L, T>(yt, 0);
+    bw = half<L, T>(yw, 1);
+    bt = half<L, T>(yt, 1);
+    const T ui = gather<L, false, T>(args.u, k, k), vi = gather<L, false, T>(args.v, k, k), fi = gather<L, false, T>(args.f, k, k);
+    auto c = [&](int v) { return Steps<L, false>::c(single, v); };
+    const T rw = one.rhs(single, ui, vi, fi);
+    const T xw = (c(kCdS) * rw - (c(kCdG) * tw + c(kCdG + 1) * tt)) - (c(kCdP) * bw + c(kCdP + 1) * bt);
+    const T xt = (c(kCdS + 1) * rw - (c(kCdG + 2) * tw + c(kCdG + 3) * tt)) - (c(kCdP + 2) * bw + c(kCdP + 3) * bt);
+    one.update(k, k, xw, ui, vi);
+    yw = join<L, T2>(xw, xw);
+    yt = join<L, T2>(xt, xt);
+  }
+  for (int j = top - 1; j >= 0; --j) two.substitute(pair_coef(j), j, n - 1 - extra - j, yw, yt, pair_rec(j));
+  if (extra) {
+    T xw = half<L, T>(yw, 1), xt = half<L, T>(yt, 1);
+    one.substitute(single + kCdValues * L, n - 1, n - 1, xw, xt, rec_extra);
+  }
+  return !(Lanes<L>::all(one.ok) && Lanes<2 * L>::all(two.ok));
+}
+
+}  // namespace
+
+// Runtime dispatch (GCC target_clones): the four lanes in one AVX2 register (x86-64-v3), or the
+// portable baseline in two SSE2 halves; the same IEEE operations either way (no FMA contraction).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define CATENARY_SIM_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define CATENARY_SIM_CLONES
+#endif
+
+CATENARY_SIM_CLONES bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s) {
+  const double *u[2], *v[2];
+  double *f[2], *un[2], *vn[2], *acc[2];
+  for (int k = 0; k < pack.lanes; ++k) {
+    const int d = m.wires[pack.wire[k]].w_dof;
+    u[k] = s.u.data() + d;
+    v[k] = s.v.data() + d;
+    f[k] = s.force.data() + d;
+    un[k] = s.u_next.data() + d;
+    vn[k] = s.v_next.data() + d;
+    acc[k] = s.accel.data() + d;
+  }
+  const CentredArgs args{u, v, f, un, vn, acc, m.dt, m.centred_v_ratio, 2.0 / m.beta, m.scene.numerics.divergence_limit};
+  double* rec = s.sweep.data() + kSweepRecord * pack.offset;
+  return pack.lanes == 2 ? sweep<2>(pack, args, rec) : sweep<1>(pack, args, rec);
+}
+
+}  // namespace catenary_sim

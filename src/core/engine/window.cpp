@@ -1,0 +1,182 @@
+// The moving window (numerics.window): only the spans around the pantographs are integrated.
+// Ahead of it the line is at its static state, which is u = 0 (the dynamics run on displacements
+// from the design state), so spans join it at static equilibrium for free; behind it they leave
+// and return to that state. The window moves a whole span at a time (its ends on supports), so
+// the band and the condensation factors of the window change only then.
+#include "engine/window.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "catenary_sim/core/model/beam.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
+
+namespace catenary_sim {
+
+namespace {
+// window: auto. A wave the pantograph sends ahead meets a reflector D ahead of it and its echo is
+// back at the pantograph after 2 D / (c + V); one sent behind comes back from D behind after
+// 2 D / (c - V). The window holds the reflectors whose echoes return within a memory time:
+// D = (c +- V) T / 2. T measured in bench_window_lengths (BENCHMARKS.md: statistics within a few
+// tenths of a percent of a generous window at 150-350 km/h): the echoes from behind are Doppler
+// stretched to low frequencies, which the damping barely touches, so they are remembered longer.
+constexpr double kMemoryAhead = 2.0, kMemoryBehind = 4.0;  // s
+constexpr double kWindowMinSpans = 2.0;  // the droppers around the head and the joining span
+}  // namespace
+
+void window_lengths_for(const NumericsSpec& n, double c, double span, double speed, double* ahead, double* behind) {
+  if (!n.window_auto) {
+    *ahead = n.window_ahead;
+    *behind = n.window_behind;
+    return;
+  }
+  const double v = std::fabs(speed);
+  *ahead = std::max(kWindowMinSpans * span, 0.5 * (c + v) * kMemoryAhead);
+  *behind = std::max(kWindowMinSpans * span, 0.5 * std::max(0.0, c - v) * kMemoryBehind);
+}
+
+void window_lengths(const Model& m, double speed, double* ahead, double* behind) {
+  window_lengths_for(m.scene.numerics, m.wave_speed, m.longest_span, speed, ahead, behind);
+}
+
+void shift_endless_block(const Model& m, State& s) {
+  const int spans = m.endless_shift_spans;
+  const double span = spans * m.endless_span;
+  if (!(s.front + m.rear_collector_offset >= m.endless_home + span)) return;
+  double* u = s.u.data();
+  double* v = s.v.data();
+  double* a = s.accel.data();
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    WireWindow& ww = s.window[wi];
+    if (ww.hi < ww.lo) continue;
+    const int ns = spans * m.span_nodes[wi], w0 = m.wires[wi].w_dof;
+    for (int i = ww.lo; i <= ww.hi; ++i) {  // upward: the destination is always below the source
+      u[w0 + i - ns] = u[w0 + i];
+      v[w0 + i - ns] = v[w0 + i];
+      a[w0 + i - ns] = a[w0 + i];
+    }
+    for (int i = std::max(ww.lo, ww.hi - ns + 1); i <= ww.hi; ++i) u[w0 + i] = v[w0 + i] = a[w0 + i] = 0.0;
+    ww.lo -= ns;
+    ww.hi -= ns;
+  }
+  if (m.lateral) shift_lateral_block(m, s);
+  s.front -= span;
+  s.line_offset += span;
+  // The window now spans one support less on both ends; update_window() rebuilds its factors and
+  // lists there (the node ranges already match, so nothing is reset).
+  s.window_first_support = s.window_last_support = -1;
+}
+
+void set_wire_window(const Wire& w, double a, double b, WireWindow& ww) {
+  const int n = w.nodes();
+  ww.lo = static_cast<int>(std::lower_bound(w.x.begin(), w.x.end(), a - 1e-9) - w.x.begin());
+  ww.hi = static_cast<int>(std::upper_bound(w.x.begin(), w.x.end(), b + 1e-9) - w.x.begin()) - 1;
+  if (ww.hi < ww.lo) return;
+  ww.cut_lo = ww.lo > 0;
+  ww.cut_hi = ww.hi < n - 1;
+  ww.lo_ww = ww.lo_wt = ww.lo_tt = ww.hi_ww = ww.hi_wt = ww.hi_tt = 0.0;
+  if (ww.cut_lo) {
+    const Matrix4 k = beam_stiffness(w.x[ww.lo] - w.x[ww.lo - 1], w.spec.bending_stiffness, w.spec.tension);
+    ww.lo_ww = k[2][2];
+    ww.lo_wt = k[2][3];
+    ww.lo_tt = k[3][3];
+  }
+  if (ww.cut_hi) {
+    const Matrix4 k = beam_stiffness(w.x[ww.hi + 1] - w.x[ww.hi], w.spec.bending_stiffness, w.spec.tension);
+    ww.hi_ww = k[0][0];
+    ww.hi_wt = k[0][1];
+    ww.hi_tt = k[1][1];
+  }
+  // LDL^T of the window's tridiagonal K_theta_theta (free rotations at the cut ends).
+  double d = 0.0;
+  for (int i = ww.lo; i <= ww.hi; ++i) {
+    double diag = w.d_tt[i];
+    if (i == ww.lo) diag -= ww.lo_tt;
+    if (i == ww.hi) diag -= ww.hi_tt;
+    if (i == ww.lo) {
+      d = diag;
+      ww.tt_lower[i] = 0.0;
+    } else {
+      const double l = w.e_tt[i - 1] / d;
+      d = diag - l * w.e_tt[i - 1];
+      ww.tt_lower[i] = l;
+    }
+    ww.tt_inv_pivot[i] = 1.0 / d;
+  }
+}
+
+void interleave_window_factors(const std::vector<WireLanes>& packs, const std::vector<WireWindow>& windows,
+                               double* sweep_factors) {
+  for (const WireLanes& p : packs)
+    for (int k = 0; k < p.lanes; ++k) {
+      const WireWindow& ww = windows[p.wire[k]];
+      double* f = sweep_factors + 2 * p.offset;
+      for (int i = ww.lo; i <= ww.hi; ++i) {
+        f[(2 * static_cast<std::size_t>(i) + 0) * p.lanes + k] = ww.tt_lower[i];
+        f[(2 * static_cast<std::size_t>(i) + 1) * p.lanes + k] = ww.tt_inv_pivot[i];
+      }
+    }
+}
+
+void update_window(const Model& m, State& s) {
+  double x_min = 1e300, x_max = -1e300;
+  for (const Pantograph& p : m.pantographs) {
+    const double x = s.front - p.position;
+    x_min = std::min(x_min, x);
+    x_max = std::max(x_max, x);
+  }
+  if (m.pantographs.empty()) x_min = x_max = s.front;
+  const std::vector<double>& sx = m.support_x;
+  double ahead = 0.0, behind = 0.0;
+  window_lengths(m, s.speed, &ahead, &behind);
+  const double lo_x = x_min - behind, hi_x = x_max + ahead;
+  // Snap outward to supports.
+  int first = static_cast<int>(std::upper_bound(sx.begin(), sx.end(), lo_x) - sx.begin()) - 1;
+  int last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x) - sx.begin());
+  first = std::clamp(first, 0, static_cast<int>(sx.size()) - 1);
+  last = std::clamp(last, 0, static_cast<int>(sx.size()) - 1);
+  if (first == s.window_first_support && last == s.window_last_support) return;
+  const double a = sx[first], b = sx[last];
+  s.window_first_support = first;
+  s.window_last_support = last;
+
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    const Wire& w = m.wires[wi];
+    WireWindow& ww = s.window[wi];
+    const int old_lo = ww.lo, old_hi = ww.hi;
+    set_wire_window(w, a, b, ww);
+    // Nodes that left the window return to the static state.
+    for (int i = old_lo; i <= old_hi; ++i)
+      if (i < ww.lo || i > ww.hi) {
+        s.u[w.w_dof + i] = 0.0;
+        s.v[w.w_dof + i] = 0.0;
+      }
+  }
+  interleave_window_factors(m.wire_packs, s.window, s.sweep_factors.data());
+  // Index lists sized once in make_state (a copied State keeps their size): no allocation. Only
+  // the droppers and supports between the window's ends are looked at, so moving the window costs
+  // what the window holds, not the line.
+  auto inside = [&](int dof) { return in_windows(m.wires, s.window, dof); };
+  s.window_dropper_count = select_between(
+      m.dropper_order, m.dropper_order_x, a, b,
+      [&](int k) { return inside(m.droppers[k].contact_dof) && inside(m.droppers[k].messenger_dof); },
+      s.window_droppers.data());
+  s.window_spring_count = select_between(
+      m.spring_order, m.spring_order_x, a, b, [&](int k) { return inside(m.springs[k].dof); }, s.window_springs.data());
+}
+
+bool in_windows(const std::vector<Wire>& wires, const std::vector<WireWindow>& windows, int dof) {
+  for (std::size_t wi = 0; wi < wires.size(); ++wi) {
+    const int i = dof - wires[wi].w_dof;
+    if (i >= 0 && i < wires[wi].nodes()) return i >= windows[wi].lo && i <= windows[wi].hi;
+  }
+  return false;
+}
+
+void wire_elastic_force_window(const Wire& wire, const WireWindow& ww, const double* z, double* f, double* theta) {
+  if (ww.hi < ww.lo) return;
+  const double ends[4] = {ww.lo_ww, ww.lo_wt, ww.hi_ww, ww.hi_wt};
+  condensed_band_force(wire, ww.lo, ww.hi, ends, ww.tt_lower.data(), ww.tt_inv_pivot.data(), z, f, theta);
+}
+
+}  // namespace catenary_sim

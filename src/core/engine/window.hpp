@@ -1,0 +1,55 @@
+// Moving window internals (see window.cpp).
+#pragma once
+
+#include <algorithm>
+#include <vector>
+
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/engine/state.hpp"
+
+namespace catenary_sim {
+
+// The window's lengths (m) ahead and behind at a train speed (m/s), for a contact wire of wave
+// speed c (m/s) and spans of `span` m: the scene's, or the auto rule.
+void window_lengths_for(const NumericsSpec& numerics, double wave_speed, double span, double speed, double* ahead,
+                        double* behind);
+
+// One wire's window over the supports at stations a <= b: its node range, the cut ends' share of
+// the band and the LDL^T factors of its K_theta_theta (the vertical plane's window, and the lateral
+// plane's, which may reach further ahead: lateral.cpp).
+void set_wire_window(const Wire& wire, double a, double b, WireWindow& window);
+
+// The windows' factors interleaved per pack for the fused step (both lanes of a pack share the
+// node range), laid out as WireLanes::factors at the pack's offset.
+void interleave_window_factors(const std::vector<WireLanes>& packs, const std::vector<WireWindow>& windows,
+                               double* sweep_factors);
+
+// Whether DOF `dof` (numbered by `wires`' w_dof) lies in its wire's window.
+bool in_windows(const std::vector<Wire>& wires, const std::vector<WireWindow>& windows, int dof);
+
+// The entries of `order` (indices in line order, at stations `order_x`) between stations a and b
+// that `keep(index)` accepts, written to `list` in that order; returns how many. Bisection to a:
+// costs what lies between a and b, not the line. No allocation.
+template <class Keep>
+int select_between(const std::vector<int>& order, const std::vector<double>& order_x, double a, double b, Keep&& keep,
+                   int* list) {
+  int count = 0;
+  for (std::size_t j = std::lower_bound(order_x.begin(), order_x.end(), a - 1e-6) - order_x.begin();
+       j < order.size() && order_x[j] <= b + 1e-6; ++j)
+    if (keep(order[j])) list[count++] = order[j];
+  return count;
+}
+
+// Moves the window to the pantographs if they crossed into another span; no allocation.
+void update_window(const Model& model, State& state);
+
+// Endless line: once the rearmost collector has run Model::endless_shift_spans spans past
+// Model::endless_home, moves the window's displacements, velocities and accelerations back that
+// many spans (the block is periodic, so this is exact), a 3-D line's lateral state with them
+// (shift_lateral_block), the train too, and adds the distance to State::line_offset. No allocation.
+void shift_endless_block(const Model& model, State& state);
+
+// -K z over the window's nodes of one wire (condensed rotations, cut ends left free).
+void wire_elastic_force_window(const Wire& wire, const WireWindow& window, const double* z, double* f, double* theta);
+
+}  // namespace catenary_sim

@@ -1,0 +1,106 @@
+#include "catenary_sim/core/model/stability.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace catenary_sim {
+
+double highest_eigenfrequency(const Model& m, int iterations) {
+  const int n = m.n_dof;
+  int max_nodes = 1;
+  for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
+  std::vector<double> x(n), y(n), tmp(n), scratch(max_nodes);
+  Eigen::VectorXd s = m.inv_mass.cwiseSqrt();  // M^-1/2, 0 on rigid DOFs
+  // Start from the saw-tooth (+1, -1, ...) pattern, the shape of a wire's highest mode, with a
+  // deterministic aperiodic perturbation so that no mode is missed.
+  for (int i = 0; i < n; ++i) x[i] = s[i] > 0.0 ? ((i % 2) ? 1.0 : -1.0) * (1.0 + 0.1 * std::sin(0.7 * i)) : 0.0;
+  double lambda = 0.0, checkpoint = 0.0;
+  const double front = m.train_start;
+  for (int it = 0; it < iterations; ++it) {
+    // The Rayleigh quotient rises monotonically toward lambda_max: stop once it has settled.
+    if (it % 50 == 49) {
+      if (lambda - checkpoint <= 1e-10 * lambda) break;
+      checkpoint = lambda;
+    }
+    double norm = 0.0;
+    for (int i = 0; i < n; ++i) norm += x[i] * x[i];
+    norm = std::sqrt(norm);
+    if (norm == 0.0) return 0.0;
+    for (int i = 0; i < n; ++i) tmp[i] = s[i] * x[i] / norm;
+    apply_stiffness(m, front, tmp.data(), y.data(), scratch.data());
+    double rq = 0.0;
+    for (int i = 0; i < n; ++i) {
+      y[i] *= s[i];
+      rq += y[i] * x[i] / norm;
+    }
+    lambda = rq;
+    x.swap(y);
+  }
+  return std::sqrt(std::max(lambda, 0.0));
+}
+
+double critical_time_step(double w, double alpha, double beta) {
+  if (w <= 0.0) return 1.0;
+  const double xi = alpha / (2.0 * w) + 0.5 * beta * w;
+  return (2.0 / w) * (std::sqrt(1.0 + xi * xi) - xi);
+}
+
+void compute_stability_limit(Model& m) {
+  // A Rayleigh quotient can only underestimate omega_max; the 0.2 % margin covers what the
+  // iteration has not converged (measured: 3e-4 after 400 iterations on the HRZ variant), so the
+  // refusal of a user dt is on the safe side.
+  m.omega_max = 1.002 * highest_eigenfrequency(m);
+  // The contacts move along the wire: where one meets a light node its frequency is highest, and
+  // the power iteration sees it only where the train starts. Add every contact's worst case as a
+  // bound (Weyl: lambda_max(A + B) <= lambda_max(A) + lambda_max(B)), with the contact as a
+  // rank-1 spring k0 g g^T, g^T M^-1 g <= 1/m_head + max 1/m over the contact-wire nodes.
+  double lightest = 0.0;
+  for (int wi : m.contact_wires)
+    for (int i = 0; i < m.wires[wi].nodes(); ++i) lightest = std::max(lightest, m.inv_mass[m.wires[wi].w_dof + i]);
+  double contact = 0.0;
+  for (const Collector& c : m.collectors) {
+    const Pantograph& p = m.pantographs[c.pantograph];
+    if (!p.moving_force) contact += m.contact_stiffness * (m.inv_mass[c.dof] + lightest) * m.contact_wires.size();
+  }
+  m.omega_max = std::sqrt(m.omega_max * m.omega_max + contact);
+  // Centred damping (NumericsSpec::damping) leaves the wires' band the undamped limit; the
+  // supports' and droppers' springs keep their explicit share beta k (below).
+  const bool centred = m.scene.numerics.damping == DampingStep::kCentred;
+  m.dt_critical = centred ? critical_time_step(m.omega_max, 0.0, 0.0) : critical_time_step(m.omega_max, m.alpha, m.beta);
+  // The pantographs' dampers are not Rayleigh damping: the half-step velocity of eq. 19-21 takes
+  // them explicitly, and a damper c on a light mass m needs dt < 2 m / c even without a spring.
+  // Each mass with its own springs and dampers as one DOF (w^2 = k/m, mass-proportional damping
+  // c/m in the formula of validation.md section 5): far from binding on real pantographs (the
+  // reference's lower frame: 33 ms), binding on absurdly light ones, which then get a dt that holds.
+  auto limit_by = [&](double k, double c, double mass) {
+    if (!(c > 0.0)) return;
+    const double w = std::sqrt(k / mass);
+    const double dt = w > 0.0 ? critical_time_step(w, c / mass, 0.0) : 2.0 * mass / c;
+    m.dt_critical = std::min(m.dt_critical, dt);
+  };
+  if (centred) {
+    for (const SupportSpring& sp : m.springs)
+      if (m.mass[sp.dof] > 0.0) limit_by(sp.stiffness, m.beta * sp.stiffness, m.mass[sp.dof]);
+    for (const Dropper& d : m.droppers)
+      for (int dof : {d.contact_dof, d.messenger_dof})
+        if (m.mass[dof] > 0.0) limit_by(d.stiffness, m.beta * d.stiffness, m.mass[dof]);
+  }
+  for (const Pantograph& p : m.pantographs) {
+    if (p.moving_force) continue;
+    for (int i = 0; i < p.masses_count(); ++i) {
+      double k = p.stiffness[i], c = p.damping[i];
+      if (i > 0) k += p.stiffness[i - 1], c += p.damping[i - 1];
+      if (i == 0 && p.heads.empty()) k += m.contact_stiffness * static_cast<double>(p.collectors.size() * m.contact_wires.size());
+      if (i == 0)
+        for (const Head& h : p.heads) k += h.stiffness, c += h.damping;
+      limit_by(k, c, p.masses[i]);
+    }
+    // Each head: its suspension to the frame and its strips' contact springs.
+    for (const Head& h : p.heads)
+      limit_by(h.stiffness + m.contact_stiffness * static_cast<double>(h.collectors.size() * m.contact_wires.size()),
+               h.damping, h.mass);
+  }
+}
+
+}  // namespace catenary_sim

@@ -1,0 +1,419 @@
+#include "catenary_sim/core/model/statics.hpp"
+
+#include "model/assembly.hpp"
+
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace catenary_sim {
+
+// The wire's band in a sparse matrix, w of node i at w0 + i and theta at t0 + i.
+void add_wire_band(Triplets& t, const Wire& w, int w0, int t0) {
+  const int n = w.nodes();
+  for (int i = 0; i < n; ++i) {
+    t.emplace_back(w0 + i, w0 + i, w.d_ww[i]);
+    t.emplace_back(w0 + i, t0 + i, w.d_wt[i]);
+    t.emplace_back(t0 + i, w0 + i, w.d_wt[i]);
+    t.emplace_back(t0 + i, t0 + i, w.d_tt[i]);
+  }
+  for (int e = 0; e + 1 < n; ++e) {
+    const int a = e, b = e + 1;
+    const double blk[2][2] = {{w.e_ww[e], w.e_wt[e]}, {w.e_tw[e], w.e_tt[e]}};
+    const int ra[2] = {w0 + a, t0 + a}, cb[2] = {w0 + b, t0 + b};
+    for (int r = 0; r < 2; ++r)
+      for (int c = 0; c < 2; ++c) {
+        t.emplace_back(ra[r], cb[c], blk[r][c]);
+        t.emplace_back(cb[c], ra[r], blk[r][c]);
+      }
+  }
+}
+
+// A spring between DOF a (above) and b (below, -1 = ground) with compression C = P + k (x_b - x_a).
+void add_spring(Triplets& t, Eigen::VectorXd& r, int a, int b, double k, double preload) {
+  t.emplace_back(a, a, k);
+  r[a] += preload;
+  if (b >= 0) {
+    t.emplace_back(a, b, -k);
+    t.emplace_back(b, a, -k);
+    t.emplace_back(b, b, k);
+    r[b] -= preload;
+  }
+}
+
+namespace {
+
+Eigen::VectorXd solve_spd(const Eigen::SparseMatrix<double>& k, const Eigen::VectorXd& r, const char* what) {
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);
+  if (ldlt.info() != Eigen::Success)
+    throw SceneError(std::string("statics: ") + what + " is singular (a part of the system is not held by any support)");
+  Eigen::VectorXd x = ldlt.solve(r);
+  if (!x.allFinite()) throw SceneError(std::string("statics: ") + what + " has no finite solution");
+  return x;
+}
+
+}  // namespace
+
+void solve_wire_statics(const Wire& wire, const std::vector<double>& node_load, const std::vector<int>& pn,
+                        const std::vector<double>& ph, std::vector<double>& height, std::vector<double>& slope,
+                        std::vector<double>& reactions) {
+  const int n = wire.nodes();
+  Triplets t;
+  add_wire_band(t, wire, 0, n);
+  Eigen::SparseMatrix<double> k(2 * n, 2 * n);
+  k.setFromTriplets(t.begin(), t.end());
+  // Prescribed heights: move the known columns to the right-hand side, identity rows.
+  std::vector<double> fixed(2 * n, std::nan(""));
+  for (std::size_t j = 0; j < pn.size(); ++j) fixed[pn[j]] = ph[j];
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(2 * n);
+  for (int i = 0; i < n; ++i) r[i] = node_load[i];
+  Eigen::VectorXd yp = Eigen::VectorXd::Zero(2 * n);
+  for (int i = 0; i < 2 * n; ++i)
+    if (!std::isnan(fixed[i])) yp[i] = fixed[i];
+  r -= k * yp;
+  Triplets tr;
+  for (const auto& e : t) {
+    const bool fr = !std::isnan(fixed[e.row()]), fc = !std::isnan(fixed[e.col()]);
+    if (!fr && !fc) tr.push_back(e);
+  }
+  for (int i = 0; i < 2 * n; ++i)
+    if (!std::isnan(fixed[i])) {
+      tr.emplace_back(i, i, 1.0);
+      r[i] = fixed[i];
+    }
+  Eigen::SparseMatrix<double> kr(2 * n, 2 * n);
+  kr.setFromTriplets(tr.begin(), tr.end());
+  const Eigen::VectorXd y = solve_spd(kr, r, ("the " + wire.name + " statics").c_str());
+  height.assign(y.data(), y.data() + n);
+  slope.assign(y.data() + n, y.data() + 2 * n);
+  const Eigen::VectorXd ky = k * y;
+  reactions.resize(pn.size());
+  for (std::size_t j = 0; j < pn.size(); ++j) reactions[j] = ky[pn[j]] - node_load[pn[j]];
+}
+
+void solve_initial_state(const Model& m, State& st, bool roof_springs) {
+  // Unknowns: the model's DOFs, then the rotations of wires whose rotations are condensed.
+  std::vector<int> t0(m.wires.size());
+  int size = m.n_dof;
+  for (std::size_t i = 0; i < m.wires.size(); ++i) {
+    t0[i] = m.wires[i].theta_dof >= 0 ? m.wires[i].theta_dof : size;
+    if (m.wires[i].theta_dof < 0) size += m.wires[i].nodes();
+  }
+  std::vector<bool> dropper_on(m.droppers.size(), true);
+  std::vector<bool> contact_on(m.collectors.size() * m.contact_wires.size(), true);
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(size);
+
+  for (int iter = 0; iter < 60; ++iter) {
+    Triplets t;
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(size);
+    r.head(m.n_dof) = m.load;
+    for (std::size_t i = 0; i < m.wires.size(); ++i) add_wire_band(t, m.wires[i], m.wires[i].w_dof, t0[i]);
+    for (const SupportSpring& s : m.springs) t.emplace_back(s.dof, s.dof, s.stiffness);
+    for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+      const Dropper& d = m.droppers[k];
+      if (dropper_on[k]) add_spring(t, r, d.messenger_dof, d.contact_dof, d.stiffness, -d.static_tension);
+    }
+    for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
+      const Pantograph& p = m.pantographs[pi];
+      const double uplift = st.uplift[pi] + p.aero_coefficient * air_speed_squared(st, pi);
+      if (!p.moving_force) {
+        for (int i = 0; i < p.masses_count(); ++i) {
+          const bool roof = i + 1 == p.masses_count();
+          if (roof && !roof_springs) continue;
+          add_spring(t, r, p.first_dof + i, roof ? -1 : p.first_dof + i + 1, p.stiffness[i], p.spring_preload[i]);
+        }
+        r[p.first_dof + p.masses_count() - 1] += uplift;
+        // Heads on their suspensions, with their own aerodynamic uplift.
+        for (const Head& h : p.heads) {
+          add_spring(t, r, h.dof, p.first_dof, h.stiffness, h.preload);
+          r[h.dof] += h.aero_coefficient * air_speed_squared(st, pi);
+        }
+      }
+      for (std::size_t cj = 0; cj < p.collectors.size(); ++cj) {
+        const int ci = p.collectors[cj];
+        const double xc = st.front - p.position + m.collectors[ci].offset;
+        if (p.moving_force) {
+          // As in step(): the given force acts on the lowest wire(s) under the collector.
+          std::vector<double> yd(m.contact_wires.size(), std::numeric_limits<double>::infinity());
+          double lowest = std::numeric_limits<double>::infinity();
+          for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+            const Wire& w = m.wires[m.contact_wires[wk]];
+            const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+            if (cnt == 0) continue;
+            yd[wk] = 0.0;
+            for (int a = 0; a < cnt; ++a) yd[wk] += weight[a] * w.height[node[a]];
+            lowest = std::min(lowest, yd[wk]);
+          }
+          int sharing = 0;
+          for (double y : yd) sharing += y <= lowest + 1e-3;
+          const double given = (p.external ? st.external_force[pi] : uplift) / p.collectors.size();
+          for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+            if (!(yd[wk] <= lowest + 1e-3)) continue;
+            const Wire& w = m.wires[m.contact_wires[wk]];
+            const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+            for (int a = 0; a < cnt; ++a) r[w.w_dof + node[a]] += given / sharing * weight[a];
+          }
+          continue;
+        }
+        for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+          const Wire& w = m.wires[m.contact_wires[wk]];
+          const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+          if (cnt == 0) continue;
+          if (!contact_on[ci * m.contact_wires.size() + wk]) continue;
+          double yd = 0.0;
+          for (int a = 0; a < cnt; ++a) yd += weight[a] * w.height[node[a]];
+          const double gap0 = p.contact_reference(m.collectors[ci]) - yd, k0 = m.contact_stiffness;
+          const int h = m.collectors[ci].dof;
+          t.emplace_back(h, h, k0);
+          r[h] -= k0 * gap0;
+          for (int a = 0; a < cnt; ++a) {
+            const int ja = w.w_dof + node[a];
+            t.emplace_back(h, ja, -k0 * weight[a]);
+            t.emplace_back(ja, h, -k0 * weight[a]);
+            r[ja] += k0 * weight[a] * gap0;
+            for (int b = 0; b < cnt; ++b) t.emplace_back(ja, w.w_dof + node[b], k0 * weight[a] * weight[b]);
+          }
+        }
+      }
+    }
+    // Rigid supports: identity rows and columns.
+    std::vector<bool> fixed(size, false);
+    for (int i = 0; i < m.n_dof; ++i) fixed[i] = m.inv_mass[i] == 0.0;
+    Triplets tr;
+    tr.reserve(t.size());
+    for (const auto& e : t)
+      if (!fixed[e.row()] && !fixed[e.col()]) tr.push_back(e);
+    for (int i = 0; i < size; ++i)
+      if (fixed[i]) {
+        tr.emplace_back(i, i, 1.0);
+        r[i] = 0.0;
+      }
+    Eigen::SparseMatrix<double> k(size, size);
+    k.setFromTriplets(tr.begin(), tr.end());
+    x = solve_spd(k, r, "the initial configuration (eq. 23)");
+
+    // Active set: droppers carry only tension, contacts only compression (eq. 25).
+    bool changed = false;
+    for (std::size_t k2 = 0; k2 < m.droppers.size(); ++k2) {
+      const Dropper& d = m.droppers[k2];
+      const bool on = d.static_tension + d.stiffness * (x[d.messenger_dof] - x[d.contact_dof]) > 0.0;
+      if (on != dropper_on[k2]) changed = true;
+      dropper_on[k2] = on;
+    }
+    for (std::size_t ci = 0; ci < m.collectors.size(); ++ci) {
+      const Pantograph& p = m.pantographs[m.collectors[ci].pantograph];
+      if (p.moving_force) continue;
+      const double xc = st.front - p.position + m.collectors[ci].offset;
+      for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+        const Wire& w = m.wires[m.contact_wires[wk]];
+        const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+        double yw = 0.0;
+        for (int a = 0; a < cnt; ++a) yw += weight[a] * (w.height[node[a]] + x[w.w_dof + node[a]]);
+        const Collector& col = m.collectors[ci];
+        const bool on = cnt > 0 && p.contact_reference(col) + x[col.dof] - yw >= 0.0;
+        const std::size_t idx = ci * m.contact_wires.size() + wk;
+        if (on != contact_on[idx]) changed = true;
+        contact_on[idx] = on;
+      }
+    }
+    if (!changed) {
+      st.u = x.head(m.n_dof);
+      st.v.setZero();  // eq. 24
+      return;
+    }
+  }
+  throw SceneError("statics: the initial configuration (eq. 23) found no consistent set of slack droppers and "
+                   "contacts in 60 iterations; check static_uplift and the dropper data");
+}
+
+void set_pantograph_references(Model& m) {
+  // Displacement 0 of a pantograph puts its head at the design height of the contact wire under
+  // its collectors at the start; the springs between masses carry the static uplift there, so at
+  // the static state every mass is displaced as much as the head. The roof spring is relaxed at
+  // the initial static state: the static uplift is then exactly the static contact force, and the
+  // roof spring models how that force changes with working height.
+  for (Pantograph& p : m.pantographs) {
+    double sum = 0.0;
+    int count = 0;
+    for (int ci : p.collectors) {
+      // The lowest contact wire over the collector is the one the head meets first.
+      const double lowest = lowest_design_height(m, m.train_start - p.position + m.collectors[ci].offset);
+      if (std::isfinite(lowest)) {
+        sum += lowest;
+        ++count;
+      }
+    }
+    p.reference_height = count ? sum / count : m.scene.contact_wire_height;
+    p.spring_preload.assign(p.masses.size(), p.static_uplift);
+    if (!p.masses.empty()) p.spring_preload.back() = 0.0;
+    // Each head likewise at the wire over its own strips, its suspension carrying its strips'
+    // share of the static uplift (the initial statics then settle the split, eq. 23).
+    for (Head& h : p.heads) {
+      double hs = 0.0;
+      int hc = 0;
+      for (int ci : h.collectors) {
+        const double lowest = lowest_design_height(m, m.train_start - p.position + m.collectors[ci].offset);
+        if (std::isfinite(lowest)) {
+          hs += lowest;
+          ++hc;
+        }
+      }
+      h.reference_height = hc ? hs / hc : p.reference_height;
+      h.preload = p.static_uplift * static_cast<double>(h.collectors.size()) / static_cast<double>(p.collectors.size());
+    }
+  }
+  if (m.pantographs.empty()) return;
+  State st = make_state(m);
+  st.front = m.train_start;
+  try {
+    solve_initial_state(m, st, false);
+  } catch (const SceneError&) {
+    // Without roof springs (relaxed at the working height, eq. 23) only the contact holds a
+    // lumped pantograph: with no uplift it may not press on the wire, and nothing holds it.
+    for (std::size_t i = 0; i < m.pantographs.size(); ++i) {
+      const Pantograph& p = m.pantographs[i];
+      const double v = m.scene.train_speed;
+      double uplift = p.static_uplift + p.aero_coefficient * v * v;
+      for (const Head& h : p.heads) uplift += h.aero_coefficient * v * v;
+      if (!p.moving_force && !(uplift > 0.0)) {
+        std::ostringstream s;
+        s << "scene field 'pantographs[" << i << "].static_uplift' = " << p.static_uplift
+          << ": allowed > 0 N in this scene: the initial statics (eq. 23) hold pantograph '" << p.name
+          << "' at its working height by its contact alone (the roof spring is relaxed there), and with an uplift of "
+          << uplift << " N it does not press on the wire at the start";
+        throw SceneError(s.str());
+      }
+    }
+    throw;
+  }
+  for (Pantograph& p : m.pantographs) {
+    if (p.moving_force) continue;
+    const int last = p.masses_count() - 1;
+    p.spring_preload[last] = p.stiffness[last] * st.u[p.first_dof + last];
+  }
+}
+
+}  // namespace catenary_sim
+
+namespace catenary_sim {
+
+namespace {
+
+Scene probe_scene(const Scene& scene, double force) {
+  Scene s = scene;
+  PantographSpec p;
+  p.name = "probe";
+  p.masses = {1.0};
+  p.stiffness = {0.0};
+  p.damping = {0.0};
+  p.static_uplift = force;
+  p.collectors = {CollectorSpec{}};
+  s.pantographs = {p};
+  s.train_speed = 0.0;
+  s.train_start.reset();
+  s.train_end.reset();
+  s.contact.rub_length = 0.0;  // a point load: the elasticity at the station itself
+  return s;
+}
+
+}  // namespace
+
+ElasticityProbe::ElasticityProbe(const Scene& scene, double force, const std::optional<std::vector<double>>& rises) {
+  BuildOptions o;
+  o.stability = false;
+  o.support_rises = rises;
+  model_ = build_model(probe_scene(scene, force), o);
+}
+
+std::vector<double> ElasticityProbe::uplift(double x) const {
+  const Model& m = model_;
+  std::vector<double> out(m.contact_wires.size(), std::nan(""));
+  State st = make_state(m);
+  st.front = x;
+  try {
+    solve_initial_state(m, st, true);
+  } catch (const SceneError&) {
+    return out;  // nothing under the probe to press against
+  }
+  observe(m, st);
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  for (std::size_t k = 0; k < m.contact_wires.size(); ++k) {
+    if (!(st.contact_force[k] > 0.0)) continue;
+    const Wire& w = m.wires[m.contact_wires[k]];
+    const int cnt = contact_weights(w, 0.0, x, node.data(), weight.data());
+    double u = 0.0;
+    for (int a = 0; a < cnt; ++a) u += weight[a] * st.u[w.w_dof + node[a]];
+    out[k] = u;
+  }
+  return out;
+}
+
+std::vector<double> transition_support_rises(const Scene& scene) {
+  const std::size_t ns = scene.sections.size();
+  std::vector<double> rises(2 * ns, 0.0);
+  bool any = false;
+  for (const SectionSpec& sec : scene.sections) any = any || sec.first_span_transition || sec.last_span_transition;
+  if (!any) return rises;
+  if (scene.overlap && scene.overlap->support_rise) {
+    for (std::size_t i = 0; i < ns; ++i) {
+      rises[2 * i] = scene.sections[i].first_span_transition ? *scene.overlap->support_rise : 0.0;
+      rises[2 * i + 1] = scene.sections[i].last_span_transition ? *scene.overlap->support_rise : 0.0;
+    }
+    return rises;
+  }
+  // F of eq. 6: the design force, else the mean static uplift of the pantographs, else 100 N.
+  double force = 100.0;
+  if (scene.overlap && scene.overlap->design_force) {
+    force = *scene.overlap->design_force;
+  } else if (!scene.pantographs.empty()) {
+    force = 0.0;
+    for (const PantographSpec& p : scene.pantographs) force += p.static_uplift;
+    force /= scene.pantographs.size();
+  }
+  // E at mid-span of a current span, measured on the model with the supports not yet raised.
+  const ElasticityProbe probe(scene, force, std::vector<double>(2 * ns, 0.0));
+  for (std::size_t i = 0; i < ns; ++i) {
+    const SectionSpec& sec = scene.sections[i];
+    const int n = static_cast<int>(sec.spans.size());
+    int best = -1;
+    double best_dist = 1e300, x0 = sec.start;
+    std::vector<double> starts;
+    for (int j = 0; j < n; ++j) {
+      starts.push_back(x0);
+      const bool transition = (j == 0 && sec.first_span_transition) || (j == n - 1 && sec.last_span_transition);
+      const double dist = std::fabs(x0 + 0.5 * sec.spans[j] - (sec.start + 0.5 * sec.length()));
+      if (!transition && dist < best_dist) {
+        best = j;
+        best_dist = dist;
+      }
+      x0 += sec.spans[j];
+    }
+    if (best < 0) best = n / 2;  // no current span: the middle span, supports not raised
+    const std::vector<double> up = probe.uplift(starts[best] + 0.5 * sec.spans[best]);
+    double h = 0.0;
+    for (std::size_t k = 0; k < up.size(); ++k)
+      if (probe.model().wires[probe.model().contact_wires[k]].section == static_cast<int>(i) && std::isfinite(up[k]))
+        h = std::max(h, up[k]);
+    if (!(h > 0.0))
+      throw SceneError("overlap: the static uplift under " + std::to_string(force) + " N at mid-span of span " +
+                       std::to_string(best) + " of section " + std::to_string(i) +
+                       " could not be measured (eq. 6); give overlap.support_rise");
+    const double p = sec.contact_wire.linear_mass * scene.gravity, T = sec.contact_wire.tension;
+    const double b = std::sqrt(2.0 * T * h / p);  // eq. 7
+    auto rise = [&](double span) {
+      const double a = 0.5 * span;
+      return p * (a + 0.5 * b) * (a + 0.5 * b) / (2.0 * T);  // eq. 8
+    };
+    if (sec.first_span_transition) rises[2 * i] = rise(sec.spans.front());
+    if (sec.last_span_transition) rises[2 * i + 1] = rise(sec.spans.back());
+  }
+  return rises;
+}
+
+}  // namespace catenary_sim

@@ -1,0 +1,238 @@
+#include "catenary_sim/core/output/pass_files.hpp"
+
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <deque>
+#include <iomanip>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "catenary_sim/core/output/output_files.hpp"
+#include "catenary_sim/core/output/line_measures.hpp"
+
+extern char** environ;
+
+#ifndef CATENARY_SIM_SOURCE_DIR
+#define CATENARY_SIM_SOURCE_DIR ""
+#endif
+#ifndef CATENARY_SIM_SHARE_DIR
+#define CATENARY_SIM_SHARE_DIR ""
+#endif
+
+namespace catenary_sim {
+
+namespace {
+
+// A CSV of rows (time first), written in pieces of about 1 MiB. A value that does not exist (NaN)
+// is an empty field, as RFC 4180 readers take a missing value, never the text "nan".
+void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const std::deque<PassRecorder::Row>& rows) {
+  std::ostringstream c;
+  c << "time_s";
+  for (const std::string& col : columns) c << "," << csv_field(col);
+  c << "\n";
+  c << std::setprecision(9);
+  for (const auto& row : rows) {
+    c << row.time;
+    for (double v : row.values) {
+      c << ",";
+      if (std::isfinite(v)) c << v;
+    }
+    c << "\n";
+    if (c.tellp() > (1 << 20)) {
+      f.write(c.str());
+      c.str("");
+    }
+  }
+  f.write(c.str());
+}
+
+}  // namespace
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::vector<std::string> pass_file_names(const Model& model) {
+  std::vector<std::string> names{"stats.json",   "timeseries.csv",       "force_processed.csv", "contact_losses.csv",
+                                 "droppers.csv", "dropper_rainflow.csv", "psd.csv"};
+  if (model.scene.output.dropper_series) names.push_back("dropper_series.csv");
+  if (model.lateral)
+    for (const char* n : {"lateral.csv", "lateral_histogram.csv", "blow_off.csv", "pull_off.csv", "dewirements.csv"})
+      names.push_back(n);
+  return names;
+}
+
+void check_pass_files_writable(const std::string& dir, const Model& model) {
+  make_directories(dir);
+  for (const std::string& name : pass_file_names(model)) check_writable(dir + "/" + name);
+}
+
+std::string add_lateral_statistics(const std::string& stats_json, const Model& m, const LateralStatistics& lateral,
+                                   bool stopped_by_dewirement) {
+  if (!m.lateral) return stats_json;
+  nlohmann::json j = nlohmann::json::parse(stats_json);
+  j["lateral"] = nlohmann::json::parse(lateral_statistics_json(m, lateral));
+  j["stopped_by_dewirement"] = stopped_by_dewirement;
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+namespace {
+std::string stats_document(const Model& m, const State& st, const std::vector<PantographStatistics>& stats,
+                           const LineStatistics& line, const RunInfo& run, const LateralStatistics& lateral,
+                           bool stopped_by_dewirement) {
+  return add_lateral_statistics(statistics_json(m, st, stats, run, &line), m, lateral, stopped_by_dewirement);
+}
+}  // namespace
+
+std::string pass_statistics_json(const Model& m, const State& st, const PassRecorder& recorder, const RunInfo& run,
+                                 const LateralRecorder* lateral, bool stopped_by_dewirement) {
+  const LateralStatistics lateral_stats = m.lateral && lateral ? lateral->statistics(m, st) : LateralStatistics{};
+  return stats_document(m, st, recorder.statistics(m), recorder.line_statistics(m), run, lateral_stats,
+                        stopped_by_dewirement);
+}
+
+void write_pass_files(const std::string& dir, const Model& m, const State& st, const PassRecorder& recorder,
+                      const RunInfo& run, const LateralRecorder* lateral, bool stopped_by_dewirement) {
+  const std::vector<PantographStatistics> stats = recorder.statistics(m);
+  const LineStatistics line = recorder.line_statistics(m);
+  std::vector<std::unique_ptr<AtomicFile>> files;
+  auto add = [&](const std::string& name) -> AtomicFile& {
+    files.push_back(std::make_unique<AtomicFile>(dir + "/" + name));
+    return *files.back();
+  };
+  write_rows(add("timeseries.csv"), recorder.columns(), recorder.rows());
+  const bool three_d = m.lateral && lateral;
+  const LateralStatistics lateral_stats = three_d ? lateral->statistics(m, st) : LateralStatistics{};
+  add("stats.json").write(stats_document(m, st, stats, line, run, lateral_stats, stopped_by_dewirement));
+  write_rows(add("force_processed.csv"), recorder.processed_columns(), recorder.processed_rows(m));
+  {
+    std::ostringstream c;
+    c << std::setprecision(9) << "pantograph,start_time_s,station_m,duration_s,length_m\n";
+    for (const PantographStatistics& p : stats)
+      for (const ContactLossEvent& e : p.loss_events)
+        c << csv_field(p.name) << "," << e.start_time << "," << e.station << "," << e.duration << "," << e.length << "\n";
+    add("contact_losses.csv").write(c.str());
+  }
+  {
+    std::ostringstream c, r;
+    c << std::setprecision(9) << "station_m,static_tension_N,max_force_N,min_force_N,slack_percent,rainflow_cycles,max_range_N\n";
+    r << std::setprecision(9) << "station_m,range_from_N,range_to_N,cycles\n";
+    for (const DropperStatistics& d : line.droppers) {
+      c << d.station << "," << d.static_tension << "," << d.max_force << "," << d.min_force << "," << d.slack_percent << ","
+        << d.cycles << "," << d.max_range << "\n";
+      for (std::size_t b = 0; b < d.histogram.size(); ++b)
+        r << d.station << "," << b * line.range_bin_n << "," << (b + 1) * line.range_bin_n << "," << d.histogram[b] << "\n";
+    }
+    add("droppers.csv").write(c.str());
+    add("dropper_rainflow.csv").write(r.str());
+  }
+  {
+    std::ostringstream c;
+    c << std::setprecision(9) << "pantograph,frequency_hz,psd_N2_per_hz\n";
+    const std::vector<Spectrum> spectra = recorder.spectra(m);
+    for (std::size_t p = 0; p < spectra.size(); ++p)
+      for (std::size_t k = 0; k < spectra[p].frequency.size() && spectra[p].frequency[k] <= kSpectrumMaxHz; ++k)
+        c << csv_field(m.pantographs[p].name) << "," << spectra[p].frequency[k] << "," << spectra[p].psd[k] << "\n";
+    add("psd.csv").write(c.str());
+  }
+  if (m.scene.output.dropper_series) write_rows(add("dropper_series.csv"), recorder.dropper_columns(), recorder.dropper_rows());
+  if (three_d) {
+    write_rows(add("lateral.csv"), lateral->columns(), lateral->rows());
+    std::ostringstream h, b, p, d;
+    h << std::setprecision(9) << "pantograph,collector,from_m,to_m,percent_of_contact_time\n";
+    for (const LateralContactStatistics& c : lateral_stats.contacts)
+      for (std::size_t k = 0; k < c.histogram_percent.size(); ++k)
+        h << csv_field(c.pantograph) << "," << c.collector << "," << c.from + k * c.bin << "," << c.from + (k + 1) * c.bin
+          << "," << c.histogram_percent[k] << "\n";
+    add("lateral_histogram.csv").write(h.str());
+    b << std::setprecision(9) << "span,start_m,end_m,static_blow_off_m,max_blow_off_m,exceeded\n";
+    for (const SpanBlowOff& s : lateral_stats.spans)
+      b << s.span << "," << s.start << "," << s.end << "," << s.static_m << "," << s.max_m << "," << s.exceeded << "\n";
+    add("blow_off.csv").write(b.str());
+    p << std::setprecision(9) << "wire,station_m,stagger_m,anchor,rigid,pull_off_N,pull_off_mean_wind_N\n";
+    for (const LateralSupport& s : m.lateral->supports)
+      p << csv_field(m.wires[s.wire].name) << "," << s.x << "," << s.stagger << "," << s.anchor << "," << s.rigid << ","
+        << s.pull_off << "," << s.pull_off_wind << "\n";
+    add("pull_off.csv").write(p.str());
+    d << std::setprecision(9) << "pantograph,collector,time_s,station_m,lateral_m\n";
+    for (const DewirementEvent& e : lateral_stats.events)
+      d << csv_field(m.pantographs[e.pantograph].name) << "," << e.collector << "," << e.time << "," << e.station << ","
+        << e.lateral << "\n";
+    add("dewirements.csv").write(d.str());
+  }
+  // All on the disk before any is renamed into place: a full disk leaves the old set (or none),
+  // never a new CSV beside an old stats.json.
+  for (auto& f : files) f->flush();
+  for (auto& f : files) f->commit();
+}
+
+std::string find_package_file(const std::string& relative) {
+  for (const std::string& dir : {std::string(CATENARY_SIM_SOURCE_DIR), std::string(CATENARY_SIM_SHARE_DIR)}) {
+    if (dir.empty()) continue;
+    const std::string path = dir + "/" + relative;
+    struct stat st {};
+    if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return path;
+  }
+  return "";
+}
+
+std::string find_script(const std::string& name) { return find_package_file("scripts/" + name); }
+
+std::string find_pass_report_script() { return find_script("pass_report"); }
+
+pid_t start_python_script(const std::string& script, const std::vector<std::string>& args, std::string* why) {
+  const char* python = "/usr/bin/python3";
+  if (::access(python, X_OK) != 0) {
+    *why = "/usr/bin/python3 is missing: install python3, python3-numpy and python3-matplotlib (scripts/setup)";
+    return -1;
+  }
+  std::vector<std::string> all{python, script};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, python, nullptr, nullptr, argv.data(), environ) != 0) {
+    *why = "cannot start " + std::string(python);
+    return -1;
+  }
+  return pid;
+}
+
+pid_t start_pass_report(const std::string& dir, const std::string& html, bool quiet, std::string* why) {
+  const std::string script = find_pass_report_script();
+  if (script.empty()) {
+    *why = "scripts/pass_report not found beside the sources (" CATENARY_SIM_SOURCE_DIR ") or in the share path";
+    return -1;
+  }
+  std::vector<std::string> args{dir};
+  if (!html.empty()) {
+    args.push_back("--html");
+    args.push_back(html);
+  }
+  if (quiet) args.push_back("--quiet");
+  return start_python_script(script, args, why);
+}
+
+int pass_report_status(pid_t pid, bool block) {
+  int status = 0;
+  for (;;) {
+    const pid_t r = ::waitpid(pid, &status, block ? 0 : WNOHANG);
+    if (r == pid) break;
+    if (r == 0) return kReportRunning;
+    if (errno != EINTR) return kReportLost;
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+}  // namespace catenary_sim
