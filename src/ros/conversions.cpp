@@ -380,16 +380,30 @@ LineState to_line_state(const Model& m, const State& s, const PassRecorder& reco
 }
 
 std::vector<geometry_msgs::TransformStamped> to_view_transforms(const Model& m, const State& s, const ros::Time& stamp,
-                                                                const std::string& line_frame) {
+                                                                const std::string& line_frame, int followed) {
   std::vector<geometry_msgs::TransformStamped> out{to_view_transform(s, stamp, line_frame)};
   if (m.pantographs.size() < 2) return out;
+  const geometry_msgs::TransformStamped front = out.front();
+  if (followed >= 0 && followed < static_cast<int>(m.pantographs.size()))
+    out.front().transform.translation.x -= m.pantographs[followed].position;
   for (const Pantograph& p : m.pantographs) {
-    geometry_msgs::TransformStamped t = out.front();
+    geometry_msgs::TransformStamped t = front;
     t.child_frame_id = view_frame_id() + "_" + p.name;
     t.transform.translation.x -= p.position;
     out.push_back(t);
   }
   return out;
+}
+
+int view_pantograph_index(const Model& m, const std::string& name, const std::string& parameter) {
+  if (name.empty()) return -1;
+  std::string names;
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    if (m.pantographs[p].name == name) return static_cast<int>(p);
+    names += (p ? ", " : "") + m.pantographs[p].name;
+  }
+  throw std::invalid_argument("parameter " + parameter + " = '" + name + "' rejected: allowed a pantograph of the scene (" +
+                              names + ") or empty (the train front)");
 }
 
 std::string head_frame_id(const Model& m, int p) { return "pantograph_" + m.pantographs[p].name; }

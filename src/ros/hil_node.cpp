@@ -32,6 +32,9 @@ using hil::steady_now;
 // loaded machine the loop can fall far behind; a request not taken in time is withdrawn.
 constexpr double kControlWait = 5.0;  // s (wall)
 
+// How long the pass waits after rviz has subscribed before it starts (its displays draw late).
+constexpr double kViewerSettle = 1.0;  // s (wall)
+
 // An error at the end of the run: after a shutdown rosconsole no longer prints, so then on stderr.
 void end_error(const std::string& what) {
   if (ros::ok() && !ros::isShuttingDown()) ROS_ERROR("%s", what.c_str());
@@ -45,6 +48,12 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   Scene scene = load_hil_scene(params_);
   try {
     hil::LoopOptions o = loop_options(params_);
+    // Waiting for the viewer: the pass is armed by the worker once rviz subscribes (or the wait is
+    // over), so that its start is seen; until then the line holds its static state.
+    if (params_.wait_for_viewer > 0.0 && params_.auto_start) {
+      o.auto_start = false;
+      viewer_wait_until_ = steady_now() + params_.wait_for_viewer;
+    }
     o.who = "catenary_sim_hil";
     o.input = "hil/contact_force";
     loop_ = std::make_unique<hil::HilLoop>(scene, o);
@@ -113,7 +122,10 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
            scene.name.c_str(), m.n_dof, names.c_str(), params_.rate, timing.period * 1e3, timing.steps_per_period,
            m.dt * 1e3, m.dt_critical * 1e3, scene.train_speed * 3.6, params_.timeout,
            params_.extrapolate ? "linear extrapolation" : "newest measurement held", to_string(params_.at_end));
-  if (params_.auto_start)
+  if (viewer_wait_until_ > 0.0)
+    ROS_INFO("catenary_sim_hil: waiting up to %g s for a viewer (rviz) to subscribe to %s (~wait_for_viewer); the "
+             "pass then starts with the first measurement", params_.wait_for_viewer, marker_pub_.getTopic().c_str());
+  else if (params_.auto_start)
     ROS_INFO("catenary_sim_hil: waiting for the first measurement on %s%s (the line holds its static state)",
              force_sub_.getTopic().c_str(),
              external_.size() == 1 ? (" or " + wrench_sub_.getTopic()).c_str() : "");
@@ -324,9 +336,19 @@ void HilNode::worker() {
         finished_state = finished_state_;
       }
     }
+    if (viewer_wait_until_ > 0.0) arm_when_viewer_ready();
     if (have) {
       const State& s = wsnap_.state;
       const ros::Time stamp = sim_stamp(s.time, stamp_offset_);
+      // The chart's samples on simulated time; a new pass (or a reset) starts a new chart.
+      if (params_.strip_chart) {
+        if (wsnap_.pass_count != chart_pass_ || (!chart_.empty() && s.time < chart_time_)) {
+          chart_.clear(params_.chart_window);
+          chart_pass_ = wsnap_.pass_count;
+        }
+        if (chart_.due(s.time, 1e-3 * params_.chart_window)) chart_.sample(m, s);
+        chart_time_ = s.time;
+      }
       contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
       if (pantograph_pub_.getNumSubscribers() > 0) publish_pantograph_state(m, s, stamp);
       if (s.time > last_tf_time_) {
@@ -342,7 +364,15 @@ void HilNode::worker() {
         next_marker_wall_ = now + 1.0 / params_.marker_rate;
         MarkerOptions o;
         o.frame = params_.line_frame;
-        marker_pub_.publish(to_markers(m, s, stamp, o));
+        visualization_msgs::MarkerArray arr = to_markers(m, s, stamp, o);
+        if (params_.strip_chart) {
+          // The heads-up line (the loop's mode instead of a real-time factor: the loop runs on the
+          // wall clock) and the statistics so far, in the chart's panel, which follows the train.
+          const visualization_msgs::MarkerArray chart = chart_.markers(
+              m, heads_up_position(m, s) + "  hardware in the loop: " + hil::mode_name(wsnap_.mode), stamp);
+          arr.markers.insert(arr.markers.end(), chart.markers.begin(), chart.markers.end());
+        }
+        marker_pub_.publish(arr);
         if (stamp != last_view_stamp_) {
           tf_.sendTransform(to_view_transform(s, stamp, params_.line_frame));
           last_view_stamp_ = stamp;
@@ -369,6 +399,20 @@ void HilNode::worker() {
     }
     updater_.update();
   }
+}
+
+void HilNode::arm_when_viewer_ready() {
+  const double now = steady_now();
+  if (viewer_seen_ < 0.0 && marker_pub_.getNumSubscribers() > 0) {
+    // rviz subscribes before its displays have drawn the first frame: give it a moment.
+    viewer_seen_ = now;
+    viewer_wait_until_ = std::min(viewer_wait_until_, now + kViewerSettle);
+  }
+  if (now < viewer_wait_until_) return;
+  if (viewer_seen_ < 0.0)
+    ROS_WARN("catenary_sim_hil: no viewer subscribed within %g s; starting anyway", params_.wait_for_viewer);
+  viewer_wait_until_ = 0.0;
+  ask_loop(Request::kArm, "wait_for_viewer");
 }
 
 void HilNode::publish_pantograph_state(const Model& m, const State& s, const ros::Time& stamp) {

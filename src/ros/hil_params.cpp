@@ -37,6 +37,8 @@ void validate_hil_params(const HilParams& p) {
     throw ParamError("parameter ~hil/realtime_priority = " + std::to_string(p.realtime_priority) +
                      " rejected: allowed 0 (normal scheduling) to 99 (SCHED_FIFO priority)");
   check_frame_id("line_frame", p.line_frame);
+  check_range("wait_for_viewer", p.wait_for_viewer, 0.0, kMaxWaitForViewer, false, "s (0: no wait)");
+  check_range("chart_window", p.chart_window, kMinChartWindow, kMaxChartWindow, false, "s");
   check_range("hil/delay_compensation", p.delay_compensation, 0.0, 0.1, false, "s");
   if (p.udp_port < 0 || p.udp_port > 65535)
     throw ParamError("parameter ~hil/udp_port = " + std::to_string(p.udp_port) + " rejected: allowed 0 to 65535");
@@ -81,6 +83,7 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
                 {"scene", "speed_kmh", "hil/rate", "hil/timeout", "hil/extrapolate", "hil/hold_ramp",
                  "hil/hold_deceleration", "hil/report_file", "hil/realtime_priority", "hil/spin_wait", "hil/auto_start", "at_end",
                  "stats_file", "line_frame", "publish_rate", "marker_rate", "start_delay", "shape_rate",
+                 "wait_for_viewer", "strip_chart", "chart_window",
                  "shape_resolution", "diagnostic_period", "hil/lock_memory", "hil/cpus", "hil/delay_compensation",
                  "hil/udp_bind", "hil/udp_port", "hil/udp_rig", "hil/udp_allow"});  // (the last read by diagnostic_updater)
   HilParams p;
@@ -101,6 +104,9 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
   r.boolean("hil/extrapolate", p.extrapolate);
   r.boolean("hil/auto_start", p.auto_start);
   r.boolean("hil/lock_memory", p.lock_memory);
+  r.number("wait_for_viewer", p.wait_for_viewer, "a number in " + range_text(0.0, kMaxWaitForViewer, false, "s (0: no wait)"));
+  r.boolean("strip_chart", p.strip_chart);
+  r.number("chart_window", p.chart_window, "a number in " + range_text(kMinChartWindow, kMaxChartWindow, false, "s"));
   r.text("hil/cpus", p.cpus, "CPU numbers, e.g. 3, 2,3 or 0-3 (empty: any)");
   r.number("hil/delay_compensation", p.delay_compensation, "a number in [0, 0.1] s");
   r.text("hil/udp_bind", p.udp_bind, "a numeric IPv4 address");

@@ -25,14 +25,6 @@ namespace catenary_sim {
 namespace ros_layer {
 
 namespace {
-// Span of the train front along the line, counted from 0 (an endless line's spans go on).
-long span_along_line(const Model& m, const State& s) {
-  if (m.endless) return static_cast<long>(std::floor((s.front + s.line_offset) / m.endless_span));
-  const auto it = std::upper_bound(m.support_x.begin(), m.support_x.end(), s.front);
-  const long i = static_cast<long>(it - m.support_x.begin()) - 1;
-  return std::clamp<long>(i, 0, static_cast<long>(m.support_x.size()) - 2);
-}
-
 // Sample rate of the recorder's decimated time series without a report (statistics use every step).
 constexpr double kRecorderRowRate = 10.0;
 
@@ -41,10 +33,6 @@ std::string report_directory(const std::string& html) {
   const std::size_t slash = html.rfind('/');
   return slash == std::string::npos ? "." : slash == 0 ? "/" : html.substr(0, slash);
 }
-
-// m the strip chart's panel rises for a label of three lines (ChartOptions::z_bottom): a 0.6 m
-// line at the label, 16 m from the camera, spans about as much as 1 m at the panel, farther away.
-constexpr double kThirdLabelLineLift = 1.0;
 
 // The answer of set_paused false and step once the pass has ended (pass_status "ended").
 constexpr const char* kEndedMessage = "the pass has ended; reset to run again";
@@ -62,6 +50,11 @@ SimulationNode::SimulationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     sim_ = std::make_unique<Simulation>(scene);
   } catch (const SceneError& e) {
     throw ParamError("parameter ~scene = '" + params_.scene + "': " + e.what());
+  }
+  try {
+    view_pantograph_ = view_pantograph_index(sim_->model(), params_.view_pantograph, "~view_pantograph");
+  } catch (const std::invalid_argument& e) {
+    throw ParamError(e.what());
   }
   std::string err;
   if (!sim_->set_max_acceleration(params_.max_acceleration, &err)) throw ParamError("parameter ~max_acceleration: " + err);
@@ -126,50 +119,7 @@ void SimulationNode::restart_recording() {
   recorder_->record(sim_->model(), sim_->state());
   lateral_recorder_ = std::make_unique<LateralRecorder>(sim_->model(), rows);  // records nothing on a 2-D line
   lateral_recorder_->record(sim_->model(), sim_->state());
-  running_.assign(sim_->model().pantographs.size(), Running{});
-  chart_ = ChartData{};
-  last_chart_time_ = -1.0;
-}
-
-void SimulationNode::sample_chart() {
-  const Model& m = sim_->model();
-  const State& s = sim_->state();
-  if (s.time == last_chart_time_) return;
-  last_chart_time_ = s.time;
-  const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
-  if (chart_.series.empty()) {
-    for (std::size_t p = 0; p < np; ++p) {
-      chart_.series.push_back({m.pantographs[p].name, {}});
-      if (nw > 1)
-        for (std::size_t k = 0; k < nw; ++k)
-          chart_.series.push_back({m.pantographs[p].name + " on " + label_wire_name(m.wires[m.contact_wires[k]].name), {}});
-    }
-  }
-  chart_.time.push_back(s.time);
-  std::size_t j = 0;
-  for (std::size_t p = 0; p < np; ++p) {
-    const double f = total_contact_force(m, s, static_cast<int>(p));
-    chart_.series[j++].force.push_back(f);
-    Running& r = running_[p];
-    r.n += 1;
-    r.sum += f;
-    r.sum2 += f * f;
-    r.max = std::max(r.max, f);
-    r.min = std::min(r.min, f);
-    if (nw > 1)
-      for (std::size_t k = 0; k < nw; ++k) {
-        double fk = 0.0;
-        for (int ci : m.pantographs[p].collectors) fk += s.contact_force[ci * nw + k];
-        chart_.series[j++].force.push_back(fk);
-      }
-  }
-  // Keep the window (and a sample before it, so the strip starts at the panel's edge).
-  std::size_t drop = 0;
-  while (drop + 1 < chart_.time.size() && chart_.time[drop + 1] < s.time - params_.chart_window) ++drop;
-  if (drop > 0) {
-    chart_.time.erase(chart_.time.begin(), chart_.time.begin() + drop);
-    for (ChartSeries& c : chart_.series) c.force.erase(c.force.begin(), c.force.begin() + drop);
-  }
+  chart_.clear(params_.chart_window);
 }
 
 void SimulationNode::publish_line_state(const ros::Time& stamp) {
@@ -310,7 +260,7 @@ void SimulationNode::on_tf_subscriber(const ros::SingleSubscriberPublisher& pub)
   msg.transforms = to_transforms(sim_->model(), s, stamp, params_.line_frame);
   // train_view only once the markers of the hold have broadcast it (else they will, to everyone).
   if (view_sent_ && last_view_stamp_ == stamp)
-    for (const auto& t : to_view_transforms(sim_->model(), s, stamp, params_.line_frame)) msg.transforms.push_back(t);
+    for (const auto& t : to_view_transforms(sim_->model(), s, stamp, params_.line_frame, view_pantograph_)) msg.transforms.push_back(t);
   pub.publish(msg);
 }
 
@@ -343,7 +293,7 @@ std::int64_t SimulationNode::do_steps(std::int64_t n, const ros::WallTime* deadl
     lateral_recorder_->record(m, s);
     track_contact_loss();  // every step: the events resolve dt, not the publishing tick
     // The chart's samples on simulated time (a thousand per window), also when ~step jumps ahead.
-    if (params_.strip_chart && s.time - last_chart_time_ >= 1e-3 * params_.chart_window) sample_chart();
+    if (params_.strip_chart && chart_.due(s.time, 1e-3 * params_.chart_window)) chart_.sample(m, s);
     if (deadline && (done & 31) == 31 && ros::WallTime::now() >= *deadline) {
       ++done;
       break;
@@ -502,7 +452,7 @@ void SimulationNode::reap_report(bool block) {
 void SimulationNode::publish(bool force) {
   const Model& m = sim_->model();
   const State& s = sim_->state();
-  if (params_.strip_chart && last_chart_time_ < 0.0) sample_chart();  // the initial state
+  if (params_.strip_chart && chart_.empty()) chart_.sample(m, s);  // the initial state
   const ros::WallTime now = ros::WallTime::now();
   const ros::Time stamp = sim_stamp(s.time, 0.0);
   const bool advanced = s.time > last_published_time_;
@@ -550,43 +500,19 @@ void SimulationNode::publish(bool force) {
         // The heads-up line and the statistics so far (unfiltered: the filtered ones need the
         // whole pass, zero-phase), in the chart's panel, which follows the train.
         std::ostringstream head;
-        head << std::fixed << std::setprecision(1) << "x " << s.front + s.line_offset << " m  span "
-             << span_along_line(m, s) + 1 << "  t " << std::setprecision(2) << s.time << " s  "
-             << std::setprecision(2);
+        head << heads_up_position(m, s) << "  " << std::fixed << std::setprecision(2);
         if (paused_ || waiting_ || ended_ || sim_->finished()) head << (paused_ ? "paused" : ended_ || sim_->finished() ? "ended" : "waiting");
         else head << achieved_rtf_ << "x real time";
         head << "  vertical x" << std::setprecision(0) << params_.vertical_scale;
         if (m.lateral && params_.lateral_scale != 1.0) head << "  lateral x" << params_.lateral_scale;
-        chart_.heading = head.str();
-        chart_.stats.clear();
-        for (std::size_t p = 0; p < running_.size(); ++p) {
-          const Running& r = running_[p];
-          if (r.n < 1) continue;
-          const double mean = r.sum / r.n, sd = std::sqrt(std::max(0.0, r.sum2 / r.n - mean * mean));
-          std::ostringstream t;
-          t << std::fixed << std::setprecision(0) << m.pantographs[p].name << ": mean " << mean << ", std " << sd
-            << ", max " << r.max << ", min " << r.min << " N (so far, unfiltered)";
-          chart_.stats.push_back(t.str());
-        }
-        ChartOptions co;
-        co.window = params_.chart_window;
-        // The label has a third line with several contact wires (force on each) or on a 3-D line
-        // (the contact point on the strip), one line higher: the panel goes up by as much as that
-        // line spans seen from the default camera, so that the heads-up line stays clear of it.
-        // It also moves left by as much, clear of the label's wider lines.
-        if (m.contact_wires.size() > 1 || m.lateral) {
-          co.z_bottom += kThirdLabelLineLift;
-          co.origin_x -= kThirdLabelLineLift * co.dir_x;
-          co.origin_y -= kThirdLabelLineLift * co.dir_y;
-        }
-        const visualization_msgs::MarkerArray chart = to_strip_chart(chart_, stamp, co);
+        const visualization_msgs::MarkerArray chart = chart_.markers(m, head.str(), stamp);
         arr.markers.insert(arr.markers.end(), chart.markers.begin(), chart.markers.end());
       }
       marker_pub_.publish(arr);
       // The camera's frame moves with the markers, same stamp. A repeated stamp (holding) is not
       // sent again: tf2 would warn TF_REPEATED_DATA, and the last transform stays in effect.
       if (!view_sent_ || stamp != last_view_stamp_) {
-        tf_.sendTransform(to_view_transforms(m, s, stamp, params_.line_frame));
+        tf_.sendTransform(to_view_transforms(m, s, stamp, params_.line_frame, view_pantograph_));
         last_view_stamp_ = stamp;
         view_sent_ = true;
       }

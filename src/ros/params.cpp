@@ -232,8 +232,8 @@ const Range kVerticalScale{kMinVerticalScale, 10000.0, false, ""};
 const Range kLateralScale{1.0, 100.0, false, "(1: true scale)"};
 const Range kMaxAcceleration{0.0, 20.0, false, "m/s^2 (0: no limit)"};
 const Range kStartDelay{0.0, 60.0, false, "s"};
-const Range kWaitForViewer{0.0, 600.0, false, "s (0: no wait)"};
-const Range kChartWindow{0.5, 60.0, false, "s"};
+const Range kWaitForViewer{0.0, kMaxWaitForViewer, false, "s (0: no wait)"};
+const Range kChartWindow{kMinChartWindow, kMaxChartWindow, false, "s"};
 
 void check(const char* name, double v, const Range& r) { check_range(name, v, r.lo, r.hi, r.lo_open, r.unit); }
 }  // namespace
@@ -269,7 +269,7 @@ bool read_speed_kmh(ParamReader& r, const ros::NodeHandle& nh, std::optional<dou
 NodeParams load_params(const ros::NodeHandle& nh) {
   ParamReader r(nh, "catenary_sim",
                 {"scene", "speed_kmh", "real_time_factor", "publish_rate", "shape_rate", "marker_rate",
-                 "shape_resolution", "vertical_scale", "lateral_scale", "line_frame", "at_end", "stats_file", "report_file", "publish_clock",
+                 "shape_resolution", "vertical_scale", "lateral_scale", "line_frame", "view_pantograph", "at_end", "stats_file", "report_file", "publish_clock",
                  "paused", "wait_for_viewer", "max_acceleration", "start_delay", "strip_chart", "chart_window",
                  "diagnostic_period"});  // (the last read by diagnostic_updater)
   NodeParams p;
@@ -286,6 +286,7 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   r.number("start_delay", p.start_delay, kStartDelay.text());
   r.number("wait_for_viewer", p.wait_for_viewer, kWaitForViewer.text());
   r.text("line_frame", p.line_frame, "a frame id");
+  r.text("view_pantograph", p.view_pantograph, "a pantograph's name (empty: the train front)");
   std::string at_end = to_string(p.at_end);
   r.text("at_end", at_end, "stop, loop or exit");
   p.at_end = parse_at_end(at_end);

@@ -412,6 +412,34 @@ TEST(Markers, EveryPantographHasAViewFrameOnATrainWithSeveral) {
   EXPECT_EQ(to_view_transforms(one.model(), one.state(), ros::Time(5.0), "line").size(), 1u);
 }
 
+// ~view_pantograph: train_view (the default camera and the strip chart) at the station of the
+// pantograph named, the per-pantograph frames unchanged; a name not in the scene is refused with
+// the names allowed. (Stations are exact: a difference of the scene's positions.)
+TEST(Markers, TrainViewFollowsTheChosenPantograph) {
+  Simulation two(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m_two_pantographs.yaml"));
+  const Model& m = two.model();
+  const State& s = two.state();
+  const int trailing = view_pantograph_index(m, m.pantographs[1].name, "~view_pantograph");
+  EXPECT_EQ(trailing, 1);
+  EXPECT_EQ(view_pantograph_index(m, "", "~view_pantograph"), -1);
+  const auto front = to_view_transforms(m, s, ros::Time(5.0), "line");
+  const auto v = to_view_transforms(m, s, ros::Time(5.0), "line", trailing);
+  ASSERT_EQ(v.size(), 3u);
+  EXPECT_EQ(v[0].child_frame_id, "train_view");
+  EXPECT_DOUBLE_EQ(v[0].transform.translation.x, s.front + s.line_offset - m.pantographs[1].position);
+  for (std::size_t i = 1; i < 3; ++i)
+    EXPECT_DOUBLE_EQ(v[i].transform.translation.x, front[i].transform.translation.x);
+  try {
+    view_pantograph_index(m, "middle", "~view_pantograph");
+    ADD_FAILURE() << "an unknown pantograph was accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("~view_pantograph = 'middle'"), std::string::npos) << what;
+    EXPECT_NE(what.find(m.pantographs[0].name), std::string::npos) << what;
+    EXPECT_NE(what.find(m.pantographs[1].name), std::string::npos) << what;
+  }
+}
+
 TEST(Pacing, StepsDueFollowWallClockTimesFactor) {
   EXPECT_EQ(steps_due(1.0, 1.0, 1e-3, 0.0), 1000);
   EXPECT_EQ(steps_due(1.0, 2.0, 1e-3, 0.0), 2000);

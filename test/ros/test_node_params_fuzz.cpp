@@ -207,7 +207,8 @@ TEST_F(NodeParamsFuzz, NodeRejectsEveryBadValueNamingTheParameter) {
       {"shape_resolution", Kind::kNumber}, {"vertical_scale", Kind::kRate}, {"lateral_scale", Kind::kRate},  {"line_frame", Kind::kFrame},
       {"at_end", Kind::kAtEnd},          {"stats_file", Kind::kPath},        {"publish_clock", Kind::kBool},
       {"paused", Kind::kBool},           {"wait_for_viewer", Kind::kNumber}, {"max_acceleration", Kind::kNumber},
-      {"start_delay", Kind::kNumber},    {"report_file", Kind::kReportPath}};
+      {"start_delay", Kind::kNumber},    {"report_file", Kind::kReportPath}, {"view_pantograph", Kind::kString},
+      {"strip_chart", Kind::kBool},      {"chart_window", Kind::kNumber}};
   int count = 0;
   fuzz(this, kNode, params, {{"scene", kScene}, {"stats_file", out + "/stats.json"}}, out, &count);
   EXPECT_GT(count, 60);
@@ -223,7 +224,8 @@ TEST_F(NodeParamsFuzz, HilNodeRejectsEveryBadValueNamingTheParameter) {
       {"hil/realtime_priority", Kind::kInteger}, {"hil/spin_wait", Kind::kNumber}, {"at_end", Kind::kAtEnd},
       {"stats_file", Kind::kPath},       {"line_frame", Kind::kFrame},       {"publish_rate", Kind::kRate},
       {"marker_rate", Kind::kRate},      {"start_delay", Kind::kNumber},     {"shape_rate", Kind::kRate},
-      {"shape_resolution", Kind::kNumber}};
+      {"shape_resolution", Kind::kNumber}, {"wait_for_viewer", Kind::kNumber}, {"strip_chart", Kind::kBool},
+      {"chart_window", Kind::kNumber}};
   int count = 0;
   fuzz(this, kHilNode, params,
        {{"scene", kHilScene}, {"stats_file", out + "/stats.json"}, {"hil/report_file", out + "/report.json"}}, out,

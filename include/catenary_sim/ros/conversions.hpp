@@ -94,9 +94,13 @@ geometry_msgs::TransformStamped to_view_transform(const State& s, const ros::Tim
                                                   const std::string& line_frame);
 // train_view and, on a train with several pantographs, line -> train_view_<name> at each
 // pantograph's station, sent the same way: an rviz camera whose Target Frame is one of them
-// follows that pantograph (train_view is the front, the leading one's).
+// follows that pantograph. train_view is at the front, or with `followed` >= 0 at that
+// pantograph's station (~view_pantograph): the default view and the strip chart then go with it.
 std::vector<geometry_msgs::TransformStamped> to_view_transforms(const Model& m, const State& s, const ros::Time& stamp,
-                                                                const std::string& line_frame);
+                                                                const std::string& line_frame, int followed = -1);
+// The index of the pantograph named `name` for to_view_transforms (empty: -1, the front); another
+// name throws std::invalid_argument naming `parameter`, the value and the scene's pantographs.
+int view_pantograph_index(const Model& m, const std::string& name, const std::string& parameter);
 
 // line -> train (at the train front, on the rail) and train -> one frame per pantograph head (at
 // the head's true absolute height, not exaggerated; a moving force sits at the contact-wire

@@ -48,6 +48,11 @@ struct HilParams {
   std::string line_frame = "line";  // ~line_frame
   double publish_rate = 100.0;      // ~publish_rate: Hz for contact_force and tf, [1, 1000]
   double marker_rate = 10.0;        // ~marker_rate: Hz for markers (only with a subscriber), [0.1, 100]
+  double wait_for_viewer = 0.0;     // ~wait_for_viewer: s (wall) the pass waits, line held, for rviz to
+                                    //   subscribe to `markers` before it is armed, [0, 600] (0: no wait;
+                                    //   with ~hil/auto_start true only)
+  bool strip_chart = true;          // ~strip_chart: the contact-force strip chart with the markers
+  double chart_window = 5.0;        // ~chart_window: s of simulated time the strip chart shows, [0.5, 60]
   double start_delay = 0.0;         // ~start_delay: s (wall) in which measurements are ignored and the
                                     //   initial state is published (lets recorders connect), [0, 60]
   double shape_rate = 10.0;         // ~shape_rate: Hz for wire_shape (only with a subscriber), [0.1, 100]

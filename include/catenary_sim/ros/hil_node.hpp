@@ -55,6 +55,7 @@
 #include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/ros/hil.hpp"
+#include "catenary_sim/ros/strip_chart.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
@@ -94,6 +95,8 @@ class HilNode : public hil::LoopSkin {
   void on_wrench(const geometry_msgs::WrenchStamped::ConstPtr& msg);
   void snapshot(double t);
   void worker();
+  // Arms the pass once rviz has subscribed to `markers` and drawn, or ~wait_for_viewer is over.
+  void arm_when_viewer_ready();
   void publish_pantograph_state(const Model& m, const State& s, const ros::Time& stamp);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   bool write_report() const;  // false: ~hil/report_file could not be written (said on stderr)
@@ -152,6 +155,12 @@ class HilNode : public hil::LoopSkin {
   double last_tf_time_ = -1.0;
   ros::Time last_view_stamp_;
   double next_marker_wall_ = 0.0;
+  StripChart chart_;             // the contact-force strip chart (~strip_chart)
+  std::uint32_t chart_pass_ = 0;  // the pass the chart shows
+  double chart_time_ = -1.0;      // simulated time of the newest snapshot charted
+  // ~wait_for_viewer: wall time (steady clock) at which the pass is armed, 0 once it is; when rviz
+  // subscribed (-1: not yet).
+  double viewer_wait_until_ = 0.0, viewer_seen_ = -1.0;
 
   // Control: its own queue and thread (never the loop's).
   ros::CallbackQueue ctrl_queue_;

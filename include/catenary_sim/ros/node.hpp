@@ -23,6 +23,7 @@
 #include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/ros/params.hpp"
+#include "catenary_sim/ros/strip_chart.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
@@ -65,8 +66,7 @@ class SimulationNode {
   void wait_for_viewer();
   // Publishes `pass_status` (latched) when it changes: waiting, running, paused, ended, diverged.
   void publish_status();
-  // The strip chart's samples (one per publishing tick) and running statistics, and LineState.
-  void sample_chart();
+  // LineState: the line around the train, on `line_state`.
   void publish_line_state(const ros::Time& stamp);
   // Contact-loss events per pantograph (a physics result, on `events`, not on /diagnostics).
   void track_contact_loss();
@@ -95,12 +95,8 @@ class SimulationNode {
   bool waiting_ = false;                // waiting for a viewer or ~start_delay
   // Per pantograph: in a contact loss since this simulated time and station (NaN: in contact).
   std::vector<double> loss_since_, loss_station_;
-  ChartData chart_;                       // samples within the chart window
-  struct Running {                        // unfiltered contact force so far in this pass
-    double n = 0, sum = 0, sum2 = 0, max = -1e300, min = 1e300;
-  };
-  std::vector<Running> running_;          // per pantograph
-  double last_chart_time_ = -1.0;
+  int view_pantograph_ = -1;              // train_view follows this pantograph (-1: the train front)
+  StripChart chart_;                      // samples within the chart window, statistics so far
   double achieved_rtf_ = 0.0;             // over the last diagnostics period (0 while holding)
 
   // Stamps are simulated time, as gazebo_ros does (docs/user_guide.md, "Time"): no offset.

@@ -94,6 +94,9 @@ constexpr double kMinPublishRate = 1.0;
 constexpr double kMinShapeRate = 0.1;
 constexpr double kMinMarkerRate = 0.1;
 constexpr double kMinVerticalScale = 0.1;  // cfg/Node.cfg
+// The viewer wait and the strip chart's window, for both nodes that draw in rviz.
+constexpr double kMaxWaitForViewer = 600.0;  // s
+constexpr double kMinChartWindow = 0.5, kMaxChartWindow = 60.0;  // s of simulated time
 
 enum class AtEnd { kStop, kLoop, kExit };
 
@@ -109,6 +112,8 @@ struct NodeParams {
   double vertical_scale = 10.0;     // ~vertical_scale: exaggeration of displacements in the markers, [0.1, 10000]
   double lateral_scale = 1.0;       // ~lateral_scale: stretch of the markers across the track (3-D line), [1, 100]
   std::string line_frame = "line";  // ~line_frame: fixed frame, x along the track, z up
+  std::string view_pantograph;      // ~view_pantograph: the pantograph train_view (the camera, the strip
+                                    //   chart) follows, by name (empty: the train front)
   AtEnd at_end = AtEnd::kStop;      // ~at_end: stop | loop | exit
   std::string stats_file;           // ~stats_file: JSON statistics written at the end (empty: none)
   std::string report_file;          // ~report_file: the pass report (HTML, scripts/pass_report) written at the
