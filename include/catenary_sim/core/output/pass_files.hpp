@@ -13,7 +13,8 @@
 #include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/engine/state.hpp"
-#include "catenary_sim/core/output/statistics.hpp"
+#include "catenary_sim/core/output/pass_recorder.hpp"
+#include "catenary_sim/core/output/statistics_json.hpp"
 
 namespace catenary_sim {
 
