@@ -13,7 +13,7 @@
 #include <sstream>
 
 #include "catenary_sim/core/output/output_files.hpp"
-#include "catenary_sim/core/output/pass_files.hpp"
+#include "catenary_sim/tools/package_files.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 
 namespace catenary_sim {

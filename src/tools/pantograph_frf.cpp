@@ -15,7 +15,8 @@
 
 #include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/core/analysis/pantograph_frf.hpp"
-#include "catenary_sim/core/output/pass_files.hpp"
+#include "catenary_sim/tools/package_files.hpp"
+#include "catenary_sim/tools/report_launcher.hpp"
 #include "cli_checks.hpp"
 
 using namespace catenary_sim;
@@ -28,7 +29,7 @@ constexpr double kPi = 3.14159265358979323846;
 int run_plot(const std::string& csv, const std::string& png, const std::string& title, std::string* why) {
   const std::string script = find_script("plot_frf");
   if (script.empty()) {
-    *why = "scripts/plot_frf not found beside the sources or in the share path";
+    *why = script_not_found("plot_frf");
     return -1;
   }
   const pid_t pid = start_python_script(script, {csv, png, title}, why);

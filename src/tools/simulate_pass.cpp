@@ -26,6 +26,7 @@
 #include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/core/output/pass_files.hpp"
+#include "catenary_sim/tools/report_launcher.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/ros/conversions.hpp"
