@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <exception>
 #include <memory>
@@ -25,6 +26,17 @@
 using namespace catenary_sim;
 
 namespace {
+
+// --rate by the loop's own check (hil::loop_rate_error), in the words of the ROS node's ~hil/rate
+// (a non-number is kFinite's to refuse).
+const CLI::Validator kLoopRate(
+    [](std::string& text) -> std::string {
+      char* end = nullptr;
+      const double rate = std::strtod(text.c_str(), &end);
+      if (text.empty() || *end != '\0') return std::string();
+      return hil::loop_rate_error(rate, "--rate");
+    },
+    "HZ");
 
 hil::UdpLoopSkin* g_skin = nullptr;
 extern "C" void on_signal(int) {
@@ -46,7 +58,7 @@ int main(int argc, char** argv) {
   double duration = 0.0;
   app.add_option("--scene", scene_file, "scene YAML with at least one `type: external` pantograph")->required()->type_name("FILE");
   app.add_option("--speed-kmh", speed_kmh, "train speed, km/h (default: the scene's)")->check(kFinite & CLI::Range(0.0, 3.6 * kMaxTrainSpeed));
-  app.add_option("--rate", lo.rate, "loop rate, Hz")->check(kFinite & CLI::Range(1000.0, 10000.0))->capture_default_str();
+  app.add_option("--rate", lo.rate, "loop rate, Hz")->check(kFinite & kLoopRate)->capture_default_str();
   app.add_option("--timeout", lo.timeout, "s without a valid measurement before the safe hold (>= 2 periods)")
       ->check(kFinite & CLI::Range(0.0002, 10.0))->capture_default_str();
   app.add_flag("--extrapolate", lo.extrapolate, "extrapolate the last two measurements instead of holding the newest");
