@@ -17,6 +17,7 @@
 #include "catenary_sim/core/analysis/pantograph_frf.hpp"
 #include "catenary_sim/tools/package_files.hpp"
 #include "catenary_sim/tools/report_launcher.hpp"
+#include "../core/util/format.hpp"  // the core's numbers in messages: one way for all
 #include "cli_checks.hpp"
 
 using namespace catenary_sim;
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-plot", no_plot, "write the CSV only");
   try {
     app.parse(argc, argv);
-    if (fmax < fmin) throw CLI::ValidationError("--fmax", "must be >= --fmin (" + std::to_string(fmin) + ")");
+    if (fmax < fmin) throw CLI::ValidationError("--fmax", "must be >= --fmin (" + fmt(fmin) + ")");
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
