@@ -29,6 +29,7 @@
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/params.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/ros/replay.hpp"
 
@@ -50,8 +51,8 @@ double number_param(const ros::NodeHandle& pnh, const char* name, double fallbac
     }
   }
   if (!std::isfinite(v) || v < lo || v > hi)
-    throw std::runtime_error(std::string("parameter ~") + name + " = " + std::to_string(v) + " rejected: allowed [" +
-                             std::to_string(lo) + ", " + std::to_string(hi) + "] " + unit);
+    throw std::runtime_error(std::string("parameter ~") + name + " = " + format_number(v) + " rejected: allowed " +
+                             range_text(lo, hi, false, unit));
   return v;
 }
 

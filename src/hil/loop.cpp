@@ -1,5 +1,7 @@
 #include "catenary_sim/hil/loop.hpp"
 
+#include "../core/util/format.hpp"  // the core's numbers in messages: one way for all
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -33,8 +35,8 @@ constexpr double kSettleMax = 5.0;       // s (simulation)
 // Throttle slots of the log lines.
 enum Slot { kSlotOverrun, kSlotCompute, kSlotReject, kSlotNonFinite };
 
-std::string fmt(const char* f, ...) __attribute__((format(printf, 1, 2)));
-std::string fmt(const char* f, ...) {
+std::string printf_text(const char* f, ...) __attribute__((format(printf, 1, 2)));
+std::string printf_text(const char* f, ...) {
   char buf[512];
   va_list ap;
   va_start(ap, f);
@@ -49,16 +51,14 @@ double steady_now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::string format_value(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
+std::string loop_rate_error(double rate, const std::string& name) {
+  if (std::isfinite(rate) && rate >= kMinLoopRate && rate <= kMaxLoopRate) return "";
+  return name + " = " + fmt(rate) + " rejected: allowed [" + fmt(kMinLoopRate) + ", " + fmt(kMaxLoopRate) + "] Hz";
 }
 
 HilTiming hil_timing(double rate, std::optional<double> scene_dt, double auto_dt, const std::string& rate_name,
                      const std::string& scene_name) {
-  if (!std::isfinite(rate) || rate < 1000.0 || rate > 10000.0)
-    throw HilError(rate_name + " = " + format_value(rate) + " rejected: allowed [1000, 10000] Hz");
+  if (const std::string e = loop_rate_error(rate, rate_name); !e.empty()) throw HilError(e);
   HilTiming t;
   t.period = 1.0 / rate;
   if (scene_dt) {
@@ -66,15 +66,15 @@ HilTiming hil_timing(double rate, std::optional<double> scene_dt, double auto_dt
     const double kr = std::round(k);
     if (kr < 1.0 || std::fabs(k - kr) > 1e-6 * kr) {
       const int k_auto = static_cast<int>(std::ceil(t.period / *scene_dt - 1e-9));
-      throw HilError("numerics.dt = " + format_value(*scene_dt) + " s of " + scene_name +
-                     " does not divide the loop period " + format_value(t.period) + " s of " + rate_name + " = " +
-                     format_value(rate) + " Hz: the period must be a whole number of core steps; use numerics.dt = "
-                     "period / k, e.g. " + format_value(t.period / std::max(1, k_auto)) +
+      throw HilError("numerics.dt = " + fmt(*scene_dt) + " s of " + scene_name +
+                     " does not divide the loop period " + fmt(t.period) + " s of " + rate_name + " = " +
+                     fmt(rate) + " Hz: the period must be a whole number of core steps; use numerics.dt = "
+                     "period / k, e.g. " + fmt(t.period / std::max(1, k_auto)) +
                      " s, or numerics.dt: auto (the loop then chooses it)");
     }
     t.steps_per_period = static_cast<int>(kr);
   } else {
-    if (!(auto_dt > 0.0)) throw HilError(scene_name + ": the automatic dt is " + format_value(auto_dt) + " s");
+    if (!(auto_dt > 0.0)) throw HilError(scene_name + ": the automatic dt is " + fmt(auto_dt) + " s");
     t.steps_per_period = static_cast<int>(std::ceil(t.period / auto_dt - 1e-9));
   }
   t.dt = t.period / t.steps_per_period;
@@ -264,10 +264,10 @@ HilLoop::HilLoop(Scene scene, const LoopOptions& o, const std::string& rate_name
   if (!scene.numerics.dt) auto_dt = build_model(scene).dt;
   timing_ = hil_timing(opt_.rate, scene.numerics.dt, auto_dt, rate_name, scene_name);
   if (!std::isfinite(opt_.delay_compensation) || opt_.delay_compensation < 0.0 || opt_.delay_compensation > 0.1)
-    throw HilError("delay compensation = " + format_value(opt_.delay_compensation) + " s rejected: allowed [0, 0.1] s");
+    throw HilError("delay compensation = " + fmt(opt_.delay_compensation) + " s rejected: allowed [0, 0.1] s");
   if (!std::isfinite(opt_.timeout) || opt_.timeout < 2.0 * timing_.period || opt_.timeout > 10.0)
-    throw HilError("timeout = " + format_value(opt_.timeout) + " s rejected: allowed [2 loop periods = " +
-                   format_value(2.0 * timing_.period) + ", 10] s");
+    throw HilError("timeout = " + fmt(opt_.timeout) + " s rejected: allowed [2 loop periods = " +
+                   fmt(2.0 * timing_.period) + ", 10] s");
   scene.numerics.dt = timing_.dt;
   sim_ = std::make_unique<Simulation>(scene);
   const Model& m = sim_->model();
@@ -315,7 +315,7 @@ std::pair<bool, std::string> HilLoop::ask(Request r, double wait) {
   ctrl_cv_.wait_for(l, std::chrono::duration<double>(wait), [this] { return ctrl_done_ || !loop_running_; });
   if (!ctrl_done_) {
     ctrl_posted_ = false;  // withdrawn: the loop has not taken it (it takes it under ctrl_mu_)
-    return {false, "refused: the loop did not take the request within " + format_value(wait) +
+    return {false, "refused: the loop did not take the request within " + fmt(wait) +
                        " s (far behind its schedule, or stopping); nothing changed"};
   }
   return {ctrl_ok_, ctrl_reply_};
@@ -354,7 +354,7 @@ bool HilLoop::execute(Request r, std::string& msg) {
     msg = "refused: the pass is " + now + "; " + why;
     return false;
   };
-  const std::string t = fmt("t = %.4f s", sim_->state().time);
+  const std::string t = printf_text("t = %.4f s", sim_->state().time);
   switch (r) {
     case Request::kArm:
       if (mode_ == Mode::kWaiting) {
@@ -405,8 +405,8 @@ bool HilLoop::execute(Request r, std::string& msg) {
       if (stopping_) return refuse("already stopping");
       if (mode_ == Mode::kRunning || mode_ == Mode::kHold || mode_ == Mode::kPaused) {
         begin_stop();
-        msg = "stopping at " + t + ": safe hold (the train stops at " + format_value(opt_.hold_deceleration) +
-              " m/s^2, the force ramps to the static uplift over " + format_value(opt_.hold_ramp) +
+        msg = "stopping at " + t + ": safe hold (the train stops at " + fmt(opt_.hold_deceleration) +
+              " m/s^2, the force ramps to the static uplift over " + fmt(opt_.hold_ramp) +
               " s), then ENDED with the statistics written once the line has settled";
         return true;
       }
@@ -542,7 +542,7 @@ int HilLoop::run() {
   send_point();
   double w = steady_now() + period;  // centre of the next period's window
   const double start_wait_end = steady_now() + opt_.start_delay;
-  if (opt_.start_delay > 0.0) log(LogLevel::kInfo, "measurements ignored for " + format_value(opt_.start_delay) + " s");
+  if (opt_.start_delay > 0.0) log(LogLevel::kInfo, "measurements ignored for " + fmt(opt_.start_delay) + " s");
   next_quantiles_ = steady_now();
   bool relock = false;  // centre the windows on the next arrival
   int off_centre = 0;   // triggering arrivals in a row more than a quarter period off the centre
@@ -590,7 +590,7 @@ int HilLoop::run() {
       ++c_.overruns;
       const double missed = std::ceil((done - (w + half)) / period);
       if (throttle(kSlotOverrun, 5.0))
-        log(LogLevel::kWarn, fmt("overrun: the loop is %.3f ms behind its %g Hz schedule (%lld overruns so far); %g "
+        log(LogLevel::kWarn, printf_text("overrun: the loop is %.3f ms behind its %g Hz schedule (%lld overruns so far); %g "
                                  "period(s) dropped", (done - w) * 1e3, opt_.rate,
                                  static_cast<long long>(c_.overruns), missed));
       w += missed * period;
@@ -612,7 +612,7 @@ void HilLoop::enter_hold(double t, double age) {
   for (int p : external_) hold_from_[p] = sim_->state().external_force[p];
   std::string err;
   sim_->set_target_speed(0.0, &err);
-  log(LogLevel::kError, fmt("no valid %s for %.3f s (> timeout = %g s): safe hold: the train stops (%g m/s^2) and "
+  log(LogLevel::kError, printf_text("no valid %s for %.3f s (> timeout = %g s): safe hold: the train stops (%g m/s^2) and "
                             "the applied force ramps to the static uplift over %g s",
                             opt_.input.c_str(), std::isfinite(age) ? age : (t - started_), opt_.timeout,
                             opt_.hold_deceleration, opt_.hold_ramp));
@@ -623,7 +623,7 @@ void HilLoop::leave_hold() {
   recovering_ = true;
   std::string err;
   sim_->set_target_speed(commanded_speed_, &err);
-  log(LogLevel::kWarn, fmt("fresh %s: safe hold ended after %.3f s of simulation; the train accelerates back to "
+  log(LogLevel::kWarn, printf_text("fresh %s: safe hold ended after %.3f s of simulation; the train accelerates back to "
                            "%.1f km/h", opt_.input.c_str(), sim_->state().time - hold_start_time_,
                            commanded_speed_ * 3.6));
 }
@@ -698,7 +698,7 @@ void HilLoop::batch(double t, bool triggered) {
   const double published = steady_now();
   compute_.add(published - t);
   if (published - t > timing_.period && throttle(kSlotCompute, 5.0))
-    log(LogLevel::kWarn, fmt("a period's steps and contact point took %.3f ms (period %g ms) at t = %.4f s",
+    log(LogLevel::kWarn, printf_text("a period's steps and contact point took %.3f ms (period %g ms) at t = %.4f s",
                              (published - t) * 1e3, timing_.period * 1e3, sim_->state().time));
   if (unused_) latency_.add(published - hold_.arrival());  // the first output computed with it
   unused_ = false;
@@ -746,7 +746,7 @@ void HilLoop::send_point() {
   for (PantographPoint& c : frame_.pantographs) c.measurement_age = age_in_effect_;
   if (!all_finite(frame_)) {
     if (throttle(kSlotNonFinite, 1.0))
-      log(LogLevel::kError, fmt("a contact point with a non-finite value was not sent (t = %g s)", sim_->state().time));
+      log(LogLevel::kError, printf_text("a contact point with a non-finite value was not sent (t = %g s)", sim_->state().time));
     return;
   }
   published_step_ = frame_.step;
@@ -770,11 +770,11 @@ void HilLoop::handle_end() {
     diverged_ = true;
     log(LogLevel::kError, sim_->status_message());
   } else if (stopping_) {
-    log(LogLevel::kInfo, fmt("pass %u stopped (~stop) at t = %.4f s (train front at %.2f m), the line settled: ended; "
+    log(LogLevel::kInfo, printf_text("pass %u stopped (~stop) at t = %.4f s (train front at %.2f m), the line settled: ended; "
                              "%lld periods, %lld overruns", pass_count_, s.time, s.front + s.line_offset,
                              static_cast<long long>(c_.batches), static_cast<long long>(c_.overruns)));
   } else {
-    log(LogLevel::kInfo, fmt("pass %u finished at t = %.4f s (train front at %.2f m): %lld periods, %lld overruns",
+    log(LogLevel::kInfo, printf_text("pass %u finished at t = %.4f s (train front at %.2f m): %lld periods, %lld overruns",
                              pass_count_, s.time, s.front + s.line_offset, static_cast<long long>(c_.batches),
                              static_cast<long long>(c_.overruns)));
   }

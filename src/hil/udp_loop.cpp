@@ -1,5 +1,7 @@
 #include "catenary_sim/hil/udp_loop.hpp"
 
+#include "../core/util/format.hpp"  // the core's numbers in messages: one way for all
+
 #include <arpa/inet.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -402,11 +404,11 @@ UdpVirtualRig::UdpVirtualRig(const Scene& scene, const UdpRigOptions& o)
     : scene_(scene), opt_(o), socket_(o.bind_address, o.port, "--bind/--port"), stepper_(o.extrapolate) {
   simulator_ = udp_address(o.simulator_address, o.simulator_port, "--simulator");
   if (!std::isfinite(o.rate) || !(o.rate == 0.0 || (o.rate >= 1.0 && o.rate <= 20000.0)))
-    throw HilError("--rate = " + format_value(o.rate) + " rejected: allowed 0 (the simulator's loop rate) or [1, 20000] Hz");
+    throw HilError("--rate = " + fmt(o.rate) + " rejected: allowed 0 (the simulator's loop rate) or [1, 20000] Hz");
   if (!std::isfinite(o.contact_timeout) || o.contact_timeout < 0.0 || o.contact_timeout > 3600.0)
-    throw HilError("--timeout = " + format_value(o.contact_timeout) + " rejected: allowed 0 (never) or up to 3600 s");
+    throw HilError("--timeout = " + fmt(o.contact_timeout) + " rejected: allowed 0 (never) or up to 3600 s");
   if (!std::isfinite(o.connect_timeout) || o.connect_timeout < 0.0 || o.connect_timeout > 3600.0)
-    throw HilError("--connect-timeout = " + format_value(o.connect_timeout) +
+    throw HilError("--connect-timeout = " + fmt(o.connect_timeout) +
                    " rejected: allowed 0 (wait for ever) or up to 3600 s");
   for (const PantographSpec& ps : scene_.pantographs) {
     if (ps.moving_force || ps.external || ps.masses.empty()) continue;
@@ -538,7 +540,7 @@ RigEnd UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_
     if (auto r = over()) return *r;
     if (opt_.connect_timeout > 0.0 && steady_now() - started > opt_.connect_timeout) {
       message_ = "no contact point from the simulator at " + address_text(simulator_) + " within --connect-timeout = " +
-                 format_value(opt_.connect_timeout) + " s (is it running, on that address and port?)";
+                 fmt(opt_.connect_timeout) + " s (is it running, on that address and port?)";
       return RigEnd::kConnectTimeout;
     }
     csim_udp_measurement hello;
@@ -554,7 +556,7 @@ RigEnd UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_
   while (true) {
     if (auto r = over()) return *r;
     if (opt_.contact_timeout > 0.0 && steady_now() - last_point_ > opt_.contact_timeout) {
-      message_ = "no contact point from the simulator for --timeout = " + format_value(opt_.contact_timeout) +
+      message_ = "no contact point from the simulator for --timeout = " + fmt(opt_.contact_timeout) +
                  " s: the simulator stopped or the link broke";
       return RigEnd::kContactTimeout;
     }

@@ -1,5 +1,7 @@
 #include "catenary_sim/hil/udp_packets.hpp"
 
+#include "../core/util/format.hpp"  // the core's numbers in messages: one way for all
+
 #include <cmath>
 #include <cstring>
 
@@ -47,7 +49,7 @@ bool check_header(const void* data, std::size_t size, std::uint16_t kind, std::u
 
 bool finite_field(double v, const std::string& name, Reject& why, std::string& reason) {
   if (std::isfinite(v)) return true;
-  return fail(Reject::kNonFinite, why, reason, name + " = " + format_value(v) + " rejected: allowed a finite value");
+  return fail(Reject::kNonFinite, why, reason, name + " = " + fmt(v) + " rejected: allowed a finite value");
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "catenary_sim/core/scene/scene.hpp"
+#include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/ros/hil.hpp"
 #include "catenary_sim/ros/params.hpp"
 
@@ -16,7 +17,7 @@ void validate_hil_params(const HilParams& p) {
   if (p.scene.empty())
     throw ParamError("parameter ~scene is required: path of a scene YAML file with a `type: external` pantograph");
   if (p.speed_kmh) check_range("speed_kmh", *p.speed_kmh, 0.0, 3.6 * kMaxTrainSpeed, false, "km/h");
-  check_range("hil/rate", p.rate, 1000.0, 10000.0, false, "Hz");
+  if (const std::string e = hil::loop_rate_error(p.rate, "parameter ~hil/rate"); !e.empty()) throw ParamError(e);
   const double period = 1.0 / p.rate;
   if (!std::isfinite(p.timeout) || p.timeout < 2.0 * period || p.timeout > 10.0)
     throw ParamError("parameter ~hil/timeout = " + format_number(p.timeout) + " s rejected: allowed [" + format_number(2.0 * period) +
@@ -90,7 +91,7 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
   // (the ranges are checked by validate_hil_params; the type errors name them too)
   r.text("scene", p.scene, "the path of a scene YAML file");
   read_speed_kmh(r, nh, p.speed_kmh, "a number in " + range_text(0.0, 3.6 * kMaxTrainSpeed, false, "km/h"));
-  r.number("hil/rate", p.rate, "a number in [1000, 10000] Hz");
+  r.number("hil/rate", p.rate, "a number in " + range_text(hil::kMinLoopRate, hil::kMaxLoopRate, false, "Hz"));
   r.number("hil/timeout", p.timeout, "a number of seconds in [2 loop periods, 10]");
   r.number("hil/hold_ramp", p.hold_ramp, "a number in [0, 60] s");
   r.number("hil/hold_deceleration", p.hold_deceleration, "a number in [0, 50] m/s^2");

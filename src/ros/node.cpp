@@ -19,6 +19,7 @@
 #include "catenary_sim/WireShapeArray.h"
 #include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/core/output/pass_files.hpp"
+#include "catenary_sim/tools/report_launcher.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 
 namespace catenary_sim {

@@ -13,18 +13,15 @@
 #include <sstream>
 
 #include "catenary_sim/core/output/output_files.hpp"
-#include "catenary_sim/core/output/pass_files.hpp"
+#include "catenary_sim/tools/package_files.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
+#include "../core/util/format.hpp"  // the core's numbers in messages: one way for all
 
 namespace catenary_sim {
 namespace ros_layer {
 
 
-std::string format_number(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
+std::string format_number(double v) { return fmt(v); }
 
 std::string range_text(double lo, double hi, bool lo_open, const char* unit) {
   std::string s = (lo_open ? "(" : "[") + format_number(lo) + ", " + format_number(hi) + "]";

@@ -1,4 +1,4 @@
-// Recording an endless pass in bounded memory (statistics.hpp, "An endless line's pass"): the
+// Recording an endless pass in bounded memory (pass_recorder.hpp, "An endless line's pass"): the
 // recorders of an endless line stepped for 10 simulated minutes hold a constant amount after the
 // warm-up, and their running statistics are those of the whole record.
 #include <gtest/gtest.h>
@@ -163,7 +163,7 @@ TEST(BoundedRecording, RunningStatisticsAreTheWholeRecords) {
   const ForceStatistics ref = force_statistics(fin), raw = force_statistics(rin);
   const PantographStatistics st = rec.statistics(m)[0];
   EXPECT_EQ(st.samples, rin.size());
-  // The blocks' overlap leaves the filter's transient at 2e-17 of the force (statistics.hpp), and
+  // The blocks' overlap leaves the filter's transient at 2e-17 of the force (pass_recorder.hpp), and
   // the running mean and variance (Welford) round differently from the two-pass sums: 1e-9
   // relative is a million times that rounding and far below any physical difference (a block
   // filtered without its overlap is off by percents at the block edges).

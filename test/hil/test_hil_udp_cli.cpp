@@ -55,6 +55,8 @@ TEST(HilUdpCli, BadOptionsAreRefusedNamingTheOption) {
   };
   expect_refused(with({"--rate", "500"}), {"--rate", "500"});
   expect_refused(with({"--rate", "nan"}), {"--rate", "nan"});
+  // The loop's own limits and words, as the ROS node's ~hil/rate says them.
+  expect_refused(with({"--rate", "20000"}), {"--rate = 20000 rejected: allowed [1000, 10000] Hz"});
   expect_refused(with({"--timeout", "0.0015", "--rate", "1000"}), {"timeout", "0.0015", "allowed"});
   expect_refused(with({"--delay-compensation", "0.5"}), {"--delay-compensation"});
   expect_refused(with({"--rig", "localhost"}), {"--rig", "HOST:PORT"});

@@ -27,6 +27,7 @@ namespace {
 const std::string kReference = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
 const std::string kSimulatePass = CATENARY_SIM_DEVEL_LIB "/simulate_pass";
 const std::string kElasticity = CATENARY_SIM_DEVEL_LIB "/elasticity_curve";
+const std::string kFrf = CATENARY_SIM_DEVEL_LIB "/pantograph_frf";
 
 // Runs argv to its end (at most `limit` s) with its output in dir/output.txt.
 ChildRun run(const std::vector<std::string>& args, const std::string& dir, double limit = 10.0) {
@@ -175,6 +176,10 @@ TEST(FuzzBadInput, OverridePathsAndValues) {
   expect_rejected(kElasticity, {"elasticity: bad --set", {"--scene", kReference, "--set", "name.foo=1"}, {"name"}}, dir, &count);
   expect_rejected(kElasticity, {"elasticity: --step 0", {"--scene", kReference, "--step", "0"}, {"--step"}}, dir, &count);
   expect_rejected(kElasticity, {"elasticity: unknown flag", {"--scene", kReference, "--stepp", "1"}, {"--stepp"}}, dir, &count);
+  // The lower bound as written (5), not std::to_string's 5.000000.
+  expect_rejected(kFrf, {"frf: --fmax below --fmin", {kReference, "--pantograph", "pantograph", "--out", "@OUT", "--fmin",
+                                                       "5", "--fmax", "1"}, {"--fmax: must be >= --fmin (5)"}},
+                  dir, &count);
   RecordProperty("cases", count);
   std::system(("rm -rf '" + dir + "'").c_str());
 }

@@ -42,7 +42,14 @@ class HilError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-std::string format_value(double v);  // as `ostream << v`
+// The loop rates (Hz) every HIL transport accepts (~hil/rate, catenary_sim_hil_udp --rate): a rig's
+// force loop runs at 1 kHz at least to follow the contact force's content up to EN 50318's 20 Hz
+// with room for its own filters; above 10 kHz a period (0.1 ms) is within the scheduling jitter of
+// a general-purpose kernel (docs/benchmark_history.md).
+constexpr double kMinLoopRate = 1000.0, kMaxLoopRate = 10000.0;
+// "" when `rate` Hz is one the loop runs at, else "NAME = RATE rejected: allowed [1000, 10000] Hz"
+// (`name`: how the caller's user names the rate).
+std::string loop_rate_error(double rate, const std::string& name);
 
 // The loop period and the core steps in it. The core's dt must divide the period: a scene with
 // numerics.dt: auto gets the largest dt = period / k not above the automatic dt; an explicit
@@ -145,7 +152,7 @@ enum class Request { kArm, kPause, kResume, kReset, kStop };
 enum class LogLevel { kInfo, kWarn, kError };
 
 struct LoopOptions {
-  double rate = 1000.0;            // Hz, [1000, 10000]
+  double rate = 1000.0;            // Hz, [kMinLoopRate, kMaxLoopRate]
   double timeout = 0.05;           // s, [2 periods, 10]: older input puts the line into the safe hold
   bool extrapolate = false;        // extrapolate the last two measurements instead of holding
   double hold_ramp = 0.5;          // s, force ramp to the static force in the safe hold

@@ -1,11 +1,5 @@
 #include "catenary_sim/core/output/pass_files.hpp"
 
-#include <spawn.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cmath>
 #include <deque>
 #include <iomanip>
@@ -16,15 +10,6 @@
 
 #include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/core/output/line_measures.hpp"
-
-extern char** environ;
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR ""
-#endif
-#ifndef CATENARY_SIM_SHARE_DIR
-#define CATENARY_SIM_SHARE_DIR ""
-#endif
 
 namespace catenary_sim {
 
@@ -174,65 +159,6 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
   // never a new CSV beside an old stats.json.
   for (auto& f : files) f->flush();
   for (auto& f : files) f->commit();
-}
-
-std::string find_package_file(const std::string& relative) {
-  for (const std::string& dir : {std::string(CATENARY_SIM_SOURCE_DIR), std::string(CATENARY_SIM_SHARE_DIR)}) {
-    if (dir.empty()) continue;
-    const std::string path = dir + "/" + relative;
-    struct stat st {};
-    if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return path;
-  }
-  return "";
-}
-
-std::string find_script(const std::string& name) { return find_package_file("scripts/" + name); }
-
-std::string find_pass_report_script() { return find_script("pass_report"); }
-
-pid_t start_python_script(const std::string& script, const std::vector<std::string>& args, std::string* why) {
-  const char* python = "/usr/bin/python3";
-  if (::access(python, X_OK) != 0) {
-    *why = "/usr/bin/python3 is missing: install python3, python3-numpy and python3-matplotlib (scripts/setup)";
-    return -1;
-  }
-  std::vector<std::string> all{python, script};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, python, nullptr, nullptr, argv.data(), environ) != 0) {
-    *why = "cannot start " + std::string(python);
-    return -1;
-  }
-  return pid;
-}
-
-pid_t start_pass_report(const std::string& dir, const std::string& html, bool quiet, std::string* why) {
-  const std::string script = find_pass_report_script();
-  if (script.empty()) {
-    *why = "scripts/pass_report not found beside the sources (" CATENARY_SIM_SOURCE_DIR ") or in the share path";
-    return -1;
-  }
-  std::vector<std::string> args{dir};
-  if (!html.empty()) {
-    args.push_back("--html");
-    args.push_back(html);
-  }
-  if (quiet) args.push_back("--quiet");
-  return start_python_script(script, args, why);
-}
-
-int pass_report_status(pid_t pid, bool block) {
-  int status = 0;
-  for (;;) {
-    const pid_t r = ::waitpid(pid, &status, block ? 0 : WNOHANG);
-    if (r == pid) break;
-    if (r == 0) return kReportRunning;
-    if (errno != EINTR) return kReportLost;
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }
 
 }  // namespace catenary_sim

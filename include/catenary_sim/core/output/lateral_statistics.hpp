@@ -9,7 +9,7 @@
 
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/engine/state.hpp"
-#include "catenary_sim/core/output/statistics.hpp"
+#include "catenary_sim/core/output/pass_recorder.hpp"
 
 namespace catenary_sim {
 

@@ -1,6 +1,6 @@
 // What line engineers measure, as pure functions of recorded series (no Model, no State): contact
 // losses as arcing events, rainflow counting for dropper fatigue, the Welch power spectral density
-// and its peaks. PassRecorder (statistics.hpp) feeds them; simulate_pass and scripts/pass_report
+// and its peaks. PassRecorder (pass_recorder.hpp) feeds them; simulate_pass and scripts/pass_report
 // write and draw what they return.
 #pragma once
 

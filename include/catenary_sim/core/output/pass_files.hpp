@@ -1,11 +1,9 @@
 // The files of one pass in an output directory, as simulate_pass --out and the node's
 // ~report_file write them: stats.json, timeseries.csv and the measurement files (force_processed,
 // contact_losses, droppers, dropper_rainflow, psd, dropper_series when the scene asks for it),
-// each whole or not at all and all on the disk before any is renamed into place. And the report
-// drawn from them by scripts/pass_report (a child process: matplotlib takes seconds).
+// each whole or not at all and all on the disk before any is renamed into place. The report drawn
+// from them (scripts/pass_report) is the tools' business: catenary_sim/tools/report_launcher.hpp.
 #pragma once
-
-#include <sys/types.h>
 
 #include <string>
 #include <vector>
@@ -13,7 +11,8 @@
 #include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/engine/state.hpp"
-#include "catenary_sim/core/output/statistics.hpp"
+#include "catenary_sim/core/output/pass_recorder.hpp"
+#include "catenary_sim/core/output/statistics_json.hpp"
 
 namespace catenary_sim {
 
@@ -45,26 +44,5 @@ std::string pass_statistics_json(const Model& model, const State& state, const P
 void write_pass_files(const std::string& dir, const Model& model, const State& state, const PassRecorder& recorder,
                       const RunInfo& run, const LateralRecorder* lateral = nullptr,
                       bool stopped_by_dewirement = false);
-
-// scripts/NAME beside the sources this was built from, or in the installed share path; empty if
-// neither has it.
-std::string find_script(const std::string& name);
-// A file of the package by its path in it (e.g. config/reference_55m.yaml), beside the sources
-// this was built from or in the installed share path; empty if neither has it.
-std::string find_package_file(const std::string& relative);
-std::string find_pass_report_script();
-
-// Starts /usr/bin/python3 SCRIPT ARGS... with its output going to ours; returns its pid, or -1
-// with the reason in *why. Wait for it with pass_report_status(pid, true).
-pid_t start_python_script(const std::string& script, const std::vector<std::string>& args, std::string* why);
-
-// Starts /usr/bin/python3 scripts/pass_report DIR [--html HTML] [--quiet] with its output going to
-// ours; returns its pid, or -1 with the reason in *why.
-pid_t start_pass_report(const std::string& dir, const std::string& html, bool quiet, std::string* why);
-
-// The report's exit status: 0 written, 2 bad input, 3 matplotlib missing, 128 + signal;
-// kReportRunning while it is still running (block = false); kReportLost if pid is not our child.
-constexpr int kReportRunning = -1, kReportLost = -2;
-int pass_report_status(pid_t pid, bool block);
 
 }  // namespace catenary_sim
