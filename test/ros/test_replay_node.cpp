@@ -174,11 +174,4 @@ TEST(Replay, RecordedPassIsDrawnAndPlotted) {
   if (!HasFailure()) (void)!std::system(("rm -rf " + dir).c_str());  // kept for a look when it failed
 }
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_replay_node");
-  ros::NodeHandle nh;
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  return RUN_ALL_TESTS();
-}
+int main(int argc, char** argv) { return ros_test::ros_test_main(argc, argv, "test_replay_node", 1); }
