@@ -20,10 +20,7 @@
 #include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../test/support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -42,7 +39,7 @@ double rss_mb() {
 
 int main(int argc, char** argv) {
   double hours = 2.0, report = 600.0;
-  std::string scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml";
+  std::string scene = test_scenes::kReferenceEndless;
   std::vector<std::string> overrides = {"numerics.preset=fast", "output.sample_rate=0.001", "train.speed_kmh=300"};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];

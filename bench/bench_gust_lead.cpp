@@ -19,10 +19,7 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../test/support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -41,8 +38,8 @@ Scene scene(bool endless, const std::vector<std::string>& extra) {
   std::vector<std::string> ov = kLine;
   ov.insert(ov.end(), extra.begin(), extra.end());
   if (!endless) ov.insert(ov.end(), {"line.span_count=104", "numerics.window=auto"});
-  return load_scene_file(endless ? CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml"
-                                 : CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+  return load_scene_file(endless ? test_scenes::kReferenceEndless
+                                 : test_scenes::kReference,
                          ov);
 }
 

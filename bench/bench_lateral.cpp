@@ -23,10 +23,7 @@
 #include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../test/support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -34,7 +31,7 @@ namespace {
 
 // 2-D and 3-D windowed passes on `spans` spans and on 20, the repetitions interleaved.
 void run_windowed(int reps, int spans, const std::vector<std::string>& steady, const std::vector<std::string>& windy) {
-  const std::string path = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string path = test_scenes::kReference;
   struct Variant {
     std::string label;
     int spans;
@@ -85,7 +82,7 @@ void run_windowed(int reps, int spans, const std::vector<std::string>& steady, c
 // The contact point's turbulent motion (position in the turbulent wind less in the steady mean
 // wind) on the full line and with the window, over spans 4 to 36 of 40.
 void turbulent_motion(int seed, std::vector<std::string> windy) {
-  const std::string path = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string path = test_scenes::kReference;
   windy.insert(windy.end(), {"numerics.preset=balanced", "line.span_count=40"});
   std::vector<std::string> full = windy, steady = windy, window = windy;
   full.push_back("wind.turbulence.seed=" + std::to_string(seed));
@@ -117,7 +114,7 @@ void turbulent_motion(int seed, std::vector<std::string> windy) {
 int main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
   const int long_spans = argc > 2 ? std::max(0, std::atoi(argv[2])) : 100;
-  const std::string path = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string path = test_scenes::kReference;
   struct Variant {
     std::string label;
     std::vector<std::string> overrides;

@@ -13,16 +13,13 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../test/support/scenes.hpp"
 
 using namespace catenary_sim;
 
 int main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
-  const std::string path = argc > 2 ? argv[2] : CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string path = argc > 2 ? argv[2] : test_scenes::kReference;
   std::printf("%-34s %6s %9s %7s %10s %10s %8s\n", "variant", "DOFs", "dt_ms", "steps", "wall_med_s", "wall_min_s", "RTF_med");
   struct Variant {
     std::string label;

@@ -19,11 +19,8 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
+#include "../test/support/scenes.hpp"
 #include "../src/core/engine/wire_lanes.hpp"  // the step's kernel, timed alone
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
 
 using namespace catenary_sim;
 
@@ -203,7 +200,7 @@ std::vector<Floor> floors_of(const Model& m, const State& s0) {
 
 int main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 7;
-  const std::string path = argc > 2 ? argv[2] : CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string path = argc > 2 ? argv[2] : test_scenes::kReference;
   const std::string preset = argc > 3 ? argv[3] : "accurate";
   const Scene scene = load_scene_file(path, {"train.speed_kmh=300", "numerics.preset=" + preset});
   const Simulation proto(scene);

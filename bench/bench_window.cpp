@@ -11,10 +11,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../test/support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -26,7 +23,7 @@ struct Run {
   PantographStatistics st;
 };
 
-Run run(std::vector<std::string> ov, const char* scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml") {
+Run run(std::vector<std::string> ov, const std::string& scene = test_scenes::kReference) {
   Simulation sim(load_scene_file(scene, ov));
   const Model& m = sim.model();
   PassRecorder rec(m);
@@ -70,7 +67,7 @@ int main(int argc, char** argv) {
 
   // The endless line over the same pass (front from 0 to the line's end) and ten times longer;
   // statistics over the same spans as above.
-  const char* endless_scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml";
+  const std::string& endless_scene = test_scenes::kReferenceEndless;
   const double length = 55.0 * spans;
   const Run endless = run({"numerics.preset=balanced", "train.end=" + std::to_string(length), section}, endless_scene);
   const Run endless_long = run({"numerics.preset=balanced", "train.end=" + std::to_string(10 * length), section}, endless_scene);

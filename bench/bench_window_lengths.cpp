@@ -17,16 +17,13 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../test/support/scenes.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
-const char* kScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+const std::string& kScene = test_scenes::kReference;
 
 ForceStatistics run(std::vector<std::string> ov) {
   Simulation sim(load_scene_file(kScene, ov));

@@ -12,15 +12,12 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../test/support/scenes.hpp"
 
 namespace bench {
 
 // The scene both benches measure unless given another.
-inline const std::string kReferenceScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+inline const std::string& kReferenceScene = test_scenes::kReference;
 
 struct PassResult {
   int dofs = 0;

@@ -10,10 +10,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/model/statics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -31,7 +28,7 @@ struct Pass {
 const Pass& calpe_pass() {
   static const Pass pass = [] {
     Pass p;
-    Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml"));
+    Simulation sim(load_scene_file(test_scenes::kCalpeExample));
     const Model& m = sim.model();
     EXPECT_EQ(m.contact_wires.size(), 2u);
     p.rise = m.sections[0].rise_last;
@@ -62,7 +59,7 @@ double mean_total(double x0, double x1) {
 TEST(CalpeExample, SupportRiseFollowsEq6To8) {
   // d = p (a + b/2)^2 / (2T) with b = sqrt(2 T h / p), h = E F: E measured independently here
   // with the probe at mid-span of the current span of series I (30 m), F = 120 N.
-  const Scene scene = load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml");
+  const Scene scene = load_scene_file(test_scenes::kCalpeExample);
   const ElasticityProbe probe(scene, 120.0, std::vector<double>(4, 0.0));
   const double h = probe.uplift(30.0)[0];
   const double p = 1.0066 * 9.81, T = 10000.0, a = 10.0, b = std::sqrt(2 * T * h / p);

@@ -7,10 +7,7 @@
 #include <new>
 
 #include "catenary_sim/core/simulation.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 // Count every allocation made through operator new while counting is on.
 static std::atomic<bool> g_counting{false};
@@ -30,7 +27,7 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 using namespace catenary_sim;
 
 namespace {
-const std::string kReference = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+using test_scenes::kReference;
 }
 
 TEST(Determinism, IdenticalInputsGiveBitIdenticalOutput) {
@@ -75,7 +72,7 @@ TEST(Allocation, StepNeverAllocates) {
     EXPECT_EQ(sim.state().status, StepStatus::kOk);
   }
   // The endless line: 2000 steps run 145 m, so the block is moved back at least twice.
-  Simulation endless(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml"));
+  Simulation endless(load_scene_file(test_scenes::kReferenceEndless));
   const double offset0 = endless.state().line_offset;
   endless.step();
   g_allocations = 0;
@@ -91,7 +88,7 @@ TEST(Allocation, StepNeverAllocates) {
 // sway, the wind in the uplift, and the endless line moving its block: no allocation in step(),
 // and two passes of one scene give the same bits, lateral state included.
 TEST(Allocation, ThreeDimensionalStepNeverAllocatesAndRepeatsItsBits) {
-  const std::string three_d = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml";
+  const std::string three_d = test_scenes::kReference3d;
   const std::vector<std::string> sway = {"pantograph_head.sway.amplitude=0.03", "pantograph_head.sway.frequency=0.8",
                                          "pantographs.0.aero_coefficient=0.005"};
   struct Case {
@@ -100,7 +97,7 @@ TEST(Allocation, ThreeDimensionalStepNeverAllocatesAndRepeatsItsBits) {
   };
   std::vector<Case> cases = {{three_d, {}}, {three_d, {"numerics.window=auto"}},
                              {three_d, {"numerics.window=auto", "wind.turbulence=null"}},
-                             {CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml",
+                             {test_scenes::kReferenceEndless,
                               {"stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]", "wind.speed=20",
                                "wind.turbulence.intensity=0.15", "alignment.radius=1200"}}};
   for (Case& c : cases) {

@@ -9,17 +9,14 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
-const std::string kEndless = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml";
-const std::string kFinite = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+const std::string& kEndless = test_scenes::kReferenceEndless;
+const std::string& kFinite = test_scenes::kReference;
 
 }  // namespace
 

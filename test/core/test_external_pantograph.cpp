@@ -9,28 +9,23 @@
 #include <sstream>
 
 #include "catenary_sim/core/simulation.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
 Scene reference(bool external) {
-  YAML::Node root = YAML::LoadFile(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml");
-  root["numerics"]["dt"] = 0.0008;  // the same fixed step for both (auto dt sees the pantograph)
-  if (external) {
-    YAML::Node p = root["pantographs"][0];
-    p["type"] = "external";
-    p.remove("masses");
-    p.remove("stiffness");
-    p.remove("damping");
-  }
-  std::stringstream s;
-  s << root;
-  return load_scene_string(s.str());
+  return test_scenes::edited_scene("reference_55m.yaml", [external](YAML::Node& root) {
+    root["numerics"]["dt"] = 0.0008;  // the same fixed step for both (auto dt sees the pantograph)
+    if (external) {
+      YAML::Node p = root["pantographs"][0];
+      p["type"] = "external";
+      p.remove("masses");
+      p.remove("stiffness");
+      p.remove("damping");
+    }
+  });
 }
 
 }  // namespace

@@ -12,16 +12,13 @@
 #include "catenary_sim/core/output/line_measures.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
-const std::string kReference = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+using test_scenes::kReference;
 
 std::string beam_scene(double mass) {
   std::ostringstream s;
@@ -110,7 +107,7 @@ TEST(Imperfections, BadInputNamesTheField) {
   EXPECT_NE(error_of({"imperfections.point_masses=[{station: 1000, mass: 5}]"}).find("imperfections.point_masses[0].station"), std::string::npos);
   EXPECT_NE(error_of({"imperfections.dropper_length_std=-1"}).find("imperfections.dropper_length_std"), std::string::npos);
   EXPECT_NE(error_of({"imperfections.spam=1"}).find("imperfections.spam"), std::string::npos);
-  EXPECT_NE(error_of({"imperfections.dropper_length_std=0.001"}, CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml").find("imperfections"),
+  EXPECT_NE(error_of({"imperfections.dropper_length_std=0.001"}, test_scenes::kReferenceEndless).find("imperfections"),
             std::string::npos);
 }
 

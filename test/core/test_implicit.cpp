@@ -8,10 +8,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -19,7 +16,7 @@ namespace {
 
 // slack_steps: steps that ended with at least one dropper slack.
 PantographStatistics pass(const std::vector<std::string>& overrides, double* dt = nullptr, int* slack_steps = nullptr) {
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", overrides));
+  Simulation sim(load_scene_file(test_scenes::kReference, overrides));
   const Model& m = sim.model();
   if (dt) *dt = m.dt;
   PassRecorder rec(m);
@@ -101,7 +98,7 @@ TEST(Implicit, NoStepLimitFromDroppers) {
 
 TEST(Implicit, CondensedRotationsAreRefused) {
   try {
-    Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+    Simulation sim(load_scene_file(test_scenes::kReference,
                                    {"numerics.integrator=implicit", "numerics.rotary_inertia=condensed"}));
     FAIL() << "condensed rotations accepted with the implicit integrator";
   } catch (const SceneError& e) {

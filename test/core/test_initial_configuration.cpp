@@ -18,16 +18,13 @@
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/engine/state.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "/work/main"
-#endif
+#include "../support/scenes.hpp"
 
 namespace cs = catenary_sim;
 
 namespace {
 
-const char* const kScenePath = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+const std::string& kScenePath = test_scenes::kReference;
 
 // The reference scene with its pantographs removed (a list cannot be deleted by an override).
 cs::Scene scene_without_pantographs() {

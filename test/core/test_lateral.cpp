@@ -14,10 +14,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/model/statics.hpp"
 #include "catenary_sim/core/model/wind_field.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -49,7 +46,7 @@ double tensioned_beam_mid(double q, double L, double T, double EI) {
 }  // namespace
 
 TEST(Lateral, NoLateralFeatureBuildsNothing) {
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml"));
+  Simulation sim(load_scene_file(test_scenes::kReference));
   EXPECT_FALSE(sim.model().lateral);
   EXPECT_EQ(sim.state().lateral.y.size(), 0);
 }
@@ -123,8 +120,8 @@ TEST(Lateral, VerticalResultsAreBitIdenticalWhenNoDropperLeans) {
   for (const char* o : {"stagger.contact_wire=[0.0]", "stagger.steady_arm_stiffness=20000",
                         "pantograph_head.sway.amplitude=0.05", "pantograph_head.sway.frequency=0.7"})
     with.push_back(o);
-  Simulation a(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", base));
-  Simulation b(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", with));
+  Simulation a(load_scene_file(test_scenes::kReference, base));
+  Simulation b(load_scene_file(test_scenes::kReference, with));
   ASSERT_FALSE(a.model().lateral);
   ASSERT_TRUE(b.model().lateral);
   ASSERT_EQ(a.model().dt, b.model().dt);
@@ -168,8 +165,8 @@ TEST(Lateral, StaggerAndGustsChangeTheContactForceThroughTheLean) {
   };
   for (bool gusts : {false, true}) {
     SCOPED_TRACE(gusts ? "gusts" : "calm");
-    Simulation a(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", base));
-    Simulation b(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", with(gusts)));
+    Simulation a(load_scene_file(test_scenes::kReference, base));
+    Simulation b(load_scene_file(test_scenes::kReference, with(gusts)));
     ASSERT_EQ(a.model().dt, b.model().dt);
     double diff_sq = 0.0, delta_max = 0.0, height_max = 0.0, sum_a = 0.0, sum_b = 0.0, sq_a = 0.0;
     std::int64_t n = 0;
@@ -205,7 +202,7 @@ TEST(Lateral, StaggerChordsUnderThePantograph) {
   // d = c (1 - 2 xi / L) toward each support's side, c = |sigma| / (lambda - 2/L), sigma = 0.6/L
   // the chord's slope (the homogeneous solutions 1, x, exp(+-lambda x) matched to y' = 0 at the
   // supports): about 1 mm at each support, linear in between.
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+  Simulation sim(load_scene_file(test_scenes::kReference,
                                  {"line.span_count=4", "output.analysis_spans=[1,3]", "stagger.contact_wire=[0.3,-0.3]"}));
   const Model& m = sim.model();
   const double L = 55.0, lambda = std::sqrt(22000.0 / 195.0), c = (0.6 / L) / (lambda - 2.0 / L);
@@ -318,7 +315,7 @@ TEST(Lateral, EnergyBoundedWithoutDamping) {
   // through the droppers; the central differences conserve a shadow energy, so the energy measured
   // with the half-step velocity wanders by O((omega dt)^2) of the kinetic part and never grows.
   Model m = build_model(load_scene_file(
-      CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+      test_scenes::kReference,
       {"line.span_count=3", "numerics.preset=balanced", "damping.alpha=0", "damping.beta=0", "pantographs=[]",
        "stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]", "stagger.steady_arm_stiffness=20000"}));
   State s = make_state(m);
@@ -373,7 +370,7 @@ TEST(Lateral, CoupledEnergyIsConserved) {
   auto run = [&](double dt) {
     std::vector<std::string> o = scene;
     if (dt > 0.0) o.push_back("numerics.dt=" + std::to_string(dt));
-    Model m = build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", o));
+    Model m = build_model(load_scene_file(test_scenes::kReference, o));
     State s = make_state(m);
     solve_initial_state(m, s);
     s.lateral = make_lateral_state(m);
@@ -463,16 +460,8 @@ TEST(Lateral, LeanLiftsTheContactWireAsTheSpringsInSeriesSay) {
 }
 
 TEST(Lateral, TurbulentFieldMatchesItsSpectrumAndCoherence) {
-  WindSpec w;
-  w.speed = 20.0;
-  TurbulenceSpec t;
-  t.intensity = 0.15;
-  t.length_scale = 50.0;
-  t.coherence_decay = 10.0;
-  t.max_frequency = 5.0;
-  t.spacing = 4.0;
-  t.seed = 11;
-  w.turbulence = t;
+  const WindSpec w = test_scenes::gusty_wind(11, 4.0);
+  const TurbulenceSpec& t = *w.turbulence;
   const WindField f = make_wind_field(w, 0.0, 2000.0, 600.0);
   ASSERT_GT(f.points, 400);
   ASSERT_EQ(f.held, f.points);
@@ -570,7 +559,7 @@ TEST(Lateral, BadInputNamesTheField) {
   // An endless line takes a stagger pattern and wind, not curves placed by station or a list per support.
   auto endless_error = [](const std::vector<std::string>& ov) {
     try {
-      load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml", ov);
+      load_scene_file(test_scenes::kReferenceEndless, ov);
     } catch (const SceneError& e) {
       return std::string(e.what());
     }
@@ -647,8 +636,8 @@ struct EndlessAndFinite {
     return p;
   }
   explicit EndlessAndFinite(const std::vector<std::string>& extra)
-      : endless(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml", pass(extra))),
-        finite(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", finite_pass(extra))) {}
+      : endless(load_scene_file(test_scenes::kReferenceEndless, pass(extra))),
+        finite(load_scene_file(test_scenes::kReference, finite_pass(extra))) {}
   Simulation endless, finite;
 };
 
@@ -657,7 +646,7 @@ struct EndlessAndFinite {
 TEST(Lateral, WindowGivesTheFullLinesContactPoint) {
   // Stagger +-0.3 m, messenger over the track centre, a steady 20 m/s cross wind, the pantograph
   // swaying 3 cm at 0.8 Hz, on 16 spans (the window holds about 5: both ends cut for most of it).
-  const std::string scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml";
+  const std::string scene = test_scenes::kReference3d;
   const std::vector<std::string> pass = {"numerics.preset=balanced", "line.span_count=16", "wind.turbulence=null",
                                          "pantograph_head.sway.amplitude=0.03", "pantograph_head.sway.frequency=0.8"};
   std::vector<std::string> windowed = pass;
@@ -691,7 +680,7 @@ TEST(Lateral, InATurbulentWindTheWindowKeepsTheWholeLinesLateralPlane) {
   // the lateral modes' decay (about 9 s, against the window's 1-2 s lead): on a finite line the
   // lateral plane then steps the whole line, and the contact point is the full line's within the
   // same 1 mm (the vertical plane alone is windowed: its far ends' echoes reach the droppers' pull).
-  const std::string scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml";
+  const std::string scene = test_scenes::kReference3d;
   const std::vector<std::string> pass = {"numerics.preset=balanced", "line.span_count=16",
                                          "pantograph_head.sway.amplitude=0.03", "pantograph_head.sway.frequency=0.8"};
   std::vector<std::string> windowed = pass;
@@ -738,14 +727,14 @@ TEST(Lateral, GustLeadGivesTheEndlessLineTheFiniteLinesTurbulentMotion) {
   auto endless_scene = [&](const std::vector<std::string>& extra) {
     std::vector<std::string> ov = common;
     ov.insert(ov.end(), extra.begin(), extra.end());
-    return load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml", EndlessAndFinite::pass(ov));
+    return load_scene_file(test_scenes::kReferenceEndless, EndlessAndFinite::pass(ov));
   };
   auto finite_scene = [&](const std::vector<std::string>& extra) {
     std::vector<std::string> ov = common;
     ov.insert(ov.end(), extra.begin(), extra.end());
     std::vector<std::string> p = EndlessAndFinite::finite_pass(ov);
     p.push_back("line.span_count=66");  // (the later key wins: 3630 m, beyond the pass's window)
-    return load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", p);
+    return load_scene_file(test_scenes::kReference, p);
   };
   Simulation endless(endless_scene({})), no_lead(endless_scene({"numerics.gust_lead=0"}));
   Simulation finite(finite_scene({})), steady(finite_scene({"wind.turbulence=null"}));
@@ -800,7 +789,7 @@ TEST(Lateral, EndlessLineReportsTheBlowOffPerSpanByStation) {
   // line's span k (stations 55k to 55(k+1)) the largest |y - calm| of the contact wire's nodes at
   // those stations, whichever block span holds them as the block moves. Computed here from the
   // nodes' stations at the recorder's own sampling times (every 5 ms).
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml",
+  Simulation sim(load_scene_file(test_scenes::kReferenceEndless,
                                  EndlessAndFinite::pass({"train.start=0", "train.end=1500", "numerics.preset=fast",
                                                          "wind.speed=25", "wind.turbulence.intensity=0.2",
                                                          "wind.turbulence.seed=5"})));
@@ -856,7 +845,7 @@ TEST(Lateral, EndlessLineOnOneRadiusHasTheCurvesPullOff) {
   // CurvePullOffIsTensionTimesTheAngleBetweenChords: each wire pulls on a support with
   // T [2 (s_next - s) / L + L / R], T times the angle between its chords; 1 % for the bending.
   const double L = 55.0, R = 1000.0;
-  const Model m = build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml",
+  const Model m = build_model(load_scene_file(test_scenes::kReferenceEndless,
                                               {"alignment.radius=1000", "stagger.contact_wire=[0.3,-0.3]",
                                                "stagger.messenger=[0.3,-0.3]"}));
   ASSERT_TRUE(m.endless);
@@ -891,7 +880,7 @@ TEST(Lateral, EndlessLineOnOneRadiusGivesTheFiniteLinesContactPoint) {
   // And the curve is there: the chords lie inside the arc, so mid-span the contact point is
   // L^2 / (8 R) = 0.25 m off the straight line's (checked on the model's static state).
   const Model straight =
-      build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml", EndlessAndFinite::pass({})));
+      build_model(load_scene_file(test_scenes::kReferenceEndless, EndlessAndFinite::pass({})));
   const Model& curved = a.model();
   const Wire& w = curved.lateral->wires[0];
   ASSERT_TRUE(w.is_contact_wire);
@@ -907,7 +896,7 @@ TEST(Lateral, TurbulentWindOnTheEndlessLineFollowsTheStations) {
   // The endless line's turbulent field lies along the line the block passes over: a node feels
   // the field at its station (block station + line offset), so after the block has moved, the
   // wind on a node equals the field there (to float rounding of the stored field).
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml",
+  Simulation sim(load_scene_file(test_scenes::kReferenceEndless,
                                  {"train.start=0", "train.end=400", "numerics.preset=fast", "wind.speed=20",
                                   "wind.turbulence.intensity=0.15", "wind.turbulence.seed=4"}));
   const Model& m = sim.model();
@@ -947,7 +936,7 @@ TEST(Lateral, TurbulentWindOnTheNodesIsTheFieldAtTheirStations) {
   for (const std::string window : {"", "numerics.window=auto"}) {
     std::vector<std::string> ov = {"numerics.preset=fast", "line.span_count=12"};
     if (!window.empty()) ov.push_back(window);
-    Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml", ov));
+    Simulation sim(load_scene_file(test_scenes::kReference3d, ov));
     const Model& m = sim.model();
     ASSERT_TRUE(m.lateral);
     const LateralModel& lat = *m.lateral;
@@ -996,7 +985,7 @@ TEST(Lateral, SwayMovesTheContactPointAcrossTheStrip) {
     std::vector<std::string> ov = {"line.span_count=4", "output.analysis_spans=[1,3]", "stagger.contact_wire=[0.3,-0.3]"};
     if (series) ov.push_back("pantograph_head.sway={times: [0, 0.5, 1.2, 2.0], lateral: [0, 0.1, -0.15, 0.05]}");
     else ov.insert(ov.end(), {"pantograph_head.sway.amplitude=0.12", "pantograph_head.sway.frequency=1.3"});
-    Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", ov));
+    Simulation sim(load_scene_file(test_scenes::kReference, ov));
     const Model& m = sim.model();
     double worst = 0.0, widest_sway = 0.0;
     int checked = 0;
@@ -1067,8 +1056,8 @@ TEST(Lateral, StaggerErrorsMoveTheRegistration) {
     const std::vector<std::string> base{"line.span_count=4", "output.analysis_spans=[1,3]", "stagger.contact_wire=[0.3,-0.3]"};
     std::vector<std::string> with_errors = base;
     with_errors.push_back("imperfections.stagger_errors=[0.0,0.05,-0.04,0.02,0.0]");
-    const Model m = build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", with_errors));
-    const Model m0 = build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", base));
+    const Model m = build_model(load_scene_file(test_scenes::kReference, with_errors));
+    const Model m0 = build_model(load_scene_file(test_scenes::kReference, base));
     const Eigen::VectorXd& y = m.lateral->calm;
     const Eigen::VectorXd& y0 = m0.lateral->calm;
     const Wire& cw = m.lateral->wires[m.contact_wires.front()];
@@ -1095,7 +1084,7 @@ TEST(Lateral, RandomStaggerErrorsHaveTheirStdAndLeaveTheOtherDraws) {
   auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> o = base;
     o.insert(o.end(), extra.begin(), extra.end());
-    return build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", o));
+    return build_model(load_scene_file(test_scenes::kReference, o));
   };
   auto errors = [](const Model& m) {
     std::vector<double> e;
@@ -1121,7 +1110,7 @@ TEST(Lateral, RandomStaggerErrorsHaveTheirStdAndLeaveTheOtherDraws) {
   const Model b = with({});
   ASSERT_EQ(a.droppers.size(), b.droppers.size());
   for (std::size_t k = 0; k < a.droppers.size(); ++k) EXPECT_EQ(a.droppers[k].static_tension, b.droppers[k].static_tension);
-  const Model ref = build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+  const Model ref = build_model(load_scene_file(test_scenes::kReference,
                                                 {"line.span_count=100", "output.analysis_spans=[1,3]"}));
   const double k0 = ref.droppers[0].stiffness;
   // Dropper k's error e_d = (T_ref - T) / k; the first dropper's would be e[0] / 0.03 * 0.003 if shared.
@@ -1132,7 +1121,7 @@ TEST(Lateral, RandomStaggerErrorsHaveTheirStdAndLeaveTheOtherDraws) {
 TEST(Lateral, StaggerErrorsBadInputNamesTheField) {
   auto error_of = [](const std::vector<std::string>& o) {
     try {
-      build_model(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", o));
+      build_model(load_scene_file(test_scenes::kReference, o));
     } catch (const SceneError& e) {
       return std::string(e.what());
     }
@@ -1158,7 +1147,7 @@ namespace {
 // generic step) side by side; every lateral value must agree to the bit, and every vertical one
 // (Simulation::step may sweep both planes at once: step_both_planes). Returns the steps taken.
 int expect_fused_is_generic(const std::vector<std::string>& overrides, int* windowed_fused_steps) {
-  Simulation a(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml", overrides));
+  Simulation a(load_scene_file(test_scenes::kReference3d, overrides));
   EXPECT_TRUE(a.model().lateral);
   if (!a.model().lateral) return 0;
   if (a.model().lateral->planes.empty()) {
@@ -1211,7 +1200,7 @@ TEST(Lateral, FusedStepIsTheGenericStepBitForBit) {
   std::vector<std::string> line = pass;
   line.push_back("line.span_count=4");
   int windowed_fused = 0;
-  Simulation joint(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml", line));
+  Simulation joint(load_scene_file(test_scenes::kReference3d, line));
   EXPECT_GT(expect_fused_is_generic(line, &windowed_fused), 1000);
   // Without a window both planes are swept at once (sweep_pack_pair) at every step.
   while (joint.step() == StepStatus::kOk) {
@@ -1235,7 +1224,7 @@ TEST(Lateral, EachStripHasItsOwnWorkingWidth) {
   // beam rounds the chord by under 1 mm (StaggerChordsUnderThePantograph): 0.5 % of the span's
   // share either way, and the exit point within 1 mm plus one step's sideways travel (0.9 m/s x
   // dt) of 0.25 m.
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+  Simulation sim(load_scene_file(test_scenes::kReference,
                                  {"line.span_count=6", "output.analysis_spans=[1,5]", "stagger.contact_wire=[0.3,-0.3]",
                                   "pantographs.0.collectors=[{offset: 0.3, working_width: 1.2}, "
                                   "{offset: -0.3, working_width: 0.5}]"}));
@@ -1258,7 +1247,7 @@ TEST(Lateral, EachStripHasItsOwnWorkingWidth) {
   }
   // A strip wider than the head's horns is refused, naming it.
   try {
-    load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+    load_scene_file(test_scenes::kReference,
                     {"stagger.contact_wire=[0.3,-0.3]", "pantographs.0.collectors=[{offset: 0.0, working_width: 2.5}]"});
     ADD_FAILURE() << "a strip wider than the horns accepted";
   } catch (const SceneError& e) {
@@ -1273,7 +1262,7 @@ TEST(Lateral, HeadWindAddsToThePantographsAerodynamicUplift) {
   // at 300 km/h, a = 0.01 N s^2/m^2 (70 N at 300 km/h in still air).
   const double a = 0.01, v = 300.0 / 3.6, U = 15.0;
   auto scene = [&](const std::string& direction) {
-    return load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+    return load_scene_file(test_scenes::kReference,
                            {"line.span_count=6", "output.analysis_spans=[1,5]", "pantographs.0.aero_coefficient=0.01",
                             "wind.speed=15", "wind.direction=" + direction});
   };
@@ -1292,7 +1281,7 @@ TEST(Lateral, HeadWindAddsToThePantographsAerodynamicUplift) {
   // which must be a ((v + U)^2 - v^2) = 27.3 N; what is left is the round-off of sums over 20000
   // steps (1e-9 relative), checked at 1e-6 N.
   auto received = [&](const std::string& direction, double* impulse_per_step, long* steps) {
-    Simulation sim(direction.empty() ? load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+    Simulation sim(direction.empty() ? load_scene_file(test_scenes::kReference,
                                                        {"line.span_count=6", "output.analysis_spans=[1,5]",
                                                         "pantographs.0.aero_coefficient=0.01", "stagger.contact_wire=[0.0]"})
                                      : scene(direction));

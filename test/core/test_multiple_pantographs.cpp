@@ -8,15 +8,12 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
 TEST(MultiplePantographs, TrailingPantographVariesMoreThanTheLeadingOne) {
-  Scene scene = load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_pantographs.yaml");
+  Scene scene = load_scene_file(test_scenes::kReferenceTwoPantographs);
   scene.train_speed = 300.0 / 3.6;
   Simulation sim(scene);
   const Model& m = sim.model();

@@ -8,10 +8,7 @@
 #include <sstream>
 
 #include "catenary_sim/core/simulation.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -19,19 +16,17 @@ namespace {
 
 // calpe_example with a twin contact wire in both series and a two-strip head, pressed on at x.
 Scene twin_overlap(double x) {
-  YAML::Node root = YAML::LoadFile(CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml");
-  for (YAML::Node sec : root["sections"]) sec["contact_wire_count"] = 2;
-  YAML::Node strips;
-  for (double off : {-0.25, 0.25}) {
-    YAML::Node c;
-    c["offset"] = off;
-    strips.push_back(c);
-  }
-  root["pantographs"][0]["collectors"] = strips;
-  root["train"]["start"] = x;
-  std::stringstream s;
-  s << root;
-  return load_scene_string(s.str());
+  return test_scenes::edited_scene("calpe_example.yaml", [x](YAML::Node& root) {
+    for (YAML::Node sec : root["sections"]) sec["contact_wire_count"] = 2;
+    YAML::Node strips;
+    for (double off : {-0.25, 0.25}) {
+      YAML::Node c;
+      c["offset"] = off;
+      strips.push_back(c);
+    }
+    root["pantographs"][0]["collectors"] = strips;
+    root["train"]["start"] = x;
+  });
 }
 
 }  // namespace

@@ -7,10 +7,7 @@
 #include <complex>
 
 #include "catenary_sim/core/analysis/pantograph_frf.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -27,7 +24,7 @@ std::vector<double> log_frequencies(double f0, double f1, int n) {
 // One mass on a spring and a damper to the roof: H = 1 / (k - w^2 m + i w c), whatever k0 drives
 // it (the driven set-up only adds the contact spring between drive and head, which X/F skips).
 TEST(PantographFrf, OneMassMatchesTheClosedForm) {
-  Scene scene = load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml");
+  Scene scene = load_scene_file(test_scenes::kCalpeExample);
   PantographSpec& p = scene.pantographs[0];
   p.masses = {10.0};
   p.stiffness = {3000.0};
@@ -55,7 +52,7 @@ TEST(PantographFrf, OneMassMatchesTheClosedForm) {
 // is below 1.3e-5 here. The drive settles until the slowest free transient is below 1e-4 of its
 // size (FrfMeasurement::settle_tolerance): 2e-4 for it in X and F. Bound: w dt / 2 + 2e-4.
 TEST(PantographFrf, SimulatedRigMatchesTheAnalyticTransferFunction) {
-  const Scene scene = load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml");
+  const Scene scene = load_scene_file(test_scenes::kCalpeExample);
   const double dt = 1e-4;
   const Model rig = build_model(frf_rig_scene(scene, 0, dt));
   ASSERT_DOUBLE_EQ(rig.dt, dt);
@@ -76,7 +73,7 @@ TEST(PantographFrf, SimulatedRigMatchesTheAnalyticTransferFunction) {
 // The error above is the scheme's, not the settling's: it is first order in dt (the damper's
 // half-step lag), so halving dt halves it (ratio 2 within 20 %).
 TEST(PantographFrf, RigErrorIsFirstOrderInTheTimeStep) {
-  const Scene scene = load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml");
+  const Scene scene = load_scene_file(test_scenes::kCalpeExample);
   const std::vector<double> f = {1.0, 2.5, 4.0};
   double err[2] = {0, 0};
   const double dts[2] = {2e-4, 1e-4};
@@ -92,7 +89,7 @@ TEST(PantographFrf, RigErrorIsFirstOrderInTheTimeStep) {
 }
 
 TEST(PantographFrf, MovingForceHasNoFrequencyResponse) {
-  Scene scene = load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml");
+  Scene scene = load_scene_file(test_scenes::kCalpeExample);
   scene.pantographs[0].moving_force = true;
   const Model rig = build_model(frf_rig_scene(scene, 0, 1e-4));
   try {

@@ -12,16 +12,13 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
-YAML::Node calpe() { return YAML::LoadFile(CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml"); }
+YAML::Node calpe() { return YAML::LoadFile(test_scenes::kCalpeExample); }
 
 Scene load(const YAML::Node& root) {
   std::stringstream s;
@@ -271,7 +268,7 @@ TEST(PantographHeads, MeanForceFollowsPerHeadAeroForTheKneeAndIsReportedAgainstT
 // that and far below any slip (a missing head or aero term is tens of N).
 TEST(PantographHeads, MeasuringPantographSumsItsHeads) {
   // The example two-head scene (heads' own aero 0.002 N s^2/m^2 each), its head dampers removed.
-  YAML::Node root = YAML::LoadFile(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_heads.yaml");
+  YAML::Node root = YAML::LoadFile(test_scenes::kReferenceTwoHeads);
   for (YAML::Node h : root["pantographs"][0]["heads"]) h["damping"] = 0.0;
   const auto st = run(load(root));
   ASSERT_TRUE(st[0].measured.available);
@@ -284,7 +281,7 @@ TEST(PantographHeads, MeasuringPantographSumsItsHeads) {
 // example scene (at +-0.25 m) are under the wire and pressed on it (eq. 23), none hanging off
 // the line's end rising on its preload; a train.start with a head off the line is refused.
 TEST(PantographHeads, EveryHeadsStripStartsAndEndsOnTheLine) {
-  const YAML::Node root = YAML::LoadFile(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_heads.yaml");
+  const YAML::Node root = YAML::LoadFile(test_scenes::kReferenceTwoHeads);
   Simulation sim(load(root));
   const Model& m = sim.model();
   EXPECT_NEAR(m.train_start, 0.25, 1e-12);

@@ -8,10 +8,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -25,7 +22,7 @@ struct Pass {
 };
 
 Pass run(std::vector<std::string> overrides) {
-  Scene scene = load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", overrides);
+  Scene scene = load_scene_file(test_scenes::kReference, overrides);
   Pass p;
   p.sim = std::make_unique<Simulation>(scene);
   const Model& m = p.sim->model();

@@ -7,10 +7,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -23,7 +20,7 @@ struct PassResult {
 };
 
 PassResult run_pass(double speed_kmh) {
-  Scene scene = load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml");
+  Scene scene = load_scene_file(test_scenes::kReference);
   scene.train_speed = speed_kmh / 3.6;
   Simulation sim(scene);
   const Model& m = sim.model();

@@ -9,16 +9,13 @@
 #include <sstream>
 
 #include "catenary_sim/core/simulation.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
-const std::string kReference = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+using test_scenes::kReference;
 
 std::string error_of(const std::vector<std::string>& overrides) {
   try {
@@ -181,7 +178,7 @@ TEST(Commands, RejectedCommandsLeaveTheStateAsItWas) {
 
 namespace {
 
-const std::string kReference3d = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml";
+using test_scenes::kReference3d;
 
 std::string error_of_3d(const std::vector<std::string>& overrides) {
   try {
@@ -276,7 +273,7 @@ TEST(SceneErrors, TurbulencePointsAreBounded) {
   EXPECT_EQ(estimate_model_bytes(fine) - estimate_model_bytes(s), estimate_wind_field_bytes(fine) - estimate_wind_field_bytes(s));
   // An endless line holds only its block's points (generated as the block moves): the length of
   // the pass is no reason to refuse a spacing, 900 km at 5 m being 180,000 points along the way.
-  const std::string endless = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml";
+  const std::string endless = test_scenes::kReferenceEndless;
   EXPECT_NO_THROW(load_scene_file(endless, {"train.end=900000", "stagger.contact_wire=[0.3, -0.3]", "wind.speed=20",
                                             "wind.turbulence.intensity=0.15"}));
   std::string fine_endless;

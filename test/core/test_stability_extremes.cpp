@@ -9,16 +9,13 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
-const std::string kScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+const std::string& kScene = test_scenes::kReference;
 
 // Steps up to `max_steps` (or to the end of the pass) and checks every state stays finite.
 int run_finite(Simulation& sim, int max_steps) {

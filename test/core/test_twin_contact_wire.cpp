@@ -9,10 +9,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/model/statics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
@@ -20,18 +17,7 @@ namespace {
 
 // The reference catenary on 4 spans, as one section with `count` contact wires.
 Scene reference_with_contact_wires(int count) {
-  YAML::Node root = YAML::LoadFile(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml");
-  root["line"].remove("span_length");
-  root["line"].remove("span_count");
-  YAML::Node sec;
-  sec["span_length"] = 55.0;
-  sec["span_count"] = 4;
-  sec["contact_wire_count"] = count;
-  root["sections"].push_back(sec);
-  root["train"]["speed_kmh"] = 250.0;
-  std::stringstream s;
-  s << root;
-  return load_scene_string(s.str());
+  return test_scenes::reference_with_contact_wires(count, 4, [](YAML::Node& root) { root["train"]["speed_kmh"] = 250.0; });
 }
 
 }  // namespace

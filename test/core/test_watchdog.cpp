@@ -5,17 +5,14 @@
 #include <cmath>
 
 #include "catenary_sim/core/simulation.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
 TEST(Watchdog, RunawayDisplacementStopsTheRun) {
   // The head starts 2 mm up (at the anchor) and rises by centimetres mid-span under 100 N, so a
   // 10 mm limit must trip within the pass.
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", {"numerics.divergence_limit=0.01"}));
+  Simulation sim(load_scene_file(test_scenes::kReference, {"numerics.divergence_limit=0.01"}));
   StepStatus st = StepStatus::kOk;
   int n = 0;
   while (st == StepStatus::kOk && n < 100000) {
@@ -34,7 +31,7 @@ TEST(Watchdog, RunawayDisplacementStopsTheRun) {
 }
 
 TEST(Watchdog, NaNIsCaughtOnTheStepItAppears) {
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml"));
+  Simulation sim(load_scene_file(test_scenes::kReference));
   State s = sim.state();
   const Wire& cw = sim.model().wires[0];
   s.u[cw.w_dof + cw.nodes() / 2] = std::nan("");

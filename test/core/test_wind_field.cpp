@@ -13,30 +13,11 @@
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/model/wind_field.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
-namespace {
-
-WindSpec gusty_wind(std::uint64_t seed) {
-  WindSpec w;
-  w.speed = 20.0;
-  TurbulenceSpec t;
-  t.intensity = 0.15;
-  t.length_scale = 50.0;
-  t.coherence_decay = 10.0;
-  t.max_frequency = 5.0;
-  t.spacing = 5.0;
-  t.seed = seed;
-  w.turbulence = t;
-  return w;
-}
-
-}  // namespace
+using test_scenes::gusty_wind;
 
 TEST(WindField, SpectrumAsTheWiresFeelItIsVonKarmansUpToMaxFrequency) {
   // The field at a point sampled as the wires take it (refreshed every 0.01 s, the refresh of
@@ -118,7 +99,7 @@ TEST(WindField, EndlessLinesFieldHasABoundedSizeWhateverTheDistance) {
   const std::vector<std::string> ov = {"train.start=0", "train.end=200000", "numerics.preset=fast",
                                        "stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]",
                                        "wind.speed=20", "wind.turbulence.intensity=0.15", "wind.turbulence.seed=5"};
-  const std::string endless = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml";
+  const std::string endless = test_scenes::kReferenceEndless;
   const Scene scene = load_scene_file(endless, ov);
   Simulation sim(scene);
   const Model& m = sim.model();

@@ -8,17 +8,14 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
 PantographStatistics pass(const std::vector<std::string>& overrides) {
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", overrides));
+  Simulation sim(load_scene_file(test_scenes::kReference, overrides));
   const Model& m = sim.model();
   PassRecorder rec(m);
   rec.record(m, sim.state());
@@ -67,7 +64,7 @@ TEST(Window, AutoLengthsFollowTheSpeed) {
   generous.push_back("numerics.window={ahead: 275, behind: 770}");
   automatic.push_back("numerics.window=auto");
   const PantographStatistics ref = pass(generous), win = pass(automatic);
-  Simulation probe(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", automatic));
+  Simulation probe(load_scene_file(test_scenes::kReference, automatic));
   double ahead_350 = 0, behind_350 = 0, ahead_150 = 0, behind_150 = 0;
   window_lengths(probe.model(), 350 / 3.6, &ahead_350, &behind_350);
   window_lengths(probe.model(), 150 / 3.6, &ahead_150, &behind_150);
@@ -110,7 +107,7 @@ TEST(Window, EndsLetAPulseOut) {
 }
 
 TEST(Window, RefusedWithTheImplicitIntegrator) {
-  EXPECT_THROW(Simulation(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml",
+  EXPECT_THROW(Simulation(load_scene_file(test_scenes::kReference,
                                           {"numerics.window=auto", "numerics.integrator=implicit"})),
                SceneError);
 }

@@ -16,20 +16,19 @@
 #include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/hil/rig_pantograph.hpp"
+#include "../support/scenes.hpp"
 
 namespace hil_test {
 
 using namespace catenary_sim;
 using namespace catenary_sim::hil;
 
-inline const std::string kDir = CATENARY_SIM_SOURCE_DIR;
+inline const std::string& kDir = test_scenes::kSourceDir;
 
 inline Scene scene_with_dt(const std::string& file, double dt) {
-  YAML::Node root = YAML::LoadFile(kDir + "/config/" + file);
-  if (dt > 0.0) root["numerics"]["dt"] = dt;
-  std::stringstream yaml;
-  yaml << root;
-  return load_scene_string(yaml.str());
+  return test_scenes::edited_scene(file, [dt](YAML::Node& root) {
+    if (dt > 0.0) root["numerics"]["dt"] = dt;
+  });
 }
 
 inline const PantographSpec& lumped_spec(const Scene& lumped, const std::string& name) {
@@ -81,7 +80,7 @@ bool replay(double dt, int k, const std::vector<std::uint64_t>* measurement_step
     return false;
   }
   const int p = external[0];
-  const Scene lumped = load_scene_file(kDir + "/config/reference_55m.yaml");
+  const Scene lumped = load_scene_file(test_scenes::kReference);
   RigPantograph rig(lumped_spec(lumped, m.pantographs[p].name), lumped.contact.stiffness);
   Observed point = observe(m, sim.state(), k);
   rig.reset(point.wire, point.speed);

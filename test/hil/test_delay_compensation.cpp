@@ -18,6 +18,7 @@
 
 #include "catenary_sim/hil/loop.hpp"
 #include "hil_test_support.hpp"
+#include "../support/scenes.hpp"
 
 using namespace hil_test;
 
@@ -29,7 +30,7 @@ class DelayedRig : public LoopSkin {
  public:
   DelayedRig(HilLoop& loop, int delay)
       : loop_(loop),
-        lumped_(load_scene_file(kDir + "/config/reference_55m.yaml")),
+        lumped_(load_scene_file(test_scenes::kReference)),
         rig_(lumped_spec(lumped_, loop.model().pantographs[loop.external()[0]].name), lumped_.contact.stiffness),
         delay_(delay) {
     loop_.attach(this);

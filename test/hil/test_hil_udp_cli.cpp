@@ -13,16 +13,17 @@
 
 #include "../support/child_process.hpp"
 #include "catenary_sim/hil/realtime.hpp"
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim_test;
 using catenary_sim::hil::RealtimeOptions;
 
 namespace {
 
-const std::string kSim = CATENARY_SIM_DEVEL_LIB "/catenary_sim_hil_udp";
-const std::string kRig = CATENARY_SIM_DEVEL_LIB "/udp_rig_client";
-const std::string kHil = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_hil.yaml";
-const std::string kLumped = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+const std::string kSim = test_scenes::program("catenary_sim_hil_udp");
+const std::string kRig = test_scenes::program("udp_rig_client");
+const std::string& kHil = test_scenes::kReferenceHil;
+const std::string& kLumped = test_scenes::kReference;
 
 ChildRun run(const std::vector<std::string>& args, const std::vector<std::string>& prefix = {}) {
   std::vector<std::string> a = prefix;
@@ -75,7 +76,7 @@ TEST(HilUdpCli, BadOptionsAreRefusedNamingTheOption) {
   expect_refused({kRig, "--pantograph-scene", kHil, "--simulator", "127.0.0.1:47800"}, {"lumped"});
   expect_refused({kRig, "--pantograph-scene", kLumped, "--rate", "-1"}, {"--rate"});
   // A scene the rig cannot take: a pantograph with heads on their own suspensions.
-  expect_refused({kRig, "--pantograph-scene", CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_heads.yaml"},
+  expect_refused({kRig, "--pantograph-scene", test_scenes::kReferenceTwoHeads},
                  {"--pantograph-scene", "two_heads", "heads", "allowed"});
   expect_refused({kRig, "--pantograph-scene", kLumped, "--simulator", "0.0.0.0:47800"}, {"--simulator", "unicast"});
   expect_refused({kRig, "--pantograph-scene", kLumped, "--simulator", "127.0.0.1:65536"}, {"--simulator", "1 to 65535"});

@@ -34,6 +34,7 @@
 #include "catenary_sim/hil/report.hpp"
 #include "catenary_sim/hil/udp_loop.hpp"
 #include "hil_test_support.hpp"
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 using namespace catenary_sim::hil;
@@ -120,7 +121,7 @@ TEST(UdpLoop, ClosedOverLoopbackAt1kHzIsItsOwnReplayAndWithoutDelayTheInternalPa
   ro.simulator_address = "127.0.0.1";
   ro.simulator_port = skin.port();
   ro.bind_address = "127.0.0.1";
-  UdpVirtualRig rig(load_scene_file(kDir + "/config/reference_55m.yaml"), ro);
+  UdpVirtualRig rig(load_scene_file(test_scenes::kReference), ro);
   std::atomic<bool> rig_stop{false};
   std::thread rig_thread([&] { rig.run([&] { return !rig_stop.load(); }, true); });
 

@@ -23,6 +23,7 @@
 #include "catenary_sim/hil/loop.hpp"
 #include "catenary_sim/hil/udp_loop.hpp"
 #include "hil_test_support.hpp"
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 using namespace catenary_sim::hil;
@@ -302,7 +303,7 @@ RigRun run_rig(FakeSimulator& sim, const std::function<void()>& script, double c
   o.bind_address = "127.0.0.1";
   o.contact_timeout = contact_timeout;
   o.connect_timeout = connect_timeout;
-  UdpVirtualRig rig(load_scene_file(kDir + "/config/reference_55m.yaml"), o);
+  UdpVirtualRig rig(load_scene_file(test_scenes::kReference), o);
   RigRun r;
   const double start = steady_now();
   std::thread t([&] {

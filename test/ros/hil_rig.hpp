@@ -59,16 +59,10 @@ class Rig {
 // measuring on `topic`; then the rig stops and ROS shuts down.
 template <class M>
 int run_with_rig(const std::string& topic, std::function<bool(M&)> measure) {
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  int rc;
-  {
+  return ros_test::run_all_tests(2, [&] {
     Rig<M> rig(topic, std::move(measure));
-    rc = RUN_ALL_TESTS();
-  }
-  spinner.stop();
-  ros::shutdown();
-  return rc;
+    return RUN_ALL_TESTS();
+  });
 }
 
 }  // namespace hil_rostest

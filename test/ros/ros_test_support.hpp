@@ -1,7 +1,8 @@
-// Helpers of the rostest companions (test/ros): a topic recorder, a recorder of a node's log lines
-// and a wall-clock wait.
+// Helpers of the rostest companions (test/ros): a topic recorder, a recorder of a node's log lines,
+// a wall-clock wait and the companions' main().
 #pragma once
 
+#include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
 
@@ -104,6 +105,30 @@ inline bool wait_for(const std::function<bool()>& cond, double timeout_s, double
     ros::WallDuration(poll_s).sleep();
   }
   return cond();
+}
+
+// gtest and ROS initialised, this process the node `node`: the head of a companion's main().
+inline void init(int& argc, char** argv, const std::string& node) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, node);
+}
+
+// `run` (all the tests by default) with the subscriptions served by `spinner_threads` threads,
+// then ROS shut down: the tail of a companion's main().
+inline int run_all_tests(int spinner_threads, const std::function<int()>& run = [] { return RUN_ALL_TESTS(); }) {
+  ros::AsyncSpinner spinner(spinner_threads);
+  spinner.start();
+  const int rc = run();
+  spinner.stop();
+  ros::shutdown();
+  return rc;
+}
+
+// The whole main() of a companion whose subscriptions are the tests' own.
+inline int ros_test_main(int argc, char** argv, const std::string& node, int spinner_threads = 2) {
+  init(argc, argv, node);
+  ros::NodeHandle nh;  // keeps the node up between the tests' own handles
+  return run_all_tests(spinner_threads);
 }
 
 }  // namespace ros_test

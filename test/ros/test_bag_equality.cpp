@@ -13,6 +13,7 @@
 
 #include "../support/child_process.hpp"
 #include "catenary_sim/ContactForceArray.h"
+#include "../support/scenes.hpp"
 
 using catenary_sim_test::free_port;
 using catenary_sim_test::temp_dir;
@@ -33,7 +34,7 @@ std::map<double, catenary_sim::ContactForce> read_forces(const std::string& path
 
 TEST(BagEquality, LiveRecordingEqualsOfflineRunner) {
   const std::string dir = temp_dir("catenary_sim_bag_");
-  const std::string scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string scene = test_scenes::kReference;
   const std::string live = dir + "/live.bag", offline = dir + "/offline.bag";
   // A master of its own on a free loopback port. The node exits at the end of the pass, the
   // recorder closes the bag, and roslaunch ends with the node (required when headless).
@@ -50,7 +51,7 @@ TEST(BagEquality, LiveRecordingEqualsOfflineRunner) {
   const int rc = std::system(("bash -c '" + launch + "'").c_str());
   (void)!std::system(("bash -c 'kill $(cat " + dir + "/roscore.pid) 2>/dev/null; sleep 1'").c_str());
   ASSERT_EQ(rc, 0) << "roslaunch failed; see " << dir << "/launch.log";
-  const std::string run = std::string(CATENARY_SIM_DEVEL_LIB) + "/simulate_pass --scene " + scene +
+  const std::string run = test_scenes::program("simulate_pass") + " --scene " + scene +
                           " --speed 250 --quiet --out " + dir + "/offline --bag " + offline + " --bag-rate 0";
   ASSERT_EQ(std::system(run.c_str()), 0);
 

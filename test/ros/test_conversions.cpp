@@ -12,6 +12,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/ros/params.hpp"
+#include "../support/scenes.hpp"
 
 #include <xmlrpcpp/XmlRpcValue.h>
 
@@ -22,7 +23,7 @@ namespace {
 
 struct Fixture : ::testing::Test {
   static void SetUpTestSuite() {
-    sim = new Simulation(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m.yaml"));
+    sim = new Simulation(load_scene_file(test_scenes::kReference));
     for (int i = 0; i < 2000; ++i) ASSERT_EQ(sim->step(), StepStatus::kOk);
   }
   static void TearDownTestSuite() { delete sim; }
@@ -205,7 +206,7 @@ double strip_z(const visualization_msgs::Marker& strip, double x) {
 // its reference height (the wire's height where the pass started, at a support) drew it
 // (k - 1) x 55 mm ~ 0.5 m under the wire.
 TEST(Markers, HeadIsDrawnOnTheWireItTouchesAtMidSpan) {
-  Simulation sim(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m.yaml"));
+  Simulation sim(load_scene_file(test_scenes::kReference));
   const Model& m = sim.model();
   const double x_mid = m.support_x[1] + 0.5 * (m.support_x[2] - m.support_x[1]);
   step_to(sim, x_mid);
@@ -255,7 +256,7 @@ TEST(Markers, HeadIsDrawnOnTheWireItTouchesAtMidSpan) {
 // own suspensions, each with its own aero term 0.002 N s^2/m^2): the state carries both heads and
 // the markers draw each at its own height on the wire over its own strip, with its own horns.
 TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
-  Simulation sim(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m_two_heads.yaml"));
+  Simulation sim(load_scene_file(test_scenes::kReferenceTwoHeads));
   const Model& m = sim.model();
   const double x_mid = m.support_x[1] + 0.5 * (m.support_x[2] - m.support_x[1]);
   step_to(sim, x_mid);
@@ -327,7 +328,7 @@ TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
 TEST(Markers, EachStripIsDrawnOverItsOwnWorkingWidth) {
   // Two strips of one head with working widths of 1.2 m and 0.5 m (collectors[].working_width):
   // each drawn across the track over its own width, centred on the head, at its own offset.
-  Simulation sim(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m.yaml",
+  Simulation sim(load_scene_file(test_scenes::kReference,
                                  {"stagger.contact_wire=[0.3,-0.3]", "pantographs.0.collectors=[{offset: 0.3, "
                                   "working_width: 1.2}, {offset: -0.3, working_width: 0.5}]"}));
   const Model& m = sim.model();
@@ -347,7 +348,7 @@ TEST(Markers, EachStripIsDrawnOverItsOwnWorkingWidth) {
 }
 
 TEST(Markers, OverlapLabelGivesTheForcePerContactWire) {
-  Simulation sim(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/calpe_example.yaml"));
+  Simulation sim(load_scene_file(test_scenes::kCalpeExample));
   const Model& m = sim.model();
   ASSERT_EQ(m.contact_wires.size(), 2u);
   step_to(sim, 50.0);
@@ -396,7 +397,7 @@ TEST(Markers, ViewFrameFollowsTheTrainFront) {
 // With two pantographs (200 m apart in the scene) each has a view frame at its own station, so a
 // camera can follow the trailing one; train_view stays at the front. One pantograph: train_view only.
 TEST(Markers, EveryPantographHasAViewFrameOnATrainWithSeveral) {
-  Simulation two(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m_two_pantographs.yaml"));
+  Simulation two(load_scene_file(test_scenes::kReferenceTwoPantographs));
   const Model& m = two.model();
   const State& s = two.state();
   const auto v = to_view_transforms(m, s, ros::Time(5.0), "line");
@@ -408,7 +409,7 @@ TEST(Markers, EveryPantographHasAViewFrameOnATrainWithSeveral) {
     EXPECT_DOUBLE_EQ(v[p + 1].transform.translation.x, s.front + s.line_offset - m.pantographs[p].position);
   }
   EXPECT_DOUBLE_EQ(v[1].transform.translation.x - v[2].transform.translation.x, 200.0);
-  Simulation one(load_scene_file(std::string(CATENARY_SIM_SOURCE_DIR) + "/config/reference_55m.yaml"));
+  Simulation one(load_scene_file(test_scenes::kReference));
   EXPECT_EQ(to_view_transforms(one.model(), one.state(), ros::Time(5.0), "line").size(), 1u);
 }
 
@@ -453,7 +454,7 @@ TEST(Pacing, StepsDueFollowWallClockTimesFactor) {
 // The pass node and the HIL node reject cmd/train_speed with this message (the same range as the
 // core's set_target_speed, which stays the authority).
 TEST(Commands, SpeedCommandErrorNamesTopicValueAndRange) {
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml"));
+  Simulation sim(load_scene_file(test_scenes::kReference));
   const Scene& scene = sim.model().scene;
   const double c = std::sqrt(22000.0 / 1.35);  // the reference contact wire's wave speed, m/s
   EXPECT_EQ(speed_command_error(scene, 0.0), "");
@@ -638,7 +639,7 @@ TEST(Markers, NoListMarkerIsEverSentEmpty) {
       }
     }
   };
-  const std::string dir = std::string(CATENARY_SIM_SOURCE_DIR) + "/config/";
+  const std::string& dir = test_scenes::kConfigDir;
   for (const char* scene : {"reference_55m.yaml", "calpe_example.yaml", "reference_55m_hil.yaml", "reference_55m_two_sections.yaml"}) {
     Simulation sim(load_scene_file(dir + scene));
     MarkerOptions o;
@@ -666,7 +667,7 @@ TEST(Markers, NoListMarkerIsEverSentEmpty) {
 // the dot where the strip meets the wire at the contact point; ~lateral_scale stretches every
 // lateral coordinate and width alike (x and z untouched), so the wire stays where it is on the strip.
 TEST(Markers, ThreeDimensionalLineIsDrawnAcrossTheTrackAndStretchedAlike) {
-  Simulation sim(load_scene_file(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml",
+  Simulation sim(load_scene_file(test_scenes::kReference3d,
                                  {"pantograph_head.sway.amplitude=0.05", "pantograph_head.sway.frequency=0.5"}));
   for (int i = 0; i < 800; ++i) ASSERT_EQ(sim.step(), StepStatus::kOk);
   const Model& m = sim.model();

@@ -15,25 +15,18 @@
 #include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/ros/hil.hpp"
 #include "catenary_sim/ros/virtual_rig.hpp"
-
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 using namespace catenary_sim::ros_layer;
 
 namespace {
 
-const std::string kDir = CATENARY_SIM_SOURCE_DIR;
-
 Scene reference(double dt, double kmh) {
-  YAML::Node root = YAML::LoadFile(kDir + "/config/reference_55m.yaml");
-  root["numerics"]["dt"] = dt;
-  root["train"]["speed_kmh"] = kmh;
-  std::stringstream s;
-  s << root;
-  return load_scene_string(s.str());
+  return test_scenes::edited_scene("reference_55m.yaml", [dt, kmh](YAML::Node& root) {
+    root["numerics"]["dt"] = dt;
+    root["train"]["speed_kmh"] = kmh;
+  });
 }
 
 // The same scene with its lumped pantographs made external (as config/reference_55m_hil.yaml).
@@ -201,8 +194,8 @@ TEST(HilParams, SpinWaitPriorityAndShapeParametersAreChecked) {
 }
 
 TEST(HilScene, ReferenceHilIsTheReferenceSceneWithAnExternalPantograph) {
-  YAML::Node hil = YAML::LoadFile(kDir + "/config/reference_55m_hil.yaml");
-  YAML::Node ref = YAML::LoadFile(kDir + "/config/reference_55m.yaml");
+  YAML::Node hil = YAML::LoadFile(test_scenes::kReferenceHil);
+  YAML::Node ref = YAML::LoadFile(test_scenes::kReference);
   for (YAML::Node p : ref["pantographs"]) {
     p["type"] = "external";
     p.remove("masses");
@@ -212,7 +205,7 @@ TEST(HilScene, ReferenceHilIsTheReferenceSceneWithAnExternalPantograph) {
   ref["name"] = "reference_55m_hil";
   EXPECT_EQ(YAML::Dump(hil), YAML::Dump(ref));
   // dt: auto gives the steps the README states at each rate.
-  const Scene scene = load_scene_file(kDir + "/config/reference_55m_hil.yaml");
+  const Scene scene = load_scene_file(test_scenes::kReferenceHil);
   ASSERT_TRUE(scene.pantographs[0].external);
   ASSERT_FALSE(scene.numerics.dt);
   const double auto_dt = build_model(scene).dt;
@@ -288,7 +281,7 @@ TEST(RigPantograph, ResetPressesOnWithTheStaticForce) {
 // The rig's pantograph is a chain; a pantograph with heads on their own suspensions is refused by
 // name (not merged into one head, which would change its dynamics silently).
 TEST(RigPantograph, RefusesAPantographWithSeveralHeadsByName) {
-  const Scene scene = load_scene_file(kDir + "/config/reference_55m_two_heads.yaml");
+  const Scene scene = load_scene_file(test_scenes::kReferenceTwoHeads);
   ASSERT_EQ(scene.pantographs[0].heads.size(), 2u);
   try {
     RigPantograph rig(scene.pantographs[0], scene.contact.stiffness);

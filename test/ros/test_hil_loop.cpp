@@ -43,6 +43,7 @@
 #include "catenary_sim/ros/hil.hpp"
 #include "catenary_sim/ros/virtual_rig.hpp"
 #include "../hil/hil_test_support.hpp"
+#include "ros_test_support.hpp"
 
 using namespace catenary_sim;
 using namespace catenary_sim::ros_layer;
@@ -184,16 +185,10 @@ TEST(HilLoop, LiveLoopIsItsOwnReplayAndWithoutDelayTheInternalPantograph) {
 }
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_hil_loop");
+  ros_test::init(argc, argv, "test_hil_loop");
   ros::NodeHandle nh;
   ros::Subscriber sub =
       nh.subscribe("hil/contact_point", 100000, &on_point, ros::TransportHints().tcpNoDelay());
   ros::Subscriber msub = nh.subscribe("hil/contact_force", 100000, &on_measurement);
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  const int rc = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return rc;
+  return ros_test::run_all_tests(1);
 }

@@ -165,8 +165,7 @@ TEST(HilOutputs, WrenchInputPantographStateAndWireShape) {
 }
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_hil_outputs");
+  ros_test::init(argc, argv, "test_hil_outputs");
   Heard h;
   heard = &h;
   return hil_rostest::run_with_rig<geometry_msgs::WrenchStamped>("hil/contact_wrench", measure);

@@ -216,8 +216,7 @@ TEST(HilSafety, WaitingRunningSafeHoldRejectionAndRecovery) {
 }
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_hil_safety");
+  ros_test::init(argc, argv, "test_hil_safety");
   Heard h;
   heard = &h;
   ros::Subscriber diag_sub = h.nh.subscribe<diagnostic_msgs::DiagnosticArray>(

@@ -247,8 +247,7 @@ TEST(HilServices, ArmPauseSpeedResetStopAndArmAgain) {
 }
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_hil_services");
+  ros_test::init(argc, argv, "test_hil_services");
   Heard h;
   heard = &h;
   return hil_rostest::run_with_rig<MeasuredContactForce>("hil/contact_force", measure);

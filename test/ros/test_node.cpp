@@ -369,14 +369,4 @@ TEST(Node, DynamicReconfigureChangesTheRealTimeFactorLive) {
   ASSERT_TRUE(reconfigure("max_acceleration", 5.0));
 }
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_catenary_sim_node");
-  ros::NodeHandle nh;
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int rc = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return rc;
-}
+int main(int argc, char** argv) { return ros_test::ros_test_main(argc, argv, "test_catenary_sim_node"); }

@@ -112,10 +112,4 @@ TEST(Node3d, PublishesTheLateralContactPositionAndA3dWireShape) {
   EXPECT_TRUE(dot);
 }
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_node_3d");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  return RUN_ALL_TESTS();
-}
+int main(int argc, char** argv) { return ros_test::ros_test_main(argc, argv, "test_node_3d"); }

@@ -32,16 +32,17 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/child_process.hpp"
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim_test;
 
 namespace {
 
-const std::string kNode = CATENARY_SIM_DEVEL_LIB "/catenary_sim_node";
-const std::string kHilNode = CATENARY_SIM_DEVEL_LIB "/catenary_sim_hil_node";
-const std::string kRig = CATENARY_SIM_DEVEL_LIB "/virtual_rig";
-const std::string kScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
-const std::string kHilScene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_hil.yaml";
+const std::string kNode = test_scenes::program("catenary_sim_node");
+const std::string kHilNode = test_scenes::program("catenary_sim_hil_node");
+const std::string kRig = test_scenes::program("virtual_rig");
+const std::string& kScene = test_scenes::kReference;
+const std::string& kHilScene = test_scenes::kReferenceHil;
 
 bool port_open(int port) {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -364,7 +365,7 @@ TEST_F(NodeParamsFuzz, ReportFileIsWrittenAtTheEndOfThePass) {
 // and stats.json its "lateral" object (the contact point across the strip, blow-off per span).
 TEST_F(NodeParamsFuzz, ReportFileOfA3dLineHasTheLateralFiles) {
   const std::string out = dir_ + "/report3d";
-  const ChildRun r = report_pass(CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml", out, "reporting3d");
+  const ChildRun r = report_pass(test_scenes::kReference3d, out, "reporting3d");
   ASSERT_FALSE(r.hung) << r.out;
   EXPECT_EQ(r.signal, 0);
   ASSERT_EQ(r.exit_code, 0) << r.out;

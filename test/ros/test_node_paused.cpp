@@ -102,14 +102,4 @@ TEST(NodePaused, StatsFileHasTheLinesStatistics) {
   EXPECT_EQ(j["dropper_stations_m"].size(), 90u);
 }
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_catenary_sim_node_paused");
-  ros::NodeHandle nh;
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int rc = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return rc;
-}
+int main(int argc, char** argv) { return ros_test::ros_test_main(argc, argv, "test_catenary_sim_node_paused"); }

@@ -9,13 +9,14 @@
 #include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/ros/replay.hpp"
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim;
 using namespace catenary_sim::ros_layer;
 
 namespace {
 
-std::string scene_path(const char* name) { return std::string(CATENARY_SIM_SOURCE_DIR) + "/config/" + name; }
+using test_scenes::scene_path;
 
 // Marker coordinates are rebuilt as (design + u) - design, which rounds u by a few ulp of the
 // height (~5 m: 1e-15 m) before the vertical scale (10): 1e-9 m is far above that rounding and far

@@ -29,6 +29,7 @@
 #include "catenary_sim/WireShapeArray.h"
 #include "../support/child_process.hpp"
 #include "ros_test_support.hpp"
+#include "../support/scenes.hpp"
 
 namespace {
 
@@ -48,10 +49,10 @@ std::string sh(const std::string& cmd) { return "bash -c '" + cmd + "'"; }
 
 TEST(Replay, RecordedPassIsDrawnAndPlotted) {
   const std::string dir = catenary_sim_test::temp_dir("catenary_sim_replay_");
-  const std::string scene = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+  const std::string scene = test_scenes::kReference;
   const std::string bag = dir + "/pass.bag", png = dir + "/plot.png", csv = dir + "/uplift.csv";
   // The whole reference pass (550 m, 6.6 s at 300 km/h): state topics at 200 Hz, wire_shape at 10 Hz.
-  ASSERT_EQ(std::system((std::string(CATENARY_SIM_DEVEL_LIB) + "/simulate_pass --scene " + scene + " --quiet --out " +
+  ASSERT_EQ(std::system((test_scenes::program("simulate_pass") + " --scene " + scene + " --quiet --out " +
                          dir + "/offline --bag " + bag + " > " + dir + "/simulate_pass.log 2>&1").c_str()),
             0)
       << "see " << dir << "/simulate_pass.log";
@@ -90,7 +91,7 @@ TEST(Replay, RecordedPassIsDrawnAndPlotted) {
   ros::Publisher status = nh.advertise<std_msgs::String>("pass_status", 1, true);
   ros::Subscriber sub = nh.subscribe("markers", 1000, &on_markers);
   // plot_contact_force, headless, on the same playback (started here: the PNG goes to this test's directory).
-  ASSERT_EQ(std::system(sh(std::string(CATENARY_SIM_DEVEL_LIB) + "/plot_contact_force _output_png:=" + png + " _output_csv:=" + csv +
+  ASSERT_EQ(std::system(sh(test_scenes::program("plot_contact_force") + " _output_png:=" + png + " _output_csv:=" + csv +
                            " _headless:=true > " + dir + "/plot.log 2>&1 & echo $! > " + dir + "/plot.pid")
                             .c_str()),
             0);
@@ -173,11 +174,4 @@ TEST(Replay, RecordedPassIsDrawnAndPlotted) {
   if (!HasFailure()) (void)!std::system(("rm -rf " + dir).c_str());  // kept for a look when it failed
 }
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_replay_node");
-  ros::NodeHandle nh;
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  return RUN_ALL_TESTS();
-}
+int main(int argc, char** argv) { return ros_test::ros_test_main(argc, argv, "test_replay_node", 1); }

@@ -24,15 +24,6 @@
 #include <thread>
 #include <vector>
 
-// Where the programs under test are built and where the source tree is: the build defines both
-// for the tests that include this header.
-#ifndef CATENARY_SIM_SOURCE_DIR
-#define CATENARY_SIM_SOURCE_DIR "."
-#endif
-#ifndef CATENARY_SIM_DEVEL_LIB
-#define CATENARY_SIM_DEVEL_LIB "."
-#endif
-
 extern char** environ;
 
 namespace catenary_sim_test {

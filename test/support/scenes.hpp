@@ -1,6 +1,10 @@
-// Scenes the tests build from the shipped configs. Header-only.
+// Where the tests (and bench/) find the source tree, the shipped scenes and the programs under
+// test, and the scenes several tests build from them. One place, so that a test needs no path
+// or scene of its own. Header-only.
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -9,30 +13,90 @@
 
 #include "catenary_sim/core/scene/scene.hpp"
 
-// The source tree: the build defines it for the tests.
+// The source tree and the devel space's programs: the build defines both for the tests.
 #ifndef CATENARY_SIM_SOURCE_DIR
 #define CATENARY_SIM_SOURCE_DIR "."
+#endif
+#ifndef CATENARY_SIM_DEVEL_LIB
+#define CATENARY_SIM_DEVEL_LIB "."
 #endif
 
 namespace test_scenes {
 
-// The shipped scenes.
+// Built from literals alone (no other namespace-scope string), so a test's own globals can use
+// them whatever the order of initialisation.
+inline const std::string kSourceDir = CATENARY_SIM_SOURCE_DIR;
 inline const std::string kConfigDir = CATENARY_SIM_SOURCE_DIR "/config/";
+inline const std::string kDevelLib = CATENARY_SIM_DEVEL_LIB;
+
+// The shipped scenes.
+inline const std::string kReference = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
+inline const std::string kReference3d = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml";
+inline const std::string kReferenceEndless = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_endless.yaml";
+inline const std::string kReferenceHil = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_hil.yaml";
+inline const std::string kReferenceTwoHeads = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_heads.yaml";
+inline const std::string kReferenceTwoPantographs =
+    CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_pantographs.yaml";
+inline const std::string kCalpeExample = CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml";
+
+// A shipped scene by its file name (config/<file>).
+inline std::string scene_path(const std::string& file) { return kConfigDir + file; }
+
+// A program of the devel space by name (simulate_pass, catenary_sim_node, ...).
+inline std::string program(const std::string& name) { return kDevelLib + "/" + name; }
+
+// A shipped scene (config/<file>) as YAML, changed by `edit`, then loaded with `overrides`: for
+// what --set cannot say (a key removed, a section added, a pantograph's type changed).
+inline catenary_sim::Scene edited_scene(const std::string& file, const std::function<void(YAML::Node&)>& edit,
+                                        const std::vector<std::string>& overrides = {}) {
+  YAML::Node root = YAML::LoadFile(scene_path(file));
+  edit(root);
+  std::stringstream s;
+  s << root;
+  return catenary_sim::load_scene_string(s.str(), overrides);
+}
+
+// The reference catenary as one section of `span_count` 55 m spans with `contact_wires` contact
+// wires on the same stations (two: packed as two lanes and one with the messenger).
+inline catenary_sim::Scene reference_with_contact_wires(int contact_wires, int span_count,
+                                                        const std::function<void(YAML::Node&)>& edit,
+                                                        const std::vector<std::string>& overrides = {}) {
+  return edited_scene(
+      "reference_55m.yaml",
+      [&](YAML::Node& root) {
+        root["line"].remove("span_length");
+        root["line"].remove("span_count");
+        YAML::Node sec;
+        sec["span_length"] = 55.0;
+        sec["span_count"] = span_count;
+        sec["contact_wire_count"] = contact_wires;
+        root["sections"].push_back(sec);
+        edit(root);
+      },
+      overrides);
+}
 
 // The reference catenary as one 6-span section with a twin contact wire: three wires on the same
 // stations, packed as two lanes and one.
 inline catenary_sim::Scene twin_contact_wire(const std::vector<std::string>& overrides) {
-  YAML::Node root = YAML::LoadFile(kConfigDir + "reference_55m.yaml");
-  root["line"].remove("span_length");
-  root["line"].remove("span_count");
-  YAML::Node sec;
-  sec["span_length"] = 55.0;
-  sec["span_count"] = 6;
-  sec["contact_wire_count"] = 2;
-  root["sections"].push_back(sec);
-  std::stringstream s;
-  s << root;
-  return catenary_sim::load_scene_string(s.str(), overrides);
+  return reference_with_contact_wires(2, 6, [](YAML::Node&) {}, overrides);
+}
+
+// A 20 m/s wind with 15 % turbulence (von Karman length 50 m, Davenport decay 10, up to 5 Hz)
+// on points `spacing` m apart: gusts strong enough to move the wires, a field small enough to
+// draw fast.
+inline catenary_sim::WindSpec gusty_wind(std::uint64_t seed, double spacing = 5.0) {
+  catenary_sim::WindSpec w;
+  w.speed = 20.0;
+  catenary_sim::TurbulenceSpec t;
+  t.intensity = 0.15;
+  t.length_scale = 50.0;
+  t.coherence_decay = 10.0;
+  t.max_frequency = 5.0;
+  t.spacing = spacing;
+  t.seed = seed;
+  w.turbulence = t;
+  return w;
 }
 
 }  // namespace test_scenes

@@ -19,15 +19,16 @@
 #include <vector>
 
 #include "../support/child_process.hpp"
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim_test;
 
 namespace {
 
-const std::string kReference = CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml";
-const std::string kSimulatePass = CATENARY_SIM_DEVEL_LIB "/simulate_pass";
-const std::string kElasticity = CATENARY_SIM_DEVEL_LIB "/elasticity_curve";
-const std::string kFrf = CATENARY_SIM_DEVEL_LIB "/pantograph_frf";
+using test_scenes::kReference;
+const std::string kSimulatePass = test_scenes::program("simulate_pass");
+const std::string kElasticity = test_scenes::program("elasticity_curve");
+const std::string kFrf = test_scenes::program("pantograph_frf");
 
 // Runs argv to its end (at most `limit` s) with its output in dir/output.txt.
 ChildRun run(const std::vector<std::string>& args, const std::string& dir, double limit = 10.0) {
@@ -238,7 +239,7 @@ TEST(FuzzBadInput, CorruptedSceneFiles) {
     ++count;
   }
   // Files that are not scene files.
-  expect_rejected(kSimulatePass, {"a directory", {"--scene", CATENARY_SIM_SOURCE_DIR "/config", "--out", "@OUT"}, {"directory"}}, dir, &count);
+  expect_rejected(kSimulatePass, {"a directory", {"--scene", test_scenes::kSourceDir + "/config", "--out", "@OUT"}, {"directory"}}, dir, &count);
   expect_rejected(kSimulatePass, {"/dev/zero", {"--scene", "/dev/zero", "--out", "@OUT"}, {"/dev/zero", "MiB"}}, dir, &count);
   expect_rejected(kSimulatePass, {"missing file", {"--scene", dir + "/none.yaml", "--out", "@OUT"}, {"none.yaml"}}, dir, &count);
   RecordProperty("cases", count);
@@ -295,8 +296,8 @@ TEST(FuzzBadInput, OutputTargetsThatAreNotRegularFiles) {
 // each refused cleanly, naming the field (or what is refused), by every tool that reads a scene.
 TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
   const std::string dir = temp_dir("catenary_sim_fuzz_");
-  const std::string r3 = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_3d.yaml";
-  const std::string heads = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_heads.yaml";
+  const std::string r3 = test_scenes::kReference3d;
+  const std::string heads = test_scenes::kReferenceTwoHeads;
   int count = 0;
   struct SetCase {
     std::string scene, set;
@@ -376,7 +377,7 @@ TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
       {"alias bomb", with_name(bomb), {"aliases expand"}},
       {"second document", text + "---\ntrain: {speed_kmh: 100}\n", {"second YAML document"}},
   };
-  const std::string client = CATENARY_SIM_DEVEL_LIB "/udp_rig_client", hil = CATENARY_SIM_DEVEL_LIB "/catenary_sim_hil_udp";
+  const std::string client = test_scenes::program("udp_rig_client"), hil = test_scenes::program("catenary_sim_hil_udp");
   for (const FileCase& f : files) {
     const std::string path = dir + "/scene.yaml";
     std::ofstream(path) << f.body;

@@ -12,12 +12,13 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/child_process.hpp"
+#include "../support/scenes.hpp"
 
 using namespace catenary_sim_test;
 
 namespace {
 
-const std::string kSimulatePass = CATENARY_SIM_DEVEL_LIB "/simulate_pass";
+const std::string kSimulatePass = test_scenes::program("simulate_pass");
 
 class PassReport : public ::testing::Test {
  protected:
@@ -33,7 +34,7 @@ class PassReport : public ::testing::Test {
 // The limits are set so that some pass and one fails: 1 mm of uplift is far below any pass's.
 TEST_F(PassReport, ShortPassBuildsEverySection) {
   const std::string out = dir_ + "/out";
-  const ChildRun r = run_child({kSimulatePass, "--scene", CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", "--out", out,
+  const ChildRun r = run_child({kSimulatePass, "--scene", test_scenes::kReference, "--out", out,
                           "--speed", "250", "--set", "line.span_count=6", "--set", "numerics.element_length=0.5",
                           "--set", "output.allowed_uplift=0.001", "--set", "output.max_stat_force=400", "--set",
                           "output.min_stat_force=0", "--set", "output.max_contact_loss_percent=0", "--set",
@@ -83,7 +84,7 @@ TEST_F(PassReport, ShortPassBuildsEverySection) {
 // The 3-D line's section: its files written and drawn, the page one picture longer.
 TEST_F(PassReport, ThreeDimensionalLineAddsTheLateralSection) {
   const std::string out = dir_ + "/out";
-  const ChildRun r = run_child({kSimulatePass, "--scene", CATENARY_SIM_SOURCE_DIR "/config/reference_55m.yaml", "--out", out,
+  const ChildRun r = run_child({kSimulatePass, "--scene", test_scenes::kReference, "--out", out,
                           "--speed", "250", "--set", "line.span_count=6", "--set", "numerics.element_length=0.5",
                           "--set", "stagger.contact_wire=[0.3,-0.3]", "--report", "--no-progress"},
                          dir_ + "/log.txt", 300.0);
@@ -102,7 +103,7 @@ TEST_F(PassReport, ThreeDimensionalLineAddsTheLateralSection) {
 }
 
 TEST_F(PassReport, ReportOfAnEmptyDirectoryFailsNamingTheFile) {
-  const ChildRun r = run_child({"/usr/bin/python3", CATENARY_SIM_SOURCE_DIR "/scripts/pass_report", dir_},
+  const ChildRun r = run_child({"/usr/bin/python3", test_scenes::kSourceDir + "/scripts/pass_report", dir_},
                          dir_ + "/log.txt", 60.0);
   ASSERT_FALSE(r.hung);
   EXPECT_EQ(r.exit_code, 2) << r.out;
