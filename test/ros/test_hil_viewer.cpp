@@ -72,8 +72,7 @@ TEST(HilViewer, WaitsForTheViewerThenRunsWithTheStripChart) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_hil_viewer");
+  ros_test::init(argc, argv, "test_hil_viewer");
   Heard h;
   heard = &h;
   return hil_rostest::run_with_rig<MeasuredContactForce>("hil/contact_force", measure);

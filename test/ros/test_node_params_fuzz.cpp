@@ -265,7 +265,7 @@ TEST_F(NodeParamsFuzz, IssueCasesSayValueAndWhatIsAllowed) {
 // replay_markers says a bad value as it was written and its range in the same words as the
 // other nodes (not "20000.000000 rejected: allowed [0.000000, ...]").
 TEST_F(NodeParamsFuzz, ReplayMarkersSaysValueAndRangeAsWritten) {
-  const ChildRun r = run(CATENARY_SIM_DEVEL_LIB "/replay_markers", {"_vertical_scale:=20000"});
+  const ChildRun r = run(test_scenes::program("replay_markers"), {"_vertical_scale:=20000"});
   SCOPED_TRACE("output: " + r.out);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.out.find("~vertical_scale = 20000 rejected: allowed [1e-09, 10000]"), std::string::npos);
