@@ -36,117 +36,149 @@ int centred_meeting_node(int nodes) { return (nodes - 1) / 2; }
 
 namespace {
 
-// One wire's factors, kCdValues per node in line order (the packs take them in the twisted order);
-// its fixed vertical DOFs appended to `fixed_dofs`. D = shift M.
-std::vector<double> wire_factors(const Model& m, const Wire& w, double shift, std::vector<int>& fixed_dofs) {
-  std::vector<double> factors;
-  const int n = w.nodes(), k = centred_meeting_node(n);
-  factors.assign(static_cast<std::size_t>(n) * kCdValues, 0.0);
-  auto fixed = [&](int i) { return m.inv_mass[w.w_dof + i] == 0.0; };
-  auto at = [&](int i) { return factors.data() + static_cast<std::size_t>(i) * kCdValues; };
+// One wire's twisted factorisation of D + K, kCdValues per node in line order: the elimination
+// from node 0 down to the meeting node k, from node n - 1 up to it, then the meeting node.
+class TwistedFactors {
+ public:
+  TwistedFactors(const Model& m, const Wire& w, double shift) : m_(m), w_(w), shift_(shift) {
+    factors_.assign(static_cast<std::size_t>(w.nodes()) * kCdValues, 0.0);
+  }
+
+  void eliminate_from_first(int k) {
+    for (int i = 0; i < k; ++i) {
+      if (i > 0) {
+        lower(i - 1, cpl_);
+        upper(i - 1, back_);
+      }
+      Mat2 nx;
+      upper(i, nx);
+      side(i, i == 0, cpl_, back_, nx);
+    }
+    std::copy(a_prev_, a_prev_ + 4, top_a_);
+    std::copy(s_prev_, s_prev_ + 4, top_s_);
+  }
+
+  void eliminate_from_last(int n, int k) {
+    for (int i = n - 1; i > k; --i) {
+      if (i < n - 1) {
+        upper(i, cpl_);
+        lower(i, back_);
+      }
+      Mat2 nx;
+      lower(i - 1, nx);
+      side(i, i == n - 1, cpl_, back_, nx);
+    }
+  }
+
+  // The meeting node: Z = A_k - G_k U_{k-1} - H_k L_k (G_k = L_{k-1} S_{k-1}, H_k = U_k T_{k+1});
+  // zeta_k = Z^-1 r_k - (Z^-1 G_k S~_{k-1}) c_{k-1} - (Z^-1 H_k T~_{k+1}) c'_{k+1}: in its G, P
+  // and S places.
+  void meet(int n, int k) {
+    double* c = at(k);
+    diag(k, a_);
+    Mat2 g{}, h{}, zi{};
+    if (k > 0) {
+      lower(k - 1, cpl_);
+      mul(cpl_, top_s_, g);
+      upper(k - 1, back_);
+      sub_mul(a_, g, back_);
+    }
+    if (k + 1 < n) {
+      upper(k, cpl_);
+      mul(cpl_, s_prev_, h);
+      lower(k, back_);
+      sub_mul(a_, h, back_);
+    }
+    invert(a_, zi);
+    if (k > 0) {
+      mul(zi, g, tmp_);
+      mul(tmp_, top_a_, c + kCdG);
+    }
+    if (k + 1 < n) {
+      mul(zi, h, tmp_);
+      mul(tmp_, a_prev_, c + kCdP);
+    }
+    c[kCdS] = zi[0];
+    c[kCdS + 1] = zi[2];
+  }
+
+  // The coefficient of u + ratio v in r per node; the fixed vertical DOFs appended to `fixed_dofs`.
+  std::vector<double> finish(int n, std::vector<int>& fixed_dofs) {
+    for (int i = 0; i < n; ++i) {
+      const bool fx = fixed(i);
+      if (fx) fixed_dofs.push_back(w_.w_dof + i);
+      at(i)[kCdU] = fx ? 1.0 : shift_ * m_.mass[w_.w_dof + i];
+    }
+    return std::move(factors_);
+  }
+
+ private:
+  bool fixed(int i) const { return m_.inv_mass[w_.w_dof + i] == 0.0; }
+  double* at(int i) { return factors_.data() + static_cast<std::size_t>(i) * kCdValues; }
   // Blocks of D + K: A_i on node i (a fixed node's vertical row the identity), U_i from node i to
   // i + 1 and L_i from node i + 1 to i (the vertical row of a fixed node zero in both).
-  auto diag = [&](int i, double* a) {
+  void diag(int i, double* a) const {
     const bool fx = fixed(i);
-    a[0] = fx ? 1.0 : shift * m.mass[w.w_dof + i] + w.d_ww[i];
-    a[1] = fx ? 0.0 : w.d_wt[i];
-    a[2] = w.d_wt[i];
-    a[3] = w.d_tt[i];
-  };
-  auto upper = [&](int i, double* u) {  // rows i, cols i + 1
+    a[0] = fx ? 1.0 : shift_ * m_.mass[w_.w_dof + i] + w_.d_ww[i];
+    a[1] = fx ? 0.0 : w_.d_wt[i];
+    a[2] = w_.d_wt[i];
+    a[3] = w_.d_tt[i];
+  }
+  void upper(int i, double* u) const {  // rows i, cols i + 1
     const bool fx = fixed(i);
-    u[0] = fx ? 0.0 : w.e_ww[i];
-    u[1] = fx ? 0.0 : w.e_wt[i];
-    u[2] = w.e_tw[i];
-    u[3] = w.e_tt[i];
-  };
-  auto lower = [&](int i, double* l) {  // rows i + 1, cols i
+    u[0] = fx ? 0.0 : w_.e_ww[i];
+    u[1] = fx ? 0.0 : w_.e_wt[i];
+    u[2] = w_.e_tw[i];
+    u[3] = w_.e_tt[i];
+  }
+  void lower(int i, double* l) const {  // rows i + 1, cols i
     const bool fx = fixed(i + 1);
-    l[0] = fx ? 0.0 : w.e_ww[i];
-    l[1] = fx ? 0.0 : w.e_tw[i];
-    l[2] = w.e_wt[i];
-    l[3] = w.e_tt[i];
-  };
+    l[0] = fx ? 0.0 : w_.e_ww[i];
+    l[1] = fx ? 0.0 : w_.e_tw[i];
+    l[2] = w_.e_wt[i];
+    l[3] = w_.e_tt[i];
+  }
   // One side's elimination toward k: pivot a_i = A_i - M_i B (M_i = C S_prev, the coupling C
   // into node i from its predecessor and B back), S_i = a_i^-1; in the node's places the
   // recurrence on c_i = S_i y_i: c_i = s_i r_i - (S_i M_i a_prev) c_prev (s_i: S_i's first
   // column, r's rotation entry being 0), and P_i = S_i N_i toward the next node (N_i its coupling).
-  Mat2 a{}, a_prev{}, s_prev{}, mm{}, tmp{}, cpl{}, back{};
-  auto side = [&](int i, bool first, const double* into, const double* out_back, const double* next) {
+  void side(int i, bool first, const double* into, const double* out_back, const double* next) {
     double* c = at(i);
-    diag(i, a);
+    diag(i, a_);
     if (!first) {
-      mul(into, s_prev, mm);  // M_i
-      sub_mul(a, mm, out_back);
+      mul(into, s_prev_, mm_);  // M_i
+      sub_mul(a_, mm_, out_back);
     }
     Mat2 si;
-    invert(a, si);
+    invert(a_, si);
     if (!first) {
-      mul(si, mm, tmp);
-      mul(tmp, a_prev, c + kCdG);
+      mul(si, mm_, tmp_);
+      mul(tmp_, a_prev_, c + kCdG);
     }
     c[kCdS] = si[0];
     c[kCdS + 1] = si[2];
     mul(si, next, c + kCdP);
-    std::copy(a, a + 4, a_prev);
-    std::copy(si, si + 4, s_prev);
-  };
-  for (int i = 0; i < k; ++i) {
-    if (i > 0) {
-      lower(i - 1, cpl);
-      upper(i - 1, back);
-    }
-    Mat2 nx;
-    upper(i, nx);
-    side(i, i == 0, cpl, back, nx);
+    std::copy(a_, a_ + 4, a_prev_);
+    std::copy(si, si + 4, s_prev_);
   }
-  Mat2 top_a, top_s;  // S~_{k-1} and S_{k-1}
-  std::copy(a_prev, a_prev + 4, top_a);
-  std::copy(s_prev, s_prev + 4, top_s);
-  for (int i = n - 1; i > k; --i) {
-    if (i < n - 1) {
-      upper(i, cpl);
-      lower(i, back);
-    }
-    Mat2 nx;
-    lower(i - 1, nx);
-    side(i, i == n - 1, cpl, back, nx);
-  }
-  // The meeting node: Z = A_k - G_k U_{k-1} - H_k L_k (G_k = L_{k-1} S_{k-1}, H_k = U_k T_{k+1});
-  // zeta_k = Z^-1 r_k - (Z^-1 G_k S~_{k-1}) c_{k-1} - (Z^-1 H_k T~_{k+1}) c'_{k+1}: in its G, P
-  // and S places.
-  double* c = at(k);
-  diag(k, a);
-  Mat2 g{}, h{}, zi{};
-  if (k > 0) {
-    lower(k - 1, cpl);
-    mul(cpl, top_s, g);
-    upper(k - 1, back);
-    sub_mul(a, g, back);
-  }
-  if (k + 1 < n) {
-    upper(k, cpl);
-    mul(cpl, s_prev, h);
-    lower(k, back);
-    sub_mul(a, h, back);
-  }
-  invert(a, zi);
-  if (k > 0) {
-    mul(zi, g, tmp);
-    mul(tmp, top_a, c + kCdG);
-  }
-  if (k + 1 < n) {
-    mul(zi, h, tmp);
-    mul(tmp, a_prev, c + kCdP);
-  }
-  c[kCdS] = zi[0];
-  c[kCdS + 1] = zi[2];
-  for (int i = 0; i < n; ++i) {
-    const bool fx = fixed(i);
-    if (fx) fixed_dofs.push_back(w.w_dof + i);
-    at(i)[kCdU] = fx ? 1.0 : shift * m.mass[w.w_dof + i];
-  }
-  return factors;
+
+  const Model& m_;
+  const Wire& w_;
+  double shift_;
+  std::vector<double> factors_;
+  Mat2 a_{}, a_prev_{}, s_prev_{}, mm_{}, tmp_{}, cpl_{}, back_{};
+  Mat2 top_a_{}, top_s_{};  // S~_{k-1} and S_{k-1}
+};
+
+// One wire's factors, kCdValues per node in line order (the packs take them in the twisted order);
+// its fixed vertical DOFs appended to `fixed_dofs`. D = shift M.
+std::vector<double> wire_factors(const Model& m, const Wire& w, double shift, std::vector<int>& fixed_dofs) {
+  const int n = w.nodes(), k = centred_meeting_node(n);
+  TwistedFactors f(m, w, shift);
+  f.eliminate_from_first(k);
+  f.eliminate_from_last(n, k);
+  f.meet(n, k);
+  return f.finish(n, fixed_dofs);
 }
 
 }  // namespace
