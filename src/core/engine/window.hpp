@@ -9,11 +9,6 @@
 
 namespace catenary_sim {
 
-// The window's lengths (m) ahead and behind at a train speed (m/s), for a contact wire of wave
-// speed c (m/s) and spans of `span` m: the scene's, or the auto rule.
-void window_lengths_for(const NumericsSpec& numerics, double wave_speed, double span, double speed, double* ahead,
-                        double* behind);
-
 // One wire's window over the supports at stations a <= b: its node range, the cut ends' share of
 // the band and the LDL^T factors of its K_theta_theta (the vertical plane's window, and the lateral
 // plane's, which may reach further ahead: lateral.cpp).

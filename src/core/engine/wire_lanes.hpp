@@ -7,14 +7,6 @@
 
 namespace catenary_sim {
 
-// Packs the wires for the fused step (Model::wire_packs) when the model is explicit with condensed
-// rotations; leaves them empty otherwise.
-void build_wire_packs(Model& model);
-
-// The sweep's record per node and lane (State::sweep, kSweepRecord values per node, each for
-// every lane): the rotation, z = u + beta v, the load less the damping, and the band force.
-enum { kRecTheta, kRecZ, kRecInit, kRecForce, kSweepRecord };
-
 // One pack over nodes lo..hi (hi >= lo + 1), the same range in every lane.
 struct PackSweep {
   const WireLanes* pack = nullptr;

@@ -132,10 +132,15 @@ struct WireLanes {
   std::vector<double> coef;
   std::vector<double> factors;  // LDL^T of K_theta_theta: [node][lower, inv_pivot][lane]
   // Centred damping: the factors of the step's block-tridiagonal solve for the lanes' wires in
-  // the twisted order (src/core/engine/centred_damping.hpp): [pair][value][2 lanes], and the meeting and
+  // the twisted order (src/core/model/centred_factors.hpp): [pair][value][2 lanes], and the meeting and
   // extra nodes' [value][lane]. Empty with the half-step damping.
   std::vector<double> centred_twin, centred_single;
 };
+
+// The fused step's record per node and lane (State::sweep, kSweepRecord values per node, each for
+// every lane; the engine's sweep writes them, Model::dof_sweep_force and dof_sweep_z point into
+// them): the rotation, z = u + beta v, the load less the damping, and the band force.
+enum { kRecTheta, kRecZ, kRecInit, kRecForce, kSweepRecord };
 
 struct Model {
   Scene scene;
@@ -193,72 +198,11 @@ struct Model {
   std::shared_ptr<const LateralModel> lateral;
 };
 
-// Builds the model, solves the design statics (dropper lengths for the presag) and the stability
-// limit. Throws SceneError for a scene that cannot be built (e.g. dt above the stability limit).
-Model build_model(const Scene& scene);
-
-struct BuildOptions {
-  bool stability = true;  // false: skip the stability limit (static probes)
-  // Raised supports per section (first, last, first, last, ...), m; empty: from the scene / eq. 6-8.
-  std::optional<std::vector<double>> support_rises;
-};
-Model build_model(const Scene& scene, const BuildOptions& options);
-
-// Memory per wire node (bytes) to build a model and solve its statics: measured as the peak
-// resident size of simulate_pass on the reference scene at 1.1e5-2.2e5 nodes (2026-11-23:
-// 1.2-1.3 kB a node over a 25 MB base), with a margin of 1.5 for other scenes.
-constexpr double kModelBytesPerNode = 2048.0;
-// The model's size estimated from the scene before anything is allocated, and the limit (half the
-// machine's physical memory). check_model_memory throws SceneError with both, naming what to change.
-double estimate_model_bytes(const Scene& scene);
-double estimate_wind_field_bytes(const Scene& scene);  // its turbulent wind field's share (0 without)
-double model_memory_limit_bytes();
-void check_model_memory(const Scene& scene);
-
-// Steps a whole pass takes at the scene's train speed (inf at speed 0): offline tools refuse a
-// pass above their bound unless asked for.
-double pass_step_count(const Model& model);
-
-// Lengths (m) the moving window integrates ahead of the foremost and behind the rearmost
-// pantograph at a train speed (m/s): the scene's, or for `window: auto` the distances the
-// contact wire's waves run from the pantograph in the time they take to fade (window.cpp).
-void window_lengths(const Model& model, double speed_mps, double* ahead, double* behind);
-
-// The statistics section along the line (m): output.analysis_spans, or by default all spans but
-// two at each end of the line (of the pass on an endless line).
-void analysis_section(const Model& model, double* x0, double* x1);
-
-// A warning (empty if none) for a train speed above 0.7 of the contact wire's wave speed.
-std::string speed_warning(const Model& model, double speed_mps);
-
-// Heights d (m) by which each section's contact wire support is raised at its first and last
-// support (0 where the end span is a current span): overlap.support_rise, or eq. 6-8 with
-// h = E F, E measured on the model at the middle of a current span of the section.
-std::vector<double> transition_support_rises(const Scene& scene);
-
-// y = K x for the linear part of the system with every dropper and contact active (the collectors
-// at the train position `front`): used for the stability limit and by tests. x and y have n_dof
-// entries; `scratch` must have room for the condensed rotations (max wire nodes).
-void apply_stiffness(const Model& model, double front, const double* x, double* y, double* scratch);
-
-// Stiffness-only internal force of one wire: f(w) -= K z over the wire's nodes (rotations
-// condensed or taken from z). `theta` is scratch (nodes entries) and returns the rotations used.
-void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta);
-
-// The condensed band's force on nodes lo..hi of a wire (f -= K z), given the LDL^T factors of
-// K_theta_theta over that range and the diagonal shares (ww, wt at lo, then at hi) of elements
-// left out at the ends. Shared by the whole wire and the moving window.
-void condensed_band_force(const Wire& wire, int lo, int hi, const double end_correction[4], const double* lower,
-                          const double* inv_pivot, const double* z, double* f, double* theta);
-
-// Design height (m) of the lowest contact wire under station xc (eq. 12 weights), the wire a
-// rising head meets first; +inf where no contact wire is. `wire` (if given) receives its index
-// into Model::contact_wires.
-double lowest_design_height(const Model& model, double xc, int* wire = nullptr);
-
-// Weights of the contact wire's nodes for a distributed contact centred at xc (eq. 10-13): the
-// collector height is sum w_i y_i (eq. 12) and its force is spread as F w_i. Returns the count,
-// at most model.max_contact_nodes; 0 if xc is off the wire.
-int contact_weights(const Wire& wire, double rub_length, double xc, int* node, double* weight);
-
 }  // namespace catenary_sim
+
+// The functions on the model, each declared beside its definition's file.
+#include "catenary_sim/core/model/build_model.hpp"
+#include "catenary_sim/core/model/contact_geometry.hpp"
+#include "catenary_sim/core/model/model_memory.hpp"
+#include "catenary_sim/core/model/window_lengths.hpp"
+#include "catenary_sim/core/model/wire_band.hpp"

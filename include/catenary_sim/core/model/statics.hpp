@@ -26,6 +26,11 @@ void solve_initial_state(const Model& model, State& state, bool roof_springs = t
 // state, the static uplift is exactly the static contact force (part of building the model).
 void set_pantograph_references(Model& model);
 
+// Heights d (m) by which each section's contact wire support is raised at its first and last
+// support (0 where the end span is a current span): overlap.support_rise, or eq. 6-8 with
+// h = E F, E measured on the model at the middle of a current span of the section.
+std::vector<double> transition_support_rises(const Scene& scene);
+
 // Static elasticity of the line: a stiff probe collector pressed up with `force` at a station
 // (eq. 23, droppers tension-only). Used for eq. 6 (h = E F) and for elasticity curves.
 class ElasticityProbe {

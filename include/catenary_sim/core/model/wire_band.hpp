@@ -1,0 +1,30 @@
+// The wires' banded stiffness (eq. 3) and its products (wire_band.cpp).
+#pragma once
+
+#include <vector>
+
+namespace catenary_sim {
+
+struct Model;
+struct Wire;
+
+// Assembles the wire's K band and the LDL^T factors of its K_theta_theta. ei_factor: per element,
+// a multiplier of EI (a worn contact wire); empty = the wire's EI.
+void assemble_band(Wire& w, const std::vector<double>& ei_factor);
+
+// y = K x for the linear part of the system with every dropper and contact active (the collectors
+// at the train position `front`): used for the stability limit and by tests. x and y have n_dof
+// entries; `scratch` must have room for the condensed rotations (max wire nodes).
+void apply_stiffness(const Model& model, double front, const double* x, double* y, double* scratch);
+
+// Stiffness-only internal force of one wire: f(w) -= K z over the wire's nodes (rotations
+// condensed or taken from z). `theta` is scratch (nodes entries) and returns the rotations used.
+void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta);
+
+// The condensed band's force on nodes lo..hi of a wire (f -= K z), given the LDL^T factors of
+// K_theta_theta over that range and the diagonal shares (ww, wt at lo, then at hi) of elements
+// left out at the ends. Shared by the whole wire and the moving window.
+void condensed_band_force(const Wire& wire, int lo, int hi, const double end_correction[4], const double* lower,
+                          const double* inv_pivot, const double* z, double* f, double* theta);
+
+}  // namespace catenary_sim

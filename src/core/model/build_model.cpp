@@ -1,0 +1,504 @@
+// Building the model from a scene, element by element of the line: the meshed wires and the DOF
+// layout, the pantographs, the lumped masses and supports, the droppers, the design statics, the
+// constant load, the train's travel and the time step.
+#include "catenary_sim/core/model/build_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "catenary_sim/core/model/beam.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/model/newmark_matrix.hpp"
+#include "catenary_sim/core/model/stability.hpp"
+#include "catenary_sim/core/model/statics.hpp"
+#include "model/centred_factors.hpp"
+#include "model/design_statics.hpp"
+#include "model/endless_block.hpp"
+#include "model/imperfections.hpp"
+#include "model/wire_packs.hpp"
+#include "util/format.hpp"
+
+namespace catenary_sim {
+namespace {
+
+// Node stations of one tension section: every support and dropper is a node; the segments
+// between them are split into equal elements no longer than the requested length.
+std::vector<double> mesh_section(const SectionSpec& sec, double element_length, std::vector<double>& support_x) {
+  std::vector<double> breaks;
+  double x0 = sec.start;
+  support_x.assign(1, x0);
+  for (std::size_t i = 0; i < sec.spans.size(); ++i) {
+    breaks.push_back(x0);
+    if (sec.droppers)
+      for (double p : sec.droppers->positions[i]) breaks.push_back(x0 + p);
+    x0 += sec.spans[i];
+    support_x.push_back(x0);
+  }
+  breaks.push_back(x0);
+  std::vector<double> x;
+  for (std::size_t i = 0; i + 1 < breaks.size(); ++i) {
+    const double len = breaks[i + 1] - breaks[i];
+    const int n = std::max(1, static_cast<int>(std::ceil(len / element_length - 1e-9)));
+    for (int k = 0; k < n; ++k) x.push_back(breaks[i] + len * k / n);
+  }
+  x.push_back(x0);
+  return x;
+}
+
+int node_at(const std::vector<double>& x, double xs) {
+  const auto it = std::lower_bound(x.begin(), x.end(), xs - 1e-9);
+  return static_cast<int>(it - x.begin());
+}
+
+int line_support_index(const Model& m, double xs) {
+  return static_cast<int>(std::lower_bound(m.support_x.begin(), m.support_x.end(), xs - 1e-9) - m.support_x.begin());
+}
+
+// A Scene filled in code with the one-section fields only.
+void add_single_section(Scene& scene) {
+  SectionSpec sec;
+  sec.spans = scene.spans;
+  sec.contact_wire = scene.contact_wire;
+  sec.messenger = scene.messenger;
+  sec.droppers = scene.droppers;
+  sec.steady_arms = scene.steady_arms;
+  sec.messenger_supports = scene.messenger_supports;
+  if (sec.droppers && sec.droppers->positions.size() == 1 && sec.spans.size() > 1)
+    sec.droppers->positions.assign(sec.spans.size(), sec.droppers->positions.front());
+  scene.sections.push_back(sec);
+}
+
+// Raised contact-wire supports at the transition spans (eq. 6-8): given, measured, or none yet.
+void support_rises(const Scene& scene, const BuildOptions& options, std::vector<double>& rise_first,
+                   std::vector<double>& rise_last) {
+  rise_first.assign(scene.sections.size(), 0.0);
+  rise_last.assign(scene.sections.size(), 0.0);
+  if (options.support_rises) {
+    for (std::size_t i = 0; i < scene.sections.size(); ++i) {
+      rise_first[i] = (*options.support_rises)[2 * i];
+      rise_last[i] = (*options.support_rises)[2 * i + 1];
+    }
+  } else {
+    const std::vector<double> r = transition_support_rises(scene);
+    for (std::size_t i = 0; i < scene.sections.size(); ++i) {
+      rise_first[i] = r[2 * i];
+      rise_last[i] = r[2 * i + 1];
+    }
+  }
+}
+
+  // DOF layout: per wire the vertical displacements, then (lumped rotary inertia only) the
+  // rotations; section by section (contact wire(s), then messenger); the pantograph masses last.
+void mesh_wires(const Scene& scene, const std::vector<double>& rise_first, const std::vector<double>& rise_last,
+                Model& m, int& dof, std::vector<std::vector<double>>& section_supports) {
+  const bool lumped_rot = scene.numerics.rotary_inertia == RotaryInertia::kLumped;
+  for (std::size_t si = 0; si < scene.sections.size(); ++si) {
+    const SectionSpec& sec = scene.sections[si];
+    const std::vector<double> x = mesh_section(sec, scene.numerics.element_length, section_supports[si]);
+    Section info;
+    info.start = sec.start;
+    info.end = sec.end();
+    info.rise_first = rise_first[si];
+    info.rise_last = rise_last[si];
+    const std::string suffix = scene.sections.size() > 1 ? "_s" + std::to_string(si) : "";
+    auto add_wire = [&](const std::string& name, const WireSpec& spec, bool contact) {
+      Wire w;
+      w.name = name;
+      w.section = static_cast<int>(si);
+      w.is_contact_wire = contact;
+      w.spec = spec;
+      w.x = x;
+      w.w_dof = dof;
+      dof += static_cast<int>(x.size());
+      if (lumped_rot) {
+        w.theta_dof = dof;
+        dof += static_cast<int>(x.size());
+      }
+      for (double sx : section_supports[si]) w.support_nodes.push_back(node_at(x, sx));
+      assemble_band(w, {});
+      if (contact) m.contact_wires.push_back(static_cast<int>(m.wires.size()));
+      else info.messenger = static_cast<int>(m.wires.size());
+      info.wires.push_back(static_cast<int>(m.wires.size()));
+      m.wires.push_back(std::move(w));
+    };
+    for (int c = 0; c < sec.contact_wire_count; ++c)
+      add_wire("contact_wire" + suffix + (sec.contact_wire_count > 1 ? std::string(1, static_cast<char>('a' + c)) : ""),
+               sec.contact_wire, true);
+    if (sec.messenger) add_wire("messenger" + suffix, *sec.messenger, false);
+    m.sections.push_back(info);
+  }
+}
+
+// Pantographs: the chain's masses, then each head's, after the catenary's DOFs; their collectors.
+void add_pantographs(const Scene& scene, Model& m, int& dof) {
+  for (std::size_t i = 0; i < scene.pantographs.size(); ++i) {
+    const PantographSpec& ps = scene.pantographs[i];
+    Pantograph p;
+    p.name = ps.name;
+    p.position = ps.position;
+    p.moving_force = ps.moving_force || ps.external;
+    p.external = ps.external;
+    p.masses = ps.masses;
+    p.stiffness = ps.stiffness;
+    p.damping = ps.damping;
+    p.static_uplift = ps.static_uplift;
+    p.aero_coefficient = ps.frame_aero();
+    if (!p.moving_force) {
+      p.first_dof = dof;
+      dof += p.masses_count();
+    }
+    for (const CollectorSpec& c : ps.collectors) {
+      p.collectors.push_back(static_cast<int>(m.collectors.size()));
+      m.collectors.push_back(Collector{static_cast<int>(i), c.offset, -1, p.moving_force ? -1 : p.first_dof});
+      m.collectors.back().half_working_width = 0.5 * c.working_width.value_or(scene.pantograph_head.working_width);
+    }
+    // Heads: one DOF each after the chain, on a suspension to the chain's first (top) mass.
+    for (std::size_t h = 0; h < ps.heads.size(); ++h) {
+      const HeadSpec& hs = ps.heads[h];
+      Head head;
+      head.dof = dof++;
+      head.mass = hs.mass;
+      head.stiffness = hs.stiffness;
+      head.damping = hs.damping;
+      head.aero_coefficient = PantographSpec::head_aero(hs, ps.knee_trailing);
+      for (const CollectorSpec& c : hs.collectors) {
+        head.collectors.push_back(static_cast<int>(m.collectors.size()));
+        p.collectors.push_back(static_cast<int>(m.collectors.size()));
+        m.collectors.push_back(Collector{static_cast<int>(i), hs.offset + c.offset, static_cast<int>(h), head.dof});
+        m.collectors.back().half_working_width = 0.5 * c.working_width.value_or(scene.pantograph_head.working_width);
+      }
+      p.heads.push_back(std::move(head));
+    }
+    m.pantographs.push_back(std::move(p));
+  }
+}
+
+// Returns which DOFs are held rigidly.
+std::vector<bool> lump_masses(const Scene& scene, Model& m) {
+  const int dof = m.n_dof;
+  const bool lumped_rot = scene.numerics.rotary_inertia == RotaryInertia::kLumped;
+  // Lumped masses (HRZ for the beams) and which DOFs are held rigidly: the anchors at both ends
+  // of each section, and intermediate supports without a spring.
+  m.mass = Eigen::VectorXd::Zero(dof);
+  std::vector<bool> fixed(dof, false);
+  for (Wire& w : m.wires) {
+    const SectionSpec& sec = scene.sections[w.section];
+    const int n = w.nodes();
+    for (int e = 0; e + 1 < n; ++e) {
+      const double he = w.x[e + 1] - w.x[e];
+      m.mass[w.w_dof + e] += beam_translational_mass(he, w.spec.linear_mass);
+      m.mass[w.w_dof + e + 1] += beam_translational_mass(he, w.spec.linear_mass);
+      if (lumped_rot) {
+        m.mass[w.theta_dof + e] += beam_rotary_mass(he, w.spec.linear_mass);
+        m.mass[w.theta_dof + e + 1] += beam_rotary_mass(he, w.spec.linear_mass);
+      }
+    }
+    const bool contact = w.is_contact_wire;
+    const std::optional<SupportSpec>& spring = contact ? sec.steady_arms : sec.messenger_supports;
+    const int ns = static_cast<int>(w.support_nodes.size());
+    for (int k = 0; k < ns; ++k) {
+      const int node = w.support_nodes[k];
+      const bool end = k == 0 || k == ns - 1;  // anchors of the tension section
+      if (end || !spring) {
+        fixed[w.w_dof + node] = true;
+      } else {
+        m.mass[w.w_dof + node] += spring->mass;
+        SupportSpring sp{w.w_dof + node, spring->stiffness, 0.0, w.x[node], line_support_index(m, w.x[node]), contact};
+        sp.section_support = k;
+        m.springs.push_back(sp);
+      }
+    }
+  }
+  return fixed;
+}
+
+void hang_droppers(const Scene& scene, const std::vector<std::vector<double>>& section_supports, Model& m) {
+  // Droppers: one per contact wire at each dropper station (a twin contact wire hangs both wires
+  // from the same dropper), with clamp masses; lengths and tensions come from the design statics.
+  for (std::size_t si = 0; si < scene.sections.size(); ++si) {
+    const SectionSpec& sec = scene.sections[si];
+    if (!sec.droppers) continue;
+    const Section& info = m.sections[si];
+    const Wire& mwire = m.wires[info.messenger];
+    const DropperSpec& ds = *sec.droppers;
+    for (std::size_t i = 0; i < sec.spans.size(); ++i)
+      for (double p : ds.positions[i]) {
+        const double xd = section_supports[si][i] + p;
+        const int node = node_at(mwire.x, xd);
+        m.mass[mwire.w_dof + node] += ds.clamp_mass_messenger;
+        for (int wi : info.wires) {
+          if (wi == info.messenger) continue;
+          Dropper d;
+          d.x = xd;
+          d.section = static_cast<int>(si);
+          d.span = static_cast<int>(i);
+          d.contact_dof = m.wires[wi].w_dof + node;
+          d.messenger_dof = mwire.w_dof + node;
+          m.mass[d.contact_dof] += ds.clamp_mass_contact;
+          m.droppers.push_back(d);
+        }
+      }
+  }
+}
+
+void set_constant_load(const Scene& scene, Model& m, const std::vector<bool>& fixed) {
+  const int dof = m.n_dof;
+  const double g = scene.gravity;
+  // Constant load: gravity + support preloads - K y_design. At u = 0 it balances the static
+  // dropper tensions exactly (that is what the design statics solved for).
+  m.load = Eigen::VectorXd::Zero(dof);
+  for (const Wire& w : m.wires)
+    for (int i = 0; i < w.nodes(); ++i) m.load[w.w_dof + i] -= g * m.mass[w.w_dof + i];
+  for (const SupportSpring& sp : m.springs) m.load[sp.dof] += sp.static_force;
+  for (const Wire& w : m.wires) {
+    const int n = w.nodes();
+    std::vector<double> scratch(n);
+    Wire full = w;  // with explicit rotations so that K acts on the design slopes too
+    Eigen::VectorXd yfull = Eigen::VectorXd::Zero(2 * n), ffull = Eigen::VectorXd::Zero(2 * n);
+    full.w_dof = 0;
+    full.theta_dof = n;
+    for (int i = 0; i < n; ++i) {
+      yfull[i] = w.height[i];
+      yfull[n + i] = w.slope[i];
+    }
+    wire_elastic_force(full, yfull.data(), ffull.data(), scratch.data());
+    for (int i = 0; i < n; ++i) m.load[w.w_dof + i] += ffull[i];
+  }
+  for (int i = 0; i < dof; ++i)
+    if (fixed[i]) m.load[i] = 0.0;
+}
+
+void set_pantograph_masses(Model& m) {
+  // Pantographs: unit-less references are set by the initial statics in the Simulation.
+  int max_nodes = 2;
+  double hmin = 1e9;
+  for (const Wire& w : m.wires)
+    for (int e = 0; e + 1 < w.nodes(); ++e) hmin = std::min(hmin, w.x[e + 1] - w.x[e]);
+  if (m.rub_length > 0.0) max_nodes = static_cast<int>(std::ceil(m.rub_length / hmin)) + 3;
+  m.max_contact_nodes = max_nodes;
+  for (Pantograph& p : m.pantographs)
+    if (!p.moving_force) {  // a moving force set in code may keep masses it does not use (no DOFs)
+      for (int i = 0; i < p.masses_count(); ++i) m.mass[p.first_dof + i] = p.masses[i];
+      for (const Head& h : p.heads) m.mass[h.dof] = h.mass;
+    }
+}
+
+void set_inverse_mass(Model& m, const std::vector<bool>& fixed) {
+  const int dof = m.n_dof;
+  m.inv_mass = Eigen::VectorXd::Zero(dof);
+  for (int i = 0; i < dof; ++i) {
+    if (fixed[i]) continue;
+    if (!(m.mass[i] > 0.0))
+      throw SceneError("model: DOF " + std::to_string(i) + " has no mass; check linear_mass and masses");
+    m.inv_mass[i] = 1.0 / m.mass[i];
+  }
+}
+
+// The wave speed and its warning, the longest span, and the droppers and supports in line order.
+void set_line_order(const Scene& scene, Model& m) {
+  m.wave_speed = 1e300;
+  for (int wi : m.contact_wires)
+    m.wave_speed = std::min(m.wave_speed, std::sqrt(m.wires[wi].spec.tension / m.wires[wi].spec.linear_mass));
+  if (const std::string w = speed_warning(m, scene.train_speed); !w.empty()) m.warnings.push_back(w);
+  for (std::size_t i = 1; i < m.support_x.size(); ++i)
+    m.longest_span = std::max(m.longest_span, m.support_x[i] - m.support_x[i - 1]);
+  // Droppers and supports in line order, for the moving window to find its own by bisection.
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) m.dropper_order.push_back(static_cast<int>(k));
+  std::stable_sort(m.dropper_order.begin(), m.dropper_order.end(),
+                   [&](int a, int b) { return m.droppers[a].x < m.droppers[b].x; });
+  for (int k : m.dropper_order) m.dropper_order_x.push_back(m.droppers[k].x);
+  for (std::size_t k = 0; k < m.springs.size(); ++k) m.spring_order.push_back(static_cast<int>(k));
+  std::stable_sort(m.spring_order.begin(), m.spring_order.end(), [&](int a, int b) { return m.springs[a].x < m.springs[b].x; });
+  for (int k : m.spring_order) m.spring_order_x.push_back(m.springs[k].x);
+}
+
+void set_train_travel(const Scene& scene, double endless_front, Model& m) {
+  // Train travel: by default from the rearmost collector at the line start to the foremost at
+  // the line end.
+  double lead = 0.0, rear = 0.0;
+  collector_extent(scene, &lead, &rear);
+  m.train_start = scene.train_start ? *scene.train_start : -rear;
+  m.train_end = scene.train_end ? *scene.train_end : m.line_length - lead;
+  if (m.endless) {
+    check_endless_block(m);
+    if (m.train_end < endless_front)
+      throw SceneError("train.end: " + fmt(m.train_end) + " m is behind the start of the pass (train front at " +
+                       fmt(endless_front + 0.0) + " m)");
+  } else {
+    // Every collector starts and ends on the line: the statics (eq. 23) need each pantograph
+    // pressed against a wire or held by its own springs at a design height under the wire.
+    const double lo = 0.0 - rear, hi = m.line_length - lead;
+    if (lo > hi + 1e-9)
+      throw SceneError("pantographs: the collectors span " + fmt(lead - rear) + " m from the foremost to the rearmost, more than the line (" +
+                       fmt(m.line_length) + " m); allowed: pantograph positions within the line length");
+    if (scene.train_start && (m.train_start < lo - 1e-9 || m.train_start > hi + 1e-9))
+      throw SceneError("scene field 'train.start' = " + fmt(m.train_start) + ": allowed [" + fmt(lo) + ", " + fmt(hi) +
+                       "] m (the train front where every collector is on the line, 0-" + fmt(m.line_length) + " m)");
+    if (scene.train_end && m.train_end > hi + 1e-9)
+      throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": allowed at most " + fmt(hi) +
+                       " m (the foremost collector, " + fmt(lead) + " m ahead of the front, stays on the line)");
+    if (m.train_end < m.train_start)
+      throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": allowed >= train.start (" + fmt(m.train_start) + " m)");
+    // Every pantograph passes through some of the analysis section, or its statistics are empty.
+    double x0 = 0.0, x1 = 0.0;
+      x0 = m.support_x[scene.analysis_first()];
+    x1 = m.support_x[scene.analysis_last()];
+    for (const PantographSpec& p : scene.pantographs) {
+      if (m.train_end - p.position < x0)
+        throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": pantograph '" + p.name +
+                         "' would stop before the analysis section " + fmt(x0) + "-" + fmt(x1) +
+                         " m (output.analysis_spans); allowed >= " + fmt(x0 + p.position) + " m");
+      if (m.train_start - p.position > x1)
+        throw SceneError("scene field 'train.start' = " + fmt(m.train_start) + ": pantograph '" + p.name +
+                         "' would start after the analysis section " + fmt(x0) + "-" + fmt(x1) +
+                         " m (output.analysis_spans); allowed <= " + fmt(x1 + p.position) + " m");
+    }
+  }
+}
+
+// The explicit stability limit (validation.md section 5) and the step, or the implicit matrix.
+void choose_time_step(const Scene& scene, Model& m) {
+  if (scene.numerics.windowed() &&
+      (scene.numerics.integrator != Integrator::kExplicit || scene.numerics.rotary_inertia != RotaryInertia::kCondensed))
+    throw SceneError("numerics.window: needs numerics.integrator explicit with rotary_inertia condensed (the window "
+                     "integrates node ranges of the condensed band)");
+  if (scene.numerics.damping == DampingStep::kCentred) {
+    // The centred step solves each whole wire's band with the rotations condensed, for u + beta v.
+    std::string why;
+    if (scene.numerics.integrator != Integrator::kExplicit) why = "numerics.integrator explicit";
+    else if (scene.numerics.rotary_inertia != RotaryInertia::kCondensed) why = "numerics.rotary_inertia condensed";
+    else if (scene.numerics.windowed()) why = "no numerics.window (nor an endless line): it solves whole wires";
+    else if (scene.lateral()) why = "a 2-D line (no stagger, curve or wind): the lateral plane steps with half_step";
+    else if (!(m.beta > 0.0)) why = "damping.beta > 0 (it solves for u + beta v; with beta 0 half_step has the same limit)";
+    if (!why.empty()) throw SceneError("numerics.damping = 'centred': needs " + why + "; allowed otherwise: half_step");
+  }
+  if (scene.numerics.integrator == Integrator::kImplicit) {
+    // Newmark average acceleration is unconditionally stable for the linear part, and nothing is
+    // taken explicitly: slack droppers and contacts are rank-1 corrections of the factorised
+    // matrix. dt is a matter of accuracy only (auto: 1 ms, bench/speed_accuracy).
+    m.omega_max = 0.0;
+    m.dt_critical = std::numeric_limits<double>::infinity();
+    m.dt = scene.numerics.dt ? *scene.numerics.dt : 1e-3;
+    m.implicit = newmark_matrix(m, m.dt);
+    return;
+  }
+  compute_stability_limit(m);
+  if (scene.numerics.dt) {
+    if (*scene.numerics.dt > m.dt_critical)
+      throw SceneError("numerics.dt = " + fmt(*scene.numerics.dt) + " s: above the explicit stability limit " +
+                       fmt(m.dt_critical) + " s of this model (omega_max " + fmt(m.omega_max) +
+                       " rad/s); use dt <= " + fmt(m.dt_critical) + " or dt: auto");
+    m.dt = *scene.numerics.dt;
+  } else {
+    m.dt = scene.numerics.safety_factor * m.dt_critical;
+  }
+}
+
+Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) {
+  Scene scene = scene_in;
+  if (scene.sections.empty()) add_single_section(scene);
+  validate(scene);  // as given (an endless line's block and stations are made below)
+  Model m;
+  double endless_front = 0.0;  // train front at the start, station along the endless line
+  if (scene.endless) endless_front = lay_endless_block(scene, m);
+  check_model_memory(scene);
+  m.scene = scene;
+  m.line_length = scene.line_length();
+  m.alpha = scene.rayleigh_alpha;
+  m.beta = scene.rayleigh_beta;
+  m.contact_stiffness = scene.contact.stiffness;
+  m.rub_length = scene.contact.rub_length;
+  m.support_x.assign(1, scene.sections.front().start);
+  for (double l : scene.spans) m.support_x.push_back(m.support_x.back() + l);
+  std::vector<double> rise_first, rise_last;
+  support_rises(scene, options, rise_first, rise_last);
+  int dof = 0;
+  std::vector<std::vector<double>> section_supports(scene.sections.size());
+  mesh_wires(scene, rise_first, rise_last, m, dof, section_supports);
+  m.n_catenary_dof = dof;
+  add_pantographs(scene, m, dof);
+  m.n_dof = dof;
+  const std::vector<bool> fixed = lump_masses(scene, m);
+  hang_droppers(scene, section_supports, m);
+  design_statics(scene, section_supports, m);
+  apply_wear(scene, m);
+  set_constant_load(scene, m, fixed);
+  apply_imperfections(scene, m, fixed);
+  set_pantograph_masses(m);
+  set_inverse_mass(m, fixed);
+  set_line_order(scene, m);
+  set_train_travel(scene, endless_front, m);
+  // Initial pantograph references (eq. 23) and the stability limit (validation.md section 5).
+  set_pantograph_references(m);
+  if (!options.stability) {
+    m.dt = m.dt_critical = scene.numerics.dt ? *scene.numerics.dt : 1e-4;
+    return m;
+  }
+  choose_time_step(scene, m);
+  return m;
+}
+
+}  // namespace
+
+Model build_model(const Scene& scene, const BuildOptions& options) {
+  Model m = build_model_unchecked(scene, options);
+  build_wire_packs(m);
+  if (!options.stability) return m;
+  if (scene.numerics.damping == DampingStep::kCentred) {
+    if (m.wire_packs.empty())  // (condensed rotations on every wire node give packs)
+      throw SceneError("numerics.damping = 'centred': needs the wires' rotations condensed; allowed otherwise: half_step");
+    if (scene.numerics.dt && *scene.numerics.dt > kCentredMaxSafetyFactor * m.dt_critical)
+      throw SceneError("numerics.dt = " + fmt(*scene.numerics.dt) + " s: with numerics.damping centred at most " +
+                       fmt(kCentredMaxSafetyFactor) + " of the stability estimate " + fmt(m.dt_critical) + " s, dt <= " +
+                       fmt(kCentredMaxSafetyFactor * m.dt_critical) + " (the estimate is not a bound for that step; see numerics.safety_factor)");
+    factor_centred_damping(m);
+  }
+  // The statistics filter runs at the step rate: a cutoff at or above its Nyquist frequency would
+  // be no filter at all (lowpass_zero_phase returns the input unchanged).
+  const double nyquist = 0.5 / m.dt;
+  if (!(scene.output.filter_cutoff < nyquist))
+    throw SceneError("scene field 'output.filter_cutoff' = " + fmt(scene.output.filter_cutoff) + ": allowed below " +
+                     fmt(nyquist) + " Hz, the Nyquist frequency of the time step (dt " + fmt(m.dt) + " s)");
+  if (scene.lateral()) m.lateral = build_lateral(m);  // the 3-D line; nothing built for a 2-D scene
+  return m;
+}
+
+Model build_model(const Scene& scene) { return build_model(scene, BuildOptions{}); }
+
+void analysis_section(const Model& m, double* x0, double* x1) {
+  const OutputSpec& o = m.scene.output;
+  if (!m.endless) {
+    *x0 = m.support_x[m.scene.analysis_first()];
+    *x1 = m.support_x[m.scene.analysis_last()];
+    return;
+  }
+  const double span = m.endless_span;
+  if (o.analysis_first_span && o.analysis_last_span) {
+    *x0 = *o.analysis_first_span * span;
+    *x1 = *o.analysis_last_span * span;
+    return;
+  }
+  // The pass's spans but two at each end, as on a finite line.
+  const double start = m.train_start + m.initial_line_offset + m.rear_collector_offset;
+  *x0 = (std::ceil(start / span - 1e-9) + 2) * span;
+  *x1 = (std::floor(m.train_end / span + 1e-9) - 2) * span;
+  if (*x1 <= *x0) {
+    *x0 = start;
+    *x1 = m.train_end;
+  }
+}
+
+std::string speed_warning(const Model& m, double speed) {
+  if (!(speed > 0.7 * m.wave_speed)) return "";
+  std::ostringstream s;
+  s.precision(3);
+  s << "train speed " << speed * 3.6 << " km/h is " << speed / m.wave_speed << " of the contact wire's wave speed c = "
+    << m.wave_speed * 3.6 << " km/h: above 0.7 c is outside design practice (the wave ahead of the pantograph steepens "
+    << "and contact is lost as the speed nears c)";
+  return s.str();
+}
+
+}  // namespace catenary_sim

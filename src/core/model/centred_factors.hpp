@@ -1,0 +1,24 @@
+// The factors of the explicit step with centred Rayleigh damping (engine/centred_damping.hpp):
+// (D + K) zeta = R_n + D u_n + (2 M / dt) v_{n-1/2}, D = M (2 / (beta dt) + alpha / beta), one
+// block-tridiagonal solve per wire over its (w, theta) node pairs, factorised once with the model.
+#pragma once
+
+#include "catenary_sim/core/model/model.hpp"
+
+namespace catenary_sim {
+
+// Per node and lane of the solve (WireLanes::centred_*, in the twisted order),
+// eliminated from both ends toward the meeting node k = centred_meeting_node(n) (a twisted
+// factorisation: two independent recurrences per wire), as a recurrence on c_i = S_i y_i (S_i the
+// inverse pivot block): c_i = s_i r_i - G_i c_prev, with s_i the first column of S_i (the rotation
+// entry of r is 0) and G (2x2, row-major); then zeta_i = c_i - P_i zeta_next. Below k the same
+// from the other end; at k: zeta_k = s r_k - G c_{k-1} - P c'_{k+1}. Then the coefficient a of
+// u + ratio v in r (D_i, or 1 on a fixed node, whose row is zeta = u). The load is not here: the
+// state's force vector holds it on the wires between steps, and the point forces on top.
+enum { kCdG, kCdS = 4, kCdP = 6, kCdU = 10, kCdValues };
+int centred_meeting_node(int nodes);
+
+// Fills the packs' WireLanes::centred_* (every wire is in a pack) for m.dt; needs beta > 0.
+void factor_centred_damping(Model& m);
+
+}  // namespace catenary_sim

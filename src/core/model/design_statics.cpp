@@ -1,0 +1,143 @@
+#include "model/design_statics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "catenary_sim/core/model/statics.hpp"
+#include "util/format.hpp"
+
+namespace catenary_sim {
+
+namespace {
+
+// One section's statics: the contact wire(s) held at the supports and droppers, then the messenger
+// under the dropper tensions, a few fixed-point passes for the droppers' weight.
+void section_statics(const Scene& scene, std::size_t si, const std::vector<std::vector<double>>& section_supports,
+                     Model& m, std::vector<double>& weight_len, std::vector<double>& dropper_len,
+                     std::vector<std::vector<double>>& react) {
+  const double g = scene.gravity;
+  const double H = scene.contact_wire_height;
+  const SectionSpec& sec = scene.sections[si];
+  const Section& info = m.sections[si];
+  const double mu = sec.droppers ? sec.droppers->linear_mass : 0.0;
+  const int nspan = static_cast<int>(sec.spans.size());
+  auto transition = [&](int span) {
+    return (span == 0 && sec.first_span_transition) || (span == nspan - 1 && sec.last_span_transition);
+  };
+  std::vector<std::size_t> mine;
+  for (std::size_t k = 0; k < m.droppers.size(); ++k)
+    if (m.droppers[k].section == static_cast<int>(si)) mine.push_back(k);
+  const int passes = mine.empty() ? 1 : 4;
+  for (int pass = 0; pass < passes; ++pass) {
+    for (int wi : info.wires) {
+      if (wi == info.messenger) continue;
+      Wire& w = m.wires[wi];
+      const int n = w.nodes();
+      std::vector<double> load(n);
+      for (int i = 0; i < n; ++i) load[i] = -g * m.mass[w.w_dof + i];
+      std::vector<int> pn;
+      std::vector<double> ph;
+      const int ns = static_cast<int>(w.support_nodes.size());
+      for (int k = 0; k < ns; ++k) {
+        pn.push_back(w.support_nodes[k]);
+        ph.push_back(H + (k == 0 ? info.rise_first : 0.0) + (k == ns - 1 ? info.rise_last : 0.0));
+      }
+      for (std::size_t k : mine) {
+        const Dropper& d = m.droppers[k];
+        if (d.contact_dof < w.w_dof || d.contact_dof >= w.w_dof + n) continue;
+        const int node = d.contact_dof - w.w_dof;
+        load[node] -= 0.5 * g * mu * weight_len[k];
+        const double s = (d.x - section_supports[si][d.span]) / sec.spans[d.span];
+        pn.push_back(node);
+        ph.push_back(transition(d.span) ? H : H - sec.contact_wire.presag * 4.0 * s * (1.0 - s));
+      }
+      solve_wire_statics(w, load, pn, ph, w.height, w.slope, react[wi]);
+      // Dropper tensions: the reactions at the dropper nodes, in the order they were added.
+      std::size_t r = static_cast<std::size_t>(ns);
+      for (std::size_t k : mine)
+        if (m.droppers[k].contact_dof >= w.w_dof && m.droppers[k].contact_dof < w.w_dof + n)
+          m.droppers[k].static_tension = react[wi][r++];
+    }
+    if (info.messenger < 0) break;
+    Wire& mwm = m.wires[info.messenger];
+    const int n = mwm.nodes();
+    std::vector<double> mload(n);
+    for (int i = 0; i < n; ++i) mload[i] = -g * m.mass[mwm.w_dof + i];
+    for (std::size_t k : mine) {
+      const Dropper& d = m.droppers[k];
+      mload[d.messenger_dof - mwm.w_dof] -= d.static_tension + 0.5 * g * mu * weight_len[k];
+    }
+    std::vector<int> mpn(mwm.support_nodes.begin(), mwm.support_nodes.end());
+    std::vector<double> mph(mpn.size(), H + scene.encumbrance);
+    solve_wire_statics(mwm, mload, mpn, mph, mwm.height, mwm.slope, react[info.messenger]);
+    for (std::size_t k : mine) {
+      const Dropper& d = m.droppers[k];
+      const Wire& cwire = *std::find_if(m.wires.begin(), m.wires.end(), [&](const Wire& w) {
+        return d.contact_dof >= w.w_dof && d.contact_dof < w.w_dof + w.nodes();
+      });
+      dropper_len[k] = mwm.height[d.messenger_dof - mwm.w_dof] - cwire.height[d.contact_dof - cwire.w_dof];
+    }
+    if (pass + 1 < passes)
+      for (std::size_t k : mine) weight_len[k] = dropper_len[k];
+  }
+}
+
+// The droppers' design lengths, unstretched lengths, stiffness and masses; a dropper that would
+// have to push is refused.
+void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_len,
+                         const std::vector<double>& dropper_len, Model& m) {
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+    Dropper& d = m.droppers[k];
+    const SectionSpec& sec = scene.sections[d.section];
+    d.length = dropper_len[k];
+    if (d.length <= 0.01)
+      throw SceneError("droppers: at x = " + fmt(d.x) + " m the messenger hangs " + fmt(-d.length) +
+                       " m below the contact wire (dropper length " + fmt(d.length) +
+                       " m): raise line.encumbrance or the messenger tension, or reduce the presag");
+    const int nspan = static_cast<int>(sec.spans.size());
+    const bool in_transition = (d.span == 0 && sec.first_span_transition) || (d.span == nspan - 1 && sec.last_span_transition);
+    if (d.static_tension <= 0.0 && in_transition)
+      throw SceneError("droppers: at x = " + fmt(d.x) + " m, in a transition span, the dropper would have to push (static force " +
+                       fmt(d.static_tension) + " N): the raised support (rise d = " +
+                       fmt(std::max(m.sections[d.section].rise_first, m.sections[d.section].rise_last)) +
+                       " m) pulls the wire up past it; lower overlap.support_rise (or overlap.design_force) or hang "
+                       "droppers.transition_positions nearer the section's own support");
+    if (d.static_tension <= 0.0)
+      throw SceneError("droppers: at x = " + fmt(d.x) + " m the dropper would have to push (static force " +
+                       fmt(d.static_tension) + " N): contact_wire.presag " + fmt(sec.contact_wire.presag) +
+                       " m is not reachable with tension-only droppers; reduce it");
+    d.unstretched_length = d.length / (1.0 + d.static_tension / sec.droppers->axial_stiffness);
+    d.stiffness = sec.droppers->axial_stiffness / d.unstretched_length;
+    // Half the dropper's mass on each end (the length its weight had in the statics, so that the
+    // design state is an exact equilibrium).
+    m.mass[d.contact_dof] += 0.5 * sec.droppers->linear_mass * weight_len[k];
+    m.mass[d.messenger_dof] += 0.5 * sec.droppers->linear_mass * weight_len[k];
+  }
+}
+
+}  // namespace
+
+void design_statics(const Scene& scene, const std::vector<std::vector<double>>& section_supports, Model& m) {
+  // Design statics, section by section. Each contact wire is held at its supports (raised by d at
+  // the outer support of a transition span) and, at every dropper, at the presag height of a
+  // current span or at the working height in a transition span (where the free wire then rises
+  // from its last dropper to the raised support, Fig. 2); the reactions there are the dropper
+  // tensions. The messenger carries those tensions and the dropper weight to its supports. The
+  // dropper weight depends on its length, which depends on the messenger sag: a few fixed-point
+  // passes settle it.
+  std::vector<double> weight_len(m.droppers.size(), scene.encumbrance);  // lengths the weights use
+  std::vector<double> dropper_len = weight_len;                          // geometric lengths
+  std::vector<std::vector<double>> react(m.wires.size());
+  for (std::size_t si = 0; si < scene.sections.size(); ++si)
+    section_statics(scene, si, section_supports, m, weight_len, dropper_len, react);
+  set_dropper_lengths(scene, weight_len, dropper_len, m);
+  // Support preloads f0 of eq. 4: the static reactions at the elastic supports.
+  for (SupportSpring& sp : m.springs) {
+    const auto it = std::find_if(m.wires.begin(), m.wires.end(),
+                                 [&](const Wire& w) { return sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes(); });
+    sp.static_force = react[it - m.wires.begin()][sp.section_support];
+  }
+}
+
+}  // namespace catenary_sim

@@ -1,0 +1,174 @@
+// The wires' banded stiffness (eq. 3): assembled once per wire as 2x2 blocks per node and element,
+// and its products, with the massless rotations condensed exactly (an LDL^T of the tridiagonal
+// K_theta_theta) or taken as DOFs (lumped rotary inertia).
+#include "catenary_sim/core/model/wire_band.hpp"
+
+#include <algorithm>
+#include <vector>
+
+#include "catenary_sim/core/model/beam.hpp"
+#include "catenary_sim/core/model/model.hpp"
+
+namespace catenary_sim {
+
+// ei_factor: per element, a multiplier of EI (a worn contact wire); empty = the wire's EI.
+void assemble_band(Wire& w, const std::vector<double>& ei_factor) {
+  const int n = w.nodes();
+  w.d_ww.assign(n, 0.0);
+  w.d_wt.assign(n, 0.0);
+  w.d_tt.assign(n, 0.0);
+  w.e_ww.assign(n - 1, 0.0);
+  w.e_wt.assign(n - 1, 0.0);
+  w.e_tw.assign(n - 1, 0.0);
+  w.e_tt.assign(n - 1, 0.0);
+  for (int e = 0; e + 1 < n; ++e) {
+    const double ei = w.spec.bending_stiffness * (ei_factor.empty() ? 1.0 : ei_factor[e]);
+    const Matrix4 k = beam_stiffness(w.x[e + 1] - w.x[e], ei, w.spec.tension);
+    w.d_ww[e] += k[0][0];
+    w.d_wt[e] += k[0][1];
+    w.d_tt[e] += k[1][1];
+    w.d_ww[e + 1] += k[2][2];
+    w.d_wt[e + 1] += k[2][3];
+    w.d_tt[e + 1] += k[3][3];
+    w.e_ww[e] = k[0][2];
+    w.e_wt[e] = k[0][3];
+    w.e_tw[e] = k[1][2];
+    w.e_tt[e] = k[1][3];
+  }
+  // LDL^T of the tridiagonal K_theta_theta, for condensing massless rotations.
+  w.tt_inv_pivot.assign(n, 0.0);
+  w.tt_lower.assign(n, 0.0);
+  double d = w.d_tt[0];
+  w.tt_inv_pivot[0] = 1.0 / d;
+  for (int i = 1; i < n; ++i) {
+    const double l = w.e_tt[i - 1] / d;
+    d = w.d_tt[i] - l * w.e_tt[i - 1];
+    w.tt_lower[i] = l;
+    w.tt_inv_pivot[i] = 1.0 / d;
+  }
+}
+
+int Wire::element_at(double xs) const {
+  const int n = nodes();
+  const auto it = std::upper_bound(x.begin(), x.end(), xs);
+  const int e = static_cast<int>(it - x.begin()) - 1;
+  return std::clamp(e, 0, n - 2);
+}
+
+namespace {
+
+// The vertical-displacement rows of the band product, f_w -= K_ww w + K_wt theta, over nodes
+// lo..hi, less the diagonal shares of elements left out at the ends (ww, wt at lo, then at hi).
+void band_w_rows(const Wire& wire, int lo, int hi, const double end_correction[4], const double* w,
+                 const double* theta, double* fw) {
+  const double* dww = wire.d_ww.data();
+  const double* dwt = wire.d_wt.data();
+  const double* eww = wire.e_ww.data();
+  const double* ewt = wire.e_wt.data();
+  const double* etw = wire.e_tw.data();
+  auto dww_at = [&](int i) { return dww[i] - (i == lo ? end_correction[0] : 0.0) - (i == hi ? end_correction[2] : 0.0); };
+  auto dwt_at = [&](int i) { return dwt[i] - (i == lo ? end_correction[1] : 0.0) - (i == hi ? end_correction[3] : 0.0); };
+  fw[lo] -= dww_at(lo) * w[lo] + dwt_at(lo) * theta[lo];
+  for (int i = lo + 1; i <= hi; ++i) {
+    const int e = i - 1;
+    fw[i] -= dww_at(i) * w[i] + dwt_at(i) * theta[i] + eww[e] * w[e] + etw[e] * theta[e];
+    fw[e] -= eww[e] * w[i] + ewt[e] * theta[i];
+  }
+}
+
+}  // namespace
+
+void condensed_band_force(const Wire& wire, int lo, int hi, const double end_correction[4], const double* lower,
+                          const double* inv_pivot, const double* z, double* f, double* theta) {
+  const double* w = z + wire.w_dof;
+  double* fw = f + wire.w_dof;
+  const double* dwt = wire.d_wt.data();
+  const double* ewt = wire.e_wt.data();
+  const double* etw = wire.e_tw.data();
+  // Diagonal blocks less the share of elements left out at the ends (a window's cut).
+  auto dwt_at = [&](int i) { return dwt[i] - (i == lo ? end_correction[1] : 0.0) - (i == hi ? end_correction[3] : 0.0); };
+  // Massless rotations, condensed exactly: K_tt theta = -K_tw w (tridiagonal, LDL^T given).
+  double prev = 0.0;
+  for (int i = lo; i <= hi; ++i) {
+    double r = -dwt_at(i) * w[i];
+    if (i < hi) r -= etw[i] * w[i + 1];
+    if (i > lo) r -= ewt[i - 1] * w[i - 1];
+    prev = r - (i > lo ? lower[i] * prev : 0.0);
+    theta[i] = prev;
+  }
+  theta[hi] *= inv_pivot[hi];
+  for (int i = hi - 1; i >= lo; --i) theta[i] = theta[i] * inv_pivot[i] - lower[i + 1] * theta[i + 1];
+  band_w_rows(wire, lo, hi, end_correction, w, theta, fw);
+}
+
+void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta) {
+  const int n = wire.nodes();
+  if (wire.theta_dof < 0) {
+    static constexpr double kNone[4] = {0.0, 0.0, 0.0, 0.0};
+    condensed_band_force(wire, 0, n - 1, kNone, wire.tt_lower.data(), wire.tt_inv_pivot.data(), z, f, theta);
+    return;
+  }
+  const double* w = z + wire.w_dof;
+  double* fw = f + wire.w_dof;
+  const double* dwt = wire.d_wt.data();
+  const double* ewt = wire.e_wt.data();
+  const double* etw = wire.e_tw.data();
+  // Rotations as DOFs (HRZ rotary inertia): the full band.
+  const double* t = z + wire.theta_dof;
+  double* ft = f + wire.theta_dof;
+  const double* dtt = wire.d_tt.data();
+  const double* ett = wire.e_tt.data();
+  for (int i = 0; i < n; ++i) ft[i] -= dwt[i] * w[i] + dtt[i] * t[i];
+  for (int e = 0; e + 1 < n; ++e) {
+    ft[e] -= etw[e] * w[e + 1] + ett[e] * t[e + 1];
+    ft[e + 1] -= ewt[e] * w[e] + ett[e] * t[e];
+  }
+  std::copy(t, t + n, theta);
+  static constexpr double kNone[4] = {0.0, 0.0, 0.0, 0.0};
+  band_w_rows(wire, 0, n - 1, kNone, w, t, fw);
+}
+
+void apply_stiffness(const Model& m, double front, const double* x, double* y, double* scratch) {
+  std::fill(y, y + m.n_dof, 0.0);
+  for (const Wire& w : m.wires) wire_elastic_force(w, x, y, scratch);  // y = -K x so far
+  for (const SupportSpring& s : m.springs) y[s.dof] -= s.stiffness * x[s.dof];
+  for (const Dropper& d : m.droppers) {
+    const double t = d.stiffness * (x[d.messenger_dof] - x[d.contact_dof]);
+    y[d.contact_dof] += t;
+    y[d.messenger_dof] -= t;
+  }
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  for (const Pantograph& p : m.pantographs) {
+    if (p.moving_force) continue;
+    for (int i = 0; i < p.masses_count(); ++i) {
+      const int a = p.first_dof + i;
+      const double below = i + 1 < p.masses_count() ? x[a + 1] : 0.0;
+      const double c = p.stiffness[i] * (below - x[a]);
+      y[a] += c;
+      if (i + 1 < p.masses_count()) y[a + 1] -= c;
+    }
+    for (const Head& h : p.heads) {
+      const double c = h.stiffness * (x[p.first_dof] - x[h.dof]);
+      y[h.dof] += c;
+      y[p.first_dof] -= c;
+    }
+    for (int ci : p.collectors) {
+      const int hd = m.collectors[ci].dof;
+      const double xc = front - p.position + m.collectors[ci].offset;
+      for (int wi : m.contact_wires) {
+        const Wire& w = m.wires[wi];
+        const int n = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+        double yw = 0.0;
+        for (int k = 0; k < n; ++k) yw += weight[k] * x[w.w_dof + node[k]];
+        if (n == 0) continue;
+        const double f = m.contact_stiffness * (x[hd] - yw);
+        y[hd] -= f;
+        for (int k = 0; k < n; ++k) y[w.w_dof + node[k]] += f * weight[k];
+      }
+    }
+  }
+  for (int i = 0; i < m.n_dof; ++i) y[i] = -y[i];
+}
+
+}  // namespace catenary_sim

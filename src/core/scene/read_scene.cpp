@@ -1,0 +1,421 @@
+// Reading a scene's YAML tree into a Scene, room by room: the line and its tension sections here,
+// the pantographs, the 3-D line's rooms and the imperfections in the files beside it. Every field
+// is read strictly (scene_reader.hpp): a value out of range or an unknown key is an error naming it.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "scene/read_imperfections.hpp"
+#include "scene/read_lateral_scene.hpp"
+#include "scene/read_pantographs.hpp"
+#include "scene/scene_reader.hpp"
+
+namespace catenary_sim {
+
+using namespace scene_reading;
+namespace {
+
+WireSpec read_wire(Reader& r) {
+  WireSpec w;
+  w.linear_mass = r.number("linear_mass", 0.0, 100.0, std::nullopt, true);
+  w.bending_stiffness = r.number("bending_stiffness", 0.0, 1e6, 0.0);
+  w.tension = r.number("tension", 0.0, 1e6, std::nullopt, true);
+  return w;
+}
+
+SupportSpec read_support(Reader& r) {
+  SupportSpec s;
+  s.stiffness = r.number("stiffness", 0.0, 1e10, std::nullopt, true);
+  s.mass = r.number("mass", 0.0, 1000.0, 0.0);
+  r.finish();
+  return s;
+}
+
+void read_spans(Reader& r, const std::string& path, std::vector<double>& spans) {
+  if (r.has("spans")) {
+    if (r.has("span_length") || r.has("span_count"))
+      fail(path + ".spans", "(given with span_length/span_count)", "give either spans or span_length and span_count");
+    spans = r.numbers("spans", 0.5, 500.0);
+  } else {
+    const double len = r.number("span_length", 0.5, 500.0);
+    const double count = r.number("span_count", 1.0, 10000.0);
+    if (count != std::floor(count)) fail(path + ".span_count", fmt(count), "a whole number >= 1");
+    spans.assign(static_cast<std::size_t>(count), len);
+  }
+  if (spans.empty()) fail(path + ".spans", "[]", "at least one span");
+}
+
+// The wire, dropper and support parts of a section (or the scene's defaults when defaults is null).
+void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, const SectionSpec* defaults) {
+  const std::string pre = path.empty() ? "" : path + ".";
+  if (r.has("contact_wire")) {
+    Reader w(r.child("contact_wire"), pre + "contact_wire");
+    static_cast<WireSpec&>(sec.contact_wire) = read_wire(w);
+    sec.contact_wire.presag = w.number("presag", -1.0, 1.0, 0.0);
+    w.finish();
+  } else if (!defaults) {
+    fail("contact_wire", "(missing)", "required section");
+  }
+  if (r.has("messenger")) {
+    Reader w(r.child("messenger"), pre + "messenger");
+    sec.messenger = read_wire(w);
+    w.finish();
+  }
+  if (r.has("droppers")) {
+    Reader d(r.child("droppers"), pre + "droppers");
+    DropperSpec ds;
+    const std::string f = pre + "droppers";
+    if (d.has("positions") == d.has("positions_per_span"))
+      fail(f + ".positions", "(both or neither given)", "give positions (same in every span) or positions_per_span");
+    if (d.has("positions")) {
+      ds.positions.assign(1, d.numbers("positions", 0.0, 500.0, true));  // expanded per span later
+      if (ds.positions.front().empty())
+        fail(f + ".positions", "[]", "at least one dropper position in m from the span start (or remove the droppers section)");
+    } else {
+      const YAML::Node per = d.child("positions_per_span");
+      if (!per.IsSequence()) fail(f + ".positions_per_span", "(not a list)", "one list of positions per span");
+      for (std::size_t i = 0; i < per.size(); ++i) {
+        std::vector<double> v;
+        const std::string fi = f + ".positions_per_span[" + std::to_string(i) + "]";
+        if (!per[i].IsSequence()) fail(fi, "(not a list)", "a list of positions in m");
+        for (std::size_t j = 0; j < per[i].size(); ++j)
+          v.push_back(Reader::parse_number(per[i][j], fi + "[" + std::to_string(j) + "]", 0.0, 500.0, true));
+        ds.positions.push_back(v);
+      }
+      ds.per_span = true;
+      std::size_t count = 0;
+      for (const auto& v : ds.positions) count += v.size();
+      if (count == 0)
+        fail(f + ".positions_per_span", "(no dropper in any span)", "at least one dropper position (or remove the droppers section)");
+    }
+    if (d.has("transition_positions")) ds.transition_positions = d.numbers("transition_positions", 0.0, 500.0, true);
+    ds.axial_stiffness = d.number("axial_stiffness", 0.0, 1e10, std::nullopt, true);
+    ds.linear_mass = d.number("linear_mass", 0.0, 10.0, 0.0);
+    ds.clamp_mass_contact = d.number("clamp_mass_contact", 0.0, 100.0, 0.0);
+    ds.clamp_mass_messenger = d.number("clamp_mass_messenger", 0.0, 100.0, 0.0);
+    d.finish();
+    sec.droppers = ds;
+  }
+  if (r.has("steady_arms")) {
+    Reader a(r.child("steady_arms"), pre + "steady_arms");
+    sec.steady_arms = read_support(a);
+  }
+  if (r.has("messenger_supports")) {
+    Reader a(r.child("messenger_supports"), pre + "messenger_supports");
+    sec.messenger_supports = read_support(a);
+  }
+}
+
+// Section stations from the overlaps, dropper positions per span, and the line's spans (the union
+// of every section's supports).
+void resolve_line(Scene& s) {
+  const int k = s.overlap ? s.overlap->spans : 0;
+  std::vector<double> supports;
+  for (std::size_t i = 0; i < s.sections.size(); ++i) {
+    SectionSpec& sec = s.sections[i];
+    const std::string path = s.sections.size() > 1 ? "sections[" + std::to_string(i) + "]" : "line";
+    if (i > 0) {
+      const SectionSpec& prev = s.sections[i - 1];
+      if (static_cast<int>(prev.spans.size()) < k || static_cast<int>(sec.spans.size()) < k)
+        fail(path + ".spans", std::to_string(sec.spans.size()) + " spans",
+             "at least overlap.spans (" + std::to_string(k) + ") in every section");
+      for (int j = 0; j < k; ++j) {
+        const double a = prev.spans[prev.spans.size() - k + j], b = sec.spans[j];
+        if (std::fabs(a - b) > 1e-9)
+          fail(path + ".spans[" + std::to_string(j) + "]", fmt(b),
+               "equal to the overlapping span of the previous section (" + fmt(a) + " m)");
+      }
+      double st = prev.start;
+      for (std::size_t j = 0; j + k < prev.spans.size(); ++j) st += prev.spans[j];
+      sec.start = st;
+    }
+    if (sec.droppers) {
+      DropperSpec& d = *sec.droppers;
+      const std::size_t n = sec.spans.size();
+      if (d.per_span) {
+        if (d.positions.size() != n)
+          fail(path + ".droppers.positions_per_span", "(" + std::to_string(d.positions.size()) + " entries)",
+               "one list per span (" + std::to_string(n) + ")");
+      } else {
+        const std::vector<double> common = d.positions.empty() ? std::vector<double>{} : d.positions.front();
+        d.positions.assign(n, common);
+        if (!d.transition_positions.empty()) {
+          if (sec.last_span_transition) d.positions[n - 1] = d.transition_positions;
+          if (sec.first_span_transition) {
+            std::vector<double> mirrored;
+            for (auto it = d.transition_positions.rbegin(); it != d.transition_positions.rend(); ++it)
+              mirrored.push_back(sec.spans[0] - *it);
+            d.positions[0] = mirrored;
+          }
+        }
+      }
+    }
+    double x = sec.start;
+    supports.push_back(x);
+    for (double l : sec.spans) supports.push_back(x += l);
+  }
+  std::sort(supports.begin(), supports.end());
+  s.spans.clear();
+  for (std::size_t i = 1; i < supports.size(); ++i)
+    if (supports[i] - supports[i - 1] > 1e-9) s.spans.push_back(supports[i] - supports[i - 1]);
+  if (!s.sections.empty()) s.droppers = s.sections.front().droppers;
+}
+
+// line: the heights, the spans (or an endless line's one span), and the tension sections.
+void read_line(Reader& top, Scene& s) {
+  Reader r(top.child("line"), "line");
+  if (!top.has("line")) fail("line", "(missing)", "required section with spans (or span_length and span_count)");
+  s.contact_wire_height = r.number("contact_wire_height", 0.0, 100.0, 5.3);
+  s.encumbrance = r.number("encumbrance", 0.0, 10.0, 1.2, true);
+  const bool has_sections = top.has("sections");
+  if (has_sections && (r.has("spans") || r.has("span_length") || r.has("span_count")))
+    fail("line.spans", "(given with sections)", "with sections, every section gives its own spans");
+  SectionSpec defaults;
+  s.endless = r.boolean("endless", false);
+  if (s.endless) {
+    if (has_sections) fail("line.endless", "true", "a single tension section (remove the sections list)");
+    if (r.has("spans") || r.has("span_count"))
+      fail(r.has("spans") ? "line.spans" : "line.span_count", "(given with endless: true)",
+           "an endless line repeats one span: give span_length only");
+    defaults.spans.assign(1, r.number("span_length", 0.5, 500.0));
+  } else if (!has_sections) {
+    read_spans(r, "line", defaults.spans);
+  }
+  read_section_parts(top, "", defaults, nullptr);
+  if (!has_sections) {
+    defaults.contact_wire_count = 1;
+    s.sections.push_back(defaults);
+  } else {
+    const YAML::Node secs = top.child("sections");
+    if (!secs.IsSequence() || secs.size() == 0) fail("sections", "(not a non-empty list)", "a list of tension sections");
+    for (std::size_t i = 0; i < secs.size(); ++i) {
+      const std::string path = "sections[" + std::to_string(i) + "]";
+      Reader sr(secs[i], path);
+      SectionSpec sec = defaults;
+      read_spans(sr, path, sec.spans);
+      read_section_parts(sr, path, sec, &defaults);
+      const double count = sr.number("contact_wire_count", 1.0, 2.0, 1.0);
+      if (count != std::floor(count)) fail(sr.field("contact_wire_count"), fmt(count), "1 or 2 (twin contact wire)");
+      sec.contact_wire_count = static_cast<int>(count);
+      sec.first_span_transition = sr.boolean("first_span_transition", i > 0);
+      sec.last_span_transition = sr.boolean("last_span_transition", i + 1 < secs.size());
+      sr.finish();
+      s.sections.push_back(sec);
+    }
+  }
+  r.finish();
+}
+
+void read_overlap(Reader& top, Scene& s) {
+  if (top.has("overlap")) {
+    Reader r(top.child("overlap"), "overlap");
+    OverlapSpec o;
+    const double k = r.number("spans", 1.0, 10.0, 1.0);
+    if (k != std::floor(k)) fail("overlap.spans", fmt(k), "a whole number of transition spans >= 1");
+    o.spans = static_cast<int>(k);
+    if (r.has("support_rise")) o.support_rise = r.number("support_rise", 0.0, 2.0);
+    if (r.has("design_force")) o.design_force = r.number("design_force", 0.0, 2000.0, std::nullopt, true);
+    r.finish();
+    s.overlap = o;
+  } else if (s.sections.size() > 1) {
+    s.overlap = OverlapSpec{};
+  }
+}
+
+void read_damping(Reader& top, Scene& s) {
+  if (top.has("damping")) {
+    Reader r(top.child("damping"), "damping");
+    s.rayleigh_alpha = r.number("alpha", 0.0, 100.0, 0.0);
+    s.rayleigh_beta = r.number("beta", 0.0, 0.1, 0.0);
+    r.finish();
+  }
+}
+
+void read_contact(Reader& top, Scene& s) {
+  if (top.has("contact")) {
+    Reader r(top.child("contact"), "contact");
+    s.contact.stiffness = r.number("stiffness", 0.0, 1e9, 50000.0, true);
+    s.contact.rub_length = r.number("rub_length", 0.0, 5.0, 0.0);
+    r.finish();
+  }
+}
+
+void read_train(Reader& top, Scene& s) {
+  if (top.has("train")) {
+    Reader r(top.child("train"), "train");
+    if (r.has("speed") && r.has("speed_kmh")) fail("train.speed", "(given with speed_kmh)", "give either speed (m/s) or speed_kmh");
+    // Any finite speed >= 0 here; validate() applies the limit (train_speed_limit).
+    if (r.has("speed_kmh")) s.train_speed = r.number("speed_kmh", 0.0, kInf) / 3.6;
+    else s.train_speed = r.number("speed", 0.0, kInf, 0.0);
+    if (r.has("start")) s.train_start = r.number("start", -kInf, kInf);
+    if (r.has("end")) s.train_end = r.number("end", -kInf, kInf);
+    r.finish();
+  }
+}
+
+// numerics.window: auto, off, or {ahead, behind}.
+void read_window(Reader& r, Scene& s) {
+  if (!r.has("window")) return;
+  const YAML::Node wn = r.child("window");
+  if (wn.IsScalar() && wn.as<std::string>() == "auto") {
+    s.numerics.window_auto = true;  // lengths from speed and wave speed: window_lengths()
+  } else if (wn.IsScalar() && wn.as<std::string>() == "off") {
+  } else {
+    Reader w(wn, "numerics.window");
+    s.numerics.window_ahead = w.number("ahead", 0.0, 1e5, std::nullopt, true);
+    s.numerics.window_behind = w.number("behind", 0.0, 1e5, std::nullopt, true);
+    w.finish();
+  }
+}
+
+// numerics.gust_lead: auto, or seconds of travel.
+void read_gust_lead(Reader& r, Scene& s) {
+  if (!r.has("gust_lead")) return;
+  const YAML::Node n = r.child("gust_lead");
+  const std::string raw = n.IsScalar() ? n.as<std::string>() : "(not a scalar)";
+  if (raw != "auto") {
+    double v = std::nan("");
+    if (n.IsScalar()) {
+      try {
+        v = n.as<double>();
+      } catch (const YAML::Exception&) {
+      }
+    }
+    if (!(v >= 0.0 && v <= kMaxGustLead))
+      fail("numerics.gust_lead", raw, "auto, or seconds of travel in [0, " + fmt(kMaxGustLead) + "]");
+    s.numerics.gust_lead = v;
+  }
+}
+
+// numerics: the fidelity ladder. Returns whether the reference preset's own element length and
+// damping apply (neither given).
+bool read_numerics(Reader& top, Scene& s) {
+  bool reference_defaults = false;
+  if (!top.has("numerics")) return reference_defaults;
+  Reader r(top.child("numerics"), "numerics");
+  // A preset sets the defaults of the fidelity ladder; every field can still be set on its own.
+  const std::string preset = r.text("preset", "");
+  double h = 0.25;
+  // Element lengths measured in bench/speed_accuracy (BENCHMARKS.md): all explicit, because on
+  // these lines the condensed explicit scheme is the fastest at every accuracy level. The
+  // reference rung chosen in bench_reference_rung against h = 0.03125 m: h = 0.0625 m with the
+  // centred damping keeps every statistic within 0.05 % of that finer solution, its dt the
+  // undamped limit (with the half-step damping, the stiffness-proportional damping of the
+  // shortest mesh modes cut it 2.6x; where the centred step does not go, h = 0.1 m below).
+  if (preset == "fast") {
+    h = 1.0;
+  } else if (preset == "balanced") {
+    h = 0.5;
+  } else if (preset == "accurate" || preset.empty()) {
+    h = 0.25;
+  } else if (preset == "reference") {
+    h = 0.0625;
+  } else {
+    fail("numerics.preset", "'" + preset + "'", "one of: fast, balanced, accurate, reference");
+  }
+  s.numerics.preset = preset;
+  reference_defaults = preset == "reference" && !r.has("element_length") && !r.has("damping");
+  s.numerics.element_length = r.number("element_length", 0.01, 10.0, h);
+  if (r.has("dt")) {
+    const YAML::Node n = r.child("dt");
+    if (!(n.IsScalar() && n.as<std::string>() == "auto"))
+      s.numerics.dt = Reader::parse_number(n, "numerics.dt", 0.0, 0.1, true);
+  }
+  s.numerics.safety_factor = r.number("safety_factor", 0.0, 1.0, 0.9, true);
+  const std::string integ = r.text("integrator", "explicit");
+  if (integ == "explicit") s.numerics.integrator = Integrator::kExplicit;
+  else if (integ == "implicit") s.numerics.integrator = Integrator::kImplicit;
+  else fail("numerics.integrator", "'" + integ + "'", "one of: explicit (central differences, eq. 19-21), implicit (Newmark average acceleration)");
+  const std::string rt = r.text("rotary_inertia", s.numerics.integrator == Integrator::kImplicit ? "lumped" : "condensed");
+  if (rt == "condensed") s.numerics.rotary_inertia = RotaryInertia::kCondensed;
+  else if (rt == "lumped") s.numerics.rotary_inertia = RotaryInertia::kLumped;
+  else fail("numerics.rotary_inertia", "'" + rt + "'", "one of: condensed (massless rotations, statically condensed), lumped (HRZ rotary inertia)");
+  if (s.numerics.integrator == Integrator::kImplicit && s.numerics.rotary_inertia == RotaryInertia::kCondensed)
+    fail("numerics.rotary_inertia", "'condensed'", "lumped with the implicit integrator (its matrix holds the rotations as DOFs)");
+  const std::string dmp = r.text("damping", preset == "reference" ? "centred" : "half_step");
+  if (dmp == "half_step") s.numerics.damping = DampingStep::kHalfStep;
+  else if (dmp == "centred") s.numerics.damping = DampingStep::kCentred;
+  else fail("numerics.damping", "'" + dmp + "'", "one of: half_step (C v at v_{n-1/2}, eq. 19-21), centred (C v at (v_{n+1/2} + v_{n-1/2}) / 2)");
+  s.numerics.divergence_limit = r.number("divergence_limit", 0.0, 1000.0, 5.0, true);
+  s.numerics.allow_supercritical = r.boolean("allow_supercritical", false);
+  read_window(r, s);
+  read_gust_lead(r, s);
+  r.finish();
+  return reference_defaults;
+}
+
+void read_output(Reader& top, Scene& s) {
+  if (top.has("output")) {
+    Reader r(top.child("output"), "output");
+    if (r.has("analysis_spans")) {
+      const std::vector<double> a = r.numbers("analysis_spans", 0.0, 1e6);
+      if (a.size() != 2 || a[0] != std::floor(a[0]) || a[1] != std::floor(a[1]))
+        fail("output.analysis_spans", "(" + std::to_string(a.size()) + " values)", "two whole span indices [first, last)");
+      s.output.analysis_first_span = static_cast<int>(a[0]);
+      s.output.analysis_last_span = static_cast<int>(a[1]);
+    }
+    s.output.filter_cutoff = r.number("filter_cutoff", 0.0, 10000.0, 20.0, true);
+    s.output.sample_rate = r.number("sample_rate", 0.0, 1e6, 0.0);
+    s.output.sensor_bandwidth = r.number("sensor_bandwidth", 0.0, 10000.0, 20.0, true);
+    s.output.dropper_series = r.boolean("dropper_series", false);
+    auto optional_number = [&](const char* key, double lo, double hi, bool lo_open) -> std::optional<double> {
+      if (!r.has(key)) return std::nullopt;
+      return r.number(key, lo, hi, std::nullopt, lo_open);
+    };
+    s.output.allowed_uplift = optional_number("allowed_uplift", 0.0, 10.0, true);
+    s.output.max_stat_force = optional_number("max_stat_force", 0.0, 1e5, true);
+    s.output.min_stat_force = optional_number("min_stat_force", -1e5, 1e5, false);
+    s.output.max_contact_loss_percent = optional_number("max_contact_loss_percent", 0.0, 100.0, false);
+    r.finish();
+  }
+}
+
+}  // namespace
+
+Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
+  bool reference_defaults = false;  // preset reference, element length and damping its own
+  if (!root || !root.IsMap()) throw SceneError("scene: the document must be a YAML map of sections (line, contact_wire, ...)");
+  Reader top(root, "");
+  Scene s;
+  s.name = top.text("name", "scene");
+  s.gravity = top.number("gravity", 0.0, 100.0, 9.81);
+  read_line(top, s);
+  read_overlap(top, s);
+  // The first section's parts stay available as the scene's defaults.
+  const SectionSpec& first = s.sections.front();
+  s.contact_wire = first.contact_wire;
+  s.messenger = first.messenger;
+  s.droppers = first.droppers;
+  s.steady_arms = first.steady_arms;
+  s.messenger_supports = first.messenger_supports;
+  resolve_line(s);
+  read_damping(top, s);
+  read_contact(top, s);
+  read_pantographs(top, s);
+  read_train(top, s);
+  reference_defaults = read_numerics(top, s);
+  read_imperfections(top, s, base_dir);
+  read_output(top, s);
+  read_lateral_parts(top, s);
+  top.finish();
+  // The reference rung's centred damping steps a whole 2-D line with the explicit scheme and beta
+  // > 0 (NumericsSpec::damping); elsewhere (a window, an endless line, a 3-D line) the rung is
+  // h = 0.1 m with the half-step damping, the finest its explicit dt allows at a reference's cost
+  // (docs/benchmark_history.md, "Choosing the reference rung").
+  if (reference_defaults && (s.numerics.windowed() || s.endless || s.lateral() || !(s.rayleigh_beta > 0.0) ||
+                             s.numerics.integrator != Integrator::kExplicit ||
+                             s.numerics.rotary_inertia != RotaryInertia::kCondensed)) {
+    s.numerics.element_length = 0.1;
+    s.numerics.damping = DampingStep::kHalfStep;
+  }
+  // On a finite line one radius is one curve over the whole line (heading from station 0).
+  if (!s.endless && s.alignment.radius != 0.0) {
+    s.alignment.curves = {CurveSpec{0.0, s.line_length(), s.alignment.radius, 0.0}};
+    s.alignment.radius = 0.0;
+  }
+  validate(s);
+  return s;
+}
+
+}  // namespace catenary_sim

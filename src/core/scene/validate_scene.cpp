@@ -1,0 +1,246 @@
+// The scene's cross-field checks (validate): what each field alone allows is the reader's; here
+// what the fields allow together, each refusal naming a field, its value and what is allowed.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <set>
+#include <string>
+
+#include "scene/scene_reader.hpp"
+
+namespace catenary_sim {
+
+using namespace scene_reading;
+namespace {
+
+// Every section's droppers hang from its messenger, inside their spans, in order.
+void validate_sections(const Scene& s) {
+  if (s.sections.empty()) fail("line", "(no tension section)", "at least one section of spans");
+  for (std::size_t si = 0; si < s.sections.size(); ++si) {
+    const SectionSpec& sec = s.sections[si];
+    const std::string pre = s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "";
+    if (sec.droppers && !sec.messenger)
+      fail(pre + "droppers", "(given)", "droppers hang the contact wire from a messenger: add a messenger section or remove droppers");
+    if (sec.messenger_supports && !sec.messenger) fail(pre + "messenger_supports", "(given)", "needs a messenger section");
+    if (sec.contact_wire_count == 2 && !sec.droppers)
+      fail(pre + "contact_wire_count", "2", "a twin contact wire hangs from droppers: add droppers and a messenger");
+    if (sec.contact_wire.presag != 0.0 && !sec.droppers)
+      fail(pre + "contact_wire.presag", fmt(sec.contact_wire.presag), "0 without droppers (the presag is set by the dropper lengths)");
+    if (!sec.droppers) continue;
+    if (sec.droppers->positions.size() != sec.spans.size())
+      fail(pre + "droppers.positions_per_span", std::to_string(sec.droppers->positions.size()) + " lists", "one per span");
+    for (std::size_t i = 0; i < sec.spans.size(); ++i) {
+      const auto& p = sec.droppers->positions[i];
+      for (std::size_t j = 0; j < p.size(); ++j) {
+        const std::string f = pre + "droppers.positions (span " + std::to_string(i) + ", dropper " + std::to_string(j) + ")";
+        if (p[j] <= 0.0 || p[j] >= sec.spans[i])
+          fail(f, fmt(p[j]), "strictly inside the span (0, " + fmt(sec.spans[i]) + ") m");
+        if (j > 0 && p[j] <= p[j - 1]) fail(f, fmt(p[j]), "increasing along the span (previous " + fmt(p[j - 1]) + ")");
+      }
+    }
+  }
+}
+
+// The train speed, and the limits on what a pass allocates or on the centred step's dt.
+void validate_limits(const Scene& s) {
+  const TrainSpeedLimit speed = train_speed_limit(s);
+  if (!speed.allows(s.train_speed)) {
+    const double v = s.train_speed;
+    std::string value = fmt(v * 3.6) + " (" + fmt(v) + " m/s";
+    if (v >= speed.wave_speed) value += ", " + fmt4(v / speed.wave_speed) + " times the contact wire's wave speed";
+    fail("train.speed_kmh", value + ")", "allowed " + speed.text());
+  }
+  {
+    const PantographHeadSpec& h = s.pantograph_head;
+    if (!(h.histogram_bin > 0.0) || h.horn_width / h.histogram_bin > kMaxHistogramBins)
+      fail("pantograph_head.histogram_bin", fmt(h.histogram_bin),
+           "allowed [" + fmt4(h.horn_width / kMaxHistogramBins) + ", 1] m: at most " + fmt(kMaxHistogramBins) +
+               " bins across pantograph_head.horn_width = " + fmt(h.horn_width) + " m");
+  }
+  if (s.wind && s.wind->turbulence) {
+    const double points = wind_field_points(s);
+    if (!(points <= kMaxWindFieldPoints)) {
+      const double spacing = s.wind->turbulence->spacing, reach = (points - 1.0) * spacing;
+      fail("wind.turbulence.spacing", fmt(spacing),
+           "allowed [" + fmt4(reach / (kMaxWindFieldPoints - 1.0)) + ", 100] m here: at most " + fmt(kMaxWindFieldPoints) +
+               " field points over the " + fmt4(reach) + " m of line the field holds at once (this spacing gives " + fmt4(points) +
+                   ")");
+    }
+  }
+  if (s.numerics.damping == DampingStep::kCentred && s.numerics.safety_factor > kCentredMaxSafetyFactor)
+    fail("numerics.safety_factor", fmt(s.numerics.safety_factor),
+         "at most " + fmt(kCentredMaxSafetyFactor) + " with numerics.damping: centred (its stability estimate is no bound "
+         "at the estimate itself; half_step takes up to 1)");
+}
+
+// Fields that could never act in this scene are refused rather than silently ignored.
+void validate_acting_fields(const Scene& s) {
+  if (s.numerics.gust_lead && !(s.wind && s.wind->turbulence && s.numerics.windowed()))
+    fail("numerics.gust_lead", fmt(*s.numerics.gust_lead),
+         "only with a turbulent wind (wind.turbulence) and the moving window (numerics.window): it is how much further "
+         "ahead the lateral window reaches; remove it here");
+  if (!s.lateral())
+    for (std::size_t i = 0; i < s.pantographs.size(); ++i) {
+      const PantographSpec& p = s.pantographs[i];
+      auto check = [&](const std::vector<CollectorSpec>& cs, const std::string& field) {
+        for (std::size_t j = 0; j < cs.size(); ++j)
+          if (cs[j].working_width)
+            fail(field + "[" + std::to_string(j) + "].working_width", fmt(*cs[j].working_width),
+                 "only on a 3-D line (stagger, alignment, wind or pantograph_head.sway): a 2-D line has no lateral "
+                 "contact point to keep on the strip; remove it here");
+      };
+      const std::string pf = "pantographs[" + std::to_string(i) + "]";
+      check(p.collectors, pf + ".collectors");
+      for (std::size_t h = 0; h < p.heads.size(); ++h) check(p.heads[h].collectors, pf + ".heads[" + std::to_string(h) + "].collectors");
+    }
+}
+
+// Unique names, and a net uplift that pushes each pantograph up.
+void validate_pantographs(const Scene& s) {
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < s.pantographs.size(); ++i) {
+    const auto& p = s.pantographs[i];
+    const std::string pre = "pantographs[" + std::to_string(i) + "].";
+    if (!names.insert(p.name).second) fail(pre + "name", "'" + p.name + "'", "unique among pantographs");
+    // The uplift F0 + a v^2 pushes the head up against the wire; a net downward push is not a
+    // pantograph (it would pull the head off the wire and the roof spring alone cannot hold it).
+    const double v = s.train_speed, uplift = p.net_uplift(v);
+    if (!p.moving_force && uplift < 0.0) {
+      // Name the term that pulls down most (the frame's, or a head's, for the knee in use).
+      std::string f = pre + (p.knee_trailing && p.aero_coefficient_trailing ? "aero_coefficient_trailing" : "aero_coefficient");
+      double worst = p.frame_aero();
+      for (std::size_t h = 0; h < p.heads.size(); ++h) {
+        const double a = PantographSpec::head_aero(p.heads[h], p.knee_trailing);
+        if (a < worst) {
+          worst = a;
+          f = pre + "heads[" + std::to_string(h) + "]." +
+              (p.knee_trailing && p.heads[h].aero_coefficient_trailing ? "aero_coefficient_trailing" : "aero_coefficient");
+        }
+      }
+      fail(f, fmt(worst),
+           "a net uplift >= 0 at " + fmt(v * 3.6) + " km/h (knee " + (p.knee_trailing ? "trailing" : "leading") +
+               "): static_uplift + (frame and heads' aero coefficients) v^2 = " + fmt(uplift) +
+               " N; a net downward aerodynamic pull is not physical for a pantograph in service");
+    }
+  }
+}
+
+void validate_imperfections(const Scene& s, double line) {
+  if ((s.imperfections.stagger_std > 0.0 || !s.imperfections.stagger_errors.empty()) && !s.stagger)
+    fail(s.imperfections.stagger_std > 0.0 ? "imperfections.stagger_std" : "imperfections.stagger_errors", "(given)",
+         "a 3-D line: give the design stagger (scene field 'stagger') the errors move");
+  if (s.imperfections.any()) {
+    if (s.endless)
+      fail("imperfections", "(given)", "a finite line: an endless line repeats one perfect span");
+    // The mesh carries a wavelength of at least two elements (shorter ones alias onto longer ones).
+    const IrregularitySpec& ir = s.imperfections.contact_wire_irregularity;
+    if (ir.rms > 0.0 && ir.wavelength_min < 2.0 * s.numerics.element_length)
+      fail("imperfections.contact_wire_irregularity.wavelength_min", fmt(ir.wavelength_min),
+           "at least two elements (2 x numerics.element_length = " + fmt(2.0 * s.numerics.element_length) +
+               " m): the mesh cannot carry a shorter wave");
+    for (std::size_t i = 0; i < s.imperfections.point_masses.size(); ++i)
+      if (s.imperfections.point_masses[i].station > line + 1e-9)
+        fail("imperfections.point_masses[" + std::to_string(i) + "].station", fmt(s.imperfections.point_masses[i].station),
+             "on the line, [0, " + fmt(line) + "] m");
+  }
+}
+
+void validate_lateral(const Scene& s, double line) {
+  if (!s.lateral()) return;
+  // A strip's own working width lies within the head's horns (pantograph_head.horn_width).
+  auto check_strips = [&](const std::vector<CollectorSpec>& cs, const std::string& field) {
+    for (std::size_t j = 0; j < cs.size(); ++j)
+      if (cs[j].working_width && *cs[j].working_width > s.pantograph_head.horn_width + 1e-12)
+        fail(field + "[" + std::to_string(j) + "].working_width", fmt(*cs[j].working_width),
+             "at most pantograph_head.horn_width = " + fmt(s.pantograph_head.horn_width) + " m");
+  };
+  for (std::size_t i = 0; i < s.pantographs.size(); ++i) {
+    const std::string pf = "pantographs[" + std::to_string(i) + "]";
+    check_strips(s.pantographs[i].collectors, pf + ".collectors");
+    for (std::size_t h = 0; h < s.pantographs[i].heads.size(); ++h)
+      check_strips(s.pantographs[i].heads[h].collectors, pf + ".heads[" + std::to_string(h) + "].collectors");
+  }
+  // An endless line repeats its block of spans: a stagger pattern repeats with it (the block
+  // moves by whole patterns), and so does one radius for the whole line; a curve placed by
+  // station or a list per support does not.
+  if (s.endless && !s.alignment.curves.empty())
+    fail("alignment.curves", "(given with line.endless: true)",
+         "a finite line: curves are placed by station; an endless line takes alignment.radius (every span on one curve)");
+  if (s.endless && s.stagger && s.stagger->per_support)
+    fail("stagger.per_support", "true (with line.endless: true)",
+         "false on an endless line: give the stagger as a pattern repeated over the supports");
+  if (s.endless && s.stagger) {
+    const std::size_t a = s.stagger->contact_wire.size(), b = std::max<std::size_t>(1, s.stagger->messenger.size());
+    if (a * b / std::gcd(a, b) > 8)
+      fail("stagger.contact_wire", "(a pattern of " + std::to_string(a) + " with a messenger pattern of " + std::to_string(b) + ")",
+           "on an endless line, patterns that repeat together within 8 supports (the block moves by whole patterns)");
+  }
+  const double half = 0.5 * s.pantograph_head.working_width;
+  if (s.stagger) {
+    for (std::size_t i = 0; i < s.stagger->contact_wire.size(); ++i)
+      if (std::fabs(s.stagger->contact_wire[i]) >= half)
+        fail("stagger.contact_wire[" + std::to_string(i) + "]", fmt(s.stagger->contact_wire[i]),
+             "inside the pantograph head's working width, |stagger| < " + fmt(half) + " m (pantograph_head.working_width / 2)");
+    if (s.stagger->per_support) {
+      // Supports along the line, counting an overlap's shared supports once.
+      const std::size_t line_supports = s.spans.size() + 1;
+      if (s.stagger->contact_wire.size() != line_supports)
+        fail("stagger.contact_wire", "(" + std::to_string(s.stagger->contact_wire.size()) + " values)",
+             "one per support of the line with per_support: true (" + std::to_string(line_supports) + ")");
+      if (!s.stagger->messenger.empty() && s.stagger->messenger.size() != line_supports)
+        fail("stagger.messenger", "(" + std::to_string(s.stagger->messenger.size()) + " values)",
+             "one per support of the line with per_support: true (" + std::to_string(line_supports) + ")");
+    }
+  }
+  for (std::size_t i = 0; i < s.alignment.curves.size(); ++i)
+    if (s.alignment.curves[i].start >= line)
+      fail("alignment.curves[" + std::to_string(i) + "].start", fmt(s.alignment.curves[i].start), "on the line, below " + fmt(line) + " m");
+}
+
+void validate_endless(const Scene& s) {
+  if (!s.numerics.windowed())
+    fail("numerics.window", "off", "auto or {ahead, behind} on an endless line (only the window around the train is modelled)");
+  if (!s.train_end) fail("train.end", "(missing)", "required on an endless line: the train front's station where the pass ends, m");
+  if (s.droppers && s.droppers->per_span)
+    fail("droppers.positions_per_span", "(given)", "an endless line repeats one span: give droppers.positions");
+  if (s.output.analysis_first_span && s.output.analysis_last_span &&
+      !(0 <= *s.output.analysis_first_span && *s.output.analysis_first_span < *s.output.analysis_last_span))
+    fail("output.analysis_spans", "[" + std::to_string(*s.output.analysis_first_span) + ", " + std::to_string(*s.output.analysis_last_span) + "]",
+         "0 <= first < last (span indices along the endless line)");
+  if (s.train_start && *s.train_end < *s.train_start)
+    fail("train.end", fmt(*s.train_end), ">= train.start (" + fmt(*s.train_start) + ")");
+  if (s.numerics.element_length > s.spans.front() + 1e-12)
+    fail("numerics.element_length", fmt(s.numerics.element_length), "at most the span length");
+}
+
+void validate_finite_line(const Scene& s, double line) {
+  const int a0 = s.analysis_first(), a1 = s.analysis_last();
+  if (a0 < 0 || a1 > static_cast<int>(s.spans.size()) || a0 >= a1)
+    fail("output.analysis_spans", "[" + std::to_string(a0) + ", " + std::to_string(a1) + "]",
+         "0 <= first < last <= span count (" + std::to_string(s.spans.size()) + ")");
+  if (s.numerics.element_length > *std::min_element(s.spans.begin(), s.spans.end()) + 1e-12)
+    fail("numerics.element_length", fmt(s.numerics.element_length), "at most the shortest span");
+  if (s.train_start && s.train_end && *s.train_end < *s.train_start)
+    fail("train.end", fmt(*s.train_end), ">= train.start (" + fmt(*s.train_start) + ")");
+  if (s.train_end && *s.train_end > line + 1e-9)
+    fail("train.end", fmt(*s.train_end), "at most the line length " + fmt(line) + " m");
+}
+
+}  // namespace
+
+void validate(const Scene& s) {
+  const double line = s.line_length();
+  validate_sections(s);
+  validate_limits(s);
+  validate_acting_fields(s);
+  validate_pantographs(s);
+  validate_imperfections(s, line);
+  validate_lateral(s, line);
+  if (s.endless) {
+    validate_endless(s);
+    return;
+  }
+  validate_finite_line(s, line);
+}
+
+}  // namespace catenary_sim
