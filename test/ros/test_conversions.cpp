@@ -4,15 +4,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/ros/params.hpp"
 
+#include <ros/serialization.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
 using namespace catenary_sim;
@@ -681,4 +684,62 @@ TEST(Markers, ThreeDimensionalLineIsDrawnAcrossTheTrackAndStretchedAlike) {
   }
   EXPECT_TRUE(dot);
   EXPECT_TRUE(wire);
+}
+
+namespace {
+
+// FNV-1a over the serialized message (the bytes rviz receives): any change of any field moves it.
+std::uint64_t wire_bytes_hash(const visualization_msgs::MarkerArray& a) {
+  const std::uint32_t n = ros::serialization::serializationLength(a);
+  std::vector<std::uint8_t> bytes(n);
+  ros::serialization::OStream out(bytes.data(), n);
+  ros::serialization::serialize(out, a);
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::uint8_t b : bytes) h = (h ^ b) * 1099511628211ull;
+  return h;
+}
+
+}  // namespace
+
+// The drawing must not move when its code is rearranged: the markers of scenes that take every
+// branch (static parts, slack droppers, two heads, an overlap's per-wire label, a 3-D line with
+// sway stretched across the track, two pantographs, an external pantograph, a moving force) are
+// hashed byte for byte, like the golden passes (test_golden_hashes). Each drawing was checked by
+// the tests above and in rviz; a change of the drawing changes a hash on purpose, and the commit
+// that records the new hash says why. On a mismatch the message prints the new hash.
+TEST(Markers, DrawingOfTheReferenceScenesIsUnchanged) {
+  const std::string dir = std::string(CATENARY_SIM_SOURCE_DIR) + "/config/";
+  struct Case {
+    const char* name;
+    std::string scene;
+    std::vector<std::string> overrides;
+    int steps;  // < 0: to the station -steps m
+    double lateral_scale;
+    bool all_slack;
+    std::uint64_t expected;
+  };
+  const std::vector<Case> cases = {
+      {"reference", dir + "reference_55m.yaml", {}, 2000, 1.0, false, 0xef496125ab41a9acull},
+      {"reference, every dropper slack", dir + "reference_55m.yaml", {}, 2000, 1.0, true, 0x4eeb7da29370cb34ull},
+      {"two heads", dir + "reference_55m_two_heads.yaml", {}, 3000, 1.0, false, 0x2c17b1565032233cull},
+      {"overlap", dir + "calpe_example.yaml", {}, -50, 1.0, false, 0x472af5e1c1cc5aa2ull},  // to 50 m: under both wires
+      {"3-D line with sway", dir + "reference_55m_3d.yaml",
+       {"pantograph_head.sway.amplitude=0.05", "pantograph_head.sway.frequency=0.5"}, 800, 7.0, false, 0xa76580d5ec007007ull},
+      {"two pantographs", dir + "reference_55m_two_pantographs.yaml", {}, 3000, 1.0, false, 0xcc0af6d3b9d7932aull},
+      {"external pantograph", dir + "reference_55m_hil.yaml", {}, 0, 1.0, false, 0x981d981f3f1990f0ull},
+      {"moving force", dir + "reference_55m.yaml", {"pantographs=[{name: force, type: moving_force, static_uplift: 120}]"}, 1000, 1.0, false, 0x29ff643478ab0a95ull},
+  };
+  for (const Case& c : cases) {
+    Simulation sim(load_scene_file(c.scene, c.overrides));
+    for (int i = 0; i < c.steps; ++i) ASSERT_EQ(sim.step(), StepStatus::kOk) << c.name;
+    if (c.steps < 0) step_to(sim, -c.steps);
+    State s = sim.state();
+    if (c.all_slack) std::fill(s.dropper_slack.begin(), s.dropper_slack.end(), 1);
+    MarkerOptions o;
+    o.lateral_scale = c.lateral_scale;
+    const std::uint64_t h = wire_bytes_hash(to_markers(sim.model(), s, ros::Time(1.0), o));
+    char got[32];
+    std::snprintf(got, sizeof got, "0x%016llxull", static_cast<unsigned long long>(h));
+    EXPECT_EQ(h, c.expected) << c.name << ": the markers hash to " << got;
+  }
 }
