@@ -79,8 +79,8 @@ TEST_F(Fixture, PantographStateHasEveryMass) {
   ASSERT_EQ(ps.displacement.size(), static_cast<std::size_t>(pg.masses_count()));
   ASSERT_EQ(ps.velocity.size(), ps.displacement.size());
   for (int i = 0; i < pg.masses_count(); ++i) {
-    EXPECT_DOUBLE_EQ(ps.displacement[i], s.u[pg.first_dof + i]);
-    EXPECT_DOUBLE_EQ(ps.velocity[i], s.v[pg.first_dof + i]);
+    EXPECT_DOUBLE_EQ(ps.displacement[i], s.pantograph_displacement(m, 0, i));
+    EXPECT_DOUBLE_EQ(ps.velocity[i], s.pantograph_velocity(m, 0, i));
   }
   EXPECT_DOUBLE_EQ(ps.uplift, s.uplift[0]);
   EXPECT_DOUBLE_EQ(ps.head_height, head_height(m, s, 0));
@@ -88,7 +88,7 @@ TEST_F(Fixture, PantographStateHasEveryMass) {
   // A chain is one head (its first mass), whose aero is the frame's.
   EXPECT_EQ(ps.head_count, 1);
   ASSERT_EQ(ps.head_heights.size(), 1u);
-  EXPECT_DOUBLE_EQ(ps.head_heights[0], pg.reference_height + s.u[pg.first_dof]);
+  EXPECT_DOUBLE_EQ(ps.head_heights[0], pg.reference_height + s.pantograph_displacement(m, 0, 0));
   ASSERT_EQ(ps.head_aero_uplift.size(), 1u);
   EXPECT_EQ(ps.head_aero_uplift[0], 0.0);
   EXPECT_EQ(ps.knee, "leading");
@@ -123,7 +123,7 @@ TEST_F(Fixture, WireShapeSamplesAtResolutionAndKeepsEnds) {
         for (int i = 0; i < w.nodes(); ++i)
           if (w.x[i] == ws.stations[k]) node = i;
         ASSERT_GE(node, 0);
-        EXPECT_DOUBLE_EQ(ws.heights[k], w.height[node] + s.u[w.w_dof + node]);
+        EXPECT_DOUBLE_EQ(ws.heights[k], s.wire_height(m, static_cast<int>(wi), node));
       }
     }
   }
@@ -170,7 +170,7 @@ TEST_F(Fixture, MarkersCoverEveryPartAndExaggerateDisplacement) {
   const Wire& w = m.wires[0];
   const auto& strip = arr.markers[0];
   ASSERT_EQ(strip.points.size(), static_cast<std::size_t>(w.nodes()));
-  for (int i = 0; i < w.nodes(); i += 31) EXPECT_DOUBLE_EQ(strip.points[i].z, w.height[i] + 10.0 * s.u[w.w_dof + i]);
+  for (int i = 0; i < w.nodes(); i += 31) EXPECT_DOUBLE_EQ(strip.points[i].z, w.height[i] + 10.0 * s.wire_uplift(m, 0, i));
   // Unique (ns, id) pairs, or rviz would overwrite markers.
   std::set<std::pair<std::string, int>> ids;
   for (const auto& mk : arr.markers) EXPECT_TRUE(ids.insert({mk.ns, mk.id}).second) << mk.ns << " " << mk.id;
@@ -236,7 +236,7 @@ TEST(Markers, HeadIsDrawnOnTheWireItTouchesAtMidSpan) {
   EXPECT_NEAR(contact_design_height(m, s, 0), m.scene.contact_wire_height - 0.055, 0.005);
   EXPECT_NEAR(drawn_head_height(m, s, 0, 1.0), head_height(m, s, 0), 1e-12);  // k = 1: the true height
   // The old rule (reference height + k u) is far off here, so this test tells the two apart.
-  EXPECT_GT(std::fabs(pg.reference_height + k * s.u[pg.first_dof] - z_wire), 0.3);
+  EXPECT_GT(std::fabs(pg.reference_height + k * s.pantograph_displacement(m, 0, 0) - z_wire), 0.3);
   // The arrow starts on the head and is 1 m per 100 N.
   EXPECT_DOUBLE_EQ(arrow->points[0].z, head_top);
   EXPECT_NEAR(arrow->points[1].z - arrow->points[0].z, force / 100.0, 2e-3);
@@ -274,7 +274,7 @@ TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
   ASSERT_EQ(ps.displacement.size(), static_cast<std::size_t>(pg.masses_count() + 2));  // frame, then heads
   for (int h = 0; h < 2; ++h) {
     EXPECT_DOUBLE_EQ(ps.head_heights[h], pg.heads[h].reference_height + s.u[pg.heads[h].dof]);
-    EXPECT_DOUBLE_EQ(ps.displacement[pg.masses_count() + h], s.u[pg.heads[h].dof]);
+    EXPECT_DOUBLE_EQ(ps.displacement[pg.masses_count() + h], s.pantograph_displacement(m, 0, pg.masses_count() + h));
     EXPECT_NEAR(ps.head_aero_uplift[h], 0.002 * s.speed * s.speed, 1e-12);  // the scene's a_h v^2
   }
   EXPECT_NEAR(ps.head_height, 0.5 * (ps.head_heights[0] + ps.head_heights[1]), 1e-12);
@@ -300,7 +300,6 @@ TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
   // Two heads x two sides x a quarter arc of 4 segments, 2 points each.
   EXPECT_EQ(horns->points.size(), 32u);
   EXPECT_EQ(links->points.size(), 4u);
-  const std::size_t nw = m.contact_wires.size();
   for (int h = 0; h < 2; ++h) {
     const double xh = x + (h == 0 ? 0.25 : -0.25);  // the scene's head offsets
     const auto* head = find_marker(arr, "pantograph_head", h == 0 ? 0 : kHeadIdStride);
@@ -310,9 +309,7 @@ TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
     const auto& strip = strips->points[2 * h];  // (its segment's first end)
     EXPECT_NEAR(strip.x, xh, 1e-9);
     // Its strip's top on the wire over it, k x that strip's contact-spring compression above.
-    double f = 0.0;
-    for (int ci : pg.heads[h].collectors)
-      for (std::size_t w = 0; w < nw; ++w) f += s.contact_force[ci * nw + w];
+    const double f = s.head_contact_force(m, 0, h);
     ASSERT_GT(f, 0.0);
     const double top = strip.z + 0.015;  // (a strip 30 mm high, drawn along its centre line)
     EXPECT_NEAR(top - strip_z(*wire, xh), k * f / m.contact_stiffness, 0.02) << "head " << h;
