@@ -217,7 +217,7 @@ void compute_frame(const Model& m, const State& s, int steps_per_period, PointFr
     for (std::size_t ci = 0; ci < pg.collectors.size(); ++ci) {
       const ContactPointMotion* low = nullptr;
       for (std::size_t k = 0; k < nw; ++k) {
-        const ContactPointMotion& cm = c.wires[ci * nw + k];
+        const ContactPointMotion& cm = motion_under(m, c.wires, ci, k);
         if (cm.on_wire && (!low || cm.height < low->height)) low = &cm;
       }
       if (!low) continue;

@@ -288,16 +288,10 @@ PYBIND11_MODULE(_core, m) {
         d["head_wind_m_s"] = st.head_wind[i];               // the wind against the direction of travel
         // Every head (several on their own suspensions; a chain's first mass; none for a moving
         // force): its height, the force on its strips and its own aero uplift.
-        const Pantograph& pg = m.pantographs[i];
-        const std::size_t nw = m.contact_wires.size();
         py::list heights, forces, aero;
         for (int h = 0; h < head_count(m, i); ++h) {
           heights.append(head_height(m, st, i, h));
-          double f = 0.0;
-          for (int ci : pg.collectors)
-            if (pg.heads.empty() || m.collectors[ci].head == h)
-              for (std::size_t w = 0; w < nw; ++w) f += st.contact_force[ci * nw + w];
-          forces.append(f);
+          forces.append(st.head_contact_force(m, i, h));
           aero.append(head_aero_uplift(m, st, i, h));
         }
         d["head_heights_m"] = heights;

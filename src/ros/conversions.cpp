@@ -84,13 +84,6 @@ double head_lateral(const Model& m, const State& s, std::size_t p) {
   return m.lateral && p < s.lateral.pantograph_lateral.size() ? s.lateral.pantograph_lateral[p] : 0.0;
 }
 
-double collector_force(const Model& m, const State& s, int ci) {
-  const std::size_t nw = m.contact_wires.size();
-  double f = 0.0;
-  for (std::size_t k = 0; k < nw; ++k) f += s.contact_force[ci * nw + k];
-  return f;
-}
-
 // Station of a collector of pantograph p now, in the model's stations (the wires' x; on an
 // endless line the line's station is this plus State::line_offset).
 double collector_x(const Model& m, const State& s, int p, int ci) {
@@ -113,10 +106,10 @@ bool lowest_contact_wire(const Model& m, const State& s, int p, double* design, 
     int k = -1;
     const double best = lowest_design_height(m, xc, &k);
     if (!std::isfinite(best)) continue;
-    const Wire& w = m.wires[m.contact_wires[k]];
-    const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
+    const int wi = m.contact_wires[k];
+    const int cnt = contact_weights(m.wires[wi], m.rub_length, xc, node.data(), weight.data());
     double u = 0.0;
-    for (int a = 0; a < cnt; ++a) u += weight[a] * s.u[w.w_dof + node[a]];
+    for (int a = 0; a < cnt; ++a) u += weight[a] * s.wire_uplift(m, wi, node[a]);
     sum_design += best;
     sum_displaced += best + u;
     ++count;
@@ -175,15 +168,14 @@ ContactForceArray to_contact_force(const Model& m, const State& s, const ros::Ti
     c.name = pg.name;
     c.position = pantograph_position(m, s, static_cast<int>(p));
     for (int ci : pg.collectors) {
-      const double f = collector_force(m, s, ci);
+      const double f = s.collector_force(m, ci);
       c.collector_forces.push_back(f);
       c.in_contact.push_back(f > 0.0);
     }
     c.total = total_contact_force(m, s, static_cast<int>(p));
-    const std::size_t nw = m.contact_wires.size();
     for (int wi : m.contact_wires) c.contact_wires.push_back(m.wires[wi].name);
     for (int ci : pg.collectors)
-      for (std::size_t k = 0; k < nw; ++k) c.wire_forces.push_back(s.contact_force[ci * nw + k]);
+      for (std::size_t k = 0; k < m.contact_wires.size(); ++k) c.wire_forces.push_back(s.contact_force_on(m, ci, static_cast<int>(k)));
     out.pantographs.push_back(c);
   }
   return out;
@@ -210,8 +202,8 @@ PantographStateArray to_pantograph_state(const Model& m, const State& s, const r
     ps.head_height = head_height(m, s, static_cast<int>(p));
     if (!pg.moving_force) {
       for (int i = 0; i < pg.dof_count(); ++i) {
-        ps.displacement.push_back(s.u[pg.first_dof + i]);
-        ps.velocity.push_back(s.v[pg.first_dof + i]);
+        ps.displacement.push_back(s.pantograph_displacement(m, static_cast<int>(p), i));
+        ps.velocity.push_back(s.pantograph_velocity(m, static_cast<int>(p), i));
       }
     }
     ps.uplift = p < s.uplift.size() ? s.uplift[p] : 0.0;
@@ -233,14 +225,15 @@ WireShapeArray to_wire_shape(const Model& m, const State& s, double resolution, 
   out.header.stamp = stamp;
   out.header.frame_id = frame;
   out.sim_time = s.time;
-  for (const Wire& w : m.wires) {
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    const Wire& w = m.wires[wi];
     WireShape ws;
     ws.header = out.header;
     ws.name = w.name;
     for (int i : sample_nodes(w, resolution)) {
       ws.stations.push_back(w.x[i] + s.line_offset);
-      ws.heights.push_back(w.height[i] + s.u[w.w_dof + i]);
-      if (m.lateral) ws.lateral.push_back(node_lateral(m, s, &w - m.wires.data(), i));
+      ws.heights.push_back(s.wire_height(m, static_cast<int>(wi), i));
+      if (m.lateral) ws.lateral.push_back(node_lateral(m, s, wi, i));
     }
     out.wires.push_back(ws);
   }
@@ -268,7 +261,7 @@ LateralContactArray to_lateral_contact(const Model& m, const State& s, const ros
       c.lateral = static_cast<std::size_t>(ci) < s.lateral.collector_lateral.size() ? s.lateral.collector_lateral[ci]
                                                                                   : std::nan("");
       c.wire_lateral = c.lateral + c.pantograph_lateral;
-      c.in_contact = collector_force(m, s, ci) > 0.0;
+      c.in_contact = s.collector_force(m, ci) > 0.0;
       c.on_working_width = std::fabs(c.lateral) <= m.collectors[ci].half_working_width;  // false for NaN
       out.contacts.push_back(c);
     }
@@ -363,7 +356,8 @@ LineState to_line_state(const Model& m, const State& s, const PassRecorder& reco
   for (std::uint8_t d : s.dropper_slack) ls.slack_droppers += d;
   analysis_section(m, &ls.analysis_start, &ls.analysis_end);
   const double reach = m.longest_span;
-  for (const SupportSpring& sp : m.springs) {
+  for (std::size_t k = 0; k < m.springs.size(); ++k) {
+    const SupportSpring& sp = m.springs[k];
     if (!sp.steady_arm) continue;
     bool near = false;
     for (const Pantograph& p : m.pantographs) near = near || std::fabs(sp.x - (s.front - p.position)) <= reach;
@@ -371,10 +365,11 @@ LineState to_line_state(const Model& m, const State& s, const PassRecorder& reco
     const double station = sp.x + s.line_offset;
     const double most = recorder.max_steady_arm_uplift(station);
     ls.steady_arm_station.push_back(station);
-    ls.steady_arm_uplift.push_back(s.u[sp.dof]);
+    const double uplift = s.support_uplift(m, static_cast<int>(k));
+    ls.steady_arm_uplift.push_back(uplift);
     // The recorder's value (stats.json's, every step while a pantograph is within half a span);
     // before a pantograph comes that close, the uplift now.
-    ls.steady_arm_max_uplift.push_back(std::isnan(most) ? s.u[sp.dof] : most);
+    ls.steady_arm_max_uplift.push_back(std::isnan(most) ? uplift : most);
   }
   return ls;
 }
@@ -445,254 +440,321 @@ void add_list(visualization_msgs::MarkerArray& out, visualization_msgs::Marker m
 }
 }  // namespace
 
+namespace {
+
+using visualization_msgs::Marker;
+
+// What every part of the drawing reads: the pass, the header and the vertical exaggeration k
+// (wires and heads are drawn at design + k u, so that millimetres of uplift show).
+struct Drawing {
+  const Model& m;
+  const State& s;
+  const MarkerOptions& o;
+  std_msgs::Header h;
+  double k;
+  // A wire DOF (a dropper's or steady arm's end) at its design height plus k times its uplift.
+  double shown(int dof) const { return wire_dof_design_height(m, dof) + k * s.u[dof]; }
+};
+
+void add_wires(visualization_msgs::MarkerArray& out, const Drawing& d) {
+  const Model& m = d.m;
+  const State& s = d.s;
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    const Wire& w = m.wires[wi];
+    Marker mk = marker(d.h, "wires", static_cast<int>(wi), Marker::LINE_STRIP);
+    mk.scale.x = w.is_contact_wire ? 0.04 : 0.03;
+    mk.color = w.is_contact_wire ? color(0.85f, 0.55f, 0.2f) : color(0.6f, 0.6f, 0.65f);
+    for (int i : sample_nodes(w, d.o.shape_resolution))
+      mk.points.push_back(point(w.x[i] + s.line_offset, node_lateral(m, s, wi, i),
+                                w.height[i] + d.k * s.wire_uplift(m, static_cast<int>(wi), i)));
+    add_list(out, mk);
+  }
+}
+
+// Droppers: taut grey, slack red.
+void add_droppers(visualization_msgs::MarkerArray& out, const Drawing& d) {
+  const State& s = d.s;
+  Marker taut = marker(d.h, "droppers", 0, Marker::LINE_LIST);
+  Marker slack = marker(d.h, "droppers", 1, Marker::LINE_LIST);
+  taut.scale.x = slack.scale.x = 0.015;
+  taut.color = color(0.7f, 0.7f, 0.7f);
+  slack.color = color(1.0f, 0.1f, 0.1f);
+  for (std::size_t i = 0; i < d.m.droppers.size(); ++i) {
+    const Dropper& dr = d.m.droppers[i];
+    Marker& mk = (i < s.dropper_slack.size() && s.dropper_slack[i]) ? slack : taut;
+    mk.points.push_back(point(dr.x + s.line_offset, dof_lateral(d.m, s, dr.contact_dof), d.shown(dr.contact_dof)));
+    mk.points.push_back(point(dr.x + s.line_offset, dof_lateral(d.m, s, dr.messenger_dof), d.shown(dr.messenger_dof)));
+  }
+  add_list(out, taut);
+  add_list(out, slack);
+}
+
+// Masts 3 m beside the track with a cantilever over the wires; steady arms to the contact wire.
+void add_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
+  const Model& m = d.m;
+  const State& s = d.s;
+  const double y_mast = 3.0;
+  const double top = m.scene.contact_wire_height + m.scene.encumbrance + 0.5;
+  Marker masts = marker(d.h, "masts", 0, Marker::LINE_LIST);
+  masts.scale.x = 0.15;
+  masts.color = color(0.35f, 0.35f, 0.4f);
+  // On a 3-D line the cantilever reaches over the messenger's stagger at that support.
+  std::vector<double> reach(m.support_x.size(), 0.0);
+  if (m.lateral)
+    for (const LateralSupport& ls : m.lateral->supports)
+      if (!m.wires[ls.wire].is_contact_wire) reach[ls.line_support] = ls.stagger;
+  for (std::size_t k = 0; k < m.support_x.size(); ++k) {
+    const double x = m.support_x[k] + s.line_offset;
+    masts.points.push_back(point(x, y_mast, 0.0));
+    masts.points.push_back(point(x, y_mast, top));
+    masts.points.push_back(point(x, y_mast, top));
+    masts.points.push_back(point(x, std::min(0.0, reach[k]), top));
+  }
+  add_list(out, masts);
+  Marker arms = marker(d.h, "steady_arms", 0, Marker::LINE_LIST);
+  arms.scale.x = 0.03;
+  arms.color = color(0.2f, 0.5f, 0.9f);
+  for (const SupportSpring& sp : m.springs) {
+    if (!sp.steady_arm) continue;
+    const double z = d.shown(sp.dof);
+    arms.points.push_back(point(sp.x + s.line_offset, y_mast, wire_dof_design_height(m, sp.dof)));
+    arms.points.push_back(point(sp.x + s.line_offset, dof_lateral(m, s, sp.dof), z));
+  }
+  add_list(out, arms);
+}
+
+// Lateral position of collector ci's contact point on its strip; NaN where it has none.
+double collector_lateral(const State& s, int ci) {
+  return static_cast<std::size_t>(ci) < s.lateral.collector_lateral.size() ? s.lateral.collector_lateral[ci]
+                                                                           : std::nan("");
+}
+
+// One pantograph as drawn: where, how high, with what force. The head is exaggerated about the
+// design height of the contact wire under it, like the wires about theirs, so it is drawn on the
+// wire it touches (see drawn_head_height).
+struct PantographView {
+  int id = 0;
+  double x = 0.0, z_head = 0.0, force = 0.0;
+  bool contact = false;
+  double yh = 0.0;       // across the track: the head's centre (sway)
+  double y_force = 0.0;  // where the force is drawn: the mean contact point across the strips (3-D line)
+  // A plain moving force is a point; a pantograph (lumped, or a real one on a rig) has one or
+  // more heads, several of them each on its own suspension.
+  bool point_force = false, several = false;
+  int heads = 1;
+  double half_width = 0.0, horn = 0.0;  // the strips' half working width, the horns' reach beyond it
+};
+
+PantographView pantograph_view(const Drawing& d, std::size_t p) {
+  const Model& m = d.m;
+  const State& s = d.s;
+  const Pantograph& pg = m.pantographs[p];
+  PantographView v;
+  v.id = static_cast<int>(p);
+  v.x = pantograph_position(m, s, v.id);
+  v.z_head = drawn_head_height(m, s, v.id, d.k);
+  v.force = total_contact_force(m, s, v.id);
+  v.contact = v.force > 0.0;
+  v.yh = head_lateral(m, s, p);
+  v.y_force = v.yh;
+  if (m.lateral) {
+    double sum = 0.0;
+    int count = 0;
+    for (int ci : pg.collectors) {
+      const double yc = collector_lateral(s, ci);
+      if (std::isfinite(yc)) {
+        sum += yc;
+        ++count;
+      }
+    }
+    if (count) v.y_force = v.yh + sum / count;
+  }
+  v.point_force = pg.moving_force && !pg.external;
+  v.heads = std::max(1, head_count(m, v.id));
+  v.several = !pg.heads.empty();
+  v.half_width = 0.5 * m.scene.pantograph_head.working_width;
+  v.horn = std::max(0.05, 0.5 * (m.scene.pantograph_head.horn_width - m.scene.pantograph_head.working_width));
+  return v;
+}
+
+// The body of head hd at (xh, zh): a sphere for a moving force, a plate under the strips of one
+// of several heads, else a bar across the track; red when it carries no force.
+Marker head_body(const Drawing& d, std::size_t p, const PantographView& v, int hd, double xh, double zh, bool head_contact) {
+  Marker head = marker(d.h, "pantograph_head", hd == 0 ? v.id : kHeadIdStride * hd + v.id,
+                       v.point_force ? Marker::SPHERE : Marker::CUBE);
+  if (v.point_force) {
+    head.pose.position = point(v.x, v.y_force, v.z_head - 0.03);
+    head.scale.x = head.scale.y = head.scale.z = 0.2;
+  } else if (v.several) {
+    // A plate under the head's strips, as long as the head (scene `length`).
+    head.pose.position = point(xh, v.yh, zh - 0.045);
+    head.scale.x = d.m.scene.pantographs[p].heads[hd].length;
+    head.scale.y = 2.0 * v.half_width;
+    head.scale.z = 0.03;
+  } else {
+    // Its top at the drawn head height (the strips' running surface), where the arrow starts.
+    head.pose.position = point(v.x, v.yh, v.z_head - 0.02);
+    head.scale.x = 0.1;
+    head.scale.y = 2.0 * v.half_width;
+    head.scale.z = 0.04;
+  }
+  head.color = head_contact ? color(0.25f, 0.25f, 0.28f) : color(1.0f, 0.1f, 0.1f);
+  return head;
+}
+
+// The heads: collector strips across the track (carbon, pantograph_head.working_width) on each,
+// and horns curving down at both ends to pantograph_head.horn_width. Several heads (each on its
+// own suspension) are drawn each at its own height, centred on its own strips, with a suspension
+// link down to the frame; head 0 keeps id p, head h > 0 has id kHeadIdStride h + p.
+void add_heads(visualization_msgs::MarkerArray& out, const Drawing& d, std::size_t p, const PantographView& v) {
+  const Model& m = d.m;
+  const Pantograph& pg = m.pantographs[p];
+  // Each strip a segment across the track over its own working width (strips of one head may
+  // differ: collectors[].working_width), drawn as thick as a strip is wide along the track.
+  Marker strips = marker(d.h, "pantograph_strips", v.id, Marker::LINE_LIST);
+  strips.scale.x = 0.035;
+  strips.color = v.contact ? color(0.05f, 0.05f, 0.05f) : color(1.0f, 0.1f, 0.1f);
+  Marker horns = marker(d.h, "pantograph_horns", v.id, Marker::LINE_LIST);
+  horns.scale.x = 0.03;
+  horns.color = color(0.3f, 0.3f, 0.32f);
+  Marker links = marker(d.h, "pantograph_suspension", v.id, Marker::LINE_LIST);
+  links.scale.x = 0.03;
+  links.color = color(0.55f, 0.55f, 0.6f);
+  const double yh = v.yh, half_width = v.half_width;
+  for (int hd = 0; hd < v.heads; ++hd) {
+    const double zh = v.several ? drawn_head_height(m, d.s, v.id, hd, d.k) : v.z_head;
+    const double xh = v.several ? v.x + m.scene.pantographs[p].heads[hd].offset : v.x;
+    const bool head_contact = v.several ? d.s.head_contact_force(m, v.id, hd) > 0.0 : v.contact;
+    out.markers.push_back(head_body(d, p, v, hd, xh, zh, head_contact));
+    if (v.point_force) continue;
+    for (int ci : pg.collectors)
+      if (!v.several || m.collectors[ci].head == hd) {
+        const double hw = m.collectors[ci].half_working_width;
+        strips.points.push_back(point(v.x + m.collectors[ci].offset, yh - hw, zh - 0.015));
+        strips.points.push_back(point(v.x + m.collectors[ci].offset, yh + hw, zh - 0.015));
+      }
+    for (double side : {-1.0, 1.0}) {  // from the strip's end out and down: a quarter arc in 4 pieces
+      double py = yh + side * half_width, pz = zh - 0.03;
+      for (int i = 1; i <= 4; ++i) {
+        const double a = 0.5 * M_PI * i / 4.0;
+        const double ny = yh + side * (half_width + v.horn * std::sin(a)), nz = zh - 0.03 - 0.25 * (1.0 - std::cos(a));
+        horns.points.push_back(point(xh, py, pz));
+        horns.points.push_back(point(xh, ny, nz));
+        py = ny;
+        pz = nz;
+      }
+    }
+    if (v.several) {  // the head's suspension, down to the top of the frame under the reference point
+      links.points.push_back(point(xh, yh, zh - 0.06));
+      links.points.push_back(point(v.x, yh, v.z_head - 0.2));
+    }
+  }
+  if (v.point_force) return;
+  add_list(out, strips);
+  add_list(out, horns);
+  if (v.several) add_list(out, links);
+}
+
+// Where each strip meets the wire on a 3-D line: yellow on the working width, red beyond it (dewired).
+void add_contact_points(visualization_msgs::MarkerArray& out, const Drawing& d, std::size_t p, const PantographView& v) {
+  Marker spots = marker(d.h, "lateral_contact", v.id, Marker::SPHERE_LIST);
+  spots.scale.x = spots.scale.y = spots.scale.z = 0.2;
+  for (int ci : d.m.pantographs[p].collectors) {
+    const double yc = collector_lateral(d.s, ci);
+    if (!std::isfinite(yc)) continue;
+    spots.points.push_back(point(v.x + d.m.collectors[ci].offset, v.yh + yc, v.z_head));
+    spots.colors.push_back(std::fabs(yc) <= v.half_width ? color(1.0f, 0.85f, 0.1f) : color(1.0f, 0.1f, 0.1f));
+  }
+  add_list(out, spots);
+}
+
+// The frame from the roof up to the head, and the contact-force arrow up from the head.
+void add_frame_and_force(visualization_msgs::MarkerArray& out, const Drawing& d, std::size_t p, const PantographView& v) {
+  Marker frame = marker(d.h, "pantograph_frame", v.id, Marker::LINE_STRIP);
+  frame.scale.x = 0.05;
+  frame.color = color(0.3f, 0.3f, 0.3f);
+  const double z_roof = std::min(4.0, v.z_head - 1.0);
+  frame.points.push_back(point(v.x - 1.2, v.yh, z_roof));
+  frame.points.push_back(point(v.x + 0.6, v.yh, 0.5 * (z_roof + v.z_head)));
+  frame.points.push_back(point(v.x, v.yh, d.m.pantographs[p].heads.empty() ? v.z_head - 0.06 : v.z_head - 0.2));
+  add_list(out, frame);
+
+  Marker arrow = marker(d.h, "contact_force", v.id, Marker::ARROW);
+  arrow.scale.x = 0.05;  // shaft diameter
+  arrow.scale.y = 0.1;   // head diameter
+  arrow.scale.z = 0.1;   // head length
+  arrow.color = v.contact ? color(0.1f, 0.8f, 0.2f) : color(1.0f, 0.1f, 0.1f);
+  arrow.points.push_back(point(v.x, v.y_force, v.z_head));
+  arrow.points.push_back(point(v.x, v.y_force, v.z_head + std::max(0.0, v.force) * kArrowMetresPerNewton + 1e-3));
+  out.markers.push_back(arrow);
+}
+
+// The label over the head: name and force (LOSS without contact), the force on each contact wire
+// in an overlap, the contact point across the strip on a 3-D line, the train speed.
+void add_label(visualization_msgs::MarkerArray& out, const Drawing& d, std::size_t p, const PantographView& v) {
+  const Model& m = d.m;
+  Marker label = marker(d.h, "label", v.id, Marker::TEXT_VIEW_FACING);
+  label.scale.z = kLabelTextSize;
+  label.color = color(1.0f, 1.0f, 1.0f);
+  std::ostringstream t;
+  t << std::fixed << std::setprecision(0) << m.pantographs[p].name << ": " << v.force << " N" << (v.contact ? "" : " LOSS")
+    << "\n";
+  int lines = 2;
+  const std::size_t nw = m.contact_wires.size();
+  if (nw > 1) {
+    // Force on each contact wire the collectors are under (two in an overlap), on a line of its own.
+    const char* sep = "";
+    for (std::size_t kw = 0; kw < nw; ++kw) {
+      const int wi = m.contact_wires[kw];
+      if (!under_wire(m, d.s, v.id, wi)) continue;
+      t << sep << label_wire_name(m.wires[wi].name) << " " << d.s.pantograph_force_on(m, v.id, static_cast<int>(kw));
+      sep = " / ";
+    }
+    if (*sep) {
+      t << " N\n";
+      ++lines;
+    }
+  }
+  if (m.lateral && v.y_force != v.yh) {  // the contact point across the strip (mean over the collectors)
+    t << "strip " << std::showpos << std::setprecision(2) << v.y_force - v.yh << std::noshowpos << " m\n";
+    ++lines;
+  }
+  t << std::setprecision(1) << d.s.speed * 3.6 << " km/h";
+  // Text is centred on its position: keep its lowest line kLabelClearance above the head.
+  label.pose.position = point(v.x, 0.0, v.z_head + kLabelClearance + 0.5 * lines * kLabelLineHeight);
+  label.text = t.str();
+  out.markers.push_back(label);
+}
+
+// Stretch across the track: positions, points and the widths of boxes and dots.
+void stretch_across(visualization_msgs::MarkerArray& out, double lateral_scale) {
+  for (Marker& mk : out.markers) {
+    mk.pose.position.y *= lateral_scale;
+    for (geometry_msgs::Point& p : mk.points) p.y *= lateral_scale;
+    if (mk.type == Marker::CUBE || mk.type == Marker::CUBE_LIST || mk.type == Marker::SPHERE_LIST) mk.scale.y *= lateral_scale;
+  }
+}
+
+}  // namespace
+
 visualization_msgs::MarkerArray to_markers(const Model& m, const State& s, const ros::Time& stamp,
                                            const MarkerOptions& o) {
-  using visualization_msgs::Marker;
   visualization_msgs::MarkerArray out;
   std_msgs::Header h;
   h.stamp = stamp;
   h.frame_id = o.frame;
-  const double k = o.vertical_scale;
-  auto shown = [&](int dof) { return wire_dof_design_height(m, dof) + k * s.u[dof]; };
-
-  // Wires.
-  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
-    const Wire& w = m.wires[wi];
-    Marker mk = marker(h, "wires", static_cast<int>(wi), Marker::LINE_STRIP);
-    mk.scale.x = w.is_contact_wire ? 0.04 : 0.03;
-    mk.color = w.is_contact_wire ? color(0.85f, 0.55f, 0.2f) : color(0.6f, 0.6f, 0.65f);
-    for (int i : sample_nodes(w, o.shape_resolution))
-      mk.points.push_back(point(w.x[i] + s.line_offset, node_lateral(m, s, wi, i), w.height[i] + k * s.u[w.w_dof + i]));
-    add_list(out, mk);
-  }
-
-  // Droppers: taut grey, slack red.
-  Marker taut = marker(h, "droppers", 0, Marker::LINE_LIST);
-  Marker slack = marker(h, "droppers", 1, Marker::LINE_LIST);
-  taut.scale.x = slack.scale.x = 0.015;
-  taut.color = color(0.7f, 0.7f, 0.7f);
-  slack.color = color(1.0f, 0.1f, 0.1f);
-  for (std::size_t d = 0; d < m.droppers.size(); ++d) {
-    const Dropper& dr = m.droppers[d];
-    Marker& mk = (d < s.dropper_slack.size() && s.dropper_slack[d]) ? slack : taut;
-    mk.points.push_back(point(dr.x + s.line_offset, dof_lateral(m, s, dr.contact_dof), shown(dr.contact_dof)));
-    mk.points.push_back(point(dr.x + s.line_offset, dof_lateral(m, s, dr.messenger_dof), shown(dr.messenger_dof)));
-  }
-  add_list(out, taut);
-  add_list(out, slack);
-
-  if (o.include_static) {
-    // Masts 3 m beside the track with a cantilever over the wires; steady arms to the contact wire.
-    const double y_mast = 3.0;
-    const double top = m.scene.contact_wire_height + m.scene.encumbrance + 0.5;
-    Marker masts = marker(h, "masts", 0, Marker::LINE_LIST);
-    masts.scale.x = 0.15;
-    masts.color = color(0.35f, 0.35f, 0.4f);
-    // On a 3-D line the cantilever reaches over the messenger's stagger at that support.
-    std::vector<double> reach(m.support_x.size(), 0.0);
-    if (m.lateral)
-      for (const LateralSupport& ls : m.lateral->supports)
-        if (!m.wires[ls.wire].is_contact_wire) reach[ls.line_support] = ls.stagger;
-    for (std::size_t k = 0; k < m.support_x.size(); ++k) {
-      const double x = m.support_x[k] + s.line_offset;
-      masts.points.push_back(point(x, y_mast, 0.0));
-      masts.points.push_back(point(x, y_mast, top));
-      masts.points.push_back(point(x, y_mast, top));
-      masts.points.push_back(point(x, std::min(0.0, reach[k]), top));
-    }
-    add_list(out, masts);
-    Marker arms = marker(h, "steady_arms", 0, Marker::LINE_LIST);
-    arms.scale.x = 0.03;
-    arms.color = color(0.2f, 0.5f, 0.9f);
-    for (const SupportSpring& sp : m.springs) {
-      if (!sp.steady_arm) continue;
-      const double z = shown(sp.dof);
-      arms.points.push_back(point(sp.x + s.line_offset, y_mast, wire_dof_design_height(m, sp.dof)));
-      arms.points.push_back(point(sp.x + s.line_offset, dof_lateral(m, s, sp.dof), z));
-    }
-    add_list(out, arms);
-  }
-
-  // Pantographs: head, frame, force arrow and label. The head is exaggerated about the design
-  // height of the contact wire under it, like the wires about theirs, so it is drawn on the wire
-  // it touches (see drawn_head_height).
-  const std::size_t nw = m.contact_wires.size();
+  const Drawing d{m, s, o, h, o.vertical_scale};
+  add_wires(out, d);
+  add_droppers(out, d);
+  if (o.include_static) add_supports(out, d);
   for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
-    const Pantograph& pg = m.pantographs[p];
-    const int id = static_cast<int>(p);
-    const double x = pantograph_position(m, s, id);
-    const double z_head = drawn_head_height(m, s, id, k);
-    const double force = total_contact_force(m, s, id);
-    const bool contact = force > 0.0;
-    // Across the track: the head's centre (sway), its strips' working width and horn extent.
-    const double yh = head_lateral(m, s, p);
-    // Where the force is drawn: the mean contact point across the strips on a 3-D line.
-    double y_force = yh;
-    if (m.lateral) {
-      double sum = 0.0;
-      int count = 0;
-      for (int ci : pg.collectors) {
-        const double yc = static_cast<std::size_t>(ci) < s.lateral.collector_lateral.size() ? s.lateral.collector_lateral[ci]
-                                                                                         : std::nan("");
-        if (std::isfinite(yc)) {
-          sum += yc;
-          ++count;
-        }
-      }
-      if (count) y_force = yh + sum / count;
-    }
-
-    // A plain moving force is a point; a pantograph (lumped, or a real one on a rig) has one or
-    // more heads: collector strips across the track (carbon, pantograph_head.working_width) on a
-    // head, and horns curving down at both ends to pantograph_head.horn_width. Several heads (each
-    // on its own suspension) are drawn each at its own height, centred on its own strips, with a
-    // suspension link down to the frame; head 0 keeps id p, head h > 0 has id kHeadIdStride h + p.
-    const bool point_force = pg.moving_force && !pg.external;
-    const int heads = std::max(1, head_count(m, id));
-    const bool several = !pg.heads.empty();
-    const double half_width = 0.5 * m.scene.pantograph_head.working_width;
-    const double horn = std::max(0.05, 0.5 * (m.scene.pantograph_head.horn_width - m.scene.pantograph_head.working_width));
-    // Each strip a segment across the track over its own working width (strips of one head may
-    // differ: collectors[].working_width), drawn as thick as a strip is wide along the track.
-    Marker strips = marker(h, "pantograph_strips", id, Marker::LINE_LIST);
-    strips.scale.x = 0.035;
-    strips.color = contact ? color(0.05f, 0.05f, 0.05f) : color(1.0f, 0.1f, 0.1f);
-    Marker horns = marker(h, "pantograph_horns", id, Marker::LINE_LIST);
-    horns.scale.x = 0.03;
-    horns.color = color(0.3f, 0.3f, 0.32f);
-    Marker links = marker(h, "pantograph_suspension", id, Marker::LINE_LIST);
-    links.scale.x = 0.03;
-    links.color = color(0.55f, 0.55f, 0.6f);
-    for (int hd = 0; hd < heads; ++hd) {
-      const double zh = several ? drawn_head_height(m, s, id, hd, k) : z_head;
-      double xh = x, head_force = 0.0;
-      if (several) {
-        xh = x + m.scene.pantographs[p].heads[hd].offset;
-        for (int ci : pg.collectors)
-          if (m.collectors[ci].head == hd)
-            for (std::size_t kw = 0; kw < nw; ++kw) head_force += s.contact_force[ci * nw + kw];
-      }
-      const bool head_contact = several ? head_force > 0.0 : contact;
-      Marker head = marker(h, "pantograph_head", hd == 0 ? id : kHeadIdStride * hd + id,
-                           point_force ? Marker::SPHERE : Marker::CUBE);
-      if (point_force) {
-        head.pose.position = point(x, y_force, z_head - 0.03);
-        head.scale.x = head.scale.y = head.scale.z = 0.2;
-      } else if (several) {
-        // A plate under the head's strips, as long as the head (scene `length`).
-        head.pose.position = point(xh, yh, zh - 0.045);
-        head.scale.x = m.scene.pantographs[p].heads[hd].length;
-        head.scale.y = 2.0 * half_width;
-        head.scale.z = 0.03;
-      } else {
-        // Its top at the drawn head height (the strips' running surface), where the arrow starts.
-        head.pose.position = point(x, yh, z_head - 0.02);
-        head.scale.x = 0.1;
-        head.scale.y = 2.0 * half_width;
-        head.scale.z = 0.04;
-      }
-      head.color = head_contact ? color(0.25f, 0.25f, 0.28f) : color(1.0f, 0.1f, 0.1f);
-      out.markers.push_back(head);
-      if (point_force) continue;
-      for (int ci : pg.collectors)
-        if (!several || m.collectors[ci].head == hd) {
-          const double hw = m.collectors[ci].half_working_width;
-          strips.points.push_back(point(x + m.collectors[ci].offset, yh - hw, zh - 0.015));
-          strips.points.push_back(point(x + m.collectors[ci].offset, yh + hw, zh - 0.015));
-        }
-      for (double side : {-1.0, 1.0}) {  // from the strip's end out and down: a quarter arc in 4 pieces
-        double py = yh + side * half_width, pz = zh - 0.03;
-        for (int i = 1; i <= 4; ++i) {
-          const double a = 0.5 * M_PI * i / 4.0;
-          const double ny = yh + side * (half_width + horn * std::sin(a)), nz = zh - 0.03 - 0.25 * (1.0 - std::cos(a));
-          horns.points.push_back(point(xh, py, pz));
-          horns.points.push_back(point(xh, ny, nz));
-          py = ny;
-          pz = nz;
-        }
-      }
-      if (several) {  // the head's suspension, down to the top of the frame under the reference point
-        links.points.push_back(point(xh, yh, zh - 0.06));
-        links.points.push_back(point(x, yh, z_head - 0.2));
-      }
-    }
-    if (!point_force) {
-      add_list(out, strips);
-      add_list(out, horns);
-      if (several) add_list(out, links);
-      if (m.lateral) {
-        // Where each strip meets the wire: yellow on the working width, red beyond it (dewired).
-        Marker spots = marker(h, "lateral_contact", id, Marker::SPHERE_LIST);
-        spots.scale.x = spots.scale.y = spots.scale.z = 0.2;
-        for (int ci : pg.collectors) {
-          const double yc = static_cast<std::size_t>(ci) < s.lateral.collector_lateral.size()
-                                ? s.lateral.collector_lateral[ci] : std::nan("");
-          if (!std::isfinite(yc)) continue;
-          spots.points.push_back(point(x + m.collectors[ci].offset, yh + yc, z_head));
-          spots.colors.push_back(std::fabs(yc) <= half_width ? color(1.0f, 0.85f, 0.1f) : color(1.0f, 0.1f, 0.1f));
-        }
-        add_list(out, spots);
-      }
-    }
-
-    Marker frame = marker(h, "pantograph_frame", id, Marker::LINE_STRIP);
-    frame.scale.x = 0.05;
-    frame.color = color(0.3f, 0.3f, 0.3f);
-    const double z_roof = std::min(4.0, z_head - 1.0);
-    frame.points.push_back(point(x - 1.2, yh, z_roof));
-    frame.points.push_back(point(x + 0.6, yh, 0.5 * (z_roof + z_head)));
-    frame.points.push_back(point(x, yh, pg.heads.empty() ? z_head - 0.06 : z_head - 0.2));
-    add_list(out, frame);
-
-    Marker arrow = marker(h, "contact_force", id, Marker::ARROW);
-    arrow.scale.x = 0.05;  // shaft diameter
-    arrow.scale.y = 0.1;   // head diameter
-    arrow.scale.z = 0.1;   // head length
-    arrow.color = contact ? color(0.1f, 0.8f, 0.2f) : color(1.0f, 0.1f, 0.1f);
-    arrow.points.push_back(point(x, y_force, z_head));
-    arrow.points.push_back(point(x, y_force, z_head + std::max(0.0, force) * kArrowMetresPerNewton + 1e-3));
-    out.markers.push_back(arrow);
-
-    Marker label = marker(h, "label", id, Marker::TEXT_VIEW_FACING);
-    label.scale.z = kLabelTextSize;
-    label.color = color(1.0f, 1.0f, 1.0f);
-    std::ostringstream t;
-    t << std::fixed << std::setprecision(0) << pg.name << ": " << force << " N" << (contact ? "" : " LOSS") << "\n";
-    int lines = 2;
-    if (nw > 1) {
-      // Force on each contact wire the collectors are under (two in an overlap), on a line of its own.
-      const char* sep = "";
-      for (std::size_t kw = 0; kw < nw; ++kw) {
-        const int wi = m.contact_wires[kw];
-        if (!under_wire(m, s, id, wi)) continue;
-        double f = 0.0;
-        for (int ci : pg.collectors) f += s.contact_force[ci * nw + kw];
-        t << sep << label_wire_name(m.wires[wi].name) << " " << f;
-        sep = " / ";
-      }
-      if (*sep) {
-        t << " N\n";
-        ++lines;
-      }
-    }
-    if (m.lateral && y_force != yh) {  // the contact point across the strip (mean over the collectors)
-      t << "strip " << std::showpos << std::setprecision(2) << y_force - yh << std::noshowpos << " m\n";
-      ++lines;
-    }
-    t << std::setprecision(1) << s.speed * 3.6 << " km/h";
-    // Text is centred on its position: keep its lowest line kLabelClearance above the head.
-    label.pose.position = point(x, 0.0, z_head + kLabelClearance + 0.5 * lines * kLabelLineHeight);
-    label.text = t.str();
-    out.markers.push_back(label);
+    const PantographView v = pantograph_view(d, p);
+    add_heads(out, d, p, v);
+    if (!v.point_force && m.lateral) add_contact_points(out, d, p, v);
+    add_frame_and_force(out, d, p, v);
+    add_label(out, d, p, v);
   }
-  if (o.lateral_scale != 1.0) {
-    // Stretch across the track: positions, points and the widths of boxes and dots.
-    for (Marker& mk : out.markers) {
-      mk.pose.position.y *= o.lateral_scale;
-      for (geometry_msgs::Point& p : mk.points) p.y *= o.lateral_scale;
-      if (mk.type == Marker::CUBE || mk.type == Marker::CUBE_LIST || mk.type == Marker::SPHERE_LIST) mk.scale.y *= o.lateral_scale;
-    }
-  }
+  if (o.lateral_scale != 1.0) stretch_across(out, o.lateral_scale);
   return out;
 }
 

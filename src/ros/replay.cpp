@@ -59,7 +59,7 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
       return field + ".stations[0] = " + num(ws.stations.front()) + ": expected " + num(w.x.front() + offset) +
              " (the line offset of the first wire)" + kOtherScene;
     for (int i = 0; i < w.nodes(); ++i)
-      s->u[w.w_dof + i] = interpolate(ws.stations, ws.heights, w.x[i] + o) - w.height[i];
+      s->wire_uplift(m, static_cast<int>(wi), i) = interpolate(ws.stations, ws.heights, w.x[i] + o) - w.height[i];
     // A 3-D line's lateral positions (an empty list on a 2-D line).
     const std::size_t lateral_expected = m.lateral ? ws.stations.size() : 0;
     if (ws.lateral.size() != lateral_expected)
@@ -101,8 +101,8 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
       return field + ": " + num(ps.displacement.size()) + " displacements and " + num(ps.velocity.size()) +
              " velocities: expected " + num(masses) + " of each (the masses of '" + pg.name + "')" + kOtherScene;
     for (std::size_t i = 0; i < masses; ++i) {
-      s->u[pg.first_dof + i] = ps.displacement[i];
-      s->v[pg.first_dof + i] = ps.velocity[i];
+      s->pantograph_displacement(m, static_cast<int>(p), static_cast<int>(i)) = ps.displacement[i];
+      s->pantograph_velocity(m, static_cast<int>(p), static_cast<int>(i)) = ps.velocity[i];
     }
     s->uplift[p] = ps.uplift;
     if (c.contact_wires.size() != nw)
@@ -117,7 +117,7 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
              " values: expected " + num(pg.collectors.size() * nw) + " (collectors x contact wires)" + kOtherScene;
     for (std::size_t j = 0; j < pg.collectors.size(); ++j)
       for (std::size_t k = 0; k < nw; ++k)
-        s->contact_force[pg.collectors[j] * nw + k] = c.wire_forces[j * nw + k];
+        s->contact_force_on(m, pg.collectors[j], static_cast<int>(k)) = c.wire_forces[j * nw + k];  // message: collectors x wires
   }
 
   // Droppers: slack where the core's criterion says so (no tension at the elastic stretch, on a

@@ -59,11 +59,8 @@ void StripChart::sample(const Model& m, const State& s) {
     r.max = std::max(r.max, f);
     r.min = std::min(r.min, f);
     if (nw > 1)
-      for (std::size_t k = 0; k < nw; ++k) {
-        double fk = 0.0;
-        for (int ci : m.pantographs[p].collectors) fk += s.contact_force[ci * nw + k];
-        data_.series[j++].force.push_back(fk);
-      }
+      for (std::size_t k = 0; k < nw; ++k)
+        data_.series[j++].force.push_back(s.pantograph_force_on(m, static_cast<int>(p), static_cast<int>(k)));
   }
   // Keep the window (and a sample before it, so the strip starts at the panel's edge).
   std::size_t drop = 0;

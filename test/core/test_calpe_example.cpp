@@ -32,10 +32,9 @@ const Pass& calpe_pass() {
     const Model& m = sim.model();
     EXPECT_EQ(m.contact_wires.size(), 2u);
     p.rise = m.sections[0].rise_last;
-    const std::size_t nw = m.contact_wires.size();
     do {
       const State& s = sim.state();
-      p.samples.push_back({pantograph_position(m, s, 0), s.contact_force[0 * nw + 0], s.contact_force[0 * nw + 1]});
+      p.samples.push_back({pantograph_position(m, s, 0), s.contact_force_on(m, 0, 0), s.contact_force_on(m, 0, 1)});
     } while (sim.step() == StepStatus::kOk);
     EXPECT_EQ(sim.state().status, StepStatus::kFinished) << sim.status_message();
     return p;

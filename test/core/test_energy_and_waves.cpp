@@ -61,7 +61,7 @@ void pluck(const cs::Model& m, cs::State& s, Shape shape, Slope slope) {
   s.v.setZero();
   for (int i = 0; i < w.nodes(); ++i) {
     if (m.inv_mass[w.w_dof + i] == 0.0) continue;  // rigid ends stay put
-    s.u[w.w_dof + i] = shape(w.x[i]);
+    s.wire_uplift(m, 0, i) = shape(w.x[i]);
     if (w.theta_dof >= 0) s.u[w.theta_dof + i] = slope(w.x[i]);
   }
 }
@@ -183,10 +183,10 @@ TEST(Waves, PulseTravelsAtWaveSpeed) {
     // Crest of the right-going half: the largest u ahead of the release point.
     int best = -1;
     for (int i = 1; i + 1 < w.nodes(); ++i)
-      if (w.x[i] > x0 && (best < 0 || s.u[w.w_dof + i] > s.u[w.w_dof + best])) best = i;
+      if (w.x[i] > x0 && (best < 0 || s.wire_uplift(m, 0, i) > s.wire_uplift(m, 0, best))) best = i;
     ASSERT_GT(best, 0);
     ASSERT_LT(best + 1, w.nodes());
-    const double ym = s.u[w.w_dof + best - 1], y0 = s.u[w.w_dof + best], yp = s.u[w.w_dof + best + 1];
+    const double ym = s.wire_uplift(m, 0, best - 1), y0 = s.wire_uplift(m, 0, best), yp = s.wire_uplift(m, 0, best + 1);
     const double h = w.x[best + 1] - w.x[best];
     const double den = ym - 2.0 * y0 + yp;
     const double shift = den < 0.0 ? 0.5 * (ym - yp) / den : 0.0;  // vertex of the parabola

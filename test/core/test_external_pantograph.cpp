@@ -67,7 +67,7 @@ TEST(ExternalPantograph, ContactPointMotionIsTheWireUnderTheCollector) {
   contact_point_motion(m, sim.state(), 0, c1);
   ASSERT_EQ(c0.size(), 1u);
   ASSERT_TRUE(c0[0].on_wire);
-  EXPECT_NEAR(c1[0].height, sim.state().collector_height[0], 1e-12);  // the eq. 12 height
+  EXPECT_NEAR(c1[0].height, sim.state().wire_height_under(m, 0, 0), 1e-12);  // the eq. 12 height
   // The height the moving pantograph meets changes at path_velocity: the mean of the values at
   // both ends of a step matches the difference quotient of the heights. The velocity at the
   // state's time is the half-step velocity advanced by half a step with the previous step's

@@ -252,14 +252,14 @@ TEST(InitialConfiguration, PantographPressedOnWithStaticUplift) {
   double wsum = 0.0, yw = 0.0;
   for (int a = 0; a < cnt; ++a) {
     wsum += weight[a];
-    yw += weight[a] * (cw.height[node[a]] + s.u[cw.w_dof + node[a]]);
+    yw += weight[a] * s.wire_height(m, m.contact_wires.at(0), node[a]);
   }
   EXPECT_NEAR(wsum, 1.0, 1e-12);  // eq. 11
-  const double head = p.reference_height + s.u[p.first_dof];
+  const double head = p.reference_height + s.pantograph_displacement(m, 0, 0);
   EXPECT_NEAR(m.contact_stiffness * (head - yw), F, 1e-4);
   // The wire is pushed up under the head (the static uplift lifts it).
   double wire_u = 0.0;
-  for (int a = 0; a < cnt; ++a) wire_u += weight[a] * s.u[cw.w_dof + node[a]];
+  for (int a = 0; a < cnt; ++a) wire_u += weight[a] * s.wire_uplift(m, m.contact_wires.at(0), node[a]);
   EXPECT_GT(wire_u, 0.0);
 
   // The initial state's own observation reports the static contact force (eq. 22 at t_0).

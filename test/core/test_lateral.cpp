@@ -172,13 +172,14 @@ TEST(Lateral, StaggerAndGustsChangeTheContactForceThroughTheLean) {
     std::int64_t n = 0;
     while (a.step() == StepStatus::kOk) {
       ASSERT_EQ(b.step(), StepStatus::kOk) << b.status_message();
-      const double fa = a.state().contact_force[0], fb = b.state().contact_force[0];
+      const double fa = a.state().contact_force_on(a.model(), 0, 0), fb = b.state().contact_force_on(b.model(), 0, 0);
       diff_sq += (fb - fa) * (fb - fa);
       sum_a += fa;
       sum_b += fb;
       sq_a += fa * fa;
       for (double e : b.state().lateral.dropper_stretch) delta_max = std::max(delta_max, std::fabs(e));
-      height_max = std::max(height_max, std::fabs(b.state().collector_height[0] - a.state().collector_height[0]));
+      height_max = std::max(height_max, std::fabs(b.state().wire_height_under(b.model(), 0, 0) -
+                                                  a.state().wire_height_under(a.model(), 0, 0)));
       ++n;
     }
     const double mean_a = sum_a / n, mean_b = sum_b / n, std_a = std::sqrt(sq_a / n - mean_a * mean_a);
@@ -1287,10 +1288,10 @@ TEST(Lateral, HeadWindAddsToThePantographsAerodynamicUplift) {
                                      : scene(direction));
     const Model& m = sim.model();
     const Pantograph& p = m.pantographs[0];
-    const int nm = p.masses_count(), low = p.first_dof + nm - 1;
+    const int nm = p.masses_count(), low = nm - 1;
     auto momentum = [&] {
       double q = 0.0;
-      for (int i = 0; i < nm; ++i) q += p.masses[i] * sim.state().v[p.first_dof + i];
+      for (int i = 0; i < nm; ++i) q += p.masses[i] * sim.state().pantograph_velocity(m, 0, i);
       return q;
     };
     const double q0 = momentum();
@@ -1298,7 +1299,8 @@ TEST(Lateral, HeadWindAddsToThePantographsAerodynamicUplift) {
     *steps = 0;
     while (!sim.finished()) {
       const State& st = sim.state();
-      sum += p.stiffness[nm - 1] * st.u[low] + p.damping[nm - 1] * st.v[low] + total_contact_force(m, st, 0);
+      sum += p.stiffness[nm - 1] * st.pantograph_displacement(m, 0, low) + p.damping[nm - 1] * st.pantograph_velocity(m, 0, low) +
+             total_contact_force(m, st, 0);
       ASSERT_EQ(sim.step(), StepStatus::kOk);
       ++*steps;
     }

@@ -93,7 +93,7 @@ PassResult run_pass(double speed, bool implicit) {
     if (x >= kSpan) break;
     const int cnt = cs::contact_weights(wire, 0.0, x, node.data(), weight.data());
     double u = 0.0;
-    for (int a = 0; a < cnt; ++a) u += weight[a] * s.u[wire.w_dof + node[a]];
+    for (int a = 0; a < cnt; ++a) u += weight[a] * s.wire_uplift(m, 0, node[a]);
     const double w = modal_deflection(x, t, speed, kModes);
     r.max_error = std::max(r.max_error, std::fabs(u - w));
     r.peak = std::max(r.peak, std::fabs(w));

@@ -39,9 +39,9 @@ TEST(OverlapContacts, TwoStripsOnATwinOverlapTouchFourWiresAtTheCrossing) {
   const State& s = sim.state();  // eq. 23 with the head at the crossing point Q
   std::set<int> touched;
   double total = 0.0;
-  for (std::size_t c = 0; c < m.collectors.size(); ++c)
-    for (std::size_t w = 0; w < m.contact_wires.size(); ++w) {
-      const double f = s.contact_force[c * m.contact_wires.size() + w];
+  for (int c = 0; c < static_cast<int>(m.collectors.size()); ++c)
+    for (int w = 0; w < static_cast<int>(m.contact_wires.size()); ++w) {
+      const double f = s.contact_force_on(m, c, w);
       EXPECT_GE(f, 0.0);
       if (f > 0.0) touched.insert(static_cast<int>(w));
       total += f;
@@ -65,10 +65,10 @@ TEST(OverlapContacts, AwayFromTheOverlapOnlyOneSeriesIsTouched) {
   for (double x : {30.0, 70.0}) {
     Simulation sim(twin_overlap(x));
     const Model& m = sim.model();
-    for (std::size_t c = 0; c < m.collectors.size(); ++c)
-      for (std::size_t w = 0; w < m.contact_wires.size(); ++w) {
+    for (int c = 0; c < static_cast<int>(m.collectors.size()); ++c)
+      for (int w = 0; w < static_cast<int>(m.contact_wires.size()); ++w) {
         const int section = m.wires[m.contact_wires[w]].section;
-        const double f = sim.state().contact_force[c * m.contact_wires.size() + w];
+        const double f = sim.state().contact_force_on(m, c, w);
         if (section == (x < 50.0 ? 0 : 1)) {
           EXPECT_GT(f, 0.0) << "x " << x << " wire " << w;
         } else {

@@ -123,15 +123,15 @@ TEST(PantographHeads, StaticLoadSplitFollowsTheSuspensions) {
   ASSERT_EQ(p.heads.size(), 2u);
   const double k0 = m.contact_stiffness, F = p.static_uplift;
   double f[2], y[2], sh[2];
-  const std::size_t nw = m.contact_wires.size();
+  const int nw = static_cast<int>(m.contact_wires.size());
   for (int h = 0; h < 2; ++h) {
     const int ci = p.heads[h].collectors[0];
     int touching = 0;
-    for (std::size_t w = 0; w < nw; ++w)
-      if (s.contact_force[ci * nw + w] > 0.0) {
+    for (int w = 0; w < nw; ++w)
+      if (s.contact_force_on(m, ci, w) > 0.0) {
         ++touching;
-        f[h] = s.contact_force[ci * nw + w];
-        y[h] = s.collector_height[ci * nw + w] - p.heads[h].reference_height;  // both measured from their reference
+        f[h] = s.contact_force_on(m, ci, w);
+        y[h] = s.wire_height_under(m, ci, w) - p.heads[h].reference_height;  // both measured from their reference
       }
     ASSERT_EQ(touching, 1) << "a current span: one wire under each strip";
     sh[h] = 1.0 / (1.0 / k0 + 1.0 / p.heads[h].stiffness);
@@ -170,9 +170,9 @@ TEST(PantographHeads, EightContactsOnATwinOverlapEachSwitchingOnItsOwn) {
     const State& s = sim.state();
     int on = 0;
     for (int ci = 0; ci < 2; ++ci)
-      for (std::size_t w = 0; w < 4; ++w) {
-        const double y = s.collector_height[ci * 4 + w];
-        const double f = s.contact_force[ci * 4 + w];
+      for (int w = 0; w < 4; ++w) {
+        const double y = s.wire_height_under(m, ci, w);
+        const double f = s.contact_force_on(m, ci, w);
         if (std::isnan(y)) continue;
         const Collector& col = m.collectors[ci];
         const double gap = p.contact_reference(col) + s.u[col.dof] - y;
@@ -187,7 +187,7 @@ TEST(PantographHeads, EightContactsOnATwinOverlapEachSwitchingOnItsOwn) {
     // one height, so they switch as a pair: that is the geometry, eq. 15-16.)
     int pattern[2] = {0, 0};
     for (int ci = 0; ci < 2; ++ci)
-      for (int w = 0; w < 4; ++w) pattern[ci] |= (s.contact_force[ci * 4 + w] > 0.0) << w;
+      for (int w = 0; w < 4; ++w) pattern[ci] |= (s.contact_force_on(m, ci, w) > 0.0) << w;
     partial_steps += on > 0 && pattern[0] != pattern[1];
   }
   EXPECT_EQ(mismatches, 0);
@@ -287,7 +287,7 @@ TEST(PantographHeads, EveryHeadsStripStartsAndEndsOnTheLine) {
   EXPECT_NEAR(m.train_start, 0.25, 1e-12);
   EXPECT_NEAR(m.train_end, m.line_length - 0.25, 1e-12);
   for (const Head& h : m.pantographs[0].heads)
-    for (int ci : h.collectors) EXPECT_GT(sim.state().contact_force[ci * m.contact_wires.size()], 0.0);
+    for (int ci : h.collectors) EXPECT_GT(sim.state().contact_force_on(m, ci, 0), 0.0);
   YAML::Node r = YAML::Clone(root);
   r["train"]["start"] = 0.1;
   std::string e = "(no error)";

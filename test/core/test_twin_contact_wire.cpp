@@ -33,12 +33,13 @@ TEST(TwinContactWire, BothWiresShareTheLoadEquallyAndTheLineIsStiffer) {
   for (int i = 0; i < a.nodes(); ++i) ASSERT_NEAR(a.height[i], b.height[i], 1e-12);
   // Static contact (eq. 23): the uplift splits in two equal halves.
   const State& s0 = sim.state();
-  EXPECT_NEAR(s0.contact_force[0] + s0.contact_force[1], 100.0, 1e-6);
-  EXPECT_NEAR(s0.contact_force[0], s0.contact_force[1], 1e-9);
+  EXPECT_NEAR(s0.contact_force_on(m, 0, 0) + s0.contact_force_on(m, 0, 1), 100.0, 1e-6);
+  EXPECT_NEAR(s0.contact_force_on(m, 0, 0), s0.contact_force_on(m, 0, 1), 1e-9);
   // During a pass too, at every step (rounding only: the two wires see identical operations).
   while (sim.step() == StepStatus::kOk) {
     const State& s = sim.state();
-    ASSERT_NEAR(s.contact_force[0], s.contact_force[1], 1e-9 * (1.0 + s.contact_force[0])) << "t = " << s.time;
+    const double f0 = s.contact_force_on(m, 0, 0), f1 = s.contact_force_on(m, 0, 1);
+    ASSERT_NEAR(f0, f1, 1e-9 * (1.0 + f0)) << "t = " << s.time;
   }
   EXPECT_EQ(sim.state().status, StepStatus::kFinished);
   // Elasticity at mid-span of span 1: two contact wires (twice the contact-wire tension and

@@ -33,8 +33,7 @@ TEST(Watchdog, RunawayDisplacementStopsTheRun) {
 TEST(Watchdog, NaNIsCaughtOnTheStepItAppears) {
   Simulation sim(load_scene_file(test_scenes::kReference));
   State s = sim.state();
-  const Wire& cw = sim.model().wires[0];
-  s.u[cw.w_dof + cw.nodes() / 2] = std::nan("");
+  s.wire_uplift(sim.model(), 0, sim.model().wires[0].nodes() / 2) = std::nan("");
   EXPECT_EQ(step(sim.model(), s), StepStatus::kDiverged);
   EXPECT_EQ(s.time, sim.state().time);  // time did not advance past the bad step
   EXPECT_GE(s.diverged_dof, 0);

@@ -95,7 +95,7 @@ TEST(Window, EndsLetAPulseOut) {
   const Wire& w = m.wires[0];
   for (int i = 0; i < w.nodes(); ++i) {
     const double d = (w.x[i] - 200.0) / 5.0;
-    s.u[w.w_dof + i] = 0.01 * std::exp(-d * d);
+    s.wire_uplift(m, 0, i) = 0.01 * std::exp(-d * d);
   }
   const double e0 = wire_energy(m, s);
   const int steps = static_cast<int>(1.0 / m.dt);

@@ -4,16 +4,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/ros/conversions.hpp"
 #include "catenary_sim/ros/params.hpp"
 #include "../support/scenes.hpp"
 
+#include <ros/serialization.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
 using namespace catenary_sim;
@@ -77,8 +80,8 @@ TEST_F(Fixture, PantographStateHasEveryMass) {
   ASSERT_EQ(ps.displacement.size(), static_cast<std::size_t>(pg.masses_count()));
   ASSERT_EQ(ps.velocity.size(), ps.displacement.size());
   for (int i = 0; i < pg.masses_count(); ++i) {
-    EXPECT_DOUBLE_EQ(ps.displacement[i], s.u[pg.first_dof + i]);
-    EXPECT_DOUBLE_EQ(ps.velocity[i], s.v[pg.first_dof + i]);
+    EXPECT_DOUBLE_EQ(ps.displacement[i], s.pantograph_displacement(m, 0, i));
+    EXPECT_DOUBLE_EQ(ps.velocity[i], s.pantograph_velocity(m, 0, i));
   }
   EXPECT_DOUBLE_EQ(ps.uplift, s.uplift[0]);
   EXPECT_DOUBLE_EQ(ps.head_height, head_height(m, s, 0));
@@ -86,7 +89,7 @@ TEST_F(Fixture, PantographStateHasEveryMass) {
   // A chain is one head (its first mass), whose aero is the frame's.
   EXPECT_EQ(ps.head_count, 1);
   ASSERT_EQ(ps.head_heights.size(), 1u);
-  EXPECT_DOUBLE_EQ(ps.head_heights[0], pg.reference_height + s.u[pg.first_dof]);
+  EXPECT_DOUBLE_EQ(ps.head_heights[0], pg.reference_height + s.pantograph_displacement(m, 0, 0));
   ASSERT_EQ(ps.head_aero_uplift.size(), 1u);
   EXPECT_EQ(ps.head_aero_uplift[0], 0.0);
   EXPECT_EQ(ps.knee, "leading");
@@ -121,7 +124,7 @@ TEST_F(Fixture, WireShapeSamplesAtResolutionAndKeepsEnds) {
         for (int i = 0; i < w.nodes(); ++i)
           if (w.x[i] == ws.stations[k]) node = i;
         ASSERT_GE(node, 0);
-        EXPECT_DOUBLE_EQ(ws.heights[k], w.height[node] + s.u[w.w_dof + node]);
+        EXPECT_DOUBLE_EQ(ws.heights[k], s.wire_height(m, static_cast<int>(wi), node));
       }
     }
   }
@@ -168,7 +171,7 @@ TEST_F(Fixture, MarkersCoverEveryPartAndExaggerateDisplacement) {
   const Wire& w = m.wires[0];
   const auto& strip = arr.markers[0];
   ASSERT_EQ(strip.points.size(), static_cast<std::size_t>(w.nodes()));
-  for (int i = 0; i < w.nodes(); i += 31) EXPECT_DOUBLE_EQ(strip.points[i].z, w.height[i] + 10.0 * s.u[w.w_dof + i]);
+  for (int i = 0; i < w.nodes(); i += 31) EXPECT_DOUBLE_EQ(strip.points[i].z, w.height[i] + 10.0 * s.wire_uplift(m, 0, i));
   // Unique (ns, id) pairs, or rviz would overwrite markers.
   std::set<std::pair<std::string, int>> ids;
   for (const auto& mk : arr.markers) EXPECT_TRUE(ids.insert({mk.ns, mk.id}).second) << mk.ns << " " << mk.id;
@@ -234,7 +237,7 @@ TEST(Markers, HeadIsDrawnOnTheWireItTouchesAtMidSpan) {
   EXPECT_NEAR(contact_design_height(m, s, 0), m.scene.contact_wire_height - 0.055, 0.005);
   EXPECT_NEAR(drawn_head_height(m, s, 0, 1.0), head_height(m, s, 0), 1e-12);  // k = 1: the true height
   // The old rule (reference height + k u) is far off here, so this test tells the two apart.
-  EXPECT_GT(std::fabs(pg.reference_height + k * s.u[pg.first_dof] - z_wire), 0.3);
+  EXPECT_GT(std::fabs(pg.reference_height + k * s.pantograph_displacement(m, 0, 0) - z_wire), 0.3);
   // The arrow starts on the head and is 1 m per 100 N.
   EXPECT_DOUBLE_EQ(arrow->points[0].z, head_top);
   EXPECT_NEAR(arrow->points[1].z - arrow->points[0].z, force / 100.0, 2e-3);
@@ -272,7 +275,7 @@ TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
   ASSERT_EQ(ps.displacement.size(), static_cast<std::size_t>(pg.masses_count() + 2));  // frame, then heads
   for (int h = 0; h < 2; ++h) {
     EXPECT_DOUBLE_EQ(ps.head_heights[h], pg.heads[h].reference_height + s.u[pg.heads[h].dof]);
-    EXPECT_DOUBLE_EQ(ps.displacement[pg.masses_count() + h], s.u[pg.heads[h].dof]);
+    EXPECT_DOUBLE_EQ(ps.displacement[pg.masses_count() + h], s.pantograph_displacement(m, 0, pg.masses_count() + h));
     EXPECT_NEAR(ps.head_aero_uplift[h], 0.002 * s.speed * s.speed, 1e-12);  // the scene's a_h v^2
   }
   EXPECT_NEAR(ps.head_height, 0.5 * (ps.head_heights[0] + ps.head_heights[1]), 1e-12);
@@ -298,7 +301,6 @@ TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
   // Two heads x two sides x a quarter arc of 4 segments, 2 points each.
   EXPECT_EQ(horns->points.size(), 32u);
   EXPECT_EQ(links->points.size(), 4u);
-  const std::size_t nw = m.contact_wires.size();
   for (int h = 0; h < 2; ++h) {
     const double xh = x + (h == 0 ? 0.25 : -0.25);  // the scene's head offsets
     const auto* head = find_marker(arr, "pantograph_head", h == 0 ? 0 : kHeadIdStride);
@@ -308,9 +310,7 @@ TEST(Markers, TwoHeadsEachInTheStateAndDrawnOverItsOwnStrip) {
     const auto& strip = strips->points[2 * h];  // (its segment's first end)
     EXPECT_NEAR(strip.x, xh, 1e-9);
     // Its strip's top on the wire over it, k x that strip's contact-spring compression above.
-    double f = 0.0;
-    for (int ci : pg.heads[h].collectors)
-      for (std::size_t w = 0; w < nw; ++w) f += s.contact_force[ci * nw + w];
+    const double f = s.head_contact_force(m, 0, h);
     ASSERT_GT(f, 0.0);
     const double top = strip.z + 0.015;  // (a strip 30 mm high, drawn along its centre line)
     EXPECT_NEAR(top - strip_z(*wire, xh), k * f / m.contact_stiffness, 0.02) << "head " << h;
@@ -710,4 +710,62 @@ TEST(Markers, ThreeDimensionalLineIsDrawnAcrossTheTrackAndStretchedAlike) {
   }
   EXPECT_TRUE(dot);
   EXPECT_TRUE(wire);
+}
+
+namespace {
+
+// FNV-1a over the serialized message (the bytes rviz receives): any change of any field moves it.
+std::uint64_t wire_bytes_hash(const visualization_msgs::MarkerArray& a) {
+  const std::uint32_t n = ros::serialization::serializationLength(a);
+  std::vector<std::uint8_t> bytes(n);
+  ros::serialization::OStream out(bytes.data(), n);
+  ros::serialization::serialize(out, a);
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::uint8_t b : bytes) h = (h ^ b) * 1099511628211ull;
+  return h;
+}
+
+}  // namespace
+
+// The drawing must not move when its code is rearranged: the markers of scenes that take every
+// branch (static parts, slack droppers, two heads, an overlap's per-wire label, a 3-D line with
+// sway stretched across the track, two pantographs, an external pantograph, a moving force) are
+// hashed byte for byte, like the golden passes (test_golden_hashes). Each drawing was checked by
+// the tests above and in rviz; a change of the drawing changes a hash on purpose, and the commit
+// that records the new hash says why. On a mismatch the message prints the new hash.
+TEST(Markers, DrawingOfTheReferenceScenesIsUnchanged) {
+  const std::string dir = std::string(CATENARY_SIM_SOURCE_DIR) + "/config/";
+  struct Case {
+    const char* name;
+    std::string scene;
+    std::vector<std::string> overrides;
+    int steps;  // < 0: to the station -steps m
+    double lateral_scale;
+    bool all_slack;
+    std::uint64_t expected;
+  };
+  const std::vector<Case> cases = {
+      {"reference", dir + "reference_55m.yaml", {}, 2000, 1.0, false, 0xef496125ab41a9acull},
+      {"reference, every dropper slack", dir + "reference_55m.yaml", {}, 2000, 1.0, true, 0x4eeb7da29370cb34ull},
+      {"two heads", dir + "reference_55m_two_heads.yaml", {}, 3000, 1.0, false, 0x2c17b1565032233cull},
+      {"overlap", dir + "calpe_example.yaml", {}, -50, 1.0, false, 0x472af5e1c1cc5aa2ull},  // to 50 m: under both wires
+      {"3-D line with sway", dir + "reference_55m_3d.yaml",
+       {"pantograph_head.sway.amplitude=0.05", "pantograph_head.sway.frequency=0.5"}, 800, 7.0, false, 0xa76580d5ec007007ull},
+      {"two pantographs", dir + "reference_55m_two_pantographs.yaml", {}, 3000, 1.0, false, 0xcc0af6d3b9d7932aull},
+      {"external pantograph", dir + "reference_55m_hil.yaml", {}, 0, 1.0, false, 0x981d981f3f1990f0ull},
+      {"moving force", dir + "reference_55m.yaml", {"pantographs=[{name: force, type: moving_force, static_uplift: 120}]"}, 1000, 1.0, false, 0x29ff643478ab0a95ull},
+  };
+  for (const Case& c : cases) {
+    Simulation sim(load_scene_file(c.scene, c.overrides));
+    for (int i = 0; i < c.steps; ++i) ASSERT_EQ(sim.step(), StepStatus::kOk) << c.name;
+    if (c.steps < 0) step_to(sim, -c.steps);
+    State s = sim.state();
+    if (c.all_slack) std::fill(s.dropper_slack.begin(), s.dropper_slack.end(), 1);
+    MarkerOptions o;
+    o.lateral_scale = c.lateral_scale;
+    const std::uint64_t h = wire_bytes_hash(to_markers(sim.model(), s, ros::Time(1.0), o));
+    char got[32];
+    std::snprintf(got, sizeof got, "0x%016llxull", static_cast<unsigned long long>(h));
+    EXPECT_EQ(h, c.expected) << c.name << ": the markers hash to " << got;
+  }
 }

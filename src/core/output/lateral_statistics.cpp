@@ -71,14 +71,12 @@ LateralRecorder::LateralRecorder(const Model& m, double sample_rate_hz)
 void LateralRecorder::record(const Model& m, const State& s) {
   if (!m.lateral) return;
   const LateralModel& lat = *m.lateral;
-  const std::size_t nw = m.contact_wires.size();
   for (std::size_t c = 0; c < m.collectors.size(); ++c) {
     const Collector& col = m.collectors[c];
     ContactTrack& t = contacts_[c];
     const double x = s.front + s.line_offset - m.pantographs[col.pantograph].position + col.offset;
     const double y = s.lateral.collector_lateral[c];
-    double f = 0.0;
-    for (std::size_t k = 0; k < nw; ++k) f += s.contact_force[c * nw + k];
+    const double f = s.collector_force(m, static_cast<int>(c));
     if (!(x < x0_ || x > x1_ || std::isnan(y))) {
       if (t.samples == 0) {
         t.min = std::numeric_limits<double>::infinity();

@@ -145,12 +145,12 @@ void PassRecorder::record(const Model& m, const State& s) {
     const Pantograph& pg = m.pantographs[p];
     row.values.push_back(s.front - pg.position + s.line_offset + 0.0);  // + 0.0: no "-0" in the CSV
     for (int ci : pg.collectors)
-      for (std::size_t w = 0; w < nw; ++w) row.values.push_back(s.contact_force[ci * nw + w]);
+      for (std::size_t w = 0; w < nw; ++w) row.values.push_back(s.contact_force_on(m, ci, static_cast<int>(w)));
     row.values.push_back(total_contact_force(m, s, static_cast<int>(p)));
-    row.values.push_back(pg.moving_force ? 0.0 : s.u[pg.first_dof]);
+    row.values.push_back(pg.moving_force ? 0.0 : s.pantograph_displacement(m, static_cast<int>(p), 0));
   }
   if (!m.endless)
-    for (int k : steady_arm_springs_) row.values.push_back(s.u[m.springs[k].dof]);
+    for (int k : steady_arm_springs_) row.values.push_back(s.support_uplift(m, k));
   rows_.push_back(std::move(row));
   if (running_ && rows_.size() > kMaxRows) rows_.pop_front();
 }
@@ -170,19 +170,20 @@ void PassRecorder::record_whole(const Model& m, const State& s) {
     if (!pg.moving_force) {
       // Head suspension: the spring (and damper) from the head to the mass below (the roof for a
       // one-mass pantograph, whose uplift then acts on the head too).
-      const int a0 = pg.first_dof, nm = pg.masses_count();
+      const int nm = pg.masses_count(), pi = static_cast<int>(p);
+      const double top = s.pantograph_displacement(m, pi, 0);  // the chain's first mass: head or top frame
       if (pg.heads.empty()) {
-        const double stretch = (nm > 1 ? s.u[a0 + 1] : 0.0) - s.u[a0];
+        const double stretch = (nm > 1 ? s.pantograph_displacement(m, pi, 1) : 0.0) - top;
         double fe = pg.spring_preload[0] + pg.stiffness[0] * stretch;
         if (nm == 1) fe += s.uplift[p] + pg.aero_coefficient * air_speed_squared(s, p);
-        head_u_[p].push_back(s.u[a0]);
+        head_u_[p].push_back(top);
         suspension_stretch_[p].push_back(stretch);
         suspension_force_[p].push_back(fe);
       } else {
         // Every head's own suspension to the top frame mass (and its own aero force, which acts
         // on the head), one entry per head per step: the load cells sit under each head.
         for (const Head& h : pg.heads) {
-          const double stretch = s.u[a0] - s.u[h.dof];
+          const double stretch = top - s.u[h.dof];
           head_u_[p].push_back(s.u[h.dof]);
           suspension_stretch_[p].push_back(stretch);
           suspension_force_[p].push_back(h.preload + h.stiffness * stretch + h.aero_coefficient * air_speed_squared(s, p));
@@ -192,11 +193,8 @@ void PassRecorder::record_whole(const Model& m, const State& s) {
     const double xp = s.front - pg.position;  // model station
     position_[p].push_back(xp + s.line_offset);
     force_[p].push_back(total_contact_force(m, s, static_cast<int>(p)));
-    for (std::size_t w = 0; w < nw; ++w) {
-      double f = 0.0;
-      for (int ci : m.pantographs[p].collectors) f += s.contact_force[ci * nw + w];
-      wire_force_[p][w].push_back(f);
-    }
+    for (std::size_t w = 0; w < nw; ++w)
+      wire_force_[p][w].push_back(s.pantograph_force_on(m, static_cast<int>(p), static_cast<int>(w)));
     const auto first = std::lower_bound(steady_arm_x_.begin(), steady_arm_x_.end(), xp - longest_span_);
     for (std::size_t k = first - steady_arm_x_.begin(); k < steady_arm_x_.size() && steady_arm_x_[k] <= xp + longest_span_; ++k) {
       const SupportSpring& sp = m.springs[steady_arm_springs_[k]];

@@ -98,19 +98,20 @@ void PassRecorder::record_head(const Model& m, const State& s, std::size_t p) {
   const std::size_t i = steps_ - 1;  // this step
   std::vector<double>& h = head_history_[p];
   const std::size_t heads = pg.heads.empty() ? 1 : pg.heads.size(), slot = i % 3;
-  const int a0 = pg.first_dof, nm = pg.masses_count();
+  const int nm = pg.masses_count(), pi = static_cast<int>(p);
+  const double top = s.pantograph_displacement(m, pi, 0);  // the chain's first mass: head or top frame
   for (std::size_t k = 0; k < heads; ++k) {
     double* e = &h[(slot * heads + k) * 3];
     if (pg.heads.empty()) {
-      const double stretch = (nm > 1 ? s.u[a0 + 1] : 0.0) - s.u[a0];
+      const double stretch = (nm > 1 ? s.pantograph_displacement(m, pi, 1) : 0.0) - top;
       double fe = pg.spring_preload[0] + pg.stiffness[0] * stretch;
       if (nm == 1) fe += s.uplift[p] + pg.aero_coefficient * air_speed_squared(s, p);
-      e[0] = s.u[a0];
+      e[0] = top;
       e[1] = stretch;
       e[2] = fe;
     } else {
       const Head& hd = pg.heads[k];
-      const double stretch = s.u[a0] - s.u[hd.dof];
+      const double stretch = top - s.u[hd.dof];
       e[0] = s.u[hd.dof];
       e[1] = stretch;
       e[2] = hd.preload + hd.stiffness * stretch + hd.aero_coefficient * air_speed_squared(s, p);
@@ -140,8 +141,7 @@ void PassRecorder::record_in_section(const Model& m, const State& s, std::size_t
   r.unfiltered.add(f);
   r.lost += f <= 0.0;
   for (std::size_t w = 0; w < nw; ++w) {
-    double fw = 0.0;
-    for (int ci : pg.collectors) fw += s.contact_force[ci * nw + w];
+    const double fw = s.pantograph_force_on(m, static_cast<int>(p), static_cast<int>(w));
     r.wire_sum[w] += fw;
     r.wire_max[w] = std::max(r.wire_max[w], fw);
     r.wire_on[w] += fw > 0.0;

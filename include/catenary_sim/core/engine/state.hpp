@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -47,10 +48,61 @@ struct State {
   Eigen::VectorXd u, v;
   Eigen::VectorXd accel;  // q'' of the last step (at its start, t_n), for observers
 
+  // Uplift (m, + up, from the design state) of node `node` of wire `wire` (Model::wires).
+  double wire_uplift(const Model& m, int wire, int node) const { return u[wire_dof(m, wire, node)]; }
+  double& wire_uplift(const Model& m, int wire, int node) { return u[wire_dof(m, wire, node)]; }
+  // Height (m, absolute) of that node: its design height plus its uplift.
+  double wire_height(const Model& m, int wire, int node) const {
+    return m.wires[wire].height[node] + u[wire_dof(m, wire, node)];
+  }
+  // Uplift (m) of a support spring's wire node (Model::springs: a steady arm or a messenger support).
+  double support_uplift(const Model& m, int spring) const {
+    assert(spring >= 0 && static_cast<std::size_t>(spring) < m.springs.size());
+    return u[m.springs[spring].dof];
+  }
+  // Displacement (m) and velocity (m/s) of a pantograph's mass `mass`, 0 <= mass < dof_count():
+  // the chain from the head down (Pantograph::masses), then its heads (Pantograph::heads).
+  double pantograph_displacement(const Model& m, int pantograph, int mass) const { return u[pantograph_dof(m, pantograph, mass)]; }
+  double& pantograph_displacement(const Model& m, int pantograph, int mass) { return u[pantograph_dof(m, pantograph, mass)]; }
+  double pantograph_velocity(const Model& m, int pantograph, int mass) const { return v[pantograph_dof(m, pantograph, mass)]; }
+  double& pantograph_velocity(const Model& m, int pantograph, int mass) { return v[pantograph_dof(m, pantograph, mass)]; }
+
   // Observations of this state (time, front, u): filled by step() and observe().
   std::vector<double> contact_force;     // N, >= 0, per collector x contact wire (eq. 22, 25)
   std::vector<double> collector_height;  // m, weighted wire height under each collector (eq. 12)
   std::vector<std::uint8_t> dropper_slack;  // 1 where the dropper carried no tension
+
+  // Contact force (N) of collector `collector` (Model::collectors) on contact wire `wire`
+  // (Model::contact_wires).
+  double contact_force_on(const Model& m, int collector, int wire) const { return contact_force[contact_index(m, collector, wire)]; }
+  double& contact_force_on(const Model& m, int collector, int wire) { return contact_force[contact_index(m, collector, wire)]; }
+  // Weighted height (m, absolute) of contact wire `wire` under collector `collector` (eq. 12).
+  double wire_height_under(const Model& m, int collector, int wire) const {
+    return collector_height[contact_index(m, collector, wire)];
+  }
+  // Contact force (N) of one collector, summed over the contact wires (two in an overlap).
+  double collector_force(const Model& m, int collector) const {
+    double f = 0.0;
+    for (std::size_t k = 0; k < m.contact_wires.size(); ++k) f += contact_force_on(m, collector, static_cast<int>(k));
+    return f;
+  }
+  // Contact force (N) of one pantograph on one contact wire, summed over its collectors.
+  double pantograph_force_on(const Model& m, int pantograph, int wire) const {
+    double f = 0.0;
+    for (int ci : m.pantographs[pantograph].collectors) f += contact_force_on(m, ci, wire);
+    return f;
+  }
+  // Contact force (N) of head `head` of Pantograph::heads (its collectors, every contact wire);
+  // head < 0 or a pantograph without heads: all its collectors (= total_contact_force). Summed
+  // collector by collector and wire by wire, in the order total_contact_force sums.
+  double head_contact_force(const Model& m, int pantograph, int head) const {
+    const Pantograph& pg = m.pantographs[pantograph];
+    double f = 0.0;
+    for (int ci : pg.collectors)
+      if (head < 0 || pg.heads.empty() || m.collectors[ci].head == head)
+        for (std::size_t k = 0; k < m.contact_wires.size(); ++k) f += contact_force_on(m, ci, static_cast<int>(k));
+    return f;
+  }
 
   StepStatus status = StepStatus::kOk;
   int diverged_dof = -1;
@@ -89,6 +141,25 @@ struct State {
 
   // 3-D line (Model::lateral): the wires' lateral planes; empty without one.
   LateralState lateral;
+
+ private:
+  // The flat layouts of the vectors above (the step's hot loops index them directly). Checked
+  // in debug builds only: the accessors stay as cheap as the index.
+  static int wire_dof(const Model& m, int wire, int node) {
+    assert(wire >= 0 && static_cast<std::size_t>(wire) < m.wires.size());
+    assert(node >= 0 && node < m.wires[wire].nodes());
+    return m.wires[wire].w_dof + node;
+  }
+  static int pantograph_dof(const Model& m, int pantograph, int mass) {
+    assert(pantograph >= 0 && static_cast<std::size_t>(pantograph) < m.pantographs.size());
+    assert(!m.pantographs[pantograph].moving_force && mass >= 0 && mass < m.pantographs[pantograph].dof_count());
+    return m.pantographs[pantograph].first_dof + mass;
+  }
+  static std::size_t contact_index(const Model& m, int collector, int wire) {
+    assert(collector >= 0 && static_cast<std::size_t>(collector) < m.collectors.size());
+    assert(wire >= 0 && static_cast<std::size_t>(wire) < m.contact_wires.size());
+    return static_cast<std::size_t>(collector) * m.contact_wires.size() + static_cast<std::size_t>(wire);
+  }
 };
 
 // A state sized for the model with zero displacement (the design state, no pantograph force).
@@ -121,6 +192,13 @@ struct ContactPointMotion {
   double force = 0.0;            // N, contact force on this wire
 };
 void contact_point_motion(const Model& model, const State& state, int pantograph, std::vector<ContactPointMotion>& out);
+// The entry of contact_point_motion's `motion` for the pantograph's collector `j` (its place in
+// Pantograph::collectors) and contact wire `wire` (Model::contact_wires).
+inline const ContactPointMotion& motion_under(const Model& model, const std::vector<ContactPointMotion>& motion,
+                                              std::size_t j, std::size_t wire) {
+  assert(wire < model.contact_wires.size() && j * model.contact_wires.size() + wire < motion.size());
+  return motion[j * model.contact_wires.size() + wire];
+}
 
 // Absolute height of a contact collector's pantograph head (m); NaN for a moving force. With
 // several heads: their mean.
