@@ -127,7 +127,6 @@ void PassRecorder::record_head(const Model& m, const State& s, std::size_t p) {
 void PassRecorder::record_in_section(const Model& m, const State& s, std::size_t p, double x, double f, double dt,
                                      double dx) {
   const std::size_t nw = m.contact_wires.size();
-  const Pantograph& pg = m.pantographs[p];
   Running& r = run_[p];
   if (!r.any_in) {
     r.first_t = s.time;
