@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "catenary_sim/core/engine/lateral_energy.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/model/statics.hpp"

@@ -9,6 +9,7 @@
 #include <map>
 #include <numeric>
 
+#include "catenary_sim/core/engine/lateral_energy.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"

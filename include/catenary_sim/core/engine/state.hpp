@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "catenary_sim/core/model/lateral.hpp"
+#include "catenary_sim/core/engine/lateral_step.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/engine/step.hpp"
 #include "catenary_sim/core/engine/wire_window.hpp"
