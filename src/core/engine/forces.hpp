@@ -17,8 +17,8 @@ namespace catenary_sim {
 // Writes state.contact_force and state.collector_height; adds the forces to f unless f is null.
 void contact_forces(const Model& m, State& s, const double* u, double* f);
 
-// A 3-D line whose state has its lateral plane (make_state alone gives none: the vertical plane
-// then steps alone, as before the lateral plane acted on it).
+// A 3-D line whose state has its lateral plane (make_state gives it one; a state whose lateral
+// plane was cleared by hand steps its vertical plane alone, the droppers without a lean).
 inline bool leaning(const Model& m, const State& s) { return m.lateral && !s.lateral.dropper_stretch.empty(); }
 
 // kLean (a 3-D line, Model::lateral): every dropper's stretch has its lean's share too, averaged

@@ -329,29 +329,6 @@ StepStatus lateral_step(const Model& m, State& s) {
   return s.status;
 }
 
-
-StepStatus step_both_planes(const Model& m, State& s) {
-  const LateralModel& lat = *m.lateral;
-  LateralState& ls = s.lateral;
-  // Both planes sweep every node of the same packs: no window, one lateral step a vertical one,
-  // both fused, and the step will be taken (not the pass's end).
-  bool two_wire_packs = true;  // (sweep_pack_pair's four lanes)
-  for (const WireLanes& p : m.wire_packs) two_wire_packs &= p.lanes == 2;
-  ls.join = !lat.planes.empty() && two_wire_packs && lat.substeps == 1 && !m.scene.numerics.windowed() &&
-            s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty();
-  // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
-  // the vertical step's s.time += dt), refreshed now for the sweep (lateral_step then finds it
-  // done: the same values, once).
-  if (ls.join) refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
-  const StepStatus st = step(m, s);
-  ls.join = false;
-  if (st != StepStatus::kOk) {
-    ls.joined = false;
-    return st;
-  }
-  return lateral_step(m, s);
-}
-
 void shift_lateral_block(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;

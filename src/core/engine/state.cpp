@@ -68,6 +68,7 @@ State make_state(const Model& m) {
   s.front = m.train_start;
   s.line_offset = m.initial_line_offset;
   s.speed = s.target_speed = m.scene.train_speed;
+  if (m.lateral) s.lateral = make_lateral_state(m);  // a 3-D line: step() moves both planes
   return s;
 }
 

@@ -1,15 +1,19 @@
-// The step: which integrator advances the line. Each path lives in its own file:
-// explicit_step.cpp (eq. 19-21), centred_damping_step.cpp, implicit_step.cpp (Newmark).
+// The step: which integrator advances the vertical plane, and the lateral plane after it. Each
+// path lives in its own file: explicit_step.cpp (eq. 19-21), centred_damping_step.cpp,
+// implicit_step.cpp (Newmark), lateral_step.cpp (the 3-D line's lateral plane).
 #include "catenary_sim/core/engine/step.hpp"
 
+#include "catenary_sim/core/engine/lateral_step.hpp"
 #include "catenary_sim/core/engine/state.hpp"
 #include "engine/centred_damping_step.hpp"
 #include "engine/explicit_step.hpp"
 #include "engine/implicit_step.hpp"
+#include "engine/lateral_wind.hpp"
+#include "engine/wire_lanes.hpp"
 
 namespace catenary_sim {
 
-StepStatus step(const Model& m, State& s) {
+StepStatus vertical_step(const Model& m, State& s) {
   if (s.status != StepStatus::kOk) return s.status;
   if (s.front + s.line_offset >= m.train_end) {
     s.status = StepStatus::kFinished;
@@ -18,6 +22,46 @@ StepStatus step(const Model& m, State& s) {
   if (m.implicit) return implicit_step(m, s);
   if (m.scene.numerics.damping == DampingStep::kCentred) return centred_damping_step(m, s);
   return explicit_step(m, s);
+}
+
+namespace {
+
+// The vertical step, then the lateral one. Where both planes sweep every node of the same
+// two-wire packs (no window, one lateral substep, both fused), the vertical step runs the lateral
+// step's band sweep with its own, both planes in four lanes (sweep_pack_pair: the band and its
+// factors are the same both ways, loaded once, and each band operation does both planes). The
+// lateral sweep reads nothing the vertical step changes (the lateral state, the wind of the
+// step's start, the shared band and factors), and each lane does its own plane's operations, so
+// the results are those of the vertical step then lateral_step, to the bit.
+StepStatus step_both_planes(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  // Both planes sweep every node of the same packs: no window, one lateral step a vertical one,
+  // both fused, and the step will be taken (not the pass's end).
+  bool two_wire_packs = true;  // (sweep_pack_pair's four lanes)
+  for (const WireLanes& p : m.wire_packs) two_wire_packs &= p.lanes == 2;
+  ls.join = !lat.planes.empty() && two_wire_packs && lat.substeps == 1 && !m.scene.numerics.windowed() &&
+            s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty();
+  // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
+  // the vertical step's s.time += dt), refreshed now for the sweep (lateral_step then finds it
+  // done: the same values, once).
+  if (ls.join) refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
+  const StepStatus st = vertical_step(m, s);
+  ls.join = false;
+  if (st != StepStatus::kOk) {
+    ls.joined = false;
+    return st;
+  }
+  return lateral_step(m, s);
+}
+
+}  // namespace
+
+StepStatus step(const Model& m, State& s) {
+  // A 3-D line steps both planes (make_state gives its state the lateral one); a state whose
+  // lateral plane was cleared by hand, the vertical plane alone.
+  const bool lateral = m.lateral && s.lateral.y.size() == m.lateral->n;
+  return lateral ? step_both_planes(m, s) : vertical_step(m, s);
 }
 
 }  // namespace catenary_sim

@@ -86,6 +86,7 @@ struct LateralState {
   bool window_fused = false;  // the fused step can take the window (every wire's range two nodes or more)
 };
 
+// The lateral plane of a state (make_state gives a 3-D line's state its own).
 LateralState make_lateral_state(const Model& model);
 // State::head_wind of every pantograph: the wind's component against the direction of travel at
 // its station, from the mean wind and `field_points` (the turbulent field's held points at one
@@ -94,16 +95,8 @@ void update_head_wind(const Model& model, State& state, const WindFieldBuffer* f
 // Contact point positions of the current state (no step).
 void lateral_observe(const Model& model, State& state);
 // One lateral step of the model's dt (its substeps), after the vertical step moved the state to
-// its new time. Never allocates. Returns kDiverged or kDewired (on_dewirement: stop), else kOk.
+// its new time: step() takes both. Never allocates. Returns kDiverged or kDewired (on_dewirement: stop), else kOk.
 StepStatus lateral_step(const Model& model, State& state);
-// The vertical step, then the lateral one (Simulation::step on a 3-D line). Where both planes
-// sweep every node of the same two-wire packs (no window, one lateral substep, both fused), the
-// vertical step runs the lateral step's band sweep with its own, both planes in four lanes
-// (sweep_pack_pair: the band and its factors are the same both ways, loaded once, and each band
-// operation does both planes). The lateral sweep reads nothing the vertical step changes (the
-// lateral state, the wind of the step's start, the shared band and factors), and each lane does
-// its own plane's operations, so the results are those of step then lateral_step, to the bit.
-StepStatus step_both_planes(const Model& model, State& state);
 
 // Endless line: moves the lateral state back Model::endless_shift_spans spans with the block
 // (called by shift_endless_block before it moves the train); the spans entering at the far end
