@@ -44,10 +44,7 @@ Simulation::Simulation(const Scene& scene) : model_(build_model(speed_checked(sc
   }
   solve_initial_state(model_, initial_);
   observe(model_, initial_);
-  if (model_.lateral) {
-    initial_.lateral = make_lateral_state(model_);
-    lateral_observe(model_, initial_);
-  }
+  if (model_.lateral) lateral_observe(model_, initial_);  // (make_state gave it its lateral plane)
   state_ = initial_;
 }
 

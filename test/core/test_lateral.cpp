@@ -9,6 +9,7 @@
 #include <map>
 #include <numeric>
 
+#include "catenary_sim/core/engine/lateral_energy.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"
@@ -95,8 +96,7 @@ TEST(Lateral, EigenfrequenciesMatchTheTensionedBeam) {
     double prev = s.lateral.y[probe], t_prev = 0.0;
     std::vector<double> crossings;
     while (crossings.size() < 21) {
-      step(m, s);
-      ASSERT_EQ(lateral_step(m, s), StepStatus::kOk);
+      ASSERT_EQ(step(m, s), StepStatus::kOk);  // both planes
       const double y = s.lateral.y[probe];
       if ((prev > 0.0) != (y > 0.0)) crossings.push_back(t_prev + (s.time - t_prev) * prev / (prev - y));
       prev = y;
@@ -385,8 +385,7 @@ TEST(Lateral, CoupledEnergyIsConserved) {
     const int steps = static_cast<int>(std::lround(1.0 / m.dt)), window = steps / 5;
     double first = 0.0, last = 0.0;
     for (int k = 0; k < steps; ++k) {
-      EXPECT_EQ(step(m, s), StepStatus::kOk);
-      EXPECT_EQ(lateral_step(m, s), StepStatus::kOk);
+      EXPECT_EQ(step(m, s), StepStatus::kOk);  // both planes
       const double e = line_energy(m, s);
       r.worst = std::max(r.worst, std::fabs(e - e0));
       if (k < window) first += e / window;
@@ -447,7 +446,7 @@ TEST(Lateral, LeanLiftsTheContactWireAsTheSpringsInSeriesSay) {
   const double fc = flexibility(Tc, EIc), fm = flexibility(Tm, EIm);
   const double dS = delta / (1.0 / d.stiffness + fc + fm);
   const double u_c0 = s.u[d.contact_dof], u_m0 = s.u[d.messenger_dof];
-  for (int k = 0; k < static_cast<int>(6.0 / m.dt); ++k) ASSERT_EQ(step(m, s), StepStatus::kOk);  // lateral held
+  for (int k = 0; k < static_cast<int>(6.0 / m.dt); ++k) ASSERT_EQ(vertical_step(m, s), StepStatus::kOk);  // lateral held
   const double rise = s.u[d.contact_dof] - u_c0, sink = u_m0 - s.u[d.messenger_dof];
   std::printf("dy0 %.4f m, dy %.4f m, delta %.3f mm: contact wire +%.4f mm (springs in series %.4f), messenger -%.4f "
               "mm (%.4f), dS %.3f N\n",
@@ -1146,7 +1145,7 @@ namespace {
 
 // Steps a pass with the fused lateral step and a copy of the model without its planes (the
 // generic step) side by side; every lateral value must agree to the bit, and every vertical one
-// (Simulation::step may sweep both planes at once: step_both_planes). Returns the steps taken.
+// (step() may sweep both planes at once where the model has planes). Returns the steps taken.
 int expect_fused_is_generic(const std::vector<std::string>& overrides, int* windowed_fused_steps) {
   Simulation a(load_scene_file(test_scenes::kReference3d, overrides));
   EXPECT_TRUE(a.model().lateral);
@@ -1164,8 +1163,7 @@ int expect_fused_is_generic(const std::vector<std::string>& overrides, int* wind
   int steps = 0;
   while (true) {
     const StepStatus sa = a.step();
-    StepStatus sg = step(generic, g);
-    if (sg == StepStatus::kOk) sg = lateral_step(generic, g);
+    const StepStatus sg = step(generic, g);  // both planes, one after the other (no planes: no joint sweep)
     EXPECT_EQ(sa, sg);
     if (sa != StepStatus::kOk || sg != StepStatus::kOk) break;
     ++steps;

@@ -19,10 +19,7 @@ class Simulation {
   const State& state() const { return state_; }
 
   // The vertical step, then (3-D line) the lateral one; a run stopped by either stays stopped.
-  StepStatus step() {
-    if (state_.status == StepStatus::kDewired) return state_.status;
-    return model_.lateral ? step_both_planes(model_, state_) : catenary_sim::step(model_, state_);
-  }
+  StepStatus step() { return catenary_sim::step(model_, state_); }
   bool finished() const { return state_.status == StepStatus::kFinished || state_.status == StepStatus::kDewired || state_.front + state_.line_offset >= model_.train_end; }
   // Human-readable status, naming the DOF and time of a divergence.
   std::string status_message() const;

@@ -9,8 +9,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "catenary_sim/core/model/lateral.hpp"
+#include "catenary_sim/core/engine/lateral_step.hpp"
 #include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/engine/step.hpp"
 #include "catenary_sim/core/engine/wire_window.hpp"
 
 namespace catenary_sim {
@@ -164,10 +165,6 @@ struct State {
 
 // A state sized for the model with zero displacement (the design state, no pantograph force).
 State make_state(const Model& model);
-
-// Advances one fixed dt with the explicit central differences of eq. 19-21 (half-step velocity).
-// Never reads a clock, never allocates, never logs. Returns the state's status.
-StepStatus step(const Model& model, State& state);
 
 // The instruction set the fused explicit step's runtime dispatch chose on this machine:
 // "x86-64-v4" (AVX-512), "x86-64-v3" (AVX2) or "default" (the x86-64 baseline). All give the

@@ -1,6 +1,6 @@
 // The 3-D line: every wire's lateral (horizontal) plane, built from the same pre-stressed beam
-// band as its vertical plane (same T, EI and nodes; a round wire bends alike both ways) and
-// stepped with its own explicit central differences after the vertical step.
+// band as its vertical plane (same T, EI and nodes; a round wire bends alike both ways). Its step,
+// after the vertical one, is the engine's (engine/lateral_step.hpp).
 //
 // Coordinates: y is the wire's lateral position from the track centre line (+ to the left in the
 // direction of increasing station), in the track's own frame. A curve of curvature kappa then
@@ -19,27 +19,18 @@
 // e = dz + (dy^2 - dy0^2) / (2 l) and one potential V(e) = S0 e + k e^2 / 2 (0 force when slack,
 // S0 + k e <= 0) serves both planes: the vertical force is S = S0 + k e, the lateral one S dy / l
 // (the pendulum). At the pass start e is the vertical plane's design stretch, so its static state
-// stays the design statics'; the lean's change during the pass acts on the vertical plane.
-// Order: the vertical step takes each dropper's lean stretch averaged over the previous lateral
-// step's substeps (LateralState::dropper_stretch), which all read the u the vertical step starts
-// from; every kick of V is then taken at one configuration for both planes, which makes the
-// partitioned step symplectic (the undamped, windless energy line_energy stays bounded, no drift:
-// Lateral.CoupledEnergyIsConserved). Reading the lean at one instant instead makes it drift.
+// stays the design statics'; the lean's change during the pass acts on the vertical plane (in
+// which order the two planes take it: engine/lateral_step.hpp).
 #pragma once
 
 #include <Eigen/Core>
-#include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/model/wind_field.hpp"
-#include "catenary_sim/core/engine/wire_window.hpp"
 
 namespace catenary_sim {
-
-struct State;
-enum class StepStatus;
 
 struct LateralSpring {
   int dof = 0;             // lateral index
@@ -155,106 +146,5 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& model);
 // LateralModel::supports) receives the lateral force of each wire on its supports.
 void solve_lateral_statics(const Model& model, const LateralModel& lat, bool with_wind, Eigen::VectorXd* y,
                            std::vector<double>* force_on_support);
-
-struct DewirementEvent {
-  double time = 0.0;     // s
-  double station = 0.0;  // m, of the collector along the line
-  int pantograph = 0, collector = 0;
-  double lateral = 0.0;  // m, contact point on the strip when it left the working width
-};
-constexpr std::size_t kMaxDewirementEvents = 1024;  // kept per pass; more are counted only
-
-struct LateralState {
-  Eigen::VectorXd y, v;      // m, m/s (v at the half step, eq. 20)
-  // m, per dropper (Model::droppers): its lean's stretch averaged over the last lateral step's
-  // substeps, which the next vertical step adds to the dropper's vertical stretch.
-  std::vector<double> dropper_stretch;
-  // Per dropper: 1 where the lean acts on its tension, 0 outside the vertical plane's window.
-  std::vector<double> lean_weight;
-  Eigen::VectorXd f, z;      // workspace
-  Eigen::VectorXd y_next, v_next, accel;  // the fused step's new values
-  // Both planes' sweep records when the vertical step takes the lateral sweep along
-  // (step_both_planes, sweep_pack_pair's joint layout), and that hand-over: `join` while the
-  // vertical step may take it, `joined` when it did, with the lateral sweep's divergence hint.
-  std::vector<double> sweep;
-  bool join = false, joined = false, joined_outside = false;
-  std::int64_t joined_steps = 0;  // steps whose lateral sweep the vertical step took along
-  std::vector<double> theta, wind_points;
-  Eigen::VectorXd wind_speed;    // m/s, per node: the wind's speed normal to the wire now
-  double next_wind_update = 0.0;  // s
-  double wind_time = 0.0;         // s, of the last refresh (wind_points' time)
-  // An endless line's turbulent field over its block: generated ahead as the block moves on,
-  // in buffers sized once (wind_field.hpp). wind_points holds its points' values from first().
-  WindFieldBuffer wind_field;
-  std::vector<int> weight_node;
-  std::vector<double> weight;
-  // Per collector x contact wire: the contact point's lateral position on the strip (wire minus
-  // pantograph), NaN where the collector is not under that wire.
-  std::vector<double> contact_lateral;
-  // Per collector: on the running wire (the one it touches, else the lowest), NaN if none.
-  std::vector<double> collector_lateral;
-  std::vector<double> pantograph_lateral;  // m, per pantograph (sway)
-  std::vector<std::uint8_t> off_strip;     // per collector: outside the working width now
-  std::vector<DewirementEvent> events;     // capacity reserved: never allocates in step
-  std::int64_t events_total = 0;
-  bool diverged = false, dewired_stop = false;
-  // Moving window: the part of each wire the lateral plane steps, from the vertical plane's
-  // window's first support to its last or, with a gust lead (LateralModel::gust_lead), a support
-  // further ahead (outside, the nodes stay in the static state under the mean wind, at rest); the
-  // factors interleaved for the fused step; the springs and the droppers' pendulums in it (first
-  // *_count entries; pendulum k is dropper k), the static force of the left-out elements on the
-  // nodes near the cuts, and the nodes with point forces for the fused step. Sized once: no
-  // allocation.
-  std::vector<WireWindow> window;
-  int window_first_support = -1, window_last_support = -1;
-  bool window_dirty = true;  // lists and factors to rebuild (the endless block moved)
-  std::vector<double> sweep_factors;
-  std::vector<int> window_springs, window_droppers;
-  int window_spring_count = 0, window_dropper_count = 0;
-  std::vector<int> cut_node;
-  std::vector<double> cut_force;
-  int cut_count = 0;
-  std::vector<int> window_points;
-  int window_point_count = 0;
-  bool window_fused = false;  // the fused step can take the window (every wire's range two nodes or more)
-};
-
-LateralState make_lateral_state(const Model& model);
-// State::head_wind of every pantograph: the wind's component against the direction of travel at
-// its station, from the mean wind and `field_points` (the turbulent field's held points at one
-// time, WindFieldBuffer::at_time; null: the mean wind alone). The lateral step calls it with its latest refresh.
-void update_head_wind(const Model& model, State& state, const WindFieldBuffer* field, const double* field_points);
-// Contact point positions of the current state (no step).
-void lateral_observe(const Model& model, State& state);
-// One lateral step of the model's dt (its substeps), after the vertical step moved the state to
-// its new time. Never allocates. Returns kDiverged or kDewired (on_dewirement: stop), else kOk.
-StepStatus lateral_step(const Model& model, State& state);
-// The vertical step, then the lateral one (Simulation::step on a 3-D line). Where both planes
-// sweep every node of the same two-wire packs (no window, one lateral substep, both fused), the
-// vertical step runs the lateral step's band sweep with its own, both planes in four lanes
-// (sweep_pack_pair: the band and its factors are the same both ways, loaded once, and each band
-// operation does both planes). The lateral sweep reads nothing the vertical step changes (the
-// lateral state, the wind of the step's start, the shared band and factors), and each lane does
-// its own plane's operations, so the results are those of step then lateral_step, to the bit.
-StepStatus step_both_planes(const Model& model, State& state);
-
-// Endless line: moves the lateral state back Model::endless_shift_spans spans with the block
-// (called by shift_endless_block before it moves the train); the spans entering at the far end
-// start in the static state. No allocation.
-void shift_lateral_block(const Model& model, State& state);
-
-// Sets LateralState::dropper_stretch from the current y (after y was set by hand, or moved).
-void set_dropper_stretch(const Model& model, State& state);
-
-// Lateral energy without wind: 0.5 v M v + 0.5 y K y - load . y of the wires and lateral supports,
-// plus what the lean adds to the droppers' potential at the current vertical state,
-// V(e_z + e_lean) - V(e_z) (J); constant in an undamped, windless free motion of the lateral
-// plane alone (the vertical one held).
-double lateral_energy(const Model& model, const State& state);
-
-// Energy of the whole line, both planes, the droppers' shared potential V(e) counted once:
-// kinetic, the wires' and supports' strain, less the constant loads' work (J). Constant in an
-// undamped, windless free motion of a line without pantographs on the full line (no window).
-double line_energy(const Model& model, const State& state);
 
 }  // namespace catenary_sim

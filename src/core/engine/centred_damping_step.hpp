@@ -1,0 +1,15 @@
+// The explicit step with centred Rayleigh damping (centred_damping_step.cpp; the scheme and its
+// factors: centred_damping.hpp).
+#pragma once
+
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/engine/state.hpp"
+
+namespace catenary_sim {
+
+// The explicit step with centred damping (centred_damping.hpp): the point forces on z = u + beta v
+// as in the half-step scheme, then per wire pack the block-tridiagonal solve for zeta and the
+// update (centred_sweep_pack; build_model gives such a model its packs), then the pantographs.
+StepStatus centred_damping_step(const Model& m, State& s);
+
+}  // namespace catenary_sim

@@ -1,0 +1,290 @@
+// Explicit central differences with the half-step velocity (paper eq. 19-21, 26):
+//   v_{n+1/2} = v_{n-1/2} + dt M^-1 (R_n - K_n q_n - C_n v_{n-1/2} - phi^T lambda_n)
+//   q_{n+1}   = q_n + dt v_{n+1/2}
+// with C_n = alpha M + beta K_n (eq. 5), droppers switched by their tension every step, and the
+// massless collectors condensed: the collector sits on the weighted wire height (eq. 12) and its
+// spring k0 carries the contact force (eq. 22) while that force is compressive (eq. 25).
+#include "engine/explicit_step.hpp"
+
+#include <cmath>
+
+#include "engine/forces.hpp"
+#include "engine/train_motion.hpp"
+#include "engine/window.hpp"
+#include "engine/wire_lanes.hpp"
+
+namespace catenary_sim {
+
+namespace {
+
+// Whether the fused sweeps can take this state: a pack's window needs two nodes or more, the
+// same range in both lanes.
+bool packs_take_window(const Model& m, const State& s, bool windowed) {
+  if (!windowed) return true;
+  for (const WireWindow& ww : s.window)
+    if (ww.hi == ww.lo) return false;
+  for (const WireLanes& p : m.wire_packs)
+    if (p.lanes == 2 && (s.window[p.wire[0]].lo != s.window[p.wire[1]].lo || s.window[p.wire[0]].hi != s.window[p.wire[1]].hi))
+      return false;
+  return true;
+}
+
+// The band sweeps of every pack (sweep_pack), a 3-D line's lateral sweep taken along where it can
+// (step_both_planes). Returns the vertical sweeps' divergence hint.
+bool sweep_packs(const Model& m, State& s, bool windowed) {
+  const double* u = s.u.data();
+  const double* v = s.v.data();
+  double* un = s.u_next.data();
+  double* vn = s.v_next.data();
+  double* acc = s.accel.data();
+  const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
+  bool outside = false;
+  // The lateral step's band sweep taken along (step_both_planes): both planes' records then in the
+  // joint layout (LateralState::sweep, joint_record_index).
+  const bool join = m.lateral && s.lateral.join;
+  bool lateral_outside = false;
+  for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
+    PackSweep a, b;
+    if (!setup_pack_sweep(m.wire_packs[pk], m.wires, windowed ? &s.window : nullptr, s.sweep_factors.data(), s.sweep.data(), u, v,
+                          un, vn, acc, a))
+      continue;
+    a.beta = beta;
+    a.dt = dt;
+    a.limit = limit;
+    if (join && setup_lateral_sweep(m, s, pk, false, b)) {
+      bool b_outside = false;
+      outside |= sweep_pack_pair(a, b, s.lateral.sweep.data() + 2 * kSweepRecord * m.wire_packs[pk].offset, &b_outside);
+      lateral_outside |= b_outside;
+    } else {
+      outside |= sweep_pack(a);
+    }
+  }
+  if (join) {
+    s.lateral.joined = true;
+    s.lateral.joined_outside = lateral_outside;
+    ++s.lateral.joined_steps;
+  }
+  return outside;
+}
+
+// The nodes with point forces: the contact wire's nodes under every collector (contact_forces'
+// weights), listed once per step into State::point_node; returns how many. A node may come more
+// than once.
+int list_contact_nodes(const Model& m, State& s, bool windowed) {
+  int contacts = 0;
+  int* contact_node = s.point_node.data();
+  for (const Pantograph& p : m.pantographs)
+    for (int ci : p.collectors) {
+      const double xc = s.front - p.position + m.collectors[ci].offset;
+      for (int cw : m.contact_wires) {
+        const Wire& w = m.wires[cw];
+        // The nodes contact_weights gives weights to (without the weights: no sin, cos).
+        int first = 0, last = -1;
+        const double x0 = w.x.front(), x1 = w.x.back();
+        if (m.rub_length <= 0.0) {
+          if (xc >= x0 && xc <= x1) last = (first = w.element_at(xc)) + 1;
+        } else {
+          const double a = xc - 0.5 * m.rub_length, b = xc + 0.5 * m.rub_length;
+          if (!(b <= x0 || a >= x1)) {
+            first = w.element_at(a);
+            last = w.element_at(b) + 1;
+          }
+        }
+        for (int i = first; i <= last; ++i)
+          if (!windowed || (i >= s.window[cw].lo && i <= s.window[cw].hi)) contact_node[contacts++] = w.w_dof + i;
+      }
+    }
+  return contacts;
+}
+
+// Calls fn(dof) on the window's cut ends, supports and droppers (each DOF in the window by
+// construction of its lists), or on every support and dropper of the line.
+template <class Fn>
+void for_each_point(const Model& m, const State& s, bool windowed, Fn&& fn) {
+  if (windowed) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const WireWindow& ww = s.window[wi];
+      if (ww.hi < ww.lo) continue;
+      if (ww.cut_lo) fn(m.wires[wi].w_dof + ww.lo);
+      if (ww.cut_hi) fn(m.wires[wi].w_dof + ww.hi);
+    }
+    for (int j = 0; j < s.window_spring_count; ++j) fn(m.springs[s.window_springs[j]].dof);
+    for (int j = 0; j < s.window_dropper_count; ++j) {
+      const Dropper& d = m.droppers[s.window_droppers[j]];
+      fn(d.contact_dof);
+      fn(d.messenger_dof);
+    }
+  } else {
+    for (const SupportSpring& sp : m.springs) fn(sp.dof);
+    for (const Dropper& d : m.droppers) {
+      fn(d.contact_dof);
+      fn(d.messenger_dof);
+    }
+  }
+}
+
+// The index of the last new displacement beyond the divergence limit (or not a number), scanned
+// in the generic step's order; -1 if none.
+int last_beyond(const Model& m, const State& s, bool windowed) {
+  const double* un = s.u_next.data();
+  const double limit = m.scene.numerics.divergence_limit;
+  auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
+  int bad = -1;
+  if (windowed) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
+      for (int i = s.window[wi].lo; i <= s.window[wi].hi; ++i)
+        if (beyond(m.wires[wi].w_dof + i)) bad = m.wires[wi].w_dof + i;
+    for (int i = m.n_catenary_dof; i < m.n_dof; ++i)
+      if (beyond(i)) bad = i;
+  } else {
+    for (int i = 0; i < m.n_dof; ++i)
+      if (beyond(i)) bad = i;
+  }
+  return bad;
+}
+
+// The explicit step with the wires packed (Model::wire_packs): one fused sweep pair per pack
+// (sweep_pack) computes every wire node's force from the band, load and damping and updates it;
+// the few nodes that also carry a point force (supports, droppers, the window's dashpots, the
+// contact) are then redone: the point forces are added to the band force the sweep kept, in the
+// generic step's order, and the update repeated.
+// Every value is the generic step's to the bit. Writes u_next, v_next, accel; returns the diverged
+// DOF or -1.
+int explicit_fused_update(const Model& m, State& s, bool windowed) {
+  const double* u = s.u.data();
+  const double* v = s.v.data();
+  double* un = s.u_next.data();
+  double* vn = s.v_next.data();
+  double* acc = s.accel.data();
+  double* f = s.force.data();
+  const double dt = m.dt, limit = m.scene.numerics.divergence_limit;
+  bool outside = sweep_packs(m, s, windowed);
+  const bool join = m.lateral && s.lateral.join;
+  const int contacts = list_contact_nodes(m, s, windowed);
+  const int* contact_node = s.point_node.data();
+  // Supports, droppers and the window's dashpots act straight on the band forces the sweep left in
+  // its records (where z is too), in the generic step's order; the contact nodes then take their
+  // force so far into the force vector, where the pantographs' contact adds to it.
+  double* rec = join ? s.lateral.sweep.data() : s.sweep.data();
+  const int* f_at = m.dof_sweep_force.data();
+  const int* z_at = m.dof_sweep_z.data();
+  const int joint = join;
+  auto force_at = [rec, f_at, joint](int i) -> double& { return rec[joint_record_index(f_at[i], joint, false)]; };
+  auto z_rec = [rec, z_at, joint](int i) { return rec[joint_record_index(z_at[i], joint, false)]; };
+  if (leaning(m, s)) add_wire_point_forces<true>(m, s, u, v, force_at, z_rec, false);
+  else add_wire_point_forces<false>(m, s, u, v, force_at, z_rec, false);
+  for (int q = 0; q < contacts; ++q) f[contact_node[q]] = force_at(contact_node[q]);
+  add_pantograph_forces(m, s, u, v, f);
+  const double* im = m.inv_mass.data();
+  auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
+  auto update = [&](int i, double fi) {
+    acc[i] = im[i] * fi;  // q'' at t_n (eq. 20)
+    vn[i] = v[i] + dt * acc[i];
+    un[i] = u[i] + dt * vn[i];
+    outside |= beyond(i);
+  };
+  for_each_point(m, s, windowed, [&](int i) { update(i, force_at(i)); });  // the contact nodes last: theirs has the contact
+  for (int q = 0; q < contacts; ++q) update(contact_node[q], f[contact_node[q]]);
+  for (int i = m.n_catenary_dof; i < m.n_dof; ++i) update(i, f[i]);
+  // The displacement check: the sweeps' flag is only a hint (they saw the nodes before the point
+  // forces), so on a flag, or a pantograph or point beyond the limit, every new value is scanned
+  // in the generic step's order.
+  return outside ? last_beyond(m, s, windowed) : -1;
+}
+
+// Copies the window's new values back (outside the window the new buffers hold nothing current).
+void commit_window(const Model& m, State& s, const double* u_new, const double* v_new) {
+  double* u = s.u.data();
+  double* v = s.v.data();
+  auto commit = [&](int i0, int i1) {
+    for (int i = i0; i < i1; ++i) {
+      v[i] = v_new[i];
+      u[i] = u_new[i];
+    }
+  };
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
+    commit(m.wires[wi].w_dof + s.window[wi].lo, m.wires[wi].w_dof + s.window[wi].hi + 1);
+  commit(m.n_catenary_dof, m.n_dof);
+}
+
+StepStatus diverged(State& s, int dof) {
+  s.status = StepStatus::kDiverged;
+  s.diverged_dof = dof;
+  return s.status;
+}
+
+// The fused step's end: the new values swapped in (or copied back in the window) once all are good.
+StepStatus fused_step(const Model& m, State& s, bool windowed) {
+  const int bad = explicit_fused_update(m, s, windowed);
+  if (bad >= 0) return diverged(s, bad);
+  if (windowed) {
+    commit_window(m, s, s.u_next.data(), s.v_next.data());
+  } else {
+    s.u.swap(s.u_next);  // O(1): every DOF has its new value
+    s.v.swap(s.v_next);
+  }
+  advance_train(m, s, m.dt);
+  return s.status;
+}
+
+// The generic step: the whole force (assemble_force), then the update of every DOF stepped.
+StepStatus generic_step(const Model& m, State& s, bool windowed) {
+  const int n = m.n_dof;
+  const double dt = m.dt;
+  double* u = s.u.data();
+  double* v = s.v.data();
+  double* f = s.force.data();
+  double* z = s.z.data();
+  double* acc = s.accel.data();
+  const double limit = m.scene.numerics.divergence_limit;
+  int bad = -1;
+  assemble_force(m, s, u, v, z, f);
+  // Update (eq. 21, 26); rigid DOFs have inv_mass 0 and stay at rest. The new values go to the
+  // workspace first: a displacement beyond the divergence limit (or NaN) stops the run and the
+  // state keeps the last good step, so nothing diverged is ever passed on.
+  const double* im = m.inv_mass.data();
+  double* v_new = f;  // the force is no longer needed
+  double* u_new = z;
+  auto update = [&](int i0, int i1) {
+    for (int i = i0; i < i1; ++i) {
+      acc[i] = im[i] * f[i];  // q'' at t_n (eq. 20)
+      const double vn = v[i] + dt * acc[i];
+      const double un = u[i] + dt * vn;
+      if (!(std::fabs(un) <= limit)) bad = i;
+      v_new[i] = vn;
+      u_new[i] = un;
+    }
+  };
+  if (windowed) {
+    // Only the window moves: new values for its DOFs go to the workspace, and are copied back
+    // (not swapped: outside the window the buffers hold nothing current) once all are good.
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const WireWindow& ww = s.window[wi];
+      update(m.wires[wi].w_dof + ww.lo, m.wires[wi].w_dof + ww.hi + 1);
+    }
+    update(m.n_catenary_dof, n);
+  } else {
+    update(0, n);
+  }
+  if (bad >= 0) return diverged(s, bad);
+  if (windowed) {
+    commit_window(m, s, u_new, v_new);
+  } else {
+    s.v.swap(s.force);  // O(1): swaps the buffers, no copy, no allocation
+    s.u.swap(s.z);
+  }
+  advance_train(m, s, dt);
+  return s.status;
+}
+
+}  // namespace
+
+StepStatus explicit_step(const Model& m, State& s) {
+  const bool windowed = m.scene.numerics.windowed();
+  if (m.endless) shift_endless_block(m, s);
+  if (windowed) update_window(m, s);
+  if (!m.wire_packs.empty() && packs_take_window(m, s, windowed)) return fused_step(m, s, windowed);
+  return generic_step(m, s, windowed);
+}
+
+}  // namespace catenary_sim

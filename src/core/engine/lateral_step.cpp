@@ -1,0 +1,381 @@
+// The lateral plane's step (lateral_step.hpp): explicit central differences of the lateral
+// plane's own dt (substeps of the vertical one), fused as the vertical step's where the model has
+// planes (wire_lanes.hpp), with the wind's drag, the steady arms as springs and the droppers as
+// pendulums; then the contact points across the strips and dewirement.
+#include "catenary_sim/core/engine/lateral_step.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "catenary_sim/core/engine/state.hpp"
+#include "engine/lateral_window.hpp"
+#include "engine/lateral_wind.hpp"
+#include "engine/window.hpp"
+#include "engine/wire_lanes.hpp"
+
+namespace catenary_sim {
+
+void update_head_wind(const Model& m, State& s, const WindFieldBuffer* field, const double* field_points) {
+  const LateralModel& lat = *m.lateral;
+  if (!lat.windy) return;
+  const double phi = m.scene.wind->direction * M_PI / 180.0;
+  const WindField& fd = lat.field;
+  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
+    const double x = s.front - m.pantographs[p].position + s.line_offset;  // station along the line
+    double along_wind = lat.wind_speed;  // the along-wind speed U + u' (wind_field.hpp)
+    if (field && field_points && !fd.empty()) along_wind += field->at(fd, field_points, x);
+    // Its component along the track, against the direction of travel (+x).
+    s.head_wind[p] = -along_wind * std::cos(phi - m.scene.alignment.heading(x));
+  }
+}
+
+LateralState make_lateral_state(const Model& m) {
+  const LateralModel& lat = *m.lateral;
+  LateralState s;
+  s.y = lat.initial;
+  s.v = Eigen::VectorXd::Zero(lat.n);
+  s.f = Eigen::VectorXd::Zero(lat.n);
+  s.z = Eigen::VectorXd::Zero(lat.n);
+  s.y_next = s.y;
+  s.v_next = Eigen::VectorXd::Zero(lat.n);
+  s.accel = Eigen::VectorXd::Zero(lat.n);
+  s.sweep.assign(2 * kSweepRecord * m.sweep_size, 0.0);  // (both planes' records when joint)
+  int longest = 0;
+  for (const Wire& w : lat.wires) longest = std::max(longest, w.nodes());
+  s.theta.assign(longest, 0.0);
+  s.wind_points.assign(std::max(0, lat.field.held), 0.0);
+  if (m.endless) s.wind_field.reset(lat.field);  // (nothing for a steady wind)
+  if (lat.windy) s.wind_speed = lat.wind_speed * lat.wind_normal;  // the mean wind until the field's first refresh
+  s.weight_node.assign(m.max_contact_nodes, 0);
+  s.weight.assign(m.max_contact_nodes, 0.0);
+  s.contact_lateral.assign(m.collectors.size() * m.contact_wires.size(), std::nan(""));
+  s.collector_lateral.assign(m.collectors.size(), std::nan(""));
+  s.pantograph_lateral.assign(m.pantographs.size(), 0.0);
+  s.off_strip.assign(m.collectors.size(), 0);
+  s.events.reserve(kMaxDewirementEvents);
+  s.dropper_stretch.assign(m.droppers.size(), 0.0);
+  s.lean_weight.assign(m.droppers.size(), 1.0);
+  for (const LateralPendulum& p : lat.pendulums) s.dropper_stretch[p.dropper] = lean_stretch(p, s.y.data());  // 0: y is initial
+  s.window.resize(lat.wires.size());
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    s.window[wi].tt_lower.assign(lat.wires[wi].nodes(), 0.0);
+    s.window[wi].tt_inv_pivot.assign(lat.wires[wi].nodes(), 0.0);
+  }
+  if (lat.windowed && !lat.planes.empty()) s.sweep_factors.assign(2 * m.sweep_size, 0.0);
+  s.window_springs.assign(lat.springs.size(), 0);
+  s.window_droppers.assign(lat.pendulums.size(), 0);
+  s.cut_node.assign(2 * kCutLayer * m.wires.size(), 0);
+  s.cut_force.assign(s.cut_node.size(), 0.0);
+  s.window_points.assign(s.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size(), 0);
+  return s;
+}
+
+namespace {
+
+// Contact points across the strips and dewirement (a change of the off-strip flag). Returns true
+// when a collector left the working width in this call.
+bool contact_points(const Model& m, State& s, bool record) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const PantographHeadSpec& head = m.scene.pantograph_head;
+  const double sway = head.sway(s.time);  // the contact point on the strip is wire minus pantograph
+  const std::size_t nw = m.contact_wires.size();
+  bool left = false;
+  for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
+    const Pantograph& p = m.pantographs[pi];
+    ls.pantograph_lateral[pi] = sway;
+    const double x_ref = s.front - p.position;
+    for (int ci : p.collectors) {
+      const double xc = x_ref + m.collectors[ci].offset;
+      double best_force = 0.0;
+      int running = -1;
+      for (std::size_t wk = 0; wk < nw; ++wk) {
+        const Wire& w = lat.wires[m.contact_wires[wk]];
+        const int cnt = contact_weights(w, m.rub_length, xc, ls.weight_node.data(), ls.weight.data());
+        double y = 0.0;
+        for (int a = 0; a < cnt; ++a) y += ls.weight[a] * ls.y[w.w_dof + ls.weight_node[a]];
+        ls.contact_lateral[ci * nw + wk] = cnt ? y - sway : std::nan("");
+        const double fc = s.contact_force[ci * nw + wk];
+        if (cnt && fc > best_force) {
+          best_force = fc;
+          running = static_cast<int>(wk);
+        }
+      }
+      if (running < 0) lowest_design_height(m, xc, &running);  // not touching: the wire it meets first
+      const double yc = running >= 0 ? ls.contact_lateral[ci * nw + running] : std::nan("");
+      ls.collector_lateral[ci] = yc;
+      const bool off = std::fabs(yc) > m.collectors[ci].half_working_width;  // false for NaN
+      if (off && !ls.off_strip[ci] && record) {
+        left = true;
+        ++ls.events_total;
+        if (ls.events.size() < kMaxDewirementEvents)
+          ls.events.push_back(DewirementEvent{s.time, xc + s.line_offset, static_cast<int>(pi), ci, yc});
+      }
+      ls.off_strip[ci] = off;
+    }
+  }
+  return left;
+}
+
+}  // namespace
+
+void lateral_observe(const Model& m, State& s) {
+  if (m.lateral) contact_points(m, s, false);
+}
+
+bool setup_lateral_sweep(const Model& m, State& s, std::size_t pack, bool windowed, PackSweep& a) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const WireLanes& p = m.wire_packs[pack];
+  if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, ls.sweep_factors.data(), s.sweep.data(), ls.y.data(),
+                        ls.v.data(), ls.y_next.data(), ls.v_next.data(), ls.accel.data(), a))
+    return false;
+  // (the records in the vertical step's scratch, State::sweep; sweep_pack_pair puts them elsewhere)
+  a.plane = lat.planes[pack].data();
+  // The wind's drag is taken in the sweep (PackSweep::wind), on the velocity it reads anyway.
+  for (int k = 0; k < p.lanes; ++k) a.wind[k] = lat.windy ? ls.wind_speed.data() + lat.wires[p.wire[k]].w_dof : nullptr;
+  a.beta = m.beta;
+  a.dt = lat.dt;
+  a.limit = m.scene.numerics.divergence_limit;
+  return true;
+}
+
+namespace {
+
+// The springs (steady arms, messenger supports) and the droppers' pendulums on f, at
+// z = y + beta v (`z_at`), over the window's lists or the whole line: the pendulums at the
+// droppers' tension now with their lean's share (two-way coupling, lateral.hpp), 0 when slack, and
+// each lean summed into dropper_stretch for the next vertical step. The fused and the generic
+// step share it, so they do the same operations.
+template <class ZAt>
+void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const double* y, ZAt z_at, double* f) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const int n_springs = windowed ? ls.window_spring_count : static_cast<int>(lat.springs.size());
+  for (int j = 0; j < n_springs; ++j) {
+    const LateralSpring& sp = lat.springs[windowed ? ls.window_springs[j] : j];
+    f[sp.dof] -= sp.stiffness * z_at(sp.dof);
+  }
+  const double* u = s.u.data();
+  double* stretch = ls.dropper_stretch.data();
+  const double* w = ls.lean_weight.data();
+  const int n_pendulums = windowed ? ls.window_dropper_count : static_cast<int>(lat.pendulums.size());
+  for (int j = 0; j < n_pendulums; ++j) {
+    const LateralPendulum& p = lat.pendulums[windowed ? ls.window_droppers[j] : j];
+    const Dropper& d = m.droppers[p.dropper];
+    const double lean = lean_stretch(p, y);
+    stretch[p.dropper] += lean;
+    const double tension = d.static_tension + d.stiffness * ((u[d.messenger_dof] - u[d.contact_dof]) + lean * w[p.dropper]);
+    const double k = std::max(0.0, tension) * p.inv_length;
+    const double df = k * (z_at(p.messenger) - z_at(p.contact));
+    f[p.contact] += df;
+    f[p.messenger] -= df;
+  }
+}
+
+// One lateral substep fused as the vertical plane's (wire_lanes.hpp): per pack one sweep pair for
+// z, the condensed rotations, the band force with the load, damping and the wind's drag, and the
+// update; then the nodes with point forces (steady arms and
+// messenger supports as springs, droppers as pendulums) are updated again with theirs, in the
+// generic step's order. The new values go to y_next, v_next and are swapped in when all are
+// inside the divergence limit (else the state keeps the last good substep and this returns true).
+// Windowed: over the window's nodes (the vertical plane's factors of it), the window's forces
+// first among the point forces, the new values copied back in the window.
+bool fused_substep(const Model& m, State& s, bool windowed) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const double h = lat.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
+  const double* y = ls.y.data();
+  const double* v = ls.v.data();
+  double* yn = ls.y_next.data();
+  double* vn = ls.v_next.data();
+  double* acc = ls.accel.data();
+  // The band sweeps: taken along by this step's vertical sweeps (step_both_planes), else here.
+  const int joined = ls.joined;  // (its records then in the joint layout: joint_record_index)
+  bool outside = joined && ls.joined_outside;
+  if (!joined)
+    for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
+      PackSweep a;
+      if (setup_lateral_sweep(m, s, pk, windowed, a)) outside |= sweep_pack(a);
+    }
+  ls.joined = false;
+  // Point forces on the band forces the sweep left in its records, as the generic step adds them.
+  double* f = ls.f.data();
+  const double* rec = joined ? ls.sweep.data() : s.sweep.data();
+  const int* at = lat.sweep_force_at.data();
+  const int* points = windowed ? ls.window_points.data() : lat.point_nodes.data();
+  const int np = windowed ? ls.window_point_count : static_cast<int>(lat.point_nodes.size());
+  for (int q = 0; q < np; ++q) f[points[q]] = rec[joint_record_index(at[points[q]], joined, true)];
+  if (windowed) add_window_forces(m, s, v, f);
+  add_springs_and_pendulums(m, s, windowed, y, [y, v, beta](int i) { return y[i] + beta * v[i]; }, f);
+  const double* im = lat.inv_mass.data();
+  for (int q = 0; q < np; ++q) {
+    const int i = points[q];
+    acc[i] = im[i] * f[i];
+    vn[i] = v[i] + h * acc[i];
+    yn[i] = y[i] + h * vn[i];
+    outside |= !(std::fabs(yn[i]) <= limit);
+  }
+  if (outside) {  // the sweeps' flag is a hint (they saw the point nodes before their forces)
+    int bad = 0;
+    over_stepped(m, s, windowed, [&](int i0, int i1) {
+      for (int i = i0; i < i1; ++i) bad |= !(std::fabs(yn[i]) <= limit);
+    });
+    if (bad) return true;
+  }
+  if (windowed) {  // outside the window the new buffers hold nothing current: copy the window back
+    double* yw = ls.y.data();
+    double* vw = ls.v.data();
+    over_stepped(m, s, true, [&](int i0, int i1) {
+      for (int i = i0; i < i1; ++i) {
+        yw[i] = yn[i];
+        vw[i] = vn[i];
+      }
+    });
+    return false;
+  }
+  ls.y.swap(ls.y_next);  // O(1)
+  ls.v.swap(ls.v_next);
+  return false;
+}
+
+// One lateral substep, the generic step (what the fused one computes, bit for bit: test_lateral):
+// the force on z = y + beta v with the load, damping and the wind's drag on the wire's velocity
+// (aerodynamic damping), the band, the window's forces, springs and pendulums, then the update.
+// True if a new displacement left the divergence limit.
+bool generic_substep(const Model& m, State& s, bool windowed) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const double h = lat.dt, beta = m.beta, alpha = m.alpha;
+  const double* load = lat.load.data();
+  const double* mass = lat.mass.data();
+  const double* inv_mass = lat.inv_mass.data();
+  double* f = ls.f.data();
+  double* z = ls.z.data();
+  const double limit = m.scene.numerics.divergence_limit;
+  double* y = ls.y.data();
+  double* v = ls.v.data();
+  over_stepped(m, s, windowed, [&](int i0, int i1) {
+    if (lat.windy) {
+      const double* cw = lat.wind_coefficient.data();
+      const double* W = ls.wind_speed.data();
+      for (int i = i0; i < i1; ++i) {
+        z[i] = y[i] + beta * v[i];
+        const double vn = W[i] - v[i];  // relative to the moving wire: aerodynamic damping
+        f[i] = load[i] - alpha * mass[i] * v[i] + cw[i] * vn * std::fabs(vn);
+      }
+    } else {
+      for (int i = i0; i < i1; ++i) {
+        z[i] = y[i] + beta * v[i];
+        f[i] = load[i] - alpha * mass[i] * v[i];
+      }
+    }
+  });
+  if (windowed) {
+    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) wire_elastic_force_window(lat.wires[wi], ls.window[wi], z, f, ls.theta.data());
+    add_window_forces(m, s, v, f);
+  } else {
+    for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, ls.theta.data());
+  }
+  add_springs_and_pendulums(m, s, windowed, y, [z](int i) { return z[i]; }, f);
+  int out = 0;  // an integer OR vectorises where a max over doubles (NaN rules) does not
+  over_stepped(m, s, windowed, [&](int i0, int i1) {
+    for (int i = i0; i < i1; ++i) {
+      const double a = inv_mass[i] * f[i];  // eq. 20-21, in the fused sweep's order
+      v[i] += h * a;
+      y[i] += h * v[i];
+      out |= !(std::fabs(y[i]) <= limit);  // also NaN
+    }
+  });
+  return out;
+}
+
+}  // namespace
+
+StepStatus lateral_step(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const double h = lat.dt;
+  const double t0 = s.time - m.dt;  // the vertical step has already moved the clock on
+  // The droppers' lean over this step's substeps (all at this u), for the next vertical step.
+  for (double& e : ls.dropper_stretch) e = 0.0;
+  if (m.scene.numerics.windowed()) {
+    // Outside the vertical plane's window the droppers' ends are held vertically (the window does
+    // not move them), so a lean there would load the dropper with k delta against rigid wires,
+    // where the free line gives way (delta / (1/k + f_c + f_m), some 1/300 of it): the lean acts on
+    // the tension only inside the window, as in the vertical step.
+    for (double& x : ls.lean_weight) x = 0.0;
+    for (int j = 0; j < s.window_dropper_count; ++j) ls.lean_weight[s.window_droppers[j]] = 1.0;
+  }
+  const bool windowed = lat.windowed;
+  if (windowed) sync_window(m, s);
+  for (int sub = 0; sub < lat.substeps; ++sub) {
+    refresh_wind_if_due(m, s, t0 + sub * h, windowed);
+    const bool fused = !lat.planes.empty() && (!windowed || ls.window_fused);
+    if (fused ? fused_substep(m, s, windowed) : generic_substep(m, s, windowed)) {
+      ls.diverged = true;
+      s.status = StepStatus::kDiverged;
+      return s.status;
+    }
+  }
+  const double per_substep = 1.0 / lat.substeps;
+  for (double& e : ls.dropper_stretch) e *= per_substep;
+  update_head_wind(m, s, &field_values(m, s), ls.wind_points.data());
+  const bool left = contact_points(m, s, true);
+  if (left && m.scene.pantograph_head.on_dewirement == DewirementAction::kStop) {
+    ls.dewired_stop = true;
+    s.status = StepStatus::kDewired;
+  }
+  return s.status;
+}
+
+void shift_lateral_block(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const bool windowed = lat.windowed;  // (an endless line always is)
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    const Wire& w = lat.wires[wi];
+    const int ns = m.endless_shift_spans * m.span_nodes[wi], o = w.w_dof, nn = w.nodes();
+    // The nodes stepped: the window (outside it they are in the static state), as the vertical
+    // plane moves its window (shift_endless_block).
+    const int lo = windowed ? ls.window[wi].lo : 0, hi = windowed ? ls.window[wi].hi : nn - 1;
+    if (hi < lo) continue;
+    // Upward, the destination below the source. Held nodes (supports at the stagger, which
+    // repeats with the block's move) keep their value. The wind moves along: a node's station
+    // along the line is the one the node ns above had.
+    for (int i = std::max(lo, ns); i <= hi; ++i) {
+      if (lat.inv_mass[o + i - ns] > 0.0) {
+        ls.y[o + i - ns] = ls.y[o + i];
+        ls.v[o + i - ns] = ls.v[o + i];
+      }
+      if (lat.windy) ls.wind_speed[o + i - ns] = ls.wind_speed[o + i];
+    }
+    // The nodes the move leaves (the spans entering at the far end of the block or window) are
+    // at rest in the static state under the mean wind, as the vertical plane's at u = 0.
+    for (int i = std::max({0, lo, hi - ns + 1}); i <= hi; ++i)
+      if (lat.inv_mass[o + i] > 0.0) {
+        ls.y[o + i] = lat.initial[o + i];
+        ls.v[o + i] = 0.0;
+      }
+    if (windowed) {
+      ls.window[wi].lo = std::max(0, lo - ns);
+      ls.window[wi].hi = hi - ns;
+    }
+  }
+  ls.window_dirty = true;  // the lists and factors hold the old DOFs (the node ranges already match)
+  set_dropper_stretch(m, s);  // the droppers' lean moved with the block
+  if (lat.windy && !lat.field.empty()) {
+    // The spans entering ahead take the wind of the last refresh at their stations (sync_window):
+    // the field generated that far (the caller moves line_offset on by the shift after this), and
+    // the held points' values at that refresh.
+    extend_endless_field(m, s, s.line_offset + m.endless_shift_spans * m.endless_span);
+    ls.wind_field.at_time(lat.field, ls.wind_time, ls.wind_points.data());
+  }
+}
+
+void set_dropper_stretch(const Model& m, State& s) {
+  for (const LateralPendulum& p : m.lateral->pendulums)
+    s.lateral.dropper_stretch[p.dropper] = lean_stretch(p, s.lateral.y.data());
+}
+
+}  // namespace catenary_sim

@@ -1,0 +1,139 @@
+// The lateral plane's moving window: which part of each wire the lateral step moves, and the
+// forces that stand in for the rest.
+#include "engine/lateral_window.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/lateral_wind.hpp"
+#include "engine/window.hpp"
+#include "engine/wire_lanes.hpp"
+
+namespace catenary_sim {
+
+namespace {
+
+// One wire's part of the window at stations xa..xb (no window: first < 0): the nodes that left it
+// back to the static state at rest, the entering ones' wind, and the static force of the elements
+// left out on the cut layers.
+void move_wire_window(const Model& m, State& s, std::size_t wi, int first, double xa, double xb, bool turbulent) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  double* y = ls.y.data();
+  double* v = ls.v.data();
+  double* f = ls.f.data();
+  const Wire& w = lat.wires[wi];
+  WireWindow& ww = ls.window[wi];
+  const int o = w.w_dof, old_lo = ww.lo, old_hi = ww.hi;
+  if (first >= 0) {
+    set_wire_window(w, xa, xb, ww);
+  } else {
+    ww.lo = 0;
+    ww.hi = -1;
+  }
+  const int lo = ww.lo, hi = ww.hi;
+  for (int i = old_lo; i <= old_hi; ++i)
+    if (i < lo || i > hi) {
+      y[o + i] = lat.initial[o + i];
+      v[o + i] = 0.0;
+    }
+  if (turbulent)
+    for (int i = lo; i <= hi; ++i)
+      if (i < old_lo || i > old_hi) refresh_wind(m, s, o + i, o + i + 1);
+  if (hi < lo) return;
+  if (hi == lo) ls.window_fused = false;  // (as the vertical step: the sweep needs two nodes)
+  if (!ww.cut_lo && !ww.cut_hi) return;
+  for (int i = lo; i <= hi; ++i) f[o + i] = 0.0;
+  wire_elastic_force_window(w, ww, lat.initial.data(), f, ls.theta.data());
+  auto add_cut = [&](int i) {
+    ls.cut_node[ls.cut_count] = o + i;
+    ls.cut_force[ls.cut_count++] = lat.static_elastic_force[o + i] - f[o + i];
+  };
+  const int lo_end = ww.cut_lo ? std::min(hi, lo + kCutLayer - 1) : lo - 1;
+  for (int i = lo; i <= lo_end; ++i) add_cut(i);
+  if (ww.cut_hi)
+    for (int i = std::max(lo_end + 1, hi - kCutLayer + 1); i <= hi; ++i) add_cut(i);
+}
+
+// The springs and pendulums (droppers) between the window's end supports whose nodes it holds,
+// and the fused step's nodes with point forces: the cut layers, springs, pendulums.
+void list_window_points(const Model& m, State& s, int first, double xa, double xb) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  auto inside = [&](int dof) { return in_windows(lat.wires, ls.window, dof); };
+  ls.window_spring_count = ls.window_dropper_count = 0;
+  if (first >= 0) {
+    ls.window_spring_count = select_between(
+        lat.spring_order, lat.spring_order_x, xa, xb, [&](int k) { return inside(lat.springs[k].dof); },
+        ls.window_springs.data());
+    ls.window_dropper_count = select_between(
+        m.dropper_order, m.dropper_order_x, xa, xb,
+        [&](int k) { return inside(lat.pendulums[k].contact) && inside(lat.pendulums[k].messenger); },
+        ls.window_droppers.data());
+  }
+  // The fused step's nodes with point forces: the cut layers, springs, pendulums.
+  int q = 0;
+  for (int j = 0; j < ls.cut_count; ++j) ls.window_points[q++] = ls.cut_node[j];
+  for (int j = 0; j < ls.window_spring_count; ++j) ls.window_points[q++] = lat.springs[ls.window_springs[j]].dof;
+  for (int j = 0; j < ls.window_dropper_count; ++j) {
+    const LateralPendulum& p = lat.pendulums[ls.window_droppers[j]];
+    ls.window_points[q++] = p.contact;
+    ls.window_points[q++] = p.messenger;
+  }
+  ls.window_point_count = q;
+}
+
+}  // namespace
+
+// The moving window (numerics.window): the lateral plane steps the vertical plane's window
+// (State::window, which update_window moved before this step; the lateral waves run at the same
+// sqrt(T/rhoA), so the same window holds their echoes) and, in a turbulent wind, a lead of
+// LateralModel::gust_lead seconds of travel further ahead, so that a span has felt the gusts that
+// long when the pantograph reaches it. When it moved, the nodes that left it return to the static
+// state under the mean wind at rest (as the vertical plane's to u = 0), the nodes that entered
+// get the wind of the last refresh, and the lists are rebuilt: springs and pendulums in the
+// window, and at each cut the static force of the elements left out (-K initial of the whole line
+// less the window's), so that the static state stays at rest in the window as outside it. Costs
+// what the window holds (bisection for the springs and droppers), not the line.
+void sync_window(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const std::vector<double>& sx = m.support_x;
+  const int first = s.window_first_support;
+  int last = s.window_last_support;
+  if (first >= 0 && lat.gust_lead > 0.0) {
+    const double hi_x = sx[last] + lat.gust_lead * std::fabs(s.speed);  // the lead, snapped outward to a support
+    last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x - 1e-6) - sx.begin());
+    last = std::min(last, static_cast<int>(sx.size()) - 1);
+  }
+  if (first == ls.window_first_support && last == ls.window_last_support && !ls.window_dirty) return;
+  ls.window_dirty = false;
+  ls.window_first_support = first;
+  ls.window_last_support = last;
+  const bool turbulent = lat.windy && !lat.field.empty();
+  ls.cut_count = 0;
+  ls.window_fused = !lat.planes.empty();
+  const double xa = first >= 0 ? sx[first] : 0.0, xb = first >= 0 ? sx[last] : -1.0;
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) move_wire_window(m, s, wi, first, xa, xb, turbulent);
+  for (const WireLanes& p : m.wire_packs)
+    if (p.lanes == 2 && (ls.window[p.wire[0]].lo != ls.window[p.wire[1]].lo || ls.window[p.wire[0]].hi != ls.window[p.wire[1]].hi))
+      ls.window_fused = false;
+  if (ls.window_fused) interleave_window_factors(m.wire_packs, ls.window, ls.sweep_factors.data());
+  list_window_points(m, s, first, xa, xb);
+}
+
+void add_window_forces(const Model& m, const State& s, const double* v, double* f) {
+  const LateralModel& lat = *m.lateral;
+  const LateralState& ls = s.lateral;
+  for (int j = 0; j < ls.cut_count; ++j) f[ls.cut_node[j]] += ls.cut_force[j];
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    const WireWindow& ww = ls.window[wi];
+    if (ww.hi < ww.lo) continue;
+    const Wire& w = lat.wires[wi];
+    const double c = std::sqrt(w.spec.tension * w.spec.linear_mass);
+    if (ww.cut_lo) f[w.w_dof + ww.lo] -= c * v[w.w_dof + ww.lo];
+    if (ww.cut_hi) f[w.w_dof + ww.hi] -= c * v[w.w_dof + ww.hi];
+  }
+}
+
+}  // namespace catenary_sim
