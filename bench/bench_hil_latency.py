@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Latency of the hardware-in-the-loop node (issue: hardware in the loop).
+"""Latency of the hardware-in-the-loop node (the loop on the wall clock).
 
   bench/bench_hil_latency.py [--rates 1000,2000,5000] [--durations 600,60,60] [--chrt 0]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The hardware-in-the-loop loop over three transports, in one run (issue: HIL as rigs run it).
+"""The hardware-in-the-loop loop over three transports, in one run (as rigs run it).
 
   bench/bench_hil_transports.py [--rates 1000,5000,10000] [--duration 30]
 

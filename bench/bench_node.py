@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Times the live node against the offline runner on the reference pass (issue: live node).
+"""Times the live node against the offline runner on the reference pass (the pacing overhead).
 
   bench/bench_node.py [--reps 3] [--rt-runs 1] [--speed 300] [--scene config/reference_55m.yaml]
 

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Throughput of a study on Dask with 1 and 2 local workers, and its overhead per case against a
-bare simulate_pass of the same case (issue: studies at scale).
+bare simulate_pass of the same case (the study harness's overhead).
 
   bench/bench_study_scale.py [--cases 24] [--spans 30] [--reps 2]
 

@@ -1,5 +1,5 @@
 // How late a bare periodic thread wakes up on this machine: the floor under the HIL loop's
-// overruns (issue: hardware in the loop). A thread with 1 us timer slack sleeps to absolute
+// overruns (hardware in the loop). A thread with 1 us timer slack sleeps to absolute
 // deadlines on CLOCK_MONOTONIC at `rate` Hz for `seconds` and counts the wake-ups later than
 // 0.1, 0.5, 1 and 5 ms. It does nothing else, so lateness here is the machine's (other processes,
 // or, on a VM, the hypervisor taking the vCPU away), not the node's. Run it under `chrt -f 50`

@@ -71,8 +71,8 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   // One second of contact points queued per subscriber: a subscriber stalled for a few periods (a
   // loaded machine) gets them late instead of losing them; roscpp drops the oldest of a fuller
   // queue, and a rig that loses one integrates its pantograph against an extrapolated wire for
-  // two periods, a recorder a hole in its series (seen in test_ros_hil_loop at 2 kHz on a loaded
-  // 2-core machine with the former 10: 41 lost in a pass).
+  // two periods, a recorder a hole in its series (test_ros_hil_loop at 2 kHz on a loaded 2-core
+  // machine lost 41 in a pass with a queue of 10).
   point_pub_ = nh_.advertise<ContactPointArray>("hil/contact_point", static_cast<std::uint32_t>(std::ceil(params_.rate)));
   contact_pub_ = nh_.advertise<ContactForceArray>("contact_force", 10);
   pantograph_pub_ = nh_.advertise<PantographStateArray>("pantograph_state", 10);

@@ -62,7 +62,7 @@ TEST(SceneErrors, OutOfRangeNamesFieldValueAndRange) {
   EXPECT_MENTIONS(error_of({"pantographs.0.static_uplift=-1"}), "pantographs[0].static_uplift", "-1", "allowed range");
 }
 
-// The report's fields (issue 15): limits absent by default, each checked like the others.
+// The report's fields: limits absent by default, each checked like the others.
 TEST(SceneErrors, OutputLimitsAndMeasurementFields) {
   EXPECT_EQ(error_of({"output.allowed_uplift=0.12", "output.max_stat_force=350", "output.min_stat_force=0",
                       "output.max_contact_loss_percent=0.1", "output.sensor_bandwidth=40", "output.dropper_series=true"}),

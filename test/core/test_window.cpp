@@ -40,7 +40,7 @@ TEST(Window, StatisticsMatchTheFullLine) {
   // 20 spans at 300 km/h, balanced preset: the window (auto: 3.8 spans ahead, 2 behind) against the
   // full line, over spans 4-15: the window stands for a line that goes on, so the statistics are
   // taken where the full line's anchors are out of reach (near them the full line's reflections
-  // are real and the window's are not). The budget is 1 %: mean, std and max relative;
+  // are real and the window's are not). The window's accuracy budget is 1 %: mean, std and max relative;
   // the min relative to the mean (it is a small number whose relative change means little).
   const PantographStatistics full = pass({"line.span_count=20", "numerics.preset=balanced", "output.analysis_spans=[4,16]"});
   const PantographStatistics win =
@@ -57,7 +57,7 @@ TEST(Window, AutoLengthsFollowTheSpeed) {
   // moves the std by 3.9 % there (bench_window_lengths). The auto window against a generous one
   // (5 spans ahead, 14 behind) on a 42-span line, statistics over spans 16-35 (the generous
   // window stands for the line that goes on; a finite full line would add its anchors' echoes):
-  // within the 1 %, the min relative to the mean as above.
+  // within the budget's 1 %, the min relative to the mean as above.
   const std::vector<std::string> base = {"line.span_count=42", "numerics.preset=balanced", "output.analysis_spans=[16,36]",
                                          "train.speed_kmh=350"};
   std::vector<std::string> generous = base, automatic = base;

@@ -522,7 +522,7 @@ TEST(Params, ErrorsNameParameterValueAndRange) {
 }
 
 // The lower bounds of the rates keep every period within ros::WallDuration (int32 seconds): the
-// issue's 1e-10 and 1e-300 are refused with the parameter named, and the smallest value allowed
+// values 1e-10 and 1e-300 are refused with the parameter named, and the smallest value allowed
 // gives a period that a WallDuration holds (constructing it throws past 2^31 s).
 TEST(Params, AbsurdRatesAreRejectedAndTheSmallestAllowedHasAPeriod) {
   NodeParams p;

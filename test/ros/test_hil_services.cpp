@@ -81,7 +81,7 @@ std_srvs::SetBool::Response set_paused(bool paused) {
 }
 
 // A refused call: success false, a message that says so, and nothing changed: the mode and
-// pass_count as before and, where the line is held, the step too.
+// pass_count unchanged and, where the line is held, the step too.
 template <class Response>
 void expect_refused(const Response& r, const ContactPointArray& before, bool held, const std::string& what) {
   EXPECT_FALSE(r.success) << what << ": " << r.message;

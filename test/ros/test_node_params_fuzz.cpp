@@ -1,8 +1,8 @@
-// Fuzz of bad node parameters (issue 10): catenary_sim_node, catenary_sim_hil_node and virtual_rig
+// Fuzz of bad node parameters: catenary_sim_node, catenary_sim_hil_node and virtual_rig
 // run as child processes against a master of this test's own, each with one private parameter
 // set to a value its type or range does not allow (`_name:=value` on the command line, as a user
 // would). For each: a non-zero exit, no signal, no hang (20 s), no output file written, and a
-// message naming the parameter. Also: the issue's cases by name (_publish_rate:=1e-10,
+// message naming the parameter. Also: known cases by name (_publish_rate:=1e-10,
 // _marker_rate:=1e-300, _at_end:=1, _line_frame:=5), unknown parameters warned about by name with
 // the closest known one, unwritable output files refused at start-up, and a ~stats_file that
 // becomes unwritable during the pass failing the node's exit code.
@@ -130,7 +130,7 @@ struct Param {
 // boolean, anything else as a string. The reading and the range checks are shared by all
 // parameters, so each parameter gets one value of every class (wrong type, not finite, out of
 // range), the class's values taken in turn over the parameters (`i`: the parameter's index);
-// the rates get every tiny value (the issue's crashes) and every parameter the empty string.
+// the rates get every tiny value (values that once crashed a node) and every parameter the empty string.
 std::vector<std::string> bad_values(Kind k, std::size_t i) {
   auto pick = [i](const std::vector<std::string>& v) { return v[i % v.size()]; };
   const std::string wrong_type = pick({"abc", "true", "[1]", "{a: 1}"});
@@ -244,8 +244,8 @@ TEST_F(NodeParamsFuzz, VirtualRigRejectsEveryBadValueNamingTheParameter) {
   EXPECT_GT(count, 15);
 }
 
-// The issue's cases, by name: the messages say the value as given and what is allowed.
-TEST_F(NodeParamsFuzz, IssueCasesSayValueAndWhatIsAllowed) {
+// Known cases, by name: the messages say the value as given and what is allowed.
+TEST_F(NodeParamsFuzz, KnownCasesSayValueAndWhatIsAllowed) {
   struct Case {
     std::string arg, says;
   };

@@ -1,11 +1,11 @@
-// Fuzz of bad input to the offline tools (issue 10): generated bad scenes, --set overrides and
+// Fuzz of bad input to the offline tools: generated bad scenes, --set overrides and
 // command lines, each run as a child process of simulate_pass (and elasticity_curve). For each:
 // a non-zero exit, no signal, no hang (10 s), no output file written (so nothing half-written and
 // no NaN), and a message naming the field (or flag, or file) that is wrong.
 //
 // The inputs are generated from the reference scene itself: every numeric field it holds gets
 // values no range allows (NaN, inf, 1e300, text, lists, maps), every map gets an unknown field
-// and a scalar in its place, and the YAML text is corrupted in the ways the issue's fuzz found.
+// and a scalar in its place, and the YAML text is corrupted in the ways a fuzzer finds.
 // Deterministic (fixed seed): a failure is reproducible, never by chance.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>

@@ -118,7 +118,7 @@ struct MarkerOptions {
   bool include_static = true;     // masts and steady arms (constant parts)
 };
 
-// The contact-force strip chart drawn in rviz beside the line (issue: "see the force"): the last
+// The contact-force strip chart drawn in rviz beside the line, to see the force as it happens: the last
 // `window` seconds of one or more series (per pantograph, and per contact wire in overlaps), in a
 // panel in the train-following frame, with a force axis (ticks every 100 N), a time axis, a legend,
 // the statistics so far and a heads-up line (station, span, time, real-time factor, scale).

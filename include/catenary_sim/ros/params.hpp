@@ -85,7 +85,7 @@ bool read_speed_kmh(ParamReader& r, const ros::NodeHandle& private_nh, std::opti
                     const std::string& expected);
 
 // The lower bounds of the rates (Hz). The period 1/rate becomes a ros::WallDuration, whose
-// seconds are an int32: anything below 1/2^31 Hz (the 1e-10, 1e-300) threw out of the
+// seconds are an int32: anything below 1/2^31 Hz (e.g. 1e-10, 1e-300) threw out of the
 // run loop and aborted the node. The bounds are those of cfg/Node.cfg (dynamic_reconfigure clamps
 // to them), far above that limit: the pacing tick (publish_rate) is when commands, services and
 // the end of the pass are handled, so at least once a second; a topic sent at shape_rate or

@@ -8,7 +8,7 @@
 // one block-tridiagonal solve per wire over its (w, theta) node pairs, factorised once. Central
 // differences with centred damping are stable up to the undamped limit 2 / omega_max whatever the
 // damping, where the half-step damping of the shortest mesh modes sets a limit falling like
-// 1 / (beta omega_max^2). Point forces (supports, droppers, pantographs, contact) as before.
+// 1 / (beta omega_max^2). Point forces (supports, droppers, pantographs, contact) as in the half-step.
 #pragma once
 #include "catenary_sim/core/model/model.hpp"
 #include "model/centred_factors.hpp"
