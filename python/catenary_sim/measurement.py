@@ -474,12 +474,16 @@ def simulate_run(scene, record=None, overrides=None, speed_profile=None, sensor_
     v0 = float(np.interp(x0, px, pv))
     sim = Simulation(scene, ov + ["train.speed=null", f"train.speed_kmh={3.6 * v0!r}"], sample_rate=0)
     speeds = [sim.speed]
+    applied_x, applied_v = [], []  # the speed set at each station (the profile as the train met it)
     steps = 0
     while not sim.finished():
         x = sim.pantograph_state(i)["position_m"]
-        sim.set_speed(float(np.interp(x, px, pv)))
+        v = float(np.interp(x, px, pv))
+        sim.set_speed(v)
         if sim.step(1) == 0:
             break
+        applied_x.append(x)
+        applied_v.append(v)
         speeds.append(sim.speed)
         steps += 1
         if steps > max_steps:
@@ -497,6 +501,7 @@ def simulate_run(scene, record=None, overrides=None, speed_profile=None, sensor_
     uplift = [(a["station_m"], np.asarray(series[c])) for a, c in zip(arms, ucols)] if len(arms) == len(ucols) else []
     return SimulatedRun(simulation=sim, scene=scene, overrides=ov, reference=ref, time_s=np.asarray(series["time_s"]),
                         speed_mps=np.asarray(speeds[:n]), profile=(px, pv), profile_source=source,
+                        applied=(np.asarray(applied_x), np.asarray(applied_v)),
                         position_m={p: np.asarray(series[p + "_position_m"]) for p in names},
                         force_N={p: np.asarray(series[p + "_force_N"]) for p in names},
                         measured_N={p: processed[p + "_force_measured_N"].to_numpy(float) for p in names},
@@ -805,7 +810,9 @@ def synthesise_record(scene, path, overrides=None, speed_profile=300.0, sample_r
     station = np.interp(t, run.time_s, run.position_m[ref])
     cols = {"station_m": np.round(station + origin, DECIMALS["station_m"]),
             "time_s": np.round(t - t[0], DECIMALS["time_s"]),
-            "speed_kmh": np.round(3.6 * np.interp(t, run.time_s, run.speed_mps), DECIMALS["speed_kmh"])}
+            # The speed the train was set to at each station: a record's speed column drives the
+            # comparison's run the same way, station by station.
+            "speed_kmh": np.round(3.6 * np.interp(station, *run.applied), DECIMALS["speed_kmh"])}
     rng = np.random.default_rng(seed)
     for p in run.names:
         f = np.interp(t, run.time_s, run.measured_N[p])
