@@ -75,8 +75,11 @@ class RecordError(SceneError):
 
     def __init__(self, kind, path, field, value, allowed, why, row=None):
         where = f"line {row}, " if row is not None else ""
-        message = (f"record {path}: {kind}: {where}{'column' if kind not in ('metadata', 'section_outside_line') else 'field'}"
-                   f" '{field}' = {value}: {why}; allowed {allowed}")
+        if kind == "format":
+            what = f"{field} {value}"
+        else:
+            what = f"{'field' if kind in ('metadata', 'section_outside_line') else 'column'} '{field}' = {value}"
+        message = f"record {path}: {kind}: {where}{what}: {why}; allowed {allowed}"
         super().__init__(message, field=field, value=value, allowed=allowed)
         self.kind, self.row, self.path = kind, row, path
 

@@ -62,6 +62,14 @@ def pictures(c):
         ax.plot(x, s[f"simulated_force_{p}_filtered_N"], color=SIMULATED, lw=1.2, ls="--",
                 label="simulated measuring pantograph, filtered")
         _marks(ax, c, lo, hi)
+        # The range of the analysis section (the line's ends, where the pantograph meets the
+        # anchors, can spike far above it), with room on top for the legend.
+        inside = s["in_section"].to_numpy() > 0
+        if inside.any():
+            both = np.concatenate([s[f"record_force_{p}_N"].to_numpy()[inside],
+                                   s[f"simulated_force_{p}_filtered_N"].to_numpy()[inside]])
+            top, bottom = float(np.max(both)), min(0.0, float(np.min(both)))
+            ax.set_ylim(bottom - 0.05 * (top - bottom), top + 0.35 * (top - bottom))
         ax.set_ylabel("contact force (N)")
         ax.set_title("%s: contact force against station (filtered at %g Hz; green: analysis section)" % (
             p, c.settings["cutoff_hz"]), fontsize=11)
@@ -96,6 +104,9 @@ def pictures(c):
         ax.axvline(h * sp, color="tab:green", lw=1.2 if h == 1 else 0.5, ls="-" if h == 1 else ":",
                    label="span passing %.2f Hz and harmonics" % sp if h == 1 else None)
     ax.axvline(fmax, color="k", lw=1.0, ls="-.", label="compared up to %g Hz" % fmax)
+    top = float(np.max(c.spectra[["record_psd_N2_per_hz", "simulated_psd_N2_per_hz"]].to_numpy()))
+    if top > 0:
+        ax.set_ylim(top * 1e-7, top * 30)  # seven decades: what lies below is beyond the bandwidth
     ax.set_xlim(0, 1.5 * fmax)
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("PSD of the contact force (N$^2$/Hz)")
