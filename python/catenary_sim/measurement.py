@@ -20,6 +20,7 @@ import os
 import re
 import shutil
 import tempfile
+import textwrap
 
 import numpy as np
 import pandas as pd
@@ -112,7 +113,9 @@ def _read_metadata(path, meta, comment_lines):
         for ext in (".yaml", ".yml"):
             if os.path.isfile(stem + ext):
                 side = stem + ext
-    header = "\n".join(line[1:] for line in comment_lines).strip()
+    # '# key: value' lines: the '#' and the indent they share removed, nested YAML kept.
+    header = textwrap.dedent("\n".join(line[1:] for line in comment_lines))
+    header = header if header.strip() else ""
     if side is not None and header:
         raise RecordError("metadata", path, "metadata", side, "the metadata in one place only",
                           "given both in the CSV's '#' header and in a side YAML")

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 import yaml
 
+import catenary_sim as cs
 from catenary_sim import measurement as cm
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -265,3 +266,57 @@ def test_the_cli_refuses_bad_input_and_writes_nothing(tmp_path, clean):
     assert r.returncode == 2 and "tolerances key 'spread'" in r.stderr, r.stderr
     assert sorted(os.listdir(out)) == ["keep.txt"]
     assert sorted(os.listdir(tmp_path)) == sorted(["bad.csv", "bad.yaml", "never"])
+
+
+# --------------------------------------------------------------------------------------------
+# Other shapes of the same record
+# --------------------------------------------------------------------------------------------
+def test_a_header_a_railways_stations_and_a_time_based_record_read_alike(tmp_path, clean):
+    with open(clean.path) as f:
+        lines = f.read().splitlines()
+    with open(os.path.splitext(clean.path)[0] + ".yaml") as f:
+        doc = yaml.safe_load(f)
+    # The metadata as '#' lines atop the CSV instead of beside it.
+    header = ["# " + ln for ln in yaml.safe_dump(doc).splitlines()]
+    (tmp_path / "h.csv").write_text("\n".join(header + lines) + "\n")
+    r = cm.read_record(str(tmp_path / "h.csv"))
+    assert np.array_equal(r.station_m, clean.station_m) and np.array_equal(r.force_N["leading"], clean.force_N["leading"])
+    # Both at once is ambiguous.
+    (tmp_path / "h.yaml").write_text(yaml.safe_dump(doc))
+    refused(str(tmp_path / "h.csv"), "metadata", "metadata")
+    # Stations counted from a kilometre post 12.345 km before the scene's station 0.
+    head = lines[0].split(",")
+    k = head.index("station_m")
+    rows = [ln.split(",") for ln in lines[1:]]
+    for row in rows:
+        row[k] = "%.6f" % (float(row[k]) / 1000.0 + 12.345)
+    head[k] = "station_km"
+    (tmp_path / "km.csv").write_text("\n".join([",".join(head)] + [",".join(row) for row in rows]) + "\n")
+    moved = dict(doc, station_origin_m=12345.0, supports={n: x + 12345.0 for n, x in doc["supports"].items()})
+    (tmp_path / "km.yaml").write_text(yaml.safe_dump(moved))
+    r = cm.read_record(str(tmp_path / "km.csv"))
+    # km to 1e-6 is mm: the stations agree to half a millimetre.
+    assert np.max(np.abs(r.station_m - clean.station_m)) <= 0.5e-3 + 1e-9
+    assert r.support_station_m == pytest.approx(clean.support_station_m)
+    # Without a station column: the stations are the speed integrated over the times from
+    # start_station_m. The simulated train's speed is constant over each step (dt) and changes
+    # between steps, so a speed sampled anywhere in a step misplaces that step's change by at most
+    # dt: over the record at most (v_end - v_start) dt, about 10 mm here; the trapezoid rule on a
+    # speed linear in station adds (dv/dt) h^2 / 12 per 5 ms row, 1e-7 m, 1e-4 m in all.
+    (tmp_path / "t.csv").write_text("\n".join(",".join(c for j, c in enumerate(ln.split(",")) if j != lines[0]
+                                                       .split(",").index("station_m")) for ln in lines) + "\n")
+    (tmp_path / "t.yaml").write_text(yaml.safe_dump(dict(doc, start_station_m=float(clean.station_m[0]))))
+    r = cm.read_record(str(tmp_path / "t.csv"))
+    dt = cs.Simulation(REFERENCE, SHORT).dt
+    assert np.max(np.abs(r.station_m - clean.station_m)) <= (RAMP[1][1] - RAMP[1][0]) / 3.6 * dt + 2e-4
+
+
+def test_a_given_speed_profile_replaces_the_records(clean):
+    # The record's run (230 to 270 km/h) compared against a pass at a constant 250 km/h: the
+    # simulated train follows the given speed, and the record's stations still place the samples.
+    c = cm.compare(REFERENCE, clean, overrides=SHORT, speed_profile=250.0)
+    assert c.settings["speed_profile"] == "250 km/h throughout"
+    assert np.allclose(c.series["simulated_speed_kmh"], 250.0)
+    assert c.settings["mean_speed_kmh"] == pytest.approx(250.0)
+    dev = {r["quantity"]: r["deviation"] for r in c.rows if r["of"] == "leading"}
+    assert abs(dev["std_force_N"]) > 1e-3  # another run than the record's
