@@ -319,7 +319,8 @@ def read_record(path, meta=None):
     for name in uplift:
         if name not in supports:
             raise RecordError("unknown_support", path, by[("uplift", name)], "(header)",
-                              f"a support declared in the metadata's supports (given: {', '.join(map(str, supports)) or 'none'})",
+                              "a support declared in the metadata's supports (given: "
+                              f"{', '.join(map(str, supports)) or 'none'})",
                               "the record does not say where this support stands")
     support_station = {}
     for name, x in supports.items():
@@ -421,7 +422,7 @@ def _profile(record, speed_profile):
                          allowed="a speed in km/h or a pair (stations m, speeds km/h)") from None
     if (x.ndim != 1 or x.shape != v.shape or len(x) < 1 or not np.all(np.isfinite(x)) or not np.all(np.isfinite(v))
             or np.any(np.diff(x) <= 0) or np.any(v <= 0) or np.any(v > 540)):
-        raise SceneError(f"speed_profile rejected: allowed increasing stations (m) and speeds 0 < v <= 540 km/h of "
+        raise SceneError("speed_profile rejected: allowed increasing stations (m) and speeds 0 < v <= 540 km/h of "
                          "the same length", field="speed_profile", value=_shown(speed_profile),
                          allowed="increasing stations (m) and speeds 0 < v <= 540 km/h")
     return x, v / 3.6, "the given profile"

@@ -280,7 +280,8 @@ def test_a_header_a_railways_stations_and_a_time_based_record_read_alike(tmp_pat
     header = ["# " + ln for ln in yaml.safe_dump(doc).splitlines()]
     (tmp_path / "h.csv").write_text("\n".join(header + lines) + "\n")
     r = cm.read_record(str(tmp_path / "h.csv"))
-    assert np.array_equal(r.station_m, clean.station_m) and np.array_equal(r.force_N["leading"], clean.force_N["leading"])
+    assert np.array_equal(r.station_m, clean.station_m)
+    assert np.array_equal(r.force_N["leading"], clean.force_N["leading"])
     # Both at once is ambiguous.
     (tmp_path / "h.yaml").write_text(yaml.safe_dump(doc))
     refused(str(tmp_path / "h.csv"), "metadata", "metadata")
