@@ -673,7 +673,14 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
     ref = record.station_of
     pos = run.position_m[ref]
     travel = (float(pos[0]), float(pos[-1]))
-    section = record.section_m or tuple(stats["analysis_section_m"])
+    section = record.section_m
+    if section is None:
+        # The scene's analysis section where both the pantograph's run and the record reach (a
+        # pantograph behind the train's front starts inside the line, as the core counts it).
+        a0, a1 = stats["analysis_section_m"]
+        section = (max(a0, travel[0], record.station_m[0]), min(a1, travel[1], record.station_m[-1]))
+        if not section[0] < section[1]:
+            section = (a0, a1)
     if not (travel[0] <= section[0] < section[1] <= travel[1]):
         raise RecordError("section_outside_line", record.path, "section_m",
                           f"[{section[0] + record.station_origin_m:g}, {section[1] + record.station_origin_m:g}]",
@@ -748,15 +755,16 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
                 rows.append(_row(name, p, "m", float(fn(rh[inside])), float(fn(sh[inside])), _tolerance(tol, name, p)))
             columns[f"record_head_{p}_m"] = rh
             columns[f"simulated_head_{p}_m"] = sh
-    # Steady arms: the largest uplift while the reference pantograph is within half the shorter
-    # adjacent span of the arm (the core's reach), on both sides at the record's rows.
+    # Steady arms: the largest uplift while a pantograph is within half the shorter adjacent span
+    # of the arm (the core's reach), on both sides at the record's rows.
+    at_rows = [np.interp(t_at, run.time_s, run.position_m[q]) for q in run.names]
     for name, x in record.support_station_m.items():
         sx, su = min(arms, key=lambda a: abs(a[0] - x))
         k = int(np.searchsorted(supports, sx - 1e-6))
         left = sx - supports[k - 1] if k > 0 else math.inf
         right = supports[k + 1] - sx if k + 1 < len(supports) else math.inf
         reach = 0.5 * min(left, right)
-        near = np.abs(station - sx) <= reach
+        near = np.any([np.abs(xq - sx) <= reach for xq in at_rows], axis=0)
         ru = record.uplift_m[name][keep]
         su_at = np.interp(t_at, run.time_s, su)
         rows.append(_row("max_uplift_m", name, "m", float(np.max(ru[near])) if near.any() else None,
