@@ -1,0 +1,414 @@
+"""Calibration: the scene parameters a measured record is best reproduced with, their uncertainty,
+and which of them the record cannot identify.
+
+    scripts/calibrate CALIBRATION.yaml --out DIR [--workers 2 | --scheduler tcp://host:8786]
+    from catenary_sim.calibration import calibrate; result = calibrate("CALIBRATION.yaml", "DIR")
+
+A calibration file (YAML; paths relative to it):
+
+    scene: ../config/reference_55m.yaml
+    record: measured_run.csv            # its metadata beside it (measured_run.yaml) or in '#' lines
+    overrides: {}                       # applied to every evaluation, as simulate_pass --set
+    speed_profile: null                 # null: the record's; a speed in km/h
+    cutoff: scene                       # the comparison's low-pass: scene, bandwidth or Hz
+    parameters:                         # any scene field, with its bounds
+      - {key: damping.beta, low: 5.0e-5, high: 1.0e-3, scale: log}       # scale: linear (default) or log
+      - {key: droppers.axial_stiffness, low: 2.0e4, high: 4.0e5, scale: log}
+    objective:                          # weights; the residuals are squared and summed
+      statistics: {std_force_N: 1, max_force_N: 1, min_force_N: 1}       # relative deviations
+      time_history: 1                   # (simulated - record) / std(record), rms over the section
+      spectrum: 0                       # dB differences up to the cutoff, rms
+    optimiser: {method: least_squares, max_evaluations: 60}   # or minimize:Nelder-Mead, minimize:Powell
+
+Every evaluation is catenary_sim.measurement.compare with the parameters as overrides, run on a
+Dask cluster (a local one of --workers processes by default) and written atomically to
+DIR/evaluations/ keyed by its parameter values, so that a calibration started again on the same DIR
+replays them and goes on where it stopped. Writes DIR/calibrated.yaml (the scene snippet),
+DIR/calibration.json (values, uncertainties, identifiability, residuals before and after) and
+DIR/before/ and DIR/after/ (compare_measurement's report at the initial and calibrated values).
+"""
+import hashlib
+import json
+import math
+import os
+import tempfile
+
+import numpy as np
+import yaml
+from scipy import optimize
+
+from . import SceneError
+from . import measurement as cm
+
+METHODS = ("least_squares", "minimize:Nelder-Mead", "minimize:Powell")
+FIELDS = {"scene", "record", "meta", "overrides", "speed_profile", "cutoff", "parameters", "objective", "optimiser"}
+# Forward differences in the parameters' unit scale (bounds mapped to [0, 1]): a step of 1 % of the
+# range, far above the passes' rounding (they are deterministic to the last bit) and small against
+# the curvature of the deviations over the range.
+DIFF_STEP = 0.01
+# A direction of the parameters whose singular value is below this share of the largest changes the
+# residuals a thousand times less than the best-determined one: the record does not fix it.
+IDENTIFIABLE_SV = 1e-3
+
+
+class CalibrationError(ValueError):
+    """A calibration file that cannot be run: names the field, the value and what is allowed."""
+
+
+def _fail(field, value, allowed):
+    raise CalibrationError(f"calibration field '{field}' = {value!r}: {allowed}")
+
+
+def _number(v, field, allowed, positive=False):
+    if isinstance(v, str):  # YAML 1.1 reads 2.0e4 (no sign in the exponent) as text
+        try:
+            v = float(v)
+        except ValueError:
+            pass
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or (positive and v <= 0):
+        _fail(field, v, allowed)
+    return float(v)
+
+
+def load_calibration(path):
+    """Reads and checks a calibration file; returns a dict with absolute paths."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            doc = yaml.safe_load(f)
+    except (OSError, yaml.YAMLError, UnicodeDecodeError) as e:
+        raise CalibrationError(f"calibration file {path!r} cannot be read: {e}") from None
+    if not isinstance(doc, dict):
+        _fail("", doc, "a YAML map (scene, record, parameters, objective, ...)")
+    for k in doc:
+        if k not in FIELDS:
+            _fail(k, doc[k], "not a field; allowed " + ", ".join(sorted(FIELDS)))
+    base = os.path.dirname(os.path.abspath(path))
+    out = dict(doc)
+    for k in ("scene", "record"):
+        if not isinstance(doc.get(k), str):
+            _fail(k, doc.get(k), "a file path (relative to the calibration file)")
+        out[k] = os.path.join(base, doc[k])
+    out["meta"] = os.path.join(base, doc["meta"]) if isinstance(doc.get("meta"), str) else None
+    ov = doc.get("overrides") or {}
+    if not isinstance(ov, dict):
+        _fail("overrides", ov, "a map {dotted.key: value}")
+    out["overrides"] = ov
+    out["speed_profile"] = doc.get("speed_profile")
+    if out["speed_profile"] is not None:
+        _number(out["speed_profile"], "speed_profile", "null (the record's) or a speed in km/h > 0", True)
+    out["cutoff"] = doc.get("cutoff", "scene")
+    params = doc.get("parameters")
+    if not isinstance(params, list) or not params:
+        _fail("parameters", params, "a list of {key, low, high, scale}")
+    keys = set()
+    for i, p in enumerate(params):
+        where = f"parameters[{i}]"
+        if not isinstance(p, dict) or not isinstance(p.get("key"), str) or not p["key"]:
+            _fail(where, p, "a map with key (a scene field), low, high and optionally scale and initial")
+        if p["key"] in keys:
+            _fail(where + ".key", p["key"], "each parameter once")
+        keys.add(p["key"])
+        lo = p["low"] = _number(p.get("low"), where + ".low", "a finite number")
+        hi = p["high"] = _number(p.get("high"), where + ".high", "a finite number above low")
+        scale = p.get("scale", "linear")
+        if scale not in ("linear", "log"):
+            _fail(where + ".scale", scale, "linear or log")
+        if not lo < hi or (scale == "log" and lo <= 0):
+            _fail(where, p, "low < high (both > 0 on a log scale)")
+        if "initial" in p:
+            v = p["initial"] = _number(p["initial"], where + ".initial", "a number within [low, high]")
+            if not lo <= v <= hi:
+                _fail(where + ".initial", v, f"within [{lo:g}, {hi:g}]")
+        for k in p:
+            if k not in ("key", "low", "high", "scale", "initial"):
+                _fail(f"{where}.{k}", p[k], "not a field; allowed key, low, high, scale, initial")
+    obj = doc.get("objective") or {"time_history": 1.0}
+    if not isinstance(obj, dict):
+        _fail("objective", obj, "a map with statistics, time_history, spectrum")
+    for k in obj:
+        if k not in ("statistics", "time_history", "spectrum"):
+            _fail(f"objective.{k}", obj[k], "statistics, time_history or spectrum")
+    stats = obj.get("statistics") or {}
+    if not isinstance(stats, dict):
+        _fail("objective.statistics", stats, "a map NAME: weight")
+    for k, w in stats.items():
+        if k not in cm.TOLERANCE_NAMES or k in cm.DIFFERENCES:
+            _fail(f"objective.statistics.{k}", w, "a statistic: " + ", ".join(
+                n for n in cm.TOLERANCE_NAMES if n not in cm.DIFFERENCES))
+        _number(w, f"objective.statistics.{k}", "a weight >= 0")
+    for k in ("time_history", "spectrum"):
+        _number(obj.get(k, 0.0), f"objective.{k}", "a weight >= 0")
+    out["objective"] = {"statistics": stats, "time_history": float(obj.get("time_history", 0.0)),
+                        "spectrum": float(obj.get("spectrum", 0.0))}
+    if not stats and not out["objective"]["time_history"] and not out["objective"]["spectrum"]:
+        _fail("objective", obj, "at least one weight above 0")
+    opt = doc.get("optimiser") or {}
+    method = opt.get("method", "least_squares")
+    if method not in METHODS:
+        _fail("optimiser.method", method, "one of " + ", ".join(METHODS))
+    n = opt.get("max_evaluations", 100)
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 100000:
+        _fail("optimiser.max_evaluations", n, "an integer from 1 to 100000")
+    out["optimiser"] = {"method": method, "max_evaluations": n}
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Parameters on the unit scale, residuals
+# --------------------------------------------------------------------------------------------
+def to_values(params, u):
+    out = []
+    for p, x in zip(params, np.clip(u, 0.0, 1.0)):
+        lo, hi = float(p["low"]), float(p["high"])
+        out.append(lo * (hi / lo) ** x if p.get("scale") == "log" else lo + x * (hi - lo))
+    return out
+
+
+def to_unit(params, values):
+    out = []
+    for p, v in zip(params, values):
+        lo, hi = float(p["low"]), float(p["high"])
+        out.append(math.log(v / lo) / math.log(hi / lo) if p.get("scale") == "log" else (v - lo) / (hi - lo))
+    return np.array(out)
+
+
+def residuals(comparison, objective):
+    """The residual vector of a comparison: each chosen statistic's relative deviation (absolute
+    when the record's value is 0) times its weight; with time_history the filtered force's
+    difference over the section in units of the record's std, / sqrt(rows) (its squares sum to the
+    mean square); with spectrum the dB differences up to the cutoff, / sqrt(frequencies)."""
+    r = []
+    for row in comparison.rows:
+        w = objective["statistics"].get(row["quantity"])
+        if w and row["deviation"] is not None:
+            scale = abs(row["record"]) if row["record"] else 1.0
+            r.append(w * row["deviation"] / scale)
+    s = comparison.series
+    inside = s["in_section"].to_numpy() > 0
+    for p in comparison.record.force_N:
+        if objective["time_history"]:
+            rec = s[f"record_force_{p}_filtered_N"].to_numpy()[inside]
+            sim = s[f"simulated_force_{p}_filtered_N"].to_numpy()[inside]
+            r.extend(objective["time_history"] * (sim - rec) / (np.std(rec) * math.sqrt(len(rec))))
+        if objective["spectrum"]:
+            t = comparison.spectra[comparison.spectra["pantograph"] == p]
+            f = t["frequency_hz"].to_numpy()
+            pr, ps = t["record_psd_N2_per_hz"].to_numpy(), t["simulated_psd_N2_per_hz"].to_numpy()
+            band = (f > 0) & (f <= min(comparison.settings["cutoff_hz"], comparison.record.bandwidth_hz)) & \
+                (pr > 0) & (ps > 0)
+            r.extend(objective["spectrum"] * 10 * np.log10(ps[band] / pr[band]) / math.sqrt(band.sum()))
+    return np.asarray(r, dtype=float)
+
+
+def evaluate(cal, keys, values):
+    """One evaluation (runs on a Dask worker): the residuals at these parameter values."""
+    ov = dict(cal["overrides"])
+    ov.update(zip(keys, values))
+    c = cm.compare(cal["scene"], cal["record"], overrides=ov, speed_profile=cal["speed_profile"],
+                   cutoff_hz=cal["cutoff"], meta=cal["meta"])
+    return {"residuals": residuals(c, cal["objective"]).tolist(),
+            "band_hz": min(c.settings["cutoff_hz"], c.record.bandwidth_hz)}
+
+
+def _key(values):
+    return hashlib.sha1(json.dumps([float("%.12g" % v) for v in values]).encode()).hexdigest()[:16]
+
+
+def _write_atomically(path, text):
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=os.path.dirname(path))
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+class _Evaluator:
+    """Evaluations by their parameter values, on the cluster, each kept in DIR/evaluations/."""
+
+    def __init__(self, cal, out, client):
+        self.cal, self.client = cal, client
+        self.keys = [p["key"] for p in cal["parameters"]]
+        self.dir = os.path.join(out, "evaluations")
+        os.makedirs(self.dir, exist_ok=True)
+        self.count = self.replayed = 0
+
+    def many(self, us):
+        values = [to_values(self.cal["parameters"], u) for u in us]
+        results, todo = [None] * len(values), []
+        for i, v in enumerate(values):
+            path = os.path.join(self.dir, _key(v) + ".json")
+            if os.path.isfile(path):
+                with open(path, encoding="utf-8") as f:
+                    done = json.load(f)
+                results[i] = np.array(done["residuals"])
+                self.band_hz = done["band_hz"]
+                self.replayed += 1
+            else:
+                todo.append(i)
+        futures = [self.client.submit(evaluate, self.cal, self.keys, values[i], pure=False) for i in todo]
+        for i, fut in zip(todo, futures):
+            r = fut.result()
+            _write_atomically(os.path.join(self.dir, _key(values[i]) + ".json"),
+                              json.dumps({"values": dict(zip(self.keys, values[i])), **r}))
+            results[i] = np.array(r["residuals"])
+            self.band_hz = r["band_hz"]
+        self.count += len(values)
+        return results
+
+    def jacobian(self, u):
+        """Forward differences in the unit scale, stepping inwards at an upper bound; all n + 1
+        passes at once on the cluster."""
+        n = len(u)
+        points = [np.array(u, dtype=float)]
+        steps = []
+        for i in range(n):
+            h = DIFF_STEP if u[i] + DIFF_STEP <= 1.0 else -DIFF_STEP
+            x = np.array(u, dtype=float)
+            x[i] += h
+            points.append(x)
+            steps.append(h)
+        res = self.many(points)
+        return res[0], np.column_stack([(res[i + 1] - res[0]) / steps[i] for i in range(n)])
+
+
+def uncertainty(params, u, r, jac_u, correlated=1.0):
+    """Each parameter's standard uncertainty from the Jacobian at the optimum, cov = s^2 (J^T J)^+
+    with s^2 = sum r^2 / (m - n) (the residuals' own scatter), times `correlated`, the number of
+    residuals per independent one (a time history sampled at fs and band-limited to B holds
+    2 B independent values a second: fs / 2B per one), and which parameters the record
+    cannot identify: a parameter with a large share (> 1/2) in a direction of the parameters whose
+    singular value is below IDENTIFIABLE_SV of the largest, or whose std exceeds its range."""
+    m, n = jac_u.shape
+    dof = max(m / correlated - n, 1.0)
+    s2 = float(np.sum(r ** 2)) / dof
+    sv_u, sv, vt = np.linalg.svd(jac_u, full_matrices=False)
+    cov_u = s2 * np.linalg.pinv(jac_u.T @ jac_u)
+    values = to_values(params, u)
+    out = []
+    weak = sv < IDENTIFIABLE_SV * (sv[0] if len(sv) and sv[0] > 0 else 1.0)
+    for i, p in enumerate(params):
+        lo, hi = float(p["low"]), float(p["high"])
+        # d value / d u at the optimum (log scale: value x ln(hi / lo))
+        dvdu = values[i] * math.log(hi / lo) if p.get("scale") == "log" else hi - lo
+        std = math.sqrt(max(cov_u[i, i], 0.0)) * abs(dvdu)
+        share = float(np.sum(vt[weak, i] ** 2)) if weak.any() else 0.0
+        reasons = []
+        if share > 0.5:
+            reasons.append("the residuals hardly change along it (singular value below %g of the largest)" %
+                           IDENTIFIABLE_SV)
+        if std > hi - lo:
+            reasons.append("its uncertainty exceeds its range")
+        out.append({"key": p["key"], "value": values[i], "std": std, "identifiable": not reasons,
+                    "why_not": "; ".join(reasons) or None, "low": lo, "high": hi})
+    return out, {"singular_values": sv.tolist(), "residual_variance": s2, "residuals": m}
+
+
+def calibrate(path, out, scheduler=None, workers=2, report=True):
+    """Runs a calibration file into DIR (resumable); returns the dict of calibration.json."""
+    from dask.distributed import Client, LocalCluster
+    import dask
+
+    cal = load_calibration(path)
+    out = os.path.abspath(out)
+    if os.path.lexists(out) and not os.path.isdir(out):
+        raise CalibrationError(f"--out {out}: exists and is not a directory; allowed a directory (made if absent)")
+    params = cal["parameters"]
+    # Checked here, before any cluster starts: the record, the scene, each parameter at its initial value.
+    rec = cm.read_record(cal["record"], cal["meta"])
+    # The initial values (the range's middle unless given), just inside the bounds as the
+    # trust-region method needs.
+    u0 = np.array([to_unit([p], [p["initial"]])[0] if "initial" in p else 0.5 for p in params])
+    u0 = np.clip(u0, 1e-6, 1.0 - 1e-6)
+    try:
+        ov = dict(cal["overrides"])
+        ov.update(zip([p["key"] for p in params], to_values(params, u0)))
+        from . import check_scene
+        check_scene(cal["scene"], ov)
+    except SceneError as e:
+        raise CalibrationError(f"calibration {path}: {e}") from None
+    os.makedirs(out, exist_ok=True)
+    own = None
+    if scheduler:
+        client = Client(scheduler, timeout=10)
+    else:
+        with dask.config.set({"distributed.worker.profile.enabled": False}):
+            own = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        client = Client(own)
+    try:
+        ev = _Evaluator(cal, out, client)
+        budget = cal["optimiser"]["max_evaluations"]
+        r0 = ev.many([u0])[0]
+        if cal["optimiser"]["method"] == "least_squares":
+            res = optimize.least_squares(lambda u: ev.many([u])[0], u0, jac=lambda u: ev.jacobian(u)[1],
+                                         bounds=(np.zeros(len(u0)), np.ones(len(u0))), method="trf",
+                                         max_nfev=budget, x_scale=1.0)
+            u = res.x
+        else:
+            method = cal["optimiser"]["method"].split(":", 1)[1]
+            res = optimize.minimize(lambda u: 0.5 * float(np.sum(ev.many([u])[0] ** 2)), u0, method=method,
+                                    bounds=[(0.0, 1.0)] * len(u0), options={"maxfev": budget})
+            u = np.clip(res.x, 0.0, 1.0)
+        r, jac = ev.jacobian(u)
+        correlated = max(1.0, rec.sample_rate_hz / (2.0 * ev.band_hz)) if cal["objective"]["time_history"] else 1.0
+        table, info = uncertainty(params, u, r, jac, correlated)
+        info["residuals_per_independent_one"] = correlated
+        result = {"calibration": os.path.abspath(path), "method": cal["optimiser"]["method"],
+                  "converged": bool(res.success), "message": str(res.message),
+                  "evaluations": ev.count, "replayed": ev.replayed,
+                  "cost_before": 0.5 * float(np.sum(r0 ** 2)), "cost_after": 0.5 * float(np.sum(r ** 2)),
+                  "rms_residual_before": float(np.sqrt(np.mean(r0 ** 2))),
+                  "rms_residual_after": float(np.sqrt(np.mean(r ** 2))),
+                  "parameters": table, **info}
+    finally:
+        client.close()
+        if own is not None:
+            own.close()
+    snippet = {}
+    for p in table:
+        node = snippet
+        parts = p["key"].split(".")
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+        node[parts[-1]] = float("%.6g" % p["value"])
+    _write_atomically(os.path.join(out, "calibrated.yaml"),
+                      "# calibrated against %s (rms residual %.4g, was %.4g)\n" % (
+                          cal["record"], result["rms_residual_after"], result["rms_residual_before"])
+                      + yaml.safe_dump(snippet, sort_keys=False))
+    _write_atomically(os.path.join(out, "calibration.json"), json.dumps(result, indent=2) + "\n")
+    if report:
+        for name, values in (("before", to_values(params, u0)), ("after", [p["value"] for p in table])):
+            ov = dict(cal["overrides"])
+            ov.update(zip([p["key"] for p in params], values))
+            cm.compare(cal["scene"], rec, overrides=ov, speed_profile=cal["speed_profile"],
+                       cutoff_hz=cal["cutoff"]).write(os.path.join(out, name), pass_files=False)
+    return result
+
+
+def main():
+    import argparse
+    import sys
+    ap = argparse.ArgumentParser(description="calibrate: scene parameters from a measured record")
+    ap.add_argument("calibration", help="the calibration file (YAML)")
+    ap.add_argument("--out", required=True, help="output directory (resumes the evaluations found there)")
+    ap.add_argument("--workers", type=int, default=2, help="local Dask workers (default 2; ignored with --scheduler)")
+    ap.add_argument("--scheduler", help="address of a running dask-scheduler, e.g. tcp://host:8786")
+    ap.add_argument("--no-report", action="store_true", help="no before/ and after/ comparisons")
+    a = ap.parse_args()
+    if not 1 <= a.workers <= 1024:
+        ap.error(f"--workers {a.workers}: allowed 1 to 1024")
+    try:
+        result = calibrate(a.calibration, a.out, a.scheduler, a.workers, not a.no_report)
+    except (CalibrationError, SceneError) as e:
+        sys.stderr.write(f"calibrate: {e}\n")
+        return 2
+    for p in result["parameters"]:
+        print("%-32s %.6g +- %.2g%s" % (p["key"], p["value"], p["std"],
+                                       "" if p["identifiable"] else "  NOT IDENTIFIABLE: " + p["why_not"]))
+    print("rms residual %.4g (was %.4g), %d evaluations (%d replayed); wrote %s" % (
+        result["rms_residual_after"], result["rms_residual_before"], result["evaluations"], result["replayed"],
+        a.out))
+    return 0

@@ -1,0 +1,75 @@
+"""Calibration (catenary_sim.calibration, scripts/calibrate): a record synthesised from a scene with
+other damping and dropper stiffness, with sensor noise, is calibrated back to them within the
+uncertainty the calibration states; a parameter the pass does not depend on is reported as not
+identifiable; a calibration started again on its directory replays its evaluations."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+import yaml
+
+from catenary_sim import calibration
+from catenary_sim import measurement as cm
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+REFERENCE = os.path.join(ROOT, "config", "reference_55m.yaml")
+CLI = os.path.join(ROOT, "scripts", "calibrate")
+SHORT = {"line.span_count": 6, "numerics.element_length": 0.5}
+TRUTH = {"damping.beta": 3.0e-4, "droppers.axial_stiffness": 1.0e5}
+
+
+def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path):
+    cm.synthesise_record(REFERENCE, str(tmp_path / "rec.csv"), overrides=dict(SHORT, **TRUTH), speed_profile=250.0,
+                         noise_std_N=2.0, seed=3)
+    spec = {"scene": REFERENCE, "record": "rec.csv", "overrides": SHORT,
+            "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3, "scale": "log", "initial": 1e-4},
+                           {"key": "droppers.axial_stiffness", "low": 2e4, "high": 1e6, "scale": "log",
+                            "initial": 2e5},
+                           # the allowed uplift is a limit the report checks: the pass does not depend on it
+                           {"key": "output.allowed_uplift", "low": 0.05, "high": 0.2}],
+            "objective": {"time_history": 1.0}, "optimiser": {"method": "least_squares", "max_evaluations": 30}}
+    path = tmp_path / "cal.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, CLI, str(path), "--out", str(out), "--workers", "2", "--no-report"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=1200)
+    assert r.returncode == 0, r.stdout[-3000:]
+    result = json.loads((out / "calibration.json").read_text())
+    got = {p["key"]: p for p in result["parameters"]}
+    for key, true in TRUTH.items():
+        p = got[key]
+        assert p["identifiable"], p
+        # Within three of its stated standard uncertainties, and that uncertainty small enough
+        # (10 % of the value) for the check to mean something.
+        assert abs(p["value"] - true) <= 3 * p["std"], (key, p)
+        assert p["std"] <= 0.1 * p["value"], (key, p)
+    assert not got["output.allowed_uplift"]["identifiable"]
+    assert "hardly change" in got["output.allowed_uplift"]["why_not"]
+    assert result["cost_after"] < result["cost_before"]
+    snippet = yaml.safe_load((out / "calibrated.yaml").read_text())
+    assert snippet["damping"]["beta"] == pytest.approx(got["damping.beta"]["value"], rel=1e-5)
+    # Started again on the same directory: every evaluation is read back, none run.
+    again = calibration.calibrate(str(path), str(out), workers=1, report=False)
+    assert again["replayed"] == again["evaluations"]
+    assert [p["value"] for p in again["parameters"]] == [p["value"] for p in result["parameters"]]
+
+
+@pytest.mark.parametrize("edit,words", [
+    (lambda d: d.update(parameters=[]), "parameters"),
+    (lambda d: d["parameters"][0].update(low=5.0, high=1.0), "parameters[0]"),
+    (lambda d: d["parameters"][0].update(scale="cubic"), "parameters[0].scale"),
+    (lambda d: d.update(objective={"statistics": {"spread": 1}}), "objective.statistics.spread"),
+    (lambda d: d.update(optimiser={"method": "simplex"}), "optimiser.method"),
+    (lambda d: d.update(colour="red"), "colour"),
+], ids=["no parameters", "bounds reversed", "unknown scale", "unknown statistic", "unknown method", "unknown field"])
+def test_a_bad_calibration_file_is_refused_by_field(tmp_path, edit, words):
+    spec = {"scene": REFERENCE, "record": "rec.csv",
+            "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3}]}
+    edit(spec)
+    path = tmp_path / "cal.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    with pytest.raises(calibration.CalibrationError) as e:
+        calibration.load_calibration(str(path))
+    assert f"'{words}'" in str(e.value)

@@ -1,0 +1,340 @@
+"""Measured records (catenary_sim.measurement, scripts/compare_measurement): a record made from the
+model's own pass compares with zero deviation to the CSV's rounding; the one Python statistics
+function agrees with the core's stats.json on the simulated side; a synthesised record's statistics
+stay within bounds derived from the noise added; each class of bad record is refused by name with
+its column and line; the CLI writes its report and refuses bad input without writing anything."""
+import json
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import yaml
+
+import catenary_sim as cs
+from catenary_sim import measurement as cm
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+REFERENCE = os.path.join(ROOT, "config", "reference_55m.yaml")
+CLI = os.path.join(ROOT, "scripts", "compare_measurement")
+# Six 55 m spans with 0.5 m elements: a pass of a second or two, analysis section 110-220 m.
+SHORT = ["line.span_count=6", "numerics.element_length=0.5"]
+RAMP = ([0.0, 330.0], [230.0, 270.0])  # km/h rising along the line: a speed profile, not one speed
+
+
+@pytest.fixture(scope="module")
+def clean(tmp_path_factory):
+    path = str(tmp_path_factory.mktemp("clean") / "run.csv")
+    return cm.synthesise_record(REFERENCE, path, overrides=SHORT, speed_profile=RAMP, sample_rate_hz=200.0,
+                                bandwidth_hz=20.0)
+
+
+def filter_gain(fs, fc, n=4096):
+    """The l1 norm of the zero-phase low-pass's impulse response: the most a filtered series can
+    move per unit change of the series anywhere (sup norm)."""
+    x = np.zeros(n)
+    x[n // 2] = 1.0
+    return float(np.sum(np.abs(cm.lowpass(x, fs, fc))))
+
+
+def test_a_record_of_the_models_own_pass_compares_with_zero_deviation(clean):
+    c = cm.compare(REFERENCE, clean, overrides=SHORT)
+    assert c.settings["speed_profile"] == "the record's speed column"
+    # The CSV's rounding: forces to 1e-4 N, stations to 1e-6 m (a station off by e moves the
+    # simulated force by e |dF/dx|), uplift and head to 1e-4 mm. Each row's force differs by at
+    # most half a unit of both; the filter moves a sup-norm difference by at most its l1 gain.
+    rec = clean.force_N["leading"]
+    slope = np.max(np.abs(np.diff(rec) / np.diff(clean.station_m)))
+    row_bound = 0.5e-4 + 0.5e-6 * slope
+    bound = filter_gain(200.0, c.settings["cutoff_hz"]) * row_bound
+    assert bound < 1e-3  # the rounding is fine enough to make the identity a strict check
+    rows = {(r["quantity"], r["of"]): r for r in c.rows}
+    for name in ("mean_force_N", "std_force_N", "max_force_N", "min_force_N"):
+        assert abs(rows[(name, "leading")]["deviation"]) <= bound, name
+    for name in ("stat_max_force_N", "stat_min_force_N"):  # mean +- 3 std
+        assert abs(rows[(name, "leading")]["deviation"]) <= 4 * bound, name
+    assert rows[("force_max_abs_difference_N", "leading")]["simulated"] <= bound
+    assert rows[("contact_loss_percent", "leading")]["deviation"] == 0.0
+    # Uplift and head in mm to 1e-4: half that in m, and the station's share as for the force.
+    for (q, owner), r in rows.items():
+        if q == "max_uplift_m":
+            u = clean.uplift_m[owner]
+            du = np.max(np.abs(np.diff(u) / np.diff(clean.station_m)))
+            assert abs(r["deviation"]) <= 0.5e-7 + 0.5e-6 * du, owner
+    assert sum(q == "max_uplift_m" for q, _ in rows) == 3  # the steady arms at 110, 165 and 220 m
+    h = clean.head_m["leading"]
+    dh = np.max(np.abs(np.diff(h) / np.diff(clean.station_m)))
+    assert abs(rows[("head_std_m", "leading")]["deviation"]) <= 0.5e-7 + 0.5e-6 * dh
+
+
+def test_the_python_statistics_agree_with_the_cores_stats_json():
+    # One function computes both sides' statistics: on the simulated pass at every step, with the
+    # core's cutoff, it must give stats.json's figures. Both filters are the same 4th-order
+    # bilinear Butterworth run forward and backward from the steady state with the same odd
+    # padding (zero_phase_filter.cpp, scipy's sosfiltfilt): they differ by the rounding of the
+    # coefficients and of the sums, about 1e-13 of the force; 1e-9 relative leaves room.
+    run = cm.simulate_run(REFERENCE, None, SHORT, 280.0)
+    core = run.stats["pantographs"][0]
+    raw = run.force_N["leading"]
+    x = run.position_m["leading"]
+    a0, a1 = run.stats["analysis_section_m"]
+    inside = (x >= a0) & (x <= a1)
+    assert inside.sum() == core["samples"]
+    filtered = cm.lowpass(raw, 1.0 / run.dt, run.stats["filter_cutoff_hz"])
+    ours = cm.section_statistics(filtered, inside, loss_force=raw)
+    for name in ("mean_force_N", "std_force_N", "stat_max_force_N", "stat_min_force_N", "max_force_N", "min_force_N"):
+        assert ours[name] == pytest.approx(core[name], rel=1e-9, abs=1e-9), name
+    assert ours["contact_loss_percent"] == core["contact_loss_percent"]
+    unfiltered = cm.section_statistics(raw, inside)
+    assert unfiltered["max_force_N"] == core["unfiltered"]["max_force_N"]
+    # The largest steady-arm uplift: every arm in the section while the pantograph is within half
+    # a span (55 m spans) of it, as the core takes it, from the same every-step series.
+    worst = max(np.max(u[np.abs(x - xs) <= 27.5]) for xs, u in run.uplift_m if a0 - 1e-6 <= xs <= a1 + 1e-6)
+    assert worst == core["max_uplift_at_support_m"]
+
+
+def test_a_synthesised_records_statistics_differ_from_the_simulation_by_its_noise(tmp_path):
+    # The comparison's cutoff above the measuring chain's bandwidth, so that the record's noise
+    # shows whether the chain's filter was applied to it (unfiltered it would be 1.6 times larger).
+    sigma, fs, bw, fc = 8.0, 1000.0, 40.0, 100.0
+    rec = cm.synthesise_record(REFERENCE, str(tmp_path / "noisy.csv"), overrides=SHORT, speed_profile=250.0,
+                               sample_rate_hz=fs, bandwidth_hz=bw, noise_std_N=sigma, seed=7)
+    c = cm.compare(REFERENCE, rec, overrides=SHORT, cutoff_hz=fc)
+    n = c.settings["rows_in_section"]
+    # White noise of sigma per sample through the measuring filter and the comparison's filter
+    # (both zero phase): its std in the compared force is sigma_f (from the filters' gains).
+    sigma_f = cm.noise_after_filters(sigma, fs, [bw, fc])
+    rows = {r["quantity"]: r for r in c.rows if r["of"] == "leading"}
+    # The mean of the noise: the filters pass DC whole, so it is the mean of n white samples,
+    # std sigma / sqrt(n); 5 of them is a chance of 6e-7.
+    assert abs(rows["mean_force_N"]["deviation"]) <= 5 * sigma / math.sqrt(n)
+    # std is a norm of the de-meaned series: |std(s + e) - std(s)| <= std(e), and std(e) is sigma_f
+    # within a few per cent over ~2 x 40 Hz x 1.6 s independent values; 1.5 sigma_f is far beyond.
+    assert abs(rows["std_force_N"]["deviation"]) <= 1.5 * sigma_f
+    # max(s + e) - max(s) and min likewise are at most max |e|: 6 sigma_f over a thousand samples
+    # of a Gaussian is a chance below 1e-6.
+    for name in ("max_force_N", "min_force_N"):
+        assert abs(rows[name]["deviation"]) <= 6 * sigma_f, name
+    for name in ("stat_max_force_N", "stat_min_force_N"):
+        assert abs(rows[name]["deviation"]) <= 5 * sigma / math.sqrt(n) + 3 * 1.5 * sigma_f, name
+    # And the noise is there, as large as the filters make it: over the whole record (4.75 s, about
+    # 2 x 40 Hz x 4.75 s = 380 independent values) the rms difference of the two sides is sigma_f
+    # with a sampling error of 1 / sqrt(2 x 380) = 3.6 %; 15 % is four of them.
+    s = c.series
+    diff = s["record_force_leading_filtered_N"] - s["simulated_force_leading_filtered_N"]
+    assert float(np.sqrt(np.mean(diff ** 2))) == pytest.approx(sigma_f, rel=0.15)
+    assert sigma_f > 1.0  # a noise that shows beside the CSV's rounding
+
+
+# --------------------------------------------------------------------------------------------
+# Bad records, each class by name
+# --------------------------------------------------------------------------------------------
+def write(tmp_path, clean, edit_rows=None, header=None, meta=None, name="bad.csv"):
+    """A copy of the clean record with its lines edited: edit_rows {data row k: function(fields)}."""
+    with open(clean.path) as f:
+        lines = f.read().splitlines()
+    head = lines[0].split(",")
+    rows = [ln.split(",") for ln in lines[1:]]
+    for k, fn in (edit_rows or {}).items():
+        rows[k] = fn(rows[k], head)
+    if header:
+        head = header(head)
+    out = tmp_path / name
+    out.write_text("\n".join([",".join(head)] + [",".join(r) for r in rows if r is not None]) + "\n")
+    with open(os.path.splitext(clean.path)[0] + ".yaml") as f:
+        doc = yaml.safe_load(f)
+    if meta:
+        meta(doc)
+    (tmp_path / (os.path.splitext(name)[0] + ".yaml")).write_text(yaml.safe_dump(doc))
+    return str(out)
+
+
+def setcol(col, value):
+    def fn(r, head):
+        r[head.index(col)] = value
+        return r
+    return fn
+
+
+def refused(path, kind, field, row=None, scene=False):
+    with pytest.raises(cm.RecordError) as e:
+        if scene:
+            cm.compare(REFERENCE, path, overrides=SHORT)
+        else:
+            cm.read_record(path)
+    err = e.value
+    assert err.kind == kind, str(err)
+    assert err.field == field, str(err)
+    assert err.row == row, str(err)
+    assert kind in str(err) and field in str(err)
+    return err
+
+
+def test_nan_and_empty_cells_are_refused_with_their_line(tmp_path, clean):
+    # data row k is line k + 2 (the header is line 1)
+    refused(write(tmp_path, clean, {10: setcol("force_leading_N", "nan")}), "nan", "force_leading_N", 12)
+    refused(write(tmp_path, clean, {20: setcol("speed_kmh", "")}), "nan", "speed_kmh", 22)
+    refused(write(tmp_path, clean, {5: setcol("head_leading_mm", "1.2.3")}), "nan", "head_leading_mm", 7)
+
+
+def test_gaps_and_stations_going_back_are_refused(tmp_path, clean):
+    drop = lambda r, h: None  # noqa: E731
+    # Rows 50 and 51 missing: row 52 (line 52 once they are gone) is 3 sample intervals after 49.
+    refused(write(tmp_path, clean, {50: drop, 51: drop}), "gap", "time_s", 52)
+    def back(r, h):
+        r[h.index("station_m")] = "%.6f" % (float(r[h.index("station_m")]) - 1.0)
+        return r
+    refused(write(tmp_path, clean, {30: back}), "non_monotonic", "station_m", 32)
+
+
+def test_wrong_and_unknown_units_are_refused(tmp_path, clean):
+    refused(write(tmp_path, clean, header=lambda h: [c.replace("force_leading_N", "force_leading_lbf") for c in h]),
+            "unknown_unit", "force_leading_lbf")
+    refused(write(tmp_path, clean, header=lambda h: h[:-1] + ["temperature_C"]), "unknown_column", "temperature_C")
+    # A force in kN under a column in N: a mean of 0.1 N is no contact force.
+    def kn(r, h):
+        k = h.index("force_leading_N")
+        r[k] = "%.7f" % (float(r[k]) / 1000)
+        return r
+    with open(clean.path) as f:
+        n = len(f.read().splitlines()) - 1
+    refused(write(tmp_path, clean, {k: kn for k in range(n)}), "wrong_unit", "force_leading_N")
+    # A speed in m/s under a column in km/h: the stations advance 3.6 times faster than it says.
+    def mps(r, h):
+        k = h.index("speed_kmh")
+        r[k] = "%.6f" % (float(r[k]) / 3.6)
+        return r
+    refused(write(tmp_path, clean, {k: mps for k in range(n)}), "wrong_unit", "speed_kmh")
+    # A force beyond 5 kN (N written under kN) on one row, named with its line.
+    refused(write(tmp_path, clean, {40: setcol("force_leading_N", "9000")}), "wrong_unit", "force_leading_N", 42)
+
+
+def test_bad_metadata_is_refused_by_field(tmp_path, clean):
+    refused(write(tmp_path, clean, meta=lambda d: d.pop("sample_rate_hz")), "metadata", "sample_rate_hz")
+    refused(write(tmp_path, clean, meta=lambda d: d.update(bandwith_hz=20)), "metadata", "bandwith_hz")
+    refused(write(tmp_path, clean, meta=lambda d: d.update(sample_rate_hz=1000.0)), "wrong_unit", "time_s")
+    refused(write(tmp_path, clean, {3: setcol("speed_kmh", "0")}), "speed_profile", "speed_kmh", 5)
+
+
+def test_what_the_scene_lacks_is_refused_by_name(tmp_path, clean):
+    renamed = write(tmp_path, clean, header=lambda h: [c.replace("_leading_", "_trailing_") for c in h],
+                    meta=lambda d: d.update(pantographs=["trailing"], station_of="trailing"), name="p.csv")
+    err = refused(renamed, "unknown_pantograph", "force_trailing_N", scene=True)
+    assert "leading" in err.allowed
+    refused(write(tmp_path, clean, meta=lambda d: d.update(section_m=[200.0, 900.0]), name="s.csv"),
+            "section_outside_line", "section_m", scene=True)
+    refused(write(tmp_path, clean, meta=lambda d: d["supports"].update(A2=112.5), name="a.csv"),
+            "unknown_support", "supports.A2", scene=True)
+
+
+# --------------------------------------------------------------------------------------------
+# The command line
+# --------------------------------------------------------------------------------------------
+def cli(*args):
+    return subprocess.run([sys.executable, CLI] + [str(a) for a in args], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True, timeout=600)
+
+
+def test_the_cli_writes_its_report_and_marks_the_tolerances(tmp_path, clean):
+    out = tmp_path / "cmp"
+    r = cli(REFERENCE, clean.path, "--out", out, "--set", SHORT[0], "--set", SHORT[1], "--tolerance",
+            "std_force_N=10%", "--tolerance", "leading.max_force_N=0", "--strict")
+    # max_force_N = 0 N cannot hold to rounding: --strict exits 1, everything is written
+    assert r.returncode == 1, r.stderr
+    page = (out / "report.html").read_text()
+    assert "id='statistics'" in page and "OUTSIDE" in page and "within" in page
+    for name in ("force", "spectrum", "uplift", "speed"):
+        assert (out / f"report_{name}.png").stat().st_size > 1000
+    summary = json.loads((out / "comparison.json").read_text())
+    assert summary["within"] is False
+    assert summary["settings"]["tolerances"] == {"std_force_N": "10%", "leading.max_force_N": 0.0}
+    assert (out / "simulated" / "stats.json").is_file()
+
+
+def test_the_cli_refuses_bad_input_and_writes_nothing(tmp_path, clean):
+    bad = write(tmp_path, clean, {10: setcol("force_leading_N", "nan")})
+    out = tmp_path / "never"
+    r = cli(REFERENCE, bad, "--out", out, "--set", SHORT[0], "--set", SHORT[1])
+    assert r.returncode == 2 and "nan: line 12, column 'force_leading_N'" in r.stderr, r.stderr
+    assert not out.exists()
+    # An existing directory keeps what it held; no staging directory is left beside it.
+    out.mkdir()
+    (out / "keep.txt").write_text("x")
+    r = cli(REFERENCE, clean.path, "--out", out, "--set", SHORT[0], "--set", SHORT[1], "--tolerance", "spread=1")
+    assert r.returncode == 2 and "tolerances key 'spread'" in r.stderr, r.stderr
+    assert sorted(os.listdir(out)) == ["keep.txt"]
+    assert sorted(os.listdir(tmp_path)) == sorted(["bad.csv", "bad.yaml", "never"])
+
+
+# --------------------------------------------------------------------------------------------
+# Other shapes of the same record
+# --------------------------------------------------------------------------------------------
+def test_a_header_a_railways_stations_and_a_time_based_record_read_alike(tmp_path, clean):
+    with open(clean.path) as f:
+        lines = f.read().splitlines()
+    with open(os.path.splitext(clean.path)[0] + ".yaml") as f:
+        doc = yaml.safe_load(f)
+    # The metadata as '#' lines atop the CSV instead of beside it.
+    header = ["# " + ln for ln in yaml.safe_dump(doc).splitlines()]
+    (tmp_path / "h.csv").write_text("\n".join(header + lines) + "\n")
+    r = cm.read_record(str(tmp_path / "h.csv"))
+    assert np.array_equal(r.station_m, clean.station_m)
+    assert np.array_equal(r.force_N["leading"], clean.force_N["leading"])
+    # Both at once is ambiguous.
+    (tmp_path / "h.yaml").write_text(yaml.safe_dump(doc))
+    refused(str(tmp_path / "h.csv"), "metadata", "metadata")
+    # Stations counted from a kilometre post 12.345 km before the scene's station 0.
+    head = lines[0].split(",")
+    k = head.index("station_m")
+    rows = [ln.split(",") for ln in lines[1:]]
+    for row in rows:
+        row[k] = "%.6f" % (float(row[k]) / 1000.0 + 12.345)
+    head[k] = "station_km"
+    (tmp_path / "km.csv").write_text("\n".join([",".join(head)] + [",".join(row) for row in rows]) + "\n")
+    moved = dict(doc, station_origin_m=12345.0, supports={n: x + 12345.0 for n, x in doc["supports"].items()})
+    (tmp_path / "km.yaml").write_text(yaml.safe_dump(moved))
+    r = cm.read_record(str(tmp_path / "km.csv"))
+    # km to 1e-6 is mm: the stations agree to half a millimetre.
+    assert np.max(np.abs(r.station_m - clean.station_m)) <= 0.5e-3 + 1e-9
+    assert r.support_station_m == pytest.approx(clean.support_station_m)
+    # Without a station column: the stations are the speed integrated over the times from
+    # start_station_m. The simulated train's speed is constant over each step (dt) and changes
+    # between steps, so a speed sampled anywhere in a step misplaces that step's change by at most
+    # dt: over the record at most (v_end - v_start) dt, about 10 mm here; the trapezoid rule on a
+    # speed linear in station adds (dv/dt) h^2 / 12 per 5 ms row, 1e-7 m, 1e-4 m in all.
+    (tmp_path / "t.csv").write_text("\n".join(",".join(c for j, c in enumerate(ln.split(",")) if j != lines[0]
+                                                       .split(",").index("station_m")) for ln in lines) + "\n")
+    (tmp_path / "t.yaml").write_text(yaml.safe_dump(dict(doc, start_station_m=float(clean.station_m[0]))))
+    r = cm.read_record(str(tmp_path / "t.csv"))
+    dt = cs.Simulation(REFERENCE, SHORT).dt
+    assert np.max(np.abs(r.station_m - clean.station_m)) <= (RAMP[1][1] - RAMP[1][0]) / 3.6 * dt + 2e-4
+
+
+def test_a_given_speed_profile_replaces_the_records(clean):
+    # The record's run (230 to 270 km/h) compared against a pass at a constant 250 km/h: the
+    # simulated train follows the given speed, and the record's stations still place the samples.
+    c = cm.compare(REFERENCE, clean, overrides=SHORT, speed_profile=250.0)
+    assert c.settings["speed_profile"] == "250 km/h throughout"
+    assert np.allclose(c.series["simulated_speed_kmh"], 250.0)
+    assert c.settings["mean_speed_kmh"] == pytest.approx(250.0)
+    dev = {r["quantity"]: r["deviation"] for r in c.rows if r["of"] == "leading"}
+    assert abs(dev["std_force_N"]) > 1e-3  # another run than the record's
+
+
+def test_two_pantographs_share_the_section_and_the_steady_arms(tmp_path):
+    # The leading pantograph of a two-pantograph train starts 200 m into the line: the default
+    # section is the scene's analysis section where it runs, and a steady arm only the trailing
+    # pantograph passes still has its uplift (the core takes it over all pantographs).
+    scene = os.path.join(ROOT, "config", "reference_55m_two_pantographs.yaml")
+    ov = ["numerics.element_length=0.5"]
+    rec = cm.synthesise_record(scene, str(tmp_path / "two.csv"), overrides=ov)
+    c = cm.compare(scene, rec, overrides=ov)
+    assert c.settings["section_m"][0] == pytest.approx(rec.station_m[0])
+    assert set(rec.force_N) == {"leading", "trailing"}
+    uplift = [r for r in c.rows if r["quantity"] == "max_uplift_m"]
+    assert uplift and all(r["record"] is not None and abs(r["deviation"]) < 1e-6 for r in uplift)
+    # sampled at 200 Hz, the largest uplift is at most the core's every-step one
+    core = max(p["max_uplift_at_support_m"] for p in c.run.stats["pantographs"])
+    assert max(r["record"] for r in uplift) <= core + 0.5e-7
