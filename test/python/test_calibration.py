@@ -1,11 +1,14 @@
 """Calibration (catenary_sim.calibration, scripts/calibrate): a record synthesised from a scene with
 other damping and dropper stiffness, with sensor noise, is calibrated back to them within the
 uncertainty the calibration states; a parameter the pass does not depend on is reported as not
-identifiable; a calibration started again on its directory replays its evaluations."""
+identifiable; a calibration killed part-way and started again on its directory replays its
+evaluations and still recovers the parameters."""
 import json
 import os
+import signal
 import subprocess
 import sys
+import time
 
 import pytest
 import yaml
@@ -18,6 +21,10 @@ REFERENCE = os.path.join(ROOT, "config", "reference_55m.yaml")
 CLI = os.path.join(ROOT, "scripts", "calibrate")
 SHORT = {"line.span_count": 6, "numerics.element_length": 0.5}
 TRUTH = {"damping.beta": 3.0e-4, "droppers.axial_stiffness": 1.0e5}
+
+
+def _kept(directory):
+    return [n for n in os.listdir(directory) if n.endswith(".json") and not n.startswith(".")]
 
 
 def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path):
@@ -33,10 +40,23 @@ def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path)
     path = tmp_path / "cal.yaml"
     path.write_text(yaml.safe_dump(spec))
     out = tmp_path / "out"
-    r = subprocess.run([sys.executable, CLI, str(path), "--out", str(out), "--workers", "2", "--no-report"],
-                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=1200)
+    cmd = [sys.executable, CLI, str(path), "--out", str(out), "--workers", "2", "--no-report"]
+    # Killed (the runner and its Dask workers, SIGKILL) once a few evaluations are kept, then
+    # started again on the same directory: it replays them and goes on to the optimum.
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    kept = out / "evaluations"
+    deadline = time.time() + 600
+    while time.time() < deadline and p.poll() is None and not (kept.is_dir() and len(_kept(kept)) >= 3):
+        time.sleep(0.02)
+    os.killpg(p.pid, signal.SIGKILL)
+    p.wait()
+    before = len(_kept(kept))
+    assert 3 <= before and not (out / "calibration.json").exists(), "the calibration ended before the kill"
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=1200)
     assert r.returncode == 0, r.stdout[-3000:]
     result = json.loads((out / "calibration.json").read_text())
+    assert result["replayed"] >= before, result
+    assert result["evaluations"] >= 20, result  # a study-sized calibration
     got = {p["key"]: p for p in result["parameters"]}
     for key, true in TRUTH.items():
         p = got[key]
