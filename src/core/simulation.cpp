@@ -6,7 +6,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/engine/initial_state.hpp"
 
 namespace catenary_sim {
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/engine/initial_state.hpp"
 #include "../support/scenes.hpp"
 
 using namespace catenary_sim;

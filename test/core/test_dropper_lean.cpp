@@ -23,7 +23,7 @@
 #include "catenary_sim/core/engine/lateral_energy.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/engine/initial_state.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 
 using namespace catenary_sim;

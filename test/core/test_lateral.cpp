@@ -13,7 +13,7 @@
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/simulation.hpp"
-#include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/engine/initial_state.hpp"
 #include "catenary_sim/core/model/wind_field.hpp"
 #include "../support/scenes.hpp"
 

@@ -180,15 +180,14 @@ long long frf_steps(const Model& rig, const std::vector<double>& frequencies, co
   return total;
 }
 
-std::vector<FrfPoint> measured_frf(const Model& rig, const std::vector<double>& frequencies, const FrfMeasurement& how) {
+namespace {
+
+// The start of every frequency: the rig's static equilibrium on the still wire, the preloads and
+// the uplift against the contact springs (the rig's wire is where the references were set).
+// Displacements of the pantograph's DOFs (PantographSystem's order).
+Eigen::VectorXd rig_equilibrium(const Model& rig, const PantographSystem& sys) {
   const int pi = 0;
   const Pantograph& p = rig.pantographs.at(pi);
-  const PantographSystem sys = pantograph_system(rig, pi);
-  const int n = static_cast<int>(sys.mass.rows());
-  const double sigma = slowest_decay_rate(rig, pi);
-  const double dt = rig.dt;
-  // Static equilibrium on the still wire, the start of every frequency: the preloads and the
-  // uplift against the contact springs (the rig's wire is where the references were set).
   State s0 = make_state(rig);
   observe(rig, s0);
   Eigen::MatrixXd kc = sys.stiffness;
@@ -198,79 +197,127 @@ std::vector<FrfPoint> measured_frf(const Model& rig, const std::vector<double>& 
     kc(sys.contact[cj], sys.contact[cj]) += rig.contact_stiffness;
     for (std::size_t wk = 0; wk < nw; ++wk) r[sys.contact[cj]] -= s0.contact_force[p.collectors[cj] * nw + wk];
   }
-  const Eigen::VectorXd x_eq = kc.ldlt().solve(r);
+  return kc.ldlt().solve(r);
+}
 
+// Drive amplitude (m) at w: the dynamic contact force (analytic, per metre of drive) stays a
+// share of the static uplift, so the strips never leave the wire.
+double drive_amplitude(const Model& rig, const PantographSystem& sys, double w, const FrfMeasurement& how) {
+  Eigen::MatrixXcd a;
+  Eigen::VectorXcd b;
+  driven_system(rig, sys, w, &a, &b);
+  const Eigen::VectorXcd x1 = a.partialPivLu().solve(b);
+  std::complex<double> f1 = 0.0;
+  for (int c : sys.contact) f1 += rig.contact_stiffness * (x1[c] - 1.0);
+  return how.force_share * rig.pantographs.at(0).static_uplift / std::abs(f1);
+}
+
+// Moves every contact-wire node as one rigid body: y = Y env(t) sin(w t) with a raised-cosine
+// ramp env over `ramp` seconds, and its time derivative as the nodes' velocity.
+void drive_rigid_wire(const Model& rig, State& s, double amplitude, double w, double ramp, double t) {
+  const double env = t < ramp ? 0.5 * (1.0 - std::cos(kPi * t / ramp)) : 1.0;
+  const double denv = t < ramp ? 0.5 * kPi / ramp * std::sin(kPi * t / ramp) : 0.0;
+  const double y = amplitude * env * std::sin(w * t);
+  const double yd = amplitude * (denv * std::sin(w * t) + env * w * std::cos(w * t));
+  for (int wi : rig.contact_wires) {
+    const Wire& wire = rig.wires[wi];
+    for (int j = 0; j < wire.nodes(); ++j) {
+      s.u[wire.w_dof + j] = y;
+      s.v[wire.w_dof + j] = yd;
+    }
+  }
+}
+
+// Least squares of the head displacement x and the contact force F on (1, cos, sin) over the
+// window: the sums of the normal equations, then x = a + b cos + c sin = Re((b - i c) e^{i w t}).
+struct HarmonicFit {
+  Eigen::Matrix3d nn = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d bx = Eigen::Vector3d::Zero(), bf = Eigen::Vector3d::Zero();
+  void add(double w, double t, double head, double force) {
+    const Eigen::Vector3d phi(1.0, std::cos(w * t), std::sin(w * t));
+    nn += phi * phi.transpose();
+    bx += phi * head;
+    bf += phi * force;
+  }
+  std::complex<double> receptance() const {
+    const Eigen::Vector3d cx = nn.ldlt().solve(bx), cf = nn.ldlt().solve(bf);
+    const std::complex<double> xa(cx[1], -cx[2]), fa(cf[1], -cf[2]);
+    return xa / fa;
+  }
+};
+
+// The head displacement (mean over the collectors' DOFs) and the force on it (+ up: minus the
+// contact forces of eq. 22 at the state observed). Throws if a strip has left the wire.
+void head_motion(const Model& rig, const PantographSystem& sys, const State& s, double f, double amplitude,
+                 double* head_out, double* force_out) {
+  const Pantograph& p = rig.pantographs.at(0);
+  const std::size_t nw = rig.contact_wires.size();
+  double head = 0.0, force = 0.0;
+  for (std::size_t cj = 0; cj < p.collectors.size(); ++cj) {
+    head += s.u[p.first_dof + sys.contact[cj]];
+    for (std::size_t wk = 0; wk < nw; ++wk) {
+      const double fc = s.contact_force[p.collectors[cj] * nw + wk];
+      if (!(fc > 0.0))
+        throw SceneError("pantograph_frf: pantograph '" + p.name + "' lost contact at " + fmt(f) +
+                         " Hz (drive amplitude " + fmt(amplitude * 1e3) + " mm); lower the force share");
+      force -= fc;  // on the head, + up
+    }
+  }
+  head /= static_cast<double>(p.collectors.size());
+  *head_out = head;
+  *force_out = force;
+}
+
+// One stepped sine at f: from the equilibrium x_eq, ramp, settle and fit over the window.
+// `done` (advanced by the steps taken) and `total` count the steps of the whole measurement for
+// the progress line.
+FrfPoint measure_frequency(const Model& rig, const PantographSystem& sys, const Eigen::VectorXd& x_eq, double f,
+                           double sigma, const FrfMeasurement& how, long long* done, long long total) {
+  const Pantograph& p = rig.pantographs.at(0);
+  const int n = static_cast<int>(sys.mass.rows());
+  const double dt = rig.dt, w = 2.0 * kPi * f, period = 1.0 / f;
+  const double amplitude = drive_amplitude(rig, sys, w, how);
+  const double ramp = how.ramp_periods * period;
+  double t0 = 0.0;
+  long long start = 0, count = 0;
+  frf_window(f, sigma, dt, how, &t0, &start, &count);
+
+  State s = make_state(rig);
+  for (int i = 0; i < n; ++i) s.u[p.first_dof + i] = x_eq[i];
+  HarmonicFit fit;
+  for (long long step_i = 0; step_i < start + count; ++step_i) {
+    if (how.progress && (*done + step_i) % how.progress_every == 0) how.progress(*done + step_i, total);
+    const double t = step_i * dt;
+    drive_rigid_wire(rig, s, amplitude, w, ramp, t);
+    observe(rig, s);  // the contact force step() applies over this step (eq. 22 at t_n)
+    if (step_i >= start) {
+      double head = 0.0, force = 0.0;
+      head_motion(rig, sys, s, f, amplitude, &head, &force);
+      fit.add(w, t, head, force);
+    }
+    if (step(rig, s) != StepStatus::kOk)
+      throw SceneError("pantograph_frf: the rig run stopped at " + fmt(f) + " Hz, t = " + fmt(t) + " s");
+  }
+  FrfPoint pt;
+  pt.frequency = f;
+  pt.receptance = fit.receptance();
+  pt.apparent_mass = -1.0 / (w * w * pt.receptance);
+  pt.drive_amplitude = amplitude;
+  pt.settle_time = t0;
+  *done += start + count;
+  return pt;
+}
+
+}  // namespace
+
+std::vector<FrfPoint> measured_frf(const Model& rig, const std::vector<double>& frequencies, const FrfMeasurement& how) {
+  const PantographSystem sys = pantograph_system(rig, 0);
+  const double sigma = slowest_decay_rate(rig, 0);
+  const Eigen::VectorXd x_eq = rig_equilibrium(rig, sys);
   std::vector<FrfPoint> out;
   const long long total = how.progress ? frf_steps(rig, frequencies, how) : 0;
   long long done = 0;
-  for (std::size_t k = 0; k < frequencies.size(); ++k) {
-    const double f = frequencies[k], w = 2.0 * kPi * f, period = 1.0 / f;
-    // Drive amplitude: the dynamic contact force stays a share of the static uplift (no loss of contact).
-    Eigen::MatrixXcd a;
-    Eigen::VectorXcd b;
-    driven_system(rig, sys, w, &a, &b);
-    const Eigen::VectorXcd x1 = a.partialPivLu().solve(b);
-    std::complex<double> f1 = 0.0;
-    for (int c : sys.contact) f1 += rig.contact_stiffness * (x1[c] - 1.0);
-    const double amplitude = how.force_share * p.static_uplift / std::abs(f1);
-    const double ramp = how.ramp_periods * period;
-    double t0 = 0.0;
-    long long start = 0, count = 0;
-    frf_window(f, sigma, dt, how, &t0, &start, &count);
-
-    State s = make_state(rig);
-    for (int i = 0; i < n; ++i) s.u[p.first_dof + i] = x_eq[i];
-    // Least squares of x and F on (1, cos, sin) over the window: sums of the normal equations.
-    Eigen::Matrix3d nn = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d bx = Eigen::Vector3d::Zero(), bf = Eigen::Vector3d::Zero();
-    for (long long step_i = 0; step_i < start + count; ++step_i) {
-      if (how.progress && (done + step_i) % how.progress_every == 0) how.progress(done + step_i, total);
-      const double t = step_i * dt;
-      const double env = t < ramp ? 0.5 * (1.0 - std::cos(kPi * t / ramp)) : 1.0;
-      const double denv = t < ramp ? 0.5 * kPi / ramp * std::sin(kPi * t / ramp) : 0.0;
-      const double y = amplitude * env * std::sin(w * t);
-      const double yd = amplitude * (denv * std::sin(w * t) + env * w * std::cos(w * t));
-      for (int wi : rig.contact_wires) {
-        const Wire& wire = rig.wires[wi];
-        for (int j = 0; j < wire.nodes(); ++j) {
-          s.u[wire.w_dof + j] = y;
-          s.v[wire.w_dof + j] = yd;
-        }
-      }
-      observe(rig, s);  // the contact force step() applies over this step (eq. 22 at t_n)
-      if (step_i >= start) {
-        double head = 0.0, force = 0.0;
-        for (std::size_t cj = 0; cj < p.collectors.size(); ++cj) {
-          head += s.u[p.first_dof + sys.contact[cj]];
-          for (std::size_t wk = 0; wk < nw; ++wk) {
-            const double fc = s.contact_force[p.collectors[cj] * nw + wk];
-            if (!(fc > 0.0))
-              throw SceneError("pantograph_frf: pantograph '" + p.name + "' lost contact at " + fmt(f) +
-                               " Hz (drive amplitude " + fmt(amplitude * 1e3) + " mm); lower the force share");
-            force -= fc;  // on the head, + up
-          }
-        }
-        head /= static_cast<double>(p.collectors.size());
-        const Eigen::Vector3d phi(1.0, std::cos(w * t), std::sin(w * t));
-        nn += phi * phi.transpose();
-        bx += phi * head;
-        bf += phi * force;
-      }
-      if (step(rig, s) != StepStatus::kOk)
-        throw SceneError("pantograph_frf: the rig run stopped at " + fmt(f) + " Hz, t = " + fmt(t) + " s");
-    }
-    const Eigen::Vector3d cx = nn.ldlt().solve(bx), cf = nn.ldlt().solve(bf);
-    // x = a + b cos + c sin = Re((b - i c) e^{i w t})
-    const std::complex<double> xa(cx[1], -cx[2]), fa(cf[1], -cf[2]);
-    FrfPoint pt;
-    pt.frequency = f;
-    pt.receptance = xa / fa;
-    pt.apparent_mass = -1.0 / (w * w * pt.receptance);
-    pt.drive_amplitude = amplitude;
-    pt.settle_time = t0;
-    out.push_back(pt);
-    done += start + count;
-  }
+  for (double f : frequencies) out.push_back(measure_frequency(rig, sys, x_eq, f, sigma, how, &done, total));
   return out;
 }
 

@@ -2,6 +2,7 @@
 // wire part of eq. 19-21 with the rotations condensed.
 #pragma once
 
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/engine/state.hpp"
 
@@ -31,7 +32,6 @@ struct PackSweep {
   // added to the load. Null: none.
   const double* wind[2] = {nullptr, nullptr};
 };
-enum { kPlaneLoad, kPlaneDamping, kPlaneInvMass, kPlaneDrag, kPlaneValues };
 
 // z = u + beta v, the condensed rotations (forward and backward tridiagonal sweeps), the band
 // force with the load and the mass-proportional damping, and the update of eq. 20-21, fused in

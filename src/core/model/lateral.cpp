@@ -12,7 +12,6 @@
 
 #include "catenary_sim/core/model/beam.hpp"
 #include "model/normal_errors.hpp"
-#include "engine/wire_lanes.hpp"
 
 namespace catenary_sim {
 namespace {

@@ -11,39 +11,6 @@
 
 namespace catenary_sim {
 
-// The wire's band in a sparse matrix, w of node i at w0 + i and theta at t0 + i.
-void add_wire_band(Triplets& t, const Wire& w, int w0, int t0) {
-  const int n = w.nodes();
-  for (int i = 0; i < n; ++i) {
-    t.emplace_back(w0 + i, w0 + i, w.d_ww[i]);
-    t.emplace_back(w0 + i, t0 + i, w.d_wt[i]);
-    t.emplace_back(t0 + i, w0 + i, w.d_wt[i]);
-    t.emplace_back(t0 + i, t0 + i, w.d_tt[i]);
-  }
-  for (int e = 0; e + 1 < n; ++e) {
-    const int a = e, b = e + 1;
-    const double blk[2][2] = {{w.e_ww[e], w.e_wt[e]}, {w.e_tw[e], w.e_tt[e]}};
-    const int ra[2] = {w0 + a, t0 + a}, cb[2] = {w0 + b, t0 + b};
-    for (int r = 0; r < 2; ++r)
-      for (int c = 0; c < 2; ++c) {
-        t.emplace_back(ra[r], cb[c], blk[r][c]);
-        t.emplace_back(cb[c], ra[r], blk[r][c]);
-      }
-  }
-}
-
-// A spring between DOF a (above) and b (below, -1 = ground) with compression C = P + k (x_b - x_a).
-void add_spring(Triplets& t, Eigen::VectorXd& r, int a, int b, double k, double preload) {
-  t.emplace_back(a, a, k);
-  r[a] += preload;
-  if (b >= 0) {
-    t.emplace_back(a, b, -k);
-    t.emplace_back(b, a, -k);
-    t.emplace_back(b, b, k);
-    r[b] -= preload;
-  }
-}
-
 namespace {
 
 Eigen::VectorXd solve_spd(const Eigen::SparseMatrix<double>& k, const Eigen::VectorXd& r, const char* what) {
@@ -94,138 +61,224 @@ void solve_wire_statics(const Wire& wire, const std::vector<double>& node_load, 
   for (std::size_t j = 0; j < pn.size(); ++j) reactions[j] = ky[pn[j]] - node_load[pn[j]];
 }
 
-void solve_initial_state(const Model& m, State& st, bool roof_springs) {
-  // Unknowns: the model's DOFs, then the rotations of wires whose rotations are condensed.
-  std::vector<int> t0(m.wires.size());
-  int size = m.n_dof;
+namespace {
+
+// The unknowns of eq. 23: the model's DOFs, then the rotations of the wires whose rotations the
+// step condenses (statics solves for them directly). theta0[i]: wire i's first rotation.
+struct StaticUnknowns {
+  std::vector<int> theta0;
+  int size = 0;
+};
+
+StaticUnknowns static_unknowns(const Model& m) {
+  StaticUnknowns q;
+  q.theta0.resize(m.wires.size());
+  q.size = m.n_dof;
   for (std::size_t i = 0; i < m.wires.size(); ++i) {
-    t0[i] = m.wires[i].theta_dof >= 0 ? m.wires[i].theta_dof : size;
-    if (m.wires[i].theta_dof < 0) size += m.wires[i].nodes();
+    q.theta0[i] = m.wires[i].theta_dof >= 0 ? m.wires[i].theta_dof : q.size;
+    if (m.wires[i].theta_dof < 0) q.size += m.wires[i].nodes();
   }
-  std::vector<bool> dropper_on(m.droppers.size(), true);
-  std::vector<bool> contact_on(m.collectors.size() * m.contact_wires.size(), true);
-  std::vector<int> node(m.max_contact_nodes);
-  std::vector<double> weight(m.max_contact_nodes);
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(size);
+  return q;
+}
 
+// The active set of eq. 25: which droppers are taut (tension only) and which collector presses
+// on which contact wire (compression only, per collector x contact wire). All on at the start.
+struct ActiveSet {
+  std::vector<bool> dropper_on, contact_on;
+};
+
+// K x = r of one active set, in triplets, with the scratch of eq. 12's contact weights.
+struct StaticSystem {
+  Triplets t;
+  Eigen::VectorXd r;
+  std::vector<int> node;
+  std::vector<double> weight;
+};
+
+// The line: the wires' bands under their own weight and the clamp masses (Model::load), the
+// supports' springs, and the taut droppers, each pulling with its design tension (the design
+// shape is the state of zero displacement, eq. 23).
+void add_line(const Model& m, const StaticUnknowns& q, const ActiveSet& active, StaticSystem& sys) {
+  sys.r.head(m.n_dof) = m.load;
+  for (std::size_t i = 0; i < m.wires.size(); ++i) add_wire_band(sys.t, m.wires[i], m.wires[i].w_dof, q.theta0[i]);
+  for (const SupportSpring& s : m.springs) sys.t.emplace_back(s.dof, s.dof, s.stiffness);
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+    const Dropper& d = m.droppers[k];
+    if (active.dropper_on[k]) add_spring(sys.t, sys.r, d.messenger_dof, d.contact_dof, d.stiffness, -d.static_tension);
+  }
+}
+
+// A lumped pantograph's frame (eq. 9 at rest): the springs between its masses with their
+// preloads, the roof spring unless left out, the uplift on the lowest mass and the heads on
+// their suspensions with their own aerodynamic uplift.
+void add_pantograph_frame(const Pantograph& p, double uplift, double air_speed_squared, bool roof_springs,
+                          StaticSystem& sys) {
+  for (int i = 0; i < p.masses_count(); ++i) {
+    const bool roof = i + 1 == p.masses_count();
+    if (roof && !roof_springs) continue;
+    add_spring(sys.t, sys.r, p.first_dof + i, roof ? -1 : p.first_dof + i + 1, p.stiffness[i], p.spring_preload[i]);
+  }
+  sys.r[p.first_dof + p.masses_count() - 1] += uplift;
+  for (const Head& h : p.heads) {
+    add_spring(sys.t, sys.r, h.dof, p.first_dof, h.stiffness, h.preload);
+    sys.r[h.dof] += h.aero_coefficient * air_speed_squared;
+  }
+}
+
+// A force-driven collector at station xc, as in step(): its force `given` acts on the lowest
+// contact wire(s) under it, shared equally among wires within 1 mm of the lowest.
+void add_given_force(const Model& m, double xc, double given, StaticSystem& sys) {
+  std::vector<double> yd(m.contact_wires.size(), std::numeric_limits<double>::infinity());
+  double lowest = std::numeric_limits<double>::infinity();
+  for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+    const Wire& w = m.wires[m.contact_wires[wk]];
+    const int cnt = contact_weights(w, m.rub_length, xc, sys.node.data(), sys.weight.data());
+    if (cnt == 0) continue;
+    yd[wk] = 0.0;
+    for (int a = 0; a < cnt; ++a) yd[wk] += sys.weight[a] * w.height[sys.node[a]];
+    lowest = std::min(lowest, yd[wk]);
+  }
+  int sharing = 0;
+  for (double y : yd) sharing += y <= lowest + 1e-3;
+  for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+    if (!(yd[wk] <= lowest + 1e-3)) continue;
+    const Wire& w = m.wires[m.contact_wires[wk]];
+    const int cnt = contact_weights(w, m.rub_length, xc, sys.node.data(), sys.weight.data());
+    for (int a = 0; a < cnt; ++a) sys.r[w.w_dof + sys.node[a]] += given / sharing * sys.weight[a];
+  }
+}
+
+// Collector ci at station xc pressed on every contact wire under it that the active set keeps
+// in touch: the contact spring k0 between the strip and the wire (eq. 22), whose gap at zero
+// displacement is the strip's reference height less the wire's design height there (eq. 12).
+void add_contact_springs(const Model& m, const Pantograph& p, int ci, double xc, const ActiveSet& active,
+                         StaticSystem& sys) {
+  for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+    const Wire& w = m.wires[m.contact_wires[wk]];
+    const int cnt = contact_weights(w, m.rub_length, xc, sys.node.data(), sys.weight.data());
+    if (cnt == 0) continue;
+    if (!active.contact_on[ci * m.contact_wires.size() + wk]) continue;
+    double yd = 0.0;
+    for (int a = 0; a < cnt; ++a) yd += sys.weight[a] * w.height[sys.node[a]];
+    const double gap0 = p.contact_reference(m.collectors[ci]) - yd, k0 = m.contact_stiffness;
+    const int h = m.collectors[ci].dof;
+    sys.t.emplace_back(h, h, k0);
+    sys.r[h] -= k0 * gap0;
+    for (int a = 0; a < cnt; ++a) {
+      const int ja = w.w_dof + sys.node[a];
+      sys.t.emplace_back(h, ja, -k0 * sys.weight[a]);
+      sys.t.emplace_back(ja, h, -k0 * sys.weight[a]);
+      sys.r[ja] += k0 * sys.weight[a] * gap0;
+      for (int b = 0; b < cnt; ++b) sys.t.emplace_back(ja, w.w_dof + sys.node[b], k0 * sys.weight[a] * sys.weight[b]);
+    }
+  }
+}
+
+// Every pantograph at the loads' train position: its frame, and each collector either pressed
+// through its contact springs or, for a moving force or an external rig, pushing with its force.
+void add_pantographs(const Model& m, const PantographLoads& loads, const ActiveSet& active, bool roof_springs,
+                     StaticSystem& sys) {
+  for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
+    const Pantograph& p = m.pantographs[pi];
+    const double uplift = loads.uplift[pi] + p.aero_coefficient * loads.air_speed_squared[pi];
+    if (!p.moving_force) add_pantograph_frame(p, uplift, loads.air_speed_squared[pi], roof_springs, sys);
+    for (std::size_t cj = 0; cj < p.collectors.size(); ++cj) {
+      const int ci = p.collectors[cj];
+      const double xc = loads.front - p.position + m.collectors[ci].offset;
+      if (p.moving_force) {
+        add_given_force(m, xc, (p.external ? loads.external_force[pi] : uplift) / p.collectors.size(), sys);
+        continue;
+      }
+      add_contact_springs(m, p, ci, xc, active, sys);
+    }
+  }
+}
+
+// The rigid supports (no inverse mass) held at zero: identity rows and columns; then K x = r.
+Eigen::VectorXd solve_held(const Model& m, int size, StaticSystem& sys) {
+  std::vector<bool> fixed(size, false);
+  for (int i = 0; i < m.n_dof; ++i) fixed[i] = m.inv_mass[i] == 0.0;
+  Triplets tr;
+  tr.reserve(sys.t.size());
+  for (const auto& e : sys.t)
+    if (!fixed[e.row()] && !fixed[e.col()]) tr.push_back(e);
+  for (int i = 0; i < size; ++i)
+    if (fixed[i]) {
+      tr.emplace_back(i, i, 1.0);
+      sys.r[i] = 0.0;
+    }
+  Eigen::SparseMatrix<double> k(size, size);
+  k.setFromTriplets(tr.begin(), tr.end());
+  return solve_spd(k, sys.r, "the initial configuration (eq. 23)");
+}
+
+// Eq. 25 on the solution x: a dropper is taut while its tension S0 + k (w_messenger - w_contact)
+// is positive. True if any dropper changed.
+bool update_taut_droppers(const Model& m, const Eigen::VectorXd& x, ActiveSet& active) {
+  bool changed = false;
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+    const Dropper& d = m.droppers[k];
+    const bool on = d.static_tension + d.stiffness * (x[d.messenger_dof] - x[d.contact_dof]) > 0.0;
+    if (on != active.dropper_on[k]) changed = true;
+    active.dropper_on[k] = on;
+  }
+  return changed;
+}
+
+// Eq. 25 on the solution x: a collector presses on a contact wire while its strip is not below
+// the wire under it (eq. 12). True if any contact changed.
+bool update_contacts(const Model& m, const PantographLoads& loads, const Eigen::VectorXd& x, ActiveSet& active,
+                     StaticSystem& sys) {
+  bool changed = false;
+  for (std::size_t ci = 0; ci < m.collectors.size(); ++ci) {
+    const Pantograph& p = m.pantographs[m.collectors[ci].pantograph];
+    if (p.moving_force) continue;
+    const double xc = loads.front - p.position + m.collectors[ci].offset;
+    for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+      const Wire& w = m.wires[m.contact_wires[wk]];
+      const int cnt = contact_weights(w, m.rub_length, xc, sys.node.data(), sys.weight.data());
+      double yw = 0.0;
+      for (int a = 0; a < cnt; ++a) yw += sys.weight[a] * (w.height[sys.node[a]] + x[w.w_dof + sys.node[a]]);
+      const Collector& col = m.collectors[ci];
+      const bool on = cnt > 0 && p.contact_reference(col) + x[col.dof] - yw >= 0.0;
+      const std::size_t idx = ci * m.contact_wires.size() + wk;
+      if (on != active.contact_on[idx]) changed = true;
+      active.contact_on[idx] = on;
+    }
+  }
+  return changed;
+}
+
+}  // namespace
+
+PantographLoads design_pantograph_loads(const Model& m) {
+  PantographLoads loads;
+  loads.front = m.train_start;
+  for (const Pantograph& p : m.pantographs) loads.uplift.push_back(p.static_uplift);
+  loads.external_force = loads.uplift;
+  const double v = m.scene.train_speed;
+  loads.air_speed_squared.assign(m.pantographs.size(), v * v);
+  return loads;
+}
+
+Eigen::VectorXd solve_static_equilibrium(const Model& m, const PantographLoads& loads, bool roof_springs) {
+  const StaticUnknowns q = static_unknowns(m);
+  ActiveSet active;
+  active.dropper_on.assign(m.droppers.size(), true);
+  active.contact_on.assign(m.collectors.size() * m.contact_wires.size(), true);
+  StaticSystem sys;
+  sys.node.resize(m.max_contact_nodes);
+  sys.weight.resize(m.max_contact_nodes);
+  // The active set is guessed, solved for, and corrected until it agrees with its solution.
   for (int iter = 0; iter < 60; ++iter) {
-    Triplets t;
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(size);
-    r.head(m.n_dof) = m.load;
-    for (std::size_t i = 0; i < m.wires.size(); ++i) add_wire_band(t, m.wires[i], m.wires[i].w_dof, t0[i]);
-    for (const SupportSpring& s : m.springs) t.emplace_back(s.dof, s.dof, s.stiffness);
-    for (std::size_t k = 0; k < m.droppers.size(); ++k) {
-      const Dropper& d = m.droppers[k];
-      if (dropper_on[k]) add_spring(t, r, d.messenger_dof, d.contact_dof, d.stiffness, -d.static_tension);
-    }
-    for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
-      const Pantograph& p = m.pantographs[pi];
-      const double uplift = st.uplift[pi] + p.aero_coefficient * air_speed_squared(st, pi);
-      if (!p.moving_force) {
-        for (int i = 0; i < p.masses_count(); ++i) {
-          const bool roof = i + 1 == p.masses_count();
-          if (roof && !roof_springs) continue;
-          add_spring(t, r, p.first_dof + i, roof ? -1 : p.first_dof + i + 1, p.stiffness[i], p.spring_preload[i]);
-        }
-        r[p.first_dof + p.masses_count() - 1] += uplift;
-        // Heads on their suspensions, with their own aerodynamic uplift.
-        for (const Head& h : p.heads) {
-          add_spring(t, r, h.dof, p.first_dof, h.stiffness, h.preload);
-          r[h.dof] += h.aero_coefficient * air_speed_squared(st, pi);
-        }
-      }
-      for (std::size_t cj = 0; cj < p.collectors.size(); ++cj) {
-        const int ci = p.collectors[cj];
-        const double xc = st.front - p.position + m.collectors[ci].offset;
-        if (p.moving_force) {
-          // As in step(): the given force acts on the lowest wire(s) under the collector.
-          std::vector<double> yd(m.contact_wires.size(), std::numeric_limits<double>::infinity());
-          double lowest = std::numeric_limits<double>::infinity();
-          for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
-            const Wire& w = m.wires[m.contact_wires[wk]];
-            const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
-            if (cnt == 0) continue;
-            yd[wk] = 0.0;
-            for (int a = 0; a < cnt; ++a) yd[wk] += weight[a] * w.height[node[a]];
-            lowest = std::min(lowest, yd[wk]);
-          }
-          int sharing = 0;
-          for (double y : yd) sharing += y <= lowest + 1e-3;
-          const double given = (p.external ? st.external_force[pi] : uplift) / p.collectors.size();
-          for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
-            if (!(yd[wk] <= lowest + 1e-3)) continue;
-            const Wire& w = m.wires[m.contact_wires[wk]];
-            const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
-            for (int a = 0; a < cnt; ++a) r[w.w_dof + node[a]] += given / sharing * weight[a];
-          }
-          continue;
-        }
-        for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
-          const Wire& w = m.wires[m.contact_wires[wk]];
-          const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
-          if (cnt == 0) continue;
-          if (!contact_on[ci * m.contact_wires.size() + wk]) continue;
-          double yd = 0.0;
-          for (int a = 0; a < cnt; ++a) yd += weight[a] * w.height[node[a]];
-          const double gap0 = p.contact_reference(m.collectors[ci]) - yd, k0 = m.contact_stiffness;
-          const int h = m.collectors[ci].dof;
-          t.emplace_back(h, h, k0);
-          r[h] -= k0 * gap0;
-          for (int a = 0; a < cnt; ++a) {
-            const int ja = w.w_dof + node[a];
-            t.emplace_back(h, ja, -k0 * weight[a]);
-            t.emplace_back(ja, h, -k0 * weight[a]);
-            r[ja] += k0 * weight[a] * gap0;
-            for (int b = 0; b < cnt; ++b) t.emplace_back(ja, w.w_dof + node[b], k0 * weight[a] * weight[b]);
-          }
-        }
-      }
-    }
-    // Rigid supports: identity rows and columns.
-    std::vector<bool> fixed(size, false);
-    for (int i = 0; i < m.n_dof; ++i) fixed[i] = m.inv_mass[i] == 0.0;
-    Triplets tr;
-    tr.reserve(t.size());
-    for (const auto& e : t)
-      if (!fixed[e.row()] && !fixed[e.col()]) tr.push_back(e);
-    for (int i = 0; i < size; ++i)
-      if (fixed[i]) {
-        tr.emplace_back(i, i, 1.0);
-        r[i] = 0.0;
-      }
-    Eigen::SparseMatrix<double> k(size, size);
-    k.setFromTriplets(tr.begin(), tr.end());
-    x = solve_spd(k, r, "the initial configuration (eq. 23)");
-
-    // Active set: droppers carry only tension, contacts only compression (eq. 25).
-    bool changed = false;
-    for (std::size_t k2 = 0; k2 < m.droppers.size(); ++k2) {
-      const Dropper& d = m.droppers[k2];
-      const bool on = d.static_tension + d.stiffness * (x[d.messenger_dof] - x[d.contact_dof]) > 0.0;
-      if (on != dropper_on[k2]) changed = true;
-      dropper_on[k2] = on;
-    }
-    for (std::size_t ci = 0; ci < m.collectors.size(); ++ci) {
-      const Pantograph& p = m.pantographs[m.collectors[ci].pantograph];
-      if (p.moving_force) continue;
-      const double xc = st.front - p.position + m.collectors[ci].offset;
-      for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
-        const Wire& w = m.wires[m.contact_wires[wk]];
-        const int cnt = contact_weights(w, m.rub_length, xc, node.data(), weight.data());
-        double yw = 0.0;
-        for (int a = 0; a < cnt; ++a) yw += weight[a] * (w.height[node[a]] + x[w.w_dof + node[a]]);
-        const Collector& col = m.collectors[ci];
-        const bool on = cnt > 0 && p.contact_reference(col) + x[col.dof] - yw >= 0.0;
-        const std::size_t idx = ci * m.contact_wires.size() + wk;
-        if (on != contact_on[idx]) changed = true;
-        contact_on[idx] = on;
-      }
-    }
-    if (!changed) {
-      st.u = x.head(m.n_dof);
-      st.v.setZero();  // eq. 24
-      return;
-    }
+    sys.t.clear();
+    sys.r = Eigen::VectorXd::Zero(q.size);
+    add_line(m, q, active, sys);
+    add_pantographs(m, loads, active, roof_springs, sys);
+    const Eigen::VectorXd x = solve_held(m, q.size, sys);
+    const bool droppers_changed = update_taut_droppers(m, x, active);
+    const bool contacts_changed = update_contacts(m, loads, x, active, sys);
+    if (!droppers_changed && !contacts_changed) return x.head(m.n_dof);
   }
   throw SceneError("statics: the initial configuration (eq. 23) found no consistent set of slack droppers and "
                    "contacts in 60 iterations; check static_uplift and the dropper data");
@@ -268,10 +321,9 @@ void set_pantograph_references(Model& m) {
     }
   }
   if (m.pantographs.empty()) return;
-  State st = make_state(m);
-  st.front = m.train_start;
+  Eigen::VectorXd u;
   try {
-    solve_initial_state(m, st, false);
+    u = solve_static_equilibrium(m, design_pantograph_loads(m), false);
   } catch (const SceneError&) {
     // Without roof springs (relaxed at the working height, eq. 23) only the contact holds a
     // lumped pantograph: with no uplift it may not press on the wire, and nothing holds it.
@@ -294,7 +346,7 @@ void set_pantograph_references(Model& m) {
   for (Pantograph& p : m.pantographs) {
     if (p.moving_force) continue;
     const int last = p.masses_count() - 1;
-    p.spring_preload[last] = p.stiffness[last] * st.u[p.first_dof + last];
+    p.spring_preload[last] = p.stiffness[last] * u[p.first_dof + last];
   }
 }
 
@@ -321,6 +373,22 @@ Scene probe_scene(const Scene& scene, double force) {
   return s;
 }
 
+// The probe's (collector 0's) contact force on contact wire k at displacements u with the train
+// at `front`: eq. 22 with eq. 25, max(0, k0 (head - wire)), as the engine observes it.
+double probe_contact_force(const Model& m, const Eigen::VectorXd& u, double front, std::size_t k, int* node,
+                           double* weight) {
+  const Collector& col = m.collectors[0];
+  const Pantograph& p = m.pantographs[col.pantograph];
+  const double head = p.contact_reference(col) + u[col.dof];
+  const double xc = front - p.position + col.offset;
+  const Wire& w = m.wires[m.contact_wires[k]];
+  const int cnt = contact_weights(w, m.rub_length, xc, node, weight);
+  if (cnt == 0) return 0.0;
+  double yw = 0.0;
+  for (int a = 0; a < cnt; ++a) yw += weight[a] * (w.height[node[a]] + u[w.w_dof + node[a]]);
+  return std::max(0.0, m.contact_stiffness * (head - yw));
+}
+
 }  // namespace
 
 ElasticityProbe::ElasticityProbe(const Scene& scene, double force, const std::optional<std::vector<double>>& rises) {
@@ -333,23 +401,23 @@ ElasticityProbe::ElasticityProbe(const Scene& scene, double force, const std::op
 std::vector<double> ElasticityProbe::uplift(double x) const {
   const Model& m = model_;
   std::vector<double> out(m.contact_wires.size(), std::nan(""));
-  State st = make_state(m);
-  st.front = x;
+  PantographLoads loads = design_pantograph_loads(m);
+  loads.front = x;
+  Eigen::VectorXd u;
   try {
-    solve_initial_state(m, st, true);
+    u = solve_static_equilibrium(m, loads, true);
   } catch (const SceneError&) {
     return out;  // nothing under the probe to press against
   }
-  observe(m, st);
   std::vector<int> node(m.max_contact_nodes);
   std::vector<double> weight(m.max_contact_nodes);
   for (std::size_t k = 0; k < m.contact_wires.size(); ++k) {
-    if (!(st.contact_force[k] > 0.0)) continue;
+    if (!(probe_contact_force(m, u, x, k, node.data(), weight.data()) > 0.0)) continue;
     const Wire& w = m.wires[m.contact_wires[k]];
     const int cnt = contact_weights(w, 0.0, x, node.data(), weight.data());
-    double u = 0.0;
-    for (int a = 0; a < cnt; ++a) u += weight[a] * st.u[w.w_dof + node[a]];
-    out[k] = u;
+    double uplift = 0.0;
+    for (int a = 0; a < cnt; ++a) uplift += weight[a] * u[w.w_dof + node[a]];
+    out[k] = uplift;
   }
   return out;
 }

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "catenary_sim/core/output/zero_phase_filter.hpp"
+#include "output/steady_arms_near.hpp"
 
 namespace catenary_sim {
 
@@ -195,19 +196,12 @@ void PassRecorder::record_whole(const Model& m, const State& s) {
     force_[p].push_back(total_contact_force(m, s, static_cast<int>(p)));
     for (std::size_t w = 0; w < nw; ++w)
       wire_force_[p][w].push_back(s.pantograph_force_on(m, static_cast<int>(p), static_cast<int>(w)));
-    const auto first = std::lower_bound(steady_arm_x_.begin(), steady_arm_x_.end(), xp - longest_span_);
-    for (std::size_t k = first - steady_arm_x_.begin(); k < steady_arm_x_.size() && steady_arm_x_[k] <= xp + longest_span_; ++k) {
-      const SupportSpring& sp = m.springs[steady_arm_springs_[k]];
-      const int span = sp.span_index;
-      const double reach = 0.5 * std::min(m.scene.spans[span - 1], m.scene.spans[span]);
-      if (std::fabs(xp - sp.x) > reach) continue;
-      // Keyed by the steady arm's station along the line (mm), which on an endless line is not
-      // the same spring from one span to the next.
-      const long long key = std::llround(1e3 * (sp.x + s.line_offset));
-      const auto it = max_uplift_[p].find(key);
-      if (it == max_uplift_[p].end()) max_uplift_[p].emplace(key, s.u[sp.dof]);
-      else it->second = std::max(it->second, s.u[sp.dof]);
-    }
+    for_each_steady_arm_near(m, steady_arm_springs_, steady_arm_x_, longest_span_, s.line_offset, xp,
+                             [&](const SupportSpring& sp, long long key) {
+                               const auto it = max_uplift_[p].find(key);
+                               if (it == max_uplift_[p].end()) max_uplift_[p].emplace(key, s.u[sp.dof]);
+                               else it->second = std::max(it->second, s.u[sp.dof]);
+                             });
   }
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "catenary_sim/core/output/zero_phase_filter.hpp"
+#include "output/steady_arms_near.hpp"
 
 namespace catenary_sim {
 
@@ -161,19 +162,14 @@ void PassRecorder::record_in_section(const Model& m, const State& s, std::size_t
 
 // Steady arms within half a span, as record_whole() finds them; the line's arms by station.
 void PassRecorder::record_steady_arms(const Model& m, const State& s, double xp, Running* r) {
-  const auto first = std::lower_bound(steady_arm_x_.begin(), steady_arm_x_.end(), xp - longest_span_);
-  for (std::size_t k = first - steady_arm_x_.begin(); k < steady_arm_x_.size() && steady_arm_x_[k] <= xp + longest_span_; ++k) {
-    const SupportSpring& sp = m.springs[steady_arm_springs_[k]];
-    const int span = sp.span_index;
-    const double reach = 0.5 * std::min(m.scene.spans[span - 1], m.scene.spans[span]);
-    if (std::fabs(xp - sp.x) > reach) continue;
-    const long long key = std::llround(1e3 * (sp.x + s.line_offset));
-    const double up = s.u[sp.dof], xs = 1e-3 * key;
-    if (xs >= x0_ - 1e-6 && xs <= x1_ + 1e-6) r->uplift = std::max(r->uplift, up);
-    const auto it = arms_.find(key);
-    if (it == arms_.end()) arms_.emplace(key, up);
-    else it->second = std::max(it->second, up);
-  }
+  for_each_steady_arm_near(m, steady_arm_springs_, steady_arm_x_, longest_span_, s.line_offset, xp,
+                           [&](const SupportSpring& sp, long long key) {
+                             const double up = s.u[sp.dof], xs = 1e-3 * key;
+                             if (xs >= x0_ - 1e-6 && xs <= x1_ + 1e-6) r->uplift = std::max(r->uplift, up);
+                             const auto it = arms_.find(key);
+                             if (it == arms_.end()) arms_.emplace(key, up);
+                             else it->second = std::max(it->second, up);
+                           });
 }
 
 void PassRecorder::settle_block(const Model& m) {

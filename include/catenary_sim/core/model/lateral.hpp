@@ -65,6 +65,11 @@ struct LateralSupport {
   double pull_off = 0.0, pull_off_wind = 0.0;
 };
 
+// The values per node and lane of LateralModel::planes ([node][value][lane]): the lateral plane's
+// load, its mass-proportional damping alpha m, inverse mass and the wind drag coefficient
+// cw = 0.5 rho Cd d h (the fused step reads them as PackSweep::plane).
+enum { kPlaneLoad, kPlaneDamping, kPlaneInvMass, kPlaneDrag, kPlaneValues };
+
 struct LateralModel {
   std::vector<Wire> wires;  // per Model::wires: its band; w_dof indexes the lateral arrays; rotations condensed
   int n = 0;                // lateral DOFs (one per wire node)

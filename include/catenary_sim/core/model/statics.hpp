@@ -3,10 +3,10 @@
 // (eq. 23, q_dot0 = 0 by eq. 24).
 #pragma once
 
+#include <Eigen/Core>
 #include <vector>
 
 #include "catenary_sim/core/model/model.hpp"
-#include "catenary_sim/core/engine/state.hpp"
 
 namespace catenary_sim {
 
@@ -17,10 +17,24 @@ void solve_wire_statics(const Wire& wire, const std::vector<double>& node_load,
                         const std::vector<int>& prescribed_nodes, const std::vector<double>& prescribed_heights,
                         std::vector<double>& height, std::vector<double>& slope, std::vector<double>& reactions);
 
-// Eq. 23: static equilibrium with every pantograph pressed on at the train position of `state`,
-// droppers tension-only and contacts compression-only (iterated to a consistent active set).
-// Writes state.u and zeroes state.v (eq. 24). Throws SceneError if no consistent set is found.
-void solve_initial_state(const Model& model, State& state, bool roof_springs = true);
+// What the pantographs press with in the static problem: the train front's position (m) and,
+// per pantograph, the static uplift in effect (N), an external pantograph's given force (N) and
+// the square of its speed through the air (m^2/s^2, the v^2 of every aerodynamic uplift a v^2).
+struct PantographLoads {
+  double front = 0.0;
+  std::vector<double> uplift, external_force, air_speed_squared;
+};
+
+// The loads at the model's start: each pantograph's static uplift (an external one's force too),
+// the train at train_start at the scene's speed in still air.
+PantographLoads design_pantograph_loads(const Model& model);
+
+// Eq. 23: static equilibrium with every pantograph pressed on under `loads`, droppers
+// tension-only and contacts compression-only (iterated to a consistent active set, eq. 25).
+// Returns the displacements from the design state (Model::n_dof entries). Without
+// `roof_springs` the roof springs are left out (relaxed at the working height). Throws
+// SceneError if no consistent set is found. (engine/initial_state.hpp: a pass's initial state.)
+Eigen::VectorXd solve_static_equilibrium(const Model& model, const PantographLoads& loads, bool roof_springs = true);
 
 // Sets each pantograph's reference height and spring preloads so that, at the initial static
 // state, the static uplift is exactly the static contact force (part of building the model).
