@@ -29,6 +29,7 @@
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/markers.hpp"
 #include "catenary_sim/ros/params.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/ros/replay.hpp"

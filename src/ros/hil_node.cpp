@@ -20,6 +20,7 @@
 #include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/hil/report.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/markers.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {

@@ -21,6 +21,7 @@
 #include "catenary_sim/core/output/pass_files.hpp"
 #include "catenary_sim/tools/report_launcher.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/markers.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {

@@ -7,6 +7,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/markers.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/ros/replay.hpp"
 #include "../support/scenes.hpp"
