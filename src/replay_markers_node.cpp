@@ -105,7 +105,7 @@ class ReplayMarkers {
 
   void use_scene(const Scene& scene) {
     model_ = std::make_unique<Model>(build_model(scene));
-    state_ = make_state(*model_);  // (a 3-D line's with its lateral state: wires drawn at their lateral positions)
+    state_ = make_state(*model_);  // (on a 3-D line with its lateral state: wires drawn at their lateral positions)
     last_drawn_ = ros::Time();
     drawn_any_ = false;
   }
