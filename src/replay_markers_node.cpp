@@ -29,8 +29,8 @@
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/markers.hpp"
 #include "catenary_sim/ros/params.hpp"
-#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/ros/replay.hpp"
 
 using namespace catenary_sim;
@@ -105,8 +105,7 @@ class ReplayMarkers {
 
   void use_scene(const Scene& scene) {
     model_ = std::make_unique<Model>(build_model(scene));
-    state_ = make_state(*model_);
-    if (model_->lateral) state_.lateral = make_lateral_state(*model_);  // a 3-D line: wires drawn at their lateral positions
+    state_ = make_state(*model_);  // (on a 3-D line with its lateral state: wires drawn at their lateral positions)
     last_drawn_ = ros::Time();
     drawn_any_ = false;
   }

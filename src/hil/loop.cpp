@@ -14,9 +14,6 @@ namespace hil {
 
 namespace {
 
-constexpr double kBinWidth = 1e-6;    // s
-constexpr std::size_t kBins = 10000;  // up to 10 ms
-
 // Phase lock of the loop's windows onto the arrivals of a rig sending at the same rate: a gain
 // per period on the offset of a triggering arrival from the window's centre, at most this share
 // of a period per period: the rate stays within 0.2 % of the loop rate (a rig's crystal drifts far
@@ -46,214 +43,6 @@ std::string printf_text(const char* f, ...) {
 }
 
 }  // namespace
-
-double steady_now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-std::string loop_rate_error(double rate, const std::string& name) {
-  if (std::isfinite(rate) && rate >= kMinLoopRate && rate <= kMaxLoopRate) return "";
-  return name + " = " + fmt(rate) + " rejected: allowed [" + fmt(kMinLoopRate) + ", " + fmt(kMaxLoopRate) + "] Hz";
-}
-
-HilTiming hil_timing(double rate, std::optional<double> scene_dt, double auto_dt, const std::string& rate_name,
-                     const std::string& scene_name) {
-  if (const std::string e = loop_rate_error(rate, rate_name); !e.empty()) throw HilError(e);
-  HilTiming t;
-  t.period = 1.0 / rate;
-  if (scene_dt) {
-    const double k = t.period / *scene_dt;
-    const double kr = std::round(k);
-    if (kr < 1.0 || std::fabs(k - kr) > 1e-6 * kr) {
-      const int k_auto = static_cast<int>(std::ceil(t.period / *scene_dt - 1e-9));
-      throw HilError("numerics.dt = " + fmt(*scene_dt) + " s of " + scene_name +
-                     " does not divide the loop period " + fmt(t.period) + " s of " + rate_name + " = " +
-                     fmt(rate) + " Hz: the period must be a whole number of core steps; use numerics.dt = "
-                     "period / k, e.g. " + fmt(t.period / std::max(1, k_auto)) +
-                     " s, or numerics.dt: auto (the loop then chooses it)");
-    }
-    t.steps_per_period = static_cast<int>(kr);
-  } else {
-    if (!(auto_dt > 0.0)) throw HilError(scene_name + ": the automatic dt is " + fmt(auto_dt) + " s");
-    t.steps_per_period = static_cast<int>(std::ceil(t.period / auto_dt - 1e-9));
-  }
-  t.dt = t.period / t.steps_per_period;
-  return t;
-}
-
-void MeasurementHold::accept(const std::vector<double>& force, double arrival, double measured, std::uint64_t step) {
-  previous_ = force_;
-  previous_time_ = time_;
-  force_ = force;
-  arrival_ = arrival;
-  // The measurement's own time when it has one, else its arrival: only differences are used.
-  time_ = measured > 0.0 ? measured : arrival;
-  previous_stamped_ = stamped_;
-  stamped_ = measured > 0.0;
-  step_ = step;
-  ++count_;
-}
-
-double MeasurementHold::value(std::size_t i, double t, bool extrapolate, double horizon) const {
-  if (i >= force_.size()) return 0.0;
-  const double f = force_[i];
-  // (a stamped and an unstamped measurement: two clocks, no slope)
-  if (!extrapolate || count_ < 2 || stamped_ != previous_stamped_) return f;
-  const double span = time_ - previous_time_;
-  if (!(span > 0.0) || span > 1.0) return f;
-  const double ahead = std::clamp(t - arrival_, 0.0, std::max(0.0, horizon));
-  return f + (f - previous_[i]) / span * ahead;
-}
-
-double hold_ramp_force(double from, double to, double elapsed, double ramp) {
-  if (!(ramp > 0.0) || elapsed >= ramp) return to;
-  if (elapsed <= 0.0) return from;
-  return from + (to - from) * (elapsed / ramp);
-}
-
-LatencyHistogram::LatencyHistogram() : bins_(kBins, 0) {}
-
-void LatencyHistogram::add(double s) {
-  if (!std::isfinite(s)) return;
-  s = std::max(0.0, s);
-  const std::size_t b = std::min(kBins - 1, static_cast<std::size_t>(s / kBinWidth));
-  ++bins_[b];
-  ++count_;
-  sum_ += s;
-  max_ = std::max(max_, s);
-}
-
-double LatencyHistogram::quantile(double q) const {
-  if (count_ == 0) return 0.0;
-  const double target = std::clamp(q, 0.0, 1.0) * static_cast<double>(count_);
-  std::uint64_t cum = 0;
-  for (std::size_t b = 0; b < kBins; ++b) {
-    cum += bins_[b];
-    if (static_cast<double>(cum) >= target && cum > 0)
-      return b + 1 == kBins ? max_ : std::min(max_, (b + 1) * kBinWidth);  // (the last bin: beyond 10 ms)
-  }
-  return max_;
-}
-
-std::vector<std::uint64_t> LatencyHistogram::coarse(double width) const {
-  const std::size_t per = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(width / kBinWidth)));
-  std::vector<std::uint64_t> out((kBins + per - 1) / per, 0);
-  for (std::size_t b = 0; b < kBins; ++b) out[b / per] += bins_[b];
-  while (!out.empty() && out.back() == 0) out.pop_back();
-  return out;
-}
-
-std::uint64_t LatencyHistogram::count_below(double s) const {
-  const std::size_t end = std::min(kBins, static_cast<std::size_t>(std::llround(std::max(0.0, s) / kBinWidth)));
-  std::uint64_t n = 0;
-  for (std::size_t b = 0; b < end; ++b) n += bins_[b];
-  return n;
-}
-
-JitterSummary summarize_jitter(const LatencyHistogram& h) {
-  JitterSummary j;
-  j.p50 = h.quantile(0.5);
-  j.p99 = h.quantile(0.99);
-  j.max = h.max();
-  std::uint64_t below = 0;
-  for (std::size_t i = 0; i < JitterSummary::kEdges.size(); ++i) {
-    const std::uint64_t n = h.count_below(JitterSummary::kEdges[i]);
-    j.counts[i] = n - below;
-    below = n;
-  }
-  j.counts.back() = h.count() - below;
-  return j;
-}
-
-void LatencyHistogram::clear() {
-  std::fill(bins_.begin(), bins_.end(), 0);
-  count_ = 0;
-  max_ = sum_ = 0.0;
-}
-
-std::vector<int> external_pantographs(const Model& m) {
-  std::vector<int> out;
-  for (std::size_t p = 0; p < m.pantographs.size(); ++p)
-    if (m.pantographs[p].external) out.push_back(static_cast<int>(p));
-  return out;
-}
-
-const char* mode_name(Mode m) {
-  switch (m) {
-    case Mode::kWaiting: return "waiting";
-    case Mode::kRunning: return "running";
-    case Mode::kHold: return "safe hold";
-    case Mode::kPaused: return "paused";
-    case Mode::kEnded: return "ended";
-  }
-  return "ended";
-}
-
-void compute_frame(const Model& m, const State& s, int steps_per_period, PointFrame& out) {
-  out.simulation_time = s.time;
-  out.step = static_cast<std::uint64_t>(s.steps);
-  out.dt = m.dt;
-  out.steps_per_period = static_cast<std::uint32_t>(steps_per_period);
-  out.speed = s.speed;
-  out.mode = Mode::kRunning;
-  out.measurement_step = 0;
-  std::size_t n = 0;
-  for (std::size_t p = 0; p < m.pantographs.size(); ++p)
-    if (m.pantographs[p].external) ++n;
-  out.pantographs.resize(n);
-  std::size_t e = 0;
-  for (std::size_t p = 0; p < m.pantographs.size(); ++p) {
-    const Pantograph& pg = m.pantographs[p];
-    if (!pg.external) continue;
-    PantographPoint& c = out.pantographs[e++];
-    if (c.name != pg.name) c.name = pg.name;
-    c.position = pantograph_position(m, s, static_cast<int>(p));
-    c.measurement_age = -1.0;
-    contact_point_motion(m, s, static_cast<int>(p), c.wires);
-    const std::size_t nw = m.contact_wires.size();
-    // Per collector: the lowest contact wire under it (the one a force-driven collector pushes).
-    double h = 0.0, v = 0.0, a = 0.0, pv = 0.0;
-    int under = 0;
-    for (std::size_t ci = 0; ci < pg.collectors.size(); ++ci) {
-      const ContactPointMotion* low = nullptr;
-      for (std::size_t k = 0; k < nw; ++k) {
-        const ContactPointMotion& cm = motion_under(m, c.wires, ci, k);
-        if (cm.on_wire && (!low || cm.height < low->height)) low = &cm;
-      }
-      if (!low) continue;
-      h += low->height;
-      v += low->velocity;
-      a += low->acceleration;
-      pv += low->path_velocity;
-      ++under;
-    }
-    if (under > 0) {
-      c.height = h / under;
-      c.velocity = v / under;
-      c.acceleration = a / under;
-      c.path_velocity = pv / under;
-    } else {
-      c.height = m.scene.contact_wire_height;
-      c.velocity = c.acceleration = c.path_velocity = 0.0;
-    }
-    c.applied_force = total_contact_force(m, s, static_cast<int>(p));
-  }
-}
-
-bool all_finite(const PointFrame& f) {
-  auto ok = [](double x) { return std::isfinite(x); };
-  if (!ok(f.dt) || !ok(f.speed) || !ok(f.simulation_time)) return false;
-  for (const PantographPoint& c : f.pantographs) {
-    for (double x : {c.position, c.height, c.velocity, c.acceleration, c.path_velocity, c.applied_force,
-                     c.measurement_age})
-      if (!ok(x)) return false;
-    for (const ContactPointMotion& w : c.wires)
-      if (w.on_wire && (!ok(w.height) || !ok(w.velocity) || !ok(w.acceleration) || !ok(w.path_velocity) ||
-                        !ok(w.force)))
-        return false;
-  }
-  return true;
-}
 
 // ---- The loop ----
 
@@ -647,31 +436,36 @@ void HilLoop::batch(double t, bool triggered) {
   if (mode_ == Mode::kRunning) c_.max_age_running = std::max(c_.max_age_running, age);
   age_in_effect_ = std::isfinite(age) ? age : -1.0;
   step_in_effect_ = mode_ == Mode::kRunning ? hold_.step() : 0;
+  if (mode_ == Mode::kRunning) add_coupling_energy(t);
+  step_period(t);
+  finish_period(t, triggered);
+}
 
-  if (mode_ == Mode::kRunning) {
-    // Coupling energy of this period (CouplingEnergy): the force applied now against the line's
-    // motion now (the last contact point) and against the motion the rig answered.
-    // (with delay compensation the answered point stands for the state that much later: what
-    // is left is the delay not compensated)
-    const std::uint64_t answered =
-        hold_.step() > 0 ? hold_.step() + static_cast<std::uint64_t>(std::llround(opt_.delay_compensation / timing_.dt)) : 0;
-    const std::size_t slot = answered % kSentHistory;
-    const bool known = answered > 0 && answered <= published_step_ && sent_step_[slot] == answered;
-    ++energy_.periods;
-    if (known) ++energy_.known;
-    for (std::size_t i = 0; i < external_.size(); ++i) {
-      const double f = std::clamp(hold_.value(i, t, opt_.extrapolate, opt_.timeout), 0.0, Simulation::kMaxExternalForce);
-      const double p_line = f * last_pv_[i];
-      energy_.interface_j += p_line * timing_.period;
-      energy_.peak_power_w = std::max(energy_.peak_power_w, std::fabs(p_line));
-      if (known) {
-        const double p_rig = f * sent_pv_[slot * external_.size() + i];
-        energy_.rig_j += p_rig * timing_.period;
-        energy_.delay_j += (p_line - p_rig) * timing_.period;
-      }
+void HilLoop::add_coupling_energy(double t) {
+  // Coupling energy of this period (CouplingEnergy): the force applied now against the line's
+  // motion now (the last contact point) and against the motion the rig answered.
+  // (with delay compensation the answered point stands for the state that much later: what
+  // is left is the delay not compensated)
+  const std::uint64_t answered =
+      hold_.step() > 0 ? hold_.step() + static_cast<std::uint64_t>(std::llround(opt_.delay_compensation / timing_.dt)) : 0;
+  const std::size_t slot = answered % kSentHistory;
+  const bool known = answered > 0 && answered <= published_step_ && sent_step_[slot] == answered;
+  ++energy_.periods;
+  if (known) ++energy_.known;
+  for (std::size_t i = 0; i < external_.size(); ++i) {
+    const double f = std::clamp(hold_.value(i, t, opt_.extrapolate, opt_.timeout), 0.0, Simulation::kMaxExternalForce);
+    const double p_line = f * last_pv_[i];
+    energy_.interface_j += p_line * timing_.period;
+    energy_.peak_power_w = std::max(energy_.peak_power_w, std::fabs(p_line));
+    if (known) {
+      const double p_rig = f * sent_pv_[slot * external_.size() + i];
+      energy_.rig_j += p_rig * timing_.period;
+      energy_.delay_j += (p_line - p_rig) * timing_.period;
     }
   }
+}
 
+void HilLoop::step_period(double t) {
   const Model& m = sim_->model();
   std::string err;
   for (int j = 0; j < timing_.steps_per_period; ++j) {
@@ -694,6 +488,9 @@ void HilLoop::batch(double t, bool triggered) {
     if (mode_ != Mode::kHold) recorder_->record(m, sim_->state());
   }
   if (recovering_ && sim_->state().speed >= sim_->state().target_speed - 1e-9) recovering_ = false;
+}
+
+void HilLoop::finish_period(double t, bool triggered) {
   send_point();
   const double published = steady_now();
   compute_.add(published - t);

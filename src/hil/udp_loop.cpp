@@ -195,8 +195,12 @@ void UdpLoopSkin::receive(double until) {
   }
 }
 
+namespace {
+// Throttle slots of UdpLoopSkin's log lines about the packets it takes.
+enum { kSlotForeign, kSlotRefused, kSlotUnusable };
+}  // namespace
+
 void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_in& from, double arrival) {
-  enum { kSlotForeign, kSlotRefused, kSlotUnusable };
   if (!allowed(from)) {
     ++refused_;
     if (throttle(kSlotRefused))
@@ -207,15 +211,9 @@ void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_i
   const bool same_address = have_peer_ ? from.sin_addr.s_addr == peer_.sin_addr.s_addr
                                        : !fixed_rig_ || from.sin_addr.s_addr == rig_.sin_addr.s_addr;
   const bool from_peer = have_peer_ && same_address && from.sin_port == peer_.sin_port;
-  auto foreign = [&](const char* why) {
-    ++foreign_;
-    if (throttle(kSlotForeign))
-      say(LogLevel::kWarn, "UDP packet from " + address_text(from) + " ignored: " + why + " (" +
-                               std::to_string(foreign_) + " foreign packets so far)");
-  };
   if (!same_address) {
-    foreign(have_peer_ ? ("the loop follows the rig at " + address_text(peer_)).c_str()
-                       : ("only the rig at --rig " + address_text(rig_) + " may send").c_str());
+    ignore_foreign(from, have_peer_ ? "the loop follows the rig at " + address_text(peer_)
+                                    : "only the rig at --rig " + address_text(rig_) + " may send");
     return;
   }
   csim_udp_measurement m;
@@ -223,13 +221,26 @@ void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_i
   std::string reason;
   if (!udp::decode_measurement(data, n, static_cast<std::uint32_t>(loop_.external().size()), m, why, reason)) {
     if (have_peer_ && !from_peer) {
-      foreign(("the loop follows the rig at " + address_text(peer_)).c_str());
+      ignore_foreign(from, "the loop follows the rig at " + address_text(peer_));
       return;
     }
     ++rejected_[static_cast<int>(why)];
     loop_.reject("UDP " + reason);
     return;
   }
+  if (!follow_rig(from, from_peer, m)) return;
+  if (!in_sequence(from, m)) return;
+  hand_to_loop(m, arrival);
+}
+
+void UdpLoopSkin::ignore_foreign(const sockaddr_in& from, const std::string& why) {
+  ++foreign_;
+  if (throttle(kSlotForeign))
+    say(LogLevel::kWarn, "UDP packet from " + address_text(from) + " ignored: " + why + " (" +
+                             std::to_string(foreign_) + " foreign packets so far)");
+}
+
+bool UdpLoopSkin::follow_rig(const sockaddr_in& from, bool from_peer, const csim_udp_measurement& m) {
   const bool hello = m.pantographs == 0;
   if (!have_peer_ || (!from_peer && hello)) {
     // The rig: the first valid sender, or the rig's own address on a new port saying hello (a
@@ -245,8 +256,8 @@ void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_i
     peer_ = from;
     have_peer_ = true;
   } else if (!from_peer) {
-    foreign(("the loop follows the rig at " + address_text(peer_) + "; a restarted rig says hello first").c_str());
-    return;
+    ignore_foreign(from, "the loop follows the rig at " + address_text(peer_) + "; a restarted rig says hello first");
+    return false;
   } else if (hello && tracker_.behind(m.header.sequence)) {
     tracker_.restart();  // a hello numbered below what the rig sent before: it started numbering again
   }
@@ -254,8 +265,12 @@ void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_i
     rig_ = from;
     have_rig_ = true;
   }
+  return true;
+}
+
+bool UdpLoopSkin::in_sequence(const sockaddr_in& from, const csim_udp_measurement& m) {
   const auto verdict = tracker_.observe(m.header.sequence);
-  if (hello) return;  // a hello: the rig's address, no measurement
+  if (m.pantographs == 0) return false;  // a hello: the rig's address, no measurement
   if (!udp::SequenceTracker::usable(verdict)) {
     ++unusable_;  // older than one already taken (reordered) or a duplicate: counted, not used
     if (throttle(kSlotUnusable))
@@ -267,11 +282,15 @@ void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_i
                                " (" + std::to_string(unusable_) + " reordered or duplicated so far; " +
                                std::to_string(udp::SequenceTracker::kResyncRun) +
                                " in a row from lower numbers are taken as a restart)");
-    return;
+    return false;
   }
   if (verdict == udp::SequenceTracker::Verdict::kRestart)
     say(LogLevel::kWarn, "UDP rig " + address_text(from) + " numbers its packets again from " +
                              std::to_string(m.header.sequence) + ": followed");
+  return true;
+}
+
+void UdpLoopSkin::hand_to_loop(const csim_udp_measurement& m, double arrival) {
   for (std::uint32_t i = 0; i < m.pantographs; ++i) force_[i] = m.force[i];
   const double measured = m.measured_time_ns > 0 ? 1e-9 * static_cast<double>(m.measured_time_ns) : 0.0;
   if (!loop_.accept(force_.data(), m.pantographs, arrival, measured, m.answers_step, "UDP measurement.force", true))
@@ -484,60 +503,61 @@ void UdpVirtualRig::send_measurement() {
   }
 }
 
-RigEnd UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_ended) {
-  const double started = steady_now();
-  auto stopped = [&] { return !keep_running(); };
+void UdpVirtualRig::drain() {
   alignas(8) std::uint8_t buf[2048];
   csim_udp_contact_point p;
   csim_udp_end e;
   const bool any_source = simulator_.sin_addr.s_addr == htonl(INADDR_ANY);
-  auto drain = [&] {
-    sockaddr_in from{};
-    long n;
-    while ((n = socket_.receive(buf, sizeof buf, &from)) >= 0) {
-      // Only the simulator's packets (a stray sender must not move the rig's actuator).
-      if (from.sin_port != simulator_.sin_port || (!any_source && from.sin_addr.s_addr != simulator_.sin_addr.s_addr)) {
-        ++foreign_;
-        continue;
-      }
-      udp::Reject why;
-      std::string reason;
-      if (udp::kind_of(buf, static_cast<std::size_t>(n)) == CSIM_UDP_KIND_END) {
-        if (!udp::decode_end(buf, static_cast<std::size_t>(n), e, why, reason)) {
-          ++rejected_;
-          continue;
-        }
-        if (!end_received_ || end_reason_ != e.reason)
-          message_ = std::string("the simulator sent the end of pass ") + std::to_string(e.pass_count) + ": " +
-                     udp::end_reason_name(e.reason);
-        end_received_ = true;
-        end_reason_ = e.reason;
-        continue;
-      }
-      if (!udp::decode_contact_point(buf, static_cast<std::size_t>(n), p, why, reason)) {
+  sockaddr_in from{};
+  long n;
+  while ((n = socket_.receive(buf, sizeof buf, &from)) >= 0) {
+    // Only the simulator's packets (a stray sender must not move the rig's actuator).
+    if (from.sin_port != simulator_.sin_port || (!any_source && from.sin_addr.s_addr != simulator_.sin_addr.s_addr)) {
+      ++foreign_;
+      continue;
+    }
+    udp::Reject why;
+    std::string reason;
+    if (udp::kind_of(buf, static_cast<std::size_t>(n)) == CSIM_UDP_KIND_END) {
+      if (!udp::decode_end(buf, static_cast<std::size_t>(n), e, why, reason)) {
         ++rejected_;
         continue;
       }
-      if (!udp::SequenceTracker::usable(tracker_.observe(p.header.sequence))) continue;
-      on_point(p);
+      if (!end_received_ || end_reason_ != e.reason)
+        message_ = std::string("the simulator sent the end of pass ") + std::to_string(e.pass_count) + ": " +
+                   udp::end_reason_name(e.reason);
+      end_received_ = true;
+      end_reason_ = e.reason;
+      continue;
     }
-  };
+    if (!udp::decode_contact_point(buf, static_cast<std::size_t>(n), p, why, reason)) {
+      ++rejected_;
+      continue;
+    }
+    if (!udp::SequenceTracker::usable(tracker_.observe(p.header.sequence))) continue;
+    on_point(p);
+  }
+}
+
+std::optional<RigEnd> UdpVirtualRig::over(const std::function<bool()>& keep_running, bool until_ended) {
   // The simulator ends the rig's run with an end packet: always when it stops, for a pass that
   // ended only with `until_ended` (else the rig waits for the next pass).
-  auto over = [&]() -> std::optional<RigEnd> {
-    if (cannot_serve_) return RigEnd::kCannotServe;
-    if (end_received_ && (until_ended || end_reason_ == CSIM_UDP_END_SHUTDOWN)) return RigEnd::kEnded;
-    if (until_ended && ended_) {
-      if (message_.empty()) message_ = "the simulator reports the pass ENDED";
-      return RigEnd::kEnded;
-    }
-    if (stopped()) return RigEnd::kStopped;
-    return std::nullopt;
-  };
+  if (cannot_serve_) return RigEnd::kCannotServe;
+  if (end_received_ && (until_ended || end_reason_ == CSIM_UDP_END_SHUTDOWN)) return RigEnd::kEnded;
+  if (until_ended && ended_) {
+    if (message_.empty()) message_ = "the simulator reports the pass ENDED";
+    return RigEnd::kEnded;
+  }
+  if (!keep_running()) return RigEnd::kStopped;
+  return std::nullopt;
+}
+
+std::optional<RigEnd> UdpVirtualRig::connect(const std::function<bool()>& keep_running, bool until_ended) {
   // Until the first contact point: a hello every 50 ms (a measurement of no pantographs), from
   // which the simulator learns where to send (unless it was given --rig).
+  const double started = steady_now();
   while (!have_) {
-    if (auto r = over()) return *r;
+    if (auto r = over(keep_running, until_ended)) return r;
     if (opt_.connect_timeout > 0.0 && steady_now() - started > opt_.connect_timeout) {
       message_ = "no contact point from the simulator at " + address_text(simulator_) + " within --connect-timeout = " +
                  fmt(opt_.connect_timeout) + " s (is it running, on that address and port?)";
@@ -550,11 +570,16 @@ RigEnd UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_
     socket_.wait_readable(steady_now() + 0.05);
     drain();
   }
+  return std::nullopt;
+}
+
+RigEnd UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_ended) {
+  if (auto r = connect(keep_running, until_ended)) return *r;
   const double period0 = dt_ * steps_per_period_;
   const double period = opt_.rate > 0.0 ? 1.0 / opt_.rate : period0;
   double next = steady_now() + 0.25 * period;
   while (true) {
-    if (auto r = over()) return *r;
+    if (auto r = over(keep_running, until_ended)) return *r;
     if (opt_.contact_timeout > 0.0 && steady_now() - last_point_ > opt_.contact_timeout) {
       message_ = "no contact point from the simulator for --timeout = " + fmt(opt_.contact_timeout) +
                  " s: the simulator stopped or the link broke";
@@ -562,12 +587,12 @@ RigEnd UdpVirtualRig::run(const std::function<bool()>& keep_running, bool until_
     }
     // Take contact points as they come (stepping the pantograph up to each at once) until the
     // tick, then send the contact force: the measurement, as a rig samples its load cell.
-    for (double now = steady_now(); now < next && !stopped(); now = steady_now()) {
+    for (double now = steady_now(); now < next && keep_running(); now = steady_now()) {
       socket_.wait_readable(next);
       drain();
     }
     drain();
-    if (over()) continue;
+    if (over(keep_running, until_ended)) continue;
     send_measurement();
     next = next_rig_tick(next, period, steady_now(), missed_);
   }

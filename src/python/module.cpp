@@ -160,10 +160,10 @@ void check_sample_rate(double sample_rate) {
     throw py::value_error("sample_rate = " + fmt(sample_rate) + " rejected: allowed >= 0 Hz (0: every step)");
 }
 
-}  // namespace
+using PyClass = py::class_<PySimulation>;
 
-PYBIND11_MODULE(_core, m) {
-  m.doc() = "catenary_sim core (pybind11): scenes, passes, stepping; see catenary_sim.__doc__";
+// The module's own names: the scene exception, the commands' ranges, the scene checks.
+void bind_scene_checks(py::module& m) {
   py::register_exception<SceneError>(m, "_SceneError", PyExc_ValueError);
   // The commands' ranges (the core's), for the Python side's messages about arguments of a wrong type.
   m.attr("_MAX_SPEED") = Simulation::kMaxSpeed;
@@ -181,9 +181,11 @@ PYBIND11_MODULE(_core, m) {
       "_check_scene_file",
       [](const std::string& path, const std::vector<std::string>& overrides) { load_scene_file(path, overrides); },
       py::arg("path"), py::arg("overrides"));
+}
 
-  py::class_<PySimulation>(m, "_Simulation")
-      .def(py::init([](const std::string& yaml, const std::vector<std::string>& overrides, double sample_rate) {
+// A pass: made from a scene, stepped, run to the end, its statistics, files and series, reset.
+void bind_pass(PyClass& c) {
+  c.def(py::init([](const std::string& yaml, const std::vector<std::string>& overrides, double sample_rate) {
              check_sample_rate(sample_rate);
              return std::make_unique<PySimulation>(load_scene_string(yaml, overrides), sample_rate);
            }),
@@ -204,8 +206,12 @@ PYBIND11_MODULE(_core, m) {
            }, py::arg("dir"), py::arg("wall_s") = 0.0)
       .def("series", [](const PySimulation& s) { Locked l(s); return s.series(); })
       .def("finished", [](const PySimulation& s) { Locked l(s); return s.sim_.finished(); })
-      .def("reset", [](PySimulation& s) { Locked l(s); s.reset(); })
-      .def_property_readonly("time", [](const PySimulation& s) { Locked l(s); return s.sim_.state().time; })
+      .def("reset", [](PySimulation& s) { Locked l(s); s.reset(); });
+}
+
+// What the pass is and where it stands: its clock, train, status, pantographs, steady arms and wires.
+void bind_pass_description(PyClass& c) {
+  c.def_property_readonly("time", [](const PySimulation& s) { Locked l(s); return s.sim_.state().time; })
       .def_property_readonly("steps", [](const PySimulation& s) { Locked l(s); return static_cast<long long>(s.sim_.state().steps); })
       .def_property_readonly("dt", [](const PySimulation& s) { Locked l(s); return s.sim_.model().dt; })
       .def_property_readonly("dofs", [](const PySimulation& s) { Locked l(s); return s.sim_.model().n_dof; })
@@ -251,9 +257,13 @@ PYBIND11_MODULE(_core, m) {
         std::vector<std::string> n;
         for (int w : s.sim_.model().contact_wires) n.push_back(s.sim_.model().wires[w].name);
         return n;
-      })
-      // Views (read-only, no copy) of the state: they change as the simulation steps.
-      .def_property_readonly("displacements", [](py::object self) {
+      });
+}
+
+// What the state is now: displacements, velocities, contact forces, and one pantograph's state.
+// The first three are views (read-only, no copy) of the state: they change as the simulation steps.
+void bind_state_views(PyClass& c) {
+  c.def_property_readonly("displacements", [](py::object self) {
         const PySimulation& s = self.cast<const PySimulation&>();
         Locked l(s);
         return view(s.sim_.state().u.data(), static_cast<std::size_t>(s.sim_.state().u.size()), self);
@@ -299,8 +309,12 @@ PYBIND11_MODULE(_core, m) {
         d["head_aero_uplift_N"] = aero;
         d["knee"] = m.scene.pantographs[i].knee_trailing ? "trailing" : "leading";
         return d;
-      }, py::arg("index") = 0)
-      .def("set_speed", [](PySimulation& s, double v) {
+      }, py::arg("index") = 0);
+}
+
+// The commands, refused as the core refuses them (the state is then as it was).
+void bind_commands(PyClass& c) {
+  c.def("set_speed", [](PySimulation& s, double v) {
         Locked l(s);
         std::string e;
         s.command(s.sim_.set_target_speed(v, &e), e);
@@ -326,4 +340,16 @@ PYBIND11_MODULE(_core, m) {
         std::string e;
         s.command(s.sim_.set_external_force(i, f, &e), e);
       }, py::arg("force_n"), py::arg("pantograph") = 0);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "catenary_sim core (pybind11): scenes, passes, stepping; see catenary_sim.__doc__";
+  bind_scene_checks(m);
+  PyClass sim(m, "_Simulation");
+  bind_pass(sim);
+  bind_pass_description(sim);
+  bind_state_views(sim);
+  bind_commands(sim);
 }

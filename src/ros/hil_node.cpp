@@ -20,6 +20,7 @@
 #include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/hil/report.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/markers.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
@@ -45,7 +46,21 @@ void end_error(const std::string& what) {
 
 HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), params_(load_hil_params(pnh)), updater_(nh, pnh) {
-  Scene scene = load_hil_scene(params_);
+  const Scene scene = load_hil_scene(params_);
+  make_loop(scene);
+  loop_->attach(this);
+  external_ = loop_->external();
+  stamp_offset_ = std::floor(ros::WallTime::now().toSec());
+  advertise_outputs();
+  subscribe_measurements();
+  serve_control();
+  updater_.setHardwareID("catenary_sim_hil/" + scene.name);
+  updater_.add("hardware in the loop", this, &HilNode::diagnose);
+  log_start(scene);
+  worker_ = std::thread([this] { worker(); });
+}
+
+void HilNode::make_loop(const Scene& scene) {
   try {
     hil::LoopOptions o = loop_options(params_);
     // Waiting for the viewer: the pass is armed by the worker once rviz subscribes (or the wait is
@@ -62,12 +77,9 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   } catch (const hil::HilError& e) {
     throw ParamError(e.what());
   }
-  loop_->attach(this);
-  const Model& m = loop_->model();
-  const hil::HilTiming& timing = loop_->timing();
-  external_ = loop_->external();
-  stamp_offset_ = std::floor(ros::WallTime::now().toSec());
+}
 
+void HilNode::advertise_outputs() {
   // One second of contact points queued per subscriber: a subscriber stalled for a few periods (a
   // loaded machine) gets them late instead of losing them; roscpp drops the oldest of a fuller
   // queue, and a rig that loses one integrates its pantograph against an extrapolated wire for
@@ -78,6 +90,9 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   pantograph_pub_ = nh_.advertise<PantographStateArray>("pantograph_state", 10);
   shape_pub_ = nh_.advertise<WireShapeArray>("wire_shape", 2);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
+}
+
+void HilNode::subscribe_measurements() {
   // The rig's measurements on a queue of their own, waited on by the loop; TCP_NODELAY: no
   // Nagle delay on the small messages (the hint is also applied to the rig's end of the socket).
   ros::SubscribeOptions so = ros::SubscribeOptions::create<MeasuredContactForce>(
@@ -91,6 +106,9 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
       ros::VoidPtr(), &hil_queue_);
   wo.transport_hints = ros::TransportHints().tcpNoDelay();
   wrench_sub_ = nh_.subscribe(wo);
+}
+
+void HilNode::serve_control() {
   // Control on a queue and a thread of its own: the loop never serves it (see the header).
   auto trigger = [this](const char* name, bool (HilNode::*f)(std_srvs::Trigger::Request&, std_srvs::Trigger::Response&)) {
     ros::AdvertiseServiceOptions o = ros::AdvertiseServiceOptions::create<std_srvs::Trigger>(
@@ -111,10 +129,11 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   speed_sub_ = nh_.subscribe(vo);
   ctrl_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &ctrl_queue_);
   ctrl_spinner_->start();
+}
 
-  updater_.setHardwareID("catenary_sim_hil/" + scene.name);
-  updater_.add("hardware in the loop", this, &HilNode::diagnose);
-
+void HilNode::log_start(const Scene& scene) const {
+  const Model& m = loop_->model();
+  const hil::HilTiming& timing = loop_->timing();
   std::string names;
   for (int p : external_) names += (names.empty() ? "" : ", ") + m.pantographs[p].name;
   ROS_INFO("catenary_sim_hil: scene %s: %d DOFs, external pantograph(s) %s; loop %g Hz (period %g ms) = %d step(s) "
@@ -132,7 +151,6 @@ HilNode::HilNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   else
     ROS_INFO("catenary_sim_hil: ~hil/auto_start false: the line holds its static state until `rosservice call %s`; "
              "the pass then starts with the first measurement", arm_srv_.getService().c_str());
-  worker_ = std::thread([this] { worker(); });
 }
 
 HilNode::~HilNode() {
@@ -320,84 +338,91 @@ void HilNode::worker() {
     std::unique_ptr<PassRecorder> finished;
     State finished_state;
     bool have = false;
-    {
-      std::unique_lock<std::mutex> l(snap_mu_);
-      snap_cv_.wait_for(l, std::chrono::milliseconds(100),
-                        [this] { return snap_new_ || stop_worker_ || finished_recorder_ != nullptr; });
-      // (stopping: only the statistics of a pass that has ended are still written)
-      if (stop_worker_ && !finished_recorder_) return;
-      if (snap_new_ && !stop_worker_) {
-        std::swap(wsnap_, snap_);
-        snap_new_ = false;
-        have = true;
-      }
-      if (finished_recorder_) {
-        finished = std::move(finished_recorder_);
-        finished_state = finished_state_;
-      }
-    }
+    if (!take_work(&have, &finished, &finished_state)) return;
     if (viewer_wait_until_ > 0.0) arm_when_viewer_ready();
-    if (have) {
-      const State& s = wsnap_.state;
-      const ros::Time stamp = sim_stamp(s.time, stamp_offset_);
-      // The chart's samples on simulated time; a new pass (or a reset) starts a new chart.
-      if (params_.strip_chart) {
-        if (wsnap_.pass_count != chart_pass_ || (!chart_.empty() && s.time < chart_time_)) {
-          chart_.clear(params_.chart_window);
-          chart_pass_ = wsnap_.pass_count;
-        }
-        if (chart_.due(s.time, 1e-3 * params_.chart_window)) chart_.sample(m, s);
-        chart_time_ = s.time;
-      }
-      contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
-      if (pantograph_pub_.getNumSubscribers() > 0) publish_pantograph_state(m, s, stamp);
-      if (s.time > last_tf_time_) {
-        tf_.sendTransform(to_transforms(m, s, stamp, params_.line_frame));
-        last_tf_time_ = s.time;
-      }
-      const double now = steady_now();
-      if (now >= next_shape_wall_ && shape_pub_.getNumSubscribers() > 0) {
-        next_shape_wall_ = now + 1.0 / params_.shape_rate;
-        shape_pub_.publish(to_wire_shape(m, s, params_.shape_resolution, stamp, params_.line_frame));
-      }
-      if (now >= next_marker_wall_ && marker_pub_.getNumSubscribers() > 0) {
-        next_marker_wall_ = now + 1.0 / params_.marker_rate;
-        MarkerOptions o;
-        o.frame = params_.line_frame;
-        visualization_msgs::MarkerArray arr = to_markers(m, s, stamp, o);
-        if (params_.strip_chart) {
-          // The heads-up line (the loop's mode instead of a real-time factor: the loop runs on the
-          // wall clock) and the statistics so far, in the chart's panel, which follows the train.
-          const visualization_msgs::MarkerArray chart = chart_.markers(
-              m, heads_up_position(m, s) + "  hardware in the loop: " + hil::mode_name(wsnap_.mode), stamp);
-          arr.markers.insert(arr.markers.end(), chart.markers.begin(), chart.markers.end());
-        }
-        marker_pub_.publish(arr);
-        if (stamp != last_view_stamp_) {
-          tf_.sendTransform(to_view_transform(s, stamp, params_.line_frame));
-          last_view_stamp_ = stamp;
-        }
-      }
-    }
-    if (finished) {
-      const std::vector<PantographStatistics> stats = finished->statistics(m);
-      for (const PantographStatistics& st : stats) {
-        ROS_INFO("catenary_sim_hil: %s: mean %.1f N, std %.1f N, max %.1f N, min %.1f N, contact loss %.2f %% "
-                 "(%zu samples, filtered %.0f Hz)", st.name.c_str(), st.filtered.mean, st.filtered.std_dev,
-                 st.filtered.max, st.filtered.min, st.contact_loss_percent, st.samples, m.scene.output.filter_cutoff);
-      }
-      if (!params_.stats_file.empty()) {
-        // Whole or not at all (checked writable at start-up; a full disk is still possible).
-        try {
-          write_file_atomically(params_.stats_file,
-                                statistics_json(m, finished_state, stats, RunInfo{-1.0, -1.0, wsnap_.counters.overruns}));
-        } catch (const OutputError& e) {
-          end_error(std::string("catenary_sim_hil: ~stats_file: ") + e.what());
-          stats_failed_ = true;
-        }
-      }
-    }
+    if (have) publish_snapshot(m);
+    if (finished) report_pass(m, *finished, finished_state);
     updater_.update();
+  }
+}
+
+bool HilNode::take_work(bool* have, std::unique_ptr<PassRecorder>* finished, State* finished_state) {
+  std::unique_lock<std::mutex> l(snap_mu_);
+  snap_cv_.wait_for(l, std::chrono::milliseconds(100),
+                    [this] { return snap_new_ || stop_worker_ || finished_recorder_ != nullptr; });
+  // (stopping: only the statistics of a pass that has ended are still written)
+  if (stop_worker_ && !finished_recorder_) return false;
+  if (snap_new_ && !stop_worker_) {
+    std::swap(wsnap_, snap_);
+    snap_new_ = false;
+    *have = true;
+  }
+  if (finished_recorder_) {
+    *finished = std::move(finished_recorder_);
+    *finished_state = finished_state_;
+  }
+  return true;
+}
+
+void HilNode::publish_snapshot(const Model& m) {
+  const State& s = wsnap_.state;
+  const ros::Time stamp = sim_stamp(s.time, stamp_offset_);
+  // The chart's samples on simulated time; a new pass (or a reset) starts a new chart.
+  if (params_.strip_chart) {
+    if (wsnap_.pass_count != chart_pass_ || (!chart_.empty() && s.time < chart_time_)) {
+      chart_.clear(params_.chart_window);
+      chart_pass_ = wsnap_.pass_count;
+    }
+    if (chart_.due(s.time, 1e-3 * params_.chart_window)) chart_.sample(m, s);
+    chart_time_ = s.time;
+  }
+  contact_pub_.publish(to_contact_force(m, s, stamp, params_.line_frame));
+  if (pantograph_pub_.getNumSubscribers() > 0) publish_pantograph_state(m, s, stamp);
+  if (s.time > last_tf_time_) {
+    tf_.sendTransform(to_transforms(m, s, stamp, params_.line_frame));
+    last_tf_time_ = s.time;
+  }
+  const double now = steady_now();
+  if (now >= next_shape_wall_ && shape_pub_.getNumSubscribers() > 0) {
+    next_shape_wall_ = now + 1.0 / params_.shape_rate;
+    shape_pub_.publish(to_wire_shape(m, s, params_.shape_resolution, stamp, params_.line_frame));
+  }
+  if (now >= next_marker_wall_ && marker_pub_.getNumSubscribers() > 0) {
+    next_marker_wall_ = now + 1.0 / params_.marker_rate;
+    MarkerOptions o;
+    o.frame = params_.line_frame;
+    visualization_msgs::MarkerArray arr = to_markers(m, s, stamp, o);
+    if (params_.strip_chart) {
+      // The heads-up line (the loop's mode instead of a real-time factor: the loop runs on the
+      // wall clock) and the statistics so far, in the chart's panel, which follows the train.
+      const visualization_msgs::MarkerArray chart = chart_.markers(
+          m, heads_up_position(m, s) + "  hardware in the loop: " + hil::mode_name(wsnap_.mode), stamp);
+      arr.markers.insert(arr.markers.end(), chart.markers.begin(), chart.markers.end());
+    }
+    marker_pub_.publish(arr);
+    if (stamp != last_view_stamp_) {
+      tf_.sendTransform(to_view_transform(s, stamp, params_.line_frame));
+      last_view_stamp_ = stamp;
+    }
+  }
+}
+
+void HilNode::report_pass(const Model& m, const PassRecorder& finished, const State& finished_state) {
+  const std::vector<PantographStatistics> stats = finished.statistics(m);
+  for (const PantographStatistics& st : stats) {
+    ROS_INFO("catenary_sim_hil: %s: mean %.1f N, std %.1f N, max %.1f N, min %.1f N, contact loss %.2f %% "
+             "(%zu samples, filtered %.0f Hz)", st.name.c_str(), st.filtered.mean, st.filtered.std_dev,
+             st.filtered.max, st.filtered.min, st.contact_loss_percent, st.samples, m.scene.output.filter_cutoff);
+  }
+  if (!params_.stats_file.empty()) {
+    // Whole or not at all (checked writable at start-up; a full disk is still possible).
+    try {
+      write_file_atomically(params_.stats_file,
+                            statistics_json(m, finished_state, stats, RunInfo{-1.0, -1.0, wsnap_.counters.overruns}));
+    } catch (const OutputError& e) {
+      end_error(std::string("catenary_sim_hil: ~stats_file: ") + e.what());
+      stats_failed_ = true;
+    }
   }
 }
 

@@ -21,6 +21,7 @@
 #include "catenary_sim/core/output/pass_files.hpp"
 #include "catenary_sim/tools/report_launcher.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/markers.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
@@ -34,9 +35,6 @@ std::string report_directory(const std::string& html) {
   const std::size_t slash = html.rfind('/');
   return slash == std::string::npos ? "." : slash == 0 ? "/" : html.substr(0, slash);
 }
-
-// The answer of set_paused false and step once the pass has ended (pass_status "ended").
-constexpr const char* kEndedMessage = "the pass has ended; reset to run again";
 
 // At real_time_factor > 0, a tick may take this many times its nominal share of steps before the
 // backlog is dropped (counted as an overrun) instead of trying to catch up.
@@ -263,24 +261,6 @@ void SimulationNode::on_tf_subscriber(const ros::SingleSubscriberPublisher& pub)
   if (view_sent_ && last_view_stamp_ == stamp)
     for (const auto& t : to_view_transforms(sim_->model(), s, stamp, params_.line_frame, view_pantograph_)) msg.transforms.push_back(t);
   pub.publish(msg);
-}
-
-void SimulationNode::on_reconfigure(NodeConfig& c, uint32_t) {
-  // The ranges of the .cfg are those of the parameters; dynamic_reconfigure clamps to them.
-  if (c.real_time_factor != params_.real_time_factor) reanchor();
-  params_.real_time_factor = c.real_time_factor;
-  params_.vertical_scale = c.vertical_scale;
-  params_.lateral_scale = c.lateral_scale;
-  params_.publish_rate = c.publish_rate;
-  params_.shape_rate = c.shape_rate;
-  params_.marker_rate = c.marker_rate;
-  std::string err;
-  if (sim_->set_max_acceleration(c.max_acceleration, &err)) {
-    params_.max_acceleration = c.max_acceleration;
-  } else {
-    ROS_ERROR("catenary_sim: max_acceleration = %g rejected: %s", c.max_acceleration, err.c_str());
-    c.max_acceleration = params_.max_acceleration;  // the server publishes the value in effect
-  }
 }
 
 std::int64_t SimulationNode::do_steps(std::int64_t n, const ros::WallTime* deadline) {
@@ -520,117 +500,6 @@ void SimulationNode::publish(bool force) {
       last_marker_time_ = s.time;
     }
   }
-}
-
-void SimulationNode::on_speed(const std_msgs::Float64::ConstPtr& msg) {
-  // The range is checked here too, for a message with %g numbers (the core's has std::to_string's
-  // "200.000000"); the core's check stays the authority.
-  const double v = msg->data;
-  if (const std::string e = speed_command_error(sim_->model().scene, v); !e.empty()) {
-    ROS_ERROR_THROTTLE(1.0, "catenary_sim: %s; command ignored", e.c_str());
-    return;
-  }
-  std::string err;
-  if (!sim_->set_target_speed(v, &err)) {
-    ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/train_speed: %s; command ignored", err.c_str());
-    return;
-  }
-  if (const std::string w = speed_warning(sim_->model(), v); !w.empty()) ROS_WARN_THROTTLE(5.0, "catenary_sim: %s", w.c_str());
-  have_command_ = true;
-  last_command_wall_ = ros::WallTime::now();
-  // A new speed after the end of a held pass does not restart it: use ~reset.
-}
-
-void SimulationNode::on_uplift(const std_msgs::Float64MultiArray::ConstPtr& msg) {
-  const std::size_t np = sim_->model().pantographs.size();
-  const std::size_t n = msg->data.size();
-  if (n != 1 && n != np) {
-    if (np == 1)
-      ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force: %zu values rejected: the scene has one pantograph, "
-                         "send 1 value; command ignored", n);
-    else
-      ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force: %zu values rejected: send 1 (all pantographs) or %zu "
-                         "(one per pantograph); command ignored", n, np);
-    return;
-  }
-  // Check every value first so that a rejected command leaves the state unchanged.
-  for (std::size_t i = 0; i < n; ++i) {
-    const double f = msg->data[i];
-    if (!std::isfinite(f) || f < 0.0 || f > Simulation::kMaxUplift) {
-      ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force[%zu] = %g N rejected: allowed 0 to %g N; command ignored",
-                         i, f, Simulation::kMaxUplift);
-      return;
-    }
-  }
-  std::string err;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!sim_->set_uplift(n == 1 ? -1 : static_cast<int>(i), msg->data[i], &err)) {
-      ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force: %s", err.c_str());  // not reached after the check
-      return;
-    }
-  }
-  have_command_ = true;
-  last_command_wall_ = ros::WallTime::now();
-}
-
-bool SimulationNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
-  sim_->reset(true);
-  restart_recording();
-  ended_ = false;
-  reanchor();
-  publish(true);
-  std::ostringstream s;
-  s << "new pass from the start at t = " << sim_->state().time << " s (time keeps running)";
-  res.success = true;
-  res.message = s.str();
-  ROS_INFO("catenary_sim: reset: %s", res.message.c_str());
-  return true;
-}
-
-bool SimulationNode::on_set_paused(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
-  // After the end (at_end stop, or a divergence) nothing runs until ~reset, whatever the pause
-  // says: the answer agrees with pass_status.
-  if (ended_ && !req.data) {
-    res.success = false;
-    res.message = kEndedMessage;
-    return true;
-  }
-  if (!req.data && paused_) reanchor();
-  paused_ = req.data;
-  res.success = true;
-  res.message = paused_ ? (ended_ ? std::string("paused (the pass has ended; a reset starts the next pass paused)")
-                                  : std::string("paused"))
-                        : "running";
-  return true;
-}
-
-bool SimulationNode::on_step(Step::Request& req, Step::Response& res) {
-  res.total_steps = sim_->state().steps;
-  res.sim_time = sim_->state().time;
-  res.steps_advanced = 0;
-  if (ended_) {
-    res.success = false;
-    res.message = std::string("rejected: ") + kEndedMessage;
-    return true;
-  }
-  if (!paused_) {
-    res.success = false;
-    res.message = "rejected: the simulation is running; call ~set_paused true first";
-    return true;
-  }
-  if (req.steps < 1 || req.steps > kMaxStepsPerCall) {
-    res.success = false;
-    res.message = "steps = " + std::to_string(req.steps) + " rejected: allowed 1 to " + std::to_string(kMaxStepsPerCall);
-    return true;
-  }
-  res.steps_advanced = do_steps(req.steps, nullptr);
-  res.total_steps = sim_->state().steps;
-  res.sim_time = sim_->state().time;
-  res.success = res.steps_advanced == req.steps;
-  res.message = res.success ? "ok" : "stopped early: " + sim_->status_message();
-  handle_end();
-  publish(true);
-  return true;
 }
 
 void SimulationNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {

@@ -28,11 +28,9 @@ double interpolate(const std::vector<double>& xs, const std::vector<double>& ys,
   return ys[k - 1] + t * (ys[k] - ys[k - 1]);
 }
 
-}  // namespace
-
-std::string state_from_messages(const Model& m, const WireShapeArray& shape, const PantographStateArray& state,
-                                const ContactForceArray& force, State* s) {
-  // Wires: same names in the same order, each sampled over the stations of the scene's wire.
+// Wires: same names in the same order, each sampled over the stations of the scene's wire; the
+// wires' displacements, lateral positions (3-D line) and the line offset.
+std::string wires_from_shape(const Model& m, const WireShapeArray& shape, State* s) {
   if (shape.wires.size() != m.wires.size())
     return "wire_shape has " + num(shape.wires.size()) + " wires, the scene " + num(m.wires.size()) + kOtherScene;
   double offset = 0.0;
@@ -73,8 +71,14 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
         s->lateral.y[m.lateral->wires[wi].w_dof + i] = interpolate(ws.stations, ws.lateral, w.x[i] + o);
   }
   s->line_offset = offset;
+  return "";
+}
 
-  // Train and pantographs.
+// Train and pantographs: the kinematics, the masses, the uplift and the contact forces (after the
+// wires: the train front is on the line offset they set).
+std::string train_from_messages(const Model& m, const PantographStateArray& state, const ContactForceArray& force,
+                                State* s) {
+  const double offset = s->line_offset;
   if (state.pantographs.size() != m.pantographs.size())
     return "pantograph_state has " + num(state.pantographs.size()) + " pantographs, the scene " +
            num(m.pantographs.size()) + kOtherScene;
@@ -119,9 +123,13 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
       for (std::size_t k = 0; k < nw; ++k)
         s->contact_force_on(m, pg.collectors[j], static_cast<int>(k)) = c.wire_forces[j * nw + k];  // message: collectors x wires
   }
+  return "";
+}
 
-  // Droppers: slack where the core's criterion says so (no tension at the elastic stretch, on a
-  // 3-D line with the lean's share from the recorded lateral positions: lateral.hpp).
+// Droppers: slack where the core's criterion says so (no tension at the elastic stretch, on a
+// 3-D line with the lean's share from the recorded lateral positions: lateral.hpp); on a 3-D line
+// the contact points across the strips and the sway.
+void droppers_and_contact_points(const Model& m, State* s) {
   const bool leaning = m.lateral && s->lateral.y.size() == m.lateral->n && !s->lateral.dropper_stretch.empty();
   if (leaning) set_dropper_stretch(m, *s);
   for (std::size_t d = 0; d < m.droppers.size(); ++d) {
@@ -131,6 +139,15 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
     s->dropper_slack[d] = !(dr.static_tension + dr.stiffness * stretch > 0.0);
   }
   if (m.lateral && s->lateral.y.size() == m.lateral->n) lateral_observe(m, *s);  // the contact points across the strips and the sway (3-D line)
+}
+
+}  // namespace
+
+std::string state_from_messages(const Model& m, const WireShapeArray& shape, const PantographStateArray& state,
+                                const ContactForceArray& force, State* s) {
+  if (std::string e = wires_from_shape(m, shape, s); !e.empty()) return e;
+  if (std::string e = train_from_messages(m, state, force, s); !e.empty()) return e;
+  droppers_and_contact_points(m, s);
   return "";
 }
 

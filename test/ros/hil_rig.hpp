@@ -1,5 +1,5 @@
 // The rig of the hardware-in-the-loop rostests (test_hil_outputs, test_hil_safety,
-// test_hil_services): catenary_sim_hil_node runs at 1 kHz without hardware and the test measures
+// test_hil_services, test_hil_viewer): catenary_sim_hil_node runs at 1 kHz without hardware and the test measures
 // for it, on a thread of its own, while the test's checks run against what the node publishes.
 #pragma once
 
@@ -12,6 +12,8 @@
 #include <thread>
 #include <utility>
 
+#include "catenary_sim/ContactPointArray.h"
+#include "catenary_sim/MeasuredContactForce.h"
 #include "ros_test_support.hpp"
 
 namespace hil_rostest {
@@ -54,6 +56,24 @@ class Rig {
   std::atomic<bool> quit_{false};
   std::thread thread_;  // (last: started once quit_ is set up)
 };
+
+// A rig that measures kSteadyForce all along, above the static uplift (100 N) of the scenes of
+// these tests, so that a running pass is told from a held one.
+constexpr double kSteadyForce = 120.0;  // N
+inline bool measure_steady(catenary_sim::MeasuredContactForce& m) {
+  m.force = {kSteadyForce};
+  return true;
+}
+
+// What a test hears of the node: its contact points (made in main, after ros::init).
+struct HeardPoints {
+  ros::NodeHandle nh;  // (first: the end of the last handle would shut ROS down)
+  ros_test::Recorder<catenary_sim::ContactPointArray> points{"hil/contact_point", 100,
+                                                             ros::TransportHints().tcpNoDelay()};
+};
+// The HeardPoints of the test (set in main), and its newest contact point.
+inline HeardPoints* heard_points = nullptr;
+inline catenary_sim::ContactPointArray point() { return heard_points->points.last(); }
 
 // RUN_ALL_TESTS with the test's subscriptions served by two spinner threads and the rig
 // measuring on `topic`; then the rig stops and ROS shuts down.

@@ -13,6 +13,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/markers.hpp"
 #include "catenary_sim/ros/params.hpp"
 #include "../support/scenes.hpp"
 

@@ -32,26 +32,15 @@ using namespace catenary_sim;
 
 namespace {
 
+using hil_rostest::point;
 using hil_rostest::wait_for;
 
-constexpr double kForce = 120.0;     // N, what the rig measures (static uplift 100 N)
-
-// What the test hears of the node (made in main, after ros::init).
-struct Heard {
-  ros::NodeHandle nh;  // (first: the end of the last handle would shut ROS down)
-  ros_test::Recorder<ContactPointArray> points{"hil/contact_point", 100, ros::TransportHints().tcpNoDelay()};
-  ros_test::NodeLog errors{"catenary_sim_hil"};  // the node's ERROR lines on /rosout
+// What the test hears of the node (made in main, after ros::init): its contact points and its
+// ERROR lines on /rosout.
+struct Heard : hil_rostest::HeardPoints {
+  ros_test::NodeLog errors{"catenary_sim_hil"};
 };
 Heard* heard = nullptr;
-
-// The rig: measures kForce all along.
-bool measure(MeasuredContactForce& m) {
-  m.force = {kForce};
-  return true;
-}
-
-// The newest contact point.
-ContactPointArray point() { return heard->points.last(); }
 
 // A contact point that arrived after now (the node has run a period since).
 ContactPointArray next_point() {
@@ -133,7 +122,7 @@ TEST(HilServices, ArmPauseSpeedResetStopAndArmAgain) {
   ASSERT_TRUE(mode_is(ContactPointArray::RUNNING)) << name(point().mode);
   ASSERT_TRUE(wait_for([] { return point().step > 1000; }, 20.0)) << point().step;
   p = point();
-  EXPECT_DOUBLE_EQ(p.pantographs.at(0).applied_force, kForce);
+  EXPECT_DOUBLE_EQ(p.pantographs.at(0).applied_force, hil_rostest::kSteadyForce);
   EXPECT_DOUBLE_EQ(p.speed, 15.0);
   r = trigger("arm");
   EXPECT_FALSE(r.success) << r.message;
@@ -241,7 +230,7 @@ TEST(HilServices, ArmPauseSpeedResetStopAndArmAgain) {
   p = point();
   EXPECT_EQ(p.speed, 10.0);
   EXPECT_LT(p.pantographs.at(0).position, ended.pantographs.at(0).position);
-  EXPECT_DOUBLE_EQ(p.pantographs.at(0).applied_force, kForce);
+  EXPECT_DOUBLE_EQ(p.pantographs.at(0).applied_force, hil_rostest::kSteadyForce);
   EXPECT_TRUE(ros_layer::all_finite(p));
   std::remove(stats_file.c_str());
 }
@@ -250,5 +239,6 @@ int main(int argc, char** argv) {
   ros_test::init(argc, argv, "test_hil_services");
   Heard h;
   heard = &h;
-  return hil_rostest::run_with_rig<MeasuredContactForce>("hil/contact_force", measure);
+  hil_rostest::heard_points = &h;
+  return hil_rostest::run_with_rig<MeasuredContactForce>("hil/contact_force", hil_rostest::measure_steady);
 }

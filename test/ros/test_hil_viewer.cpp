@@ -18,22 +18,8 @@ using namespace catenary_sim;
 
 namespace {
 
+using hil_rostest::point;
 using hil_rostest::wait_for;
-
-constexpr double kForce = 120.0;  // N, what the rig measures (static uplift 100 N)
-
-struct Heard {
-  ros::NodeHandle nh;  // (first: the end of the last handle would shut ROS down)
-  ros_test::Recorder<ContactPointArray> points{"hil/contact_point", 100, ros::TransportHints().tcpNoDelay()};
-};
-Heard* heard = nullptr;
-
-bool measure(MeasuredContactForce& m) {
-  m.force = {kForce};
-  return true;
-}
-
-ContactPointArray point() { return heard->points.last(); }
 
 TEST(HilViewer, WaitsForTheViewerThenRunsWithTheStripChart) {
   ASSERT_TRUE(wait_for([] { return point().steps_per_period > 0; }, 30.0)) << "no hil/contact_point";
@@ -53,7 +39,7 @@ TEST(HilViewer, WaitsForTheViewerThenRunsWithTheStripChart) {
     std::lock_guard<std::mutex> l(mu);
     return heading;
   };
-  ros::Subscriber viewer = heard->nh.subscribe<visualization_msgs::MarkerArray>(
+  ros::Subscriber viewer = hil_rostest::heard_points->nh.subscribe<visualization_msgs::MarkerArray>(
       "markers", 2, [&](const visualization_msgs::MarkerArray::ConstPtr& msg) {
         std::lock_guard<std::mutex> l(mu);
         for (const auto& mk : msg->markers) {
@@ -73,7 +59,7 @@ TEST(HilViewer, WaitsForTheViewerThenRunsWithTheStripChart) {
 
 int main(int argc, char** argv) {
   ros_test::init(argc, argv, "test_hil_viewer");
-  Heard h;
-  heard = &h;
-  return hil_rostest::run_with_rig<MeasuredContactForce>("hil/contact_force", measure);
+  hil_rostest::HeardPoints h;
+  hil_rostest::heard_points = &h;
+  return hil_rostest::run_with_rig<MeasuredContactForce>("hil/contact_force", hil_rostest::measure_steady);
 }

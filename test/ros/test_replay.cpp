@@ -7,7 +7,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/ros/conversions.hpp"
-#include "catenary_sim/core/model/lateral.hpp"
+#include "catenary_sim/ros/markers.hpp"
 #include "catenary_sim/ros/replay.hpp"
 #include "../support/scenes.hpp"
 
@@ -58,7 +58,6 @@ struct Rebuilt {
 Rebuilt rebuild(const Model& m, const State& s, double resolution) {
   const ros::Time stamp(1.0 + s.time);  // a stamp offset, as simulate_pass --bag writes
   Rebuilt r{"", make_state(m)};
-  if (m.lateral) r.state.lateral = make_lateral_state(m);  // as replay_markers does
   r.error = state_from_messages(m, to_wire_shape(m, s, resolution, stamp, "line"),
                                 to_pantograph_state(m, s, stamp, "line"), to_contact_force(m, s, stamp, "line"),
                                 &r.state);

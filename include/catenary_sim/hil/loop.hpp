@@ -32,120 +32,13 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/engine/state.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
+#include "catenary_sim/hil/contact_frame.hpp"
+#include "catenary_sim/hil/latency.hpp"
+#include "catenary_sim/hil/loop_timing.hpp"
+#include "catenary_sim/hil/measurement_hold.hpp"
 
 namespace catenary_sim {
 namespace hil {
-
-// A setting of the loop that cannot be used; the message names it, the value and what is allowed.
-class HilError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-// The loop rates (Hz) every HIL transport accepts (~hil/rate, catenary_sim_hil_udp --rate): a rig's
-// force loop runs at 1 kHz at least to follow the contact force's content up to EN 50318's 20 Hz
-// with room for its own filters; above 10 kHz a period (0.1 ms) is within the scheduling jitter of
-// a general-purpose kernel (docs/benchmark_history.md).
-constexpr double kMinLoopRate = 1000.0, kMaxLoopRate = 10000.0;
-// "" when `rate` Hz is one the loop runs at, else "NAME = RATE rejected: allowed [1000, 10000] Hz"
-// (`name`: how the caller's user names the rate).
-std::string loop_rate_error(double rate, const std::string& name);
-
-// The loop period and the core steps in it. The core's dt must divide the period: a scene with
-// numerics.dt: auto gets the largest dt = period / k not above the automatic dt; an explicit
-// numerics.dt must divide the period (to 1e-6 relative), else HilError naming both values
-// (`rate_name`, `scene_name`: how the caller's user names them).
-struct HilTiming {
-  double period = 0.0;  // s
-  int steps_per_period = 0;
-  double dt = 0.0;  // s, period / steps_per_period exactly
-};
-HilTiming hil_timing(double rate_hz, std::optional<double> scene_dt, double auto_dt,
-                     const std::string& rate_name = "parameter ~hil/rate", const std::string& scene_name = "~scene");
-
-// The newest valid measurement, held, with the previous one for the optional extrapolation.
-// Times are seconds on one monotonic clock.
-class MeasurementHold {
- public:
-  explicit MeasurementHold(std::size_t pantographs = 0) : force_(pantographs), previous_(pantographs) {}
-  // A valid measurement (one total force per external pantograph) that arrived at `arrival`;
-  // `measured` is its own stamp (0: unknown, the arrival is used for the slope).
-  void accept(const std::vector<double>& force, double arrival, double measured, std::uint64_t step);
-  bool has_value() const { return count_ > 0; }
-  std::uint64_t count() const { return count_; }
-  double arrival() const { return arrival_; }
-  std::uint64_t step() const { return step_; }
-  // s since the newest arrival; +inf before the first.
-  double age(double now) const { return count_ ? now - arrival_ : std::numeric_limits<double>::infinity(); }
-  // Force (N) for pantograph i at time t: the newest value, or with `extrapolate` the line through
-  // the last two measurements continued to t, at most `horizon` s past the newest arrival (the
-  // newest value when there is no earlier one or their times do not increase).
-  double value(std::size_t i, double t, bool extrapolate, double horizon) const;
-
- private:
-  std::vector<double> force_, previous_;
-  double arrival_ = 0.0, time_ = 0.0, previous_time_ = 0.0;
-  bool stamped_ = false, previous_stamped_ = false;
-  std::uint64_t count_ = 0, step_ = 0;
-};
-
-// Safe hold: force ramped linearly from `from` to `to` over `ramp` s (0: `to` at once).
-double hold_ramp_force(double from, double to, double elapsed, double ramp);
-
-// Latencies (s) in 1 us bins up to 10 ms (longer ones count in the last bin and in max()).
-// Fixed size: add() never allocates.
-class LatencyHistogram {
- public:
-  LatencyHistogram();
-  void add(double seconds);
-  std::uint64_t count() const { return count_; }
-  double max() const { return max_; }
-  double mean() const { return count_ ? sum_ / count_ : 0.0; }
-  // q in [0, 1]: the upper edge of the bin holding the q-quantile (0 when empty).
-  double quantile(double q) const;
-  // Counts per bin of `width` s (a multiple of 1 us) up to the last non-empty one: a histogram to
-  // print or write (the last bin also holds everything beyond 10 ms).
-  std::vector<std::uint64_t> coarse(double width) const;
-  // Samples below `seconds` (to the microsecond).
-  std::uint64_t count_below(double seconds) const;
-  void clear();
-
- private:
-  std::vector<std::uint64_t> bins_;
-  std::uint64_t count_ = 0;
-  double max_ = 0.0, sum_ = 0.0;
-};
-
-// Indices of the external pantographs of a model, in scene order.
-std::vector<int> external_pantographs(const Model& m);
-
-// The motion of the wire under one external pantograph: what a rig imposes on it.
-struct PantographPoint {
-  std::string name;
-  double position = 0.0;       // m along the line
-  // The lowest contact wire under each collector (the one a force-driven collector pushes),
-  // averaged over the collectors; the scene's contact-wire height at rest with none under it.
-  double height = 0.0, velocity = 0.0, acceleration = 0.0, path_velocity = 0.0;
-  double applied_force = 0.0;  // N, total force applied in the last step
-  double measurement_age = -1.0;  // s, age of the measurement in effect (-1: none)
-  std::vector<ContactPointMotion> wires;  // per collector and contact wire, collector-major
-};
-
-// Mode codes as in ContactPointArray.msg and udp_packets.h.
-enum class Mode : std::uint8_t { kWaiting = 0, kRunning = 1, kHold = 2, kEnded = 3, kPaused = 4 };
-const char* mode_name(Mode m);
-
-// The contact points of one period: every external pantograph.
-struct PointFrame {
-  double simulation_time = 0.0, dt = 0.0, speed = 0.0;
-  std::uint64_t step = 0, measurement_step = 0;
-  std::uint32_t pass_count = 0, steps_per_period = 1;
-  Mode mode = Mode::kWaiting;
-  std::vector<PantographPoint> pantographs;
-};
-// Fills `out` (reusing its storage) from the state: mode kRunning, no measurement.
-void compute_frame(const Model& m, const State& s, int steps_per_period, PointFrame& out);
-bool all_finite(const PointFrame& f);
 
 enum class EndAction { kStop, kLoop, kExit };
 enum class Request { kArm, kPause, kResume, kReset, kStop };
@@ -200,16 +93,6 @@ struct LoopCounters {
   double max_age_running = 0.0;    // s, oldest measurement used while running
 };
 
-// The loop's jitter for diagnostics: percentiles and counts between fixed edges.
-struct JitterSummary {
-  static constexpr std::array<double, 7> kEdges{10e-6, 20e-6, 50e-6, 100e-6, 200e-6, 500e-6, 1e-3};  // s
-  static constexpr std::array<const char*, 8> kLabels{"< 10 us",    "10-20 us",   "20-50 us", "50-100 us",
-                                                      "100-200 us", "200-500 us", "0.5-1 ms", ">= 1 ms"};
-  double p50 = 0.0, p99 = 0.0, max = 0.0;
-  std::array<std::uint64_t, 8> counts{};  // [0, 10 us), [10, 20 us), ..., [0.5, 1 ms), >= 1 ms
-};
-JitterSummary summarize_jitter(const LatencyHistogram& h);
-
 class HilLoop;
 
 // What a transport provides. Every call but log() comes from the loop thread.
@@ -228,8 +111,6 @@ class LoopSkin {
   // A pass has ended: its recorder and final state (statistics are the skin's, off the loop).
   virtual void pass_ended(std::unique_ptr<PassRecorder> /*recorder*/, const State& /*state*/) {}
 };
-
-double steady_now();  // s on the monotonic clock every loop time is on
 
 class HilLoop {
  public:
@@ -300,7 +181,14 @@ class HilLoop {
   // At most once per `period` s for each `slot`: true when the line may be logged now.
   bool throttle(int slot, double period);
   void wait_for_period(double w, double half, double& t);
+  // One period at t (steady s), started by a fresh measurement or not: the mode's transitions and
+  // counters, then add_coupling_energy (running), step_period and finish_period.
   void batch(double t, bool triggered);
+  void add_coupling_energy(double t);
+  // The period's core steps, each with the force in effect (held, extrapolated or the safe hold's ramp).
+  void step_period(double t);
+  // The contact point sent, the latencies counted and the end of the pass handled.
+  void finish_period(double t, bool triggered);
   void send_point();
   void handle_end();
   void enter_hold(double t, double age);

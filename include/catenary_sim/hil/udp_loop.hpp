@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -145,7 +146,17 @@ class UdpLoopSkin : public LoopSkin {
   void add_report(nlohmann::ordered_json& j) const;
 
  private:
+  // A packet from `from`: refused off the allow-list, ignored from another sender than the rig,
+  // rejected when it does not decode, else it names the rig (follow_rig), is checked against the
+  // rig's numbering (in_sequence) and handed to the loop (hand_to_loop).
   void take(const std::uint8_t* data, std::size_t n, const sockaddr_in& from, double arrival);
+  void ignore_foreign(const sockaddr_in& from, const std::string& why);
+  // The sender of a valid packet: the rig (the first, or one saying hello from the rig's address);
+  // false (counted as foreign) for another.
+  bool follow_rig(const sockaddr_in& from, bool from_peer, const csim_udp_measurement& m);
+  // False for a hello, a duplicate or one older than a measurement already taken.
+  bool in_sequence(const sockaddr_in& from, const csim_udp_measurement& m);
+  void hand_to_loop(const csim_udp_measurement& m, double arrival);
   bool allowed(const sockaddr_in& from) const;
   void send_end(std::uint32_t reason, const PointFrame* f);
   // At most once per second per `slot`: true when the line may be logged now.
@@ -241,6 +252,12 @@ class UdpVirtualRig {
  private:
   void on_point(const csim_udp_contact_point& p);
   void send_measurement();
+  // Takes every packet waiting from the simulator: contact points (on_point) and end packets.
+  void drain();
+  // Why run() returns now (an end, a rig that cannot serve, !keep_running), or nothing.
+  std::optional<RigEnd> over(const std::function<bool()>& keep_running, bool until_ended);
+  // Says hello until the first contact point; a reason to return from run(), or nothing once connected.
+  std::optional<RigEnd> connect(const std::function<bool()>& keep_running, bool until_ended);
 
   Scene scene_;
   UdpRigOptions opt_;

@@ -91,10 +91,27 @@ class HilNode : public hil::LoopSkin {
   void after_period(double now) override;
   void pass_ended(std::unique_ptr<PassRecorder> recorder, const State& state) override;
 
+  // Construction, in this order: the loop of the scene (a bad setting is a ParamError naming the
+  // parameter), the publishers, the rig's measurement subscriptions, the control services and
+  // cmd/train_speed on their own queue and thread, and the start-up lines in the log.
+  void make_loop(const Scene& scene);
+  void advertise_outputs();
+  void subscribe_measurements();
+  void serve_control();
+  void log_start(const Scene& scene) const;
+
   void on_measurement(const MeasuredContactForce::ConstPtr& msg);
   void on_wrench(const geometry_msgs::WrenchStamped::ConstPtr& msg);
   void snapshot(double t);
   void worker();
+  // Worker thread: waits (up to 100 ms) for a new snapshot (then in wsnap_, *have set) or a pass
+  // that has ended (moved to *finished); false once the worker is to stop.
+  bool take_work(bool* have, std::unique_ptr<PassRecorder>* finished, State* finished_state);
+  // The slow publications of wsnap_: contact_force, pantograph_state, tf, wire_shape, markers and
+  // the strip chart, each at its own rate.
+  void publish_snapshot(const Model& m);
+  // The statistics of a pass that has ended: in the log and in ~stats_file.
+  void report_pass(const Model& m, const PassRecorder& finished, const State& finished_state);
   // Arms the pass once rviz has subscribed to `markers` and drawn, or ~wait_for_viewer is over.
   void arm_when_viewer_ready();
   void publish_pantograph_state(const Model& m, const State& s, const ros::Time& stamp);

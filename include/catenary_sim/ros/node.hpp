@@ -54,6 +54,7 @@ class SimulationNode {
   void write_report();
   void reap_report(bool block);
 
+  // The node's inputs (node_commands.cpp): commands, services and dynamic_reconfigure.
   void on_speed(const std_msgs::Float64::ConstPtr& msg);
   void on_uplift(const std_msgs::Float64MultiArray::ConstPtr& msg);
   bool on_reset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);

@@ -10,7 +10,7 @@
 
 #include "catenary_sim/core/engine/state.hpp"
 #include "catenary_sim/core/model/model.hpp"
-#include "catenary_sim/ros/conversions.hpp"
+#include "catenary_sim/ros/markers.hpp"
 
 namespace catenary_sim {
 namespace ros_layer {
