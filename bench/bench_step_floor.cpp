@@ -21,6 +21,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "../test/support/scenes.hpp"
 #include "../src/core/engine/wire_lanes.hpp"  // the step's kernel, timed alone
+#include "../src/core/engine/step_workspace.hpp"
 
 using namespace catenary_sim;
 
@@ -258,18 +259,18 @@ int main(int argc, char** argv) {
               a.ww_hi[l] = mm.wires[p.wire[l]].d_ww[p.nodes - 1];
               a.u[l] = s.u.data() + w0;
               a.v[l] = s.v.data() + w0;
-              a.u_next[l] = s.u_next.data() + w0;
-              a.v_next[l] = s.v_next.data() + w0;
+              a.u_next[l] = s.work->u_next.data() + w0;
+              a.v_next[l] = s.work->v_next.data() + w0;
               a.accel[l] = s.accel.data() + w0;
             }
-            a.record = s.sweep.data() + kSweepRecord * p.offset;
+            a.record = s.work->sweep.data() + kSweepRecord * p.offset;
             a.beta = mm.beta;
             a.dt = mm.dt;
             a.limit = mm.scene.numerics.divergence_limit;
             bad |= sweep_pack(a);
           }
-          s.u.swap(s.u_next);
-          s.v.swap(s.v_next);
+          s.u.swap(s.work->u_next);
+          s.v.swap(s.work->v_next);
         }
         flagged += bad;
       } else {

@@ -10,6 +10,7 @@
 #include "catenary_sim/core/engine/state.hpp"
 #include "engine/lateral_window.hpp"
 #include "engine/lateral_wind.hpp"
+#include "engine/step_workspace.hpp"
 #include "engine/window.hpp"
 #include "engine/wire_lanes.hpp"
 
@@ -127,10 +128,10 @@ bool setup_lateral_sweep(const Model& m, State& s, std::size_t pack, bool window
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
   const WireLanes& p = m.wire_packs[pack];
-  if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, ls.sweep_factors.data(), s.sweep.data(), ls.y.data(),
+  if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, ls.sweep_factors.data(), s.work->sweep.data(), ls.y.data(),
                         ls.v.data(), ls.y_next.data(), ls.v_next.data(), ls.accel.data(), a))
     return false;
-  // (the records in the vertical step's scratch, State::sweep; sweep_pack_pair puts them elsewhere)
+  // (the records in the vertical step's scratch, StepWorkspace::sweep; sweep_pack_pair puts them elsewhere)
   a.plane = lat.planes[pack].data();
   // The wind's drag is taken in the sweep (PackSweep::wind), on the velocity it reads anyway.
   for (int k = 0; k < p.lanes; ++k) a.wind[k] = lat.windy ? ls.wind_speed.data() + lat.wires[p.wire[k]].w_dof : nullptr;
@@ -201,7 +202,7 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
   ls.joined = false;
   // Point forces on the band forces the sweep left in its records, as the generic step adds them.
   double* f = ls.f.data();
-  const double* rec = joined ? ls.sweep.data() : s.sweep.data();
+  const double* rec = joined ? ls.sweep.data() : s.work->sweep.data();
   const int* at = lat.sweep_force_at.data();
   const int* points = windowed ? ls.window_points.data() : lat.point_nodes.data();
   const int np = windowed ? ls.window_point_count : static_cast<int>(lat.point_nodes.size());

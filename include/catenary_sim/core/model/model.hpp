@@ -125,7 +125,7 @@ struct WireLanes {
   int lanes = 1;
   int wire[2] = {-1, -1};  // indices into Model::wires
   int nodes = 0;
-  std::size_t offset = 0;  // of this pack, in node-lanes: its records start at State::sweep[4 * offset]
+  std::size_t offset = 0;  // of this pack, in node-lanes: its records start at StepWorkspace::sweep[4 * offset]
   // One record per node: kCoefficients values, each for every lane ([node][value][lane]); the
   // element values (e_*) belong to the element from the node to the next.
   enum { kDww, kDwt, kEww, kEwt, kEtw, kLoad, kDampingMass, kInvMass, kCoefficients };  // kDampingMass: alpha m (eq. 5)
@@ -137,7 +137,7 @@ struct WireLanes {
   std::vector<double> centred_twin, centred_single;
 };
 
-// The fused step's record per node and lane (State::sweep, kSweepRecord values per node, each for
+// The fused step's record per node and lane (StepWorkspace::sweep, kSweepRecord values per node, each for
 // every lane; the engine's sweep writes them, Model::dof_sweep_force and dof_sweep_z point into
 // them): the rotation, z = u + beta v, the load less the damping, and the band force.
 enum { kRecTheta, kRecZ, kRecInit, kRecForce, kSweepRecord };
@@ -172,9 +172,9 @@ struct Model {
   std::vector<int> wire_pack, wire_lane;
   std::vector<int> centred_fixed_dofs;  // the wires' fixed vertical DOFs (centred damping step)
   double centred_v_ratio = 0.0;         // (2 / dt) / D_i per mass (centred damping step)
-  // Per catenary DOF: where the sweep leaves its band force and its z in State::sweep.
+  // Per catenary DOF: where the sweep leaves its band force and its z in StepWorkspace::sweep.
   std::vector<int> dof_sweep_force, dof_sweep_z;
-  std::size_t sweep_size = 0;  // node-lanes of all packs (State::sweep holds 4 values for each)
+  std::size_t sweep_size = 0;  // node-lanes of all packs (StepWorkspace::sweep holds 4 values for each)
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
   double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)
