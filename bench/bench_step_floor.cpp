@@ -177,7 +177,7 @@ bool floor_step_scalar(Floor& F) {
 // The floor's arrays from the model: each pack of two wires (contact wire, messenger) as built.
 std::vector<Floor> floors_of(const Model& m, const State& s0) {
   std::vector<Floor> out;
-  for (const WireLanes& p : m.wire_packs) {
+  for (const WireLanes& p : packs_of(m)) {
     if (p.lanes != 2) continue;
     Floor F;
     F.n = p.nodes;
@@ -206,7 +206,7 @@ int main(int argc, char** argv) {
   const Scene scene = load_scene_file(path, {"train.speed_kmh=300", "numerics.preset=" + preset});
   const Simulation proto(scene);
   const Model& m = proto.model();
-  if (m.wire_packs.empty()) {
+  if (!m.wire_packs) {
     std::fprintf(stderr, "bench_step_floor: the scene has no wire packs (explicit, condensed rotations needed)\n");
     return 1;
   }
@@ -218,7 +218,7 @@ int main(int argc, char** argv) {
   int wire_dofs = 0;
   for (const Wire& w : m.wires) wire_dofs += w.nodes();
   std::printf("scene %s, preset %s: %d DOFs (%d wire nodes in %zu packs), dt %.4f ms, %ld steps; sweep_pack dispatches to: %s\n",
-              path.c_str(), preset.c_str(), m.n_dof, wire_dofs, m.wire_packs.size(), m.dt * 1e3, steps, sweep_pack_isa());
+              path.c_str(), preset.c_str(), m.n_dof, wire_dofs, packs_of(m).size(), m.dt * 1e3, steps, sweep_pack_isa());
   struct Row {
     const char* label;
     std::vector<double> walls;
@@ -244,7 +244,7 @@ int main(int argc, char** argv) {
         const Model& mm = sim.model();
         bool bad = false;
         for (long k = 0; k < steps; ++k) {
-          for (const WireLanes& p : mm.wire_packs) {
+          for (const WireLanes& p : packs_of(mm)) {
             PackSweep a;
             a.pack = &p;
             a.lo = 0;

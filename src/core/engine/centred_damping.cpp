@@ -239,7 +239,7 @@ CATENARY_SIM_CLONES bool centred_sweep_pack(const Model& m, const WireLanes& pac
     vn[k] = s.work->v_next.data() + d;
     acc[k] = s.accel.data() + d;
   }
-  const CentredArgs args{u, v, f, un, vn, acc, m.dt, m.centred_v_ratio, 2.0 / m.beta, m.scene.numerics.divergence_limit};
+  const CentredArgs args{u, v, f, un, vn, acc, m.dt, m.wire_packs->centred_v_ratio, 2.0 / m.beta, m.scene.numerics.divergence_limit};
   double* rec = s.work->sweep.data() + kSweepRecord * pack.offset;
   return pack.lanes == 2 ? sweep<2>(pack, args, rec) : sweep<1>(pack, args, rec);
 }

@@ -51,11 +51,11 @@ StepStatus centred_damping_step(const Model& m, State& s) {
   if (leaning(m, s)) add_wire_point_forces<true>(m, s, u, v, force_at, z_at, false);
   else add_wire_point_forces<false>(m, s, u, v, force_at, z_at, false);
   add_pantograph_forces(m, s, u, v, f);
-  for (int d : m.centred_fixed_dofs) f[d] = 0.0;  // a fixed node's row is zeta = u (a contact may reach it; load 0)
+  for (int d : m.wire_packs->centred_fixed_dofs) f[d] = 0.0;  // a fixed node's row is zeta = u (a contact may reach it; load 0)
   double* un = s.work->u_next.data();
   double* vn = s.work->v_next.data();
   bool out = false;
-  for (const WireLanes& p : m.wire_packs) out |= centred_sweep_pack(m, p, s);
+  for (const WireLanes& p : packs_of(m)) out |= centred_sweep_pack(m, p, s);
   clear_point_forces(m, s, f);
   const double* im = m.inv_mass.data();
   for (int i = nc; i < n; ++i) {

@@ -24,7 +24,7 @@ bool packs_take_window(const Model& m, const State& s, bool windowed) {
   if (!windowed) return true;
   for (const WireWindow& ww : s.window)
     if (ww.hi == ww.lo) return false;
-  for (const WireLanes& p : m.wire_packs)
+  for (const WireLanes& p : packs_of(m))
     if (p.lanes == 2 && (s.window[p.wire[0]].lo != s.window[p.wire[1]].lo || s.window[p.wire[0]].hi != s.window[p.wire[1]].hi))
       return false;
   return true;
@@ -44,9 +44,9 @@ bool sweep_packs(const Model& m, State& s, bool windowed) {
   // joint layout (LateralState::sweep, joint_record_index).
   const bool join = m.lateral && s.lateral.join;
   bool lateral_outside = false;
-  for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
+  for (std::size_t pk = 0; pk < m.wire_packs->packs.size(); ++pk) {
     PackSweep a, b;
-    if (!setup_pack_sweep(m.wire_packs[pk], m.wires, windowed ? &s.window : nullptr, s.work->sweep_factors.data(), s.work->sweep.data(), u, v,
+    if (!setup_pack_sweep(m.wire_packs->packs[pk], m.wires, windowed ? &s.window : nullptr, s.work->sweep_factors.data(), s.work->sweep.data(), u, v,
                           un, vn, acc, a))
       continue;
     a.beta = beta;
@@ -54,7 +54,7 @@ bool sweep_packs(const Model& m, State& s, bool windowed) {
     a.limit = limit;
     if (join && setup_lateral_sweep(m, s, pk, false, b)) {
       bool b_outside = false;
-      outside |= sweep_pack_pair(a, b, s.lateral.sweep.data() + 2 * kSweepRecord * m.wire_packs[pk].offset, &b_outside);
+      outside |= sweep_pack_pair(a, b, s.lateral.sweep.data() + 2 * kSweepRecord * m.wire_packs->packs[pk].offset, &b_outside);
       lateral_outside |= b_outside;
     } else {
       outside |= sweep_pack(a);
@@ -167,8 +167,8 @@ int explicit_fused_update(const Model& m, State& s, bool windowed) {
   // its records (where z is too), in the generic step's order; the contact nodes then take their
   // force so far into the force vector, where the pantographs' contact adds to it.
   double* rec = join ? s.lateral.sweep.data() : s.work->sweep.data();
-  const int* f_at = m.dof_sweep_force.data();
-  const int* z_at = m.dof_sweep_z.data();
+  const int* f_at = m.wire_packs->dof_sweep_force.data();
+  const int* z_at = m.wire_packs->dof_sweep_z.data();
   const int joint = join;
   auto force_at = [rec, f_at, joint](int i) -> double& { return rec[joint_record_index(f_at[i], joint, false)]; };
   auto z_rec = [rec, z_at, joint](int i) { return rec[joint_record_index(z_at[i], joint, false)]; };
@@ -284,7 +284,7 @@ StepStatus explicit_step(const Model& m, State& s) {
   const bool windowed = m.scene.numerics.windowed();
   if (m.endless) shift_endless_block(m, s);
   if (windowed) update_window(m, s);
-  if (!m.wire_packs.empty() && packs_take_window(m, s, windowed)) return fused_step(m, s, windowed);
+  if (m.wire_packs && packs_take_window(m, s, windowed)) return fused_step(m, s, windowed);
   return generic_step(m, s, windowed);
 }
 

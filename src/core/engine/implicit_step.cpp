@@ -12,10 +12,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "catenary_sim/core/model/newmark_matrix.hpp"
 #include "engine/forces.hpp"
 #include "engine/step_workspace.hpp"
 #include "engine/train_motion.hpp"
+#include "model/newmark_matrix.hpp"
 
 namespace catenary_sim {
 

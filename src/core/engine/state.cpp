@@ -54,13 +54,13 @@ State make_state(const Model& m) {
   s.work->z = Eigen::VectorXd::Zero(m.n_dof);
   // The centred damping step keeps the load in the wires' force entries (clear_point_forces).
   if (m.scene.numerics.damping == DampingStep::kCentred) s.work->force.head(m.n_catenary_dof) = m.load.head(m.n_catenary_dof);
-  if (!m.wire_packs.empty() || m.scene.numerics.damping == DampingStep::kCentred) {
+  if (m.wire_packs || m.scene.numerics.damping == DampingStep::kCentred) {
     s.work->u_next = Eigen::VectorXd::Zero(m.n_dof);
     s.work->v_next = Eigen::VectorXd::Zero(m.n_dof);
-    s.work->sweep.assign(kSweepRecord * m.sweep_size, 0.0);
+    s.work->sweep.assign(kSweepRecord * sweep_size(m), 0.0);
     s.work->point_node.assign(m.collectors.size() * m.contact_wires.size() * m.max_contact_nodes, 0);
     if (m.scene.numerics.windowed()) {
-      s.work->sweep_factors.assign(2 * m.sweep_size, 0.0);
+      s.work->sweep_factors.assign(2 * sweep_size(m), 0.0);
     }
   }
   int max_nodes = 1;

@@ -39,7 +39,7 @@ StepStatus step_both_planes(const Model& m, State& s) {
   // Both planes sweep every node of the same packs: no window, one lateral step a vertical one,
   // both fused, and the step will be taken (not the pass's end).
   bool two_wire_packs = true;  // (sweep_pack_pair's four lanes)
-  for (const WireLanes& p : m.wire_packs) two_wire_packs &= p.lanes == 2;
+  for (const WireLanes& p : packs_of(m)) two_wire_packs &= p.lanes == 2;
   ls.join = !lat.planes.empty() && two_wire_packs && lat.substeps == 1 && !m.scene.numerics.windowed() &&
             s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty();
   // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
