@@ -124,23 +124,6 @@ void lateral_observe(const Model& m, State& s) {
   if (m.lateral) contact_points(m, s, false);
 }
 
-bool setup_lateral_sweep(const Model& m, State& s, std::size_t pack, bool windowed, PackSweep& a) {
-  const LateralModel& lat = *m.lateral;
-  LateralState& ls = s.lateral;
-  const WireLanes& p = m.wire_packs->packs[pack];
-  if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, ls.sweep_factors.data(), s.work->sweep.data(), ls.y.data(),
-                        ls.v.data(), ls.y_next.data(), ls.v_next.data(), ls.accel.data(), a))
-    return false;
-  // (the records in the vertical step's scratch, StepWorkspace::sweep; sweep_pack_pair puts them elsewhere)
-  a.plane = lat.planes[pack].data();
-  // The wind's drag is taken in the sweep (PackSweep::wind), on the velocity it reads anyway.
-  for (int k = 0; k < p.lanes; ++k) a.wind[k] = lat.windy ? ls.wind_speed.data() + lat.wires[p.wire[k]].w_dof : nullptr;
-  a.beta = m.beta;
-  a.dt = lat.dt;
-  a.limit = m.scene.numerics.divergence_limit;
-  return true;
-}
-
 namespace {
 
 // The springs (steady arms, messenger supports) and the droppers' pendulums on f, at

@@ -57,6 +57,19 @@ StepStatus step_both_planes(const Model& m, State& s) {
 
 }  // namespace
 
+// GCC's resolver takes the clone (engine/wire_lanes.cpp) of the highest priority the CPU supports:
+// x86-64-v4 (AVX-512 with VL, BW, DQ, CD) over x86-64-v3 (AVX2) over the baseline; this asks the
+// same question. The benchmark prints it beside the figures; gdb on sweep_pack shows the clone
+// taken (BENCHMARKS.md).
+const char* sweep_pack_isa() {
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("x86-64-v4")) return "x86-64-v4";
+  if (__builtin_cpu_supports("x86-64-v3")) return "x86-64-v3";
+#endif
+  return "default";
+}
+
 StepStatus step(const Model& m, State& s) {
   // A 3-D line steps both planes (make_state gives its state the lateral one); a state whose
   // lateral plane was cleared by hand, the vertical plane alone.

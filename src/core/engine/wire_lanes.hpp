@@ -70,8 +70,9 @@ bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const 
                       const double* window_factors, double* records, const double* x, const double* v, double* x_next,
                       double* v_next, double* accel, PackSweep& a);
 
-// The lateral plane's sweep of pack `pack` (lateral.cpp) on the lateral state, its records in
-// LateralState::sweep; false when the window holds no node of the pack.
+// The lateral plane's sweep of pack `pack` (its coefficients: LateralModel::planes) on the lateral
+// state, its records in the vertical step's StepWorkspace::sweep (sweep_pack_pair's joint layout
+// puts them elsewhere); false when the window holds no node of the pack.
 bool setup_lateral_sweep(const Model& model, State& s, std::size_t pack, bool windowed, PackSweep& a);
 
 

@@ -166,11 +166,6 @@ struct State {
 // A state sized for the model with zero displacement (the design state, no pantograph force).
 State make_state(const Model& model);
 
-// The instruction set the fused explicit step's runtime dispatch chose on this machine:
-// "x86-64-v4" (AVX-512), "x86-64-v3" (AVX2) or "default" (the x86-64 baseline). All give the
-// same bits.
-const char* sweep_pack_isa();
-
 // Fills the observations (contact forces, collector heights) for the current state without
 // advancing it, e.g. for the initial state.
 void observe(const Model& model, State& state);
