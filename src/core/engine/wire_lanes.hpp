@@ -53,7 +53,7 @@ bool sweep_pack(const PackSweep& sweep);
 // the lateral's in `lateral_outside`.
 bool sweep_pack_pair(const PackSweep& vertical, const PackSweep& lateral, double* joint_record, bool* lateral_outside);
 
-// Where a record of StepWorkspace::sweep's layout (index r, e.g. Model::dof_sweep_force) is in the
+// Where a record of StepWorkspace::sweep's layout (index r, e.g. WirePacks::dof_sweep_force) is in the
 // joint records of sweep_pack_pair: the pack's two lanes become four, the vertical plane's first.
 // joint 0: r itself (the plane's own records).
 inline int joint_record_index(int r, int joint, bool lateral) {
