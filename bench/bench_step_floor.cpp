@@ -21,6 +21,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "../test/support/scenes.hpp"
 #include "../src/core/engine/wire_lanes.hpp"  // the step's kernel, timed alone
+#include "../src/core/engine/step_workspace.hpp"
 
 using namespace catenary_sim;
 
@@ -176,7 +177,7 @@ bool floor_step_scalar(Floor& F) {
 // The floor's arrays from the model: each pack of two wires (contact wire, messenger) as built.
 std::vector<Floor> floors_of(const Model& m, const State& s0) {
   std::vector<Floor> out;
-  for (const WireLanes& p : m.wire_packs) {
+  for (const WireLanes& p : packs_of(m)) {
     if (p.lanes != 2) continue;
     Floor F;
     F.n = p.nodes;
@@ -205,7 +206,7 @@ int main(int argc, char** argv) {
   const Scene scene = load_scene_file(path, {"train.speed_kmh=300", "numerics.preset=" + preset});
   const Simulation proto(scene);
   const Model& m = proto.model();
-  if (m.wire_packs.empty()) {
+  if (!m.wire_packs) {
     std::fprintf(stderr, "bench_step_floor: the scene has no wire packs (explicit, condensed rotations needed)\n");
     return 1;
   }
@@ -217,7 +218,7 @@ int main(int argc, char** argv) {
   int wire_dofs = 0;
   for (const Wire& w : m.wires) wire_dofs += w.nodes();
   std::printf("scene %s, preset %s: %d DOFs (%d wire nodes in %zu packs), dt %.4f ms, %ld steps; sweep_pack dispatches to: %s\n",
-              path.c_str(), preset.c_str(), m.n_dof, wire_dofs, m.wire_packs.size(), m.dt * 1e3, steps, sweep_pack_isa());
+              path.c_str(), preset.c_str(), m.n_dof, wire_dofs, packs_of(m).size(), m.dt * 1e3, steps, sweep_pack_isa());
   struct Row {
     const char* label;
     std::vector<double> walls;
@@ -243,7 +244,7 @@ int main(int argc, char** argv) {
         const Model& mm = sim.model();
         bool bad = false;
         for (long k = 0; k < steps; ++k) {
-          for (const WireLanes& p : mm.wire_packs) {
+          for (const WireLanes& p : packs_of(mm)) {
             PackSweep a;
             a.pack = &p;
             a.lo = 0;
@@ -258,18 +259,18 @@ int main(int argc, char** argv) {
               a.ww_hi[l] = mm.wires[p.wire[l]].d_ww[p.nodes - 1];
               a.u[l] = s.u.data() + w0;
               a.v[l] = s.v.data() + w0;
-              a.u_next[l] = s.u_next.data() + w0;
-              a.v_next[l] = s.v_next.data() + w0;
+              a.u_next[l] = s.work->u_next.data() + w0;
+              a.v_next[l] = s.work->v_next.data() + w0;
               a.accel[l] = s.accel.data() + w0;
             }
-            a.record = s.sweep.data() + kSweepRecord * p.offset;
+            a.record = s.work->sweep.data() + kSweepRecord * p.offset;
             a.beta = mm.beta;
             a.dt = mm.dt;
             a.limit = mm.scene.numerics.divergence_limit;
             bad |= sweep_pack(a);
           }
-          s.u.swap(s.u_next);
-          s.v.swap(s.v_next);
+          s.u.swap(s.work->u_next);
+          s.v.swap(s.work->v_next);
         }
         flagged += bad;
       } else {

@@ -1154,7 +1154,7 @@ int expect_fused_is_generic(const std::vector<std::string>& overrides, int* wind
     ADD_FAILURE() << "no fused lateral step";
     return 0;
   }
-  EXPECT_EQ(a.model().wire_packs[0].lanes, 2);  // contact wire and messenger side by side
+  EXPECT_EQ(wire_pack_lanes(a.model(), 0), 2);  // contact wire and messenger side by side
   Model generic = a.model();
   auto lat = std::make_shared<LateralModel>(*generic.lateral);
   lat->planes.clear();

@@ -1,5 +1,6 @@
 #include "engine/centred_damping.hpp"
 
+#include "engine/step_workspace.hpp"
 #include "engine/wire_lanes.hpp"
 
 #include <cmath>
@@ -233,13 +234,13 @@ CATENARY_SIM_CLONES bool centred_sweep_pack(const Model& m, const WireLanes& pac
     const int d = m.wires[pack.wire[k]].w_dof;
     u[k] = s.u.data() + d;
     v[k] = s.v.data() + d;
-    f[k] = s.force.data() + d;
-    un[k] = s.u_next.data() + d;
-    vn[k] = s.v_next.data() + d;
+    f[k] = s.work->force.data() + d;
+    un[k] = s.work->u_next.data() + d;
+    vn[k] = s.work->v_next.data() + d;
     acc[k] = s.accel.data() + d;
   }
-  const CentredArgs args{u, v, f, un, vn, acc, m.dt, m.centred_v_ratio, 2.0 / m.beta, m.scene.numerics.divergence_limit};
-  double* rec = s.sweep.data() + kSweepRecord * pack.offset;
+  const CentredArgs args{u, v, f, un, vn, acc, m.dt, m.wire_packs->centred_v_ratio, 2.0 / m.beta, m.scene.numerics.divergence_limit};
+  double* rec = s.work->sweep.data() + kSweepRecord * pack.offset;
   return pack.lanes == 2 ? sweep<2>(pack, args, rec) : sweep<1>(pack, args, rec);
 }
 

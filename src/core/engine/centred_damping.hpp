@@ -13,6 +13,7 @@
 #include "catenary_sim/core/model/model.hpp"
 #include "model/centred_factors.hpp"
 #include "catenary_sim/core/engine/state.hpp"
+#include "model/wire_packs.hpp"
 
 namespace catenary_sim {
 

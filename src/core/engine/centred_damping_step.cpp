@@ -6,6 +6,7 @@
 
 #include "engine/centred_damping.hpp"
 #include "engine/forces.hpp"
+#include "engine/step_workspace.hpp"
 #include "engine/train_motion.hpp"
 #include "engine/wire_lanes.hpp"
 
@@ -28,8 +29,8 @@ void clear_point_forces(const Model& m, State& s, double* f) {
       const double xc = s.front - p.position + m.collectors[ci].offset;
       for (int wi : m.contact_wires) {
         const Wire& w = m.wires[wi];
-        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
-        for (int a = 0; a < cnt; ++a) f[w.w_dof + s.weight_node[a]] = load[w.w_dof + s.weight_node[a]];
+        const int cnt = contact_weights(w, m.rub_length, xc, s.work->weight_node.data(), s.work->weight.data());
+        for (int a = 0; a < cnt; ++a) f[w.w_dof + s.work->weight_node[a]] = load[w.w_dof + s.work->weight_node[a]];
       }
     }
 }
@@ -40,7 +41,7 @@ StepStatus centred_damping_step(const Model& m, State& s) {
   const int n = m.n_dof, nc = m.n_catenary_dof;
   double* u = s.u.data();
   double* v = s.v.data();
-  double* f = s.force.data();
+  double* f = s.work->force.data();
   double* acc = s.accel.data();
   const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
   // The wires' entries of f hold the load here (make_state, clear_point_forces); the point forces
@@ -50,11 +51,11 @@ StepStatus centred_damping_step(const Model& m, State& s) {
   if (leaning(m, s)) add_wire_point_forces<true>(m, s, u, v, force_at, z_at, false);
   else add_wire_point_forces<false>(m, s, u, v, force_at, z_at, false);
   add_pantograph_forces(m, s, u, v, f);
-  for (int d : m.centred_fixed_dofs) f[d] = 0.0;  // a fixed node's row is zeta = u (a contact may reach it; load 0)
-  double* un = s.u_next.data();
-  double* vn = s.v_next.data();
+  for (int d : m.wire_packs->centred_fixed_dofs) f[d] = 0.0;  // a fixed node's row is zeta = u (a contact may reach it; load 0)
+  double* un = s.work->u_next.data();
+  double* vn = s.work->v_next.data();
   bool out = false;
-  for (const WireLanes& p : m.wire_packs) out |= centred_sweep_pack(m, p, s);
+  for (const WireLanes& p : packs_of(m)) out |= centred_sweep_pack(m, p, s);
   clear_point_forces(m, s, f);
   const double* im = m.inv_mass.data();
   for (int i = nc; i < n; ++i) {
@@ -72,8 +73,8 @@ StepStatus centred_damping_step(const Model& m, State& s) {
       }
     return s.status;
   }
-  s.u.swap(s.u_next);
-  s.v.swap(s.v_next);
+  s.u.swap(s.work->u_next);
+  s.v.swap(s.work->v_next);
   advance_train(m, s, dt);
   return s.status;
 }

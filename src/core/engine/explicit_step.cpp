@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "engine/forces.hpp"
+#include "engine/step_workspace.hpp"
 #include "engine/train_motion.hpp"
 #include "engine/window.hpp"
 #include "engine/wire_lanes.hpp"
@@ -23,7 +24,7 @@ bool packs_take_window(const Model& m, const State& s, bool windowed) {
   if (!windowed) return true;
   for (const WireWindow& ww : s.window)
     if (ww.hi == ww.lo) return false;
-  for (const WireLanes& p : m.wire_packs)
+  for (const WireLanes& p : packs_of(m))
     if (p.lanes == 2 && (s.window[p.wire[0]].lo != s.window[p.wire[1]].lo || s.window[p.wire[0]].hi != s.window[p.wire[1]].hi))
       return false;
   return true;
@@ -34,8 +35,8 @@ bool packs_take_window(const Model& m, const State& s, bool windowed) {
 bool sweep_packs(const Model& m, State& s, bool windowed) {
   const double* u = s.u.data();
   const double* v = s.v.data();
-  double* un = s.u_next.data();
-  double* vn = s.v_next.data();
+  double* un = s.work->u_next.data();
+  double* vn = s.work->v_next.data();
   double* acc = s.accel.data();
   const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
   bool outside = false;
@@ -43,9 +44,9 @@ bool sweep_packs(const Model& m, State& s, bool windowed) {
   // joint layout (LateralState::sweep, joint_record_index).
   const bool join = m.lateral && s.lateral.join;
   bool lateral_outside = false;
-  for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
+  for (std::size_t pk = 0; pk < m.wire_packs->packs.size(); ++pk) {
     PackSweep a, b;
-    if (!setup_pack_sweep(m.wire_packs[pk], m.wires, windowed ? &s.window : nullptr, s.sweep_factors.data(), s.sweep.data(), u, v,
+    if (!setup_pack_sweep(m.wire_packs->packs[pk], m.wires, windowed ? &s.window : nullptr, s.work->sweep_factors.data(), s.work->sweep.data(), u, v,
                           un, vn, acc, a))
       continue;
     a.beta = beta;
@@ -53,7 +54,7 @@ bool sweep_packs(const Model& m, State& s, bool windowed) {
     a.limit = limit;
     if (join && setup_lateral_sweep(m, s, pk, false, b)) {
       bool b_outside = false;
-      outside |= sweep_pack_pair(a, b, s.lateral.sweep.data() + 2 * kSweepRecord * m.wire_packs[pk].offset, &b_outside);
+      outside |= sweep_pack_pair(a, b, s.lateral.sweep.data() + 2 * kSweepRecord * m.wire_packs->packs[pk].offset, &b_outside);
       lateral_outside |= b_outside;
     } else {
       outside |= sweep_pack(a);
@@ -68,11 +69,11 @@ bool sweep_packs(const Model& m, State& s, bool windowed) {
 }
 
 // The nodes with point forces: the contact wire's nodes under every collector (contact_forces'
-// weights), listed once per step into State::point_node; returns how many. A node may come more
+// weights), listed once per step into StepWorkspace::point_node; returns how many. A node may come more
 // than once.
 int list_contact_nodes(const Model& m, State& s, bool windowed) {
   int contacts = 0;
-  int* contact_node = s.point_node.data();
+  int* contact_node = s.work->point_node.data();
   for (const Pantograph& p : m.pantographs)
     for (int ci : p.collectors) {
       const double xc = s.front - p.position + m.collectors[ci].offset;
@@ -126,7 +127,7 @@ void for_each_point(const Model& m, const State& s, bool windowed, Fn&& fn) {
 // The index of the last new displacement beyond the divergence limit (or not a number), scanned
 // in the generic step's order; -1 if none.
 int last_beyond(const Model& m, const State& s, bool windowed) {
-  const double* un = s.u_next.data();
+  const double* un = s.work->u_next.data();
   const double limit = m.scene.numerics.divergence_limit;
   auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
   int bad = -1;
@@ -153,21 +154,21 @@ int last_beyond(const Model& m, const State& s, bool windowed) {
 int explicit_fused_update(const Model& m, State& s, bool windowed) {
   const double* u = s.u.data();
   const double* v = s.v.data();
-  double* un = s.u_next.data();
-  double* vn = s.v_next.data();
+  double* un = s.work->u_next.data();
+  double* vn = s.work->v_next.data();
   double* acc = s.accel.data();
-  double* f = s.force.data();
+  double* f = s.work->force.data();
   const double dt = m.dt, limit = m.scene.numerics.divergence_limit;
   bool outside = sweep_packs(m, s, windowed);
   const bool join = m.lateral && s.lateral.join;
   const int contacts = list_contact_nodes(m, s, windowed);
-  const int* contact_node = s.point_node.data();
+  const int* contact_node = s.work->point_node.data();
   // Supports, droppers and the window's dashpots act straight on the band forces the sweep left in
   // its records (where z is too), in the generic step's order; the contact nodes then take their
   // force so far into the force vector, where the pantographs' contact adds to it.
-  double* rec = join ? s.lateral.sweep.data() : s.sweep.data();
-  const int* f_at = m.dof_sweep_force.data();
-  const int* z_at = m.dof_sweep_z.data();
+  double* rec = join ? s.lateral.sweep.data() : s.work->sweep.data();
+  const int* f_at = m.wire_packs->dof_sweep_force.data();
+  const int* z_at = m.wire_packs->dof_sweep_z.data();
   const int joint = join;
   auto force_at = [rec, f_at, joint](int i) -> double& { return rec[joint_record_index(f_at[i], joint, false)]; };
   auto z_rec = [rec, z_at, joint](int i) { return rec[joint_record_index(z_at[i], joint, false)]; };
@@ -218,10 +219,10 @@ StepStatus fused_step(const Model& m, State& s, bool windowed) {
   const int bad = explicit_fused_update(m, s, windowed);
   if (bad >= 0) return diverged(s, bad);
   if (windowed) {
-    commit_window(m, s, s.u_next.data(), s.v_next.data());
+    commit_window(m, s, s.work->u_next.data(), s.work->v_next.data());
   } else {
-    s.u.swap(s.u_next);  // O(1): every DOF has its new value
-    s.v.swap(s.v_next);
+    s.u.swap(s.work->u_next);  // O(1): every DOF has its new value
+    s.v.swap(s.work->v_next);
   }
   advance_train(m, s, m.dt);
   return s.status;
@@ -233,8 +234,8 @@ StepStatus generic_step(const Model& m, State& s, bool windowed) {
   const double dt = m.dt;
   double* u = s.u.data();
   double* v = s.v.data();
-  double* f = s.force.data();
-  double* z = s.z.data();
+  double* f = s.work->force.data();
+  double* z = s.work->z.data();
   double* acc = s.accel.data();
   const double limit = m.scene.numerics.divergence_limit;
   int bad = -1;
@@ -270,8 +271,8 @@ StepStatus generic_step(const Model& m, State& s, bool windowed) {
   if (windowed) {
     commit_window(m, s, u_new, v_new);
   } else {
-    s.v.swap(s.force);  // O(1): swaps the buffers, no copy, no allocation
-    s.u.swap(s.z);
+    s.v.swap(s.work->force);  // O(1): swaps the buffers, no copy, no allocation
+    s.u.swap(s.work->z);
   }
   advance_train(m, s, dt);
   return s.status;
@@ -283,7 +284,7 @@ StepStatus explicit_step(const Model& m, State& s) {
   const bool windowed = m.scene.numerics.windowed();
   if (m.endless) shift_endless_block(m, s);
   if (windowed) update_window(m, s);
-  if (!m.wire_packs.empty() && packs_take_window(m, s, windowed)) return fused_step(m, s, windowed);
+  if (m.wire_packs && packs_take_window(m, s, windowed)) return fused_step(m, s, windowed);
   return generic_step(m, s, windowed);
 }
 

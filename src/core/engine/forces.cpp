@@ -5,6 +5,7 @@
 
 #include <limits>
 
+#include "engine/step_workspace.hpp"
 #include "engine/window.hpp"
 
 namespace catenary_sim {
@@ -24,9 +25,9 @@ void contact_forces(const Model& m, State& s, const double* u, double* f) {
       double lowest = std::numeric_limits<double>::infinity();
       for (std::size_t wk = 0; wk < nw; ++wk) {
         const Wire& w = m.wires[m.contact_wires[wk]];
-        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
+        const int cnt = contact_weights(w, m.rub_length, xc, s.work->weight_node.data(), s.work->weight.data());
         double yw = 0.0;
-        for (int a = 0; a < cnt; ++a) yw += s.weight[a] * (w.height[s.weight_node[a]] + u[w.w_dof + s.weight_node[a]]);
+        for (int a = 0; a < cnt; ++a) yw += s.work->weight[a] * (w.height[s.work->weight_node[a]] + u[w.w_dof + s.work->weight_node[a]]);
         s.collector_height[ci * nw + wk] = cnt ? yw : std::nan("");
         if (cnt) lowest = std::min(lowest, yw);
       }
@@ -47,9 +48,9 @@ void contact_forces(const Model& m, State& s, const double* u, double* f) {
         s.contact_force[idx] = fc;
         if (fc == 0.0 || !f) continue;
         const Wire& w = m.wires[m.contact_wires[wk]];
-        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
+        const int cnt = contact_weights(w, m.rub_length, xc, s.work->weight_node.data(), s.work->weight.data());
         if (!p.moving_force) f[col.dof] -= fc;
-        for (int a = 0; a < cnt; ++a) f[w.w_dof + s.weight_node[a]] += fc * s.weight[a];
+        for (int a = 0; a < cnt; ++a) f[w.w_dof + s.work->weight_node[a]] += fc * s.work->weight[a];
       }
     }
   }
@@ -110,10 +111,10 @@ void assemble_force(const Model& m, State& s, const double* u, const double* v, 
       const Wire& w = m.wires[wi];
       init(w.w_dof + ww.lo, w.w_dof + ww.hi + 1);
     }
-    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) wire_elastic_force_window(m.wires[wi], s.window[wi], z, f, s.theta.data());
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) wire_elastic_force_window(m.wires[wi], s.window[wi], z, f, s.work->theta.data());
   } else {
     init(0, nc);
-    for (const Wire& w : m.wires) wire_elastic_force(w, z, f, s.theta.data());
+    for (const Wire& w : m.wires) wire_elastic_force(w, z, f, s.work->theta.data());
   }
   add_point_forces(m, s, u, v, z, f, given_slack);
 }

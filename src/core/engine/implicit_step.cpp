@@ -12,9 +12,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "catenary_sim/core/model/newmark_matrix.hpp"
 #include "engine/forces.hpp"
+#include "engine/step_workspace.hpp"
 #include "engine/train_motion.hpp"
+#include "model/newmark_matrix.hpp"
 
 namespace catenary_sim {
 
@@ -38,23 +39,23 @@ int contact_corrections(const Model& m, State& s) {
         if (!(s.contact_force[ci * nw + wk] > 0.0)) continue;
         const Wire& w = m.wires[m.contact_wires[wk]];
         const double xc = s.front - p.position + m.collectors[ci].offset;
-        const int cnt = contact_weights(w, m.rub_length, xc, s.weight_node.data(), s.weight.data());
-        double* y = s.contact_solve.data() + static_cast<std::size_t>(active) * n;
+        const int cnt = contact_weights(w, m.rub_length, xc, s.work->weight_node.data(), s.work->weight.data());
+        double* y = s.work->contact_solve.data() + static_cast<std::size_t>(active) * n;
         std::fill(y, y + n, 0.0);
-        int* gi = s.correction_g_index.data() + active * stride;
-        double* gv = s.correction_g_value.data() + active * stride;
+        int* gi = s.work->correction_g_index.data() + active * stride;
+        double* gv = s.work->correction_g_value.data() + active * stride;
         gi[0] = m.collectors[ci].dof;
         gv[0] = 1.0;
         for (int a = 0; a < cnt; ++a) {
-          gi[a + 1] = w.w_dof + s.weight_node[a];
-          gv[a + 1] = -s.weight[a];
+          gi[a + 1] = w.w_dof + s.work->weight_node[a];
+          gv[a + 1] = -s.work->weight[a];
         }
-        s.correction_g_count[active] = cnt + 1;
-        s.correction_factor[active] = 0.25 * m.dt * m.dt * m.contact_stiffness;
+        s.work->correction_g_count[active] = cnt + 1;
+        s.work->correction_factor[active] = 0.25 * m.dt * m.dt * m.contact_stiffness;
         for (int a = 0; a <= cnt; ++a)
           if (im[gi[a]] != 0.0) y[gi[a]] += gv[a];
-        newmark_solve(*m.implicit, y, s.solve_tmp.data());  // y = A^-1 g
-        s.correction_solve[active] = y;
+        newmark_solve(*m.implicit, y, s.work->solve_tmp.data());  // y = A^-1 g
+        s.work->correction_solve[active] = y;
         ++active;
       }
   }
@@ -67,23 +68,23 @@ int contact_corrections(const Model& m, State& s) {
 bool slack_dropper_correction(const Model& m, State& s, int k, int index) {
   const int n = m.n_dof, stride = m.max_contact_nodes + 1;
   const Dropper& d = m.droppers[k];
-  int slot = s.dropper_slot[k];
+  int slot = s.work->dropper_slot[k];
   if (slot < 0) {
-    for (std::size_t j = 0; j < s.slot_dropper.size(); ++j)
-      if (s.slot_used[j] < s.steps && (slot < 0 || s.slot_used[j] < s.slot_used[slot])) slot = static_cast<int>(j);
+    for (std::size_t j = 0; j < s.work->slot_dropper.size(); ++j)
+      if (s.work->slot_used[j] < s.steps && (slot < 0 || s.work->slot_used[j] < s.work->slot_used[slot])) slot = static_cast<int>(j);
     if (slot < 0) return false;
-    if (s.slot_dropper[slot] >= 0) s.dropper_slot[s.slot_dropper[slot]] = -1;
-    s.slot_dropper[slot] = k;
-    s.dropper_slot[k] = slot;
-    double* y = s.dropper_solve.data() + static_cast<std::size_t>(slot) * n;
+    if (s.work->slot_dropper[slot] >= 0) s.work->dropper_slot[s.work->slot_dropper[slot]] = -1;
+    s.work->slot_dropper[slot] = k;
+    s.work->dropper_slot[k] = slot;
+    double* y = s.work->dropper_solve.data() + static_cast<std::size_t>(slot) * n;
     std::fill(y, y + n, 0.0);
     if (m.inv_mass[d.messenger_dof] != 0.0) y[d.messenger_dof] = 1.0;
     if (m.inv_mass[d.contact_dof] != 0.0) y[d.contact_dof] = -1.0;
-    newmark_solve(*m.implicit, y, s.solve_tmp.data());
+    newmark_solve(*m.implicit, y, s.work->solve_tmp.data());
   }
-  s.slot_used[slot] = s.steps;
-  int* gi = s.correction_g_index.data() + index * stride;
-  double* gv = s.correction_g_value.data() + index * stride;
+  s.work->slot_used[slot] = s.steps;
+  int* gi = s.work->correction_g_index.data() + index * stride;
+  double* gv = s.work->correction_g_value.data() + index * stride;
   int cnt = 0;
   if (m.inv_mass[d.messenger_dof] != 0.0) {
     gi[cnt] = d.messenger_dof;
@@ -93,9 +94,9 @@ bool slack_dropper_correction(const Model& m, State& s, int k, int index) {
     gi[cnt] = d.contact_dof;
     gv[cnt++] = -1.0;
   }
-  s.correction_g_count[index] = cnt;
-  s.correction_factor[index] = -(0.25 * m.dt * m.dt + 0.5 * m.dt * m.beta) * d.stiffness;
-  s.correction_solve[index] = s.dropper_solve.data() + static_cast<std::size_t>(slot) * n;
+  s.work->correction_g_count[index] = cnt;
+  s.work->correction_factor[index] = -(0.25 * m.dt * m.dt + 0.5 * m.dt * m.beta) * d.stiffness;
+  s.work->correction_solve[index] = s.work->dropper_solve.data() + static_cast<std::size_t>(slot) * n;
   return true;
 }
 
@@ -105,18 +106,18 @@ bool slack_dropper_correction(const Model& m, State& s, int k, int index) {
 // `stride`: entries reserved per correction's g (Model::max_contact_nodes + 1).
 void woodbury(State& s, int count, int n, int stride, double* x) {
   if (count == 0) return;
-  double* sm = s.correction_small.data();
+  double* sm = s.work->correction_small.data();
   double* rhs = sm + count * count;
   auto g_dot = [&](int i, const double* y) {
-    const int* gi = s.correction_g_index.data() + i * stride;
-    const double* gv = s.correction_g_value.data() + i * stride;
+    const int* gi = s.work->correction_g_index.data() + i * stride;
+    const double* gv = s.work->correction_g_value.data() + i * stride;
     double r = 0.0;
-    for (int a = 0; a < s.correction_g_count[i]; ++a) r += gv[a] * y[gi[a]];
+    for (int a = 0; a < s.work->correction_g_count[i]; ++a) r += gv[a] * y[gi[a]];
     return r;
   };
   for (int i = 0; i < count; ++i) {
     rhs[i] = g_dot(i, x);
-    for (int j = 0; j < count; ++j) sm[i * count + j] = g_dot(i, s.correction_solve[j]) + (i == j ? 1.0 / s.correction_factor[i] : 0.0);
+    for (int j = 0; j < count; ++j) sm[i * count + j] = g_dot(i, s.work->correction_solve[j]) + (i == j ? 1.0 / s.work->correction_factor[i] : 0.0);
   }
   for (int k = 0; k < count; ++k) {
     int p = k;
@@ -138,7 +139,7 @@ void woodbury(State& s, int count, int n, int stride, double* x) {
     rhs[i] = r / sm[i * count + i];
   }
   for (int j = 0; j < count; ++j) {
-    const double* y = s.correction_solve[j];
+    const double* y = s.work->correction_solve[j];
     const double cj = rhs[j];
     for (int i = 0; i < n; ++i) x[i] -= y[i] * cj;
   }
@@ -151,12 +152,12 @@ void woodbury(State& s, int count, int n, int stride, double* x) {
 bool solve_active_set(const Model& m, State& s) {
   const int n = m.n_dof;
   const double dt = m.dt, b = kNewmarkBeta;
-  double* f = s.force.data();
-  double* z = s.z.data();
-  const double* up = s.u_pred.data();
-  const double* vp = s.v_pred.data();
+  double* f = s.work->force.data();
+  double* z = s.work->z.data();
+  const double* up = s.work->u_pred.data();
+  const double* vp = s.work->v_pred.data();
   const double* im = m.inv_mass.data();
-  double* tmp = s.solve_tmp.data();
+  double* tmp = s.work->solve_tmp.data();
   const double bdt2 = b * dt * dt;
   int contacts = 0;
   for (int iteration = 0;; ++iteration) {
@@ -201,8 +202,8 @@ StepStatus implicit_step(const Model& m, State& s) {
   const double dt = m.dt;
   double* u = s.u.data();
   double* v = s.v.data();
-  double* f = s.force.data();
-  double* z = s.z.data();
+  double* f = s.work->force.data();
+  double* z = s.work->z.data();
   double* acc = s.accel.data();
   const double limit = m.scene.numerics.divergence_limit;
   int bad = -1;
@@ -212,8 +213,8 @@ StepStatus implicit_step(const Model& m, State& s) {
   // k0 V dt F / (2T), several newtons at 300 km/h and 1 ms).
   const double front_n = s.front;
   s.front = front_n + next_speed(s, dt) * dt;
-  double* up = s.u_pred.data();
-  double* vp = s.v_pred.data();
+  double* up = s.work->u_pred.data();
+  double* vp = s.work->v_pred.data();
   for (int i = 0; i < n; ++i) {
     up[i] = u[i] + dt * v[i] + dt * dt * (0.5 - b) * acc[i];
     vp[i] = v[i] + dt * (1.0 - g) * acc[i];
@@ -226,7 +227,7 @@ StepStatus implicit_step(const Model& m, State& s) {
     return s.status;
   }
   double* u_new = z;
-  double* v_new = s.solve_tmp.data();
+  double* v_new = s.work->solve_tmp.data();
   for (int i = 0; i < n; ++i) {
     const double un = up[i] + b * dt * dt * f[i];
     if (!(std::fabs(un) <= limit)) bad = i;
@@ -243,8 +244,8 @@ StepStatus implicit_step(const Model& m, State& s) {
     s.diverged_dof = bad;
     return s.status;
   }
-  s.v.swap(s.force);  // O(1): swaps the buffers, no copy, no allocation
-  s.u.swap(s.z);
+  s.v.swap(s.work->force);  // O(1): swaps the buffers, no copy, no allocation
+  s.u.swap(s.work->z);
   advance_train(m, s, dt);
   return s.status;
 }

@@ -10,6 +10,7 @@
 #include "catenary_sim/core/engine/state.hpp"
 #include "engine/lateral_window.hpp"
 #include "engine/lateral_wind.hpp"
+#include "engine/step_workspace.hpp"
 #include "engine/window.hpp"
 #include "engine/wire_lanes.hpp"
 
@@ -39,7 +40,7 @@ LateralState make_lateral_state(const Model& m) {
   s.y_next = s.y;
   s.v_next = Eigen::VectorXd::Zero(lat.n);
   s.accel = Eigen::VectorXd::Zero(lat.n);
-  s.sweep.assign(2 * kSweepRecord * m.sweep_size, 0.0);  // (both planes' records when joint)
+  s.sweep.assign(2 * kSweepRecord * sweep_size(m), 0.0);  // (both planes' records when joint)
   int longest = 0;
   for (const Wire& w : lat.wires) longest = std::max(longest, w.nodes());
   s.theta.assign(longest, 0.0);
@@ -61,7 +62,7 @@ LateralState make_lateral_state(const Model& m) {
     s.window[wi].tt_lower.assign(lat.wires[wi].nodes(), 0.0);
     s.window[wi].tt_inv_pivot.assign(lat.wires[wi].nodes(), 0.0);
   }
-  if (lat.windowed && !lat.planes.empty()) s.sweep_factors.assign(2 * m.sweep_size, 0.0);
+  if (lat.windowed && !lat.planes.empty()) s.sweep_factors.assign(2 * sweep_size(m), 0.0);
   s.window_springs.assign(lat.springs.size(), 0);
   s.window_droppers.assign(lat.pendulums.size(), 0);
   s.cut_node.assign(2 * kCutLayer * m.wires.size(), 0);
@@ -123,23 +124,6 @@ void lateral_observe(const Model& m, State& s) {
   if (m.lateral) contact_points(m, s, false);
 }
 
-bool setup_lateral_sweep(const Model& m, State& s, std::size_t pack, bool windowed, PackSweep& a) {
-  const LateralModel& lat = *m.lateral;
-  LateralState& ls = s.lateral;
-  const WireLanes& p = m.wire_packs[pack];
-  if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, ls.sweep_factors.data(), s.sweep.data(), ls.y.data(),
-                        ls.v.data(), ls.y_next.data(), ls.v_next.data(), ls.accel.data(), a))
-    return false;
-  // (the records in the vertical step's scratch, State::sweep; sweep_pack_pair puts them elsewhere)
-  a.plane = lat.planes[pack].data();
-  // The wind's drag is taken in the sweep (PackSweep::wind), on the velocity it reads anyway.
-  for (int k = 0; k < p.lanes; ++k) a.wind[k] = lat.windy ? ls.wind_speed.data() + lat.wires[p.wire[k]].w_dof : nullptr;
-  a.beta = m.beta;
-  a.dt = lat.dt;
-  a.limit = m.scene.numerics.divergence_limit;
-  return true;
-}
-
 namespace {
 
 // The springs (steady arms, messenger supports) and the droppers' pendulums on f, at
@@ -194,14 +178,14 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
   const int joined = ls.joined;  // (its records then in the joint layout: joint_record_index)
   bool outside = joined && ls.joined_outside;
   if (!joined)
-    for (std::size_t pk = 0; pk < m.wire_packs.size(); ++pk) {
+    for (std::size_t pk = 0; pk < packs_of(m).size(); ++pk) {
       PackSweep a;
       if (setup_lateral_sweep(m, s, pk, windowed, a)) outside |= sweep_pack(a);
     }
   ls.joined = false;
   // Point forces on the band forces the sweep left in its records, as the generic step adds them.
   double* f = ls.f.data();
-  const double* rec = joined ? ls.sweep.data() : s.sweep.data();
+  const double* rec = joined ? ls.sweep.data() : s.work->sweep.data();
   const int* at = lat.sweep_force_at.data();
   const int* points = windowed ? ls.window_points.data() : lat.point_nodes.data();
   const int np = windowed ? ls.window_point_count : static_cast<int>(lat.point_nodes.size());

@@ -115,10 +115,10 @@ void sync_window(const Model& m, State& s) {
   ls.window_fused = !lat.planes.empty();
   const double xa = first >= 0 ? sx[first] : 0.0, xb = first >= 0 ? sx[last] : -1.0;
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) move_wire_window(m, s, wi, first, xa, xb, turbulent);
-  for (const WireLanes& p : m.wire_packs)
+  for (const WireLanes& p : packs_of(m))
     if (p.lanes == 2 && (ls.window[p.wire[0]].lo != ls.window[p.wire[1]].lo || ls.window[p.wire[0]].hi != ls.window[p.wire[1]].hi))
       ls.window_fused = false;
-  if (ls.window_fused) interleave_window_factors(m.wire_packs, ls.window, ls.sweep_factors.data());
+  if (ls.window_fused) interleave_window_factors(packs_of(m), ls.window, ls.sweep_factors.data());
   list_window_points(m, s, first, xa, xb);
 }
 

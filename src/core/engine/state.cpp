@@ -5,52 +5,69 @@
 #include <cmath>
 
 #include "engine/forces.hpp"
+#include "engine/step_workspace.hpp"
 #include "engine/wire_lanes.hpp"
 
 namespace catenary_sim {
+
+StepWorkspaceHandle::StepWorkspaceHandle() : work_(std::make_unique<StepWorkspace>()) {}
+StepWorkspaceHandle::StepWorkspaceHandle(const StepWorkspaceHandle& other)
+    : work_(other.work_ ? std::make_unique<StepWorkspace>(*other.work_) : nullptr) {}
+StepWorkspaceHandle::StepWorkspaceHandle(StepWorkspaceHandle&& other) noexcept = default;
+// Into an existing workspace: its buffers keep their storage when the sizes match (a skin
+// restoring a snapshot of the same model allocates nothing).
+StepWorkspaceHandle& StepWorkspaceHandle::operator=(const StepWorkspaceHandle& other) {
+  if (this == &other) return *this;
+  if (!other.work_) work_.reset();
+  else if (work_) *work_ = *other.work_;
+  else work_ = std::make_unique<StepWorkspace>(*other.work_);
+  return *this;
+}
+StepWorkspaceHandle& StepWorkspaceHandle::operator=(StepWorkspaceHandle&& other) noexcept = default;
+StepWorkspaceHandle::~StepWorkspaceHandle() = default;
 
 State make_state(const Model& m) {
   State s;
   s.u = Eigen::VectorXd::Zero(m.n_dof);
   s.v = Eigen::VectorXd::Zero(m.n_dof);
-  s.force = Eigen::VectorXd::Zero(m.n_dof);
+  s.work->force = Eigen::VectorXd::Zero(m.n_dof);
   s.accel = Eigen::VectorXd::Zero(m.n_dof);
   if (m.implicit) {
-    s.u_pred = Eigen::VectorXd::Zero(m.n_dof);
-    s.v_pred = Eigen::VectorXd::Zero(m.n_dof);
-    s.solve_tmp = Eigen::VectorXd::Zero(m.n_dof);
+    s.work->u_pred = Eigen::VectorXd::Zero(m.n_dof);
+    s.work->v_pred = Eigen::VectorXd::Zero(m.n_dof);
+    s.work->solve_tmp = Eigen::VectorXd::Zero(m.n_dof);
     const std::size_t contacts = m.collectors.size() * m.contact_wires.size();
     const std::size_t slots = std::min<std::size_t>(m.droppers.size(), kSlackDropperCapacity);
     const std::size_t corrections = contacts + slots, stride = m.max_contact_nodes + 1;
-    s.contact_solve.assign(contacts * m.n_dof, 0.0);
-    s.dropper_solve.assign(slots * m.n_dof, 0.0);
-    s.dropper_slot.assign(m.droppers.size(), -1);
-    s.slot_dropper.assign(slots, -1);
-    s.slot_used.assign(slots, -1);
-    s.correction_g_index.assign(corrections * stride, 0);
-    s.correction_g_value.assign(corrections * stride, 0.0);
-    s.correction_g_count.assign(corrections, 0);
-    s.correction_factor.assign(corrections, 0.0);
-    s.correction_solve.assign(corrections, nullptr);
-    s.correction_small.assign(corrections * corrections + corrections, 0.0);
+    s.work->contact_solve.assign(contacts * m.n_dof, 0.0);
+    s.work->dropper_solve.assign(slots * m.n_dof, 0.0);
+    s.work->dropper_slot.assign(m.droppers.size(), -1);
+    s.work->slot_dropper.assign(slots, -1);
+    s.work->slot_used.assign(slots, -1);
+    s.work->correction_g_index.assign(corrections * stride, 0);
+    s.work->correction_g_value.assign(corrections * stride, 0.0);
+    s.work->correction_g_count.assign(corrections, 0);
+    s.work->correction_factor.assign(corrections, 0.0);
+    s.work->correction_solve.assign(corrections, nullptr);
+    s.work->correction_small.assign(corrections * corrections + corrections, 0.0);
   }
-  s.z = Eigen::VectorXd::Zero(m.n_dof);
+  s.work->z = Eigen::VectorXd::Zero(m.n_dof);
   // The centred damping step keeps the load in the wires' force entries (clear_point_forces).
-  if (m.scene.numerics.damping == DampingStep::kCentred) s.force.head(m.n_catenary_dof) = m.load.head(m.n_catenary_dof);
-  if (!m.wire_packs.empty() || m.scene.numerics.damping == DampingStep::kCentred) {
-    s.u_next = Eigen::VectorXd::Zero(m.n_dof);
-    s.v_next = Eigen::VectorXd::Zero(m.n_dof);
-    s.sweep.assign(kSweepRecord * m.sweep_size, 0.0);
-    s.point_node.assign(m.collectors.size() * m.contact_wires.size() * m.max_contact_nodes, 0);
+  if (m.scene.numerics.damping == DampingStep::kCentred) s.work->force.head(m.n_catenary_dof) = m.load.head(m.n_catenary_dof);
+  if (m.wire_packs || m.scene.numerics.damping == DampingStep::kCentred) {
+    s.work->u_next = Eigen::VectorXd::Zero(m.n_dof);
+    s.work->v_next = Eigen::VectorXd::Zero(m.n_dof);
+    s.work->sweep.assign(kSweepRecord * sweep_size(m), 0.0);
+    s.work->point_node.assign(m.collectors.size() * m.contact_wires.size() * m.max_contact_nodes, 0);
     if (m.scene.numerics.windowed()) {
-      s.sweep_factors.assign(2 * m.sweep_size, 0.0);
+      s.work->sweep_factors.assign(2 * sweep_size(m), 0.0);
     }
   }
   int max_nodes = 1;
   for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
-  s.theta.assign(max_nodes, 0.0);
-  s.weight_node.assign(m.max_contact_nodes, 0);
-  s.weight.assign(m.max_contact_nodes, 0.0);
+  s.work->theta.assign(max_nodes, 0.0);
+  s.work->weight_node.assign(m.max_contact_nodes, 0);
+  s.work->weight.assign(m.max_contact_nodes, 0.0);
   s.contact_force.assign(m.collectors.size() * m.contact_wires.size(), 0.0);
   s.collector_height.assign(m.collectors.size() * m.contact_wires.size(), 0.0);
   s.dropper_slack.assign(m.droppers.size(), 0);

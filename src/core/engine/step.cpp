@@ -39,7 +39,7 @@ StepStatus step_both_planes(const Model& m, State& s) {
   // Both planes sweep every node of the same packs: no window, one lateral step a vertical one,
   // both fused, and the step will be taken (not the pass's end).
   bool two_wire_packs = true;  // (sweep_pack_pair's four lanes)
-  for (const WireLanes& p : m.wire_packs) two_wire_packs &= p.lanes == 2;
+  for (const WireLanes& p : packs_of(m)) two_wire_packs &= p.lanes == 2;
   ls.join = !lat.planes.empty() && two_wire_packs && lat.substeps == 1 && !m.scene.numerics.windowed() &&
             s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty();
   // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
@@ -56,6 +56,19 @@ StepStatus step_both_planes(const Model& m, State& s) {
 }
 
 }  // namespace
+
+// GCC's resolver takes the clone (engine/wire_lanes.cpp) of the highest priority the CPU supports:
+// x86-64-v4 (AVX-512 with VL, BW, DQ, CD) over x86-64-v3 (AVX2) over the baseline; this asks the
+// same question. The benchmark prints it beside the figures; gdb on sweep_pack shows the clone
+// taken (BENCHMARKS.md).
+const char* sweep_pack_isa() {
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("x86-64-v4")) return "x86-64-v4";
+  if (__builtin_cpu_supports("x86-64-v3")) return "x86-64-v3";
+#endif
+  return "default";
+}
 
 StepStatus step(const Model& m, State& s) {
   // A 3-D line steps both planes (make_state gives its state the lateral one); a state whose

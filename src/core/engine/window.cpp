@@ -10,6 +10,7 @@
 
 #include "catenary_sim/core/model/beam.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
+#include "engine/step_workspace.hpp"
 
 namespace catenary_sim {
 
@@ -126,7 +127,7 @@ void update_window(const Model& m, State& s) {
         s.v[w.w_dof + i] = 0.0;
       }
   }
-  interleave_window_factors(m.wire_packs, s.window, s.sweep_factors.data());
+  interleave_window_factors(packs_of(m), s.window, s.work->sweep_factors.data());
   // Index lists sized once in make_state (a copied State keeps their size): no allocation. Only
   // the droppers and supports between the window's ends are looked at, so moving the window costs
   // what the window holds, not the line.

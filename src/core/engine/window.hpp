@@ -6,6 +6,7 @@
 
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/engine/state.hpp"
+#include "model/wire_packs.hpp"
 
 namespace catenary_sim {
 

@@ -10,6 +10,9 @@
 #include <cmath>
 #include <cstring>
 
+#include "catenary_sim/core/model/lateral.hpp"
+#include "engine/step_workspace.hpp"
+
 namespace catenary_sim {
 
 namespace {
@@ -439,18 +442,6 @@ CATENARY_SIM_CLONES bool sweep_pack_pair(const PackSweep& a, const PackSweep& b,
   return b.wind[0] ? sweep_pair<true>(a, b, joint_record, b_outside) : sweep_pair<false>(a, b, joint_record, b_outside);
 }
 
-// GCC's resolver takes the clone of the highest priority the CPU supports: x86-64-v4 (AVX-512
-// with VL, BW, DQ, CD) over x86-64-v3 (AVX2) over the baseline; this asks the same question. The
-// benchmark prints it beside the figures; gdb on sweep_pack shows the clone taken (BENCHMARKS.md).
-const char* sweep_pack_isa() {
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("x86-64-v4")) return "x86-64-v4";
-  if (__builtin_cpu_supports("x86-64-v3")) return "x86-64-v3";
-#endif
-  return "default";
-}
-
 bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const std::vector<WireWindow>* windows,
                       const double* window_factors, double* records, const double* x, const double* v, double* x_next,
                       double* v_next, double* accel, PackSweep& a) {
@@ -477,6 +468,23 @@ bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const 
     a.accel[k] = accel + w.w_dof;
   }
   a.record = records + kSweepRecord * p.offset;
+  return true;
+}
+
+bool setup_lateral_sweep(const Model& m, State& s, std::size_t pack, bool windowed, PackSweep& a) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const WireLanes& p = m.wire_packs->packs[pack];
+  if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, ls.sweep_factors.data(), s.work->sweep.data(), ls.y.data(),
+                        ls.v.data(), ls.y_next.data(), ls.v_next.data(), ls.accel.data(), a))
+    return false;
+  // (the records in the vertical step's scratch, StepWorkspace::sweep; sweep_pack_pair puts them elsewhere)
+  a.plane = lat.planes[pack].data();
+  // The wind's drag is taken in the sweep (PackSweep::wind), on the velocity it reads anyway.
+  for (int k = 0; k < p.lanes; ++k) a.wind[k] = lat.windy ? ls.wind_speed.data() + lat.wires[p.wire[k]].w_dof : nullptr;
+  a.beta = m.beta;
+  a.dt = lat.dt;
+  a.limit = m.scene.numerics.divergence_limit;
   return true;
 }
 

@@ -5,6 +5,7 @@
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/engine/state.hpp"
+#include "model/wire_packs.hpp"
 
 namespace catenary_sim {
 
@@ -20,7 +21,7 @@ struct PackSweep {
   double* u_next[2] = {nullptr, nullptr};
   double* v_next[2] = {nullptr, nullptr};
   double* accel[2] = {nullptr, nullptr};
-  double* record = nullptr;  // State::sweep at the pack's records: kept for the nodes with point forces
+  double* record = nullptr;  // StepWorkspace::sweep at the pack's records: kept for the nodes with point forces
   double beta = 0.0, dt = 0.0, limit = 0.0;
   // The lateral plane (lateral.cpp) sweeps with the vertical pack's band and factors (the same
   // beam both ways) but its own load, mass-proportional damping and inverse mass, and the wind's
@@ -52,7 +53,7 @@ bool sweep_pack(const PackSweep& sweep);
 // the lateral's in `lateral_outside`.
 bool sweep_pack_pair(const PackSweep& vertical, const PackSweep& lateral, double* joint_record, bool* lateral_outside);
 
-// Where a record of State::sweep's layout (index r, e.g. Model::dof_sweep_force) is in the
+// Where a record of StepWorkspace::sweep's layout (index r, e.g. WirePacks::dof_sweep_force) is in the
 // joint records of sweep_pack_pair: the pack's two lanes become four, the vertical plane's first.
 // joint 0: r itself (the plane's own records).
 inline int joint_record_index(int r, int joint, bool lateral) {
@@ -63,14 +64,15 @@ inline int joint_record_index(int r, int joint, bool lateral) {
 // `window_factors`: the vertical plane's State::window or the lateral plane's own; null: the whole
 // wires) on the state arrays x, v, x_next, v_next and accel, indexed by `wires`' w_dof (the
 // vertical plane's Model::wires, or the lateral plane's, whose band is the same), its records in
-// `records` (State::sweep). The ends take off the cut's share of the band (condensed_band_force's).
+// `records` (StepWorkspace::sweep). The ends take off the cut's share of the band (condensed_band_force's).
 // False when the window holds no node of the pack.
 bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const std::vector<WireWindow>* windows,
                       const double* window_factors, double* records, const double* x, const double* v, double* x_next,
                       double* v_next, double* accel, PackSweep& a);
 
-// The lateral plane's sweep of pack `pack` (lateral.cpp) on the lateral state, its records in
-// LateralState::sweep; false when the window holds no node of the pack.
+// The lateral plane's sweep of pack `pack` (its coefficients: LateralModel::planes) on the lateral
+// state, its records in the vertical step's StepWorkspace::sweep (sweep_pack_pair's joint layout
+// puts them elsewhere); false when the window holds no node of the pack.
 bool setup_lateral_sweep(const Model& model, State& s, std::size_t pack, bool windowed, PackSweep& a);
 
 

@@ -11,13 +11,13 @@
 #include "catenary_sim/core/model/beam.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
-#include "catenary_sim/core/model/newmark_matrix.hpp"
 #include "catenary_sim/core/model/stability.hpp"
 #include "catenary_sim/core/model/statics.hpp"
 #include "model/centred_factors.hpp"
 #include "model/design_statics.hpp"
 #include "model/endless_block.hpp"
 #include "model/imperfections.hpp"
+#include "model/newmark_matrix.hpp"
 #include "model/wire_packs.hpp"
 #include "util/format.hpp"
 
@@ -445,16 +445,18 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
 
 Model build_model(const Scene& scene, const BuildOptions& options) {
   Model m = build_model_unchecked(scene, options);
-  build_wire_packs(m);
+  // Built here, filled further for the centred damping step below, then only read.
+  const std::shared_ptr<WirePacks> packs = build_wire_packs(m);
+  m.wire_packs = packs;
   if (!options.stability) return m;
   if (scene.numerics.damping == DampingStep::kCentred) {
-    if (m.wire_packs.empty())  // (condensed rotations on every wire node give packs)
+    if (!packs)  // (condensed rotations on every wire node give packs)
       throw SceneError("numerics.damping = 'centred': needs the wires' rotations condensed; allowed otherwise: half_step");
     if (scene.numerics.dt && *scene.numerics.dt > kCentredMaxSafetyFactor * m.dt_critical)
       throw SceneError("numerics.dt = " + fmt(*scene.numerics.dt) + " s: with numerics.damping centred at most " +
                        fmt(kCentredMaxSafetyFactor) + " of the stability estimate " + fmt(m.dt_critical) + " s, dt <= " +
                        fmt(kCentredMaxSafetyFactor * m.dt_critical) + " (the estimate is not a bound for that step; see numerics.safety_factor)");
-    factor_centred_damping(m);
+    factor_centred_damping(m, *packs);
   }
   // The statistics filter runs at the step rate: a cutoff at or above its Nyquist frequency would
   // be no filter at all (lowpass_zero_phase returns the input unchanged).

@@ -183,19 +183,19 @@ std::vector<double> wire_factors(const Model& m, const Wire& w, double shift, st
 
 }  // namespace
 
-void factor_centred_damping(Model& m) {
+void factor_centred_damping(const Model& m, WirePacks& packs) {
   const double shift = 2.0 / (m.beta * m.dt) + m.alpha / m.beta;
-  m.centred_fixed_dofs.clear();
-  m.centred_v_ratio = (2.0 / m.dt) / shift;
+  packs.centred_fixed_dofs.clear();
+  packs.centred_v_ratio = (2.0 / m.dt) / shift;
   // The packs: pair j of the twisted order (top node j, bottom node n - 1 - (bottom - top) - j,
   // both eliminated at step j and substituted at step top - 1 - j) in 2L lanes, the top's lanes
   // first; the meeting node and the extra bottom node (when n is even) alone, in L lanes.
-  for (WireLanes& p : m.wire_packs) {
+  for (WireLanes& p : packs.packs) {
     const int L = p.lanes, n = p.nodes, k = centred_meeting_node(n), top = k, extra = (n - 1 - k) - top;
     p.centred_twin.assign(static_cast<std::size_t>(top) * kCdValues * 2 * L, 0.0);
     p.centred_single.assign(2 * kCdValues * static_cast<std::size_t>(L), 0.0);
     for (int lane = 0; lane < L; ++lane) {
-      const std::vector<double> factors = wire_factors(m, m.wires[p.wire[lane]], shift, m.centred_fixed_dofs);
+      const std::vector<double> factors = wire_factors(m, m.wires[p.wire[lane]], shift, packs.centred_fixed_dofs);
       auto value = [&](int i, int v) { return factors[static_cast<std::size_t>(i) * kCdValues + v]; };
       for (int j = 0; j < top; ++j)
         for (int v = 0; v < kCdValues; ++v) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "catenary_sim/core/model/model.hpp"
+#include "model/wire_packs.hpp"
 
 namespace catenary_sim {
 
@@ -18,7 +19,8 @@ namespace catenary_sim {
 enum { kCdG, kCdS = 4, kCdP = 6, kCdU = 10, kCdValues };
 int centred_meeting_node(int nodes);
 
-// Fills the packs' WireLanes::centred_* (every wire is in a pack) for m.dt; needs beta > 0.
-void factor_centred_damping(Model& m);
+// Fills the packs' WireLanes::centred_* and WirePacks::centred_* (every wire is in a pack) for
+// m.dt; needs beta > 0.
+void factor_centred_damping(const Model& m, WirePacks& packs);
 
 }  // namespace catenary_sim

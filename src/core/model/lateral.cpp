@@ -12,6 +12,7 @@
 
 #include "catenary_sim/core/model/beam.hpp"
 #include "model/normal_errors.hpp"
+#include "model/wire_packs.hpp"
 
 namespace catenary_sim {
 namespace {
@@ -76,8 +77,8 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
   lat.planes.clear();
   lat.point_nodes.clear();
   lat.sweep_force_at.clear();
-  if (m.wire_packs.empty()) return;  // the vertical step is not fused: neither is this one
-  for (const WireLanes& p : m.wire_packs) {
+  if (!m.wire_packs) return;  // the vertical step is not fused: neither is this one
+  for (const WireLanes& p : m.wire_packs->packs) {
     const int L = p.lanes;
     std::vector<double> plane(static_cast<std::size_t>(p.nodes) * kPlaneValues * L, 0.0);
     for (int k = 0; k < L; ++k) {
@@ -101,7 +102,7 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
   lat.sweep_force_at.assign(lat.n, 0);
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi)
     for (int i = 0; i < lat.wires[wi].nodes(); ++i)
-      lat.sweep_force_at[lat.wires[wi].w_dof + i] = m.dof_sweep_force[m.wires[wi].w_dof + i];
+      lat.sweep_force_at[lat.wires[wi].w_dof + i] = m.wire_packs->dof_sweep_force[m.wires[wi].w_dof + i];
   std::vector<char> listed(lat.n, 0);
   auto add = [&](int i) {
     if (listed[i]) return;

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "model/assembly.hpp"
-#include "catenary_sim/core/model/newmark_matrix.hpp"
+#include "model/newmark_matrix.hpp"
 
 namespace catenary_sim {
 

@@ -1,12 +1,13 @@
 // The mutable state of a pass (MuJoCo's mjData to the Model's mjModel): displacements, half-step
 // velocities, train kinematics, commands in effect, the contact and dropper activity of the last
-// step, and preallocated workspace so that step() never allocates.
+// step, and the step's preallocated workspace (opaque here) so that step() never allocates.
 #pragma once
 
 #include <Eigen/Core>
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "catenary_sim/core/engine/lateral_step.hpp"
@@ -28,6 +29,26 @@ enum class StepStatus {
 // of n values); more stops the run with a message. Active-set passes per step at most.
 constexpr std::size_t kSlackDropperCapacity = 64;
 constexpr int kMaxActiveSetPasses = 4;
+
+struct StepWorkspace;
+
+// Owns a State's step workspace (whose contents only the engine sees) and copies it deep.
+class StepWorkspaceHandle {
+ public:
+  StepWorkspaceHandle();
+  StepWorkspaceHandle(const StepWorkspaceHandle& other);
+  StepWorkspaceHandle(StepWorkspaceHandle&& other) noexcept;
+  StepWorkspaceHandle& operator=(const StepWorkspaceHandle& other);
+  StepWorkspaceHandle& operator=(StepWorkspaceHandle&& other) noexcept;
+  ~StepWorkspaceHandle();
+  StepWorkspace& operator*() { return *work_; }
+  const StepWorkspace& operator*() const { return *work_; }
+  StepWorkspace* operator->() { return work_.get(); }
+  const StepWorkspace* operator->() const { return work_.get(); }
+
+ private:
+  std::unique_ptr<StepWorkspace> work_;
+};
 
 struct State {
   double time = 0.0;       // s, simulation time since the pass started
@@ -107,6 +128,7 @@ struct State {
 
   StepStatus status = StepStatus::kOk;
   int diverged_dof = -1;
+  bool active_set_full = false;  // implicit: more droppers slack at once than it takes out (kDiverged)
 
   // Moving window (numerics.window): the supports it spans and what it integrates.
   int window_first_support = -1, window_last_support = -1;
@@ -114,31 +136,9 @@ struct State {
   std::vector<int> window_droppers, window_springs;  // the first *_count entries are in the window
   int window_dropper_count = 0, window_spring_count = 0;
 
-  // Workspace, sized once by make_state().
-  Eigen::VectorXd force, z;
-  // Fused explicit step: the new displacements and velocities (swapped in, or copied back in the
-  // window, once all are good); per node and lane of every wire pack the sweep's record (rotation,
-  // z, load less damping, band force: src/core/engine/wire_lanes.hpp); the window's LDL^T factors laid
-  // out as WireLanes::factors; the contact wire's nodes under the collectors this step.
-  Eigen::VectorXd u_next, v_next;
-  std::vector<double> sweep, sweep_factors;
-  std::vector<int> point_node;
-  // Implicit integrator only: the prediction, and the rank-1 corrections of the factorised
-  // matrix A (contacts in touch add k0 g g^T, slack droppers take their stiffness out again),
-  // each with its sparse g, its stiffness factor and its column A^-1 g.
-  Eigen::VectorXd u_pred, v_pred, solve_tmp;
-  std::vector<double> contact_solve;           // A^-1 g per contact in touch (they move: every step)
-  std::vector<double> dropper_solve;           // A^-1 g per cache slot (A never changes: kept)
-  std::vector<int> dropper_slot;               // per dropper: its cache slot, -1 if none
-  std::vector<int> slot_dropper;               // per slot: its dropper, -1 if free
-  std::vector<std::int64_t> slot_used;         // per slot: the step that last used it
-  std::vector<int> correction_g_index, correction_g_count;
-  std::vector<double> correction_g_value, correction_factor, correction_small;
-  std::vector<const double*> correction_solve;
-  bool active_set_full = false;  // more droppers slack at once than the cache holds: run stopped
-  std::vector<double> theta;
-  std::vector<int> weight_node;
-  std::vector<double> weight;
+  // The step's buffers and caches (engine/step_workspace.hpp, private to the engine), sized once
+  // by make_state(); a copied state gets its own, so it steps exactly as its original would.
+  StepWorkspaceHandle work;
 
   // 3-D line (Model::lateral): the wires' lateral planes; empty without one.
   LateralState lateral;
@@ -165,11 +165,6 @@ struct State {
 
 // A state sized for the model with zero displacement (the design state, no pantograph force).
 State make_state(const Model& model);
-
-// The instruction set the fused explicit step's runtime dispatch chose on this machine:
-// "x86-64-v4" (AVX-512), "x86-64-v3" (AVX2) or "default" (the x86-64 baseline). All give the
-// same bits.
-const char* sweep_pack_isa();
 
 // Fills the observations (contact forces, collector heights) for the current state without
 // advancing it, e.g. for the initial state.

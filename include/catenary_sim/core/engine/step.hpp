@@ -19,4 +19,9 @@ StepStatus step(const Model& model, State& state);
 // lean. A pass steps with step().
 StepStatus vertical_step(const Model& model, State& state);
 
+// The instruction set the fused explicit step's runtime dispatch chose on this machine:
+// "x86-64-v4" (AVX-512), "x86-64-v3" (AVX2) or "default" (the x86-64 baseline). All give the
+// same bits.
+const char* sweep_pack_isa();
+
 }  // namespace catenary_sim

@@ -14,7 +14,9 @@
 
 namespace catenary_sim {
 
-struct LateralModel;  // lateral.hpp: the 3-D line's lateral plane
+struct LateralModel;    // lateral.hpp: the 3-D line's lateral plane
+struct ImplicitMatrix;  // model/newmark_matrix.hpp (private): the implicit integrator's factors
+struct WirePacks;       // model/wire_packs.hpp (private): the wires' lane layout for the fused step
 
 // One tensioned wire of a tension section, meshed with pre-stressed Euler-Bernoulli (Hermite)
 // beam elements (eq. 3). Its stiffness is stored as a block-tridiagonal band of 2x2 blocks
@@ -108,40 +110,6 @@ struct Pantograph {
   double contact_reference(const Collector& c) const { return c.head < 0 ? reference_height : heads[c.head].reference_height; }
 };
 
-// The Newmark matrix M + dt/2 C + dt^2/4 K0, factorised once: L D L^T of P A P^T with L unit
-// lower triangular (strict part in compressed columns).
-struct ImplicitMatrix {
-  std::vector<int> perm;           // P as indices: (P b)[perm[i]] = b[i]
-  std::vector<int> col, row;       // CSC of the strict lower part of L
-  std::vector<double> val;
-  std::vector<double> inv_diag;    // 1 / D
-};
-
-// Wires packed for the fused explicit step (condensed rotations): one wire, or two on the same node
-// stations (a section's contact wire and messenger) side by side, so that their independent
-// recurrences (the condensation's tridiagonal sweeps) run in the two lanes of one vector register.
-// Node i of lane k is entry i * lanes + k. Copies of the wires' band, factors, load and masses.
-struct WireLanes {
-  int lanes = 1;
-  int wire[2] = {-1, -1};  // indices into Model::wires
-  int nodes = 0;
-  std::size_t offset = 0;  // of this pack, in node-lanes: its records start at State::sweep[4 * offset]
-  // One record per node: kCoefficients values, each for every lane ([node][value][lane]); the
-  // element values (e_*) belong to the element from the node to the next.
-  enum { kDww, kDwt, kEww, kEwt, kEtw, kLoad, kDampingMass, kInvMass, kCoefficients };  // kDampingMass: alpha m (eq. 5)
-  std::vector<double> coef;
-  std::vector<double> factors;  // LDL^T of K_theta_theta: [node][lower, inv_pivot][lane]
-  // Centred damping: the factors of the step's block-tridiagonal solve for the lanes' wires in
-  // the twisted order (src/core/model/centred_factors.hpp): [pair][value][2 lanes], and the meeting and
-  // extra nodes' [value][lane]. Empty with the half-step damping.
-  std::vector<double> centred_twin, centred_single;
-};
-
-// The fused step's record per node and lane (State::sweep, kSweepRecord values per node, each for
-// every lane; the engine's sweep writes them, Model::dof_sweep_force and dof_sweep_z point into
-// them): the rotation, z = u + beta v, the load less the damping, and the band force.
-enum { kRecTheta, kRecZ, kRecInit, kRecForce, kSweepRecord };
-
 struct Model {
   Scene scene;
   std::vector<Section> sections;
@@ -166,15 +134,10 @@ struct Model {
   double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction (inf: implicit)
   double dt = 0.0;              // s, the step in use
   std::shared_ptr<const ImplicitMatrix> implicit;  // set when the integrator is implicit
-  // Explicit with condensed rotations: the wires packed for the fused step (empty otherwise: the
-  // generic step). wire_pack[wi], wire_lane[wi]: where wire wi is.
-  std::vector<WireLanes> wire_packs;
-  std::vector<int> wire_pack, wire_lane;
-  std::vector<int> centred_fixed_dofs;  // the wires' fixed vertical DOFs (centred damping step)
-  double centred_v_ratio = 0.0;         // (2 / dt) / D_i per mass (centred damping step)
-  // Per catenary DOF: where the sweep leaves its band force and its z in State::sweep.
-  std::vector<int> dof_sweep_force, dof_sweep_z;
-  std::size_t sweep_size = 0;  // node-lanes of all packs (State::sweep holds 4 values for each)
+  // Explicit with condensed rotations: the wires packed side by side for the fused step, their
+  // copies in SIMD lanes and where the sweep leaves each DOF's results (their layout is the
+  // engine's business: model/wire_packs.hpp); null: the generic step.
+  std::shared_ptr<const WirePacks> wire_packs;
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
   double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)
@@ -205,4 +168,5 @@ struct Model {
 #include "catenary_sim/core/model/contact_geometry.hpp"
 #include "catenary_sim/core/model/model_memory.hpp"
 #include "catenary_sim/core/model/window_lengths.hpp"
+#include "catenary_sim/core/model/wire_packs.hpp"
 #include "catenary_sim/core/model/wire_band.hpp"
