@@ -135,6 +135,7 @@ int SimulationNode::run() {
   publish_status();
   publish(true);
   wait_for_viewer();
+  wait_for_recorder();
   if (params_.start_delay > 0.0 && ros::ok()) {
     ROS_INFO("catenary_sim: starting in %g s (~start_delay)", params_.start_delay);
     const ros::WallTime start = ros::WallTime::now() + ros::WallDuration(params_.start_delay);
@@ -202,6 +203,29 @@ void SimulationNode::wait_for_viewer() {
       publish(true);
       ros::WallDuration(0.05).sleep();
     }
+}
+
+void SimulationNode::wait_for_recorder() {
+  if (!(params_.wait_for_recorder > 0.0)) return;
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(params_.wait_for_recorder);
+  if (pantograph_pub_.getNumSubscribers() == 0)
+    ROS_INFO("catenary_sim: waiting up to %g s for a recorder to subscribe to %s (~wait_for_recorder)",
+             params_.wait_for_recorder, pantograph_pub_.getTopic().c_str());
+  while (ros::ok() && pantograph_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < give_up) {
+    ros::spinOnce();
+    publish(false);
+    ros::WallDuration(0.05).sleep();
+  }
+  if (pantograph_pub_.getNumSubscribers() == 0) {
+    ROS_WARN("catenary_sim: no recorder subscribed within %g s; starting anyway", params_.wait_for_recorder);
+    return;
+  }
+  // Its other subscriptions connect in the same moment: half a second covers them.
+  for (int i = 0; i < 10 && ros::ok(); ++i) {
+    ros::spinOnce();
+    publish(true);
+    ros::WallDuration(0.05).sleep();
+  }
 }
 
 void SimulationNode::publish_status() {

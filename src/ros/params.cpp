@@ -248,6 +248,7 @@ void validate(const NodeParams& p) {
   check("max_acceleration", p.max_acceleration, kMaxAcceleration);
   check("start_delay", p.start_delay, kStartDelay);
   check("wait_for_viewer", p.wait_for_viewer, kWaitForViewer);
+  check("wait_for_recorder", p.wait_for_recorder, kWaitForViewer);
   check("chart_window", p.chart_window, kChartWindow);
   check_frame_id("line_frame", p.line_frame);
 }
@@ -267,7 +268,7 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   ParamReader r(nh, "catenary_sim",
                 {"scene", "speed_kmh", "real_time_factor", "publish_rate", "shape_rate", "marker_rate",
                  "shape_resolution", "vertical_scale", "lateral_scale", "line_frame", "view_pantograph", "at_end", "stats_file", "report_file", "publish_clock",
-                 "paused", "wait_for_viewer", "max_acceleration", "start_delay", "strip_chart", "chart_window",
+                 "paused", "wait_for_viewer", "wait_for_recorder", "max_acceleration", "start_delay", "strip_chart", "chart_window",
                  "diagnostic_period"});  // (the last read by diagnostic_updater)
   NodeParams p;
   r.text("scene", p.scene, "the path of a scene YAML file");
@@ -282,6 +283,7 @@ NodeParams load_params(const ros::NodeHandle& nh) {
   r.number("max_acceleration", p.max_acceleration, kMaxAcceleration.text());
   r.number("start_delay", p.start_delay, kStartDelay.text());
   r.number("wait_for_viewer", p.wait_for_viewer, kWaitForViewer.text());
+  r.number("wait_for_recorder", p.wait_for_recorder, kWaitForViewer.text());
   r.text("line_frame", p.line_frame, "a frame id");
   r.text("view_pantograph", p.view_pantograph, "a pantograph's name (empty: the train front)");
   std::string at_end = to_string(p.at_end);

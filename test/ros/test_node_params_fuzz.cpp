@@ -208,7 +208,7 @@ TEST_F(NodeParamsFuzz, NodeRejectsEveryBadValueNamingTheParameter) {
       {"shape_resolution", Kind::kNumber}, {"vertical_scale", Kind::kRate}, {"lateral_scale", Kind::kRate},  {"line_frame", Kind::kFrame},
       {"at_end", Kind::kAtEnd},          {"stats_file", Kind::kPath},        {"publish_clock", Kind::kBool},
       {"paused", Kind::kBool},           {"wait_for_viewer", Kind::kNumber}, {"max_acceleration", Kind::kNumber},
-      {"start_delay", Kind::kNumber},    {"report_file", Kind::kReportPath}, {"view_pantograph", Kind::kString},
+      {"start_delay", Kind::kNumber},    {"wait_for_recorder", Kind::kNumber}, {"report_file", Kind::kReportPath}, {"view_pantograph", Kind::kString},
       {"strip_chart", Kind::kBool},      {"chart_window", Kind::kNumber}};
   int count = 0;
   fuzz(this, kNode, params, {{"scene", kScene}, {"stats_file", out + "/stats.json"}}, out, &count);

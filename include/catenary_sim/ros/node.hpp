@@ -65,6 +65,10 @@ class SimulationNode {
   // Waits (wall clock) for a subscriber of `markers` up to ~wait_for_viewer, publishing the initial
   // state and /clock meanwhile.
   void wait_for_viewer();
+  // Waits (wall clock) for a subscriber of `pantograph_state` up to ~wait_for_recorder, publishing
+  // the initial state meanwhile: rosbag subscribes to all its topics at once, so the bag then
+  // holds the pass from its first step however long rosbag took to start.
+  void wait_for_recorder();
   // Publishes `pass_status` (latched) when it changes: waiting, running, paused, ended, diverged.
   void publish_status();
   // LineState: the line around the train, on `line_state`.

@@ -121,6 +121,9 @@ struct NodeParams {
   bool publish_clock = true;        // ~publish_clock: publish rosgraph_msgs/Clock on /clock (simulated time,
                                     //   from 0, also while paused; pass.launch sets /use_sim_time with it)
   bool paused = false;              // ~paused: start paused (like gazebo's paused:=true); ~set_paused false starts
+  // ~wait_for_recorder: s (wall) to wait for a subscriber of `pantograph_state` (the bag recorder of
+  // pass.launch record:=true, which alone listens to it) so that the bag holds the pass's start
+  double wait_for_recorder = 0.0;
   double wait_for_viewer = 0.0;     // ~wait_for_viewer: s (wall) to wait for a subscriber of `markers` (rviz)
                                     //   before the pass starts, [0, 600]; 0: no wait
   double max_acceleration = 1.0;    // ~max_acceleration: m/s^2 toward commanded speeds, [0, 20] (0: jump)
