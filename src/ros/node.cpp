@@ -185,43 +185,33 @@ int SimulationNode::run() {
 }
 
 void SimulationNode::wait_for_viewer() {
-  if (!(params_.wait_for_viewer > 0.0)) return;
-  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(params_.wait_for_viewer);
-  if (marker_pub_.getNumSubscribers() == 0)
-    ROS_INFO("catenary_sim: waiting up to %g s for a viewer (rviz) to subscribe to %s (~wait_for_viewer)",
-             params_.wait_for_viewer, marker_pub_.getTopic().c_str());
-  while (ros::ok() && marker_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < give_up) {
-    ros::spinOnce();
-    publish(false);
-    ros::WallDuration(0.05).sleep();
-  }
-  if (marker_pub_.getNumSubscribers() == 0)
-    ROS_WARN("catenary_sim: no viewer subscribed within %g s; starting anyway", params_.wait_for_viewer);
-  else  // rviz subscribes before its displays have drawn the first frame: give it a moment
-    for (int i = 0; i < 20 && ros::ok(); ++i) {
-      ros::spinOnce();
-      publish(true);
-      ros::WallDuration(0.05).sleep();
-    }
+  // rviz subscribes before its displays have drawn the first frame: give it a second.
+  wait_for_subscriber(marker_pub_, params_.wait_for_viewer, "a viewer (rviz)", "wait_for_viewer", 1.0);
 }
 
 void SimulationNode::wait_for_recorder() {
-  if (!(params_.wait_for_recorder > 0.0)) return;
-  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(params_.wait_for_recorder);
-  if (pantograph_pub_.getNumSubscribers() == 0)
-    ROS_INFO("catenary_sim: waiting up to %g s for a recorder to subscribe to %s (~wait_for_recorder)",
-             params_.wait_for_recorder, pantograph_pub_.getTopic().c_str());
-  while (ros::ok() && pantograph_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < give_up) {
+  // rosbag's other subscriptions connect in the same moment: half a second covers them.
+  wait_for_subscriber(pantograph_pub_, params_.wait_for_recorder, "a recorder", "wait_for_recorder", 0.5);
+}
+
+void SimulationNode::wait_for_subscriber(const ros::Publisher& pub, double wait_s, const char* who,
+                                         const char* param, double settle_s) {
+  if (!(wait_s > 0.0)) return;
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(wait_s);
+  if (pub.getNumSubscribers() == 0)
+    ROS_INFO("catenary_sim: waiting up to %g s for %s to subscribe to %s (~%s)", wait_s, who, pub.getTopic().c_str(),
+             param);
+  while (ros::ok() && pub.getNumSubscribers() == 0 && ros::WallTime::now() < give_up) {
     ros::spinOnce();
     publish(false);
     ros::WallDuration(0.05).sleep();
   }
-  if (pantograph_pub_.getNumSubscribers() == 0) {
-    ROS_WARN("catenary_sim: no recorder subscribed within %g s; starting anyway", params_.wait_for_recorder);
+  if (pub.getNumSubscribers() == 0) {
+    ROS_WARN("catenary_sim: no subscriber (%s) within %g s; starting anyway", who, wait_s);
     return;
   }
-  // Its other subscriptions connect in the same moment: half a second covers them.
-  for (int i = 0; i < 10 && ros::ok(); ++i) {
+  for (const ros::WallTime settled = ros::WallTime::now() + ros::WallDuration(settle_s);
+       ros::ok() && ros::WallTime::now() < settled;) {
     ros::spinOnce();
     publish(true);
     ros::WallDuration(0.05).sleep();

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <ros/topic.h>
 #include <rosgraph_msgs/Log.h>
+#include <std_msgs/String.h>
 
 #include <cstdint>
 #include <functional>
@@ -96,6 +98,12 @@ struct NodeLog {
   std::mutex mu;
   std::vector<std::string> lines;
 };
+
+// The pass node's latched pass_status ("(none)" if nothing came within 5 s).
+inline std::string pass_status() {
+  const auto m = ros::topic::waitForMessage<std_msgs::String>("pass_status", ros::Duration(5.0));
+  return m ? m->data : "(none)";
+}
 
 // Polls `cond` every `poll_s` of wall time until it holds or `timeout_s` has passed.
 inline bool wait_for(const std::function<bool()>& cond, double timeout_s, double poll_s = 0.01) {

@@ -18,14 +18,9 @@
 
 using namespace catenary_sim;
 using ros_test::Recorder;
+using ros_test::pass_status;
 using ros_test::wait_for;
 
-namespace {
-std::string pass_status() {
-  const auto m = ros::topic::waitForMessage<std_msgs::String>("pass_status", ros::Duration(5.0));
-  return m ? m->data : "(none)";
-}
-}  // namespace
 
 // rviz started with a paused pass (pass.launch rviz:=true paused:=true) subscribes to /tf after
 // the node has sent its first transforms; tf is not latched, and the hold sends no new time. The

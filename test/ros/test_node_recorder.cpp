@@ -11,14 +11,9 @@
 
 using namespace catenary_sim;
 using ros_test::Recorder;
+using ros_test::pass_status;
 using ros_test::wait_for;
 
-namespace {
-std::string pass_status() {
-  const auto m = ros::topic::waitForMessage<std_msgs::String>("pass_status", ros::Duration(5.0));
-  return m ? m->data : "(none)";
-}
-}  // namespace
 
 // rosbag on a loaded machine can take seconds to subscribe; a fixed start delay then loses the
 // start of the pass. Here the "recorder" comes 4 s late: a pass at real_time_factor 0 would be

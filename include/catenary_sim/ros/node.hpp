@@ -69,6 +69,10 @@ class SimulationNode {
   // the initial state meanwhile: rosbag subscribes to all its topics at once, so the bag then
   // holds the pass from its first step however long rosbag took to start.
   void wait_for_recorder();
+  // Both waits: publishing the initial state, up to wait_s for a subscriber of `pub`, then
+  // settle_s more so that it has the initial state in hand.
+  void wait_for_subscriber(const ros::Publisher& pub, double wait_s, const char* who, const char* param,
+                           double settle_s);
   // Publishes `pass_status` (latched) when it changes: waiting, running, paused, ended, diverged.
   void publish_status();
   // LineState: the line around the train, on `line_state`.
