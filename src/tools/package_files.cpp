@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 
 namespace catenary_sim {
@@ -36,6 +37,24 @@ std::string this_binary() {
   return path;
 }
 
+// A catkin devel space's source directories: its .catkin file lists them (';'-separated), as
+// catkin_find reads it; an install space's .catkin is empty. Each that holds this package (its
+// package.xml at the top, or in a catenary_sim folder of a workspace's src) is one.
+void add_devel_sources(const std::string& prefix, std::vector<std::string>& dirs) {
+  std::ifstream marker(prefix + "/.catkin");
+  std::string list;
+  if (!marker || !std::getline(marker, list)) return;
+  std::istringstream sources(list);
+  for (std::string source; std::getline(sources, source, ';');) {
+    if (source.empty()) continue;
+    for (const std::string& dir : {source, source + "/catenary_sim"})
+      if (is_file(dir + "/package.xml") && is_dir(dir + "/scripts")) {
+        dirs.push_back(dir);
+        break;
+      }
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> package_share_dirs() {
@@ -49,6 +68,7 @@ std::vector<std::string> package_share_dirs() {
       const std::string share = dir + "/share/catenary_sim";
       if (is_dir(share)) {
         dirs.push_back(share);
+        add_devel_sources(dir, dirs);
         break;
       }
     }
@@ -56,7 +76,10 @@ std::vector<std::string> package_share_dirs() {
   if (const char* prefixes = std::getenv("CMAKE_PREFIX_PATH")) {
     std::istringstream list(prefixes);
     for (std::string prefix; std::getline(list, prefix, ':');)
-      if (!prefix.empty()) dirs.push_back(prefix + "/share/catenary_sim");
+      if (!prefix.empty()) {
+        dirs.push_back(prefix + "/share/catenary_sim");
+        add_devel_sources(prefix, dirs);
+      }
   }
   return dirs;
 }

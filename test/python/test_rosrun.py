@@ -76,14 +76,40 @@ def test_rosrun_finds_the_documented_programs_once(env):
     assert not wrong, wrong
 
 
+PYTHON_NODES = ["record_until_end", "catenary_sim_study", "plot_contact_force", "fit_pantograph", "pass_report",
+                "plot_frf", "compare_measurement", "calibrate"]
+
+
+def test_rosrun_finds_each_python_node_once(env):
+    # The Python nodes run from their sources in scripts/: a second file of the same name in the
+    # devel space or the build tree makes rosrun ask which one, and wait on stdin.
+    r = run_sourced('for n in "$@"; do echo "== $n"; rosrun --prefix echo catenary_sim "$n"; done', PYTHON_NODES,
+                    env)
+    assert r.returncode == 0, r.stdout[-4000:]
+    found, name = {}, None
+    for line in r.stdout.splitlines():
+        if line.startswith("== "):
+            name = line[3:]
+            found[name] = []
+        else:
+            found[name].append(line)
+    wrong = {n: found.get(n) for n in PYTHON_NODES
+             if [os.path.realpath(p) for p in found.get(n, [])] != [os.path.realpath(os.path.join(ROOT, "scripts", n))]}
+    assert not wrong, wrong
+
+
+def test_rosrun_runs_a_python_node(env):
+    # pass_report needs no master: its help comes back at once.
+    r = run_sourced('rosrun catenary_sim pass_report --help', [], env)
+    assert r.returncode == 0, r.stdout[-4000:]
+    assert "non-unique" not in r.stdout and "usage:" in r.stdout, r.stdout[-4000:]
+
+
 def test_the_package_holds_one_executable_of_each_compiled_programs_name():
     # What rosrun's search sees of every other program, in one walk instead of a rosrun each: the
     # package followed through its links (`find -L`, build/ at the top left out as rosrun does),
-    # where a compiled program must lie once, in the devel space. The Python nodes
-    # (catkin_install_python's relays) are left out: rosrun also finds their sources in scripts/ (and
-    # through share/catenary_sim/scripts), as for any catkin package's scripts, and asks; roslaunch
-    # starts them, taking the relay it finds first.
-    names = compiled_programs()
+    # where a compiled program must lie once, in the devel space, and a Python node once, in scripts/.
+    names = compiled_programs() + PYTHON_NODES
     root = os.path.realpath(ROOT)
     r = subprocess.run(["find", "-L", root, "-type", "f", "-perm", "/111"], stdout=subprocess.PIPE,
                        stderr=subprocess.PIPE, text=True, timeout=600)
@@ -92,5 +118,7 @@ def test_the_package_holds_one_executable_of_each_compiled_programs_name():
     for path in r.stdout.splitlines():
         if os.path.basename(path) in names and not path.startswith(os.path.join(root, "build") + "/"):
             found.setdefault(os.path.basename(path), []).append(path)
-    wrong = {n: found.get(n) for n in names if found.get(n) != [os.path.join(os.path.realpath(LIB), n)]}
+    def home(n):
+        return os.path.join(root, "scripts", n) if n in PYTHON_NODES else os.path.join(os.path.realpath(LIB), n)
+    wrong = {n: found.get(n) for n in names if found.get(n) != [home(n)]}
     assert not wrong, wrong

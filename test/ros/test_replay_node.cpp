@@ -91,7 +91,7 @@ TEST(Replay, RecordedPassIsDrawnAndPlotted) {
   ros::Publisher status = nh.advertise<std_msgs::String>("pass_status", 1, true);
   ros::Subscriber sub = nh.subscribe("markers", 1000, &on_markers);
   // plot_contact_force, headless, on the same playback (started here: the PNG goes to this test's directory).
-  ASSERT_EQ(std::system(sh(test_scenes::program("plot_contact_force") + " _output_png:=" + png + " _output_csv:=" + csv +
+  ASSERT_EQ(std::system(sh(test_scenes::script("plot_contact_force") + " _output_png:=" + png + " _output_csv:=" + csv +
                            " _headless:=true > " + dir + "/plot.log 2>&1 & echo $! > " + dir + "/plot.pid")
                             .c_str()),
             0);

@@ -44,6 +44,8 @@ inline std::string scene_path(const std::string& file) { return kConfigDir + fil
 
 // A program of the devel space by name (simulate_pass, catenary_sim_node, ...).
 inline std::string program(const std::string& name) { return kDevelLib + "/" + name; }
+// A Python node of the package (run from its source, as rosrun and roslaunch find it).
+inline std::string script(const std::string& name) { return kSourceDir + "/scripts/" + name; }
 
 // A shipped scene (config/<file>) as YAML, changed by `edit`, then loaded with `overrides`: for
 // what --set cannot say (a key removed, a section added, a pantograph's type changed).

@@ -1,8 +1,8 @@
 // The package's own files (scripts/, config/) found at run time from where the running binary
 // lies, so that a binary carries no path of the tree it was built in and runs wherever it is
 // installed: <prefix>/lib/catenary_sim/TOOL (or <prefix>/lib/libX.so) looks in
-// <prefix>/share/catenary_sim. A devel space's share/catenary_sim links scripts/ and config/ to the
-// sources (made when CMake configures), an install space holds copies.
+// <prefix>/share/catenary_sim, where an install space holds copies; a devel space holds none and
+// names its sources in <prefix>/.catkin (catkin's record, read as catkin_find reads it).
 #pragma once
 
 #include <string>
@@ -11,8 +11,8 @@
 namespace catenary_sim {
 
 // The directories looked in, in order: share/catenary_sim beside the binary or library this code
-// is linked into, then PREFIX/share/catenary_sim for each PREFIX of $CMAKE_PREFIX_PATH (a sourced
-// workspace's).
+// is linked into and, if that prefix is a devel space, the package's sources; then the same for
+// each PREFIX of $CMAKE_PREFIX_PATH (a sourced workspace's).
 std::vector<std::string> package_share_dirs();
 
 // A file of the package by its path in it (e.g. config/reference_55m.yaml); empty if none of
