@@ -27,7 +27,7 @@ import pandas as pd
 import yaml
 from scipy import signal
 
-from . import SceneError, Simulation, _override_list, _path, _real, _integer
+from . import SceneError, Simulation, _core, _override_list, _path, _real, _integer
 
 __all__ = ["RecordError", "Record", "read_record", "simulate_run", "compare", "Comparison",
            "synthesise_record", "lowpass", "section_statistics", "STATISTICS"]
@@ -347,16 +347,10 @@ def read_record(path, meta=None):
 # The same filter and statistics for both sides
 # --------------------------------------------------------------------------------------------
 def lowpass(x, fs, fc):
-    """The core's zero-phase low-pass (output/zero_phase_filter.cpp): a 4th-order Butterworth
-    (bilinear, pre-warped) run forward and backward from the steady state of the first sample, with
-    odd reflection over ceil(3 fs / fc) samples at both ends; a cutoff at or above Nyquist passes
-    the series through."""
-    x = np.asarray(x, dtype=float)
-    n = len(x)
-    if n < 3 or fc >= 0.5 * fs:
-        return x.copy()
-    sos = signal.butter(4, fc, btype="low", fs=fs, output="sos")
-    return signal.sosfiltfilt(sos, x, padtype="odd", padlen=min(n - 1, math.ceil(3.0 * fs / fc)))
+    """The core's zero-phase low-pass (output/zero_phase_filter.cpp), the filter of stats.json: a
+    4th-order Butterworth run forward and backward with odd reflection at both ends; a cutoff at or
+    above Nyquist passes the series through."""
+    return np.asarray(_core._lowpass_zero_phase(np.asarray(x, dtype=float), float(fs), float(fc)))
 
 
 def section_statistics(force, inside, loss_force=None):

@@ -18,6 +18,7 @@
 #include "catenary_sim/core/output/pass_files.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
+#include "catenary_sim/core/output/zero_phase_filter.hpp"
 
 namespace py = pybind11;
 using namespace catenary_sim;
@@ -177,6 +178,20 @@ void bind_scene_checks(py::module& m) {
         load_scene_string(yaml, overrides, base_dir);
       },
       py::arg("yaml"), py::arg("overrides"), py::arg("base_dir") = "");
+  // The statistics' filter, so that a measured record and a simulated pass go through the same one.
+  m.def(
+      "_lowpass_zero_phase",
+      [](const std::vector<double>& x, double fs, double fc) {
+        if (!(std::isfinite(fs) && fs > 0.0))
+          throw py::value_error("sample rate fs = " + fmt(fs) + " Hz rejected: allowed a finite rate > 0 Hz");
+        if (!(std::isfinite(fc) && fc > 0.0))
+          throw py::value_error("cutoff fc = " + fmt(fc) + " Hz rejected: allowed a finite frequency > 0 Hz");
+        for (std::size_t i = 0; i < x.size(); ++i)
+          if (!std::isfinite(x[i]))
+            throw py::value_error("sample " + std::to_string(i) + " = " + fmt(x[i]) + " rejected: allowed finite values");
+        return lowpass_zero_phase(x, fs, fc);
+      },
+      py::arg("x"), py::arg("fs"), py::arg("fc"));
   m.def(
       "_check_scene_file",
       [](const std::string& path, const std::vector<std::string>& overrides) { load_scene_file(path, overrides); },
