@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "catenary_sim/core/scene/scene.hpp"
+#include "scene/capped_file.hpp"
 #include "scene/document_shape.hpp"
 #include "scene/scene_overrides.hpp"
 
@@ -50,10 +51,7 @@ Scene load_scene_file(const std::string& path, const std::vector<std::string>& o
   if (S_ISDIR(st.st_mode)) throw SceneError("scene file '" + path + "': is a directory, expected a YAML file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError("scene file '" + path + "': cannot be opened (" + std::strerror(errno) + ")");
-  // Read at most the cap and one byte more: /dev/zero or a huge file must not fill the memory.
-  std::string text(kMaxSceneFileBytes + 1, '\0');
-  in.read(&text[0], static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
+  const std::string text = read_capped(in, kMaxSceneFileBytes);
   if (text.size() > kMaxSceneFileBytes)
     throw SceneError("scene file '" + path + "': larger than " + std::to_string(kMaxSceneFileBytes >> 20) +
                      " MiB, the limit for a scene (scenes are a few kB of YAML)");

@@ -1,4 +1,5 @@
 #include "scene/read_imperfections.hpp"
+#include "scene/capped_file.hpp"
 
 #include <sys/stat.h>
 
@@ -24,10 +25,7 @@ LineProfile read_profile_csv(const std::string& field, const std::string& path, 
   if (S_ISDIR(st.st_mode)) fail(field, "'" + path + "'", "a CSV file, not a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(field, "'" + path + "'", std::string("a readable CSV file (") + std::strerror(errno) + ")");
-  // Read at most the cap and one byte more (/dev/zero or a huge file must not fill the memory).
-  std::string text(kMaxSceneFileBytes + 1, '\0');
-  in.read(&text[0], static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
+  const std::string text = read_capped(in, kMaxSceneFileBytes);
   if (text.size() > kMaxSceneFileBytes)
     fail(field, "'" + path + "'", "a CSV of at most " + std::to_string(kMaxSceneFileBytes >> 20) + " MiB");
   if (in.bad()) fail(field, "'" + path + "'", std::string("a readable CSV file (") + std::strerror(errno) + ")");
