@@ -1,5 +1,6 @@
 #include "catenary_sim/core/output/pass_files.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <deque>
 #include <iomanip>
@@ -17,25 +18,31 @@ namespace {
 
 // A CSV of rows (time first), written in pieces of about 1 MiB. A value that does not exist (NaN)
 // is an empty field, as RFC 4180 readers take a missing value, never the text "nan".
+// 9 significant digits as printf's %.9g (to_chars' general format is specified to match it),
+// without the stream's per-number locale and format work: the series is most of a pass's output.
+void append_number(std::string& out, double v) {
+  char buf[32];
+  const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 9);
+  out.append(buf, r.ptr);
+}
+
 void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const std::deque<PassRecorder::Row>& rows) {
-  std::ostringstream c;
-  c << "time_s";
-  for (const std::string& col : columns) c << "," << csv_field(col);
-  c << "\n";
-  c << std::setprecision(9);
+  std::string c = "time_s";
+  for (const std::string& col : columns) c += "," + csv_field(col);
+  c += "\n";
   for (const auto& row : rows) {
-    c << row.time;
+    append_number(c, row.time);
     for (double v : row.values) {
-      c << ",";
-      if (std::isfinite(v)) c << v;
+      c += ',';
+      if (std::isfinite(v)) append_number(c, v);
     }
-    c << "\n";
-    if (c.tellp() > (1 << 20)) {
-      f.write(c.str());
-      c.str("");
+    c += '\n';
+    if (c.size() > (1u << 20)) {
+      f.write(c);
+      c.clear();
     }
   }
-  f.write(c.str());
+  f.write(c);
 }
 
 }  // namespace
