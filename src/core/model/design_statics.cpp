@@ -5,6 +5,7 @@
 #include <string>
 
 #include "catenary_sim/core/model/statics.hpp"
+#include "model/spd_solver.hpp"
 #include "util/format.hpp"
 
 namespace catenary_sim {
@@ -29,6 +30,7 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
   for (std::size_t k = 0; k < m.droppers.size(); ++k)
     if (m.droppers[k].section == static_cast<int>(si)) mine.push_back(k);
   const int passes = mine.empty() ? 1 : 4;
+  std::vector<SpdSolver> solver(m.wires.size());  // per wire: its pattern is the same every pass
   for (int pass = 0; pass < passes; ++pass) {
     for (int wi : info.wires) {
       if (wi == info.messenger) continue;
@@ -52,7 +54,7 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
         pn.push_back(node);
         ph.push_back(transition(d.span) ? H : H - sec.contact_wire.presag * 4.0 * s * (1.0 - s));
       }
-      solve_wire_statics(w, load, pn, ph, w.height, w.slope, react[wi]);
+      solve_wire_statics(w, load, pn, ph, w.height, w.slope, react[wi], &solver[wi]);
       // Dropper tensions: the reactions at the dropper nodes, in the order they were added.
       std::size_t r = static_cast<std::size_t>(ns);
       for (std::size_t k : mine)
@@ -70,7 +72,7 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
     }
     std::vector<int> mpn(mwm.support_nodes.begin(), mwm.support_nodes.end());
     std::vector<double> mph(mpn.size(), H + scene.encumbrance);
-    solve_wire_statics(mwm, mload, mpn, mph, mwm.height, mwm.slope, react[info.messenger]);
+    solve_wire_statics(mwm, mload, mpn, mph, mwm.height, mwm.slope, react[info.messenger], &solver[info.messenger]);
     for (std::size_t k : mine) {
       const Dropper& d = m.droppers[k];
       const Wire& cwire = *std::find_if(m.wires.begin(), m.wires.end(), [&](const Wire& w) {

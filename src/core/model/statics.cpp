@@ -1,6 +1,7 @@
 #include "catenary_sim/core/model/statics.hpp"
 
 #include "model/assembly.hpp"
+#include "model/spd_solver.hpp"
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -11,22 +12,9 @@
 
 namespace catenary_sim {
 
-namespace {
-
-Eigen::VectorXd solve_spd(const Eigen::SparseMatrix<double>& k, const Eigen::VectorXd& r, const char* what) {
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);
-  if (ldlt.info() != Eigen::Success)
-    throw SceneError(std::string("statics: ") + what + " is singular (a part of the system is not held by any support)");
-  Eigen::VectorXd x = ldlt.solve(r);
-  if (!x.allFinite()) throw SceneError(std::string("statics: ") + what + " has no finite solution");
-  return x;
-}
-
-}  // namespace
-
 void solve_wire_statics(const Wire& wire, const std::vector<double>& node_load, const std::vector<int>& pn,
                         const std::vector<double>& ph, std::vector<double>& height, std::vector<double>& slope,
-                        std::vector<double>& reactions) {
+                        std::vector<double>& reactions, SpdSolver* solver) {
   const int n = wire.nodes();
   Triplets t;
   add_wire_band(t, wire, 0, n);
@@ -53,7 +41,8 @@ void solve_wire_statics(const Wire& wire, const std::vector<double>& node_load, 
     }
   Eigen::SparseMatrix<double> kr(2 * n, 2 * n);
   kr.setFromTriplets(tr.begin(), tr.end());
-  const Eigen::VectorXd y = solve_spd(kr, r, ("the " + wire.name + " statics").c_str());
+  SpdSolver own;
+  const Eigen::VectorXd y = (solver ? *solver : own).solve(kr, r, "the " + wire.name + " statics");
   height.assign(y.data(), y.data() + n);
   slope.assign(y.data() + n, y.data() + 2 * n);
   const Eigen::VectorXd ky = k * y;
@@ -195,7 +184,7 @@ void add_pantographs(const Model& m, const PantographLoads& loads, const ActiveS
 }
 
 // The rigid supports (no inverse mass) held at zero: identity rows and columns; then K x = r.
-Eigen::VectorXd solve_held(const Model& m, int size, StaticSystem& sys) {
+Eigen::VectorXd solve_held(const Model& m, int size, StaticSystem& sys, SpdSolver& solver) {
   std::vector<bool> fixed(size, false);
   for (int i = 0; i < m.n_dof; ++i) fixed[i] = m.inv_mass[i] == 0.0;
   Triplets tr;
@@ -209,7 +198,7 @@ Eigen::VectorXd solve_held(const Model& m, int size, StaticSystem& sys) {
     }
   Eigen::SparseMatrix<double> k(size, size);
   k.setFromTriplets(tr.begin(), tr.end());
-  return solve_spd(k, sys.r, "the initial configuration (eq. 23)");
+  return solver.solve(k, sys.r, "the initial configuration (eq. 23)");
 }
 
 // Eq. 25 on the solution x: a dropper is taut while its tension S0 + k (w_messenger - w_contact)
@@ -267,6 +256,7 @@ Eigen::VectorXd solve_static_equilibrium(const Model& m, const PantographLoads& 
   active.dropper_on.assign(m.droppers.size(), true);
   active.contact_on.assign(m.collectors.size() * m.contact_wires.size(), true);
   StaticSystem sys;
+  SpdSolver solver;  // the active set changes values, seldom the pattern
   sys.node.resize(m.max_contact_nodes);
   sys.weight.resize(m.max_contact_nodes);
   // The active set is guessed, solved for, and corrected until it agrees with its solution.
@@ -275,7 +265,7 @@ Eigen::VectorXd solve_static_equilibrium(const Model& m, const PantographLoads& 
     sys.r = Eigen::VectorXd::Zero(q.size);
     add_line(m, q, active, sys);
     add_pantographs(m, loads, active, roof_springs, sys);
-    const Eigen::VectorXd x = solve_held(m, q.size, sys);
+    const Eigen::VectorXd x = solve_held(m, q.size, sys, solver);
     const bool droppers_changed = update_taut_droppers(m, x, active);
     const bool contacts_changed = update_contacts(m, loads, x, active, sys);
     if (!droppers_changed && !contacts_changed) return x.head(m.n_dof);

@@ -12,10 +12,13 @@ namespace catenary_sim {
 
 // Statics of one wire with some nodes held at prescribed heights: returns (w, theta) per node in
 // `height`/`slope` and the support reactions (N, upward positive) at the prescribed nodes.
-// `node_load` is the vertical load on each node (N, upward positive).
+// `node_load` is the vertical load on each node (N, upward positive). `solver` (model/spd_solver.hpp,
+// private) keeps the ordering between solves of one wire; null: a solver of the call's own.
+class SpdSolver;
 void solve_wire_statics(const Wire& wire, const std::vector<double>& node_load,
                         const std::vector<int>& prescribed_nodes, const std::vector<double>& prescribed_heights,
-                        std::vector<double>& height, std::vector<double>& slope, std::vector<double>& reactions);
+                        std::vector<double>& height, std::vector<double>& slope, std::vector<double>& reactions,
+                        SpdSolver* solver = nullptr);
 
 // What the pantographs press with in the static problem: the train front's position (m) and,
 // per pantograph, the static uplift in effect (N), an external pantograph's given force (N) and
