@@ -47,19 +47,26 @@ std::vector<ContactLossEvent> contact_loss_events(const std::vector<double>& t, 
 }
 
 void TurningPoints::add(double v) {
-  if (points_.empty()) {
-    points_.push_back(v);
+  if (!started_) {
+    last_ = v;
+    started_ = true;
     return;
   }
-  const double last = points_.back();
-  if (v == last) return;
-  const int dir = v > last ? 1 : -1;
-  if (dir == direction_) {
-    points_.back() = v;  // still rising (falling): the reversal moves on
-  } else {
-    points_.push_back(v);
+  if (v == last_) return;
+  const int dir = v > last_ ? 1 : -1;
+  if (dir != direction_) {
+    points_.push_back(last_);  // the direction turned: the last reversal is final
     direction_ = dir;
   }
+  last_ = v;  // still rising (falling): the reversal moves on
+}
+
+std::vector<double> TurningPoints::points() const {
+  std::vector<double> p;
+  p.reserve(points_.size() + 1);
+  p = points_;
+  if (started_) p.push_back(last_);
+  return p;
 }
 
 std::vector<double> turning_points(const std::vector<double>& x) {
@@ -70,6 +77,7 @@ std::vector<double> turning_points(const std::vector<double>& x) {
 
 std::vector<RainflowCycle> rainflow(const std::vector<double>& reversals) {
   std::vector<RainflowCycle> out;
+  out.reserve(reversals.size());  // each cycle or half cycle takes at least one reversal off
   std::vector<double> stack;
   stack.reserve(64);
   auto cycle = [&](double a, double b, double count) {

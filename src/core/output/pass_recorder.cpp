@@ -226,7 +226,7 @@ std::size_t PassRecorder::memory_bytes() const {
   vecs(suspension_stretch_);
   vecs(suspension_force_);
   for (const auto& a : max_uplift_) b += a.size() * (sizeof(long long) + sizeof(double) + 32);
-  for (const DropperTrack& t : droppers_) b += t.reversals.points().capacity() * sizeof(double);
+  for (const DropperTrack& t : droppers_) b += t.reversals.capacity() * sizeof(double);
   b += row_index_.capacity() * sizeof(std::size_t);
   rows(rows_);
   rows(dropper_rows_);

@@ -28,16 +28,20 @@ std::vector<ContactLossEvent> contact_loss_events(const std::vector<double>& t, 
 // ---- Rainflow counting (ASTM E1049-85 (2017), section 5.4.4) -------------------------------
 
 // Reversals (peaks and valleys) of a series, built one sample at a time: a sample that continues
-// the current direction replaces the last reversal, a repeated value is dropped. Cheap enough to
-// run on every step of a pass (one comparison and at most one push per sample).
+// the current direction replaces the last reversal, a repeated value is dropped. Run on every step
+// of a pass for each dropper, so the reversal still moving is held here and the list is written
+// only when the direction turns (one comparison a sample, a push a reversal).
 class TurningPoints {
  public:
   void add(double v);
-  const std::vector<double>& points() const { return points_; }
-  bool empty() const { return points_.empty(); }
+  std::vector<double> points() const;  // the reversals so far, the one still moving last
+  bool empty() const { return !started_; }
+  std::size_t capacity() const { return points_.capacity(); }
 
  private:
-  std::vector<double> points_;
+  std::vector<double> points_;  // the reversals before the last
+  double last_ = 0.0;           // the last reversal (moves on while the direction holds)
+  bool started_ = false;
   int direction_ = 0;  // +1 rising, -1 falling, 0 not yet known
 };
 
