@@ -31,6 +31,7 @@ constexpr std::size_t kSlackDropperCapacity = 64;
 constexpr int kMaxActiveSetPasses = 4;
 
 struct StepWorkspace;
+extern template class DeepCopied<StepWorkspace>;  // (instantiated in state.cpp)
 
 // Owns a State's step workspace (whose contents only the engine sees) and copies it deep.
 using StepWorkspaceHandle = DeepCopied<StepWorkspace>;
