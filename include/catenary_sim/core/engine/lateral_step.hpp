@@ -52,10 +52,12 @@ struct LateralState {
   // in buffers sized once (wind_field.hpp). wind_points holds its points' values from first().
   WindFieldBuffer wind_field;
 
-  // Moving window's placement: the part of each wire the lateral plane steps (node ranges, with
-  // their factors), from the vertical plane's window's first support to its last or, with a gust
-  // lead (LateralModel::gust_lead), a support further ahead; outside, the nodes stay in the static
-  // state under the mean wind, at rest. Support indices into Model::support_x, -1: none yet.
+  // Moving window's placement, for observers (lateral_statistics counts the blow-off where it
+  // steps): the part of each wire the lateral plane steps (node ranges, with their factors), from
+  // the vertical plane's window's first support to its last or, with a gust lead
+  // (LateralModel::gust_lead), a support further ahead; outside, the nodes stay in the static
+  // state under the mean wind, at rest. Support indices into Model::support_x, -1: none yet. The
+  // step derives it from State::window (sync_window; test_state: a copy without it steps the same).
   std::vector<WireWindow> window;
   int window_first_support = -1, window_last_support = -1;
 
@@ -67,7 +69,7 @@ struct LateralState {
   std::vector<double> pantograph_lateral;  // m, per pantograph (sway)
   // Per collector: outside the working width now (a dewirement is a change of it: state too).
   std::vector<std::uint8_t> off_strip;
-  std::vector<DewirementEvent> events;     // the pass's first dewirements; capacity reserved
+  std::vector<DewirementEvent> events;     // the pass's first ones; capacity reserved (no allocation)
   std::int64_t events_total = 0;           // dewirements of the pass, kept or not
   bool diverged = false;                   // the lateral step left the divergence limit
   bool dewired_stop = false;               // a dewirement stopped the pass (on_dewirement: stop)
