@@ -16,6 +16,7 @@
 #include "catenary_sim/core/engine/initial_state.hpp"
 #include "catenary_sim/core/model/wind_field.hpp"
 #include "../support/scenes.hpp"
+#include "engine/lateral_workspace.hpp"  // (the window's and the joint sweep's diagnostics)
 
 using namespace catenary_sim;
 
@@ -1167,7 +1168,7 @@ int expect_fused_is_generic(const std::vector<std::string>& overrides, int* wind
     EXPECT_EQ(sa, sg);
     if (sa != StepStatus::kOk || sg != StepStatus::kOk) break;
     ++steps;
-    *windowed_fused_steps += a.state().lateral.window_fused;
+    *windowed_fused_steps += a.state().lateral.work->window_fused;
     EXPECT_EQ(a.state().lateral.y.size(), g.lateral.y.size());
     for (int i = 0; i < generic.n_dof; ++i) {
       if (a.state().u[i] != g.u[i] || a.state().v[i] != g.v[i]) {
@@ -1204,7 +1205,7 @@ TEST(Lateral, FusedStepIsTheGenericStepBitForBit) {
   // Without a window both planes are swept at once (sweep_pack_pair) at every step.
   while (joint.step() == StepStatus::kOk) {
   }
-  EXPECT_EQ(joint.state().lateral.joined_steps, joint.state().steps);
+  EXPECT_EQ(joint.state().lateral.work->joined_steps, joint.state().steps);
   // And with the moving window on 12 spans (about 5 in the window: both ends cut, the window
   // moved span by span, the cut layers' static force and the dashpots in the point forces), in a
   // steady wind (in a turbulent one a finite line's lateral plane is not windowed).

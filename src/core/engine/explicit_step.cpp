@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "engine/forces.hpp"
+#include "engine/lateral_workspace.hpp"
 #include "engine/step_workspace.hpp"
 #include "engine/train_motion.hpp"
 #include "engine/window.hpp"
@@ -41,8 +42,8 @@ bool sweep_packs(const Model& m, State& s, bool windowed) {
   const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
   bool outside = false;
   // The lateral step's band sweep taken along (step_both_planes): both planes' records then in the
-  // joint layout (LateralState::sweep, joint_record_index).
-  const bool join = m.lateral && s.lateral.join;
+  // joint layout (LateralWorkspace::sweep, joint_record_index).
+  const bool join = m.lateral && s.lateral.work->join;
   bool lateral_outside = false;
   for (std::size_t pk = 0; pk < m.wire_packs->packs.size(); ++pk) {
     PackSweep a, b;
@@ -54,16 +55,17 @@ bool sweep_packs(const Model& m, State& s, bool windowed) {
     a.limit = limit;
     if (join && setup_lateral_sweep(m, s, pk, false, b)) {
       bool b_outside = false;
-      outside |= sweep_pack_pair(a, b, s.lateral.sweep.data() + 2 * kSweepRecord * m.wire_packs->packs[pk].offset, &b_outside);
+      double* joint_record = s.lateral.work->sweep.data() + 2 * kSweepRecord * m.wire_packs->packs[pk].offset;
+      outside |= sweep_pack_pair(a, b, joint_record, &b_outside);
       lateral_outside |= b_outside;
     } else {
       outside |= sweep_pack(a);
     }
   }
   if (join) {
-    s.lateral.joined = true;
-    s.lateral.joined_outside = lateral_outside;
-    ++s.lateral.joined_steps;
+    s.lateral.work->joined = true;
+    s.lateral.work->joined_outside = lateral_outside;
+    ++s.lateral.work->joined_steps;
   }
   return outside;
 }
@@ -160,13 +162,13 @@ int explicit_fused_update(const Model& m, State& s, bool windowed) {
   double* f = s.work->force.data();
   const double dt = m.dt, limit = m.scene.numerics.divergence_limit;
   bool outside = sweep_packs(m, s, windowed);
-  const bool join = m.lateral && s.lateral.join;
+  const bool join = m.lateral && s.lateral.work->join;
   const int contacts = list_contact_nodes(m, s, windowed);
   const int* contact_node = s.work->point_node.data();
   // Supports, droppers and the window's dashpots act straight on the band forces the sweep left in
   // its records (where z is too), in the generic step's order; the contact nodes then take their
   // force so far into the force vector, where the pantographs' contact adds to it.
-  double* rec = join ? s.lateral.sweep.data() : s.work->sweep.data();
+  double* rec = join ? s.lateral.work->sweep.data() : s.work->sweep.data();
   const int* f_at = m.wire_packs->dof_sweep_force.data();
   const int* z_at = m.wire_packs->dof_sweep_z.data();
   const int joint = join;

@@ -10,9 +10,11 @@
 #include "catenary_sim/core/engine/state.hpp"
 #include "engine/lateral_window.hpp"
 #include "engine/lateral_wind.hpp"
+#include "engine/lateral_workspace.hpp"
 #include "engine/step_workspace.hpp"
 #include "engine/window.hpp"
 #include "engine/wire_lanes.hpp"
+#include "util/deep_copied_impl.hpp"
 
 namespace catenary_sim {
 
@@ -30,44 +32,47 @@ void update_head_wind(const Model& m, State& s, const WindFieldBuffer* field, co
   }
 }
 
+template class DeepCopied<LateralWorkspace>;  // LateralState::work
+
 LateralState make_lateral_state(const Model& m) {
   const LateralModel& lat = *m.lateral;
   LateralState s;
+  LateralWorkspace& work = *s.work;
   s.y = lat.initial;
   s.v = Eigen::VectorXd::Zero(lat.n);
-  s.f = Eigen::VectorXd::Zero(lat.n);
-  s.z = Eigen::VectorXd::Zero(lat.n);
-  s.y_next = s.y;
-  s.v_next = Eigen::VectorXd::Zero(lat.n);
-  s.accel = Eigen::VectorXd::Zero(lat.n);
-  s.sweep.assign(2 * kSweepRecord * sweep_size(m), 0.0);  // (both planes' records when joint)
+  work.f = Eigen::VectorXd::Zero(lat.n);
+  work.z = Eigen::VectorXd::Zero(lat.n);
+  work.y_next = s.y;
+  work.v_next = Eigen::VectorXd::Zero(lat.n);
+  work.accel = Eigen::VectorXd::Zero(lat.n);
+  work.sweep.assign(2 * kSweepRecord * sweep_size(m), 0.0);  // (both planes' records when joint)
   int longest = 0;
   for (const Wire& w : lat.wires) longest = std::max(longest, w.nodes());
-  s.theta.assign(longest, 0.0);
+  work.theta.assign(longest, 0.0);
   s.wind_points.assign(std::max(0, lat.field.held), 0.0);
   if (m.endless) s.wind_field.reset(lat.field);  // (nothing for a steady wind)
   if (lat.windy) s.wind_speed = lat.wind_speed * lat.wind_normal;  // the mean wind until the field's first refresh
-  s.weight_node.assign(m.max_contact_nodes, 0);
-  s.weight.assign(m.max_contact_nodes, 0.0);
+  work.weight_node.assign(m.max_contact_nodes, 0);
+  work.weight.assign(m.max_contact_nodes, 0.0);
   s.contact_lateral.assign(m.collectors.size() * m.contact_wires.size(), std::nan(""));
   s.collector_lateral.assign(m.collectors.size(), std::nan(""));
   s.pantograph_lateral.assign(m.pantographs.size(), 0.0);
   s.off_strip.assign(m.collectors.size(), 0);
   s.events.reserve(kMaxDewirementEvents);
   s.dropper_stretch.assign(m.droppers.size(), 0.0);
-  s.lean_weight.assign(m.droppers.size(), 1.0);
+  work.lean_weight.assign(m.droppers.size(), 1.0);
   for (const LateralPendulum& p : lat.pendulums) s.dropper_stretch[p.dropper] = lean_stretch(p, s.y.data());  // 0: y is initial
   s.window.resize(lat.wires.size());
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     s.window[wi].tt_lower.assign(lat.wires[wi].nodes(), 0.0);
     s.window[wi].tt_inv_pivot.assign(lat.wires[wi].nodes(), 0.0);
   }
-  if (lat.windowed && !lat.planes.empty()) s.sweep_factors.assign(2 * sweep_size(m), 0.0);
-  s.window_springs.assign(lat.springs.size(), 0);
-  s.window_droppers.assign(lat.pendulums.size(), 0);
-  s.cut_node.assign(2 * kCutLayer * m.wires.size(), 0);
-  s.cut_force.assign(s.cut_node.size(), 0.0);
-  s.window_points.assign(s.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size(), 0);
+  if (lat.windowed && !lat.planes.empty()) work.sweep_factors.assign(2 * sweep_size(m), 0.0);
+  work.window_springs.assign(lat.springs.size(), 0);
+  work.window_droppers.assign(lat.pendulums.size(), 0);
+  work.cut_node.assign(2 * kCutLayer * m.wires.size(), 0);
+  work.cut_force.assign(work.cut_node.size(), 0.0);
+  work.window_points.assign(work.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size(), 0);
   return s;
 }
 
@@ -78,6 +83,7 @@ namespace {
 bool contact_points(const Model& m, State& s, bool record) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
   const PantographHeadSpec& head = m.scene.pantograph_head;
   const double sway = head.sway(s.time);  // the contact point on the strip is wire minus pantograph
   const std::size_t nw = m.contact_wires.size();
@@ -92,9 +98,9 @@ bool contact_points(const Model& m, State& s, bool record) {
       int running = -1;
       for (std::size_t wk = 0; wk < nw; ++wk) {
         const Wire& w = lat.wires[m.contact_wires[wk]];
-        const int cnt = contact_weights(w, m.rub_length, xc, ls.weight_node.data(), ls.weight.data());
+        const int cnt = contact_weights(w, m.rub_length, xc, lw.weight_node.data(), lw.weight.data());
         double y = 0.0;
-        for (int a = 0; a < cnt; ++a) y += ls.weight[a] * ls.y[w.w_dof + ls.weight_node[a]];
+        for (int a = 0; a < cnt; ++a) y += lw.weight[a] * ls.y[w.w_dof + lw.weight_node[a]];
         ls.contact_lateral[ci * nw + wk] = cnt ? y - sway : std::nan("");
         const double fc = s.contact_force[ci * nw + wk];
         if (cnt && fc > best_force) {
@@ -135,17 +141,18 @@ template <class ZAt>
 void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const double* y, ZAt z_at, double* f) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
-  const int n_springs = windowed ? ls.window_spring_count : static_cast<int>(lat.springs.size());
+  LateralWorkspace& lw = *ls.work;
+  const int n_springs = windowed ? lw.window_spring_count : static_cast<int>(lat.springs.size());
   for (int j = 0; j < n_springs; ++j) {
-    const LateralSpring& sp = lat.springs[windowed ? ls.window_springs[j] : j];
+    const LateralSpring& sp = lat.springs[windowed ? lw.window_springs[j] : j];
     f[sp.dof] -= sp.stiffness * z_at(sp.dof);
   }
   const double* u = s.u.data();
   double* stretch = ls.dropper_stretch.data();
-  const double* w = ls.lean_weight.data();
-  const int n_pendulums = windowed ? ls.window_dropper_count : static_cast<int>(lat.pendulums.size());
+  const double* w = lw.lean_weight.data();
+  const int n_pendulums = windowed ? lw.window_dropper_count : static_cast<int>(lat.pendulums.size());
   for (int j = 0; j < n_pendulums; ++j) {
-    const LateralPendulum& p = lat.pendulums[windowed ? ls.window_droppers[j] : j];
+    const LateralPendulum& p = lat.pendulums[windowed ? lw.window_droppers[j] : j];
     const Dropper& d = m.droppers[p.dropper];
     const double lean = lean_stretch(p, y);
     stretch[p.dropper] += lean;
@@ -168,27 +175,28 @@ void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const do
 bool fused_substep(const Model& m, State& s, bool windowed) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
   const double h = lat.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
   const double* y = ls.y.data();
   const double* v = ls.v.data();
-  double* yn = ls.y_next.data();
-  double* vn = ls.v_next.data();
-  double* acc = ls.accel.data();
+  double* yn = lw.y_next.data();
+  double* vn = lw.v_next.data();
+  double* acc = lw.accel.data();
   // The band sweeps: taken along by this step's vertical sweeps (step_both_planes), else here.
-  const int joined = ls.joined;  // (its records then in the joint layout: joint_record_index)
-  bool outside = joined && ls.joined_outside;
+  const int joined = lw.joined;  // (its records then in the joint layout: joint_record_index)
+  bool outside = joined && lw.joined_outside;
   if (!joined)
     for (std::size_t pk = 0; pk < packs_of(m).size(); ++pk) {
       PackSweep a;
       if (setup_lateral_sweep(m, s, pk, windowed, a)) outside |= sweep_pack(a);
     }
-  ls.joined = false;
+  lw.joined = false;
   // Point forces on the band forces the sweep left in its records, as the generic step adds them.
-  double* f = ls.f.data();
-  const double* rec = joined ? ls.sweep.data() : s.work->sweep.data();
+  double* f = lw.f.data();
+  const double* rec = joined ? lw.sweep.data() : s.work->sweep.data();
   const int* at = lat.sweep_force_at.data();
-  const int* points = windowed ? ls.window_points.data() : lat.point_nodes.data();
-  const int np = windowed ? ls.window_point_count : static_cast<int>(lat.point_nodes.size());
+  const int* points = windowed ? lw.window_points.data() : lat.point_nodes.data();
+  const int np = windowed ? lw.window_point_count : static_cast<int>(lat.point_nodes.size());
   for (int q = 0; q < np; ++q) f[points[q]] = rec[joint_record_index(at[points[q]], joined, true)];
   if (windowed) add_window_forces(m, s, v, f);
   add_springs_and_pendulums(m, s, windowed, y, [y, v, beta](int i) { return y[i] + beta * v[i]; }, f);
@@ -218,8 +226,8 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
     });
     return false;
   }
-  ls.y.swap(ls.y_next);  // O(1)
-  ls.v.swap(ls.v_next);
+  ls.y.swap(lw.y_next);  // O(1)
+  ls.v.swap(lw.v_next);
   return false;
 }
 
@@ -230,12 +238,13 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
 bool generic_substep(const Model& m, State& s, bool windowed) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
   const double h = lat.dt, beta = m.beta, alpha = m.alpha;
   const double* load = lat.load.data();
   const double* mass = lat.mass.data();
   const double* inv_mass = lat.inv_mass.data();
-  double* f = ls.f.data();
-  double* z = ls.z.data();
+  double* f = lw.f.data();
+  double* z = lw.z.data();
   const double limit = m.scene.numerics.divergence_limit;
   double* y = ls.y.data();
   double* v = ls.v.data();
@@ -256,10 +265,10 @@ bool generic_substep(const Model& m, State& s, bool windowed) {
     }
   });
   if (windowed) {
-    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) wire_elastic_force_window(lat.wires[wi], ls.window[wi], z, f, ls.theta.data());
+    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) wire_elastic_force_window(lat.wires[wi], ls.window[wi], z, f, lw.theta.data());
     add_window_forces(m, s, v, f);
   } else {
-    for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, ls.theta.data());
+    for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, lw.theta.data());
   }
   add_springs_and_pendulums(m, s, windowed, y, [z](int i) { return z[i]; }, f);
   int out = 0;  // an integer OR vectorises where a max over doubles (NaN rules) does not
@@ -279,6 +288,7 @@ bool generic_substep(const Model& m, State& s, bool windowed) {
 StepStatus lateral_step(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
   const double h = lat.dt;
   const double t0 = s.time - m.dt;  // the vertical step has already moved the clock on
   // The droppers' lean over this step's substeps (all at this u), for the next vertical step.
@@ -288,14 +298,14 @@ StepStatus lateral_step(const Model& m, State& s) {
     // not move them), so a lean there would load the dropper with k delta against rigid wires,
     // where the free line gives way (delta / (1/k + f_c + f_m), some 1/300 of it): the lean acts on
     // the tension only inside the window, as in the vertical step.
-    for (double& x : ls.lean_weight) x = 0.0;
-    for (int j = 0; j < s.window_dropper_count; ++j) ls.lean_weight[s.window_droppers[j]] = 1.0;
+    for (double& x : lw.lean_weight) x = 0.0;
+    for (int j = 0; j < s.window_dropper_count; ++j) lw.lean_weight[s.window_droppers[j]] = 1.0;
   }
   const bool windowed = lat.windowed;
   if (windowed) sync_window(m, s);
   for (int sub = 0; sub < lat.substeps; ++sub) {
     refresh_wind_if_due(m, s, t0 + sub * h, windowed);
-    const bool fused = !lat.planes.empty() && (!windowed || ls.window_fused);
+    const bool fused = !lat.planes.empty() && (!windowed || lw.window_fused);
     if (fused ? fused_substep(m, s, windowed) : generic_substep(m, s, windowed)) {
       ls.diverged = true;
       s.status = StepStatus::kDiverged;
@@ -316,6 +326,7 @@ StepStatus lateral_step(const Model& m, State& s) {
 void shift_lateral_block(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
   const bool windowed = lat.windowed;  // (an endless line always is)
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     const Wire& w = lat.wires[wi];
@@ -346,7 +357,7 @@ void shift_lateral_block(const Model& m, State& s) {
       ls.window[wi].hi = hi - ns;
     }
   }
-  ls.window_dirty = true;  // the lists and factors hold the old DOFs (the node ranges already match)
+  lw.window_dirty = true;  // the lists and factors hold the old DOFs (the node ranges already match)
   set_dropper_stretch(m, s);  // the droppers' lean moved with the block
   if (lat.windy && !lat.field.empty()) {
     // The spans entering ahead take the wind of the last refresh at their stations (sync_window):

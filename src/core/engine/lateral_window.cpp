@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "engine/lateral_wind.hpp"
+#include "engine/lateral_workspace.hpp"
 #include "engine/window.hpp"
 #include "engine/wire_lanes.hpp"
 
@@ -19,9 +20,10 @@ namespace {
 void move_wire_window(const Model& m, State& s, std::size_t wi, int first, double xa, double xb, bool turbulent) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
   double* y = ls.y.data();
   double* v = ls.v.data();
-  double* f = ls.f.data();
+  double* f = lw.f.data();
   const Wire& w = lat.wires[wi];
   WireWindow& ww = ls.window[wi];
   const int o = w.w_dof, old_lo = ww.lo, old_hi = ww.hi;
@@ -41,13 +43,13 @@ void move_wire_window(const Model& m, State& s, std::size_t wi, int first, doubl
     for (int i = lo; i <= hi; ++i)
       if (i < old_lo || i > old_hi) refresh_wind(m, s, o + i, o + i + 1);
   if (hi < lo) return;
-  if (hi == lo) ls.window_fused = false;  // (as the vertical step: the sweep needs two nodes)
+  if (hi == lo) lw.window_fused = false;  // (as the vertical step: the sweep needs two nodes)
   if (!ww.cut_lo && !ww.cut_hi) return;
   for (int i = lo; i <= hi; ++i) f[o + i] = 0.0;
-  wire_elastic_force_window(w, ww, lat.initial.data(), f, ls.theta.data());
+  wire_elastic_force_window(w, ww, lat.initial.data(), f, lw.theta.data());
   auto add_cut = [&](int i) {
-    ls.cut_node[ls.cut_count] = o + i;
-    ls.cut_force[ls.cut_count++] = lat.static_elastic_force[o + i] - f[o + i];
+    lw.cut_node[lw.cut_count] = o + i;
+    lw.cut_force[lw.cut_count++] = lat.static_elastic_force[o + i] - f[o + i];
   };
   const int lo_end = ww.cut_lo ? std::min(hi, lo + kCutLayer - 1) : lo - 1;
   for (int i = lo; i <= lo_end; ++i) add_cut(i);
@@ -60,27 +62,28 @@ void move_wire_window(const Model& m, State& s, std::size_t wi, int first, doubl
 void list_window_points(const Model& m, State& s, int first, double xa, double xb) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
   auto inside = [&](int dof) { return in_windows(lat.wires, ls.window, dof); };
-  ls.window_spring_count = ls.window_dropper_count = 0;
+  lw.window_spring_count = lw.window_dropper_count = 0;
   if (first >= 0) {
-    ls.window_spring_count = select_between(
+    lw.window_spring_count = select_between(
         lat.spring_order, lat.spring_order_x, xa, xb, [&](int k) { return inside(lat.springs[k].dof); },
-        ls.window_springs.data());
-    ls.window_dropper_count = select_between(
+        lw.window_springs.data());
+    lw.window_dropper_count = select_between(
         m.dropper_order, m.dropper_order_x, xa, xb,
         [&](int k) { return inside(lat.pendulums[k].contact) && inside(lat.pendulums[k].messenger); },
-        ls.window_droppers.data());
+        lw.window_droppers.data());
   }
   // The fused step's nodes with point forces: the cut layers, springs, pendulums.
   int q = 0;
-  for (int j = 0; j < ls.cut_count; ++j) ls.window_points[q++] = ls.cut_node[j];
-  for (int j = 0; j < ls.window_spring_count; ++j) ls.window_points[q++] = lat.springs[ls.window_springs[j]].dof;
-  for (int j = 0; j < ls.window_dropper_count; ++j) {
-    const LateralPendulum& p = lat.pendulums[ls.window_droppers[j]];
-    ls.window_points[q++] = p.contact;
-    ls.window_points[q++] = p.messenger;
+  for (int j = 0; j < lw.cut_count; ++j) lw.window_points[q++] = lw.cut_node[j];
+  for (int j = 0; j < lw.window_spring_count; ++j) lw.window_points[q++] = lat.springs[lw.window_springs[j]].dof;
+  for (int j = 0; j < lw.window_dropper_count; ++j) {
+    const LateralPendulum& p = lat.pendulums[lw.window_droppers[j]];
+    lw.window_points[q++] = p.contact;
+    lw.window_points[q++] = p.messenger;
   }
-  ls.window_point_count = q;
+  lw.window_point_count = q;
 }
 
 }  // namespace
@@ -98,6 +101,7 @@ void list_window_points(const Model& m, State& s, int first, double xa, double x
 void sync_window(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
   const std::vector<double>& sx = m.support_x;
   const int first = s.window_first_support;
   int last = s.window_last_support;
@@ -106,26 +110,27 @@ void sync_window(const Model& m, State& s) {
     last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x - 1e-6) - sx.begin());
     last = std::min(last, static_cast<int>(sx.size()) - 1);
   }
-  if (first == ls.window_first_support && last == ls.window_last_support && !ls.window_dirty) return;
-  ls.window_dirty = false;
+  if (first == ls.window_first_support && last == ls.window_last_support && !lw.window_dirty) return;
+  lw.window_dirty = false;
   ls.window_first_support = first;
   ls.window_last_support = last;
   const bool turbulent = lat.windy && !lat.field.empty();
-  ls.cut_count = 0;
-  ls.window_fused = !lat.planes.empty();
+  lw.cut_count = 0;
+  lw.window_fused = !lat.planes.empty();
   const double xa = first >= 0 ? sx[first] : 0.0, xb = first >= 0 ? sx[last] : -1.0;
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) move_wire_window(m, s, wi, first, xa, xb, turbulent);
   for (const WireLanes& p : packs_of(m))
     if (p.lanes == 2 && (ls.window[p.wire[0]].lo != ls.window[p.wire[1]].lo || ls.window[p.wire[0]].hi != ls.window[p.wire[1]].hi))
-      ls.window_fused = false;
-  if (ls.window_fused) interleave_window_factors(packs_of(m), ls.window, ls.sweep_factors.data());
+      lw.window_fused = false;
+  if (lw.window_fused) interleave_window_factors(packs_of(m), ls.window, lw.sweep_factors.data());
   list_window_points(m, s, first, xa, xb);
 }
 
 void add_window_forces(const Model& m, const State& s, const double* v, double* f) {
   const LateralModel& lat = *m.lateral;
   const LateralState& ls = s.lateral;
-  for (int j = 0; j < ls.cut_count; ++j) f[ls.cut_node[j]] += ls.cut_force[j];
+  const LateralWorkspace& lw = *ls.work;
+  for (int j = 0; j < lw.cut_count; ++j) f[lw.cut_node[j]] += lw.cut_force[j];
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     const WireWindow& ww = ls.window[wi];
     if (ww.hi < ww.lo) continue;

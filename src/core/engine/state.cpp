@@ -7,24 +7,11 @@
 #include "engine/forces.hpp"
 #include "engine/step_workspace.hpp"
 #include "engine/wire_lanes.hpp"
+#include "util/deep_copied_impl.hpp"
 
 namespace catenary_sim {
 
-StepWorkspaceHandle::StepWorkspaceHandle() : work_(std::make_unique<StepWorkspace>()) {}
-StepWorkspaceHandle::StepWorkspaceHandle(const StepWorkspaceHandle& other)
-    : work_(other.work_ ? std::make_unique<StepWorkspace>(*other.work_) : nullptr) {}
-StepWorkspaceHandle::StepWorkspaceHandle(StepWorkspaceHandle&& other) noexcept = default;
-// Into an existing workspace: its buffers keep their storage when the sizes match (a skin
-// restoring a snapshot of the same model allocates nothing).
-StepWorkspaceHandle& StepWorkspaceHandle::operator=(const StepWorkspaceHandle& other) {
-  if (this == &other) return *this;
-  if (!other.work_) work_.reset();
-  else if (work_) *work_ = *other.work_;
-  else work_ = std::make_unique<StepWorkspace>(*other.work_);
-  return *this;
-}
-StepWorkspaceHandle& StepWorkspaceHandle::operator=(StepWorkspaceHandle&& other) noexcept = default;
-StepWorkspaceHandle::~StepWorkspaceHandle() = default;
+template class DeepCopied<StepWorkspace>;  // StepWorkspaceHandle
 
 State make_state(const Model& m) {
   State s;

@@ -9,6 +9,7 @@
 #include "engine/explicit_step.hpp"
 #include "engine/implicit_step.hpp"
 #include "engine/lateral_wind.hpp"
+#include "engine/lateral_workspace.hpp"
 #include "engine/wire_lanes.hpp"
 
 namespace catenary_sim {
@@ -40,16 +41,16 @@ StepStatus step_both_planes(const Model& m, State& s) {
   // both fused, and the step will be taken (not the pass's end).
   bool two_wire_packs = true;  // (sweep_pack_pair's four lanes)
   for (const WireLanes& p : packs_of(m)) two_wire_packs &= p.lanes == 2;
-  ls.join = !lat.planes.empty() && two_wire_packs && lat.substeps == 1 && !m.scene.numerics.windowed() &&
+  ls.work->join = !lat.planes.empty() && two_wire_packs && lat.substeps == 1 && !m.scene.numerics.windowed() &&
             s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty();
   // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
   // the vertical step's s.time += dt), refreshed now for the sweep (lateral_step then finds it
   // done: the same values, once).
-  if (ls.join) refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
+  if (ls.work->join) refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
   const StepStatus st = vertical_step(m, s);
-  ls.join = false;
+  ls.work->join = false;
   if (st != StepStatus::kOk) {
-    ls.joined = false;
+    ls.work->joined = false;
     return st;
   }
   return lateral_step(m, s);

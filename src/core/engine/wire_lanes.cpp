@@ -11,6 +11,7 @@
 #include <cstring>
 
 #include "catenary_sim/core/model/lateral.hpp"
+#include "engine/lateral_workspace.hpp"
 #include "engine/step_workspace.hpp"
 
 namespace catenary_sim {
@@ -474,9 +475,10 @@ bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const 
 bool setup_lateral_sweep(const Model& m, State& s, std::size_t pack, bool windowed, PackSweep& a) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
   const WireLanes& p = m.wire_packs->packs[pack];
-  if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, ls.sweep_factors.data(), s.work->sweep.data(), ls.y.data(),
-                        ls.v.data(), ls.y_next.data(), ls.v_next.data(), ls.accel.data(), a))
+  if (!setup_pack_sweep(p, lat.wires, windowed ? &ls.window : nullptr, lw.sweep_factors.data(), s.work->sweep.data(), ls.y.data(),
+                        ls.v.data(), lw.y_next.data(), lw.v_next.data(), lw.accel.data(), a))
     return false;
   // (the records in the vertical step's scratch, StepWorkspace::sweep; sweep_pack_pair puts them elsewhere)
   a.plane = lat.planes[pack].data();

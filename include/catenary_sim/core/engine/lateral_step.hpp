@@ -17,6 +17,7 @@
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/model/wind_field.hpp"
 #include "catenary_sim/core/engine/wire_window.hpp"
+#include "catenary_sim/core/util/deep_copied.hpp"
 
 namespace catenary_sim {
 
@@ -31,59 +32,51 @@ struct DewirementEvent {
 };
 constexpr std::size_t kMaxDewirementEvents = 1024;  // kept per pass; more are counted only
 
+struct LateralWorkspace;
+extern template class DeepCopied<LateralWorkspace>;  // (instantiated in lateral_step.cpp)
+
+// The lateral plane's state: what a copy needs to step on exactly as its original (test_state),
+// and its outputs. The step's buffers and lists live in `work`, private to the engine.
 struct LateralState {
-  Eigen::VectorXd y, v;      // m, m/s (v at the half step, eq. 20)
+  Eigen::VectorXd y, v;      // m, m/s per lateral DOF (v at the half step, eq. 20)
   // m, per dropper (Model::droppers): its lean's stretch averaged over the last lateral step's
   // substeps, which the next vertical step adds to the dropper's vertical stretch.
   std::vector<double> dropper_stretch;
-  // Per dropper: 1 where the lean acts on its tension, 0 outside the vertical plane's window.
-  std::vector<double> lean_weight;
-  Eigen::VectorXd f, z;      // workspace
-  Eigen::VectorXd y_next, v_next, accel;  // the fused step's new values
-  // Both planes' sweep records when the vertical step takes the lateral sweep along
-  // (step_both_planes, sweep_pack_pair's joint layout), and that hand-over: `join` while the
-  // vertical step may take it, `joined` when it did, with the lateral sweep's divergence hint.
-  std::vector<double> sweep;
-  bool join = false, joined = false, joined_outside = false;
-  std::int64_t joined_steps = 0;  // steps whose lateral sweep the vertical step took along
-  std::vector<double> theta, wind_points;
-  Eigen::VectorXd wind_speed;    // m/s, per node: the wind's speed normal to the wire now
-  double next_wind_update = 0.0;  // s
+
+  // The wind held between its refreshes (a turbulent wind; steady: the mean wind throughout).
+  Eigen::VectorXd wind_speed;     // m/s, per node: the wind's speed normal to the wire now
+  double next_wind_update = 0.0;  // s, of the next refresh
   double wind_time = 0.0;         // s, of the last refresh (wind_points' time)
+  std::vector<double> wind_points;  // m/s, the turbulent field's held points at wind_time
   // An endless line's turbulent field over its block: generated ahead as the block moves on,
   // in buffers sized once (wind_field.hpp). wind_points holds its points' values from first().
   WindFieldBuffer wind_field;
-  std::vector<int> weight_node;
-  std::vector<double> weight;
-  // Per collector x contact wire: the contact point's lateral position on the strip (wire minus
-  // pantograph), NaN where the collector is not under that wire.
-  std::vector<double> contact_lateral;
-  // Per collector: on the running wire (the one it touches, else the lowest), NaN if none.
-  std::vector<double> collector_lateral;
-  std::vector<double> pantograph_lateral;  // m, per pantograph (sway)
-  std::vector<std::uint8_t> off_strip;     // per collector: outside the working width now
-  std::vector<DewirementEvent> events;     // capacity reserved: never allocates in step
-  std::int64_t events_total = 0;
-  bool diverged = false, dewired_stop = false;
-  // Moving window: the part of each wire the lateral plane steps, from the vertical plane's
-  // window's first support to its last or, with a gust lead (LateralModel::gust_lead), a support
-  // further ahead (outside, the nodes stay in the static state under the mean wind, at rest); the
-  // factors interleaved for the fused step; the springs and the droppers' pendulums in it (first
-  // *_count entries; pendulum k is dropper k), the static force of the left-out elements on the
-  // nodes near the cuts, and the nodes with point forces for the fused step. Sized once: no
-  // allocation.
+
+  // Moving window's placement, for observers (lateral_statistics counts the blow-off where it
+  // steps): the part of each wire the lateral plane steps (node ranges, with their factors), from
+  // the vertical plane's window's first support to its last or, with a gust lead
+  // (LateralModel::gust_lead), a support further ahead; outside, the nodes stay in the static
+  // state under the mean wind, at rest. Support indices into Model::support_x, -1: none yet. The
+  // step derives it from State::window (sync_window; test_state: a copy without it steps the same).
   std::vector<WireWindow> window;
   int window_first_support = -1, window_last_support = -1;
-  bool window_dirty = true;  // lists and factors to rebuild (the endless block moved)
-  std::vector<double> sweep_factors;
-  std::vector<int> window_springs, window_droppers;
-  int window_spring_count = 0, window_dropper_count = 0;
-  std::vector<int> cut_node;
-  std::vector<double> cut_force;
-  int cut_count = 0;
-  std::vector<int> window_points;
-  int window_point_count = 0;
-  bool window_fused = false;  // the fused step can take the window (every wire's range two nodes or more)
+
+  // Outputs of the last step. Per collector x contact wire: the contact point's lateral position
+  // on the strip (m, wire minus pantograph), NaN where the collector is not under that wire.
+  std::vector<double> contact_lateral;
+  // m, per collector: on the running wire (the one it touches, else the lowest), NaN if none.
+  std::vector<double> collector_lateral;
+  std::vector<double> pantograph_lateral;  // m, per pantograph (sway)
+  // Per collector: outside the working width now (a dewirement is a change of it: state too).
+  std::vector<std::uint8_t> off_strip;
+  std::vector<DewirementEvent> events;     // the pass's first ones; capacity reserved (no allocation)
+  std::int64_t events_total = 0;           // dewirements of the pass, kept or not
+  bool diverged = false;                   // the lateral step left the divergence limit
+  bool dewired_stop = false;               // a dewirement stopped the pass (on_dewirement: stop)
+
+  // The step's buffers, lists and caches (engine/lateral_workspace.hpp, private to the engine),
+  // sized once by make_lateral_state(); a copied state gets its own.
+  DeepCopied<LateralWorkspace> work;
 };
 
 // The lateral plane of a state (make_state gives a 3-D line's state its own).

@@ -7,13 +7,13 @@
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 #include "catenary_sim/core/engine/lateral_step.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/engine/step.hpp"
 #include "catenary_sim/core/engine/wire_window.hpp"
+#include "catenary_sim/core/util/deep_copied.hpp"
 
 namespace catenary_sim {
 
@@ -31,24 +31,10 @@ constexpr std::size_t kSlackDropperCapacity = 64;
 constexpr int kMaxActiveSetPasses = 4;
 
 struct StepWorkspace;
+extern template class DeepCopied<StepWorkspace>;  // (instantiated in state.cpp)
 
 // Owns a State's step workspace (whose contents only the engine sees) and copies it deep.
-class StepWorkspaceHandle {
- public:
-  StepWorkspaceHandle();
-  StepWorkspaceHandle(const StepWorkspaceHandle& other);
-  StepWorkspaceHandle(StepWorkspaceHandle&& other) noexcept;
-  StepWorkspaceHandle& operator=(const StepWorkspaceHandle& other);
-  StepWorkspaceHandle& operator=(StepWorkspaceHandle&& other) noexcept;
-  ~StepWorkspaceHandle();
-  StepWorkspace& operator*() { return *work_; }
-  const StepWorkspace& operator*() const { return *work_; }
-  StepWorkspace* operator->() { return work_.get(); }
-  const StepWorkspace* operator->() const { return work_.get(); }
-
- private:
-  std::unique_ptr<StepWorkspace> work_;
-};
+using StepWorkspaceHandle = DeepCopied<StepWorkspace>;
 
 struct State {
   double time = 0.0;       // s, simulation time since the pass started

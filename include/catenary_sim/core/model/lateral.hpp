@@ -120,7 +120,7 @@ struct LateralModel {
   // band and factors, a round wire bends alike both ways) swept with the lateral plane's own load,
   // damping, inverse mass and wind drag coefficient (per pack [node][value][lane]: PackSweep::
   // plane) and the wind's drag, the records in the vertical step's scratch (StepWorkspace::sweep, free
-  // between steps, or LateralState::sweep when the vertical step takes it along); the nodes with
+  // between steps, or LateralWorkspace::sweep when the vertical step takes it along); the nodes with
   // point forces (springs, pendulums) with where the sweep leaves their band force. No planes
   // (the vertical step not fused: implicit, or rotations as DOFs): the generic step.
   std::vector<std::vector<double>> planes;
