@@ -98,9 +98,10 @@ void WindFieldBuffer::reset(const WindField& f) {
   X_.assign(nf + 1, 0.0);
   series_.assign(f.samples, 0.0);
   gen_.seed(f.seed);
-  fft_ = Eigen::FFT<double>();
-  fft_.SetFlag(Eigen::FFT<double>::HalfSpectrum);
-  fft_.SetFlag(Eigen::FFT<double>::Unscaled);
+  fft_.fft = Eigen::FFT<double>();
+  fft_.fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
+  fft_.fft.SetFlag(Eigen::FFT<double>::Unscaled);
+  fft_.samples = f.samples;
   extend_to(f, f.held - 1);  // (also makes the FFT's plan, so that later points allocate nothing)
 }
 
@@ -119,7 +120,7 @@ void WindFieldBuffer::generate(const WindField& f) {
   // Re sum_k c_k e^{i 2 pi k n / N}: Eigen's unscaled half-spectrum inverse gives
   // X_0 + 2 Re sum X_k e^{...}, so X_k = c_k / 2.
   for (std::size_t k = 0; k < X_.size(); ++k) X_[k] = 0.5 * c_[k];
-  fft_.inv(series_.data(), X_.data(), f.samples);
+  fft_.fft.inv(series_.data(), X_.data(), f.samples);
   const std::size_t slot = static_cast<std::size_t>(end_ % f.held);
   for (int n = 0; n < f.samples; ++n) u_[static_cast<std::size_t>(n) * f.held + slot] = static_cast<float>(series_[n]);
   ++end_;

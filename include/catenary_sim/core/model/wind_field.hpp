@@ -102,7 +102,22 @@ class WindFieldBuffer {
   std::vector<std::complex<double>> c_, X_;  // the last point's coefficients; the FFT's input
   std::vector<double> series_;
   std::mt19937_64 gen_;
-  Eigen::FFT<double> fft_;
+  // The FFT with its plan for `samples` points. Assigning a buffer of the same size keeps the
+  // target's own plan (the same plan): restoring a snapshot of a state allocates nothing.
+  struct Fft {
+    Eigen::FFT<double> fft;
+    int samples = 0;
+    Fft() = default;
+    Fft(const Fft&) = default;
+    Fft& operator=(const Fft& other) {
+      if (other.samples != samples) {
+        fft = other.fft;
+        samples = other.samples;
+      }
+      return *this;
+    }
+  };
+  Fft fft_;
   int first_ = 0, end_ = 0;
 };
 
