@@ -16,6 +16,7 @@
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/model/wind_field.hpp"
+#include "catenary_sim/core/util/reserved_vector.hpp"
 #include "catenary_sim/core/engine/wire_window.hpp"
 #include "catenary_sim/core/util/deep_copied.hpp"
 
@@ -69,7 +70,7 @@ struct LateralState {
   std::vector<double> pantograph_lateral;  // m, per pantograph (sway)
   // Per collector: outside the working width now (a dewirement is a change of it: state too).
   std::vector<std::uint8_t> off_strip;
-  std::vector<DewirementEvent> events;     // the pass's first ones; capacity reserved (no allocation)
+  ReservedVector<DewirementEvent> events;  // the pass's first ones; room for all reserved, kept by copies
   std::int64_t events_total = 0;           // dewirements of the pass, kept or not
   bool diverged = false;                   // the lateral step left the divergence limit
   bool dewired_stop = false;               // a dewirement stopped the pass (on_dewirement: stop)
