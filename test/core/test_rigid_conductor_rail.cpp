@@ -268,3 +268,38 @@ TEST(RigidConductorRail, SharedSupportsOfAJointHaveColumnsOfTheirOwn) {
   for (const std::string& c : cols) arms += c.rfind("uplift_steady_arm", 0) == 0;
   EXPECT_EQ(arms, 31);  // 16 + 15 intermediate supports of the two sections
 }
+
+// Two pantographs 20 m apart on the rail (the same machinery as on a catenary): the pass runs and
+// each pantograph's mean force over the analysis section is its static uplift, within the 2 % of
+// the single pass (the trailing one meets a rail set moving by the leading one, a few newtons of
+// oscillation that average out).
+TEST(RigidConductorRail, TwoPantographsEachPressWithTheirUplift) {
+  const cs::Scene scene = test_scenes::edited_scene("rigid_conductor_rail.yaml", [](YAML::Node& root) {
+    YAML::Node second = YAML::Clone(root["pantographs"][0]);
+    second["name"] = "trailing";
+    second["position"] = 20.0;
+    root["pantographs"].push_back(second);
+  });
+  cs::Simulation sim(scene);
+  const cs::Model& m = sim.model();
+  ASSERT_EQ(m.pantographs.size(), 2u);
+  double x0 = 0.0, x1 = 0.0;
+  cs::analysis_section(m, &x0, &x1);
+  double sum[2] = {0.0, 0.0};
+  long count[2] = {0, 0};
+  while (!sim.finished()) {
+    ASSERT_EQ(sim.step(), cs::StepStatus::kOk) << sim.status_message();
+    const cs::State& s = sim.state();
+    for (int p = 0; p < 2; ++p) {
+      const double x = s.front - m.pantographs[p].position;
+      if (x < x0 || x > x1) continue;
+      sum[p] += s.pantograph_force_on(m, p, 0) + s.pantograph_force_on(m, p, 1);
+      ++count[p];
+    }
+  }
+  for (int p = 0; p < 2; ++p) {
+    ASSERT_GT(count[p], 1000);
+    const double uplift = scene.pantographs[p].net_uplift(scene.train_speed);
+    EXPECT_NEAR(sum[p] / count[p], uplift, 0.02 * uplift) << scene.pantographs[p].name;
+  }
+}
