@@ -262,6 +262,11 @@ void validate_rigid(const Scene& s) {
   if (s.lateral())
     fail("stagger/alignment/wind/pantograph_head.sway", "(given with conductor_rail)",
          "none: the profile's lateral plane is not modelled (a 2-D line only)");
+  // Wear thins the contact wire alone; the model's beam is profile and wire together, whose
+  // mass and EI a worn wire changes by another law (not modelled).
+  if (s.imperfections.contact_wire_wear.any())
+    fail("imperfections.contact_wire_wear", "(given with conductor_rail)",
+         "none: the wear law scales the whole beam, a rail's beam is mostly the aluminium profile");
   if (s.sections.size() > 1 && !(s.overlap && s.overlap->support_rise))
     fail("overlap.support_rise", "(missing with conductor_rail)",
          "the end ramp's rise in m, [0, 2]: eq. 6-8 derive it from a tensioned wire's sag, a rigid profile has none");
