@@ -301,7 +301,8 @@ void set_inverse_mass(Model& m, const std::vector<bool>& fixed) {
 void set_line_order(const Scene& scene, Model& m) {
   m.wave_speed = 1e300;
   for (int wi : m.contact_wires)
-    m.wave_speed = std::min(m.wave_speed, std::sqrt(m.wires[wi].spec.tension / m.wires[wi].spec.linear_mass));
+    if (!scene.sections[m.wires[wi].section].rigid)  // a tension-free profile: no string wave, no such limit
+      m.wave_speed = std::min(m.wave_speed, std::sqrt(m.wires[wi].spec.tension / m.wires[wi].spec.linear_mass));
   if (const std::string w = speed_warning(m, scene.train_speed); !w.empty()) m.warnings.push_back(w);
   for (std::size_t i = 1; i < m.support_x.size(); ++i)
     m.longest_span = std::max(m.longest_span, m.support_x[i] - m.support_x[i - 1]);

@@ -47,8 +47,42 @@ void read_spans(Reader& r, const std::string& path, std::vector<double>& spans) 
 }
 
 // The wire, dropper and support parts of a section (or the scene's defaults when defaults is null).
+// conductor_rail: the profile with its clamped contact wire as one beam without tension (paper
+// Benet et al. 2021, Eqs. 5-6: EI of the equivalent section), on elastic supports. It stands for
+// contact_wire and steady_arms; a messenger, droppers or presag have nothing to act on.
+void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
+  for (const char* other : {"contact_wire", "messenger", "droppers", "steady_arms", "messenger_supports", "contact_wire_count"})
+    if (r.has(other))
+      fail(pre + other, "(given with conductor_rail)",
+           "a rigid conductor rail has no tensioned wires, droppers or steady arms: give conductor_rail alone "
+           "(its support_stiffness and support_mass hold the profile)");
+  Reader c(r.child("conductor_rail"), pre + "conductor_rail");
+  sec.rigid = true;
+  sec.contact_wire = ContactWireSpec{};
+  sec.contact_wire.linear_mass = c.number("linear_mass", 0.0, 100.0, std::nullopt, true);
+  sec.contact_wire.bending_stiffness = c.number("bending_stiffness", 0.0, 1e8, std::nullopt, true);
+  SupportSpec support;
+  support.stiffness = c.number("support_stiffness", 0.0, 1e10, std::nullopt, true);
+  support.mass = c.number("support_mass", 0.0, 1000.0, 0.0);
+  c.finish();
+  sec.steady_arms = support;
+  sec.messenger.reset();
+  sec.droppers.reset();
+  sec.messenger_supports.reset();
+  sec.contact_wire_count = 1;
+}
+
 void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, const SectionSpec* defaults) {
   const std::string pre = path.empty() ? "" : path + ".";
+  if (r.has("conductor_rail")) {
+    read_conductor_rail(r, pre, sec);
+    return;
+  }
+  if (r.has("contact_wire") && sec.rigid) {  // a catenary section among rigid defaults: none of the rail's parts
+    SectionSpec fresh;
+    fresh.spans = sec.spans;
+    sec = fresh;
+  }
   if (r.has("contact_wire")) {
     Reader w(r.child("contact_wire"), pre + "contact_wire");
     static_cast<WireSpec&>(sec.contact_wire) = read_wire(w);

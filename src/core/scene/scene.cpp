@@ -31,7 +31,7 @@ TrainSpeedLimit train_speed_limit(const Scene& scene) {
   TrainSpeedLimit l;
   l.wave_speed = std::numeric_limits<double>::infinity();
   for (const SectionSpec& sec : scene.sections)
-    if (sec.contact_wire.linear_mass > 0.0)
+    if (sec.contact_wire.linear_mass > 0.0 && !sec.rigid)  // a profile without tension has no string wave
       l.wave_speed = std::min(l.wave_speed, std::sqrt(sec.contact_wire.tension / sec.contact_wire.linear_mass));
   l.below_wave_speed = !scene.numerics.allow_supercritical && l.wave_speed <= kMaxTrainSpeed;
   l.max = l.below_wave_speed ? l.wave_speed : kMaxTrainSpeed;

@@ -19,6 +19,29 @@ void validate_sections(const Scene& s) {
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     const std::string pre = s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "";
+    if (sec.rigid != s.sections.front().rigid)
+      fail(pre + "conductor_rail", sec.rigid ? "(given)" : "(missing)",
+           "every section of one kind: all conductor_rail or all contact_wire (a transition from a catenary to a "
+           "rigid rail is not modelled)");
+    if (sec.rigid) {
+      // The rail's beam carries no tension: anything hung from a messenger, a presag set by
+      // droppers or a support-less profile has no meaning here.
+      if (sec.messenger || sec.droppers || sec.messenger_supports || sec.contact_wire_count != 1)
+        fail(pre + "conductor_rail", "(with a messenger, droppers or a twin wire)",
+             "a rigid conductor rail alone: remove messenger, droppers, messenger_supports, contact_wire_count");
+      if (!sec.steady_arms || !(sec.steady_arms->stiffness > 0.0))
+        fail(pre + "conductor_rail.support_stiffness", "(missing)", "> 0 N/m at every support");
+      if (sec.contact_wire.tension != 0.0 || sec.contact_wire.presag != 0.0)
+        fail(pre + "conductor_rail", "(tension or presag set)", "tension 0 and presag 0: the profile is not tensioned");
+      if (!(sec.contact_wire.bending_stiffness > 0.0))
+        fail(pre + "conductor_rail.bending_stiffness", fmt(sec.contact_wire.bending_stiffness), "> 0 N m^2");
+      if (sec.spans.size() < 2)
+        fail(pre + "spans", std::to_string(sec.spans.size()) + " span",
+             "at least 2 spans in a rigid section (its ends are held, its intermediate supports are elastic)");
+      continue;
+    }
+    if (!(sec.contact_wire.tension > 0.0))
+      fail(pre + "contact_wire.tension", fmt(sec.contact_wire.tension), "> 0 N (a tensioned wire; a profile without tension is a conductor_rail)");
     if (sec.droppers && !sec.messenger)
       fail(pre + "droppers", "(given)", "droppers hang the contact wire from a messenger: add a messenger section or remove droppers");
     if (sec.messenger_supports && !sec.messenger) fail(pre + "messenger_supports", "(given)", "needs a messenger section");
@@ -228,9 +251,31 @@ void validate_finite_line(const Scene& s, double line) {
 
 }  // namespace
 
+// What a rigid conductor rail does not model yet is refused rather than run wrongly.
+void validate_rigid(const Scene& s) {
+  if (s.sections.empty() || !s.sections.front().rigid) return;
+  if (s.endless)
+    fail("line.endless", "true (with conductor_rail)", "false: the endless block is laid by the tensioned wire's wave speed");
+  if (s.numerics.windowed())
+    fail("numerics.window", "(given with conductor_rail)",
+         "off: the window's absorbing ends are matched to a tensioned wire's waves, a tension-free profile has none");
+  if (s.lateral())
+    fail("stagger/alignment/wind/pantograph_head.sway", "(given with conductor_rail)",
+         "none: the profile's lateral plane is not modelled (a 2-D line only)");
+  // Wear thins the contact wire alone; the model's beam is profile and wire together, whose
+  // mass and EI a worn wire changes by another law (not modelled).
+  if (s.imperfections.contact_wire_wear.any())
+    fail("imperfections.contact_wire_wear", "(given with conductor_rail)",
+         "none: the wear law scales the whole beam, a rail's beam is mostly the aluminium profile");
+  if (s.sections.size() > 1 && !(s.overlap && s.overlap->support_rise))
+    fail("overlap.support_rise", "(missing with conductor_rail)",
+         "the end ramp's rise in m, [0, 2]: eq. 6-8 derive it from a tensioned wire's sag, a rigid profile has none");
+}
+
 void validate(const Scene& s) {
   const double line = s.line_length();
   validate_sections(s);
+  validate_rigid(s);
   validate_limits(s);
   validate_acting_fields(s);
   validate_pantographs(s);

@@ -136,6 +136,11 @@ struct SectionSpec {
   std::optional<DropperSpec> droppers;
   std::optional<SupportSpec> steady_arms;
   std::optional<SupportSpec> messenger_supports;
+  // Rigid overhead conductor rail (docs/rigid_conductor_rail.md): the contact wire is the profile
+  // with its clamped wire, a beam with no tension (contact_wire.tension 0), held at each
+  // intermediate support by `steady_arms` (the supports' spring and mass); no messenger, droppers
+  // or presag. Read from the section's `conductor_rail` fields.
+  bool rigid = false;
   bool first_span_transition = false;  // default: true where a previous section overlaps it
   bool last_span_transition = false;   // default: true where a next section overlaps it
   double length() const;

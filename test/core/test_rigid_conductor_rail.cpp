@@ -1,0 +1,306 @@
+// Rigid overhead conductor rail (docs/rigid_conductor_rail.md): the profile with its clamped
+// contact wire is a beam without tension on elastic supports. Its statics against the
+// three-moment equation of a continuous beam, the elastic support against a beam on a central
+// spring, a slow moving force against the statics, bad input, and a pass over the reference scene.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/model/build_model.hpp"
+#include "catenary_sim/core/model/contact_geometry.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/output/pass_recorder.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
+#include "catenary_sim/core/simulation.hpp"
+#include "../support/scenes.hpp"
+
+namespace cs = catenary_sim;
+
+namespace {
+
+constexpr double kRhoA = 7.27, kEI = 2.8e5, kG = 9.81, kSpan = 10.0;
+
+// A one-section rigid rail of `spans` equal spans; `extra` is appended (pantographs, train, ...).
+std::string rail_yaml(int spans, double support_stiffness, double element, const std::string& extra = "") {
+  std::ostringstream y;
+  y.precision(10);
+  y << "name: rail\n"
+    << "line:\n  span_length: " << kSpan << "\n  span_count: " << spans << "\n"
+    << "conductor_rail:\n  linear_mass: " << kRhoA << "\n  bending_stiffness: " << kEI
+    << "\n  support_stiffness: " << support_stiffness << "\n"
+    << "contact:\n  rub_length: 0.0\n"
+    << "numerics:\n  element_length: " << element << "\n"
+    << extra;
+  return y.str();
+}
+
+// Support moments (sagging +) of a continuous beam of n equal spans L, pinned at both ends on
+// rigid supports, by Clapeyron's three-moment equation (constant EI):
+//   M_{i-1} + 4 M_i + M_{i+1} = -(r_left + r_right) / L,
+// with r = q L^3 / 4 for a uniform load q on an adjacent span and 3 P L^2 / 8 for a point load P
+// at its middle. rhs[i] for supports 1..n-1; the ends carry no moment. Thomas algorithm.
+std::vector<double> three_moment(int n, const std::vector<double>& rhs) {
+  std::vector<double> c(n + 1, 0.0), d(n + 1, 0.0), m(n + 1, 0.0);
+  for (int i = 1; i < n; ++i) {
+    const double denom = 4.0 - (i > 1 ? c[i - 1] : 0.0);
+    c[i] = 1.0 / denom;
+    d[i] = (rhs[i] - (i > 1 ? d[i - 1] : 0.0)) / denom;
+  }
+  for (int i = n - 1; i >= 1; --i) m[i] = d[i] - (i + 1 < n ? c[i] * m[i + 1] : 0.0);
+  return m;
+}
+
+double height_at(const cs::Wire& w, double x) {
+  const int e = w.element_at(x);
+  const double t = (x - w.x[e]) / (w.x[e + 1] - w.x[e]);
+  return (1 - t) * w.height[e] + t * w.height[e + 1];
+}
+
+}  // namespace
+
+// (a) Own-weight sag: the design statics hold the profile at the supports (the design height)
+// and it sags between them as a continuous beam. Mid-span sag of span j from the three-moment
+// solution: 5 q L^4 / (384 EI) + (M_j + M_{j+1}) L^2 / (16 EI) (an interior span of a long line
+// tends to q L^4 / (384 EI)). Tolerance 0.5 %: beam
+// elements give exact nodal values for nodal loads; the lumped load drops only the moment
+// q h^2 / 12 at the two end nodes (the interior ones cancel), 1e-4 of the end span's moments.
+TEST(RigidConductorRail, OwnWeightSagMatchesTheContinuousBeam) {
+  const int n = 11;
+  const cs::Model m = cs::build_model(cs::load_scene_string(rail_yaml(n, 5e6, 0.25)));
+  ASSERT_EQ(m.contact_wires.size(), 1u);
+  const cs::Wire& w = m.wires[m.contact_wires[0]];
+  EXPECT_EQ(w.spec.tension, 0.0);
+  const double q = kRhoA * kG, L = kSpan;
+  const std::vector<double> M = three_moment(n, std::vector<double>(n + 1, -q * L * L / 2.0));
+  const double H = m.scene.contact_wire_height;
+  for (int j = 0; j < n; ++j) {
+    EXPECT_NEAR(height_at(w, j * L), H, 1e-9) << "support " << j;  // the design height at the supports
+    const double sag = 5.0 * q * std::pow(L, 4) / (384.0 * kEI) + (M[j] + M[j + 1]) * L * L / (16.0 * kEI);
+    EXPECT_NEAR(H - height_at(w, (j + 0.5) * L), sag, 5e-3 * sag) << "span " << j;
+  }
+  // The middle span tends to the infinite beam's q L^4 / (384 EI): the pinned end's moment
+  // deficit q L^2 / 12 decays by the factor -(2 - sqrt(3)) per support, so k supports from each
+  // end it changes the middle sag by about 2 x 2 x 0.268^k: 0.6 % for the middle span of eleven
+  // (k = 5); 1 % bounds it.
+  const double infinite = q * std::pow(L, 4) / (384.0 * kEI);
+  EXPECT_NEAR(H - height_at(w, (n / 2 + 0.5) * L), infinite, 0.01 * infinite);
+}
+
+// (b) Point-load elasticity at mid-span, nearly rigid supports (1e9 N/m: the supports give under
+// 1e-7 m against millimetres of bending): P L^3 / (48 EI) + (M_j + M_{j+1}) L^2 / (16 EI) with the
+// three-moment support moments. Nodal values of beam elements are exact for a nodal point load
+// and the probe's force is applied as given: 0.5 % covers the supports' give.
+TEST(RigidConductorRail, MidSpanElasticityMatchesTheContinuousBeam) {
+  const int n = 6;
+  const double P = 100.0, L = kSpan;
+  const cs::Scene scene = cs::load_scene_string(rail_yaml(n, 1e9, 0.25));
+  const cs::ElasticityProbe probe(scene, P);
+  for (int j : {1, 2, 3}) {
+    std::vector<double> rhs(n + 1, 0.0);
+    rhs[j] += -3.0 * P * L / 8.0;
+    rhs[j + 1] += -3.0 * P * L / 8.0;
+    const std::vector<double> M = three_moment(n, rhs);
+    const double expected = P * L * L * L / (48.0 * kEI) + (M[j] + M[j + 1]) * L * L / (16.0 * kEI);
+    const double up = probe.uplift((j + 0.5) * L).at(0);
+    EXPECT_NEAR(up, expected, 5e-3 * expected) << "span " << j;
+  }
+}
+
+// (a') The elastic support: two spans, held at the ends, a spring k at the middle support and the
+// probe's force P on it. The beam over 2L is simply supported with a central spring:
+// w = P / (k + 48 EI / (2L)^3), both terms of the same order here. Exact for the beam elements.
+TEST(RigidConductorRail, ElasticSupportUnderPointLoadMatchesBeamOnSpring) {
+  const double k = 2000.0, P = 100.0, L = kSpan;
+  const cs::ElasticityProbe probe(cs::load_scene_string(rail_yaml(2, k, 0.25)), P);
+  const double expected = P / (k + 48.0 * kEI / std::pow(2.0 * L, 3));
+  EXPECT_NEAR(probe.uplift(L).at(0), expected, 1e-3 * expected);
+}
+
+// (c) A constant force moving slowly reproduces the static deflection under it. At 1 m/s the
+// span's first mode (w1 ~ (pi/L)^2 sqrt(EI/rhoA) = 19 rad/s) sees the load at Omega = pi v / L
+// = 0.31 rad/s: inertia adds (Omega/w1)^2 = 3e-4; Rayleigh alpha = 4 1/s lags the quasi-static
+// response by alpha Omega / w1^2 = 0.3 % and damps the start transient (entering from a held end,
+// ~ Omega/w1 = 2 % of the deflection) by exp(-alpha t / 2) < 1e-8 before the load reaches the
+// checked span at t = 10 s. Tolerance 1 %.
+TEST(RigidConductorRail, SlowMovingForceReproducesTheStaticDeflection) {
+  const double P = 100.0;
+  const std::string extra =
+      "damping:\n  alpha: 4.0\n"
+      "pantographs:\n  - name: force\n    type: moving_force\n    static_uplift: 100.0\n"
+      "train:\n  speed: 1.0\n  start: 0.0\n  end: 20.0\n";
+  const cs::Scene scene = cs::load_scene_string(rail_yaml(4, 1e7, 0.5, extra));
+  const cs::ElasticityProbe probe(scene, P);
+  cs::Simulation sim(scene);
+  const cs::Model& m = sim.model();
+  const cs::Wire& wire = m.wires[m.contact_wires[0]];
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  int checked = 0;
+  double next = 12.0;
+  while (!sim.finished()) {
+    ASSERT_EQ(sim.step(), cs::StepStatus::kOk) << sim.status_message();
+    const cs::State& s = sim.state();
+    if (s.front < next) continue;
+    const int cnt = cs::contact_weights(wire, 0.0, s.front, node.data(), weight.data());
+    double u = 0.0;
+    for (int a = 0; a < cnt; ++a) u += weight[a] * s.wire_uplift(m, 0, node[a]);
+    const double expected = probe.uplift(s.front).at(0);
+    ASSERT_GT(expected, 0.0);
+    EXPECT_NEAR(u, expected, 0.01 * expected) << "x " << s.front;
+    ++checked;
+    next += 1.0;
+    if (next > 18.0) break;
+  }
+  EXPECT_EQ(checked, 7);
+}
+
+// (d) Bad input is refused naming the field.
+TEST(RigidConductorRail, BadInputIsRefusedByName) {
+  auto refused = [](const std::string& yaml, const std::string& field) {
+    try {
+      cs::load_scene_string(yaml);
+      ADD_FAILURE() << "accepted; expected a refusal naming " << field;
+    } catch (const cs::SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  std::string y = rail_yaml(3, 5e6, 0.25);
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = y;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  refused(with("bending_stiffness: 280000", "bending_stiffness: -1"), "conductor_rail.bending_stiffness");
+  refused(with("linear_mass: 7.27", "linear_mass: 0"), "conductor_rail.linear_mass");
+  refused(with("  support_stiffness: 5000000\n", ""), "conductor_rail.support_stiffness");
+  refused(y + "messenger:\n  linear_mass: 1.0\n  tension: 10000\n", "messenger");
+  refused(y + "droppers:\n  positions: [5.0]\n  axial_stiffness: 1e5\n", "droppers");
+  refused(with("conductor_rail:\n", "conductor_rail:\n  tension: 1000\n"), "conductor_rail.tension");
+  refused(with("span_count: 3", "span_count: 1"), "spans");
+  refused(with("numerics:\n", "numerics:\n  window: auto\n"), "numerics.window");
+  refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\n", "stagger");
+  refused(y + "imperfections:\n  contact_wire_wear:\n    section_loss: 0.1\n", "imperfections.contact_wire_wear");
+  // Two rigid sections need the end ramp's rise; a catenary section among rigid ones is refused.
+  const std::string two =
+      "name: two\nline: {}\nconductor_rail: {linear_mass: 7.27, bending_stiffness: 2.8e5, support_stiffness: 5e6}\n"
+      "sections:\n  - {span_length: 10.0, span_count: 4}\n  - {span_length: 10.0, span_count: 4}\n"
+      "overlap: {spans: 2}\n";
+  refused(two, "overlap.support_rise");
+  refused(
+      "name: mixed\nline: {}\nconductor_rail: {linear_mass: 7.27, bending_stiffness: 2.8e5, support_stiffness: 5e6}\n"
+      "sections:\n  - {span_length: 10.0, span_count: 4}\n"
+      "  - {span_length: 10.0, span_count: 4, contact_wire: {linear_mass: 1.35, tension: 20000}}\n"
+      "overlap: {spans: 2, support_rise: 0.02}\n",
+      "conductor_rail");
+  // A tensioned wire without tension, set in code, is refused by validate().
+  cs::Scene tensionless = cs::load_scene_string(
+      "name: t\nline: {spans: [20.0]}\ncontact_wire: {linear_mass: 1.35, tension: 20000}\n");
+  tensionless.sections[0].contact_wire.tension = 0.0;
+  try {
+    cs::validate(tensionless);
+    ADD_FAILURE() << "a contact wire without tension was accepted";
+  } catch (const cs::SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("contact_wire.tension"), std::string::npos) << e.what();
+  }
+}
+
+// (e) A pass over the reference scene: it runs, stays bounded, the expansion joint shares the
+// force, and the mean contact force over the analysis section is the static uplift (no aero
+// term here). Bound 2 % (2.4 N): the roof spring (160 N/m) over the few millimetres the contact
+// height varies along the rail gives about 1 N; the frame's momentum change over the ~7 s of the
+// section (22.5 kg x a few cm/s) and its damper (100 N s/m x the mean vertical speed) well under 1 N.
+TEST(RigidConductorRail, ReferencePassMeanForceIsTheUpliftAndTheJointSharesIt) {
+  const cs::Scene scene = cs::load_scene_file(test_scenes::scene_path("rigid_conductor_rail.yaml"));
+  cs::Simulation sim(scene);
+  const cs::Model& m = sim.model();
+  ASSERT_EQ(m.contact_wires.size(), 2u);
+  double x0 = 0.0, x1 = 0.0;
+  cs::analysis_section(m, &x0, &x1);
+  double sum = 0.0, peak_u = 0.0;
+  long count = 0;
+  long shared_steps = 0, joint_steps = 0;
+  double before_joint_on_second = 0.0, after_joint_on_first = 0.0;
+  while (!sim.finished()) {
+    ASSERT_EQ(sim.step(), cs::StepStatus::kOk) << sim.status_message();
+    const cs::State& s = sim.state();
+    const double x = s.front;
+    const double f0 = s.pantograph_force_on(m, 0, 0), f1 = s.pantograph_force_on(m, 0, 1);
+    if (x >= x0 && x <= x1) {
+      sum += f0 + f1;
+      ++count;
+    }
+    // Over the joint's middle span, 150-160 m, both profiles are at the design height.
+    if (x > 150.0 && x < 160.0 && f0 > 0.0 && f1 > 0.0) shared_steps += 1;
+    if (x > 150.0 && x < 160.0) ++joint_steps;
+    if (x < 140.0) before_joint_on_second = std::max(before_joint_on_second, f1);
+    if (x > 170.0) after_joint_on_first = std::max(after_joint_on_first, f0);
+    peak_u = std::max(peak_u, s.u.head(m.n_catenary_dof).cwiseAbs().maxCoeff());
+  }
+  ASSERT_GT(count, 1000);
+  const double uplift = scene.pantographs[0].net_uplift(scene.train_speed);
+  EXPECT_NEAR(sum / count, uplift, 0.02 * uplift);
+  // Shared over much of the middle span: both profiles sag alike there (each is held at 150 and
+  // 160 m), so the head presses on both for more than a quarter of it (a loose bound: the
+  // profiles' end ramps tilt them by a fraction of a millimetre against each other).
+  ASSERT_GT(joint_steps, 0);
+  EXPECT_GT(static_cast<double>(shared_steps) / joint_steps, 0.25);
+  EXPECT_EQ(before_joint_on_second, 0.0);  // the second profile is not reached before the joint
+  EXPECT_EQ(after_joint_on_first, 0.0);    // nor the first after it
+  // Bounded: the profile moves by millimetres (the static elasticity is ~1e-5 m/N); 5 cm would
+  // be a divergence, not a pass.
+  EXPECT_LT(peak_u, 0.05);
+}
+
+// An expansion joint of three spans holds both profiles at two shared supports: each of the two
+// steady arms there gets a column of its own (a CSV with a name twice is refused by its readers).
+TEST(RigidConductorRail, SharedSupportsOfAJointHaveColumnsOfTheirOwn) {
+  const cs::Model m = cs::build_model(cs::load_scene_file(test_scenes::scene_path("rigid_conductor_rail.yaml")));
+  const cs::PassRecorder rec(m);
+  const std::vector<std::string> cols = rec.columns();
+  const std::set<std::string> unique(cols.begin(), cols.end());
+  EXPECT_EQ(unique.size(), cols.size());
+  long arms = 0;
+  for (const std::string& c : cols) arms += c.rfind("uplift_steady_arm", 0) == 0;
+  EXPECT_EQ(arms, 31);  // 16 + 15 intermediate supports of the two sections
+}
+
+// Two pantographs 20 m apart on the rail (the same machinery as on a catenary): the pass runs and
+// each pantograph's mean force over the analysis section is its static uplift, within the 2 % of
+// the single pass (the trailing one meets a rail set moving by the leading one, a few newtons of
+// oscillation that average out).
+TEST(RigidConductorRail, TwoPantographsEachPressWithTheirUplift) {
+  const cs::Scene scene = test_scenes::edited_scene("rigid_conductor_rail.yaml", [](YAML::Node& root) {
+    YAML::Node second = YAML::Clone(root["pantographs"][0]);
+    second["name"] = "trailing";
+    second["position"] = 20.0;
+    root["pantographs"].push_back(second);
+  });
+  cs::Simulation sim(scene);
+  const cs::Model& m = sim.model();
+  ASSERT_EQ(m.pantographs.size(), 2u);
+  double x0 = 0.0, x1 = 0.0;
+  cs::analysis_section(m, &x0, &x1);
+  double sum[2] = {0.0, 0.0};
+  long count[2] = {0, 0};
+  while (!sim.finished()) {
+    ASSERT_EQ(sim.step(), cs::StepStatus::kOk) << sim.status_message();
+    const cs::State& s = sim.state();
+    for (int p = 0; p < 2; ++p) {
+      const double x = s.front - m.pantographs[p].position;
+      if (x < x0 || x > x1) continue;
+      sum[p] += s.pantograph_force_on(m, p, 0) + s.pantograph_force_on(m, p, 1);
+      ++count[p];
+    }
+  }
+  for (int p = 0; p < 2; ++p) {
+    ASSERT_GT(count[p], 1000);
+    const double uplift = scene.pantographs[p].net_uplift(scene.train_speed);
+    EXPECT_NEAR(sum[p] / count[p], uplift, 0.02 * uplift) << scene.pantographs[p].name;
+  }
+}
