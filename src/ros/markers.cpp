@@ -164,14 +164,21 @@ struct Drawing {
   double shown(int dof) const { return wire_dof_design_height(m, dof) + k * s.u[dof]; }
 };
 
+// A rigid overhead conductor rail (the scene refuses a line that mixes it with a catenary).
+bool rigid_rail(const Model& m) {
+  return std::any_of(m.scene.sections.begin(), m.scene.sections.end(), [](const SectionSpec& s) { return s.rigid; });
+}
+
 void add_wires(visualization_msgs::MarkerArray& out, const Drawing& d) {
   const Model& m = d.m;
   const State& s = d.s;
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     const Wire& w = m.wires[wi];
+    const bool profile = m.scene.sections[w.section].rigid;  // the aluminium profile with its wire
     Marker mk = marker(d.h, "wires", static_cast<int>(wi), Marker::LINE_STRIP);
-    mk.scale.x = w.is_contact_wire ? 0.04 : 0.03;
-    mk.color = w.is_contact_wire ? color(0.85f, 0.55f, 0.2f) : color(0.6f, 0.6f, 0.65f);
+    mk.scale.x = profile ? 0.11 : w.is_contact_wire ? 0.04 : 0.03;  // a profile about 110 mm high
+    mk.color = profile ? color(0.78f, 0.8f, 0.84f)
+                       : w.is_contact_wire ? color(0.85f, 0.55f, 0.2f) : color(0.6f, 0.6f, 0.65f);
     for (int i : sample_nodes(w, d.o.shape_resolution))
       mk.points.push_back(point(w.x[i] + s.line_offset, node_lateral(m, s, wi, i),
                                 w.height[i] + d.k * s.wire_uplift(m, static_cast<int>(wi), i)));
@@ -197,10 +204,30 @@ void add_droppers(visualization_msgs::MarkerArray& out, const Drawing& d) {
   add_list(out, slack);
 }
 
+// A rigid rail's supports: a drop bracket from the tunnel roof above the track to the profile.
+void add_rail_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
+  const Model& m = d.m;
+  const State& s = d.s;
+  const double roof = m.scene.contact_wire_height + 0.6;  // m, drawn only
+  Marker brackets = marker(d.h, "steady_arms", 0, Marker::LINE_LIST);
+  brackets.scale.x = 0.08;
+  brackets.color = color(0.35f, 0.35f, 0.4f);
+  for (const SupportSpring& sp : m.springs) {
+    const double x = sp.x + s.line_offset, y = dof_lateral(m, s, sp.dof);
+    brackets.points.push_back(point(x, y, roof));
+    brackets.points.push_back(point(x, y, d.shown(sp.dof)));
+  }
+  add_list(out, brackets);
+}
+
 // Masts 3 m beside the track with a cantilever over the wires; steady arms to the contact wire.
 void add_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
   const Model& m = d.m;
   const State& s = d.s;
+  if (rigid_rail(m)) {
+    add_rail_supports(out, d);
+    return;
+  }
   const double y_mast = 3.0;
   const double top = m.scene.contact_wire_height + m.scene.encumbrance + 0.5;
   Marker masts = marker(d.h, "masts", 0, Marker::LINE_LIST);
