@@ -135,12 +135,12 @@ bool floor_step_scalar(Floor& F) {
     F.th[k] = y;
     for (int i = 1; i < hi; ++i) {
       const double zn = z(i + 1);
-      y = ((-F.coef[2 * (i * NC + W::kDwt) + k] * zc - F.coef[2 * (i * NC + W::kEtw) + k] * zn) - F.coef[2 * (i - 1 * NC + W::kEwt) + k] * zp) - F.fac[2 * (2 * i) + k] * y;
+      y = ((-F.coef[2 * (i * NC + W::kDwt) + k] * zc - F.coef[2 * (i * NC + W::kEtw) + k] * zn) - F.coef[2 * ((i - 1) * NC + W::kEwt) + k] * zp) - F.fac[2 * (2 * i) + k] * y;
       F.th[2 * i + k] = y;
       zp = zc;
       zc = zn;
     }
-    y = (-F.coef[2 * (hi * NC + W::kDwt) + k] * zc - F.coef[2 * (hi - 1 * NC + W::kEwt) + k] * zp) - F.fac[2 * (2 * hi) + k] * y;
+    y = (-F.coef[2 * (hi * NC + W::kDwt) + k] * zc - F.coef[2 * ((hi - 1) * NC + W::kEwt) + k] * zp) - F.fac[2 * (2 * hi) + k] * y;
     double th1 = y * F.fac[2 * (2 * hi + 1) + k], th2 = 0, z2 = 0, u1 = at(F.u, hi), v1 = at(F.v, hi), z1 = u1 + F.beta * v1;
     F.th[2 * hi + k] = th1;
     auto update = [&](int j, double f, double u, double v) {
