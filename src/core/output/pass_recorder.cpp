@@ -10,6 +10,23 @@
 
 namespace catenary_sim {
 
+namespace {
+
+// The time series' column of steady arm k (of `arms`). Sections overlapping over more than one span
+// share supports: there each section's arm is named with its section, so that no name appears twice.
+std::string steady_arm_column(const Model& m, const std::vector<int>& arms, int k) {
+  const SupportSpring& sp = m.springs[k];
+  const bool shared =
+      std::count_if(arms.begin(), arms.end(), [&](int j) { return m.springs[j].span_index == sp.span_index; }) > 1;
+  std::string name = "uplift_steady_arm" + std::to_string(sp.span_index);
+  if (shared)
+    for (const Wire& w : m.wires)
+      if (sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes()) name += "_s" + std::to_string(w.section);
+  return name + "_m";
+}
+
+}  // namespace
+
 PassRecorder::PassRecorder(const Model& m, double sample_rate_hz) : PassRecorder(m, sample_rate_hz, true) {}
 
 PassRecorder::PassRecorder(const Model& m, double sample_rate_hz, bool record_droppers)
@@ -55,19 +72,8 @@ PassRecorder::PassRecorder(const Model& m, double sample_rate_hz, bool record_dr
     columns_.push_back(p.name + "_head_displacement_m");
   }
   // Per steady arm (not on an endless line, whose model moves along under the train).
-  // Sections overlapping over more than one span share supports: there each section's arm is
-  // named with its section, so that no column name appears twice.
   if (!m.endless)
-    for (int k : steady_arm_springs_) {
-      const SupportSpring& sp = m.springs[k];
-      const bool shared = std::count_if(steady_arm_springs_.begin(), steady_arm_springs_.end(),
-                                        [&](int j) { return m.springs[j].span_index == sp.span_index; }) > 1;
-      std::string name = "uplift_steady_arm" + std::to_string(sp.span_index);
-      if (shared)
-        for (const Wire& w : m.wires)
-          if (sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes()) name += "_s" + std::to_string(w.section);
-      columns_.push_back(name + "_m");
-    }
+    for (int k : steady_arm_springs_) columns_.push_back(steady_arm_column(m, steady_arm_springs_, k));
   analysis_section(m, &x0_, &x1_);
   running_ = m.endless;
   if (!running_) return;
