@@ -59,6 +59,12 @@ struct Recorder {
     std::lock_guard<std::mutex> l(mu);
     return msgs.size();
   }
+  // The subscription ends before the lists it writes into: a message arriving on the spinner's
+  // thread while a test's recorder goes out of scope must not write into freed memory (roscpp's
+  // shutdown waits for a callback that is running).
+  ~Recorder() { sub.shutdown(); }
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
   ros::Subscriber sub;
   std::mutex mu;
   std::vector<M> msgs;
@@ -94,6 +100,9 @@ struct NodeLog {
     for (const std::string& line : lines) n += line.find(part) != std::string::npos ? 1 : 0;
     return n;
   }
+  ~NodeLog() { sub.shutdown(); }  // as Recorder's
+  NodeLog(const NodeLog&) = delete;
+  NodeLog& operator=(const NodeLog&) = delete;
   ros::Subscriber sub;
   std::mutex mu;
   std::vector<std::string> lines;
