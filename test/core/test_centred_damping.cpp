@@ -223,6 +223,7 @@ TEST(CentredDamping, ConvergesAtSecondOrderToTheHalfStepsLimit) {
       {"two sections (anchors inside the line)", load_scene_file(kDir + "reference_55m_two_sections.yaml", base)},
       {"twin contact wire (packs of two and one)", twin_contact_wire(base)},
       {"two pantographs", load_scene_file(kDir + "reference_55m_two_pantographs.yaml", base)},
+      {"stitched (stitch wires and their clamps)", load_scene_file(kDir + "reference_55m_stitched.yaml", base)},
       {"reference at 250 km/h", load_scene_file(kDir + "reference_55m.yaml", with({"train.speed_kmh=250"}))},
   };
   const double seconds = 0.6;

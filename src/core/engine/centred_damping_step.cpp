@@ -24,6 +24,10 @@ void clear_point_forces(const Model& m, State& s, double* f) {
     f[d.contact_dof] = load[d.contact_dof];
     f[d.messenger_dof] = load[d.messenger_dof];
   }
+  for (const WireClamp& c : m.clamps) {
+    f[c.stitch_dof] = load[c.stitch_dof];
+    f[c.messenger_dof] = load[c.messenger_dof];
+  }
   for (const Pantograph& p : m.pantographs)
     for (int ci : p.collectors) {
       const double xc = s.front - p.position + m.collectors[ci].offset;

@@ -123,6 +123,10 @@ void for_each_point(const Model& m, const State& s, bool windowed, Fn&& fn) {
       fn(d.contact_dof);
       fn(d.messenger_dof);
     }
+    for (const WireClamp& c : m.clamps) {
+      fn(c.stitch_dof);
+      fn(c.messenger_dof);
+    }
   }
 }
 

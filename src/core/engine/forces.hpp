@@ -73,6 +73,12 @@ void add_wire_point_forces(const Model& m, State& s, const double* u, const doub
   } else {
     for (const SupportSpring& sp : m.springs) f(sp.dof) -= sp.stiffness * z(sp.dof);
     for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(k);
+    // Stitch wires' clamps (a 2-D line without a window only): bilateral, never slack.
+    for (const WireClamp& c : m.clamps) {
+      const double t = c.static_force + c.stiffness * (z(c.messenger_dof) - z(c.stitch_dof));
+      f(c.stitch_dof) += t;
+      f(c.messenger_dof) -= t;
+    }
   }
 }
 

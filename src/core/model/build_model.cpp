@@ -30,10 +30,21 @@ std::vector<double> mesh_section(const SectionSpec& sec, double element_length, 
   std::vector<double> breaks;
   double x0 = sec.start;
   support_x.assign(1, x0);
-  for (std::size_t i = 0; i < sec.spans.size(); ++i) {
+  const std::size_t nspan = sec.spans.size();
+  for (std::size_t i = 0; i < nspan; ++i) {
+    const std::size_t first = breaks.size();
     breaks.push_back(x0);
     if (sec.droppers)
       for (double p : sec.droppers->positions[i]) breaks.push_back(x0 + p);
+    if (sec.stitch_wire) {  // the clamps of the stitch wires at the span's intermediate supports
+      const double half = 0.5 * sec.stitch_wire->length;
+      if (i > 0) breaks.push_back(x0 + half);
+      if (i + 1 < nspan) breaks.push_back(x0 + sec.spans[i] - half);
+      std::sort(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end());
+      breaks.erase(std::unique(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end(),
+                               [](double a, double b) { return b - a < 1e-9; }),
+                   breaks.end());
+    }
     x0 += sec.spans[i];
     support_x.push_back(x0);
   }
@@ -66,6 +77,7 @@ void add_single_section(Scene& scene) {
   sec.droppers = scene.droppers;
   sec.steady_arms = scene.steady_arms;
   sec.messenger_supports = scene.messenger_supports;
+  sec.stitch_wire = scene.stitch_wire;
   if (sec.droppers && sec.droppers->positions.size() == 1 && sec.spans.size() > 1)
     sec.droppers->positions.assign(sec.spans.size(), sec.droppers->positions.front());
   scene.sections.push_back(sec);
@@ -90,8 +102,37 @@ void support_rises(const Scene& scene, const BuildOptions& options, std::vector<
   }
 }
 
-  // DOF layout: per wire the vertical displacements, then (lumped rotary inertia only) the
-  // rotations; section by section (contact wire(s), then messenger); the pantograph masses last.
+// A stitch wire at each intermediate support of a section: the section's node stations between
+// its clamps (mesh_section puts nodes there), no supports of its own.
+void add_stitch_wires(const StitchWireSpec& st, int section, const std::vector<double>& supports,
+                      const std::vector<double>& x, bool lumped_rot, const std::string& suffix, Model& m, int& dof,
+                      Section& info) {
+  WireSpec spec;
+  spec.linear_mass = st.linear_mass;
+  spec.bending_stiffness = st.bending_stiffness;
+  spec.tension = st.tension;
+  for (std::size_t k = 1; k + 1 < supports.size(); ++k) {
+    const int lo = node_at(x, supports[k] - 0.5 * st.length), hi = node_at(x, supports[k] + 0.5 * st.length);
+    Wire w;
+    w.name = "stitch_wire" + suffix + "_" + std::to_string(k);
+    w.section = section;
+    w.is_stitch_wire = true;
+    w.spec = spec;
+    w.x.assign(x.begin() + lo, x.begin() + hi + 1);
+    w.w_dof = dof;
+    dof += w.nodes();
+    if (lumped_rot) {
+      w.theta_dof = dof;
+      dof += w.nodes();
+    }
+    assemble_band(w, {});
+    info.stitch_wires.push_back(static_cast<int>(m.wires.size()));
+    m.wires.push_back(std::move(w));
+  }
+}
+
+// DOF layout: per wire the vertical displacements, then (lumped rotary inertia only) the
+// rotations; section by section (contact wire(s), messenger, stitch wires); the pantographs last.
 void mesh_wires(const Scene& scene, const std::vector<double>& rise_first, const std::vector<double>& rise_last,
                 Model& m, int& dof, std::vector<std::vector<double>>& section_supports) {
   const bool lumped_rot = scene.numerics.rotary_inertia == RotaryInertia::kLumped;
@@ -128,6 +169,7 @@ void mesh_wires(const Scene& scene, const std::vector<double>& rise_first, const
       add_wire("contact_wire" + suffix + (sec.contact_wire_count > 1 ? std::string(1, static_cast<char>('a' + c)) : ""),
                sec.contact_wire, true);
     if (sec.messenger) add_wire("messenger" + suffix, *sec.messenger, false);
+    if (sec.stitch_wire) add_stitch_wires(*sec.stitch_wire, static_cast<int>(si), section_supports[si], x, lumped_rot, suffix, m, dof, info);
     m.sections.push_back(info);
   }
 }
@@ -215,6 +257,41 @@ std::vector<bool> lump_masses(const Scene& scene, Model& m) {
   return fixed;
 }
 
+// The wire a dropper at station xd hangs from: the stitch wire whose clamps it lies strictly
+// between, else the messenger; and its node there.
+std::pair<const Wire*, int> dropper_top(const Model& m, const Section& info, double xd) {
+  for (int wi : info.stitch_wires) {
+    const Wire& w = m.wires[wi];
+    if (xd > w.x.front() + 1e-9 && xd < w.x.back() - 1e-9) return {&w, node_at(w.x, xd)};
+  }
+  const Wire& mwire = m.wires[info.messenger];
+  return {&mwire, node_at(mwire.x, xd)};
+}
+
+// Each stitch wire's two clamps on the messenger, the clamp masses on the stitch wire's ends (the
+// clamp is one body; on the lighter node it keeps the clamp's own frequency low). Their static
+// forces come from the design statics.
+void clamp_stitch_wires(const Scene& scene, Model& m) {
+  for (std::size_t si = 0; si < scene.sections.size(); ++si) {
+    const SectionSpec& sec = scene.sections[si];
+    const Section& info = m.sections[si];
+    if (!sec.stitch_wire) continue;
+    const Wire& mwire = m.wires[info.messenger];
+    for (int wi : info.stitch_wires) {
+      const Wire& w = m.wires[wi];
+      for (int end : {0, w.nodes() - 1}) {
+        WireClamp c;
+        c.x = w.x[end];
+        c.messenger_dof = mwire.w_dof + node_at(mwire.x, c.x);
+        c.stitch_dof = w.w_dof + end;
+        c.stiffness = kStitchClampStiffness;
+        m.mass[c.stitch_dof] += sec.stitch_wire->clamp_mass;
+        m.clamps.push_back(c);
+      }
+    }
+  }
+}
+
 void hang_droppers(const Scene& scene, const std::vector<std::vector<double>>& section_supports, Model& m) {
   // Droppers: one per contact wire at each dropper station (a twin contact wire hangs both wires
   // from the same dropper), with clamp masses; lengths and tensions come from the design statics.
@@ -222,13 +299,14 @@ void hang_droppers(const Scene& scene, const std::vector<std::vector<double>>& s
     const SectionSpec& sec = scene.sections[si];
     if (!sec.droppers) continue;
     const Section& info = m.sections[si];
-    const Wire& mwire = m.wires[info.messenger];
     const DropperSpec& ds = *sec.droppers;
     for (std::size_t i = 0; i < sec.spans.size(); ++i)
       for (double p : ds.positions[i]) {
         const double xd = section_supports[si][i] + p;
-        const int node = node_at(mwire.x, xd);
-        m.mass[mwire.w_dof + node] += ds.clamp_mass_messenger;
+        const auto [top, top_node] = dropper_top(m, info, xd);
+        const Wire& mwire = *top;
+        const int node = node_at(m.wires[info.messenger].x, xd);  // on the section's shared stations
+        m.mass[mwire.w_dof + top_node] += ds.clamp_mass_messenger;
         for (int wi : info.wires) {
           if (wi == info.messenger) continue;
           Dropper d;
@@ -236,7 +314,7 @@ void hang_droppers(const Scene& scene, const std::vector<std::vector<double>>& s
           d.section = static_cast<int>(si);
           d.span = static_cast<int>(i);
           d.contact_dof = m.wires[wi].w_dof + node;
-          d.messenger_dof = mwire.w_dof + node;
+          d.messenger_dof = mwire.w_dof + top_node;
           m.mass[d.contact_dof] += ds.clamp_mass_contact;
           m.droppers.push_back(d);
         }
@@ -424,6 +502,7 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
   m.n_dof = dof;
   const std::vector<bool> fixed = lump_masses(scene, m);
   hang_droppers(scene, section_supports, m);
+  clamp_stitch_wires(scene, m);
   design_statics(scene, section_supports, m);
   apply_wear(scene, m);
   set_constant_load(scene, m, fixed);

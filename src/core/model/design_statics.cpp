@@ -12,6 +12,12 @@ namespace catenary_sim {
 
 namespace {
 
+bool holds(const Wire& w, int dof) { return dof >= w.w_dof && dof < w.w_dof + w.nodes(); }
+
+const Wire& wire_holding(const Model& m, int dof) {
+  return *std::find_if(m.wires.begin(), m.wires.end(), [&](const Wire& w) { return holds(w, dof); });
+}
+
 // One section's statics: the contact wire(s) held at the supports and droppers, then the messenger
 // under the dropper tensions, a few fixed-point passes for the droppers' weight.
 void section_statics(const Scene& scene, std::size_t si, const std::vector<std::vector<double>>& section_supports,
@@ -29,7 +35,8 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
   std::vector<std::size_t> mine;
   for (std::size_t k = 0; k < m.droppers.size(); ++k)
     if (m.droppers[k].section == static_cast<int>(si)) mine.push_back(k);
-  const int passes = mine.empty() ? 1 : 4;
+  // (A stitch wire's clamps take the messenger's heights of the pass before: two more passes.)
+  const int passes = mine.empty() ? 1 : info.stitch_wires.empty() ? 4 : 6;
   std::vector<SpdSolver> solver(m.wires.size());  // per wire: its pattern is the same every pass
   for (int pass = 0; pass < passes; ++pass) {
     for (int wi : info.wires) {
@@ -63,22 +70,41 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
     }
     if (info.messenger < 0) break;
     Wire& mwm = m.wires[info.messenger];
+    // The stitch wires: each under its weight and its droppers' tensions, held at its clamps at
+    // the messenger's heights there (the last pass's; level at the encumbrance on the first).
+    for (int wi : info.stitch_wires) {
+      Wire& w = m.wires[wi];
+      const int n = w.nodes();
+      std::vector<double> load(n);
+      for (int i = 0; i < n; ++i) load[i] = -g * m.mass[w.w_dof + i];
+      for (std::size_t k : mine)
+        if (holds(w, m.droppers[k].messenger_dof))
+          load[m.droppers[k].messenger_dof - w.w_dof] -= m.droppers[k].static_tension + 0.5 * g * mu * weight_len[k];
+      const std::vector<int> pn{0, n - 1};
+      std::vector<double> ph(2, H + scene.encumbrance);
+      for (const WireClamp& c : m.clamps)
+        if (holds(w, c.stitch_dof) && !mwm.height.empty()) ph[c.stitch_dof == w.w_dof ? 0 : 1] = mwm.height[c.messenger_dof - mwm.w_dof];
+      solve_wire_statics(w, load, pn, ph, w.height, w.slope, react[wi], &solver[wi]);
+      for (WireClamp& c : m.clamps)
+        if (holds(w, c.stitch_dof)) c.static_force = react[wi][c.stitch_dof == w.w_dof ? 0 : 1];
+    }
     const int n = mwm.nodes();
     std::vector<double> mload(n);
     for (int i = 0; i < n; ++i) mload[i] = -g * m.mass[mwm.w_dof + i];
     for (std::size_t k : mine) {
       const Dropper& d = m.droppers[k];
-      mload[d.messenger_dof - mwm.w_dof] -= d.static_tension + 0.5 * g * mu * weight_len[k];
+      if (holds(mwm, d.messenger_dof)) mload[d.messenger_dof - mwm.w_dof] -= d.static_tension + 0.5 * g * mu * weight_len[k];
     }
+    for (const WireClamp& c : m.clamps)
+      if (holds(mwm, c.messenger_dof)) mload[c.messenger_dof - mwm.w_dof] -= c.static_force;
     std::vector<int> mpn(mwm.support_nodes.begin(), mwm.support_nodes.end());
     std::vector<double> mph(mpn.size(), H + scene.encumbrance);
     solve_wire_statics(mwm, mload, mpn, mph, mwm.height, mwm.slope, react[info.messenger], &solver[info.messenger]);
     for (std::size_t k : mine) {
       const Dropper& d = m.droppers[k];
-      const Wire& cwire = *std::find_if(m.wires.begin(), m.wires.end(), [&](const Wire& w) {
-        return d.contact_dof >= w.w_dof && d.contact_dof < w.w_dof + w.nodes();
-      });
-      dropper_len[k] = mwm.height[d.messenger_dof - mwm.w_dof] - cwire.height[d.contact_dof - cwire.w_dof];
+      const Wire& cwire = wire_holding(m, d.contact_dof);
+      const Wire& top = wire_holding(m, d.messenger_dof);
+      dropper_len[k] = top.height[d.messenger_dof - top.w_dof] - cwire.height[d.contact_dof - cwire.w_dof];
     }
     if (pass + 1 < passes)
       for (std::size_t k : mine) weight_len[k] = dropper_len[k];
@@ -93,10 +119,13 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
     Dropper& d = m.droppers[k];
     const SectionSpec& sec = scene.sections[d.section];
     d.length = dropper_len[k];
-    if (d.length <= 0.01)
-      throw SceneError("droppers: at x = " + fmt(d.x) + " m the messenger hangs " + fmt(-d.length) +
-                       " m below the contact wire (dropper length " + fmt(d.length) +
-                       " m): raise line.encumbrance or the messenger tension, or reduce the presag");
+    if (d.length <= 0.01) {
+      const bool stitch = wire_holding(m, d.messenger_dof).is_stitch_wire;
+      throw SceneError("droppers: at x = " + fmt(d.x) + " m the " + (stitch ? "stitch wire" : "messenger") + " hangs " +
+                       fmt(-d.length) + " m below the contact wire (dropper length " + fmt(d.length) +
+                       " m): raise line.encumbrance or the " + (stitch ? "stitch wire's" : "messenger") +
+                       " tension, or reduce the presag");
+    }
     const int nspan = static_cast<int>(sec.spans.size());
     const bool in_transition = (d.span == 0 && sec.first_span_transition) || (d.span == nspan - 1 && sec.last_span_transition);
     if (d.static_tension <= 0.0 && in_transition)

@@ -85,6 +85,9 @@ void compute_stability_limit(Model& m) {
     for (const Dropper& d : m.droppers)
       for (int dof : {d.contact_dof, d.messenger_dof})
         if (m.mass[dof] > 0.0) limit_by(d.stiffness, m.beta * d.stiffness, m.mass[dof]);
+    for (const WireClamp& c : m.clamps)
+      for (int dof : {c.stitch_dof, c.messenger_dof})
+        if (m.mass[dof] > 0.0) limit_by(c.stiffness, m.beta * c.stiffness, m.mass[dof]);
   }
   for (const Pantograph& p : m.pantographs) {
     if (p.moving_force) continue;

@@ -137,6 +137,11 @@ void apply_stiffness(const Model& m, double front, const double* x, double* y, d
     y[d.contact_dof] += t;
     y[d.messenger_dof] -= t;
   }
+  for (const WireClamp& c : m.clamps) {
+    const double t = c.stiffness * (x[c.messenger_dof] - x[c.stitch_dof]);
+    y[c.stitch_dof] += t;
+    y[c.messenger_dof] -= t;
+  }
   std::vector<int> node(m.max_contact_nodes);
   std::vector<double> weight(m.max_contact_nodes);
   for (const Pantograph& p : m.pantographs) {

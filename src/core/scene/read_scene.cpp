@@ -51,7 +51,8 @@ void read_spans(Reader& r, const std::string& path, std::vector<double>& spans) 
 // Benet et al. 2021, Eqs. 5-6: EI of the equivalent section), on elastic supports. It stands for
 // contact_wire and steady_arms; a messenger, droppers or presag have nothing to act on.
 void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
-  for (const char* other : {"contact_wire", "messenger", "droppers", "steady_arms", "messenger_supports", "contact_wire_count"})
+  for (const char* other : {"contact_wire", "messenger", "droppers", "steady_arms", "messenger_supports", "stitch_wire",
+                            "contact_wire_count"})
     if (r.has(other))
       fail(pre + other, "(given with conductor_rail)",
            "a rigid conductor rail has no tensioned wires, droppers or steady arms: give conductor_rail alone "
@@ -70,6 +71,27 @@ void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
   sec.droppers.reset();
   sec.messenger_supports.reset();
   sec.contact_wire_count = 1;
+}
+
+// A section's stitch wire; `stitch_wire: none` in a section leaves out the one the scene's
+// defaults give (a simple section, e.g. in a tunnel, on a stitched line).
+void read_stitch_wire(Reader& r, const std::string& pre, SectionSpec& sec) {
+  const YAML::Node node = r.child("stitch_wire");
+  if (node.IsScalar()) {
+    if (node.Scalar() != "none")
+      fail(pre + "stitch_wire", node.Scalar(), "a map of length, tension, linear_mass, ... or none (no stitch wire)");
+    sec.stitch_wire.reset();
+    return;
+  }
+  Reader w(r.child("stitch_wire"), pre + "stitch_wire");
+  StitchWireSpec st;
+  st.length = w.number("length", 0.0, 100.0, std::nullopt, true);
+  st.tension = w.number("tension", 0.0, 1e5, std::nullopt, true);
+  st.linear_mass = w.number("linear_mass", 0.0, 10.0, std::nullopt, true);
+  st.bending_stiffness = w.number("bending_stiffness", 0.0, 1e4, 0.0);
+  st.clamp_mass = w.number("clamp_mass", 0.0, 10.0, 0.0);
+  w.finish();
+  sec.stitch_wire = st;
 }
 
 void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, const SectionSpec* defaults) {
@@ -139,6 +161,7 @@ void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, co
     Reader a(r.child("messenger_supports"), pre + "messenger_supports");
     sec.messenger_supports = read_support(a);
   }
+  if (r.has("stitch_wire")) read_stitch_wire(r, pre, sec);
 }
 
 // Section stations from the overlaps, dropper positions per span, and the line's spans (the union
@@ -423,6 +446,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   s.droppers = first.droppers;
   s.steady_arms = first.steady_arms;
   s.messenger_supports = first.messenger_supports;
+  s.stitch_wire = first.stitch_wire;
   resolve_line(s);
   read_damping(top, s);
   read_contact(top, s);

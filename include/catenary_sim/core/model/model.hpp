@@ -25,6 +25,7 @@ struct Wire {
   std::string name;
   int section = 0;               // tension section it belongs to
   bool is_contact_wire = false;
+  bool is_stitch_wire = false;   // a stitch wire (StitchWireSpec): no supports, clamped to the messenger
   WireSpec spec;
   std::vector<double> x;         // m, node stations along the line
   std::vector<double> height;    // m, design height of each node (static shape, no pantograph)
@@ -54,6 +55,19 @@ struct Dropper {
   double unstretched_length = 0.0;
 };
 
+// A stitch wire's end clamped to the messenger: a bilateral spring, stiff beside the line's own
+// compliance (kStitchClampStiffness), carrying the stitch wire's end reaction in the design state.
+struct WireClamp {
+  int messenger_dof = 0, stitch_dof = 0;
+  double stiffness = 0.0;     // N/m
+  double static_force = 0.0;  // N: pulls the stitch wire's end up and the messenger down at u = 0
+  double x = 0.0;             // m
+};
+// 1e-6 m/N: 0.1 % of the softest point of a stitch wire (L / (4 T) ~ 1e-3 m/N for 14-18 m at
+// 3-3.5 kN) and of a messenger's span, so the clamp is rigid to the line; its frequency on the
+// clamp's node mass stays below the wires' highest (the stability limit takes it in anyway).
+constexpr double kStitchClampStiffness = 2e5;
+
 // An elastic support: steady arm on the contact wire (eq. 4) or messenger support spring.
 struct SupportSpring {
   int dof = 0;
@@ -70,8 +84,9 @@ struct SupportSpring {
 struct Section {
   double start = 0.0, end = 0.0;       // m
   double rise_first = 0.0, rise_last = 0.0;  // m, at its first and last support
-  std::vector<int> wires;              // indices into Model::wires
+  std::vector<int> wires;              // indices into Model::wires: contact wire(s), messenger
   int messenger = -1;                  // index into Model::wires, -1 without a messenger
+  std::vector<int> stitch_wires;       // indices into Model::wires, one per intermediate support
 };
 
 struct Collector {
@@ -113,10 +128,11 @@ struct Pantograph {
 struct Model {
   Scene scene;
   std::vector<Section> sections;
-  std::vector<Wire> wires;            // per section: contact wire(s), then the messenger if any
+  std::vector<Wire> wires;            // per section: contact wire(s), the messenger if any, its stitch wires
   std::vector<int> contact_wires;     // indices into wires that collectors touch
   std::vector<Dropper> droppers;
   std::vector<SupportSpring> springs;
+  std::vector<WireClamp> clamps;      // stitch wires' ends on the messenger
   std::vector<Pantograph> pantographs;
   std::vector<Collector> collectors;
   std::vector<double> support_x;      // m, station of every support along the line (all sections)

@@ -45,6 +45,19 @@ struct DropperSpec {
   double clamp_mass_messenger = 0.0;           // kg, clamp on the messenger
 };
 
+// A stitch wire (Y-wire): a short tensioned wire clamped to the messenger at length/2 on both sides
+// of every intermediate support of its section, passing free under the messenger's support. The
+// droppers strictly between its clamps hang from it instead of from the messenger, so the contact
+// wire at the support is held by a soft string (elasticity ~ L/(4 T) at its middle) rather than
+// by the messenger's support: the line is about as elastic at the supports as in mid-span.
+struct StitchWireSpec {
+  double length = 0.0;             // m between its two clamps on the messenger
+  double tension = 0.0;            // N
+  double linear_mass = 0.0;        // kg/m
+  double bending_stiffness = 0.0;  // EI, N m^2
+  double clamp_mass = 0.0;         // kg, each clamp on the messenger (lumped on the messenger node)
+};
+
 // An elastic support (steady arm, eq. 4, or messenger support); absent = rigid.
 struct SupportSpec {
   double stiffness = 0.0;  // N/m
@@ -136,6 +149,7 @@ struct SectionSpec {
   std::optional<DropperSpec> droppers;
   std::optional<SupportSpec> steady_arms;
   std::optional<SupportSpec> messenger_supports;
+  std::optional<StitchWireSpec> stitch_wire;  // at every intermediate support of the section
   // Rigid overhead conductor rail (docs/rigid_conductor_rail.md): the contact wire is the profile
   // with its clamped wire, a beam with no tension (contact_wire.tension 0), held at each
   // intermediate support by `steady_arms` (the supports' spring and mass); no messenger, droppers
@@ -376,6 +390,7 @@ struct Scene {
   std::optional<DropperSpec> droppers;
   std::optional<SupportSpec> steady_arms;         // intermediate contact-wire supports
   std::optional<SupportSpec> messenger_supports;  // intermediate messenger supports
+  std::optional<StitchWireSpec> stitch_wire;      // stitched catenary
   double rayleigh_alpha = 0.0;  // 1/s, eq. 5
   double rayleigh_beta = 0.0;   // s, eq. 5
   std::vector<PantographSpec> pantographs;
