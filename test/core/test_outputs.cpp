@@ -6,6 +6,7 @@
 #include <map>
 #include <vector>
 
+#include "catenary_sim/core/output/elasticity_uniformity.hpp"
 #include "catenary_sim/core/output/line_measures.hpp"
 
 using namespace catenary_sim;
@@ -123,3 +124,29 @@ TEST(ContactLoss, EventsDetectedExactly) {
 }
 
 }  // namespace
+
+// The elasticity's uniformity per span on a curve known in closed form: e = e0 (1 + sin^2(pi s /
+// L)) over each span of L = 10 m, sampled every 0.5 m (the supports and mid-spans among the
+// samples), so min e0, max 2 e0, mean 1.5 e0 (the samples of sin^2 over a period average 1/2
+// exactly), U = (2 - 1) / (2 + 1) = 1/3. A sample without a value (the probe not touching) is
+// skipped; a span with fewer than two samples is left out.
+TEST(ElasticityUniformity, PerSpanRangeAndUniformityOfAKnownCurve) {
+  const double e0 = 1e-4, L = 10.0;
+  std::vector<double> x, e;
+  for (int i = 0; i <= 40; ++i) {
+    x.push_back(0.5 * i);
+    const double s = std::sin(M_PI * x.back() / L);
+    e.push_back(e0 * (1.0 + s * s));
+  }
+  e[5] = std::nan("");  // 2.5 m: no value there
+  const std::vector<catenary_sim::SpanElasticity> spans = catenary_sim::elasticity_by_span(x, e, {0.0, 10.0, 20.0, 20.2});
+  ASSERT_EQ(spans.size(), 2u);  // the 0.2 m span holds one sample (20 m)
+  for (const auto& s : spans) {
+    EXPECT_NEAR(s.min, e0, 1e-15);
+    EXPECT_NEAR(s.max, 2.0 * e0, 1e-15);
+    EXPECT_NEAR(s.uniformity, 1.0 / 3.0, 1e-12);
+  }
+  EXPECT_EQ(spans[0].samples, 20);  // 21 stations in [0, 10] less the one without a value
+  EXPECT_EQ(spans[1].samples, 21);
+  EXPECT_NEAR(spans[1].mean, 1.5 * e0 * 20.0 / 21.0 + e0 / 21.0, 1e-15);  // 20 samples of a period, plus one support
+}
