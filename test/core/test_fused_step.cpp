@@ -148,6 +148,7 @@ TEST(FusedStep, MatchesTheGenericStepBitForBit) {
       {"reference_55m_two_pantographs.yaml", {}, 3000},
       {"reference_55m_two_sections.yaml", {}, 3000},
       {"reference_55m_stitched.yaml", {}, 3000},  // stitch wires: packs of one, clamps as point forces
+      {"reference_55m_stitched.yaml", {"numerics.window=auto"}, 3000},  // the window's clamp lists
       {"reference_55m.yaml", {"numerics.preset=fast", "train.speed_kmh=250"}, 2000},
       {"reference_55m.yaml", {"numerics.element_length=0.1"}, 1500},
       {"twin", {}, 2000},

@@ -279,7 +279,7 @@ TEST(StitchedCatenary, BadInputIsRefusedByName) {
   refused(with("stitch_wire: {length: 8.0, tension: 3500, linear_mass: 0.31}", "stitch_wire: off"), "stitch_wire");
   refused(with("droppers: {positions: [2.0, 18.0], axial_stiffness: 200000, linear_mass: 0.0}\n", ""), "stitch_wire");
   refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\n", "stagger");
-  refused(with("numerics: {", "numerics: {window: auto, "), "numerics.window");
+  refused(with("span_count: 2, ", "endless: true, "), "line.endless");
   refused("name: r\nline: {span_length: 10.0, span_count: 3}\n"
           "conductor_rail: {linear_mass: 7.27, bending_stiffness: 2.8e5, support_stiffness: 5e6}\n"
           "stitch_wire: {length: 8.0, tension: 3500, linear_mass: 0.31}\n",

@@ -117,6 +117,11 @@ void for_each_point(const Model& m, const State& s, bool windowed, Fn&& fn) {
       fn(d.contact_dof);
       fn(d.messenger_dof);
     }
+    for (int j = 0; j < s.window_clamp_count; ++j) {
+      const WireClamp& c = m.clamps[s.window_clamps[j]];
+      fn(c.stitch_dof);
+      fn(c.messenger_dof);
+    }
   } else {
     for (const SupportSpring& sp : m.springs) fn(sp.dof);
     for (const Dropper& d : m.droppers) {

@@ -55,6 +55,12 @@ void add_wire_point_forces(const Model& m, State& s, const double* u, const doub
     f(d.contact_dof) += t;
     f(d.messenger_dof) -= t;
   };
+  // Stitch wires' clamps: bilateral, never slack.
+  auto clamp = [&](const WireClamp& c) {
+    const double t = c.static_force + c.stiffness * (z(c.messenger_dof) - z(c.stitch_dof));
+    f(c.stitch_dof) += t;
+    f(c.messenger_dof) -= t;
+  };
   if (m.scene.numerics.windowed()) {
     for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
       const WireWindow& ww = s.window[wi];
@@ -70,15 +76,11 @@ void add_wire_point_forces(const Model& m, State& s, const double* u, const doub
       f(sp.dof) -= sp.stiffness * z(sp.dof);
     }
     for (int j = 0; j < s.window_dropper_count; ++j) dropper(static_cast<std::size_t>(s.window_droppers[j]));
+    for (int j = 0; j < s.window_clamp_count; ++j) clamp(m.clamps[s.window_clamps[j]]);
   } else {
     for (const SupportSpring& sp : m.springs) f(sp.dof) -= sp.stiffness * z(sp.dof);
     for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(k);
-    // Stitch wires' clamps (a 2-D line without a window only): bilateral, never slack.
-    for (const WireClamp& c : m.clamps) {
-      const double t = c.static_force + c.stiffness * (z(c.messenger_dof) - z(c.stitch_dof));
-      f(c.stitch_dof) += t;
-      f(c.messenger_dof) -= t;
-    }
+    for (const WireClamp& c : m.clamps) clamp(c);
   }
 }
 

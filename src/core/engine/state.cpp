@@ -65,6 +65,7 @@ State make_state(const Model& m) {
   }
   s.window_droppers.assign(m.droppers.size(), 0);
   s.window_springs.assign(m.springs.size(), 0);
+  s.window_clamps.assign(m.clamps.size(), 0);
   s.uplift.resize(m.pantographs.size());
   for (std::size_t i = 0; i < m.pantographs.size(); ++i) s.uplift[i] = m.pantographs[i].static_uplift;
   s.external_force = s.uplift;

@@ -138,6 +138,9 @@ void update_window(const Model& m, State& s) {
       s.window_droppers.data());
   s.window_spring_count = select_between(
       m.spring_order, m.spring_order_x, a, b, [&](int k) { return inside(m.springs[k].dof); }, s.window_springs.data());
+  s.window_clamp_count = select_between(
+      m.clamp_order, m.clamp_order_x, a, b,
+      [&](int k) { return inside(m.clamps[k].stitch_dof) && inside(m.clamps[k].messenger_dof); }, s.window_clamps.data());
 }
 
 bool in_windows(const std::vector<Wire>& wires, const std::vector<WireWindow>& windows, int dof) {

@@ -392,6 +392,9 @@ void set_line_order(const Scene& scene, Model& m) {
   for (std::size_t k = 0; k < m.springs.size(); ++k) m.spring_order.push_back(static_cast<int>(k));
   std::stable_sort(m.spring_order.begin(), m.spring_order.end(), [&](int a, int b) { return m.springs[a].x < m.springs[b].x; });
   for (int k : m.spring_order) m.spring_order_x.push_back(m.springs[k].x);
+  for (std::size_t k = 0; k < m.clamps.size(); ++k) m.clamp_order.push_back(static_cast<int>(k));
+  std::stable_sort(m.clamp_order.begin(), m.clamp_order.end(), [&](int a, int b) { return m.clamps[a].x < m.clamps[b].x; });
+  for (int k : m.clamp_order) m.clamp_order_x.push_back(m.clamps[k].x);
 }
 
 void set_train_travel(const Scene& scene, double endless_front, Model& m) {

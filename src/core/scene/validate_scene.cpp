@@ -273,13 +273,14 @@ void validate_rigid(const Scene& s) {
 }
 
 // Stitch wires: hung from a messenger around intermediate supports, each within its spans, on a
-// whole 2-D line (the window, the endless line and the lateral plane do not carry them).
+// finite 2-D line (the endless block and the lateral plane do not carry them).
 void validate_stitched(const Scene& s) {
-  bool any = false;
+  const bool any = std::any_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.stitch_wire.has_value(); });
+  if (!any) return;
+  if (s.endless) fail("line.endless", "true (with stitch_wire)", "false: the endless block does not carry stitch wires");
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     if (!sec.stitch_wire) continue;
-    any = true;
     const std::string f = (s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "") + "stitch_wire";
     if (!sec.messenger || !sec.droppers)
       fail(f, "(given)", "a stitch wire hangs from a messenger and carries droppers: add messenger and droppers or remove it");
@@ -290,10 +291,6 @@ void validate_stitched(const Scene& s) {
       fail(f + ".length", fmt(sec.stitch_wire->length),
            "(0, " + fmt(shortest) + ") m: shorter than the section's shortest span, so that each clamp lies in its span");
   }
-  if (!any) return;
-  if (s.endless) fail("line.endless", "true (with stitch_wire)", "false: the endless block does not carry stitch wires");
-  if (s.numerics.windowed())
-    fail("numerics.window", "(given with stitch_wire)", "off: the moving window does not carry stitch wires (a whole line only)");
   if (s.lateral())
     fail("stagger/alignment/wind/pantograph_head.sway", "(given with stitch_wire)",
          "none: the stitch wire's lateral plane is not modelled (a 2-D line only)");

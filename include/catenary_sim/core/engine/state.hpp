@@ -121,6 +121,8 @@ struct State {
   std::vector<WireWindow> window;
   std::vector<int> window_droppers, window_springs;  // the first *_count entries are in the window
   int window_dropper_count = 0, window_spring_count = 0;
+  std::vector<int> window_clamps;  // stitch wires' clamps (Model::clamps) in the window
+  int window_clamp_count = 0;
 
   // The step's buffers and caches (engine/step_workspace.hpp, private to the engine), sized once
   // by make_state(); a copied state gets its own, so it steps exactly as its original would.

@@ -172,6 +172,8 @@ struct Model {
   double longest_span = 0.0;    // m
   std::vector<int> dropper_order, spring_order;       // indices in line order (stable)
   std::vector<double> dropper_order_x, spring_order_x;  // m, their stations
+  std::vector<int> clamp_order;                       // the stitch wires' clamps in line order
+  std::vector<double> clamp_order_x;                  // m
   std::vector<std::string> warnings;  // what the scene asks that is outside design practice
   // The wires' lateral planes (3-D line); null when the scene has no stagger, curve, wind or sway.
   std::shared_ptr<const LateralModel> lateral;
