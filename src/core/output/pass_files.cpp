@@ -98,7 +98,9 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
   const std::vector<PantographStatistics> stats = recorder.statistics(m);
   const LineStatistics line = recorder.line_statistics(m);
   std::vector<std::unique_ptr<AtomicFile>> files;
+  // Each file's writing to the disk starts as soon as it is complete, while the next is formatted.
   auto add = [&](const std::string& name) -> AtomicFile& {
+    if (!files.empty()) files.back()->start_writeback();
     files.push_back(std::make_unique<AtomicFile>(dir + "/" + name));
     return *files.back();
   };
@@ -164,6 +166,8 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
   }
   // All on the disk before any is renamed into place: a full disk leaves the old set (or none),
   // never a new CSV beside an old stats.json.
+  // (Each is fsync'd once, here: commit() does not repeat it.)
+  files.back()->start_writeback();
   for (auto& f : files) f->flush();
   for (auto& f : files) f->commit();
 }
