@@ -24,11 +24,16 @@ namespace {
 void append_number(std::string& out, double v) {
   char buf[32];
   const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 9);
-  out.append(buf, r.ptr);
+  out.append(buf, static_cast<std::size_t>(r.ptr - buf));  // (pointer and length: no range replace)
 }
 
 void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const std::deque<PassRecorder::Row>& rows) {
-  std::string c = "time_s";
+  constexpr std::size_t kPiece = 1u << 20;
+  std::string c;
+  // A piece and the longest row past it, held from the start: growing by doubling copied the
+  // piece over and over, a good part of writing the series.
+  c.reserve(kPiece + 32 * (columns.size() + 2));
+  c = "time_s";
   for (const std::string& col : columns) c += "," + csv_field(col);
   c += "\n";
   for (const auto& row : rows) {
@@ -38,7 +43,7 @@ void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const st
       if (std::isfinite(v)) append_number(c, v);
     }
     c += '\n';
-    if (c.size() > (1u << 20)) {
+    if (c.size() > kPiece) {
       f.write(c);
       c.clear();
     }
