@@ -256,7 +256,11 @@ Eigen::VectorXd solve_static_equilibrium(const Model& m, const PantographLoads& 
   active.dropper_on.assign(m.droppers.size(), true);
   active.contact_on.assign(m.collectors.size() * m.contact_wires.size(), true);
   StaticSystem sys;
-  SpdSolver solver;  // the active set changes values, seldom the pattern
+  // The active set changes values, seldom the pattern; and a model's two solves (the pantographs'
+  // references without roof springs, then the initial state) mostly share one: the ordering of
+  // the last pattern solved in this thread is kept (SpdSolver compares the whole pattern, so
+  // another model's matrix is ordered afresh; the factors a kept ordering gives are the same).
+  thread_local SpdSolver solver;
   sys.node.resize(m.max_contact_nodes);
   sys.weight.resize(m.max_contact_nodes);
   // The active set is guessed, solved for, and corrected until it agrees with its solution.
