@@ -436,7 +436,7 @@ int main(int argc, char** argv) {
     RunInfo info;
     info.wall_time_s = run.wall_s;
     info.build_time_s = build_s;
-    write_pass_files(o.out_dir, m, st, recorder, info, &lateral, run.status == StepStatus::kDewired);
+    write_pass_files(o.out_dir, m, st, recorder, info, &lateral, run.status == StepStatus::kDewired, &stats);
     if (!run.bag_tmp.empty() && std::rename(run.bag_tmp.c_str(), bag_target.c_str()) != 0)
       throw OutputError("cannot write '" + o.bag_path + "': rename failed");
   } catch (const OutputError& e) {

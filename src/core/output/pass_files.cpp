@@ -100,8 +100,10 @@ std::string pass_statistics_json(const Model& m, const State& st, const PassReco
 }
 
 void write_pass_files(const std::string& dir, const Model& m, const State& st, const PassRecorder& recorder,
-                      const RunInfo& run, const LateralRecorder* lateral, bool stopped_by_dewirement) {
-  const std::vector<PantographStatistics> stats = recorder.statistics(m);
+                      const RunInfo& run, const LateralRecorder* lateral, bool stopped_by_dewirement,
+                      const std::vector<PantographStatistics>* given) {
+  const std::vector<PantographStatistics> computed = given ? std::vector<PantographStatistics>{} : recorder.statistics(m);
+  const std::vector<PantographStatistics>& stats = given ? *given : computed;
   const LineStatistics line = recorder.line_statistics(m);
   std::vector<std::unique_ptr<AtomicFile>> files;
   // Each file's writing to the disk starts as soon as it is complete, while the next is formatted.
