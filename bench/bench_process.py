@@ -15,9 +15,13 @@ and accurate / fast per simulated second of pass and of process (the ladder's ra
 
 With --base, a second simulate_pass (e.g. a build of an older commit) alternates run by run with
 this one in the same loop, and the ratios base / this are printed: the machine's load moves both
-alike. Uses Debian's /usr/bin/python3. Build first: SKIP_SETUP=1 scripts/build.
+alike. The two binaries' files of each preset are compared after the first run: byte for byte,
+stats.json without its timings (wall_time_s, build_time_s, real_time_factor); a difference is
+printed and the exit status is 1. Uses Debian's /usr/bin/python3. Build first: SKIP_SETUP=1
+scripts/build.
 """
 import argparse
+import filecmp
 import json
 import os
 import statistics
@@ -42,6 +46,27 @@ def run_once(binary, scene, speed, preset, out):
         s = json.load(f)
     return {"process": process, "pass": s["wall_time_s"], "build": s["build_time_s"],
             "simulated": s["simulated_time_s"]}
+
+
+TIMINGS = ("wall_time_s", "build_time_s", "real_time_factor")
+
+
+def differing_files(a, b):
+    """The names of the files in directory a or b that differ (stats.json: all but its timings)."""
+    names = sorted(set(os.listdir(a)) | set(os.listdir(b)))
+    out = []
+    for n in names:
+        pa, pb = os.path.join(a, n), os.path.join(b, n)
+        if not (os.path.isfile(pa) and os.path.isfile(pb)):
+            out.append(n)
+        elif n == "stats.json":
+            with open(pa) as fa, open(pb) as fb:
+                ja, jb = json.load(fa), json.load(fb)
+            if {k: v for k, v in ja.items() if k not in TIMINGS} != {k: v for k, v in jb.items() if k not in TIMINGS}:
+                out.append(n)
+        elif not filecmp.cmp(pa, pb, shallow=False):
+            out.append(n)
+    return out
 
 
 def summary(runs):
@@ -71,11 +96,14 @@ def main():
         if not os.access(b, os.X_OK):
             p.error(f"{name} simulate_pass {b}: not an executable (build first: SKIP_SETUP=1 scripts/build)")
     runs = {(b, pr): [] for b in binaries for pr in presets}
+    differ = {}
     with tempfile.TemporaryDirectory(prefix="catenary_sim_bench_process_") as tmp:
         for rep in range(a.reps):
             for pr in presets:
                 for b, path in binaries.items():
                     runs[(b, pr)].append(run_once(path, a.scene, a.speed, pr, os.path.join(tmp, f"{b}_{pr}")))
+                if rep == 0 and a.base:
+                    differ[pr] = differing_files(os.path.join(tmp, f"this_{pr}"), os.path.join(tmp, f"base_{pr}"))
             print(f"rep {rep + 1}/{a.reps} done", file=sys.stderr, flush=True)
     res = {k: summary(v) for k, v in runs.items()}
     print(f"scene {os.path.relpath(a.scene, ROOT)}, {a.speed:g} km/h, {a.reps} runs each; times in s (median; min)")
@@ -95,6 +123,11 @@ def main():
             mb, mt = res[("base", pr)][0], res[("this", pr)][0]
             print(f"{pr}: base / this: process {mb['process'] / mt['process']:.2f}, pass {mb['pass'] / mt['pass']:.2f}, "
                   f"build {mb['build'] / mt['build']:.2f}")
+        for pr, names in differ.items():
+            print(f"{pr}: files of this and base: " + ("the same (stats.json but its timings)" if not names
+                                                         else "DIFFERENT: " + ", ".join(names)))
+        if any(differ.values()):
+            sys.exit(1)
 
 
 if __name__ == "__main__":

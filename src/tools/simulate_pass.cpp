@@ -8,6 +8,9 @@
 // scripts/pass_report on DIR (report.html and its PNGs).
 #include <sys/stat.h>
 #include <unistd.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -29,9 +32,8 @@
 #include "catenary_sim/tools/report_launcher.hpp"
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
-#include "catenary_sim/ros/conversions.hpp"
-#include "catenary_sim/ros/pass_bag.hpp"
 #include "cli_checks.hpp"
+#include "pass_bag_writer.hpp"
 
 using namespace catenary_sim;
 
@@ -91,7 +93,7 @@ struct Options {
   double speed_kmh = std::nan("");
   double max_steps = kDefaultMaxSteps;
   bool quiet = false, no_progress = false, report = false;
-  ros_layer::PassBagOptions bag_options;
+  double bag_rate = 200.0;
 };
 
 // Parses argv into *o; returns -1 to go on, else the exit code (--help: 0; bad flags and values:
@@ -115,7 +117,7 @@ int parse_options(int argc, char** argv, Options* o) {
       ->take_all();
   app.add_option("--bag", o->bag_path, "also write the node's topics into a rosbag (simulation-time stamps)")
       ->type_name("FILE");
-  app.add_option("--bag-rate", o->bag_options.rate,
+  app.add_option("--bag-rate", o->bag_rate,
                  "rate of /contact_force, /pantograph_state and /tf in the bag (Hz; 0: every step)")
       ->check(kFinite & CLI::Range(0.0, 1e6))
       ->capture_default_str()
@@ -231,7 +233,7 @@ void print_scene(const Scene& scene, const Model& m) {
 // The pass stepped to its end, every state into the recorders (and the bag).
 struct PassRun {
   StepStatus status = StepStatus::kOk;
-  std::unique_ptr<ros_layer::PassBag> bag;
+  std::unique_ptr<PassBagWriter> bag;
   std::string bag_tmp;  // the bag under its temporary name until the pass's files are written
   double wall_s = 0.0;
 };
@@ -249,8 +251,8 @@ int run_pass(const Options& o, Simulation& sim, const std::string& bag_target,
     recorder.record(m, sim.state());
     lateral.record(m, sim.state());
     if (!o.bag_path.empty()) {
-      run->bag = std::make_unique<ros_layer::PassBag>(run->bag_tmp, o.bag_options);
-      run->bag->write_scene(ros_layer::scene_yaml_message(o.scene_path, o.overrides));
+      run->bag = open_pass_bag(run->bag_tmp, o.bag_rate);
+      run->bag->write_scene(o.scene_path, o.overrides);
       run->bag->write(m, sim.state(), &recorder);
     }
     Progress progress(pass_step_count(m), !o.quiet && !o.no_progress);
@@ -263,7 +265,7 @@ int run_pass(const Options& o, Simulation& sim, const std::string& bag_target,
     progress.done();
     if (run->bag) run->bag->close();
   } catch (const std::exception& e) {
-    std::cerr << "simulate_pass: " << (run->bag ? "--bag '" + o.bag_path + "': " : "") << e.what() << "\n";
+    std::cerr << "simulate_pass: " << (o.bag_path.empty() ? "" : "--bag '" + o.bag_path + "': ") << e.what() << "\n";
     if (!run->bag_tmp.empty()) std::remove(run->bag_tmp.c_str());
     return kBadInput;
   }
@@ -392,6 +394,15 @@ int draw_report(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+#ifdef __GLIBC__
+  // The model's build allocates and frees many large temporaries (the statics' triplets and
+  // matrices). By default glibc maps each above 128 KiB afresh and returns freed heap to the
+  // system, so every one is faulted in page by page again: about half of building the accurate
+  // reference model. Kept in the heap, freed memory is reused; the peak stays what it is, and
+  // this process ends after one pass.
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
   Options o;
   if (const int rc = parse_options(argc, argv, &o); rc >= 0) return rc;
   Scene scene;
@@ -425,7 +436,7 @@ int main(int argc, char** argv) {
     RunInfo info;
     info.wall_time_s = run.wall_s;
     info.build_time_s = build_s;
-    write_pass_files(o.out_dir, m, st, recorder, info, &lateral, run.status == StepStatus::kDewired);
+    write_pass_files(o.out_dir, m, st, recorder, info, &lateral, run.status == StepStatus::kDewired, &stats);
     if (!run.bag_tmp.empty() && std::rename(run.bag_tmp.c_str(), bag_target.c_str()) != 0)
       throw OutputError("cannot write '" + o.bag_path + "': rename failed");
   } catch (const OutputError& e) {

@@ -134,3 +134,42 @@ def test_a_missing_report_script_names_where_it_was_looked_for(staged):
             assert os.path.isfile(os.path.join(work, "out", "stats.json"))
     finally:
         os.rename(hidden, scripts)
+
+
+def installed_pass(staged, work, *extra):
+    """simulate_pass from the staged install, no workspace sourced: a short pass (as above)."""
+    return subprocess.run([os.path.join(staged, "lib", "catenary_sim", "simulate_pass"), "--scene",
+                           os.path.join(staged, "share", "catenary_sim", "config", "reference_55m.yaml"),
+                           "--out", os.path.join(work, "out"), "--speed", "250", "--set", "line.span_count=6",
+                           "--set", "numerics.element_length=0.5", "--quiet", "--no-progress", *extra],
+                          cwd=work, env=clean_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                          timeout=600)
+
+
+def test_simulate_pass_writes_a_bag_from_the_install_space(staged):
+    # The bag writer is a library simulate_pass loads for --bag alone: it must be installed in
+    # lib/ beside lib/catenary_sim/ and found there with no workspace sourced.
+    assert os.path.isfile(os.path.join(staged, "lib", "libcatenary_sim_pass_bag.so"))
+    with tempfile.TemporaryDirectory(prefix="catenary_sim_installed_pass_") as work:
+        bag = os.path.join(work, "pass.bag")
+        r = installed_pass(staged, work, "--bag", bag)
+        assert r.returncode == 0, r.stdout[-4000:]
+        with open(bag, "rb") as f:
+            assert f.read(13) == b"#ROSBAG V2.0\n"
+
+
+def test_a_missing_bag_writer_fails_only_a_pass_that_asks_for_a_bag(staged):
+    lib = os.path.join(staged, "lib", "libcatenary_sim_pass_bag.so")
+    hidden = lib + ".hidden"
+    os.rename(lib, hidden)
+    try:
+        with tempfile.TemporaryDirectory(prefix="catenary_sim_installed_pass_") as work:
+            r = installed_pass(staged, work)
+            assert r.returncode == 0, r.stdout[-4000:]
+            bag = os.path.join(work, "pass.bag")
+            r = installed_pass(staged, work, "--bag", bag)
+            assert r.returncode == 2, r.stdout[-4000:]
+            assert "libcatenary_sim_pass_bag.so cannot be loaded" in r.stdout, r.stdout[-4000:]
+            assert not os.path.exists(bag) and not os.path.exists(bag + ".partial")
+    finally:
+        os.rename(hidden, lib)

@@ -15,6 +15,21 @@
 
 namespace catenary_sim {
 
+// Eigen's AMD ordering, without its first step. AMDOrdering forms the pattern of A^T + A before
+// the minimum degree search, for an A that may not be structurally symmetric; the simplicial
+// factorisation hands it the full symmetric matrix (SimplicialCholeskyBase::ordering expands the
+// lower triangle first), whose pattern that sum repeats entry for entry. Forming it was most of
+// the ordering's time; the search on the matrix itself gives the same permutation.
+template <typename StorageIndex>
+struct SymmetricAmdOrdering {
+  using PermutationType = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, StorageIndex>;
+  template <typename MatrixType>
+  void operator()(const MatrixType& full, PermutationType& perm) const {
+    Eigen::SparseMatrix<typename MatrixType::Scalar, Eigen::ColMajor, StorageIndex> c = full;  // the search's workspace
+    Eigen::internal::minimum_degree_ordering(c, perm);
+  }
+};
+
 class SpdSolver {
  public:
   // x with k x = r (k symmetric positive definite, lower triangle read). Throws SceneError naming
@@ -23,7 +38,7 @@ class SpdSolver {
 
  private:
   bool same_pattern(const Eigen::SparseMatrix<double>& k) const;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, SymmetricAmdOrdering<int>> ldlt_;
   std::vector<int> outer_, inner_;  // the pattern ldlt_ was analysed for (compressed k)
   bool analysed_ = false;
 };

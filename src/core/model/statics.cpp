@@ -17,6 +17,7 @@ void solve_wire_statics(const Wire& wire, const std::vector<double>& node_load, 
                         std::vector<double>& reactions, SpdSolver* solver) {
   const int n = wire.nodes();
   Triplets t;
+  t.reserve(12 * static_cast<std::size_t>(n));  // add_wire_band's: 4 a node, 8 an element
   add_wire_band(t, wire, 0, n);
   Eigen::SparseMatrix<double> k(2 * n, 2 * n);
   k.setFromTriplets(t.begin(), t.end());
@@ -30,6 +31,7 @@ void solve_wire_statics(const Wire& wire, const std::vector<double>& node_load, 
     if (!std::isnan(fixed[i])) yp[i] = fixed[i];
   r -= k * yp;
   Triplets tr;
+  tr.reserve(t.size() + 2 * static_cast<std::size_t>(n));
   for (const auto& e : t) {
     const bool fr = !std::isnan(fixed[e.row()]), fc = !std::isnan(fixed[e.col()]);
     if (!fr && !fc) tr.push_back(e);
@@ -189,7 +191,7 @@ Eigen::VectorXd solve_held(const Model& m, int size, StaticSystem& sys, SpdSolve
   std::vector<bool> fixed(size, false);
   for (int i = 0; i < m.n_dof; ++i) fixed[i] = m.inv_mass[i] == 0.0;
   Triplets tr;
-  tr.reserve(sys.t.size());
+  tr.reserve(sys.t.size() + static_cast<std::size_t>(size));
   for (const auto& e : sys.t)
     if (!fixed[e.row()] && !fixed[e.col()]) tr.push_back(e);
   for (int i = 0; i < size; ++i)
@@ -257,7 +259,18 @@ Eigen::VectorXd solve_static_equilibrium(const Model& m, const PantographLoads& 
   active.dropper_on.assign(m.droppers.size(), true);
   active.contact_on.assign(m.collectors.size() * m.contact_wires.size(), true);
   StaticSystem sys;
-  SpdSolver solver;  // the active set changes values, seldom the pattern
+  // The active set changes values, seldom the pattern; and a model's two solves (the pantographs'
+  // references without roof springs, then the initial state) mostly share one: the ordering of
+  // the last pattern solved in this thread is kept (SpdSolver compares the whole pattern, so
+  // another model's matrix is ordered afresh; the factors a kept ordering gives are the same).
+  thread_local SpdSolver solver;
+  // Room for every iteration's triplets at once (clear() keeps it): add_wire_band's 4 a node and
+  // 8 an element, a spring's 4, the contact springs' (nodes + 2)^2 per collector and wire.
+  std::size_t room = 4 * (m.springs.size() + m.droppers.size()) + 64 * m.pantographs.size();
+  for (const Wire& w : m.wires) room += 12 * static_cast<std::size_t>(w.nodes());
+  room += static_cast<std::size_t>((m.max_contact_nodes + 2) * (m.max_contact_nodes + 2)) * m.collectors.size() *
+          m.contact_wires.size();
+  sys.t.reserve(room);
   sys.node.resize(m.max_contact_nodes);
   sys.weight.resize(m.max_contact_nodes);
   // The active set is guessed, solved for, and corrected until it agrees with its solution.

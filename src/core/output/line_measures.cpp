@@ -46,21 +46,6 @@ std::vector<ContactLossEvent> contact_loss_events(const std::vector<double>& t, 
   return out;
 }
 
-void TurningPoints::add(double v) {
-  if (!started_) {
-    last_ = v;
-    started_ = true;
-    return;
-  }
-  if (v == last_) return;
-  const int dir = v > last_ ? 1 : -1;
-  if (dir != direction_) {
-    points_.push_back(last_);  // the direction turned: the last reversal is final
-    direction_ = dir;
-  }
-  last_ = v;  // still rising (falling): the reversal moves on
-}
-
 std::vector<double> TurningPoints::points() const {
   std::vector<double> p;
   p.reserve(points_.size() + 1);

@@ -152,8 +152,17 @@ AtomicFile::~AtomicFile() {
 void AtomicFile::write(const std::string& text) {
   if (!file_) throw OutputError("cannot write '" + path_ + "': already closed");
   const QuietPipe quiet(stream_);
+  synced_ = false;
   if (std::fwrite(text.data(), 1, text.size(), file_) != text.size())
     throw OutputError("cannot write '" + path_ + "': " + reason());
+}
+
+void AtomicFile::start_writeback() {
+  if (!file_) throw OutputError("cannot write '" + path_ + "': already closed");
+  const QuietPipe quiet(stream_);
+  if (std::fflush(file_) != 0 || std::ferror(file_)) throw OutputError("cannot write '" + path_ + "': " + reason());
+  // Advice only: a failure here is found again, and reported, by flush()'s fsync.
+  if (!stream_) ::sync_file_range(::fileno(file_), 0, 0, SYNC_FILE_RANGE_WRITE);
 }
 
 void AtomicFile::flush() {
@@ -162,10 +171,12 @@ void AtomicFile::flush() {
   // fflush and fsync report what a full disk or a quota refuses (a pipe or device has no fsync).
   if (std::fflush(file_) != 0 || (!stream_ && ::fsync(::fileno(file_)) != 0) || std::ferror(file_))
     throw OutputError("cannot write '" + path_ + "': " + reason());
+  synced_ = true;
 }
 
 void AtomicFile::commit() {
-  flush();
+  // A file flushed since its last write is on the disk: a second fsync would only wait again.
+  if (!synced_) flush();
   std::FILE* f = file_;
   file_ = nullptr;
   const QuietPipe quiet(stream_);

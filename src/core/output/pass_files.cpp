@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <deque>
+#include <future>
 #include <iomanip>
 #include <memory>
 #include <sstream>
@@ -23,11 +24,16 @@ namespace {
 void append_number(std::string& out, double v) {
   char buf[32];
   const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 9);
-  out.append(buf, r.ptr);
+  out.append(buf, static_cast<std::size_t>(r.ptr - buf));  // (pointer and length: no range replace)
 }
 
 void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const std::deque<PassRecorder::Row>& rows) {
-  std::string c = "time_s";
+  constexpr std::size_t kPiece = 1u << 20;
+  std::string c;
+  // A piece and the longest row past it, held from the start: growing by doubling copied the
+  // piece over and over, a good part of writing the series.
+  c.reserve(kPiece + 32 * (columns.size() + 2));
+  c = "time_s";
   for (const std::string& col : columns) c += "," + csv_field(col);
   c += "\n";
   for (const auto& row : rows) {
@@ -37,7 +43,7 @@ void write_rows(AtomicFile& f, const std::vector<std::string>& columns, const st
       if (std::isfinite(v)) append_number(c, v);
     }
     c += '\n';
-    if (c.size() > (1u << 20)) {
+    if (c.size() > kPiece) {
       f.write(c);
       c.clear();
     }
@@ -94,11 +100,15 @@ std::string pass_statistics_json(const Model& m, const State& st, const PassReco
 }
 
 void write_pass_files(const std::string& dir, const Model& m, const State& st, const PassRecorder& recorder,
-                      const RunInfo& run, const LateralRecorder* lateral, bool stopped_by_dewirement) {
-  const std::vector<PantographStatistics> stats = recorder.statistics(m);
+                      const RunInfo& run, const LateralRecorder* lateral, bool stopped_by_dewirement,
+                      const std::vector<PantographStatistics>* given) {
+  const std::vector<PantographStatistics> computed = given ? std::vector<PantographStatistics>{} : recorder.statistics(m);
+  const std::vector<PantographStatistics>& stats = given ? *given : computed;
   const LineStatistics line = recorder.line_statistics(m);
   std::vector<std::unique_ptr<AtomicFile>> files;
+  // Each file's writing to the disk starts as soon as it is complete, while the next is formatted.
   auto add = [&](const std::string& name) -> AtomicFile& {
+    if (!files.empty()) files.back()->start_writeback();
     files.push_back(std::make_unique<AtomicFile>(dir + "/" + name));
     return *files.back();
   };
@@ -164,7 +174,13 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
   }
   // All on the disk before any is renamed into place: a full disk leaves the old set (or none),
   // never a new CSV beside an old stats.json.
-  for (auto& f : files) f->flush();
+  // Each is fsync'd once, here (commit() does not repeat it), all at once: the file system
+  // commits their metadata together and the waits for the disk overlap instead of adding up.
+  files.back()->start_writeback();
+  std::vector<std::future<void>> synced;
+  for (auto& f : files) synced.push_back(std::async(std::launch::async, [&f] { f->flush(); }));
+  for (auto& s : synced) s.wait();
+  for (auto& s : synced) s.get();  // the first failure, as an OutputError
   for (auto& f : files) f->commit();
 }
 

@@ -48,6 +48,10 @@ PassRecorder::PassRecorder(const Model& m, double sample_rate_hz, bool record_dr
       DropperTrack t;
       t.index = k;
       t.station = x;
+      t.messenger_dof = m.droppers[k].messenger_dof;
+      t.contact_dof = m.droppers[k].contact_dof;
+      t.static_tension = m.droppers[k].static_tension;
+      t.stiffness = m.droppers[k].stiffness;
       droppers_.push_back(t);
     }
   }
@@ -174,9 +178,16 @@ void PassRecorder::record(const Model& m, const State& s) {
 
 void PassRecorder::record_whole(const Model& m, const State& s) {
   const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
+  // dropper_force() with the dropper's data at hand in its track: the same numbers, without the
+  // model's dropper list in the cache at every step.
+  const double* u = s.u.data();
+  const double* lean = m.lateral && !s.lateral.dropper_stretch.empty() ? s.lateral.dropper_stretch.data() : nullptr;
   for (DropperTrack& t : droppers_) {
-    bool slack = false;
-    const double f = dropper_force(m, t.index, s, &slack);
+    double stretch = u[t.messenger_dof] - u[t.contact_dof];
+    if (lean) stretch += lean[t.index];
+    const double tension = t.static_tension + t.stiffness * stretch;
+    const bool slack = !(tension > 0.0);
+    const double f = slack ? 0.0 : tension;
     t.max = std::max(t.max, f);
     t.min = std::min(t.min, f);
     t.slack += slack;

@@ -33,7 +33,21 @@ std::vector<ContactLossEvent> contact_loss_events(const std::vector<double>& t, 
 // only when the direction turns (one comparison a sample, a push a reversal).
 class TurningPoints {
  public:
-  void add(double v);
+  // Inline: a pass adds every analysed dropper's force at every step.
+  void add(double v) {
+    if (!started_) {
+      last_ = v;
+      started_ = true;
+      return;
+    }
+    if (v == last_) return;
+    const int dir = v > last_ ? 1 : -1;
+    if (dir != direction_) {
+      points_.push_back(last_);  // the direction turned: the last reversal is final
+      direction_ = dir;
+    }
+    last_ = v;  // still rising (falling): the reversal moves on
+  }
   std::vector<double> points() const;  // the reversals so far, the one still moving last
   bool empty() const { return !started_; }
   std::size_t capacity() const { return points_.capacity(); }

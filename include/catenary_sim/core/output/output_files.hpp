@@ -57,16 +57,22 @@ class AtomicFile {
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
-  std::FILE* file() { return file_; }
+  std::FILE* file() {
+    synced_ = false;
+    return file_;
+  }
   void write(const std::string& text);  // throws OutputError on a failed write
+  // Hands what is written to the kernel and starts its writing to the disk without waiting, so
+  // that flush() later waits for less; throws OutputError.
+  void start_writeback();
   void flush();                         // writes everything to the disk; throws OutputError
-  void commit();                        // flush() and rename into place; throws OutputError
+  void commit();                        // flush() (unless done since the last write) and rename into place; throws OutputError
   const std::string& path() const { return path_; }
 
  private:
   std::string path_, tmp_, target_;
   std::FILE* file_ = nullptr;
-  bool stream_ = false;
+  bool stream_ = false, synced_ = false;
 };
 
 // An exclusive advisory lock (flock) on DIR/.catenary_sim.lock, held while the object lives, so two

@@ -40,9 +40,10 @@ std::string pass_statistics_json(const Model& model, const State& state, const P
 
 // Writes the pass's files into `dir`; throws OutputError (then none is renamed into place).
 // On a 3-D line (model.lateral) with `lateral`, also stats.json's "lateral" object and
-// lateral.csv, lateral_histogram.csv, blow_off.csv, pull_off.csv and dewirements.csv.
+// lateral.csv, lateral_histogram.csv, blow_off.csv, pull_off.csv and dewirements.csv. `stats`:
+// recorder.statistics(model) if the caller has it already (it is not computed twice).
 void write_pass_files(const std::string& dir, const Model& model, const State& state, const PassRecorder& recorder,
                       const RunInfo& run, const LateralRecorder* lateral = nullptr,
-                      bool stopped_by_dewirement = false);
+                      bool stopped_by_dewirement = false, const std::vector<PantographStatistics>* stats = nullptr);
 
 }  // namespace catenary_sim

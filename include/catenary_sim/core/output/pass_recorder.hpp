@@ -101,6 +101,8 @@ class PassRecorder {
   // Droppers of the analysis section.
   struct DropperTrack {
     int index = 0;
+    int messenger_dof = 0, contact_dof = 0;  // the model's dropper's, read at every step
+    double static_tension = 0.0, stiffness = 0.0;
     double station = 0.0;
     double max = -1e300, min = 1e300;
     std::size_t slack = 0;
