@@ -25,9 +25,15 @@ std::shared_ptr<WirePacks> build_wire_packs(const Model& m) {
     if (pk.wire_pack[a] >= 0) continue;
     WireLanes p;
     p.wire[0] = static_cast<int>(a);
-    // A partner on the same stations: the same node range in a moving window, too.
+    // A partner on the same stations: the same node range in a moving window, too. Without a
+    // window the lanes need only as many nodes: two stitch wires of a section pair up (their
+    // sweeps read no station), so the short wires around the supports do not run a lane idle.
+    auto partners = [&](const Wire& wa, const Wire& wb) {
+      if (wb.x == wa.x) return true;
+      return !m.scene.numerics.windowed() && wa.is_stitch_wire && wb.is_stitch_wire && wa.nodes() == wb.nodes();
+    };
     for (std::size_t b = a + 1; b < m.wires.size() && p.lanes == 1; ++b)
-      if (pk.wire_pack[b] < 0 && m.wires[b].x == m.wires[a].x) {
+      if (pk.wire_pack[b] < 0 && partners(m.wires[a], m.wires[b])) {
         p.wire[1] = static_cast<int>(b);
         p.lanes = 2;
       }
