@@ -1,0 +1,70 @@
+#!/usr/bin/python3
+"""Each kind of line's cost per DOF and step against the simple line's.
+
+  bench/bench_line_kinds.py [--reps 7] [--preset accurate]
+                            [--scenes config/reference_55m.yaml,config/reference_55m_stitched.yaml,...]
+
+simulate_pass runs each scene in turn, --reps rounds, the scenes alternating within each round so
+that the machine's load moves them alike. Each run gives stats.json's wall_time_s (the stepping of
+the pass alone), dofs and steps; the cost is wall_time_s / (dofs x steps) in ns. Printed per scene:
+the median and minimum cost, its dt, DOFs and steps, and the median's ratio to the first scene's
+(the simple line). Uses Debian's /usr/bin/python3. Build first: SKIP_SETUP=1 scripts/build.
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
+SIMULATE_PASS = os.path.join(ROOT, ".ws", "devel", "lib", "catenary_sim", "simulate_pass")
+DEFAULT_SCENES = ["config/reference_55m.yaml", "config/reference_55m_stitched.yaml", "config/rigid_conductor_rail.yaml"]
+
+
+def run_once(scene, preset, out):
+    args = [SIMULATE_PASS, "--scene", scene, "--set", f"numerics.preset={preset}", "--out", out, "--quiet",
+            "--no-progress"]
+    r = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600, cwd=ROOT)
+    if r.returncode != 0:
+        sys.exit(f"{' '.join(args)} failed ({r.returncode}):\n{r.stdout[-2000:]}")
+    with open(os.path.join(out, "stats.json")) as f:
+        return json.load(f)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--reps", type=int, default=7, help="rounds over the scenes (1-1000)")
+    ap.add_argument("--preset", default="accurate", choices=["fast", "balanced", "accurate", "reference"])
+    ap.add_argument("--scenes", default=",".join(DEFAULT_SCENES),
+                    help="comma-separated scene files; the first is the one the others are compared with")
+    a = ap.parse_args()
+    if not 1 <= a.reps <= 1000:
+        ap.error(f"--reps {a.reps}: allowed 1-1000")
+    scenes = [s for s in a.scenes.split(",") if s]
+    for s in scenes:
+        if not os.path.isfile(os.path.join(ROOT, s)):
+            ap.error(f"--scenes: no file '{s}' (paths relative to the repository)")
+    if not os.access(SIMULATE_PASS, os.X_OK):
+        sys.exit(f"no {SIMULATE_PASS}: build first (SKIP_SETUP=1 scripts/build)")
+    cost = {s: [] for s in scenes}
+    last = {}
+    with tempfile.TemporaryDirectory(prefix="bench_line_kinds_") as tmp:
+        for _ in range(a.reps):
+            for i, s in enumerate(scenes):
+                st = run_once(s, a.preset, os.path.join(tmp, str(i)))
+                cost[s].append(st["wall_time_s"] / (st["dofs"] * st["steps"]) * 1e9)
+                last[s] = st
+    base = statistics.median(cost[scenes[0]])
+    print(f"preset {a.preset}, {a.reps} rounds; cost = pass wall / (DOFs x steps)")
+    print(f"{'scene':40s} {'DOFs':>6s} {'steps':>6s} {'dt (ms)':>8s} {'median ns':>10s} {'min ns':>8s} {'/ first':>8s}")
+    for s in scenes:
+        med = statistics.median(cost[s])
+        st = last[s]
+        print(f"{s:40s} {st['dofs']:6d} {st['steps']:6d} {st['dt_s'] * 1e3:8.4f} {med:10.3f} {min(cost[s]):8.3f} "
+              f"{med / base:8.3f}")
+
+
+if __name__ == "__main__":
+    main()
