@@ -18,7 +18,7 @@ namespace catenary_sim {
 // Eigen's AMD ordering, without its first step. AMDOrdering forms the pattern of A^T + A before
 // the minimum degree search, for an A that may not be structurally symmetric; the simplicial
 // factorisation hands it the full symmetric matrix (SimplicialCholeskyBase::ordering expands the
-// lower triangle first), whose pattern that sum repeats entry for entry. Forming it was most of
+// lower triangle first), whose pattern that sum repeats entry for entry. Forming it is most of
 // the ordering's time; the search on the matrix itself gives the same permutation.
 template <typename StorageIndex>
 struct SymmetricAmdOrdering {
