@@ -63,9 +63,10 @@ struct WireClamp {
   double static_force = 0.0;  // N: pulls the stitch wire's end up and the messenger down at u = 0
   double x = 0.0;             // m
 };
-// 1e-6 m/N: 0.1 % of the softest point of a stitch wire (L / (4 T) ~ 1e-3 m/N for 14-18 m at
-// 3-3.5 kN) and of a messenger's span, so the clamp is rigid to the line; its frequency on the
-// clamp's node mass stays below the wires' highest (the stability limit takes it in anyway).
+// 5e-6 m/N, in series with a stitch wire's ~1e-3 m/N (L / (4 T) for 14-18 m at 3-3.5 kN): rigid to
+// the line (the reference stitched line's elasticity is within 0.03 % of 1e8 N/m clamps'). Its
+// frequency on the clamp's node masses stays below the wires' highest, so the line keeps its dt
+// (1e6 N/m would set a smaller one through the half-step's beta K).
 constexpr double kStitchClampStiffness = 2e5;
 
 // An elastic support: steady arm on the contact wire (eq. 4) or messenger support spring.
