@@ -17,6 +17,7 @@
 
 #include "catenary_sim/core/model/build_model.hpp"
 #include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/model/model_memory.hpp"
 #include "catenary_sim/core/model/statics.hpp"
 #include "catenary_sim/core/output/zero_phase_filter.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
@@ -314,5 +315,19 @@ TEST(StitchedCatenary, AStitchWireBelowTheContactWireIsRefused) {
     ADD_FAILURE() << "a stitch wire of 100 N was accepted";
   } catch (const cs::SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("stitch wire"), std::string::npos) << e.what();
+  }
+}
+
+// The memory check before building counts what a stitched line adds: every node the model has
+// (the clamps' stations on each wire of the section, the stitch wires' own) is within the
+// estimate, on the reference stitched line and with longer stitch wires (24 m: two droppers a side).
+TEST(StitchedCatenary, TheMemoryEstimateHoldsTheStitchWires) {
+  for (double length : {16.0, 24.0}) {
+    cs::Scene scene = cs::load_scene_file(test_scenes::kReferenceStitched);
+    for (cs::SectionSpec& sec : scene.sections) sec.stitch_wire->length = length;
+    const cs::Model m = cs::build_model(scene);
+    double nodes = 0.0;
+    for (const cs::Wire& w : m.wires) nodes += w.nodes();
+    EXPECT_GE(cs::estimate_model_bytes(m.scene) / cs::kModelBytesPerNode, nodes) << "stitch wires of " << length << " m";
   }
 }
