@@ -22,6 +22,7 @@
 #include "catenary_sim/core/output/zero_phase_filter.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
+#include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
 
 namespace cs = catenary_sim;
@@ -258,14 +259,7 @@ TEST(StitchedCatenary, ContactForceSpreadsLessAtSpeed) {
 }
 
 TEST(StitchedCatenary, BadInputIsRefusedByName) {
-  auto refused = [](const std::string& yaml, const std::string& field) {
-    try {
-      cs::load_scene_string(yaml);
-      ADD_FAILURE() << "accepted; expected a refusal naming " << field;
-    } catch (const cs::SceneError& e) {
-      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-    }
-  };
+  const auto refused = test_scenes::expect_refused;
   const std::string y = network_yaml(0.25);
   auto with = [&](const std::string& from, const std::string& to) {
     std::string s = y;
