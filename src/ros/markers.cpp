@@ -253,9 +253,22 @@ void add_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
   arms.color = color(0.2f, 0.5f, 0.9f);
   for (const SupportSpring& sp : m.springs) {
     if (!sp.steady_arm) continue;
-    const double z = d.shown(sp.dof);
-    arms.points.push_back(point(sp.x + s.line_offset, y_mast, wire_dof_design_height(m, sp.dof)));
-    arms.points.push_back(point(sp.x + s.line_offset, dof_lateral(m, s, sp.dof), z));
+    const double x = sp.x + s.line_offset, z = d.shown(sp.dof), z0 = wire_dof_design_height(m, sp.dof);
+    const double y = dof_lateral(m, s, sp.dof);
+    if (sp.hinged_arm()) {
+      // A hinged arm as built: the registration tube from the mast to the hinge, which stands
+      // a cos(theta0) toward the mast and a sin(theta0) above the wire; the arm from the hinge
+      // to the clamp on the wire.
+      const double yh = y + sp.arm_length * std::cos(sp.arm_inclination);
+      const double zh = z0 + sp.arm_length * std::sin(sp.arm_inclination);
+      arms.points.push_back(point(x, y_mast, zh));
+      arms.points.push_back(point(x, yh, zh));
+      arms.points.push_back(point(x, yh, zh));
+      arms.points.push_back(point(x, y, z));
+      continue;
+    }
+    arms.points.push_back(point(x, y_mast, z0));
+    arms.points.push_back(point(x, y, z));
   }
   add_list(out, arms);
 }

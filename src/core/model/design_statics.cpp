@@ -147,6 +147,32 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
   }
 }
 
+// A hinged steady arm's inclination and k_A at the assembly (HingedArmSpec). The arm is a bar of
+// length a hinged at the registration tube, pulled along its axis by F_h. Its moments about the
+// hinge, with the wire's load W at the tip, the clamp's weight there and its own at mid-length:
+//   F_h a sin(theta) = (W + m_c g + m_a g / 2) a cos(theta).
+// The spring's reaction f0 carries W and the tip mass (m_a / 3 + m_c) g, so the bracket is
+// f0 + m_a g / 6. The arm's potential -F_h a cos(theta) - (m_c + m_a / 2) g a sin(theta) in the
+// tip's height z = -a sin(theta) has d2/dz2 = F_h / (a cos^3 theta): the weights drop out, and that
+// is eq. 4's k_A. (The tip's sideways speed a sin(theta) theta' is left out of its inertia: a
+// share tan^2(theta), under 3 % for an arm below 10 degrees.)
+void set_hinged_arm(const HingedArmSpec& arm, double g, const std::string& field, SupportSpring& sp) {
+  const double bracket = sp.static_force + arm.linear_mass * arm.length * g / 6.0;
+  const double theta = std::atan2(bracket, arm.pull_off);
+  // Steeper, k_A grows as 1 / cos^3 toward a rod hanging straight down, rigid to the line and
+  // beyond any step; arms as built hang a few degrees.
+  constexpr double kMaxInclination = 0.25 * M_PI;
+  if (std::abs(theta) > kMaxInclination)
+    throw SceneError("scene field '" + field + ".pull_off' = " + fmt(arm.pull_off) + " N: the arm at station " +
+                     fmt(sp.x) + " m would hang " + fmt(theta * 180.0 / M_PI) + " degrees from its hinge under the " +
+                     fmt(bracket) + " N the wire and its weight put on it; allowed: a pull-off of at least " +
+                     fmt(std::abs(bracket) / std::tan(kMaxInclination)) + " N (within 45 degrees of horizontal)");
+  const double c = std::cos(theta);
+  sp.arm_length = arm.length;
+  sp.arm_inclination = theta;
+  sp.stiffness = arm.pull_off / (arm.length * c * c * c);
+}
+
 }  // namespace
 
 void design_statics(const Scene& scene, const std::vector<std::vector<double>>& section_supports, Model& m) {
@@ -168,6 +194,11 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
     const auto it = std::find_if(m.wires.begin(), m.wires.end(),
                                  [&](const Wire& w) { return sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes(); });
     sp.static_force = react[it - m.wires.begin()][sp.section_support];
+    const std::optional<SupportSpec>& arm = scene.sections[it->section].steady_arms;
+    if (sp.steady_arm && arm && arm->hinged_arm) {
+      const std::string pre = scene.sections.size() > 1 ? "sections[" + std::to_string(it->section) + "]." : "";
+      set_hinged_arm(*arm->hinged_arm, scene.gravity, pre + "steady_arms", sp);
+    }
   }
 }
 

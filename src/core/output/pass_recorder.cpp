@@ -505,6 +505,16 @@ LineStatistics PassRecorder::line_statistics(const Model& m) const {
     a.station = xs;
     a.max_uplift = up;
     a.exceeded = m.scene.output.allowed_uplift && up > *m.scene.output.allowed_uplift;
+    // (An endless line's arms are its block's, repeated span by span.)
+    auto same_arm = [&](double x) { return std::abs(m.endless ? std::remainder(x - xs, m.endless_span) : x - xs) < 1e-3; };
+    for (const SupportSpring& sp : m.springs)
+      if (sp.hinged_arm() && same_arm(sp.x)) {
+        a.hinged = true;
+        a.stiffness = sp.stiffness;
+        a.inclination = sp.arm_inclination;
+        a.inclination_at_max_uplift = sp.arm_inclination_at(up);
+        break;
+      }
     ls.steady_arms.push_back(a);
   }
   return ls;

@@ -148,8 +148,15 @@ void put_line(Json& j, const Model& m, const std::vector<PantographStatistics>& 
   auto opt = [](const std::optional<double>& v) { return v ? Json(*v) : Json(nullptr); };
   j["allowed_uplift_m"] = opt(o.allowed_uplift);
   Json arms = Json::array();
-  for (const SteadyArmStatistics& a : line.steady_arms)
-    arms.push_back(Json{{"station_m", a.station}, {"max_uplift_m", a.max_uplift}, {"exceeded", a.exceeded}});
+  for (const SteadyArmStatistics& a : line.steady_arms) {
+    Json arm{{"station_m", a.station}, {"max_uplift_m", a.max_uplift}, {"exceeded", a.exceeded}};
+    if (a.hinged) {
+      arm["stiffness_N_per_m"] = a.stiffness;
+      arm["inclination_rad"] = a.inclination;
+      arm["inclination_at_max_uplift_rad"] = a.inclination_at_max_uplift;
+    }
+    arms.push_back(arm);
+  }
   j["steady_arms"] = arms;
   Json dr;
   dr["rainflow_bin_N"] = line.range_bin_n;

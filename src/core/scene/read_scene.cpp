@@ -32,6 +32,27 @@ SupportSpec read_support(Reader& r) {
   return s;
 }
 
+// Steady arms: a spring of eq. 4 (`stiffness`, `mass`), or a hinged arm as built (`length`,
+// `linear_mass`, `clamp_mass`, `pull_off`) whose k_A and tip mass follow from it.
+SupportSpec read_steady_arms(Reader& r, const std::string& path) {
+  if (!r.has("length")) return read_support(r);
+  for (const char* spring : {"stiffness", "mass"})
+    if (r.has(spring))
+      fail(path + "." + spring, "(given with length)",
+           "either a spring (stiffness, mass) or a hinged arm (length, linear_mass, clamp_mass, pull_off), not both: "
+           "a hinged arm's stiffness and mass follow from its geometry and pull-off");
+  HingedArmSpec a;
+  a.length = r.number("length", 0.0, 5.0, std::nullopt, true);
+  a.linear_mass = r.number("linear_mass", 0.0, 20.0, std::nullopt);
+  a.clamp_mass = r.number("clamp_mass", 0.0, 20.0, 0.0);
+  a.pull_off = r.number("pull_off", 0.0, 1e5, std::nullopt, true);
+  r.finish();
+  SupportSpec s;
+  s.mass = a.tip_mass();
+  s.hinged_arm = a;
+  return s;
+}
+
 void read_spans(Reader& r, const std::string& path, std::vector<double>& spans) {
   if (r.has("spans")) {
     if (r.has("span_length") || r.has("span_count"))
@@ -155,10 +176,13 @@ void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, co
   }
   if (r.has("steady_arms")) {
     Reader a(r.child("steady_arms"), pre + "steady_arms");
-    sec.steady_arms = read_support(a);
+    sec.steady_arms = read_steady_arms(a, pre + "steady_arms");
   }
   if (r.has("messenger_supports")) {
     Reader a(r.child("messenger_supports"), pre + "messenger_supports");
+    if (a.has("length"))
+      fail(pre + "messenger_supports.length", "(given)",
+           "a messenger support is a spring (stiffness, mass); hinged arms (length, ...) are steady_arms'");
     sec.messenger_supports = read_support(a);
   }
   if (r.has("stitch_wire")) read_stitch_wire(r, pre, sec);

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -78,6 +80,14 @@ struct SupportSpring {
   int span_index = 0;         // index of the support along the line (Model::support_x); span i starts there
   bool steady_arm = false;
   int section_support = 0;    // index of the support within its tension section
+  // A hinged steady arm (HingedArmSpec): its length and its inclination below the hinge at the
+  // assembly (rad); 0 length for a spring given by its stiffness.
+  double arm_length = 0.0, arm_inclination = 0.0;
+  bool hinged_arm() const { return arm_length > 0.0; }
+  // The arm's inclination with its tip raised by `uplift` (m): sin(theta) = sin(theta0) - u / a.
+  double arm_inclination_at(double uplift) const {
+    return std::asin(std::clamp(std::sin(arm_inclination) - uplift / arm_length, -1.0, 1.0));
+  }
 };
 
 // A tension section as built: its wires and the raised contact-wire supports of its transition

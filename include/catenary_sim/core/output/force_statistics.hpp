@@ -85,6 +85,11 @@ struct SteadyArmStatistics {
   double station = 0.0;     // m
   double max_uplift = 0.0;  // m, largest over the pass and all pantographs
   bool exceeded = false;    // above output.allowed_uplift
+  // A hinged arm (HingedArmSpec; false: a spring of eq. 4): its k_A, its inclination below the
+  // hinge at the assembly and with the tip at the largest uplift (rad; negative: above the hinge).
+  bool hinged = false;
+  double stiffness = 0.0;  // N/m
+  double inclination = 0.0, inclination_at_max_uplift = 0.0;
 };
 
 struct LineStatistics {

@@ -58,10 +58,25 @@ struct StitchWireSpec {
   double clamp_mass = 0.0;         // kg, each clamp on the messenger (lumped on the messenger node)
 };
 
+// A steady (registration) arm as built: a bar hinged at the registration tube, its tip clamped to
+// the contact wire, which pulls it along its axis with the horizontal pull-off of the stagger and
+// the curve. The paper's eq. 4 takes k_A from "the linearization of the statics equations"; for
+// this arm that is k_A = F_h / (a cos^3 theta0), theta0 its inclination below the hinge at the
+// assembly (model/design_statics.cpp).
+struct HingedArmSpec {
+  double length = 0.0;       // m, a: hinge to clamp
+  double linear_mass = 0.0;  // kg/m
+  double clamp_mass = 0.0;   // kg, at the tip
+  double pull_off = 0.0;     // N, F_h: the wire's horizontal pull (4 T s / L on a straight zigzag)
+  // Its moment of inertia about the hinge as a mass at the tip: m a^2 / 3 / a^2, plus the clamp.
+  double tip_mass() const { return linear_mass * length / 3.0 + clamp_mass; }
+};
+
 // An elastic support (steady arm, eq. 4, or messenger support); absent = rigid.
 struct SupportSpec {
-  double stiffness = 0.0;  // N/m
-  double mass = 0.0;       // kg, lumped on the wire node
+  double stiffness = 0.0;  // N/m (a hinged arm's: set by the design statics)
+  double mass = 0.0;       // kg, lumped on the wire node (a hinged arm's: its tip mass)
+  std::optional<HingedArmSpec> hinged_arm;  // steady arms only
 };
 
 struct CollectorSpec {
