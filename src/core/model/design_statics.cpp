@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/statics.hpp"
 #include "model/spd_solver.hpp"
 #include "util/format.hpp"
@@ -148,15 +149,18 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
 }
 
 // A hinged steady arm's inclination and k_A at the assembly (HingedArmSpec). The arm is a bar of
-// length a hinged at the registration tube, pulled along its axis by F_h. Its moments about the
-// hinge, with the wire's load W at the tip, the clamp's weight there and its own at mid-length:
+// length a hinged at the registration tube; the wire pulls its end outward with F_h, less k_w per
+// metre the end moves out (k_w: the wire's own lateral stiffness there). Its moments about the
+// hinge, with the wire's load W at the end, the clamp's weight there and its own at mid-length:
 //   F_h a sin(theta) = (W + m_c g + m_a g / 2) a cos(theta).
 // The spring's reaction f0 carries W and the tip mass (m_a / 3 + m_c) g, so the bracket is
-// f0 + m_a g / 6. The arm's potential -F_h a cos(theta) - (m_c + m_a / 2) g a sin(theta) in the
-// tip's height z = -a sin(theta) has d2/dz2 = F_h / (a cos^3 theta): the weights drop out, and that
-// is eq. 4's k_A. (The tip's sideways speed a sin(theta) theta' is left out of its inertia: a
-// share tan^2(theta), under 3 % for an arm below 10 degrees.)
-void set_hinged_arm(const HingedArmSpec& arm, double g, const std::string& field, SupportSpring& sp) {
+// f0 + m_a g / 6. In the end's height z = -a sin(theta) the end moves out by tan(theta) dz, and
+// the potential -F_h a cos(theta) + k_w (a cos(theta) - a cos(theta0))^2 / 2 - (m_c + m_a / 2) g
+// a sin(theta) has d2/dz2 = F_h / (a cos^3 theta0) + k_w tan^2 theta0 at the assembly: the weights
+// drop out, and that is eq. 4's k_A. (The end's sideways speed is left out of its inertia: a share
+// tan^2(theta0) of it.)
+void set_hinged_arm(const HingedArmSpec& arm, double g, double wire_lateral_stiffness, const std::string& field,
+                    SupportSpring& sp) {
   const double bracket = sp.static_force + arm.linear_mass * arm.length * g / 6.0;
   const double theta = std::atan2(bracket, arm.pull_off);
   // Steeper, k_A grows as 1 / cos^3 toward a rod hanging straight down, rigid to the line and
@@ -170,7 +174,9 @@ void set_hinged_arm(const HingedArmSpec& arm, double g, const std::string& field
   const double c = std::cos(theta);
   sp.arm_length = arm.length;
   sp.arm_inclination = theta;
-  sp.stiffness = arm.pull_off / (arm.length * c * c * c);
+  const double t = std::tan(theta);
+  sp.arm_wire_lateral_stiffness = wire_lateral_stiffness;
+  sp.stiffness = arm.pull_off / (arm.length * c * c * c) + wire_lateral_stiffness * t * t;
 }
 
 }  // namespace
@@ -190,15 +196,25 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
     section_statics(scene, si, section_supports, m, weight_len, dropper_len, react);
   set_dropper_lengths(scene, weight_len, dropper_len, m);
   // Support preloads f0 of eq. 4: the static reactions at the elastic supports.
-  for (SupportSpring& sp : m.springs) {
-    const auto it = std::find_if(m.wires.begin(), m.wires.end(),
-                                 [&](const Wire& w) { return sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes(); });
-    sp.static_force = react[it - m.wires.begin()][sp.section_support];
-    const std::optional<SupportSpec>& arm = scene.sections[it->section].steady_arms;
+  std::vector<int> hinged;  // springs that are hinged arms, and their nodes
+  std::vector<int> hinged_dofs;
+  for (std::size_t k = 0; k < m.springs.size(); ++k) {
+    SupportSpring& sp = m.springs[k];
+    const Wire& w = wire_holding(m, sp.dof);
+    sp.static_force = react[&w - m.wires.data()][sp.section_support];
+    const std::optional<SupportSpec>& arm = scene.sections[w.section].steady_arms;
     if (sp.steady_arm && arm && arm->hinged_arm) {
-      const std::string pre = scene.sections.size() > 1 ? "sections[" + std::to_string(it->section) + "]." : "";
-      set_hinged_arm(*arm->hinged_arm, scene.gravity, pre + "steady_arms", sp);
+      hinged.push_back(static_cast<int>(k));
+      hinged_dofs.push_back(sp.dof);
     }
+  }
+  if (hinged.empty()) return;
+  const std::vector<double> k_w = registration_lateral_stiffness(m, hinged_dofs);
+  for (std::size_t q = 0; q < hinged.size(); ++q) {
+    SupportSpring& sp = m.springs[hinged[q]];
+    const int section = wire_holding(m, sp.dof).section;
+    const std::string pre = scene.sections.size() > 1 ? "sections[" + std::to_string(section) + "]." : "";
+    set_hinged_arm(*scene.sections[section].steady_arms->hinged_arm, scene.gravity, k_w[q], pre + "steady_arms", sp);
   }
 }
 

@@ -362,6 +362,43 @@ void prepare_window(LateralModel* lat) {
   for (int k : lat->spring_order) lat->spring_order_x.push_back(lat->node_x[lat->springs[k].dof]);
 }
 
+// The lateral plane's stiffness with the rotations as unknowns (y_i at i, theta_i at n + i):
+// add(i, j, value) for every entry of the wires' bands, the support springs and the droppers as
+// pendulums at their static tension.
+template <class Add>
+void add_stiffness(const Model& m, const LateralModel& lat, Add&& add) {
+  const int n = lat.n;
+  for (const Wire& w : lat.wires) {
+    const int o = w.w_dof, nn = w.nodes();
+    for (int i = 0; i < nn; ++i) {
+      const int a = o + i, t = n + o + i;
+      add(a, a, w.d_ww[i]);
+      add(a, t, w.d_wt[i]);
+      add(t, a, w.d_wt[i]);
+      add(t, t, w.d_tt[i]);
+    }
+    for (int e = 0; e + 1 < nn; ++e) {
+      const int a = o + e, b = o + e + 1, ta = n + a, tb = n + b;
+      add(a, b, w.e_ww[e]);
+      add(b, a, w.e_ww[e]);
+      add(a, tb, w.e_wt[e]);
+      add(tb, a, w.e_wt[e]);
+      add(ta, b, w.e_tw[e]);
+      add(b, ta, w.e_tw[e]);
+      add(ta, tb, w.e_tt[e]);
+      add(tb, ta, w.e_tt[e]);
+    }
+  }
+  for (const LateralSpring& sp : lat.springs) add(sp.dof, sp.dof, sp.stiffness);
+  for (const LateralPendulum& p : lat.pendulums) {
+    const double k = std::max(0.0, m.droppers[p.dropper].static_tension) * p.inv_length;
+    add(p.contact, p.contact, k);
+    add(p.messenger, p.messenger, k);
+    add(p.contact, p.messenger, -k);
+    add(p.messenger, p.contact, -k);
+  }
+}
+
 }  // namespace
 
 void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wind, Eigen::VectorXd* y_out,
@@ -392,35 +429,7 @@ void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wi
     if (fj) Fr[i] -= v * fixed_value[j];
     else reduced.emplace_back(i, j, v);
   };
-  for (const Wire& w : lat.wires) {
-    const int o = w.w_dof, nn = w.nodes();
-    for (int i = 0; i < nn; ++i) {
-      const int a = o + i, t = n + o + i;
-      add(a, a, w.d_ww[i]);
-      add(a, t, w.d_wt[i]);
-      add(t, a, w.d_wt[i]);
-      add(t, t, w.d_tt[i]);
-    }
-    for (int e = 0; e + 1 < nn; ++e) {
-      const int a = o + e, b = o + e + 1, ta = n + a, tb = n + b;
-      add(a, b, w.e_ww[e]);
-      add(b, a, w.e_ww[e]);
-      add(a, tb, w.e_wt[e]);
-      add(tb, a, w.e_wt[e]);
-      add(ta, b, w.e_tw[e]);
-      add(b, ta, w.e_tw[e]);
-      add(ta, tb, w.e_tt[e]);
-      add(tb, ta, w.e_tt[e]);
-    }
-  }
-  for (const LateralSpring& sp : lat.springs) add(sp.dof, sp.dof, sp.stiffness);
-  for (const LateralPendulum& p : lat.pendulums) {
-    const double k = std::max(0.0, m.droppers[p.dropper].static_tension) * p.inv_length;
-    add(p.contact, p.contact, k);
-    add(p.messenger, p.messenger, k);
-    add(p.contact, p.messenger, -k);
-    add(p.messenger, p.contact, -k);
-  }
+  add_stiffness(m, lat, add);
   for (int i = 0; i < n; ++i)
     if (fixed[i]) {
       reduced.emplace_back(i, i, 1.0);
@@ -437,6 +446,47 @@ void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wi
     throw SceneError("scene: the lateral statics has no solution (a wire free to move sideways)");
   *y_out = x.head(n);
   if (force_on_support) support_forces(lat, F, Kf, x, force_on_support);
+}
+
+std::vector<double> registration_lateral_stiffness(const Model& m, const std::vector<int>& dofs) {
+  LateralModel lat;
+  add_wires_and_supports(m, &lat);
+  add_pendulums(m, &lat);
+  const int n = lat.n, N = 2 * n;
+  auto lateral_dof = [&](int vertical) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const Wire& w = m.wires[wi];
+      if (vertical >= w.w_dof && vertical < w.w_dof + w.nodes()) return lat.wires[wi].w_dof + vertical - w.w_dof;
+    }
+    return -1;
+  };
+  // Every support held (rows y_i = 0), then each asked node let go in turn: its stiffness is the
+  // Schur complement K_ii - K_ir K_rr^-1 K_ri over the rest r of the plane.
+  std::vector<bool> fixed(n, false);
+  for (const LateralSupport& sup : lat.supports) fixed[lat.wires[sup.wire].w_dof + sup.node] = true;
+  std::vector<Eigen::Triplet<double>> held, full;
+  add_stiffness(m, lat, [&](int i, int j, double v) {
+    full.emplace_back(i, j, v);
+    if (!(i < n && fixed[i]) && !(j < n && fixed[j])) held.emplace_back(i, j, v);
+  });
+  for (int i = 0; i < n; ++i)
+    if (fixed[i]) held.emplace_back(i, i, 1.0);
+  Eigen::SparseMatrix<double> K(N, N), Kf(N, N);
+  K.setFromTriplets(held.begin(), held.end());
+  Kf.setFromTriplets(full.begin(), full.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(K);
+  if (solver.info() != Eigen::Success)
+    throw SceneError("scene: the lateral stiffness at the steady arms has no solution (a wire free to move sideways)");
+  std::vector<double> k(dofs.size(), 0.0);
+  for (std::size_t q = 0; q < dofs.size(); ++q) {
+    const int i = lateral_dof(dofs[q]);
+    Eigen::VectorXd c = Kf.col(i);
+    for (int j = 0; j < n; ++j)
+      if (fixed[j]) c[j] = 0.0;
+    const Eigen::VectorXd x = solver.solve(c);
+    k[q] = Kf.coeff(i, i) - c.dot(x);
+  }
+  return k;
 }
 
 double gust_lead_time(const Scene& sc) {

@@ -143,6 +143,12 @@ struct LateralModel {
 double gust_lead_time(const Scene& scene);
 constexpr double kGustLeadDecays = 2.0, kAutoGustLeadMax = 30.0;  // s
 
+// The lateral stiffness (N/m) of the wire at each of the vertical DOFs `dofs` (support nodes),
+// that support alone let go and every other held: the tensioned wires with their bending and the
+// droppers as pendulums at their design tension, as the lateral plane has them. What a steady
+// arm's sideways travel works against (HingedArmSpec); any line, 2-D ones too.
+std::vector<double> registration_lateral_stiffness(const Model& model, const std::vector<int>& dofs);
+
 // Builds the lateral plane of a model whose scene asks for one (Scene::lateral()); throws SceneError.
 std::shared_ptr<const LateralModel> build_lateral(const Model& model);
 

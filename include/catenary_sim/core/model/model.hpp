@@ -83,6 +83,8 @@ struct SupportSpring {
   // A hinged steady arm (HingedArmSpec): its length and its inclination below the hinge at the
   // assembly (rad); 0 length for a spring given by its stiffness.
   double arm_length = 0.0, arm_inclination = 0.0;
+  // N/m: the wire's lateral stiffness at the arm's end, which its sideways travel works against.
+  double arm_wire_lateral_stiffness = 0.0;
   bool hinged_arm() const { return arm_length > 0.0; }
   // The arm's inclination with its tip raised by `uplift` (m): sin(theta) = sin(theta0) - u / a.
   double arm_inclination_at(double uplift) const {
