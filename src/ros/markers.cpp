@@ -257,9 +257,10 @@ void add_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
     const double y = dof_lateral(m, s, sp.dof);
     if (sp.hinged_arm()) {
       // A hinged arm as built: the registration tube from the mast to the hinge, which stands
-      // a cos(theta0) toward the mast and a sin(theta0) above the wire; the arm from the hinge
-      // to the clamp on the wire.
-      const double yh = y + sp.arm_length * std::cos(sp.arm_inclination);
+      // a cos(theta0) against the wire's pull (on a 2-D line toward the mast) and a sin(theta0)
+      // above the wire; the arm from the hinge to the clamp on the wire.
+      const double away = sp.arm_pull_side != 0.0 ? -sp.arm_pull_side : 1.0;
+      const double yh = y + away * sp.arm_length * std::cos(sp.arm_inclination);
       const double zh = z0 + sp.arm_length * std::sin(sp.arm_inclination);
       arms.points.push_back(point(x, y_mast, zh));
       arms.points.push_back(point(x, yh, zh));

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "catenary_sim/core/model/build_model.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
@@ -77,7 +79,7 @@ TEST(HingedSteadyArms, StiffnessIsTheArmsExactStaticsLinearised) {
     auto solve = [&](double load, double cos0) {  // theta of the moments' balance, Newton from 0.3
       double th = 0.3;
       for (int it = 0; it < 50; ++it) {
-        const double F = arm.pull_off - kw * a * (std::cos(th) - cos0);
+        const double F = *arm.pull_off - kw * a * (std::cos(th) - cos0);
         const double r = F * std::sin(th) - (load + weights) * std::cos(th);
         const double dr = kw * a * std::sin(th) * std::sin(th) + F * std::cos(th) + (load + weights) * std::sin(th);
         th -= r / dr;
@@ -85,7 +87,7 @@ TEST(HingedSteadyArms, StiffnessIsTheArmsExactStaticsLinearised) {
       return th;
     };
     // The assembly: F = F_h there, so theta0 is the arm's without the wire's give.
-    const double theta0 = std::atan((W + weights) / arm.pull_off);
+    const double theta0 = std::atan((W + weights) / *arm.pull_off);
     EXPECT_NEAR(solve(W, std::cos(theta0)), theta0, 1e-14);
     const double dW = 0.01;
     const double zp = -a * std::sin(solve(W + dW, std::cos(theta0))), zm = -a * std::sin(solve(W - dW, std::cos(theta0)));
@@ -161,6 +163,66 @@ TEST(HingedSteadyArms, IsTheSpringOfItsStiffnessAndTipMass) {
   EXPECT_GT(a.max_arm_uplift, 0.0);
 }
 
+// On a 3-D line each arm's pull-off comes from the lateral statics of the stagger and the curves.
+// A zigzag of +-s on straight track, the messenger above the contact wire (no dropper leans),
+// pulls each arm with 4 T (s - F / k) / L, the registrations giving F / k toward the track centre
+// on their lateral springs k: F = (4 T s / L) / (1 + 4 T / (L k)). A curve of radius R without
+// stagger pulls with T L / R toward the curve's centre (every support gives alike). The beam
+// elements round the wire's kink at the support (0.1 % at 0.25 m, as above) and its bending
+// stiffness spreads it over sqrt(EI / T) = 0.09 m: 0.5 %. The lateral plane the pass then builds
+// reports the same pull-off at the same support (one statics: 1e-9).
+TEST(HingedSteadyArms, OnA3dLineThePullOffIsTheStaggersAndTheCurves) {
+  auto line = [](const std::function<void(YAML::Node&)>& edit) {
+    return cs::build_model(test_scenes::edited_scene("reference_55m_3d.yaml", [&](YAML::Node& root) {
+      root["line"]["span_count"] = 6;
+      root.remove("wind");
+      root["stagger"].remove("messenger");
+      YAML::Node arms;
+      arms["length"] = 1.15;
+      arms["linear_mass"] = 0.78;
+      arms["clamp_mass"] = 0.46;
+      root["steady_arms"] = arms;
+      edit(root);
+    }));
+  };
+  auto check = [](const cs::Model& m, double expected, double side) {
+    ASSERT_TRUE(m.lateral);
+    int arms = 0;
+    for (const cs::SupportSpring& sp : m.springs) {
+      if (!sp.steady_arm) continue;
+      ++arms;
+      EXPECT_NEAR(sp.arm_pull_off, expected, 0.005 * expected) << "arm at " << sp.x << " m";
+      if (side != 0.0) {
+        EXPECT_EQ(sp.arm_pull_side, side) << "arm at " << sp.x << " m";
+      }
+      for (const cs::LateralSupport& ls : m.lateral->supports) {
+        if (m.wires[ls.wire].is_contact_wire && std::abs(ls.x - sp.x) < 1e-9) {
+          EXPECT_NEAR(std::abs(ls.pull_off), sp.arm_pull_off, 1e-9 * expected);
+        }
+      }
+    }
+    EXPECT_EQ(arms, 5);
+  };
+  const double T = 22000.0, L = 55.0, k = 2.0e5;  // reference_55m_3d.yaml's steady_arm_stiffness
+  const cs::Model zigzag = line([](YAML::Node&) {});
+  check(zigzag, 4.0 * T * 0.3 / L / (1.0 + 4.0 * T / (L * k)), 0.0);
+  // The wire's give that the arm drags against is the 2-D line's: the lateral springs at the
+  // registrations are the arms themselves, stiff along their length, not the wire (round-off).
+  const cs::Model flat = cs::build_model(line_with_arms(YAML::LoadFile(test_scenes::scene_path(kHinged))["steady_arms"], 6));
+  std::vector<double> kw3, kw2;
+  for (const cs::SupportSpring& sp : zigzag.springs)
+    if (sp.steady_arm) kw3.push_back(sp.arm_wire_lateral_stiffness);
+  for (const cs::SupportSpring& sp : flat.springs)
+    if (sp.steady_arm) kw2.push_back(sp.arm_wire_lateral_stiffness);
+  ASSERT_EQ(kw3.size(), kw2.size());
+  for (std::size_t i = 0; i < kw2.size(); ++i) EXPECT_NEAR(kw3[i], kw2[i], 1e-9 * kw2[i]) << "arm " << i;
+  const cs::Model curve = line([](YAML::Node& root) {
+    root["stagger"]["contact_wire"] = std::vector<double>{0.0};
+    root["alignment"]["radius"] = 1000.0;
+  });
+  check(curve, T * L / 1000.0, 1.0);
+}
+
 // Bad input: each field refused by name with what is allowed.
 TEST(HingedSteadyArms, BadInputIsRefusedByName) {
   const std::string base =
@@ -182,16 +244,21 @@ TEST(HingedSteadyArms, BadInputIsRefusedByName) {
   test_scenes::expect_refused(base + "steady_arms: {" + arm + ", pull_off: 480}\nmessenger_supports: {length: 1.0}\n",
                               "messenger_supports.length");
   test_scenes::expect_refused(base + "steady_arms: {" + arm + ", pull_off: 480}\nstagger: {contact_wire: [0.3, -0.3]}\n",
-                              "steady_arms.length");
+                              "steady_arms.pull_off");
   // Too little pull-off for the load at the registration: the arm would hang near vertical, its
   // k_A without bound. Refused when the design statics know the load, naming the field.
-  const cs::Scene slack = cs::load_scene_string(base + "steady_arms: {" + arm + ", pull_off: 20}\n");
-  try {
-    cs::build_model(slack);
-    ADD_FAILURE() << "a pull-off of 20 N was accepted";
-  } catch (const cs::SceneError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("steady_arms.pull_off"), std::string::npos) << what;
-    EXPECT_NE(what.find("at least"), std::string::npos) << what;
-  }
+  auto refused_at_build = [](const std::string& yaml, const std::string& field) {
+    const cs::Scene scene = cs::load_scene_string(yaml);
+    try {
+      cs::build_model(scene);
+      ADD_FAILURE() << "accepted; expected a refusal naming " << field;
+    } catch (const cs::SceneError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(field), std::string::npos) << what;
+      EXPECT_NE(what.find("at least"), std::string::npos) << what;
+    }
+  };
+  refused_at_build(base + "steady_arms: {" + arm + ", pull_off: 20}\n", "steady_arms.pull_off");
+  // On a 3-D line without stagger or curve nothing pulls the arms: the stagger is named.
+  refused_at_build(base + "steady_arms: {" + arm + "}\nstagger: {contact_wire: [0.0]}\n", "stagger.contact_wire");
 }

@@ -159,24 +159,33 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
 // a sin(theta) has d2/dz2 = F_h / (a cos^3 theta0) + k_w tan^2 theta0 at the assembly: the weights
 // drop out, and that is eq. 4's k_A. (The end's sideways speed is left out of its inertia: a share
 // tan^2(theta0) of it.)
-void set_hinged_arm(const HingedArmSpec& arm, double g, double wire_lateral_stiffness, const std::string& field,
+void set_hinged_arm(const HingedArmSpec& arm, double g, const RegistrationLateral& wire, const std::string& field,
                     SupportSpring& sp) {
+  const double pull_off = arm.pull_off ? *arm.pull_off : wire.pull_off;
   const double bracket = sp.static_force + arm.linear_mass * arm.length * g / 6.0;
-  const double theta = std::atan2(bracket, arm.pull_off);
+  const double theta = std::atan2(bracket, pull_off);
   // Steeper, k_A grows as 1 / cos^3 toward a rod hanging straight down, rigid to the line and
   // beyond any step; arms as built hang a few degrees.
   constexpr double kMaxInclination = 0.25 * M_PI;
-  if (std::abs(theta) > kMaxInclination)
-    throw SceneError("scene field '" + field + ".pull_off' = " + fmt(arm.pull_off) + " N: the arm at station " +
-                     fmt(sp.x) + " m would hang " + fmt(theta * 180.0 / M_PI) + " degrees from its hinge under the " +
-                     fmt(bracket) + " N the wire and its weight put on it; allowed: a pull-off of at least " +
-                     fmt(std::abs(bracket) / std::tan(kMaxInclination)) + " N (within 45 degrees of horizontal)");
+  if (std::abs(theta) > kMaxInclination) {
+    const std::string need = fmt(std::abs(bracket) / std::tan(kMaxInclination));
+    const std::string hangs = " m would hang " + fmt(theta * 180.0 / M_PI) + " degrees from its hinge under the " +
+                              fmt(bracket) + " N the wire and its weight put on it";
+    if (arm.pull_off)
+      throw SceneError("scene field '" + field + ".pull_off' = " + fmt(pull_off) + " N: the arm at station " + fmt(sp.x) +
+                       hangs + "; allowed: a pull-off of at least " + need + " N (within 45 degrees of horizontal)");
+    throw SceneError("scene field 'stagger.contact_wire': the pull-off " + fmt(pull_off) + " N it gives the hinged arm at station " +
+                     fmt(sp.x) + hangs + "; allowed: stagger and curves that pull each arm with at least " + need +
+                     " N (within 45 degrees of horizontal), or steady_arms as a spring (stiffness, mass)");
+  }
   const double c = std::cos(theta);
   sp.arm_length = arm.length;
   sp.arm_inclination = theta;
   const double t = std::tan(theta);
-  sp.arm_wire_lateral_stiffness = wire_lateral_stiffness;
-  sp.stiffness = arm.pull_off / (arm.length * c * c * c) + wire_lateral_stiffness * t * t;
+  sp.arm_wire_lateral_stiffness = wire.stiffness;
+  sp.arm_pull_off = pull_off;
+  sp.arm_pull_side = wire.side;
+  sp.stiffness = pull_off / (arm.length * c * c * c) + wire.stiffness * t * t;
 }
 
 }  // namespace
@@ -209,12 +218,12 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
     }
   }
   if (hinged.empty()) return;
-  const std::vector<double> k_w = registration_lateral_stiffness(m, hinged_dofs);
+  const std::vector<RegistrationLateral> wire = registration_lateral(m, hinged_dofs);
   for (std::size_t q = 0; q < hinged.size(); ++q) {
     SupportSpring& sp = m.springs[hinged[q]];
     const int section = wire_holding(m, sp.dof).section;
     const std::string pre = scene.sections.size() > 1 ? "sections[" + std::to_string(section) + "]." : "";
-    set_hinged_arm(*scene.sections[section].steady_arms->hinged_arm, scene.gravity, k_w[q], pre + "steady_arms", sp);
+    set_hinged_arm(*scene.sections[section].steady_arms->hinged_arm, scene.gravity, wire[q], pre + "steady_arms", sp);
   }
 }
 

@@ -448,7 +448,7 @@ void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wi
   if (force_on_support) support_forces(lat, F, Kf, x, force_on_support);
 }
 
-std::vector<double> registration_lateral_stiffness(const Model& m, const std::vector<int>& dofs) {
+std::vector<RegistrationLateral> registration_lateral(const Model& m, const std::vector<int>& dofs) {
   LateralModel lat;
   add_wires_and_supports(m, &lat);
   add_pendulums(m, &lat);
@@ -477,16 +477,33 @@ std::vector<double> registration_lateral_stiffness(const Model& m, const std::ve
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(K);
   if (solver.info() != Eigen::Success)
     throw SceneError("scene: the lateral stiffness at the steady arms has no solution (a wire free to move sideways)");
-  std::vector<double> k(dofs.size(), 0.0);
+  std::vector<RegistrationLateral> out(dofs.size());
   for (std::size_t q = 0; q < dofs.size(); ++q) {
     const int i = lateral_dof(dofs[q]);
     Eigen::VectorXd c = Kf.col(i);
     for (int j = 0; j < n; ++j)
       if (fixed[j]) c[j] = 0.0;
     const Eigen::VectorXd x = solver.solve(c);
-    k[q] = Kf.coeff(i, i) - c.dot(x);
+    // (Without the support's own lateral spring: that is the arm itself, stiff along its length.)
+    double own = 0.0;
+    for (const LateralSpring& sp : lat.springs)
+      if (sp.dof == i) own += sp.stiffness;
+    out[q].stiffness = Kf.coeff(i, i) - own - c.dot(x);
   }
-  return k;
+  if (!m.scene.lateral()) return out;
+  // The calm statics in plan: each support's share of the wire's pull (the pull-off).
+  Eigen::VectorXd y;
+  std::vector<double> force;
+  solve_lateral_statics(m, lat, false, &y, &force);
+  for (std::size_t q = 0; q < dofs.size(); ++q) {
+    const int i = lateral_dof(dofs[q]);
+    for (std::size_t k = 0; k < lat.supports.size(); ++k)
+      if (lat.wires[lat.supports[k].wire].w_dof + lat.supports[k].node == i) {
+        out[q].pull_off = std::abs(force[k]);
+        out[q].side = force[k] > 0.0 ? 1.0 : (force[k] < 0.0 ? -1.0 : 0.0);
+      }
+  }
+  return out;
 }
 
 double gust_lead_time(const Scene& sc) {

@@ -511,6 +511,7 @@ LineStatistics PassRecorder::line_statistics(const Model& m) const {
       if (sp.hinged_arm() && same_arm(sp.x)) {
         a.hinged = true;
         a.stiffness = sp.stiffness;
+        a.pull_off = sp.arm_pull_off;
         a.inclination = sp.arm_inclination;
         a.inclination_at_max_uplift = sp.arm_inclination_at(up);
         break;

@@ -152,6 +152,7 @@ void put_line(Json& j, const Model& m, const std::vector<PantographStatistics>& 
     Json arm{{"station_m", a.station}, {"max_uplift_m", a.max_uplift}, {"exceeded", a.exceeded}};
     if (a.hinged) {
       arm["stiffness_N_per_m"] = a.stiffness;
+      arm["pull_off_N"] = a.pull_off;
       arm["inclination_rad"] = a.inclination;
       arm["inclination_at_max_uplift_rad"] = a.inclination_at_max_uplift;
     }

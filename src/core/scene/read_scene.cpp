@@ -45,7 +45,7 @@ SupportSpec read_steady_arms(Reader& r, const std::string& path) {
   a.length = r.number("length", 0.0, 5.0, std::nullopt, true);
   a.linear_mass = r.number("linear_mass", 0.0, 20.0, std::nullopt);
   a.clamp_mass = r.number("clamp_mass", 0.0, 20.0, 0.0);
-  a.pull_off = r.number("pull_off", 0.0, 1e5, std::nullopt, true);
+  if (r.has("pull_off")) a.pull_off = r.number("pull_off", 0.0, 1e5, std::nullopt, true);
   r.finish();
   SupportSpec s;
   s.mass = a.tip_mass();

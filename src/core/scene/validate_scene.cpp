@@ -49,10 +49,16 @@ void validate_sections(const Scene& s) {
       fail(pre + "contact_wire_count", "2", "a twin contact wire hangs from droppers: add droppers and a messenger");
     if (sec.contact_wire.presag != 0.0 && !sec.droppers)
       fail(pre + "contact_wire.presag", fmt(sec.contact_wire.presag), "0 without droppers (the presag is set by the dropper lengths)");
-    if (sec.steady_arms && sec.steady_arms->hinged_arm && s.lateral())
-      fail(pre + "steady_arms.length", fmt(sec.steady_arms->hinged_arm->length) + " (a hinged arm on a 3-D line)",
-           "a spring (stiffness, mass) on a 3-D line: there the arm's pull-off comes from the stagger and the arm "
-           "moves the wire sideways as it rises, which the lateral plane does not model yet");
+    if (sec.steady_arms && sec.steady_arms->hinged_arm) {
+      const std::optional<double>& pull_off = sec.steady_arms->hinged_arm->pull_off;
+      if (s.lateral() && pull_off)
+        fail(pre + "steady_arms.pull_off", fmt(*pull_off) + " (on a 3-D line)",
+             "not given on a 3-D line: there each arm's pull-off comes from the stagger and the curves (remove it)");
+      if (!s.lateral() && !pull_off)
+        fail(pre + "steady_arms.pull_off", "(missing)",
+             "required on a 2-D line, N > 0: the wire's horizontal pull on the arm (4 T s / L for a zigzag of +-s on "
+             "straight track, + T L / R on a curve)");
+    }
     if (!sec.droppers) continue;
     if (sec.droppers->positions.size() != sec.spans.size())
       fail(pre + "droppers.positions_per_span", std::to_string(sec.droppers->positions.size()) + " lists", "one per span");

@@ -143,11 +143,17 @@ struct LateralModel {
 double gust_lead_time(const Scene& scene);
 constexpr double kGustLeadDecays = 2.0, kAutoGustLeadMax = 30.0;  // s
 
-// The lateral stiffness (N/m) of the wire at each of the vertical DOFs `dofs` (support nodes),
-// that support alone let go and every other held: the tensioned wires with their bending and the
-// droppers as pendulums at their design tension, as the lateral plane has them. What a steady
-// arm's sideways travel works against (HingedArmSpec); any line, 2-D ones too.
-std::vector<double> registration_lateral_stiffness(const Model& model, const std::vector<int>& dofs);
+// What a steady arm at a support node meets sideways (HingedArmSpec), for any line, 2-D ones too:
+// `stiffness` (N/m), the wire's lateral stiffness there with that support alone let go and every
+// other held (the tensioned wires with their bending, the droppers as pendulums at their design
+// tension, as the lateral plane has them); `pull_off` (N), the wire's calm lateral force on the
+// support in the lateral statics (0 on a 2-D line: no stagger, no curve).
+struct RegistrationLateral {
+  double stiffness = 0.0, pull_off = 0.0;
+  double side = 0.0;  // the pull's direction: +1 toward + y, -1, 0 without one
+};
+// One per vertical DOF of `dofs` (support nodes of a contact wire).
+std::vector<RegistrationLateral> registration_lateral(const Model& model, const std::vector<int>& dofs);
 
 // Builds the lateral plane of a model whose scene asks for one (Scene::lateral()); throws SceneError.
 std::shared_ptr<const LateralModel> build_lateral(const Model& model);

@@ -89,6 +89,7 @@ struct SteadyArmStatistics {
   // hinge at the assembly and with the tip at the largest uplift (rad; negative: above the hinge).
   bool hinged = false;
   double stiffness = 0.0;  // N/m
+  double pull_off = 0.0;   // N
   double inclination = 0.0, inclination_at_max_uplift = 0.0;
 };
 

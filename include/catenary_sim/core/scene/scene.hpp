@@ -67,7 +67,9 @@ struct HingedArmSpec {
   double length = 0.0;       // m, a: hinge to clamp
   double linear_mass = 0.0;  // kg/m
   double clamp_mass = 0.0;   // kg, at the tip
-  double pull_off = 0.0;     // N, F_h: the wire's horizontal pull (4 T s / L on a straight zigzag)
+  // N, F_h: the wire's horizontal pull (4 T s / L on a straight zigzag); a 3-D line's comes from
+  // its stagger and curves (the lateral statics) and is not given.
+  std::optional<double> pull_off;
   // Its moment of inertia about the hinge as a mass at the tip: m a^2 / 3 / a^2, plus the clamp.
   double tip_mass() const { return linear_mass * length / 3.0 + clamp_mass; }
 };
