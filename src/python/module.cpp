@@ -90,13 +90,11 @@ class PySimulation {
     return step_locked(std::numeric_limits<long long>::max());
   }
 
+  // simulate_pass's stats.json: the pantographs', the line's (steady arms, droppers, limits) and
+  // on a 3-D line the lateral plane's.
   std::string statistics_json(double wall_s) const {
-    const Model& m = sim_.model();
-    const std::string s =
-        catenary_sim::statistics_json(m, sim_.state(), recorder_.statistics(m), RunInfo{wall_s, -1.0, -1});
-    return m.lateral ? add_lateral_statistics(s, m, lateral_.statistics(m, sim_.state()),
-                                              sim_.state().status == StepStatus::kDewired)
-                     : s;
+    return pass_statistics_json(sim_.model(), sim_.state(), recorder_, RunInfo{wall_s, -1.0, -1}, &lateral_,
+                                sim_.state().status == StepStatus::kDewired);
   }
 
   // simulate_pass's files of the pass in `dir` (core/pass_files: each whole or not at all).

@@ -148,6 +148,9 @@ def test_a_pass_from_python_equals_simulate_pass():
     for key in ("mean_force_N", "std_force_N", "max_force_N", "min_force_N", "contact_loss_percent"):
         assert stats["pantographs"][0][key] == tool["pantographs"][0][key], key
     assert stats["steps"] == tool["steps"]
+    # The line's figures too (what a study reads as steady_arms.3.max_uplift_m and the like).
+    for key in ("steady_arms", "droppers", "support_stations_m", "dropper_stations_m", "limits"):
+        assert stats[key] == tool[key], key
     # The series at the scene's output.sample_rate (1000 Hz): one row per ms of the 7.9 s pass.
     assert series["time_s"].shape[0] == pytest.approx(stats["simulated_time_s"] * 1000.0, abs=2)
     assert np.all(np.isfinite(series["leading_force_N"]))
