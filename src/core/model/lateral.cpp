@@ -229,15 +229,18 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
   for (int i = 0; i < n; ++i) lat->inv_mass[i] = fixed[i] ? 0.0 : 1.0 / lat->mass[i];
 }
 
+// The lateral DOF of a wire node's vertical DOF (-1: not a wire node).
+int lateral_dof_of(const Model& m, const LateralModel& lat, int vertical) {
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+    const Wire& w = m.wires[wi];
+    if (vertical >= w.w_dof && vertical < w.w_dof + w.nodes()) return lat.wires[wi].w_dof + vertical - w.w_dof;
+  }
+  return -1;
+}
+
 // The droppers as pendulums between their two nodes.
 void add_pendulums(const Model& m, LateralModel* lat) {
-  auto lateral_dof = [&](int vertical) {
-    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
-      const Wire& w = m.wires[wi];
-      if (vertical >= w.w_dof && vertical < w.w_dof + w.nodes()) return lat->wires[wi].w_dof + vertical - w.w_dof;
-    }
-    return -1;
-  };
+  auto lateral_dof = [&](int vertical) { return lateral_dof_of(m, *lat, vertical); };
   for (std::size_t k = 0; k < m.droppers.size(); ++k) {
     const Dropper& d = m.droppers[k];
     LateralPendulum p;
@@ -453,13 +456,7 @@ std::vector<RegistrationLateral> registration_lateral(const Model& m, const std:
   add_wires_and_supports(m, &lat);
   add_pendulums(m, &lat);
   const int n = lat.n, N = 2 * n;
-  auto lateral_dof = [&](int vertical) {
-    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
-      const Wire& w = m.wires[wi];
-      if (vertical >= w.w_dof && vertical < w.w_dof + w.nodes()) return lat.wires[wi].w_dof + vertical - w.w_dof;
-    }
-    return -1;
-  };
+  auto lateral_dof = [&](int vertical) { return lateral_dof_of(m, lat, vertical); };
   // Every support held (rows y_i = 0), then each asked node let go in turn: its stiffness is the
   // Schur complement K_ii - K_ir K_rr^-1 K_ri over the rest r of the plane.
   std::vector<bool> fixed(n, false);
