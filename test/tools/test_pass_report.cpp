@@ -102,6 +102,35 @@ TEST_F(PassReport, ThreeDimensionalLineAddsTheLateralSection) {
   EXPECT_EQ(images, 8u);  // the seven sections of a 2-D pass and the lateral one
 }
 
+// Hinged steady arms: the statistics table gives their k_A, pull-off and inclinations, as
+// stats.json has them (k_A rounded to the newton per metre); a line of springs has no such row.
+TEST_F(PassReport, HingedSteadyArmsAreListedWithTheirGeometry) {
+  const std::string out = dir_ + "/out";
+  const ChildRun r = run_child({kSimulatePass, "--scene", test_scenes::kReferenceHingedArms, "--out", out,
+                          "--speed", "250", "--set", "line.span_count=6", "--set", "numerics.element_length=0.5",
+                          "--report", "--no-progress"},
+                         dir_ + "/log.txt", 300.0);
+  ASSERT_FALSE(r.hung);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  ASSERT_FALSE(stats["steady_arms"].empty());
+  const double k = stats["steady_arms"][0]["stiffness_N_per_m"].get<double>();
+  std::ostringstream shown;
+  shown.setf(std::ios::fixed);
+  shown.precision(0);
+  shown << k << " N/m";
+  const std::string page = slurp(out + "/report.html");
+  EXPECT_NE(page.find("hinged steady arms"), std::string::npos);
+  EXPECT_NE(page.find(shown.str()), std::string::npos) << shown.str();
+  const std::string plain = dir_ + "/plain";
+  const ChildRun p = run_child({kSimulatePass, "--scene", test_scenes::kReference, "--out", plain, "--speed", "250",
+                                "--set", "line.span_count=6", "--set", "numerics.element_length=0.5", "--report",
+                                "--no-progress"},
+                               dir_ + "/log_plain.txt", 300.0);
+  ASSERT_EQ(p.exit_code, 0) << p.out;
+  EXPECT_EQ(slurp(plain + "/report.html").find("hinged steady arms"), std::string::npos);
+}
+
 TEST_F(PassReport, ReportOfAnEmptyDirectoryFailsNamingTheFile) {
   const ChildRun r = run_child({"/usr/bin/python3", test_scenes::kSourceDir + "/scripts/pass_report", dir_},
                          dir_ + "/log.txt", 60.0);
