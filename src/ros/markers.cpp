@@ -164,9 +164,18 @@ struct Drawing {
   double shown(int dof) const { return wire_dof_design_height(m, dof) + k * s.u[dof]; }
 };
 
-// A rigid overhead conductor rail (the scene refuses a line that mixes it with a catenary).
-bool rigid_rail(const Model& m) {
-  return std::any_of(m.scene.sections.begin(), m.scene.sections.end(), [](const SectionSpec& s) { return s.rigid; });
+// A support spring of a rigid overhead conductor rail's section (its wire is the profile).
+bool on_rail(const Model& m, const SupportSpring& sp) {
+  for (const Wire& w : m.wires)
+    if (sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes()) return m.scene.sections[w.section].rigid;
+  return false;
+}
+
+// A support station of a catenary section (a mast there), not only of a rail's.
+bool catenary_support(const Model& m, double x) {
+  for (const SectionSpec& sec : m.scene.sections)
+    if (!sec.rigid && x >= sec.start - 1e-6 && x <= sec.end() + 1e-6) return true;
+  return false;
 }
 
 void add_wires(visualization_msgs::MarkerArray& out, const Drawing& d) {
@@ -211,10 +220,11 @@ void add_rail_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
   const Model& m = d.m;
   const State& s = d.s;
   const double roof = m.scene.contact_wire_height + 0.6;  // m, drawn only
-  Marker brackets = marker(d.h, "steady_arms", 0, Marker::LINE_LIST);
+  Marker brackets = marker(d.h, "steady_arms", 1, Marker::LINE_LIST);  // (id 0: the catenary's arms)
   brackets.scale.x = 0.08;
   brackets.color = color(0.35f, 0.35f, 0.4f);
   for (const SupportSpring& sp : m.springs) {
+    if (!on_rail(m, sp)) continue;
     const double x = sp.x + s.line_offset, y = dof_lateral(m, s, sp.dof);
     brackets.points.push_back(point(x, y, roof));
     brackets.points.push_back(point(x, y, d.shown(sp.dof)));
@@ -226,10 +236,10 @@ void add_rail_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
 void add_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
   const Model& m = d.m;
   const State& s = d.s;
-  if (rigid_rail(m)) {
+  const auto& sections = m.scene.sections;
+  if (std::any_of(sections.begin(), sections.end(), [](const SectionSpec& sec) { return sec.rigid; }))
     add_rail_supports(out, d);
-    return;
-  }
+  if (std::all_of(sections.begin(), sections.end(), [](const SectionSpec& sec) { return sec.rigid; })) return;
   const double y_mast = 3.0;
   const double top = m.scene.contact_wire_height + m.scene.encumbrance + 0.5;
   Marker masts = marker(d.h, "masts", 0, Marker::LINE_LIST);
@@ -241,6 +251,7 @@ void add_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
     for (const LateralSupport& ls : m.lateral->supports)
       if (!m.wires[ls.wire].is_contact_wire) reach[ls.line_support] = ls.stagger;
   for (std::size_t k = 0; k < m.support_x.size(); ++k) {
+    if (!catenary_support(m, m.support_x[k])) continue;
     const double x = m.support_x[k] + s.line_offset;
     masts.points.push_back(point(x, y_mast, 0.0));
     masts.points.push_back(point(x, y_mast, top));
@@ -252,7 +263,7 @@ void add_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
   arms.scale.x = 0.03;
   arms.color = color(0.2f, 0.5f, 0.9f);
   for (const SupportSpring& sp : m.springs) {
-    if (!sp.steady_arm) continue;
+    if (!sp.steady_arm || on_rail(m, sp)) continue;
     const double x = sp.x + s.line_offset, z = d.shown(sp.dof), z0 = wire_dof_design_height(m, sp.dof);
     const double y = dof_lateral(m, s, sp.dof);
     if (sp.hinged_arm()) {

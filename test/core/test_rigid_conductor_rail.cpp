@@ -186,12 +186,14 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
       "sections:\n  - {span_length: 10.0, span_count: 4}\n  - {span_length: 10.0, span_count: 4}\n"
       "overlap: {spans: 2}\n";
   refused(two, "overlap.support_rise");
-  refused(
+  // A catenary section joined to a rigid one: the same end ramp is needed, and what the rail does
+  // not model is refused for the whole line.
+  const std::string mixed =
       "name: mixed\nline: {}\nconductor_rail: {linear_mass: 7.27, bending_stiffness: 2.8e5, support_stiffness: 5e6}\n"
       "sections:\n  - {span_length: 10.0, span_count: 4}\n"
-      "  - {span_length: 10.0, span_count: 4, contact_wire: {linear_mass: 1.35, tension: 20000}}\n"
-      "overlap: {spans: 2, support_rise: 0.02}\n",
-      "conductor_rail");
+      "  - {span_length: 10.0, span_count: 4, contact_wire: {linear_mass: 1.35, tension: 20000}}\n";
+  refused(mixed + "overlap: {spans: 1}\n", "overlap.support_rise");
+  refused(mixed + "overlap: {spans: 1, support_rise: 0.02}\nnumerics: {window: auto}\n", "numerics.window");
   // A tensioned wire without tension, set in code, is refused by validate().
   cs::Scene tensionless = cs::load_scene_string(
       "name: t\nline: {spans: [20.0]}\ncontact_wire: {linear_mass: 1.35, tension: 20000}\n");
@@ -249,6 +251,77 @@ TEST(RigidConductorRail, ReferencePassMeanForceIsTheUpliftAndTheJointSharesIt) {
   // Bounded: the profile moves by millimetres (the static elasticity is ~1e-5 m/N); 5 cm would
   // be a divergence, not a pass.
   EXPECT_LT(peak_u, 0.05);
+}
+
+// A catenary joined to the rail (config/catenary_to_rigid_rail.yaml): the open line's last span is
+// the rail's first. The pantograph is handed over inside that joint: the rail is not touched
+// before it, nor the contact wire after it, and the head stays on one of them throughout. On each
+// side the pantograph's momentum balances: the mean contact force over the catenary's part and
+// over the rail's equals the uplift less the roof spring's k3 times the lower frame's mean
+// displacement from the start's, its damper's c3 times its mean velocity and the frame's momentum
+// change over the part's time. 0.01 N: the explicit step samples the velocities half a step from
+// the forces (dt 83 us: some 1e-3 N); a force lost or counted twice at the hand-over would be the
+// uplift's share, tens of newtons.
+TEST(RigidConductorRail, ACatenaryJoinedToTheRailHandsThePantographOver) {
+  const cs::Scene scene = cs::load_scene_file(test_scenes::scene_path("catenary_to_rigid_rail.yaml"));
+  cs::Simulation sim(scene);
+  const cs::Model& m = sim.model();
+  ASSERT_EQ(m.contact_wires.size(), 2u);
+  ASSERT_FALSE(scene.sections[0].rigid);
+  ASSERT_TRUE(scene.sections[1].rigid);
+  const double joint0 = scene.sections[1].start, joint1 = scene.sections[0].end();
+  ASSERT_LT(joint0, joint1);
+  const cs::Pantograph& p = m.pantographs[0];
+  const int lower = p.masses_count() - 1;
+  const double uplift = scene.pantographs[0].net_uplift(scene.train_speed);
+  struct Part {
+    double x0 = 0.0, x1 = 0.0, force = 0.0, u = 0.0, v = 0.0, t0 = 0.0, t1 = 0.0;
+    long n = 0;
+    std::vector<double> v0, v1;
+  };
+  double x0 = 0.0, x1 = 0.0;
+  cs::analysis_section(m, &x0, &x1);
+  std::vector<Part> parts(2);
+  parts[0].x0 = x0, parts[0].x1 = joint0;
+  parts[1].x0 = joint1, parts[1].x1 = x1;
+  double rail_before = 0.0, wire_after = 0.0, peak_u = 0.0;
+  long lost = 0;
+  // The pass starts in the static state with the pantograph pressing the wire: the roof spring
+  // carries the uplift at the lower frame's displacement there.
+  const double u_start = sim.state().pantograph_displacement(m, 0, lower);
+  while (!sim.finished()) {
+    ASSERT_EQ(sim.step(), cs::StepStatus::kOk) << sim.status_message();
+    const cs::State& s = sim.state();
+    const double x = s.front, fw = s.pantograph_force_on(m, 0, 0), fr = s.pantograph_force_on(m, 0, 1);
+    if (x < joint0) rail_before = std::max(rail_before, fr);
+    if (x > joint1) wire_after = std::max(wire_after, fw);
+    if (x > x0 && x < x1 && fw + fr <= 0.0) ++lost;
+    peak_u = std::max(peak_u, s.u.head(m.n_catenary_dof).cwiseAbs().maxCoeff());
+    for (Part& part : parts) {
+      if (x < part.x0 || x > part.x1) continue;
+      std::vector<double> v(p.masses_count());
+      for (int i = 0; i < p.masses_count(); ++i) v[i] = s.pantograph_velocity(m, 0, i);
+      if (part.n == 0) part.v0 = v, part.t0 = s.time;
+      part.v1 = v;
+      part.t1 = s.time;
+      part.force += fw + fr;
+      part.u += s.pantograph_displacement(m, 0, lower);
+      part.v += s.pantograph_velocity(m, 0, lower);
+      ++part.n;
+    }
+  }
+  EXPECT_EQ(rail_before, 0.0);
+  EXPECT_EQ(wire_after, 0.0);
+  EXPECT_EQ(lost, 0);
+  EXPECT_LT(peak_u, 0.5);  // the contact wire rises by centimetres; half a metre would be a divergence
+  for (const Part& part : parts) {
+    ASSERT_GT(part.n, 1000) << part.x0;
+    double momentum = 0.0;
+    for (int i = 0; i < p.masses_count(); ++i) momentum += p.masses[i] * (part.v1[i] - part.v0[i]);
+    const double expected = uplift - p.stiffness[lower] * (part.u / part.n - u_start) - p.damping[lower] * part.v / part.n -
+                            momentum / (part.t1 - part.t0);
+    EXPECT_NEAR(part.force / part.n, expected, 0.01) << "part from " << part.x0 << " m";
+  }
 }
 
 // An expansion joint of three spans holds both profiles at two shared supports: each of the two

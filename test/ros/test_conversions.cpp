@@ -179,6 +179,43 @@ TEST_F(Fixture, MarkersCoverEveryPartAndExaggerateDisplacement) {
   EXPECT_NE(arr.markers.back().text.find("km/h"), std::string::npos);
 }
 
+// A catenary joined to a rigid rail: masts and steady arms on the catenary's supports, drop
+// brackets on the rail's, each support drawn once (the joint's two shared supports carry both
+// the wire's and the profile's), every marker with an (ns, id) of its own.
+TEST(Markers, ACatenaryJoinedToTheRailDrawsEachKindOfSupport) {
+  Simulation sim(load_scene_file(test_scenes::scene_path("catenary_to_rigid_rail.yaml")));
+  const Model& m = sim.model();
+  MarkerOptions o;
+  const auto arr = to_markers(m, sim.state(), ros::Time(1.0), o);
+  std::set<std::pair<std::string, int>> ids;
+  for (const auto& mk : arr.markers) EXPECT_TRUE(ids.insert({mk.ns, mk.id}).second) << mk.ns << " " << mk.id;
+  int catenary_arms = 0, rail_supports = 0;
+  for (const SupportSpring& sp : m.springs) {
+    if (!sp.steady_arm) continue;
+    for (const Wire& w : m.wires)
+      if (sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes()) ++(m.scene.sections[w.section].rigid ? rail_supports : catenary_arms);
+  }
+  ASSERT_GT(catenary_arms, 0);
+  ASSERT_GT(rail_supports, 0);
+  const visualization_msgs::Marker* arms = nullptr;
+  const visualization_msgs::Marker* brackets = nullptr;
+  const visualization_msgs::Marker* masts = nullptr;
+  for (const auto& mk : arr.markers) {
+    if (mk.ns == "steady_arms" && mk.id == 0) arms = &mk;
+    if (mk.ns == "steady_arms" && mk.id == 1) brackets = &mk;
+    if (mk.ns == "masts") masts = &mk;
+  }
+  ASSERT_TRUE(arms && brackets && masts);
+  EXPECT_EQ(arms->points.size(), 2u * catenary_arms);
+  EXPECT_EQ(brackets->points.size(), 2u * rail_supports);
+  // Masts (four points each) stand at the catenary's supports, 0-262 m, and not along the rail.
+  const double catenary_end = m.scene.sections[0].end();
+  int catenary_stations = 0;
+  for (double x : m.support_x) catenary_stations += x <= catenary_end + 1e-6;
+  EXPECT_EQ(masts->points.size(), 4u * catenary_stations);
+  for (const auto& p : masts->points) EXPECT_LE(p.x, catenary_end + 1e-6);
+}
+
 namespace {
 
 // Steps `sim` until its first pantograph reaches station x (m).

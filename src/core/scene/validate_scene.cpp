@@ -19,10 +19,6 @@ void validate_sections(const Scene& s) {
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     const std::string pre = s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "";
-    if (sec.rigid != s.sections.front().rigid)
-      fail(pre + "conductor_rail", sec.rigid ? "(given)" : "(missing)",
-           "every section of one kind: all conductor_rail or all contact_wire (a transition from a catenary to a "
-           "rigid rail is not modelled)");
     if (sec.rigid) {
       // The rail's beam carries no tension: anything hung from a messenger, a presag set by
       // droppers or a support-less profile has no meaning here.
@@ -263,7 +259,7 @@ void validate_finite_line(const Scene& s, double line) {
 
 // What a rigid conductor rail does not model yet is refused rather than run wrongly.
 void validate_rigid(const Scene& s) {
-  if (s.sections.empty() || !s.sections.front().rigid) return;
+  if (std::none_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.rigid; })) return;
   if (s.endless)
     fail("line.endless", "true (with conductor_rail)", "false: the endless block is laid by the tensioned wire's wave speed");
   if (s.numerics.windowed())
