@@ -180,7 +180,7 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
   refused(with("numerics:\n", "numerics:\n  window: auto\n"), "numerics.window");
   refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\n", "stagger");
   refused(y + "imperfections:\n  contact_wire_wear:\n    section_loss: 0.1\n", "imperfections.contact_wire_wear");
-  // Two rigid sections need the end ramp's rise; a catenary section among rigid ones is refused.
+  // Two rigid sections need the end ramp's rise.
   const std::string two =
       "name: two\nline: {}\nconductor_rail: {linear_mass: 7.27, bending_stiffness: 2.8e5, support_stiffness: 5e6}\n"
       "sections:\n  - {span_length: 10.0, span_count: 4}\n  - {span_length: 10.0, span_count: 4}\n"
