@@ -62,8 +62,9 @@ cs::Scene line_with_arms(const YAML::Node& arms, int spans) {
 // F(theta) sin(theta) = (W + m_c g + m_a g / 2) cos(theta), solved by Newton for W +- 0.01 N, the
 // end at z = -a sin(theta). The central difference of W against z is the stiffness to
 // (0.01 / W)^2 ~ 1e-9; 1e-7 leaves room for the round-off of z's difference (1e-16 a / (0.02 N /
-// k) ~ 1e-11). W is the wire's load on the clamp: the support's static reaction less the weight
-// of the tip mass it carries. k_w is the model's (checked on its own below).
+// k) ~ 1e-11). W is the wire's load on the clamp: the support's static reaction less the tip
+// mass's weight and the weightless share of its inertia, which the reaction carries alike. k_w
+// is the model's (checked on its own below).
 TEST(HingedSteadyArms, StiffnessIsTheArmsExactStaticsLinearised) {
   const cs::Scene scene = cs::load_scene_file(test_scenes::scene_path(kHinged));
   const cs::HingedArmSpec arm = *scene.steady_arms->hinged_arm;
@@ -75,7 +76,10 @@ TEST(HingedSteadyArms, StiffnessIsTheArmsExactStaticsLinearised) {
     if (!sp.steady_arm) continue;
     ++arms;
     ASSERT_TRUE(sp.hinged_arm());
-    const double W = sp.static_force - arm.tip_mass() * g, kw = sp.arm_wire_lateral_stiffness;
+    // The arm's inertia at its end, which moves at z' / cos(theta0): the tip mass / cos^2.
+    EXPECT_NEAR(sp.arm_tip_mass * std::pow(std::cos(sp.arm_inclination), 2), arm.tip_mass(), 1e-12);
+    // f0 carries the wire's load, the tip mass's weight and the inertia's weightless share.
+    const double W = sp.static_force - sp.arm_tip_mass * g, kw = sp.arm_wire_lateral_stiffness;
     auto solve = [&](double load, double cos0) {  // theta of the moments' balance, Newton from 0.3
       double th = 0.3;
       for (int it = 0; it < 50; ++it) {
@@ -137,7 +141,7 @@ TEST(HingedSteadyArms, TheWiresLateralStiffnessIsTheStringsAtTheRegistration) {
   }
 }
 
-// The limit that is today's model: a hinged arm is eq. 4's spring of its k_A with its tip mass on
+// The limit that is today's model: a hinged arm is eq. 4's spring of its k_A with its inertia on
 // the wire's node, so a line whose springs are given those values runs the same pass. On three
 // equal spans the two arms mirror each other, so one spring stands for both: their k_A agree to
 // round-off (1e-12), and the forces to far below 1e-6 N, where a wrong mass or stiffness moves
@@ -156,7 +160,13 @@ TEST(HingedSteadyArms, IsTheSpringOfItsStiffnessAndTipMass) {
   ks.precision(17);
   ks << k[0];
   spring["stiffness"] = ks.str();
-  spring["mass"] = with_arms.steady_arms->hinged_arm->tip_mass();
+  double tip = 0.0;
+  for (const cs::SupportSpring& sp : m.springs)
+    if (sp.steady_arm) tip = sp.arm_tip_mass;
+  std::ostringstream ms;
+  ms.precision(17);
+  ms << tip;
+  spring["mass"] = ms.str();
   const Pass a = run(with_arms), b = run(line_with_arms(spring, 3));
   ASSERT_EQ(a.force.size(), b.force.size());
   for (std::size_t i = 0; i < a.force.size(); ++i) ASSERT_NEAR(a.force[i], b.force[i], 1e-6) << "step " << i;

@@ -157,8 +157,10 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
 // f0 + m_a g / 6. In the end's height z = -a sin(theta) the end moves out by tan(theta) dz, and
 // the potential -F_h a cos(theta) + k_w (a cos(theta) - a cos(theta0))^2 / 2 - (m_c + m_a / 2) g
 // a sin(theta) has d2/dz2 = F_h / (a cos^3 theta0) + k_w tan^2 theta0 at the assembly: the weights
-// drop out, and that is eq. 4's k_A. (The end's sideways speed is left out of its inertia: a share
-// tan^2(theta0) of it.)
+// drop out, and that is eq. 4's k_A. The end's speed is z' / cos(theta0) (it moves out as it
+// rises), so the arm's inertia on the wire's node is its tip mass (m_a / 3 + m_c) / cos^2 theta0;
+// the share tan^2 theta0 of it has no weight (design_statics adds it to the node's mass and to f0
+// alike).
 void set_hinged_arm(const HingedArmSpec& arm, double g, const RegistrationLateral& wire, const std::string& field,
                     SupportSpring& sp) {
   const double pull_off = arm.pull_off ? *arm.pull_off : wire.pull_off;
@@ -186,6 +188,7 @@ void set_hinged_arm(const HingedArmSpec& arm, double g, const RegistrationLatera
   sp.arm_pull_off = pull_off;
   sp.arm_pull_side = wire.side;
   sp.stiffness = pull_off / (arm.length * c * c * c) + wire.stiffness * t * t;
+  sp.arm_tip_mass = arm.tip_mass() / (c * c);
 }
 
 }  // namespace
@@ -223,7 +226,12 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
     SupportSpring& sp = m.springs[hinged[q]];
     const int section = wire_holding(m, sp.dof).section;
     const std::string pre = scene.sections.size() > 1 ? "sections[" + std::to_string(section) + "]." : "";
-    set_hinged_arm(*scene.sections[section].steady_arms->hinged_arm, scene.gravity, wire[q], pre + "steady_arms", sp);
+    const HingedArmSpec& arm = *scene.sections[section].steady_arms->hinged_arm;
+    set_hinged_arm(arm, scene.gravity, wire[q], pre + "steady_arms", sp);
+    // The tip's sideways share of inertia: mass without weight, so the preload carries it too.
+    const double sideways = sp.arm_tip_mass - arm.tip_mass();
+    m.mass[sp.dof] += sideways;
+    sp.static_force += sideways * scene.gravity;
   }
 }
 

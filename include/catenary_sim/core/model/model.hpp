@@ -86,6 +86,7 @@ struct SupportSpring {
   // N/m: the wire's lateral stiffness at the arm's end, which its sideways travel works against.
   double arm_wire_lateral_stiffness = 0.0;
   double arm_pull_off = 0.0;  // N, F_h: given, or a 3-D line's from its lateral statics
+  double arm_tip_mass = 0.0;  // kg, its inertia on the wire's node (HingedArmSpec::tip_mass / cos^2)
   // The side the wire pulls the arm's end toward (+1: + y, to the left; -1), 0 on a 2-D line.
   double arm_pull_side = 0.0;
   bool hinged_arm() const { return arm_length > 0.0; }
