@@ -86,9 +86,10 @@ std::string Simulation::status_message() const {
       }
       const int d = state_.diverged_dof;
       std::string where = "DOF " + std::to_string(d);
-      for (const Wire& w : model_.wires)
-        if (d >= w.w_dof && d < w.w_dof + w.nodes())
-          where = w.name + " at x = " + std::to_string(w.x[d - w.w_dof] + state_.line_offset) + " m";
+      if (const int wi = wire_holding(model_, d); wi >= 0) {
+        const Wire& w = model_.wires[wi];
+        where = w.name + " at x = " + std::to_string(w.x[d - w.w_dof] + state_.line_offset) + " m";
+      }
       for (const Pantograph& p : model_.pantographs)
         if (!p.moving_force && d >= p.first_dof && d < p.first_dof + p.masses_count())
           where = "pantograph " + p.name + " mass " + std::to_string(d - p.first_dof);

@@ -246,15 +246,13 @@ void bind_pass_description(PyClass& c) {
         py::list out;
         for (const SupportSpring& sp : m.springs) {
           if (!sp.steady_arm) continue;
-          for (const Wire& w : m.wires) {
-            if (sp.dof < w.w_dof || sp.dof >= w.w_dof + w.nodes()) continue;
-            py::dict d;
-            d["wire"] = w.name;
-            d["station_m"] = sp.x;
-            d["design_height_m"] = w.height[sp.dof - w.w_dof];
-            d["wire_start_m"] = w.x.front();
-            out.append(d);
-          }
+          const Wire& w = m.wires[wire_holding(m, sp.dof)];
+          py::dict d;
+          d["wire"] = w.name;
+          d["station_m"] = sp.x;
+          d["design_height_m"] = w.height[sp.dof - w.w_dof];
+          d["wire_start_m"] = w.x.front();
+          out.append(d);
         }
         return out;
       })

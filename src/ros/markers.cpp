@@ -46,11 +46,8 @@ visualization_msgs::Marker marker(const std_msgs::Header& h, const std::string& 
 
 // Lateral position of the wire node behind a vertical DOF (a dropper's or steady arm's end).
 double dof_lateral(const Model& m, const State& s, int dof) {
-  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
-    const Wire& w = m.wires[wi];
-    if (dof >= w.w_dof && dof < w.w_dof + w.nodes()) return node_lateral(m, s, wi, dof - w.w_dof);
-  }
-  return 0.0;
+  const int wi = wire_holding(m, dof);
+  return wi < 0 ? 0.0 : node_lateral(m, s, wi, dof - m.wires[wi].w_dof);
 }
 
 // Under each collector of pantograph p, the contact wire with the lowest design height there (the
@@ -110,9 +107,8 @@ std::string label_wire_name(const std::string& name) {
 
 
 double wire_dof_design_height(const Model& m, int dof) {
-  for (const Wire& w : m.wires)
-    if (dof >= w.w_dof && dof < w.w_dof + w.nodes()) return w.height[dof - w.w_dof];
-  return std::nan("");
+  const int wi = wire_holding(m, dof);
+  return wi < 0 ? std::nan("") : m.wires[wi].height[dof - m.wires[wi].w_dof];
 }
 
 double contact_design_height(const Model& m, const State& s, int p) {
@@ -166,9 +162,7 @@ struct Drawing {
 
 // A support spring of a rigid overhead conductor rail's section (its wire is the profile).
 bool on_rail(const Model& m, const SupportSpring& sp) {
-  for (const Wire& w : m.wires)
-    if (sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes()) return m.scene.sections[w.section].rigid;
-  return false;
+  return m.scene.sections[m.wires[wire_holding(m, sp.dof)].section].rigid;
 }
 
 // A support station of a catenary section (a mast there), not only of a rail's.

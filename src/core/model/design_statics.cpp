@@ -15,9 +15,7 @@ namespace {
 
 bool holds(const Wire& w, int dof) { return dof >= w.w_dof && dof < w.w_dof + w.nodes(); }
 
-const Wire& wire_holding(const Model& m, int dof) {
-  return *std::find_if(m.wires.begin(), m.wires.end(), [&](const Wire& w) { return holds(w, dof); });
-}
+const Wire& wire_of(const Model& m, int dof) { return m.wires[wire_holding(m, dof)]; }
 
 // One section's statics: the contact wire(s) held at the supports and droppers, then the messenger
 // under the dropper tensions, a few fixed-point passes for the droppers' weight.
@@ -103,8 +101,8 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
     solve_wire_statics(mwm, mload, mpn, mph, mwm.height, mwm.slope, react[info.messenger], &solver[info.messenger]);
     for (std::size_t k : mine) {
       const Dropper& d = m.droppers[k];
-      const Wire& cwire = wire_holding(m, d.contact_dof);
-      const Wire& top = wire_holding(m, d.messenger_dof);
+      const Wire& cwire = wire_of(m, d.contact_dof);
+      const Wire& top = wire_of(m, d.messenger_dof);
       dropper_len[k] = top.height[d.messenger_dof - top.w_dof] - cwire.height[d.contact_dof - cwire.w_dof];
     }
     if (pass + 1 < passes)
@@ -121,7 +119,7 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
     const SectionSpec& sec = scene.sections[d.section];
     d.length = dropper_len[k];
     if (d.length <= 0.01) {
-      const bool stitch = wire_holding(m, d.messenger_dof).is_stitch_wire;
+      const bool stitch = wire_of(m, d.messenger_dof).is_stitch_wire;
       throw SceneError("droppers: at x = " + fmt(d.x) + " m the " + (stitch ? "stitch wire" : "messenger") + " hangs " +
                        fmt(-d.length) + " m below the contact wire (dropper length " + fmt(d.length) +
                        " m): raise line.encumbrance or the " + (stitch ? "stitch wire's" : "messenger") +
@@ -212,7 +210,7 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
   std::vector<int> hinged_dofs;
   for (std::size_t k = 0; k < m.springs.size(); ++k) {
     SupportSpring& sp = m.springs[k];
-    const Wire& w = wire_holding(m, sp.dof);
+    const Wire& w = wire_of(m, sp.dof);
     sp.static_force = react[&w - m.wires.data()][sp.section_support];
     const std::optional<SupportSpec>& arm = scene.sections[w.section].steady_arms;
     if (sp.steady_arm && arm && arm->hinged_arm) {
@@ -224,7 +222,7 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
   const std::vector<RegistrationLateral> wire = registration_lateral(m, hinged_dofs);
   for (std::size_t q = 0; q < hinged.size(); ++q) {
     SupportSpring& sp = m.springs[hinged[q]];
-    const int section = wire_holding(m, sp.dof).section;
+    const int section = wire_of(m, sp.dof).section;
     const std::string pre = scene.sections.size() > 1 ? "sections[" + std::to_string(section) + "]." : "";
     const HingedArmSpec& arm = *scene.sections[section].steady_arms->hinged_arm;
     set_hinged_arm(arm, scene.gravity, wire[q], pre + "steady_arms", sp);

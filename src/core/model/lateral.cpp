@@ -231,11 +231,8 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
 
 // The lateral DOF of a wire node's vertical DOF (-1: not a wire node).
 int lateral_dof_of(const Model& m, const LateralModel& lat, int vertical) {
-  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
-    const Wire& w = m.wires[wi];
-    if (vertical >= w.w_dof && vertical < w.w_dof + w.nodes()) return lat.wires[wi].w_dof + vertical - w.w_dof;
-  }
-  return -1;
+  const int wi = wire_holding(m, vertical);
+  return wi < 0 ? -1 : lat.wires[wi].w_dof + vertical - m.wires[wi].w_dof;
 }
 
 // The droppers as pendulums between their two nodes.

@@ -19,9 +19,7 @@ std::string steady_arm_column(const Model& m, const std::vector<int>& arms, int 
   const bool shared =
       std::count_if(arms.begin(), arms.end(), [&](int j) { return m.springs[j].span_index == sp.span_index; }) > 1;
   std::string name = "uplift_steady_arm" + std::to_string(sp.span_index);
-  if (shared)
-    for (const Wire& w : m.wires)
-      if (sp.dof >= w.w_dof && sp.dof < w.w_dof + w.nodes()) name += "_s" + std::to_string(w.section);
+  if (shared) name += "_s" + std::to_string(m.wires[wire_holding(m, sp.dof)].section);
   return name + "_m";
 }
 

@@ -196,6 +196,14 @@ struct Model {
   std::shared_ptr<const LateralModel> lateral;
 };
 
+// The index in Model::wires of the wire one of whose nodes is the vertical DOF `dof`; -1 for a
+// pantograph's DOF.
+inline int wire_holding(const Model& m, int dof) {
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
+    if (dof >= m.wires[wi].w_dof && dof < m.wires[wi].w_dof + m.wires[wi].nodes()) return static_cast<int>(wi);
+  return -1;
+}
+
 }  // namespace catenary_sim
 
 // The functions on the model, each declared beside its definition's file.

@@ -61,8 +61,8 @@ struct StitchWireSpec {
 // A steady (registration) arm as built: a bar hinged at the registration tube, its tip clamped to
 // the contact wire, which pulls it along its axis with the horizontal pull-off of the stagger and
 // the curve. The paper's eq. 4 takes k_A from "the linearization of the statics equations"; for
-// this arm that is k_A = F_h / (a cos^3 theta0), theta0 its inclination below the hinge at the
-// assembly (model/design_statics.cpp).
+// this arm that is k_A = F_h / (a cos^3 theta0) + k_w tan^2 theta0, theta0 its inclination below
+// the hinge at the assembly and k_w the wire's lateral stiffness it drags (model/design_statics.cpp).
 struct HingedArmSpec {
   double length = 0.0;       // m, a: hinge to clamp
   double linear_mass = 0.0;  // kg/m
@@ -77,7 +77,8 @@ struct HingedArmSpec {
 // An elastic support (steady arm, eq. 4, or messenger support); absent = rigid.
 struct SupportSpec {
   double stiffness = 0.0;  // N/m (a hinged arm's: set by the design statics)
-  double mass = 0.0;       // kg, lumped on the wire node (a hinged arm's: its tip mass)
+  double mass = 0.0;       // kg, lumped on the wire node (a hinged arm's: its tip mass, the design
+                           // statics add its weightless sideways share)
   std::optional<HingedArmSpec> hinged_arm;  // steady arms only
 };
 
