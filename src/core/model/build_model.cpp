@@ -36,6 +36,13 @@ std::vector<double> mesh_section(const SectionSpec& sec, double element_length, 
     breaks.push_back(x0);
     if (sec.droppers)
       for (double p : sec.droppers->positions[i]) breaks.push_back(x0 + p);
+    if (sec.hangers) {
+      for (double p : sec.hangers->positions[i]) breaks.push_back(x0 + p);
+      std::sort(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end());
+      breaks.erase(std::unique(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end(),
+                               [](double a, double b) { return b - a < 1e-9; }),
+                   breaks.end());
+    }
     if (sec.stitch_wire) {  // the clamps of the stitch wires at the span's intermediate supports
       const double half = 0.5 * sec.stitch_wire->length;
       if (i > 0) breaks.push_back(x0 + half);
@@ -78,6 +85,10 @@ void add_single_section(Scene& scene) {
   sec.steady_arms = scene.steady_arms;
   sec.messenger_supports = scene.messenger_supports;
   sec.stitch_wire = scene.stitch_wire;
+  sec.auxiliary_messenger = scene.auxiliary_messenger;
+  sec.hangers = scene.hangers;
+  if (sec.hangers && sec.hangers->positions.size() == 1 && sec.spans.size() > 1)
+    sec.hangers->positions.assign(sec.spans.size(), sec.hangers->positions.front());
   if (sec.droppers && sec.droppers->positions.size() == 1 && sec.spans.size() > 1)
     sec.droppers->positions.assign(sec.spans.size(), sec.droppers->positions.front());
   scene.sections.push_back(sec);
@@ -132,7 +143,8 @@ void add_stitch_wires(const StitchWireSpec& st, int section, const std::vector<d
 }
 
 // DOF layout: per wire the vertical displacements, then (lumped rotary inertia only) the
-// rotations; section by section (contact wire(s), messenger, stitch wires); the pantographs last.
+// rotations; section by section (contact wire(s), messenger, stitch wires or the auxiliary
+// messenger); the pantographs last.
 void mesh_wires(const Scene& scene, const std::vector<double>& rise_first, const std::vector<double>& rise_last,
                 Model& m, int& dof, std::vector<std::vector<double>>& section_supports) {
   const bool lumped_rot = scene.numerics.rotary_inertia == RotaryInertia::kLumped;
@@ -145,11 +157,12 @@ void mesh_wires(const Scene& scene, const std::vector<double>& rise_first, const
     info.rise_first = rise_first[si];
     info.rise_last = rise_last[si];
     const std::string suffix = scene.sections.size() > 1 ? "_s" + std::to_string(si) : "";
-    auto add_wire = [&](const std::string& name, const WireSpec& spec, bool contact) {
+    auto add_wire = [&](const std::string& name, const WireSpec& spec, bool contact, bool auxiliary = false) {
       Wire w;
       w.name = name;
       w.section = static_cast<int>(si);
       w.is_contact_wire = contact;
+      w.is_auxiliary_messenger = auxiliary;
       w.spec = spec;
       w.x = x;
       w.w_dof = dof;
@@ -160,6 +173,11 @@ void mesh_wires(const Scene& scene, const std::vector<double>& rise_first, const
       }
       for (double sx : section_supports[si]) w.support_nodes.push_back(node_at(x, sx));
       assemble_band(w, {});
+      if (auxiliary) {  // (not among info.wires, which the droppers hold or hang from)
+        info.auxiliary = static_cast<int>(m.wires.size());
+        m.wires.push_back(std::move(w));
+        return;
+      }
       if (contact) m.contact_wires.push_back(static_cast<int>(m.wires.size()));
       else info.messenger = static_cast<int>(m.wires.size());
       info.wires.push_back(static_cast<int>(m.wires.size()));
@@ -169,6 +187,7 @@ void mesh_wires(const Scene& scene, const std::vector<double>& rise_first, const
       add_wire("contact_wire" + suffix + (sec.contact_wire_count > 1 ? std::string(1, static_cast<char>('a' + c)) : ""),
                sec.contact_wire, true);
     if (sec.messenger) add_wire("messenger" + suffix, *sec.messenger, false);
+    if (sec.auxiliary_messenger) add_wire("auxiliary_messenger" + suffix, *sec.auxiliary_messenger, false, true);
     if (sec.stitch_wire) add_stitch_wires(*sec.stitch_wire, static_cast<int>(si), section_supports[si], x, lumped_rot, suffix, m, dof, info);
     m.sections.push_back(info);
   }
@@ -244,6 +263,7 @@ std::vector<bool> lump_masses(const Scene& scene, Model& m) {
     for (int k = 0; k < ns; ++k) {
       const int node = w.support_nodes[k];
       const bool end = k == 0 || k == ns - 1;  // anchors of the tension section
+      if (!end && w.is_auxiliary_messenger) continue;  // free through the supports, hung by droppers
       if (end || !spring) {
         fixed[w.w_dof + node] = true;
       } else {
@@ -295,29 +315,47 @@ void clamp_stitch_wires(const Scene& scene, Model& m) {
 void hang_droppers(const Scene& scene, const std::vector<std::vector<double>>& section_supports, Model& m) {
   // Droppers: one per contact wire at each dropper station (a twin contact wire hangs both wires
   // from the same dropper), with clamp masses; lengths and tensions come from the design statics.
+  // A compound line's droppers hold its auxiliary messenger, and its hangers the contact wire
+  // from the auxiliary.
+  auto hang = [&](int section, int span, double xd, const DropperSpec& ds, const Wire& top, int top_node, const Wire& low,
+                  bool hanger) {
+    Dropper d;
+    d.x = xd;
+    d.section = section;
+    d.span = span;
+    d.hanger = hanger;
+    d.contact_dof = low.w_dof + node_at(low.x, xd);
+    d.messenger_dof = top.w_dof + top_node;
+    m.mass[d.contact_dof] += ds.clamp_mass_contact;
+    m.droppers.push_back(d);
+  };
   for (std::size_t si = 0; si < scene.sections.size(); ++si) {
     const SectionSpec& sec = scene.sections[si];
     if (!sec.droppers) continue;
     const Section& info = m.sections[si];
     const DropperSpec& ds = *sec.droppers;
+    const int section = static_cast<int>(si);
     for (std::size_t i = 0; i < sec.spans.size(); ++i)
       for (double p : ds.positions[i]) {
         const double xd = section_supports[si][i] + p;
         const auto [top, top_node] = dropper_top(m, info, xd);
-        const Wire& mwire = *top;
-        const int node = node_at(m.wires[info.messenger].x, xd);  // on the section's shared stations
-        m.mass[mwire.w_dof + top_node] += ds.clamp_mass_messenger;
-        for (int wi : info.wires) {
-          if (wi == info.messenger) continue;
-          Dropper d;
-          d.x = xd;
-          d.section = static_cast<int>(si);
-          d.span = static_cast<int>(i);
-          d.contact_dof = m.wires[wi].w_dof + node;
-          d.messenger_dof = mwire.w_dof + top_node;
-          m.mass[d.contact_dof] += ds.clamp_mass_contact;
-          m.droppers.push_back(d);
+        m.mass[top->w_dof + top_node] += ds.clamp_mass_messenger;
+        if (info.auxiliary >= 0) {
+          hang(section, static_cast<int>(i), xd, ds, *top, top_node, m.wires[info.auxiliary], false);
+          continue;
         }
+        for (int wi : info.wires)
+          if (wi != info.messenger) hang(section, static_cast<int>(i), xd, ds, *top, top_node, m.wires[wi], false);
+      }
+    if (!sec.hangers) continue;
+    const Wire& aux = m.wires[info.auxiliary];
+    for (std::size_t i = 0; i < sec.spans.size(); ++i)
+      for (double p : sec.hangers->positions[i]) {
+        const double xh = section_supports[si][i] + p;
+        const int top_node = node_at(aux.x, xh);
+        m.mass[aux.w_dof + top_node] += sec.hangers->clamp_mass_messenger;
+        for (int wi : info.wires)
+          if (wi != info.messenger) hang(section, static_cast<int>(i), xh, *sec.hangers, aux, top_node, m.wires[wi], true);
       }
   }
 }

@@ -26,7 +26,8 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
   const double H = scene.contact_wire_height;
   const SectionSpec& sec = scene.sections[si];
   const Section& info = m.sections[si];
-  const double mu = sec.droppers ? sec.droppers->linear_mass : 0.0;
+  // Kg/m of a dropper's (or a compound line's hanger's) own wire.
+  auto mu_of = [&](std::size_t k) { return m.droppers[k].hanger ? sec.hangers->linear_mass : sec.droppers->linear_mass; };
   const int nspan = static_cast<int>(sec.spans.size());
   auto transition = [&](int span) {
     return (span == 0 && sec.first_span_transition) || (span == nspan - 1 && sec.last_span_transition);
@@ -35,7 +36,8 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
   for (std::size_t k = 0; k < m.droppers.size(); ++k)
     if (m.droppers[k].section == static_cast<int>(si)) mine.push_back(k);
   // (A stitch wire's clamps take the messenger's heights of the pass before: two more passes.)
-  const int passes = mine.empty() ? 1 : info.stitch_wires.empty() ? 4 : 6;
+  // (as do a compound line's auxiliary messenger's dropper heights)
+  const int passes = mine.empty() ? 1 : info.stitch_wires.empty() && info.auxiliary < 0 ? 4 : 6;
   std::vector<SpdSolver> solver(m.wires.size());  // per wire: its pattern is the same every pass
   for (int pass = 0; pass < passes; ++pass) {
     for (int wi : info.wires) {
@@ -55,7 +57,7 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
         const Dropper& d = m.droppers[k];
         if (d.contact_dof < w.w_dof || d.contact_dof >= w.w_dof + n) continue;
         const int node = d.contact_dof - w.w_dof;
-        load[node] -= 0.5 * g * mu * weight_len[k];
+        load[node] -= 0.5 * g * mu_of(k) * weight_len[k];
         const double s = (d.x - section_supports[si][d.span]) / sec.spans[d.span];
         pn.push_back(node);
         ph.push_back(transition(d.span) ? H : H - sec.contact_wire.presag * 4.0 * s * (1.0 - s));
@@ -69,6 +71,32 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
     }
     if (info.messenger < 0) break;
     Wire& mwm = m.wires[info.messenger];
+    // A compound line's auxiliary messenger: under its weight and its hangers' tensions, held at
+    // its anchors and, at each dropper, `height` above the contact wire's design shape (its
+    // reactions there are the dropper tensions).
+    if (info.auxiliary >= 0) {
+      Wire& aux = m.wires[info.auxiliary];
+      const Wire& cw = m.wires[info.wires.front()];  // the one contact wire (validate_compound)
+      const double h = sec.auxiliary_messenger->height;
+      const int n = aux.nodes();
+      std::vector<double> load(n);
+      for (int i = 0; i < n; ++i) load[i] = -g * m.mass[aux.w_dof + i];
+      std::vector<int> pn{aux.support_nodes.front(), aux.support_nodes.back()};
+      for (std::size_t k : mine) {
+        const Dropper& d = m.droppers[k];
+        if (holds(aux, d.messenger_dof)) load[d.messenger_dof - aux.w_dof] -= d.static_tension + 0.5 * g * mu_of(k) * weight_len[k];
+        if (holds(aux, d.contact_dof)) {
+          load[d.contact_dof - aux.w_dof] -= 0.5 * g * mu_of(k) * weight_len[k];
+          pn.push_back(d.contact_dof - aux.w_dof);
+        }
+      }
+      std::vector<double> ph;
+      for (int node : pn) ph.push_back(cw.height[node] + h);  // (the same stations as the contact wire's)
+      solve_wire_statics(aux, load, pn, ph, aux.height, aux.slope, react[info.auxiliary], &solver[info.auxiliary]);
+      std::size_t r = 2;
+      for (std::size_t k : mine)
+        if (holds(aux, m.droppers[k].contact_dof)) m.droppers[k].static_tension = react[info.auxiliary][r++];
+    }
     // The stitch wires: each under its weight and its droppers' tensions, held at its clamps at
     // the messenger's heights there (the last pass's; level at the encumbrance on the first).
     for (int wi : info.stitch_wires) {
@@ -78,7 +106,7 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
       for (int i = 0; i < n; ++i) load[i] = -g * m.mass[w.w_dof + i];
       for (std::size_t k : mine)
         if (holds(w, m.droppers[k].messenger_dof))
-          load[m.droppers[k].messenger_dof - w.w_dof] -= m.droppers[k].static_tension + 0.5 * g * mu * weight_len[k];
+          load[m.droppers[k].messenger_dof - w.w_dof] -= m.droppers[k].static_tension + 0.5 * g * mu_of(k) * weight_len[k];
       const std::vector<int> pn{0, n - 1};
       std::vector<double> ph(2, H + scene.encumbrance);
       for (const WireClamp& c : m.clamps)
@@ -92,7 +120,7 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
     for (int i = 0; i < n; ++i) mload[i] = -g * m.mass[mwm.w_dof + i];
     for (std::size_t k : mine) {
       const Dropper& d = m.droppers[k];
-      if (holds(mwm, d.messenger_dof)) mload[d.messenger_dof - mwm.w_dof] -= d.static_tension + 0.5 * g * mu * weight_len[k];
+      if (holds(mwm, d.messenger_dof)) mload[d.messenger_dof - mwm.w_dof] -= d.static_tension + 0.5 * g * mu_of(k) * weight_len[k];
     }
     for (const WireClamp& c : m.clamps)
       if (holds(mwm, c.messenger_dof)) mload[c.messenger_dof - mwm.w_dof] -= c.static_force;
@@ -118,31 +146,35 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
     Dropper& d = m.droppers[k];
     const SectionSpec& sec = scene.sections[d.section];
     d.length = dropper_len[k];
+    const DropperSpec& spec = d.hanger ? *sec.hangers : *sec.droppers;
+    const std::string part = d.hanger ? "hanger" : "dropper";
     if (d.length <= 0.01) {
-      const bool stitch = wire_of(m, d.messenger_dof).is_stitch_wire;
-      throw SceneError("droppers: at x = " + fmt(d.x) + " m the " + (stitch ? "stitch wire" : "messenger") + " hangs " +
-                       fmt(-d.length) + " m below the contact wire (dropper length " + fmt(d.length) +
-                       " m): raise line.encumbrance or the " + (stitch ? "stitch wire's" : "messenger") +
-                       " tension, or reduce the presag");
+      const Wire& top = wire_of(m, d.messenger_dof);
+      const std::string low = wire_of(m, d.contact_dof).is_auxiliary_messenger ? "auxiliary messenger" : "contact wire";
+      const std::string top_name = top.is_stitch_wire ? "stitch wire" : top.is_auxiliary_messenger ? "auxiliary messenger" : "messenger";
+      throw SceneError(part + "s: at x = " + fmt(d.x) + " m the " + top_name + " hangs " + fmt(-d.length) + " m below the " + low +
+                       " (" + part + " length " + fmt(d.length) + " m): raise " +
+                       (d.hanger ? "auxiliary_messenger.height or its tension" : "line.encumbrance or the " + top_name + "'s tension") +
+                       ", or reduce the presag");
     }
     const int nspan = static_cast<int>(sec.spans.size());
     const bool in_transition = (d.span == 0 && sec.first_span_transition) || (d.span == nspan - 1 && sec.last_span_transition);
     if (d.static_tension <= 0.0 && in_transition)
-      throw SceneError("droppers: at x = " + fmt(d.x) + " m, in a transition span, the dropper would have to push (static force " +
+      throw SceneError(part + "s: at x = " + fmt(d.x) + " m, in a transition span, the " + part + " would have to push (static force " +
                        fmt(d.static_tension) + " N): the raised support (rise d = " +
                        fmt(std::max(m.sections[d.section].rise_first, m.sections[d.section].rise_last)) +
-                       " m) pulls the wire up past it; lower overlap.support_rise (or overlap.design_force) or hang "
-                       "droppers.transition_positions nearer the section's own support");
+                       " m) pulls the wire up past it; lower overlap.support_rise (or overlap.design_force) or hang " + part +
+                       "s.transition_positions nearer the section's own support");
     if (d.static_tension <= 0.0)
-      throw SceneError("droppers: at x = " + fmt(d.x) + " m the dropper would have to push (static force " +
+      throw SceneError(part + "s: at x = " + fmt(d.x) + " m the " + part + " would have to push (static force " +
                        fmt(d.static_tension) + " N): contact_wire.presag " + fmt(sec.contact_wire.presag) +
-                       " m is not reachable with tension-only droppers; reduce it");
-    d.unstretched_length = d.length / (1.0 + d.static_tension / sec.droppers->axial_stiffness);
-    d.stiffness = sec.droppers->axial_stiffness / d.unstretched_length;
+                       " m is not reachable with tension-only " + part + "s; reduce it");
+    d.unstretched_length = d.length / (1.0 + d.static_tension / spec.axial_stiffness);
+    d.stiffness = spec.axial_stiffness / d.unstretched_length;
     // Half the dropper's mass on each end (the length its weight had in the statics, so that the
     // design state is an exact equilibrium).
-    m.mass[d.contact_dof] += 0.5 * sec.droppers->linear_mass * weight_len[k];
-    m.mass[d.messenger_dof] += 0.5 * sec.droppers->linear_mass * weight_len[k];
+    m.mass[d.contact_dof] += 0.5 * spec.linear_mass * weight_len[k];
+    m.mass[d.messenger_dof] += 0.5 * spec.linear_mass * weight_len[k];
   }
 }
 
@@ -198,8 +230,13 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
   // from its last dropper to the raised support, Fig. 2); the reactions there are the dropper
   // tensions. The messenger carries those tensions and the dropper weight to its supports. The
   // dropper weight depends on its length, which depends on the messenger sag: a few fixed-point
-  // passes settle it.
+  // passes settle it. On a compound line the contact wire is held so at its hangers, the
+  // auxiliary messenger at its droppers (AuxiliaryMessengerSpec::height above the contact wire),
+  // and the messenger carries the droppers.
   std::vector<double> weight_len(m.droppers.size(), scene.encumbrance);  // lengths the weights use
+  for (std::size_t k = 0; k < m.droppers.size(); ++k)  // a compound line's: the auxiliary's height
+    if (const auto& aux = scene.sections[m.droppers[k].section].auxiliary_messenger)
+      weight_len[k] = m.droppers[k].hanger ? aux->height : scene.encumbrance - aux->height;
   std::vector<double> dropper_len = weight_len;                          // geometric lengths
   std::vector<std::vector<double>> react(m.wires.size());
   for (std::size_t si = 0; si < scene.sections.size(); ++si)

@@ -24,13 +24,15 @@ double estimate_model_bytes(const Scene& scene) {
   const double h = scene.numerics.element_length;
   for (const SectionSpec& sec : scene.sections) {
     double droppers = 0.0;
-    if (sec.droppers)
-      for (const auto& span : sec.droppers->positions) droppers += static_cast<double>(span.size());
+    for (const auto& part : {sec.droppers, sec.hangers})  // (a compound line's hangers are nodes too)
+      if (part)
+        for (const auto& span : part->positions) droppers += static_cast<double>(span.size());
     // A stitch wire's two clamps are nodes of every wire of its section; the stitch wires together
     // are shorter than the section, so they count as one more wire at most.
     const double clamps = sec.stitch_wire ? 2.0 * static_cast<double>(sec.spans.size()) : 0.0;
     const double per_wire = std::ceil(sec.length() / h) + droppers + clamps + static_cast<double>(sec.spans.size()) + 1.0;
-    const double wires = sec.contact_wire_count + (sec.messenger ? 1 : 0) + (sec.stitch_wire ? 1 : 0);
+    const double wires =
+        sec.contact_wire_count + (sec.messenger ? 1 : 0) + (sec.stitch_wire ? 1 : 0) + (sec.auxiliary_messenger ? 1 : 0);
     nodes += wires * per_wire;
   }
   return kModelBytesPerNode * nodes + estimate_wind_field_bytes(scene);

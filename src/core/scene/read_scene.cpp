@@ -73,7 +73,7 @@ void read_spans(Reader& r, const std::string& path, std::vector<double>& spans) 
 // contact_wire and steady_arms; a messenger, droppers or presag have nothing to act on.
 void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
   for (const char* other : {"contact_wire", "messenger", "droppers", "steady_arms", "messenger_supports", "stitch_wire",
-                            "contact_wire_count"})
+                            "contact_wire_count", "auxiliary_messenger", "hangers"})
     if (r.has(other))
       fail(pre + other, "(given with conductor_rail)",
            "a rigid conductor rail has no tensioned wires, droppers or steady arms: give conductor_rail alone "
@@ -91,6 +91,8 @@ void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
   sec.messenger.reset();
   sec.droppers.reset();
   sec.messenger_supports.reset();
+  sec.auxiliary_messenger.reset();
+  sec.hangers.reset();
   sec.contact_wire_count = 1;
 }
 
@@ -113,6 +115,63 @@ void read_stitch_wire(Reader& r, const std::string& pre, SectionSpec& sec) {
   st.clamp_mass = w.number("clamp_mass", 0.0, 10.0, 0.0);
   w.finish();
   sec.stitch_wire = st;
+}
+
+// Droppers, or a compound line's hangers (the same parts between the auxiliary messenger and the
+// contact wire): their positions in each span and what they are made of.
+DropperSpec read_droppers(Reader& r, const std::string& f, const std::string& key) {
+  Reader d(r.child(key), f);
+  DropperSpec ds;
+  if (d.has("positions") == d.has("positions_per_span"))
+    fail(f + ".positions", "(both or neither given)", "give positions (same in every span) or positions_per_span");
+  if (d.has("positions")) {
+    ds.positions.assign(1, d.numbers("positions", 0.0, 500.0, true));  // expanded per span later
+    if (ds.positions.front().empty())
+      fail(f + ".positions", "[]", "at least one position in m from the span start (or remove the " + key + " section)");
+  } else {
+    const YAML::Node per = d.child("positions_per_span");
+    if (!per.IsSequence()) fail(f + ".positions_per_span", "(not a list)", "one list of positions per span");
+    for (std::size_t i = 0; i < per.size(); ++i) {
+      std::vector<double> v;
+      const std::string fi = f + ".positions_per_span[" + std::to_string(i) + "]";
+      if (!per[i].IsSequence()) fail(fi, "(not a list)", "a list of positions in m");
+      for (std::size_t j = 0; j < per[i].size(); ++j)
+        v.push_back(Reader::parse_number(per[i][j], fi + "[" + std::to_string(j) + "]", 0.0, 500.0, true));
+      ds.positions.push_back(v);
+    }
+    ds.per_span = true;
+    std::size_t count = 0;
+    for (const auto& v : ds.positions) count += v.size();
+    if (count == 0)
+      fail(f + ".positions_per_span", "(none in any span)", "at least one position (or remove the " + key + " section)");
+  }
+  if (d.has("transition_positions")) ds.transition_positions = d.numbers("transition_positions", 0.0, 500.0, true);
+  ds.axial_stiffness = d.number("axial_stiffness", 0.0, 1e10, std::nullopt, true);
+  ds.linear_mass = d.number("linear_mass", 0.0, 10.0, 0.0);
+  ds.clamp_mass_contact = d.number("clamp_mass_contact", 0.0, 100.0, 0.0);
+  // (A hanger's upper clamp is on the auxiliary messenger.)
+  ds.clamp_mass_messenger = d.number(key == "hangers" ? "clamp_mass_auxiliary" : "clamp_mass_messenger", 0.0, 100.0, 0.0);
+  d.finish();
+  return ds;
+}
+
+// A compound catenary's auxiliary messenger: a tensioned wire and its height above the contact
+// wire at the droppers; `auxiliary_messenger: none` in a section leaves out the scene's.
+void read_auxiliary_messenger(Reader& r, const std::string& pre, SectionSpec& sec) {
+  const YAML::Node node = r.child("auxiliary_messenger");
+  if (node.IsScalar()) {
+    if (node.Scalar() != "none")
+      fail(pre + "auxiliary_messenger", node.Scalar(), "a map of linear_mass, tension, height, ... or none (a simple catenary)");
+    sec.auxiliary_messenger.reset();
+    sec.hangers.reset();
+    return;
+  }
+  Reader w(node, pre + "auxiliary_messenger");
+  AuxiliaryMessengerSpec aux;
+  static_cast<WireSpec&>(aux) = read_wire(w);
+  aux.height = w.number("height", 0.0, 10.0, std::nullopt, true);
+  w.finish();
+  sec.auxiliary_messenger = aux;
 }
 
 void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, const SectionSpec* defaults) {
@@ -139,41 +198,9 @@ void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, co
     sec.messenger = read_wire(w);
     w.finish();
   }
-  if (r.has("droppers")) {
-    Reader d(r.child("droppers"), pre + "droppers");
-    DropperSpec ds;
-    const std::string f = pre + "droppers";
-    if (d.has("positions") == d.has("positions_per_span"))
-      fail(f + ".positions", "(both or neither given)", "give positions (same in every span) or positions_per_span");
-    if (d.has("positions")) {
-      ds.positions.assign(1, d.numbers("positions", 0.0, 500.0, true));  // expanded per span later
-      if (ds.positions.front().empty())
-        fail(f + ".positions", "[]", "at least one dropper position in m from the span start (or remove the droppers section)");
-    } else {
-      const YAML::Node per = d.child("positions_per_span");
-      if (!per.IsSequence()) fail(f + ".positions_per_span", "(not a list)", "one list of positions per span");
-      for (std::size_t i = 0; i < per.size(); ++i) {
-        std::vector<double> v;
-        const std::string fi = f + ".positions_per_span[" + std::to_string(i) + "]";
-        if (!per[i].IsSequence()) fail(fi, "(not a list)", "a list of positions in m");
-        for (std::size_t j = 0; j < per[i].size(); ++j)
-          v.push_back(Reader::parse_number(per[i][j], fi + "[" + std::to_string(j) + "]", 0.0, 500.0, true));
-        ds.positions.push_back(v);
-      }
-      ds.per_span = true;
-      std::size_t count = 0;
-      for (const auto& v : ds.positions) count += v.size();
-      if (count == 0)
-        fail(f + ".positions_per_span", "(no dropper in any span)", "at least one dropper position (or remove the droppers section)");
-    }
-    if (d.has("transition_positions")) ds.transition_positions = d.numbers("transition_positions", 0.0, 500.0, true);
-    ds.axial_stiffness = d.number("axial_stiffness", 0.0, 1e10, std::nullopt, true);
-    ds.linear_mass = d.number("linear_mass", 0.0, 10.0, 0.0);
-    ds.clamp_mass_contact = d.number("clamp_mass_contact", 0.0, 100.0, 0.0);
-    ds.clamp_mass_messenger = d.number("clamp_mass_messenger", 0.0, 100.0, 0.0);
-    d.finish();
-    sec.droppers = ds;
-  }
+  if (r.has("droppers")) sec.droppers = read_droppers(r, pre + "droppers", "droppers");
+  if (r.has("hangers")) sec.hangers = read_droppers(r, pre + "hangers", "hangers");
+  if (r.has("auxiliary_messenger")) read_auxiliary_messenger(r, pre, sec);
   if (r.has("steady_arms")) {
     Reader a(r.child("steady_arms"), pre + "steady_arms");
     sec.steady_arms = read_steady_arms(a, pre + "steady_arms");
@@ -211,12 +238,13 @@ void resolve_line(Scene& s) {
       for (std::size_t j = 0; j + k < prev.spans.size(); ++j) st += prev.spans[j];
       sec.start = st;
     }
-    if (sec.droppers) {
-      DropperSpec& d = *sec.droppers;
+    for (auto [part, key] : {std::pair{&sec.droppers, "droppers"}, std::pair{&sec.hangers, "hangers"}}) {
+      if (!*part) continue;
+      DropperSpec& d = **part;
       const std::size_t n = sec.spans.size();
       if (d.per_span) {
         if (d.positions.size() != n)
-          fail(path + ".droppers.positions_per_span", "(" + std::to_string(d.positions.size()) + " entries)",
+          fail(path + "." + key + ".positions_per_span", "(" + std::to_string(d.positions.size()) + " entries)",
                "one list per span (" + std::to_string(n) + ")");
       } else {
         const std::vector<double> common = d.positions.empty() ? std::vector<double>{} : d.positions.front();
@@ -471,6 +499,8 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   s.steady_arms = first.steady_arms;
   s.messenger_supports = first.messenger_supports;
   s.stitch_wire = first.stitch_wire;
+  s.auxiliary_messenger = first.auxiliary_messenger;
+  s.hangers = first.hangers;
   resolve_line(s);
   read_damping(top, s);
   read_contact(top, s);

@@ -55,16 +55,19 @@ void validate_sections(const Scene& s) {
              "required on a 2-D line, N > 0: the wire's horizontal pull on the arm (4 T s / L for a zigzag of +-s on "
              "straight track, + T L / R on a curve)");
     }
-    if (!sec.droppers) continue;
-    if (sec.droppers->positions.size() != sec.spans.size())
-      fail(pre + "droppers.positions_per_span", std::to_string(sec.droppers->positions.size()) + " lists", "one per span");
-    for (std::size_t i = 0; i < sec.spans.size(); ++i) {
-      const auto& p = sec.droppers->positions[i];
-      for (std::size_t j = 0; j < p.size(); ++j) {
-        const std::string f = pre + "droppers.positions (span " + std::to_string(i) + ", dropper " + std::to_string(j) + ")";
-        if (p[j] <= 0.0 || p[j] >= sec.spans[i])
-          fail(f, fmt(p[j]), "strictly inside the span (0, " + fmt(sec.spans[i]) + ") m");
-        if (j > 0 && p[j] <= p[j - 1]) fail(f, fmt(p[j]), "increasing along the span (previous " + fmt(p[j - 1]) + ")");
+    for (auto [part, key] : {std::pair{&sec.droppers, "droppers"}, std::pair{&sec.hangers, "hangers"}}) {
+      if (!*part) continue;
+      const DropperSpec& d = **part;
+      if (d.positions.size() != sec.spans.size())
+        fail(pre + key + ".positions_per_span", std::to_string(d.positions.size()) + " lists", "one per span");
+      for (std::size_t i = 0; i < sec.spans.size(); ++i) {
+        const auto& p = d.positions[i];
+        for (std::size_t j = 0; j < p.size(); ++j) {
+          const std::string f = pre + key + ".positions (span " + std::to_string(i) + ", position " + std::to_string(j) + ")";
+          if (p[j] <= 0.0 || p[j] >= sec.spans[i])
+            fail(f, fmt(p[j]), "strictly inside the span (0, " + fmt(sec.spans[i]) + ") m");
+          if (j > 0 && p[j] <= p[j - 1]) fail(f, fmt(p[j]), "increasing along the span (previous " + fmt(p[j - 1]) + ")");
+        }
       }
     }
   }
@@ -302,11 +305,42 @@ void validate_stitched(const Scene& s) {
          "none: the stitch wire's lateral plane is not modelled (a 2-D line only)");
 }
 
+// A compound catenary: messenger, droppers to the auxiliary messenger, hangers to one contact wire,
+// on a finite 2-D line (the endless block and the lateral plane do not carry the auxiliary).
+void validate_compound(const Scene& s) {
+  for (std::size_t si = 0; si < s.sections.size(); ++si) {
+    const SectionSpec& sec = s.sections[si];
+    if (!sec.auxiliary_messenger && !sec.hangers) continue;
+    const std::string pre = s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "";
+    if (!sec.auxiliary_messenger)
+      fail(pre + "hangers", "(given)", "hangers hang the contact wire from an auxiliary messenger: add auxiliary_messenger or remove hangers");
+    const std::string f = pre + "auxiliary_messenger";
+    if (!sec.hangers)
+      fail(f, "(given without hangers)", "hangers from it to the contact wire (positions, axial_stiffness, ...)");
+    if (!sec.messenger || !sec.droppers)
+      fail(f, "(given)", "the droppers hang it from a messenger: add messenger and droppers");
+    if (!(sec.auxiliary_messenger->tension > 0.0)) fail(f + ".tension", fmt(sec.auxiliary_messenger->tension), "> 0 N");
+    if (!(sec.auxiliary_messenger->height < s.encumbrance))
+      fail(f + ".height", fmt(sec.auxiliary_messenger->height),
+           "(0, " + fmt(s.encumbrance) + ") m: below the messenger (line.encumbrance above the contact wire at the supports)");
+    if (sec.contact_wire_count != 1)
+      fail(pre + "contact_wire_count", std::to_string(sec.contact_wire_count), "1 on a compound catenary (its hangers hold one contact wire)");
+    if (sec.stitch_wire) fail(pre + "stitch_wire", "(given with auxiliary_messenger)", "none: a line is stitched or compound, not both");
+  }
+  const bool any = std::any_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.auxiliary_messenger.has_value(); });
+  if (!any) return;
+  if (s.endless) fail("line.endless", "true (with auxiliary_messenger)", "false: the endless block does not carry an auxiliary messenger");
+  if (s.lateral())
+    fail("stagger/alignment/wind/pantograph_head.sway", "(given with auxiliary_messenger)",
+         "none: the auxiliary messenger's lateral plane is not modelled (a 2-D line only)");
+}
+
 void validate(const Scene& s) {
   const double line = s.line_length();
   validate_sections(s);
   validate_rigid(s);
   validate_stitched(s);
+  validate_compound(s);
   validate_limits(s);
   validate_acting_fields(s);
   validate_pantographs(s);

@@ -28,6 +28,7 @@ struct Wire {
   int section = 0;               // tension section it belongs to
   bool is_contact_wire = false;
   bool is_stitch_wire = false;   // a stitch wire (StitchWireSpec): no supports, clamped to the messenger
+  bool is_auxiliary_messenger = false;  // a compound line's (AuxiliaryMessengerSpec): held at its anchors only
   WireSpec spec;
   std::vector<double> x;         // m, node stations along the line
   std::vector<double> height;    // m, design height of each node (static shape, no pantograph)
@@ -46,9 +47,12 @@ struct Wire {
   int element_at(double xs) const;
 };
 
-// Tension-only dropper between a contact-wire node and a messenger node.
+// Tension-only dropper between a contact-wire node and a messenger node. On a compound line the
+// droppers hold the auxiliary messenger (contact_dof is its node) and the hangers the contact wire
+// from the auxiliary (messenger_dof is the auxiliary's node).
 struct Dropper {
   int contact_dof = 0, messenger_dof = 0;
+  bool hanger = false;          // a compound line's hanger (Section::auxiliary to the contact wire)
   int section = 0, span = 0;    // tension section, span index within it
   double x = 0.0;               // m
   double stiffness = 0.0;       // N/m, EA / unstretched length
@@ -104,6 +108,7 @@ struct Section {
   std::vector<int> wires;              // indices into Model::wires: contact wire(s), messenger
   int messenger = -1;                  // index into Model::wires, -1 without a messenger
   std::vector<int> stitch_wires;       // indices into Model::wires, one per intermediate support
+  int auxiliary = -1;                  // index into Model::wires of a compound line's auxiliary messenger
 };
 
 struct Collector {
@@ -145,7 +150,8 @@ struct Pantograph {
 struct Model {
   Scene scene;
   std::vector<Section> sections;
-  std::vector<Wire> wires;            // per section: contact wire(s), the messenger if any, its stitch wires
+  // per section: contact wire(s), the messenger if any, its stitch wires or auxiliary messenger
+  std::vector<Wire> wires;
   std::vector<int> contact_wires;     // indices into wires that collectors touch
   std::vector<Dropper> droppers;
   std::vector<SupportSpring> springs;

@@ -41,8 +41,21 @@ struct DropperSpec {
   bool per_span = false;                       // positions were given per span (positions_per_span)
   double axial_stiffness = 0.0;                // EA, N
   double linear_mass = 0.0;                    // kg/m
-  double clamp_mass_contact = 0.0;             // kg, clamp on the contact wire
-  double clamp_mass_messenger = 0.0;           // kg, clamp on the messenger
+  // kg, clamp on the wire it holds: the contact wire (a compound line's droppers: the auxiliary
+  // messenger; its hangers: the contact wire)
+  double clamp_mass_contact = 0.0;
+  // kg, clamp on the wire it hangs from: the messenger (a compound line's hangers: the auxiliary)
+  double clamp_mass_messenger = 0.0;
+};
+
+// A compound catenary's auxiliary messenger (Japanese high-speed lines): a tensioned wire between
+// the messenger and the contact wire, anchored with its section and free through the intermediate
+// supports. The droppers hang it from the messenger and the hangers (DropperSpec, more closely
+// spaced) hang the contact wire from it, so that the contact wire's stiffness varies less along
+// the span. Design rule: at each dropper it runs `height` above the contact wire's design shape;
+// between droppers it sags under the hangers, which sets their lengths.
+struct AuxiliaryMessengerSpec : WireSpec {
+  double height = 0.0;  // m above the contact wire at each dropper
 };
 
 // A stitch wire (Y-wire): a short tensioned wire clamped to the messenger at length/2 on both sides
@@ -168,6 +181,10 @@ struct SectionSpec {
   std::optional<SupportSpec> steady_arms;
   std::optional<SupportSpec> messenger_supports;
   std::optional<StitchWireSpec> stitch_wire;  // at every intermediate support of the section
+  // Compound catenary: the auxiliary messenger and the hangers from it to the contact wire (the
+  // droppers then hang the auxiliary from the messenger).
+  std::optional<AuxiliaryMessengerSpec> auxiliary_messenger;
+  std::optional<DropperSpec> hangers;
   // Rigid overhead conductor rail (docs/rigid_conductor_rail.md): the contact wire is the profile
   // with its clamped wire, a beam with no tension (contact_wire.tension 0), held at each
   // intermediate support by `steady_arms` (the supports' spring and mass); no messenger, droppers
@@ -409,6 +426,8 @@ struct Scene {
   std::optional<SupportSpec> steady_arms;         // intermediate contact-wire supports
   std::optional<SupportSpec> messenger_supports;  // intermediate messenger supports
   std::optional<StitchWireSpec> stitch_wire;      // stitched catenary
+  std::optional<AuxiliaryMessengerSpec> auxiliary_messenger;  // compound catenary
+  std::optional<DropperSpec> hangers;                         // compound catenary
   double rayleigh_alpha = 0.0;  // 1/s, eq. 5
   double rayleigh_beta = 0.0;   // s, eq. 5
   std::vector<PantographSpec> pantographs;
