@@ -183,6 +183,7 @@ void add_wires(visualization_msgs::MarkerArray& out, const Drawing& d) {
     mk.color = profile              ? color(0.78f, 0.8f, 0.84f)
                : w.is_contact_wire ? color(0.85f, 0.55f, 0.2f)
                : w.is_stitch_wire  ? color(0.65f, 0.5f, 0.3f)  // bronze
+               : w.is_auxiliary_messenger ? color(0.75f, 0.45f, 0.25f)  // hard-drawn copper
                                    : color(0.6f, 0.6f, 0.65f);
     for (int i : sample_nodes(w, d.o.shape_resolution))
       mk.points.push_back(point(w.x[i] + s.line_offset, node_lateral(m, s, wi, i),

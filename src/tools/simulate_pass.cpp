@@ -317,14 +317,18 @@ void print_pantograph(const PantographStatistics& s) {
 }
 
 void print_line(const Scene& scene, const LineStatistics& line) {
-  if (!line.droppers.empty()) {
+  for (const bool hangers : {false, true}) {  // (a compound line's hangers on a line of their own)
     double fmax = 0.0, slack = 0.0, rmax = 0.0;
+    int count = 0;
     for (const DropperStatistics& d : line.droppers) {
+      if (d.hanger != hangers) continue;
+      ++count;
       fmax = std::max(fmax, d.max_force);
       slack = std::max(slack, d.slack_percent);
       rmax = std::max(rmax, d.max_range);
     }
-    std::cout << std::setprecision(1) << "droppers (" << line.droppers.size() << " in the section): max force " << fmax
+    if (count == 0) continue;
+    std::cout << std::setprecision(1) << (hangers ? "hangers (" : "droppers (") << count << " in the section): max force " << fmax
               << " N, most slack " << std::setprecision(2) << slack << " % of the time, largest rainflow range "
               << std::setprecision(1) << rmax << " N\n";
   }

@@ -1,5 +1,6 @@
 #include "catenary_sim/core/output/pass_files.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <deque>
@@ -127,11 +128,15 @@ void write_pass_files(const std::string& dir, const Model& m, const State& st, c
   }
   {
     std::ostringstream c, r;
-    c << std::setprecision(9) << "station_m,static_tension_N,max_force_N,min_force_N,slack_percent,rainflow_cycles,max_range_N\n";
+    // A compound line's droppers.csv says which rows are hangers (auxiliary messenger to contact wire).
+    const bool compound = std::any_of(line.droppers.begin(), line.droppers.end(), [](const DropperStatistics& d) { return d.hanger; });
+    c << std::setprecision(9) << "station_m,static_tension_N,max_force_N,min_force_N,slack_percent,rainflow_cycles,max_range_N"
+      << (compound ? ",hanger\n" : "\n");
     r << std::setprecision(9) << "station_m,range_from_N,range_to_N,cycles\n";
     for (const DropperStatistics& d : line.droppers) {
       c << d.station << "," << d.static_tension << "," << d.max_force << "," << d.min_force << "," << d.slack_percent << ","
-        << d.cycles << "," << d.max_range << "\n";
+        << d.cycles << "," << d.max_range;
+      c << (compound ? (d.hanger ? ",1\n" : ",0\n") : "\n");
       for (std::size_t b = 0; b < d.histogram.size(); ++b)
         r << d.station << "," << b * line.range_bin_n << "," << (b + 1) * line.range_bin_n << "," << d.histogram[b] << "\n";
     }

@@ -392,13 +392,15 @@ double mean_span(const Model& m, double x0, double x1) {
   return (xs.back() - xs.front()) / (xs.size() - 1);
 }
 
-// Median spacing of consecutive droppers within a span over [x0, x1]; NaN without droppers.
+// Median spacing of consecutive droppers within a span over [x0, x1]; NaN without droppers. Those
+// the contact wire hangs from count: on a compound line its hangers.
 double dropper_spacing(const Model& m, double x0, double x1) {
   std::vector<double> gaps;
   const Dropper* last = nullptr;
+  const bool compound = std::any_of(m.droppers.begin(), m.droppers.end(), [](const Dropper& d) { return d.hanger; });
   for (int k : m.dropper_order) {
     const Dropper& d = m.droppers[k];
-    if (d.x < x0 || d.x > x1) continue;
+    if (d.x < x0 || d.x > x1 || (compound && !d.hanger)) continue;
     if (last && last->section == d.section && last->span == d.span && d.x - last->x > 1e-6) gaps.push_back(d.x - last->x);
     last = &d;
   }
@@ -471,6 +473,7 @@ LineStatistics PassRecorder::line_statistics(const Model& m) const {
     DropperStatistics ds;
     ds.station = d.x;
     ds.span = d.section * 1000 + d.span;
+    ds.hanger = d.hanger;
     ds.static_tension = d.static_tension;
     ds.max_force = steps_ ? t.max : std::nan("");
     ds.min_force = steps_ ? t.min : std::nan("");

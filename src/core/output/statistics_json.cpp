@@ -162,11 +162,13 @@ void put_line(Json& j, const Model& m, const std::vector<PantographStatistics>& 
   Json dr;
   dr["rainflow_bin_N"] = line.range_bin_n;
   Json list = Json::array();
-  for (const DropperStatistics& d : line.droppers)
+  for (const DropperStatistics& d : line.droppers) {
     list.push_back(Json{{"station_m", d.station},       {"static_tension_N", d.static_tension},
                         {"max_force_N", d.max_force},   {"min_force_N", d.min_force},
                         {"slack_percent", d.slack_percent}, {"rainflow_cycles", d.cycles},
                         {"max_range_N", d.max_range}});
+    if (d.hanger) list.back()["hanger"] = true;  // a compound line's: auxiliary messenger to contact wire
+  }
   dr["list"] = list;
   j["droppers"] = dr;
   Json supports = Json::array();

@@ -74,6 +74,7 @@ struct PantographStatistics {
 struct DropperStatistics {
   double station = 0.0;  // m
   int span = 0;          // span index along the line
+  bool hanger = false;   // a compound line's hanger (auxiliary messenger to contact wire)
   double static_tension = 0.0, max_force = 0.0, min_force = 0.0;  // N
   double slack_percent = 0.0;  // share of steps slack
   double cycles = 0.0;         // rainflow cycles counted (a half cycle as 0.5)
