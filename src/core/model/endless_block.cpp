@@ -73,6 +73,11 @@ double lay_endless_block(Scene& scene, Model& m) {
     pos.assign(count, pos.front());
     scene.droppers = scene.sections.front().droppers;
   }
+  if (scene.sections.front().hangers) {  // a compound line's
+    auto& pos = scene.sections.front().hangers->positions;
+    pos.assign(count, pos.front());
+    scene.hangers = scene.sections.front().hangers;
+  }
   m.endless = true;
   m.endless_span = span;
   m.endless_home = home * span;

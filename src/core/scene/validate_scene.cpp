@@ -306,7 +306,7 @@ void validate_stitched(const Scene& s) {
 }
 
 // A compound catenary: messenger, droppers to the auxiliary messenger, hangers to one contact wire,
-// on a finite 2-D line (the endless block and the lateral plane do not carry the auxiliary).
+// on a 2-D line (the lateral plane does not carry the auxiliary).
 void validate_compound(const Scene& s) {
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
@@ -329,7 +329,6 @@ void validate_compound(const Scene& s) {
   }
   const bool any = std::any_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.auxiliary_messenger.has_value(); });
   if (!any) return;
-  if (s.endless) fail("line.endless", "true (with auxiliary_messenger)", "false: the endless block does not carry an auxiliary messenger");
   if (s.lateral())
     fail("stagger/alignment/wind/pantograph_head.sway", "(given with auxiliary_messenger)",
          "none: the auxiliary messenger's lateral plane is not modelled (a 2-D line only)");
