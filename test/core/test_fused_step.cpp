@@ -134,8 +134,9 @@ TEST(FusedStep, MatchesThePlainStepBitForBitOverAPass) {
 // the other ways a pass runs: the moving window, the endless line, two pantographs, two sections
 // (an overlap: two packs), the coarsest rung and the half-step's finest (the reference rung's
 // h = 0.1 m where the centred damping does not go; the centred step has its own tests,
-// test_centred_damping.cpp), and a twin contact wire (a pack of one wire beside one of two), with
-// and without a window.
+// test_centred_damping.cpp), a twin contact wire (a pack of one wire beside one of two), with
+// and without a window, and a compound line (its auxiliary a pack of its own; hangers and droppers
+// as point forces on three wires), with and without a window.
 TEST(FusedStep, MatchesTheGenericStepBitForBit) {
   struct Case {
     std::string file;
@@ -153,6 +154,8 @@ TEST(FusedStep, MatchesTheGenericStepBitForBit) {
       {"reference_55m.yaml", {"numerics.element_length=0.1"}, 1500},
       {"twin", {}, 2000},
       {"twin", {"numerics.window=auto", "train.speed_kmh=250"}, 3000},
+      {"compound_catenary.yaml", {}, 3000},
+      {"compound_catenary.yaml", {"numerics.window=auto"}, 3000},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.file + (c.overrides.empty() ? "" : " " + c.overrides.front()));
