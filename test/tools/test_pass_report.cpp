@@ -131,6 +131,25 @@ TEST_F(PassReport, HingedSteadyArmsAreListedWithTheirGeometry) {
   EXPECT_EQ(slurp(plain + "/report.html").find("hinged steady arms"), std::string::npos);
 }
 
+// A compound line: the table lists droppers and hangers on rows of their own, each with its count
+// as stats.json marks them (30 droppers and 60 hangers over the six spans of the analysis section).
+TEST_F(PassReport, CompoundLineListsHangersApartFromDroppers) {
+  const std::string out = dir_ + "/out";
+  const ChildRun r = run_child({kSimulatePass, "--scene", test_scenes::kCompound, "--out", out, "--report", "--no-progress"},
+                               dir_ + "/log.txt", 300.0);
+  ASSERT_FALSE(r.hung);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  int hangers = 0, droppers = 0;
+  for (const auto& d : stats["droppers"]["list"]) (d.value("hanger", false) ? hangers : droppers) += 1;
+  ASSERT_GT(hangers, 0);
+  ASSERT_GT(droppers, 0);
+  const std::string page = slurp(out + "/report.html");
+  EXPECT_NE(page.find("(" + std::to_string(hangers) + " hangers)"), std::string::npos);
+  EXPECT_NE(page.find("(" + std::to_string(droppers) + " droppers)"), std::string::npos);
+  EXPECT_NE(slurp(out + "/droppers.csv").find(",hanger\n"), std::string::npos);
+}
+
 TEST_F(PassReport, ReportOfAnEmptyDirectoryFailsNamingTheFile) {
   const ChildRun r = run_child({"/usr/bin/python3", test_scenes::kSourceDir + "/scripts/pass_report", dir_},
                          dir_ + "/log.txt", 60.0);
