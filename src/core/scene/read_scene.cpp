@@ -162,6 +162,8 @@ void read_auxiliary_messenger(Reader& r, const std::string& pre, SectionSpec& se
   if (node.IsScalar()) {
     if (node.Scalar() != "none")
       fail(pre + "auxiliary_messenger", node.Scalar(), "a map of linear_mass, tension, height, ... or none (a simple catenary)");
+    if (r.has("hangers"))
+      fail(pre + "hangers", "(given with auxiliary_messenger: none)", "no hangers: they hang from the auxiliary messenger");
     sec.auxiliary_messenger.reset();
     sec.hangers.reset();
     return;
