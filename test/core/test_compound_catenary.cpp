@@ -264,8 +264,10 @@ TEST(CompoundCatenary, BadInputIsRefusedByName) {
   refused(with("line: {", "contact_wire_count: 2\nline: {"), "contact_wire_count");
   refused(y + "stitch_wire: {length: 8.0, tension: 3500, linear_mass: 0.31}\n", "stitch_wire");
   refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\n", "stagger");
-  refused(with("auxiliary_messenger: {linear_mass: 1.36, tension: 14700, height: 0.15}", "auxiliary_messenger: none"),
-          "hangers");
+  refused(with("line: {span_length: 20.0, span_count: 2, encumbrance: 1.5}", "line: {encumbrance: 1.5}") +
+              "sections:\n  - {span_length: 20.0, span_count: 2, auxiliary_messenger: none,\n"
+              "     hangers: {positions: [2.5], axial_stiffness: 200000}}\n",
+          "sections[0].hangers");
   std::string no_aux = y;
   no_aux.erase(no_aux.find("auxiliary_messenger:"), no_aux.find("droppers:") - no_aux.find("auxiliary_messenger:"));
   refused(no_aux, "hangers");

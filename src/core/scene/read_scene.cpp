@@ -162,7 +162,9 @@ void read_auxiliary_messenger(Reader& r, const std::string& pre, SectionSpec& se
   if (node.IsScalar()) {
     if (node.Scalar() != "none")
       fail(pre + "auxiliary_messenger", node.Scalar(), "a map of linear_mass, tension, height, ... or none (a simple catenary)");
-    if (r.has("hangers"))
+    // (A section's own hangers beside `none` contradict it; the scene's, e.g. left out by
+    // `--set auxiliary_messenger=none`, go with the auxiliary.)
+    if (!pre.empty() && r.has("hangers"))
       fail(pre + "hangers", "(given with auxiliary_messenger: none)", "no hangers: they hang from the auxiliary messenger");
     sec.auxiliary_messenger.reset();
     sec.hangers.reset();
