@@ -19,6 +19,7 @@
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/model/model_memory.hpp"
 #include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/core/output/zero_phase_filter.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
@@ -274,7 +275,6 @@ TEST(StitchedCatenary, BadInputIsRefusedByName) {
   refused(with("stitch_wire: {length: 8.0, tension: 3500, linear_mass: 0.31}", "stitch_wire: off"), "stitch_wire");
   refused(with("droppers: {positions: [2.0, 18.0], axial_stiffness: 200000, linear_mass: 0.0}\n", ""), "stitch_wire");
   refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\n", "stagger");
-  refused(with("span_count: 2, ", "endless: true, "), "line.endless");
   refused("name: r\nline: {span_length: 10.0, span_count: 3}\n"
           "conductor_rail: {linear_mass: 7.27, bending_stiffness: 2.8e5, support_stiffness: 5e6}\n"
           "stitch_wire: {length: 8.0, tension: 3500, linear_mass: 0.31}\n",
@@ -324,4 +324,36 @@ TEST(StitchedCatenary, TheMemoryEstimateHoldsTheStitchWires) {
     for (const cs::Wire& w : m.wires) nodes += w.nodes();
     EXPECT_GE(cs::estimate_model_bytes(m.scene) / cs::kModelBytesPerNode, nodes) << "stitch wires of " << length << " m";
   }
+}
+
+// The endless block carries the stitch wires: at each move every stitch wire takes the state of
+// the one a span on. The same 20 spans of pass, from station 1650 m, on the endless stitched line
+// and on a finite 60-span one whose anchors the window never reaches, must agree at every step to
+// rounding, as the simple line's (test_endless_line: 1e-4 N); a stitch wire's state handed to the
+// wrong one, or lost, would change the force by newtons at the next support.
+TEST(StitchedCatenary, TheEndlessBlockMovesTheStitchWiresExactly) {
+  std::ifstream in(test_scenes::kReferenceStitched);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string count = "  span_count: 10";
+  ASSERT_NE(text.find(count), std::string::npos);
+  const std::vector<std::string> pass = {"train.start=1650", "train.end=2750", "numerics.preset=balanced",
+                                         "numerics.window=auto"};
+  std::vector<std::string> finite = pass;
+  finite.push_back("line.span_count=60");
+  cs::Simulation b(cs::load_scene_string(text, finite));
+  text.replace(text.find(count), count.size(), "  endless: true");
+  cs::Simulation a(cs::load_scene_string(text, pass));
+  ASSERT_TRUE(a.model().endless);
+  ASSERT_FALSE(a.model().sections[0].stitch_wires.empty());
+  double worst = 0.0, offset_seen = 0.0;
+  while (true) {
+    const cs::StepStatus sa = a.step(), sb = b.step();
+    ASSERT_EQ(sa, sb) << a.status_message() << " / " << b.status_message();
+    if (sa != cs::StepStatus::kOk) break;
+    worst = std::max(worst, std::fabs(cs::total_contact_force(a.model(), a.state(), 0) -
+                                      cs::total_contact_force(b.model(), b.state(), 0)));
+    offset_seen = a.state().line_offset;
+  }
+  EXPECT_GT(offset_seen - a.model().initial_line_offset, 15 * 55.0);  // the block was moved along
+  EXPECT_LT(worst, 1e-4);
 }

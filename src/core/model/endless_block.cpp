@@ -15,8 +15,13 @@ namespace {
 
 // Spans at each end of an endless line's block that the window never reaches: the anchors'
 // effect on the design statics (messenger heights, dropper lengths) falls by about a thousand
-// per span, so from the third span on the spans are identical to well under a micrometre.
-constexpr int kEndlessMargin = 3;
+// per span, so from the third span on the spans are identical to well under a micrometre. A
+// stitched line's falls more slowly (its stitch wires carry it across the supports: 1.04 um
+// between the third span's messenger and the fourth's, 1.2e-6 of a clamp's force between the
+// fourth and the fifth): two spans more.
+int endless_margin(const Scene& scene) {
+  return scene.sections.front().stitch_wire ? 5 : 3;
+}
 
 }  // namespace
 
@@ -40,7 +45,7 @@ void collector_extent(const Scene& scene, double* lead, double* rear) {
 double lay_endless_block(Scene& scene, Model& m) {
   double endless_front = 0.0;
   // A block of equal spans: `margin` spans at each end keep the anchors out of the window's
-  // reach (kEndlessMargin); the rearmost collector stays within [home, home + span) (step() moves the state back
+  // reach (endless_margin); the rearmost collector stays within [home, home + span) (step() moves the state back
   // a span when it leaves), so the block must hold the window behind it (B spans, one more for
   // snapping to supports), the train (S) and the window ahead (A) at any speed a command allows.
   const double span = scene.spans.front();
@@ -51,7 +56,7 @@ double lay_endless_block(Scene& scene, Model& m) {
   double lead = 0.0, rear = 0.0;
   collector_extent(scene, &lead, &rear);
   auto spans_for = [&](double length) { return static_cast<int>(std::ceil(length / span - 1e-9)); };
-  const int margin = kEndlessMargin, behind = spans_for(std::max(behind_slow, behind_fast)) + 1;
+  const int margin = endless_margin(scene), behind = spans_for(std::max(behind_slow, behind_fast)) + 1;
   // In a turbulent wind the lateral plane's window reaches a gust lead further (lateral.hpp),
   // snapped outward to a support once more.
   const double gusts = gust_lead_time(scene) * std::max(scene.train_speed, kMaxTrainSpeed);
@@ -103,9 +108,26 @@ void check_endless_block(Model& m) {
     throw SceneError("line.endless: the model's spans are not identical (" + what +
                      "); the state cannot be moved back a span. Report this with the scene");
   };
+  const int margin = endless_margin(m.scene);
+  const Wire* last_stitch = nullptr;
   for (const Wire& w : m.wires) {
+    if (w.is_stitch_wire) {
+      // One at every intermediate support of the block: the move hands each one's state to the
+      // one a span behind (shift_endless_block), so each must be the one before it a span on.
+      const Wire* prev = last_stitch;
+      last_stitch = &w;
+      m.span_nodes.push_back(0);
+      const int k = static_cast<int>(std::lround(0.5 * (w.x.front() + w.x.back()) / span));  // its support
+      if (!prev || k <= margin - 1 || k > count - margin) continue;
+      if (prev->nodes() != w.nodes()) fail(w.name + ": nodes");
+      for (int i = 0; i < w.nodes(); ++i)
+        if (std::fabs(w.x[i] - prev->x[i] - span) > 1e-9 * span || std::fabs(w.height[i] - prev->height[i]) > 1e-6 ||
+            std::fabs(m.mass[w.w_dof + i] - m.mass[prev->w_dof + i]) > 1e-6 * m.mass[prev->w_dof + i])
+          fail(w.name + " at x = " + fmt(w.x[i]) + " m");
+      continue;
+    }
     if (static_cast<int>(w.support_nodes.size()) != count + 1) fail(w.name + ": supports");
-    const int first = kEndlessMargin - 1, last = count - kEndlessMargin;  // spans compared with the next
+    const int first = margin - 1, last = count - margin;  // spans compared with the next
     const int ns = w.support_nodes[first + 1] - w.support_nodes[first];
     for (int k = first; k < last; ++k) {
       if (w.support_nodes[k + 1] - w.support_nodes[k] != ns || w.support_nodes[k + 2] - w.support_nodes[k + 1] != ns)
@@ -124,11 +146,20 @@ void check_endless_block(Model& m) {
     for (std::size_t j = k + 1; j < m.droppers.size(); ++j) {
       const Dropper& a = m.droppers[k];
       const Dropper& b = m.droppers[j];
-      if (a.span < kEndlessMargin - 1 || a.span >= count - kEndlessMargin || b.span != a.span + 1 || std::fabs(b.x - a.x - span) > 1e-9 * span) continue;
+      if (a.span < margin - 1 || a.span >= count - margin || b.span != a.span + 1 || std::fabs(b.x - a.x - span) > 1e-9 * span) continue;
       if (std::fabs(b.static_tension - a.static_tension) > tol * std::fabs(a.static_tension) + 1e-9 ||
           std::fabs(b.stiffness - a.stiffness) > tol * a.stiffness)
         fail("dropper at x = " + fmt(a.x) + " m");
     }
+  // A stitched line's clamps, span by span (in line order each one's twin a span on is two clamps on).
+  for (std::size_t q = 0; q + 2 < m.clamp_order.size(); ++q) {
+    const WireClamp& a = m.clamps[m.clamp_order[q]];
+    const WireClamp& b = m.clamps[m.clamp_order[q + 2]];
+    const int k = static_cast<int>(std::floor(a.x / span));
+    if (k < margin - 1 || k >= count - margin || std::fabs(b.x - a.x - span) > 1e-9 * span) continue;
+    if (std::fabs(b.static_force - a.static_force) > tol * std::fabs(a.static_force) + 1e-9)
+      fail("stitch wire's clamp at x = " + fmt(a.x) + " m");
+  }
 }
 
 }  // namespace catenary_sim

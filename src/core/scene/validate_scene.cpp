@@ -282,18 +282,17 @@ void validate_rigid(const Scene& s) {
 }
 
 // Stitch wires: hung from a messenger around intermediate supports, each within its spans, on a
-// finite 2-D line (the endless block and the lateral plane do not carry them).
+// 2-D line (the lateral plane does not carry them).
 void validate_stitched(const Scene& s) {
   const bool any = std::any_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.stitch_wire.has_value(); });
   if (!any) return;
-  if (s.endless) fail("line.endless", "true (with stitch_wire)", "false: the endless block does not carry stitch wires");
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     if (!sec.stitch_wire) continue;
     const std::string f = (s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "") + "stitch_wire";
     if (!sec.messenger || !sec.droppers)
       fail(f, "(given)", "a stitch wire hangs from a messenger and carries droppers: add messenger and droppers or remove it");
-    if (sec.spans.size() < 2)
+    if (sec.spans.size() < 2 && !s.endless)  // (an endless line's one span repeats: supports on both sides)
       fail(f, "(given on a section of 1 span)", "a section with intermediate supports (2 spans or more): a stitch wire hangs around one");
     const double shortest = *std::min_element(sec.spans.begin(), sec.spans.end());
     if (!(sec.stitch_wire->length < shortest))
