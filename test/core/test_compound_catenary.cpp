@@ -23,6 +23,7 @@
 #include "catenary_sim/core/output/statistics.hpp"
 #include "catenary_sim/core/output/zero_phase_filter.hpp"
 #include "catenary_sim/core/simulation.hpp"
+#include "../support/design_equilibrium.hpp"
 #include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
 
@@ -217,29 +218,12 @@ TEST(CompoundCatenary, ForceVariesAtTheHangersMoreThanAtTheSpans) {
   EXPECT_LT(compound.span, simple.span);
 }
 
-// (e) The design state is an equilibrium: on every free wire node the constant load (weights,
-// support preloads, -K y_design) is balanced by the droppers' and hangers' design forces alone,
-// so the line hangs still until a pantograph comes. Round-off only: 1e-9 of the node's weight.
+// (e) The design state is an equilibrium: on every free wire node, the auxiliary's included, the
+// constant load is balanced by the droppers' and hangers' design forces alone (round-off only).
 TEST(CompoundCatenary, TheDesignStateIsAnEquilibrium) {
   const cs::Model m = cs::build_model(cs::load_scene_file(test_scenes::kCompound));
-  Eigen::VectorXd f = m.load;
-  for (const cs::Dropper& d : m.droppers) {
-    f[d.contact_dof] += d.static_tension;
-    f[d.messenger_dof] -= d.static_tension;
-  }
-  int aux_nodes = 0;
-  for (const cs::Wire& w : m.wires) {
-    aux_nodes += w.is_auxiliary_messenger ? w.nodes() : 0;
-    for (int i = 0; i < w.nodes(); ++i) {
-      const int dof = w.w_dof + i;
-      if (m.inv_mass[dof] == 0.0) continue;  // held
-      bool spring = false;
-      for (const cs::SupportSpring& sp : m.springs) spring |= sp.dof == dof;
-      if (spring) continue;  // the support spring's preload is its static reaction, in the load
-      EXPECT_NEAR(f[dof], 0.0, 1e-9 * m.mass[dof] * 9.81) << w.name << " node " << i;
-    }
-  }
-  EXPECT_GT(aux_nodes, 0);
+  ASSERT_GE(m.sections[0].auxiliary, 0);
+  test_scenes::expect_design_equilibrium(m);
 }
 
 TEST(CompoundCatenary, BadInputIsRefusedByName) {

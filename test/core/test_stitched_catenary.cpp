@@ -23,6 +23,7 @@
 #include "catenary_sim/core/output/zero_phase_filter.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
+#include "../support/design_equilibrium.hpp"
 #include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
 
@@ -187,34 +188,12 @@ TEST(StitchedCatenary, ElasticityIsMoreUniformOverTheSpan) {
   EXPECT_LT(uniformity(stitched), uniformity(simple));
 }
 
-// (d) The design state is an equilibrium: on every free wire node the constant load (weights,
-// support preloads, -K y_design) is balanced by the droppers' and clamps' design forces alone,
-// so the line hangs still until a pantograph comes. Round-off only: 1e-9 of the node's weight.
+// (d) The design state is an equilibrium: on every free wire node, the stitch wires' included, the
+// constant load is balanced by the droppers' and clamps' design forces alone (round-off only).
 TEST(StitchedCatenary, TheDesignStateIsAnEquilibrium) {
   const cs::Model m = cs::build_model(cs::load_scene_file(test_scenes::kReferenceStitched));
   ASSERT_FALSE(m.clamps.empty());
-  Eigen::VectorXd f = m.load;
-  for (const cs::Dropper& d : m.droppers) {
-    f[d.contact_dof] += d.static_tension;
-    f[d.messenger_dof] -= d.static_tension;
-  }
-  for (const cs::WireClamp& c : m.clamps) {
-    f[c.stitch_dof] += c.static_force;
-    f[c.messenger_dof] -= c.static_force;
-  }
-  int stitch_nodes = 0;
-  for (const cs::Wire& w : m.wires) {
-    stitch_nodes += w.is_stitch_wire ? w.nodes() : 0;
-    for (int i = 0; i < w.nodes(); ++i) {
-      const int dof = w.w_dof + i;
-      if (m.inv_mass[dof] == 0.0) continue;  // held
-      bool spring = false;
-      for (const cs::SupportSpring& sp : m.springs) spring |= sp.dof == dof;
-      if (spring) continue;  // the support spring's preload is its static reaction, in the load
-      EXPECT_NEAR(f[dof], 0.0, 1e-9 * m.mass[dof] * 9.81) << w.name << " node " << i;
-    }
-  }
-  EXPECT_GT(stitch_nodes, 0);
+  test_scenes::expect_design_equilibrium(m);
   // Each stitch wire hangs by its clamps: their forces carry its weight and its droppers'.
   for (const cs::Section& sec : m.sections)
     for (int wi : sec.stitch_wires) {
