@@ -36,17 +36,14 @@ std::vector<double> mesh_section(const SectionSpec& sec, double element_length, 
     breaks.push_back(x0);
     if (sec.droppers)
       for (double p : sec.droppers->positions[i]) breaks.push_back(x0 + p);
-    if (sec.hangers) {
+    if (sec.hangers)  // a compound line's
       for (double p : sec.hangers->positions[i]) breaks.push_back(x0 + p);
-      std::sort(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end());
-      breaks.erase(std::unique(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end(),
-                               [](double a, double b) { return b - a < 1e-9; }),
-                   breaks.end());
-    }
     if (sec.stitch_wire) {  // the clamps of the stitch wires at the span's intermediate supports
       const double half = 0.5 * sec.stitch_wire->length;
       if (i > 0) breaks.push_back(x0 + half);
       if (i + 1 < nspan) breaks.push_back(x0 + sec.spans[i] - half);
+    }
+    if (sec.hangers || sec.stitch_wire) {  // (droppers alone are in order: validate_sections)
       std::sort(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end());
       breaks.erase(std::unique(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end(),
                                [](double a, double b) { return b - a < 1e-9; }),

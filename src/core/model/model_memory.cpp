@@ -24,9 +24,9 @@ double estimate_model_bytes(const Scene& scene) {
   const double h = scene.numerics.element_length;
   for (const SectionSpec& sec : scene.sections) {
     double droppers = 0.0;
-    for (const auto& part : {sec.droppers, sec.hangers})  // (a compound line's hangers are nodes too)
-      if (part)
-        for (const auto& span : part->positions) droppers += static_cast<double>(span.size());
+    for (const std::optional<DropperSpec>* part : {&sec.droppers, &sec.hangers})  // (a compound line's hangers are nodes too)
+      if (*part)
+        for (const auto& span : (*part)->positions) droppers += static_cast<double>(span.size());
     // A stitch wire's two clamps are nodes of every wire of its section; the stitch wires together
     // are shorter than the section, so they count as one more wire at most.
     const double clamps = sec.stitch_wire ? 2.0 * static_cast<double>(sec.spans.size()) : 0.0;
