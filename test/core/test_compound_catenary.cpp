@@ -9,8 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
-#include <fstream>
-#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -288,18 +286,13 @@ TEST(CompoundCatenary, TheMemoryEstimateHoldsTheAuxiliary) {
 // and std within 1 % (as a window's statistics against the whole line's); a slip of the
 // auxiliary or a hanger at the block's 21 moves would put a force step into each.
 TEST(CompoundCatenary, TheEndlessBlockCarriesTheAuxiliary) {
-  std::ifstream in(test_scenes::kCompound);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string count = "  span_count: 10";
-  ASSERT_NE(text.find(count), std::string::npos);
   const std::vector<std::string> pass = {"train.start=1500", "train.end=2500", "numerics.preset=balanced",
                                          "numerics.window=auto"};
   std::vector<std::string> finite = pass, nudged = pass;
   finite.push_back("line.span_count=60");
   nudged.insert(nudged.end(), {"line.span_count=60", "pantographs.0.static_uplift=100.0000001"});
-  cs::Simulation b(cs::load_scene_string(text, finite)), c(cs::load_scene_string(text, nudged));
-  text.replace(text.find(count), count.size(), "  endless: true");
-  cs::Simulation a(cs::load_scene_string(text, pass));
+  cs::Simulation a(test_scenes::endless_scene(test_scenes::kCompound, pass));
+  cs::Simulation b(cs::load_scene_file(test_scenes::kCompound, finite)), c(cs::load_scene_file(test_scenes::kCompound, nudged));
   ASSERT_TRUE(a.model().endless);
   ASSERT_GE(a.model().sections[0].auxiliary, 0);
   std::vector<double> fa, fb, fc;

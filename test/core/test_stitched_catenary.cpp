@@ -311,17 +311,12 @@ TEST(StitchedCatenary, TheMemoryEstimateHoldsTheStitchWires) {
 // rounding, as the simple line's (test_endless_line: 1e-4 N); a stitch wire's state handed to the
 // wrong one, or lost, would change the force by newtons at the next support.
 TEST(StitchedCatenary, TheEndlessBlockMovesTheStitchWiresExactly) {
-  std::ifstream in(test_scenes::kReferenceStitched);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string count = "  span_count: 10";
-  ASSERT_NE(text.find(count), std::string::npos);
   const std::vector<std::string> pass = {"train.start=1650", "train.end=2750", "numerics.preset=balanced",
                                          "numerics.window=auto"};
   std::vector<std::string> finite = pass;
   finite.push_back("line.span_count=60");
-  cs::Simulation b(cs::load_scene_string(text, finite));
-  text.replace(text.find(count), count.size(), "  endless: true");
-  cs::Simulation a(cs::load_scene_string(text, pass));
+  cs::Simulation a(test_scenes::endless_scene(test_scenes::kReferenceStitched, pass));
+  cs::Simulation b(cs::load_scene_file(test_scenes::kReferenceStitched, finite));
   ASSERT_TRUE(a.model().endless);
   ASSERT_FALSE(a.model().sections[0].stitch_wires.empty());
   double worst = 0.0, offset_seen = 0.0;

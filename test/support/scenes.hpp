@@ -40,6 +40,17 @@ inline const std::string kReferenceTwoPantographs =
 inline const std::string kReferenceStitched = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_stitched.yaml";
 inline const std::string kCompound = CATENARY_SIM_SOURCE_DIR "/config/compound_catenary.yaml";
 inline const std::string kReferenceHingedArms = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_hinged_arms.yaml";
+
+// A shipped scene of one section of equal spans as an endless line: its `line.span_count` left
+// out, `line.endless: true` (give numerics.window among the overrides).
+inline catenary_sim::Scene endless_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  YAML::Node root = YAML::LoadFile(path);
+  root["line"].remove("span_count");
+  root["line"]["endless"] = true;
+  std::ostringstream yaml;
+  yaml << root;
+  return catenary_sim::load_scene_string(yaml.str(), overrides);
+}
 inline const std::string kCalpeExample = CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml";
 
 // A shipped scene by its file name (config/<file>).
