@@ -2,7 +2,12 @@
 // the explicit scheme at h = 0.03125 m (automatic dt: the stability limit falls with h, so dt is
 // refined with it); every candidate's 0-20 Hz statistics (mean, std, max, min) and 0-200 Hz max are
 // compared with it, with its wall time, on the reference scene at 250 and 300 km/h.
-//   bench_reference_rung [scene=config/reference_55m.yaml] [csv=reference_rung.csv] [finest_h=0.03125] [all|centred|richardson]
+//   bench_reference_rung [scene=config/reference_55m.yaml] [csv=reference_rung.csv] [finest_h=0.03125]
+//                        [all|centred|window|richardson] [field=value ...]
+// `window`: the rung with a moving window (numerics.window auto, also the endless line's), against
+// the finest solution in the same window, beside the half-step h = 0.1 m rung it replaces there.
+// Further field=value overrides apply to every pass, the finest included (e.g. train.end=1100 on
+// the endless line).
 // Errors as in bench_speed_accuracy: relative to the finest value (the min relative to the mean).
 // The finest runs take about 10 minutes each: their statistics are kept in <csv>.finest and reused
 // when that file exists (delete it after changing the scene or the model).
@@ -47,6 +52,11 @@ int main(int argc, char** argv) {
          {"implicit h=0.125 dt=0.5ms", {"numerics.integrator=implicit", "numerics.element_length=0.125", "numerics.dt=0.0005"}},
          {"implicit h=0.0625 dt=0.5ms",
           {"numerics.integrator=implicit", "numerics.element_length=0.0625", "numerics.dt=0.0005"}}});
+  if (mode == "window")
+    candidates = {
+        {"half-step h=0.1 (the window's rung before)", {"numerics.element_length=0.1", "numerics.damping=half_step"}},
+        {"centred h=0.0625 (the rung)", {"numerics.element_length=0.0625", "numerics.damping=centred"}},
+    };
   if (mode == "centred")
     candidates = {
         {"half-step h=0.0625 (the rung of 25f35a6)", {"numerics.element_length=0.0625", "numerics.damping=half_step"}},
@@ -57,6 +67,11 @@ int main(int argc, char** argv) {
         {"centred h=0.0625 (the new rung)", {"numerics.element_length=0.0625", "numerics.damping=centred"}},
         {"centred h=0.0625 dt=auto/2", {"numerics.element_length=0.0625", "numerics.damping=centred", "numerics.safety_factor=0.45"}},
     };
+  // Overrides of every pass: the window's, then the command line's.
+  std::vector<std::string> every;
+  if (mode == "window") every.push_back("numerics.window=auto");
+  for (int i = 5; i < argc; ++i) every.push_back(argv[i]);
+  for (auto& [label, ov] : candidates) ov.insert(ov.end(), every.begin(), every.end());
   // Finest statistics kept from an earlier run: kmh -> mean, std, max, min, max200, dofs, dt, wall.
   std::map<double, std::vector<double>> kept;
   {
@@ -89,7 +104,9 @@ int main(int argc, char** argv) {
       fine.dt = k[6];
       fine.wall = k[7];
     } else {
-      fine = run_pass(path, {"numerics.element_length=" + finest_h, "numerics.damping=half_step"}, kmh);
+      std::vector<std::string> ov = {"numerics.element_length=" + finest_h, "numerics.damping=half_step"};
+      ov.insert(ov.end(), every.begin(), every.end());
+      fine = run_pass(path, ov, kmh);
       std::ofstream out(csv_path + ".finest", std::ios::app);
       out.precision(17);
       out << kmh << "," << fine.s20.filtered.mean << "," << fine.s20.filtered.std_dev << "," << fine.s20.filtered.max << ","
@@ -112,8 +129,12 @@ int main(int argc, char** argv) {
     for (const auto& [ha, hb] : richardson ? pairs : std::vector<std::pair<double, double>>{}) {
       std::ostringstream label;
       label << "richardson h=" << ha << "+" << hb;
-      const PassResult a = run_pass(path, {"numerics.element_length=" + std::to_string(ha)}, kmh);
-      const PassResult b = run_pass(path, {"numerics.element_length=" + std::to_string(hb)}, kmh);
+      auto with_h = [&](double h) {
+        std::vector<std::string> ov = {"numerics.element_length=" + std::to_string(h)};
+        ov.insert(ov.end(), every.begin(), every.end());
+        return ov;
+      };
+      const PassResult a = run_pass(path, with_h(ha), kmh), b = run_pass(path, with_h(hb), kmh);
       const double q = 1.0 / ((hb / ha) * (hb / ha) - 1.0);
       auto ex = [&](double sa, double sb) { return sa + (sa - sb) * q; };
       PassResult x;  // the extrapolated statistics

@@ -697,7 +697,7 @@ TEST(Lateral, InATurbulentWindTheWindowKeepsTheWholeLinesLateralPlane) {
 }
 
 TEST(Lateral, EndlessLineGivesTheFiniteLinesContactPoint) {
-  // As EndlessLine.MovingTheBlockBackIsExact, now staggered and swaying (EndlessAndFinite) in a
+  // As EndlessLineDamping.MovingTheBlockBackIsExact, now staggered and swaying (EndlessAndFinite) in a
   // steady 20 m/s cross wind.
   EndlessAndFinite lines({"wind.speed=20"});
   Simulation &a = lines.endless, &b = lines.finite;

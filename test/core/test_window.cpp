@@ -66,6 +66,49 @@ TEST(Window, StitchedLineStatisticsMatchTheFullLine) {
   EXPECT_NEAR(win.filtered.min, full.filtered.min, 0.01 * full.filtered.mean);
 }
 
+// The same with the centred damping step (numerics.damping centred), which solves the band of
+// each wire's part in the window with the cut ends left free, as the window's band force does.
+// Same budget and reasons as above.
+TEST(Window, CentredDampingStatisticsMatchTheFullLine) {
+  const std::vector<std::string> base{"line.span_count=20", "numerics.preset=balanced", "numerics.damping=centred",
+                                      "output.analysis_spans=[4,16]"};
+  std::vector<std::string> windowed = base;
+  windowed.push_back("numerics.window=auto");
+  const PantographStatistics full = pass(base), win = pass(windowed);
+  EXPECT_NEAR(win.filtered.mean, full.filtered.mean, 0.01 * full.filtered.mean);
+  EXPECT_NEAR(win.filtered.std_dev, full.filtered.std_dev, 0.01 * full.filtered.std_dev);
+  EXPECT_NEAR(win.filtered.max, full.filtered.max, 0.01 * full.filtered.max);
+  EXPECT_NEAR(win.filtered.min, full.filtered.min, 0.01 * full.filtered.mean);
+}
+
+// A window that holds the whole line from the start (its ends on the anchors, nothing cut) is the
+// whole line: with the centred step its solve, point forces and update must then give the whole
+// line's contact force at every step. The two differ only in the order the point forces are
+// summed (the window's lists against the model's), a rounding of about 1e-16 of a force that the
+// pass carries and hardly grows; 1e-9 N (1e-11 of the force) is far inside what a wrong factor,
+// a node off by one or a missed point force would change (newtons).
+TEST(Window, CentredDampingOverTheWholeLineIsTheWholeLine) {
+  const std::vector<std::string> base{"numerics.preset=balanced", "numerics.damping=centred", "train.end=400"};
+  std::vector<std::string> windowed = base;
+  windowed.push_back("numerics.window={ahead: 2000, behind: 2000}");
+  Simulation a(load_scene_file(test_scenes::kReference, base)), b(load_scene_file(test_scenes::kReference, windowed));
+  ASSERT_TRUE(b.model().scene.numerics.windowed());
+  double worst = 0.0;
+  int steps = 0;
+  while (true) {
+    const StepStatus sa = a.step(), sb = b.step();
+    ASSERT_EQ(sa, sb) << a.status_message() << " / " << b.status_message();
+    if (sa != StepStatus::kOk) break;
+    ++steps;
+    worst = std::max(worst, std::fabs(total_contact_force(a.model(), a.state(), 0) - total_contact_force(b.model(), b.state(), 0)));
+  }
+  const WireWindow& ww = b.state().window[0];
+  EXPECT_EQ(ww.lo, 0);
+  EXPECT_EQ(ww.hi, b.model().wires[0].nodes() - 1);
+  EXPECT_GT(steps, 1000);
+  EXPECT_LT(worst, 1e-9);
+}
+
 TEST(Window, AutoLengthsFollowTheSpeed) {
   // At 350 km/h the waves' echoes from ahead return sooner (2 D / (c + V)), so the window must
   // reach further ahead than at 300 km/h; a window sized by spans alone (it had 1.5 spans ahead)

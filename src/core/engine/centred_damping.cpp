@@ -180,14 +180,13 @@ __attribute__((always_inline)) inline T half(T2 x, int h) {
 // The pack's twisted block elimination: from both ends toward node k at once (pairs of nodes in
 // 2L lanes), the meeting node k, then outward from k in pairs.
 template <int L>
-__attribute__((always_inline)) inline bool sweep(const WireLanes& p, const CentredArgs& args, double* rec) {
+__attribute__((always_inline)) inline bool sweep(int n, const double* twin, const double* single, const CentredArgs& args,
+                                                 double* rec) {
   typedef typename Lanes<L>::T T;
   typedef typename Lanes<2 * L>::T T2;
   Steps<L, false> one(args);
   Steps<2 * L, true> two(args);
-  const int n = p.nodes, k = centred_meeting_node(n), top = k, extra = (n - 1 - k) - top;
-  const double* twin = p.centred_twin.data();
-  const double* single = p.centred_single.data();
+  const int k = centred_meeting_node(n), top = k, extra = (n - 1 - k) - top;
   double* rec_extra = rec + 8 * L * static_cast<std::size_t>(top);  // the extra bottom node's
   auto pair_coef = [&](int j) { return twin + static_cast<std::size_t>(j) * kCdValues * 2 * L; };
   auto pair_rec = [&](int j) { return rec + 8 * L * static_cast<std::size_t>(j); };
@@ -227,11 +226,12 @@ __attribute__((always_inline)) inline bool sweep(const WireLanes& p, const Centr
 #define CATENARY_SIM_CLONES
 #endif
 
-CATENARY_SIM_CLONES bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s) {
+CATENARY_SIM_CLONES bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s, int lo, int hi,
+                                            const double* twin, const double* single) {
   const double *u[2], *v[2];
   double *f[2], *un[2], *vn[2], *acc[2];
   for (int k = 0; k < pack.lanes; ++k) {
-    const int d = m.wires[pack.wire[k]].w_dof;
+    const int d = m.wires[pack.wire[k]].w_dof + lo;  // the range's node 0
     u[k] = s.u.data() + d;
     v[k] = s.v.data() + d;
     f[k] = s.work->force.data() + d;
@@ -241,7 +241,12 @@ CATENARY_SIM_CLONES bool centred_sweep_pack(const Model& m, const WireLanes& pac
   }
   const CentredArgs args{u, v, f, un, vn, acc, m.dt, m.wire_packs->centred_v_ratio, 2.0 / m.beta, m.scene.numerics.divergence_limit};
   double* rec = s.work->sweep.data() + kSweepRecord * pack.offset;
-  return pack.lanes == 2 ? sweep<2>(pack, args, rec) : sweep<1>(pack, args, rec);
+  const int n = hi - lo + 1;
+  return pack.lanes == 2 ? sweep<2>(n, twin, single, args, rec) : sweep<1>(n, twin, single, args, rec);
+}
+
+bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s) {
+  return centred_sweep_pack(m, pack, s, 0, pack.nodes - 1, pack.centred_twin.data(), pack.centred_single.data());
 }
 
 }  // namespace catenary_sim

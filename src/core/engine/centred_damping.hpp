@@ -21,6 +21,10 @@ namespace catenary_sim {
 // state.force (zeroing them there for the next step), writes u_next, v_next and accel. Returns
 // true if a new displacement is beyond the limit or not a number.
 bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s);
+// The same over the pack's nodes lo..hi (a moving window, both lanes the same range) with that
+// range's factors (factor_centred_range).
+bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s, int lo, int hi, const double* twin,
+                        const double* single);
 
 
 }  // namespace catenary_sim

@@ -8,6 +8,7 @@
 #include "engine/forces.hpp"
 #include "engine/step_workspace.hpp"
 #include "engine/train_motion.hpp"
+#include "engine/window.hpp"
 #include "engine/wire_lanes.hpp"
 
 namespace catenary_sim {
@@ -17,17 +18,9 @@ namespace {
 // Back to the load the wires' entries add_wire_point_forces and contact_forces wrote (the centred
 // step keeps the load in the wires' part of f between steps, its sweep reading load and point
 // forces together).
-void clear_point_forces(const Model& m, State& s, double* f) {
+void clear_point_forces(const Model& m, State& s, bool windowed, double* f) {
   const double* load = m.load.data();
-  for (const SupportSpring& sp : m.springs) f[sp.dof] = load[sp.dof];
-  for (const Dropper& d : m.droppers) {
-    f[d.contact_dof] = load[d.contact_dof];
-    f[d.messenger_dof] = load[d.messenger_dof];
-  }
-  for (const WireClamp& c : m.clamps) {
-    f[c.stitch_dof] = load[c.stitch_dof];
-    f[c.messenger_dof] = load[c.messenger_dof];
-  }
+  for_each_point(m, s, windowed, [f, load](int i) { f[i] = load[i]; });
   for (const Pantograph& p : m.pantographs)
     for (int ci : p.collectors) {
       const double xc = s.front - p.position + m.collectors[ci].offset;
@@ -39,9 +32,26 @@ void clear_point_forces(const Model& m, State& s, double* f) {
     }
 }
 
+// Each pack's solve over the window's node range (both lanes share it), with the window's factors.
+bool sweep_window(const Model& m, State& s) {
+  const StepWorkspace& w = *s.work;
+  const std::vector<WireLanes>& packs = packs_of(m);
+  bool out = false;
+  for (std::size_t pk = 0; pk < packs.size(); ++pk) {
+    const WireWindow& ww = s.window[packs[pk].wire[0]];
+    if (ww.hi < ww.lo) continue;
+    out |= centred_sweep_pack(m, packs[pk], s, ww.lo, ww.hi, w.centred_twin.data() + w.centred_twin_at[pk],
+                              w.centred_single.data() + w.centred_single_at[pk]);
+  }
+  return out;
+}
+
 }  // namespace
 
 StepStatus centred_damping_step(const Model& m, State& s) {
+  const bool windowed = m.scene.numerics.windowed();
+  if (m.endless) shift_endless_block(m, s);
+  if (windowed) update_window(m, s);
   const int n = m.n_dof, nc = m.n_catenary_dof;
   double* u = s.u.data();
   double* v = s.v.data();
@@ -59,8 +69,10 @@ StepStatus centred_damping_step(const Model& m, State& s) {
   double* un = s.work->u_next.data();
   double* vn = s.work->v_next.data();
   bool out = false;
-  for (const WireLanes& p : packs_of(m)) out |= centred_sweep_pack(m, p, s);
-  clear_point_forces(m, s, f);
+  if (windowed) out = sweep_window(m, s);
+  else
+    for (const WireLanes& p : packs_of(m)) out |= centred_sweep_pack(m, p, s);
+  clear_point_forces(m, s, windowed, f);
   const double* im = m.inv_mass.data();
   for (int i = nc; i < n; ++i) {
     acc[i] = im[i] * f[i];
@@ -69,16 +81,24 @@ StepStatus centred_damping_step(const Model& m, State& s) {
     out |= !(std::fabs(un[i]) <= limit);
   }
   if (out) {
+    s.status = StepStatus::kDiverged;
+    if (windowed) {
+      s.diverged_dof = last_beyond(m, s, true);
+      return s.status;
+    }
     for (int i = 0; i < n; ++i)
       if (!(std::fabs(un[i]) <= limit)) {
-        s.status = StepStatus::kDiverged;
         s.diverged_dof = i;
         break;
       }
     return s.status;
   }
-  s.u.swap(s.work->u_next);
-  s.v.swap(s.work->v_next);
+  if (windowed) {
+    commit_window(m, s, un, vn);  // (outside the window the new buffers hold nothing current)
+  } else {
+    s.u.swap(s.work->u_next);
+    s.v.swap(s.work->v_next);
+  }
   advance_train(m, s, dt);
   return s.status;
 }

@@ -100,61 +100,6 @@ int list_contact_nodes(const Model& m, State& s, bool windowed) {
   return contacts;
 }
 
-// Calls fn(dof) on the window's cut ends, supports and droppers (each DOF in the window by
-// construction of its lists), or on every support and dropper of the line.
-template <class Fn>
-void for_each_point(const Model& m, const State& s, bool windowed, Fn&& fn) {
-  if (windowed) {
-    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
-      const WireWindow& ww = s.window[wi];
-      if (ww.hi < ww.lo) continue;
-      if (ww.cut_lo) fn(m.wires[wi].w_dof + ww.lo);
-      if (ww.cut_hi) fn(m.wires[wi].w_dof + ww.hi);
-    }
-    for (int j = 0; j < s.window_spring_count; ++j) fn(m.springs[s.window_springs[j]].dof);
-    for (int j = 0; j < s.window_dropper_count; ++j) {
-      const Dropper& d = m.droppers[s.window_droppers[j]];
-      fn(d.contact_dof);
-      fn(d.messenger_dof);
-    }
-    for (int j = 0; j < s.window_clamp_count; ++j) {
-      const WireClamp& c = m.clamps[s.window_clamps[j]];
-      fn(c.stitch_dof);
-      fn(c.messenger_dof);
-    }
-  } else {
-    for (const SupportSpring& sp : m.springs) fn(sp.dof);
-    for (const Dropper& d : m.droppers) {
-      fn(d.contact_dof);
-      fn(d.messenger_dof);
-    }
-    for (const WireClamp& c : m.clamps) {
-      fn(c.stitch_dof);
-      fn(c.messenger_dof);
-    }
-  }
-}
-
-// The index of the last new displacement beyond the divergence limit (or not a number), scanned
-// in the generic step's order; -1 if none.
-int last_beyond(const Model& m, const State& s, bool windowed) {
-  const double* un = s.work->u_next.data();
-  const double limit = m.scene.numerics.divergence_limit;
-  auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
-  int bad = -1;
-  if (windowed) {
-    for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
-      for (int i = s.window[wi].lo; i <= s.window[wi].hi; ++i)
-        if (beyond(m.wires[wi].w_dof + i)) bad = m.wires[wi].w_dof + i;
-    for (int i = m.n_catenary_dof; i < m.n_dof; ++i)
-      if (beyond(i)) bad = i;
-  } else {
-    for (int i = 0; i < m.n_dof; ++i)
-      if (beyond(i)) bad = i;
-  }
-  return bad;
-}
-
 // The explicit step with the wires packed (Model::wire_packs): one fused sweep pair per pack
 // (sweep_pack) computes every wire node's force from the band, load and damping and updates it;
 // the few nodes that also carry a point force (supports, droppers, the window's dashpots, the
@@ -202,21 +147,6 @@ int explicit_fused_update(const Model& m, State& s, bool windowed) {
   // forces), so on a flag, or a pantograph or point beyond the limit, every new value is scanned
   // in the generic step's order.
   return outside ? last_beyond(m, s, windowed) : -1;
-}
-
-// Copies the window's new values back (outside the window the new buffers hold nothing current).
-void commit_window(const Model& m, State& s, const double* u_new, const double* v_new) {
-  double* u = s.u.data();
-  double* v = s.v.data();
-  auto commit = [&](int i0, int i1) {
-    for (int i = i0; i < i1; ++i) {
-      v[i] = v_new[i];
-      u[i] = u_new[i];
-    }
-  };
-  for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
-    commit(m.wires[wi].w_dof + s.window[wi].lo, m.wires[wi].w_dof + s.window[wi].hi + 1);
-  commit(m.n_catenary_dof, m.n_dof);
 }
 
 StepStatus diverged(State& s, int dof) {

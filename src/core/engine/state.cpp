@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "engine/forces.hpp"
+#include "model/centred_factors.hpp"
 #include "engine/step_workspace.hpp"
 #include "engine/wire_lanes.hpp"
 #include "util/deep_copied_impl.hpp"
@@ -52,6 +53,19 @@ State make_state(const Model& m) {
   }
   int max_nodes = 1;
   for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
+  if (m.scene.numerics.windowed() && m.scene.numerics.damping == DampingStep::kCentred) {
+    // A window's range has at most its wires' nodes: the whole wires' layout sizes it.
+    std::size_t twin = 0, single = 0;
+    for (const WireLanes& p : packs_of(m)) {
+      s.work->centred_twin_at.push_back(twin);
+      s.work->centred_single_at.push_back(single);
+      twin += p.centred_twin.size();
+      single += p.centred_single.size();
+    }
+    s.work->centred_twin.assign(twin, 0.0);
+    s.work->centred_single.assign(single, 0.0);
+    s.work->centred_scratch.assign(static_cast<std::size_t>(max_nodes) * kCdValues, 0.0);
+  }
   s.work->theta.assign(max_nodes, 0.0);
   s.work->weight_node.assign(m.max_contact_nodes, 0);
   s.work->weight.assign(m.max_contact_nodes, 0.0);

@@ -20,6 +20,11 @@ struct StepWorkspace {
   Eigen::VectorXd u_next, v_next;
   std::vector<double> sweep, sweep_factors;
   std::vector<int> point_node;
+  // Centred damping in a moving window: per pack the factors of the window's node range, laid
+  // out as WireLanes::centred_twin and centred_single (at centred_twin_at[pack] and
+  // centred_single_at[pack]), rebuilt when the window moves; scratch for one wire's range.
+  std::vector<double> centred_twin, centred_single, centred_scratch;
+  std::vector<std::size_t> centred_twin_at, centred_single_at;
   // Implicit integrator only: the prediction, and the rank-1 corrections of the factorised
   // matrix A (contacts in touch add k0 g g^T, slack droppers take their stiffness out again),
   // each with its sparse g, its stiffness factor and its column A^-1 g.

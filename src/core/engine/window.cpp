@@ -11,6 +11,7 @@
 #include "catenary_sim/core/model/beam.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "engine/step_workspace.hpp"
+#include "model/centred_factors.hpp"
 
 namespace catenary_sim {
 
@@ -117,6 +118,27 @@ void interleave_window_factors(const std::vector<WireLanes>& packs, const std::v
     }
 }
 
+namespace {
+
+// The centred damping step's factors of each pack's window range (both lanes share it: a pack's
+// wires are on the same node stations).
+void factor_centred_window(const Model& m, State& s) {
+  StepWorkspace& w = *s.work;
+  const std::vector<WireLanes>& packs = packs_of(m);
+  for (std::size_t pk = 0; pk < packs.size(); ++pk) {
+    const WireLanes& p = packs[pk];
+    for (int lane = 0; lane < p.lanes; ++lane) {
+      const WireWindow& ww = s.window[p.wire[lane]];
+      if (ww.hi < ww.lo) continue;
+      const double share[6] = {ww.lo_ww, ww.lo_wt, ww.lo_tt, ww.hi_ww, ww.hi_wt, ww.hi_tt};  // 0 where not cut
+      factor_centred_range(m, p, lane, ww.lo, ww.hi, share, w.centred_scratch.data(), w.centred_twin.data() + w.centred_twin_at[pk],
+                           w.centred_single.data() + w.centred_single_at[pk]);
+    }
+  }
+}
+
+}  // namespace
+
 void update_window(const Model& m, State& s) {
   double x_min = 1e300, x_max = -1e300;
   for (const Pantograph& p : m.pantographs) {
@@ -152,6 +174,7 @@ void update_window(const Model& m, State& s) {
       }
   }
   interleave_window_factors(packs_of(m), s.window, s.work->sweep_factors.data());
+  if (m.scene.numerics.damping == DampingStep::kCentred) factor_centred_window(m, s);
   // Index lists sized once in make_state (a copied State keeps their size): no allocation. Only
   // the droppers and supports between the window's ends are looked at, so moving the window costs
   // what the window holds, not the line.
@@ -173,6 +196,38 @@ bool in_windows(const std::vector<Wire>& wires, const std::vector<WireWindow>& w
     if (i >= 0 && i < wires[wi].nodes()) return i >= windows[wi].lo && i <= windows[wi].hi;
   }
   return false;
+}
+
+int last_beyond(const Model& m, const State& s, bool windowed) {
+  const double* un = s.work->u_next.data();
+  const double limit = m.scene.numerics.divergence_limit;
+  auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
+  int bad = -1;
+  if (windowed) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
+      for (int i = s.window[wi].lo; i <= s.window[wi].hi; ++i)
+        if (beyond(m.wires[wi].w_dof + i)) bad = m.wires[wi].w_dof + i;
+    for (int i = m.n_catenary_dof; i < m.n_dof; ++i)
+      if (beyond(i)) bad = i;
+  } else {
+    for (int i = 0; i < m.n_dof; ++i)
+      if (beyond(i)) bad = i;
+  }
+  return bad;
+}
+
+void commit_window(const Model& m, State& s, const double* u_new, const double* v_new) {
+  double* u = s.u.data();
+  double* v = s.v.data();
+  auto commit = [&](int i0, int i1) {
+    for (int i = i0; i < i1; ++i) {
+      v[i] = v_new[i];
+      u[i] = u_new[i];
+    }
+  };
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
+    commit(m.wires[wi].w_dof + s.window[wi].lo, m.wires[wi].w_dof + s.window[wi].hi + 1);
+  commit(m.n_catenary_dof, m.n_dof);
 }
 
 void wire_elastic_force_window(const Wire& wire, const WireWindow& ww, const double* z, double* f, double* theta) {

@@ -45,6 +45,49 @@ void update_window(const Model& model, State& state);
 // (shift_lateral_block), the train too, and adds the distance to State::line_offset. No allocation.
 void shift_endless_block(const Model& model, State& state);
 
+// Calls fn(dof) on the window's cut ends, supports and droppers (each DOF in the window by
+// construction of its lists), or on every support and dropper of the line.
+template <class Fn>
+void for_each_point(const Model& m, const State& s, bool windowed, Fn&& fn) {
+  if (windowed) {
+    for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
+      const WireWindow& ww = s.window[wi];
+      if (ww.hi < ww.lo) continue;
+      if (ww.cut_lo) fn(m.wires[wi].w_dof + ww.lo);
+      if (ww.cut_hi) fn(m.wires[wi].w_dof + ww.hi);
+    }
+    for (int j = 0; j < s.window_spring_count; ++j) fn(m.springs[s.window_springs[j]].dof);
+    for (int j = 0; j < s.window_dropper_count; ++j) {
+      const Dropper& d = m.droppers[s.window_droppers[j]];
+      fn(d.contact_dof);
+      fn(d.messenger_dof);
+    }
+    for (int j = 0; j < s.window_clamp_count; ++j) {
+      const WireClamp& c = m.clamps[s.window_clamps[j]];
+      fn(c.stitch_dof);
+      fn(c.messenger_dof);
+    }
+  } else {
+    for (const SupportSpring& sp : m.springs) fn(sp.dof);
+    for (const Dropper& d : m.droppers) {
+      fn(d.contact_dof);
+      fn(d.messenger_dof);
+    }
+    for (const WireClamp& c : m.clamps) {
+      fn(c.stitch_dof);
+      fn(c.messenger_dof);
+    }
+  }
+}
+
+// The index of the last new displacement (StepWorkspace::u_next) beyond the divergence limit (or
+// not a number), scanned in the generic step's order over the window's nodes or every DOF; -1 if
+// none.
+int last_beyond(const Model& model, const State& state, bool windowed);
+
+// Copies the window's new values back (outside the window the new buffers hold nothing current).
+void commit_window(const Model& model, State& state, const double* u_new, const double* v_new);
+
 // -K z over the window's nodes of one wire (condensed rotations, cut ends left free).
 void wire_elastic_force_window(const Wire& wire, const WireWindow& window, const double* z, double* f, double* theta);
 

@@ -483,11 +483,11 @@ void choose_time_step(const Scene& scene, Model& m) {
     throw SceneError("numerics.window: needs numerics.integrator explicit with rotary_inertia condensed (the window "
                      "integrates node ranges of the condensed band)");
   if (scene.numerics.damping == DampingStep::kCentred) {
-    // The centred step solves each whole wire's band with the rotations condensed, for u + beta v.
+    // The centred step solves each wire's band (or its window's part) with the rotations
+    // condensed, for u + beta v.
     std::string why;
     if (scene.numerics.integrator != Integrator::kExplicit) why = "numerics.integrator explicit";
     else if (scene.numerics.rotary_inertia != RotaryInertia::kCondensed) why = "numerics.rotary_inertia condensed";
-    else if (scene.numerics.windowed()) why = "no numerics.window (nor an endless line): it solves whole wires";
     else if (scene.lateral()) why = "a 2-D line (no stagger, curve or wind): the lateral plane steps with half_step";
     else if (!(m.beta > 0.0)) why = "damping.beta > 0 (it solves for u + beta v; with beta 0 half_step has the same limit)";
     if (!why.empty()) throw SceneError("numerics.damping = 'centred': needs " + why + "; allowed otherwise: half_step");

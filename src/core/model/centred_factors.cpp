@@ -36,12 +36,14 @@ int centred_meeting_node(int nodes) { return (nodes - 1) / 2; }
 
 namespace {
 
-// One wire's twisted factorisation of D + K, kCdValues per node in line order: the elimination
-// from node 0 down to the meeting node k, from node n - 1 up to it, then the meeting node.
+// One wire's twisted factorisation of D + K over its nodes lo..hi (the range's node i is the wire's
+// lo + i), kCdValues per node in line order: the elimination from node 0 down to the meeting node
+// k, from node n - 1 up to it, then the meeting node.
 class TwistedFactors {
  public:
-  TwistedFactors(const Model& m, const Wire& w, double shift) : m_(m), w_(w), shift_(shift) {
-    factors_.assign(static_cast<std::size_t>(w.nodes()) * kCdValues, 0.0);
+  TwistedFactors(const Model& m, const Wire& w, double shift, int lo, int hi, const double* end_share, double* factors)
+      : m_(m), w_(w), shift_(shift), lo_(lo), hi_(hi), share_(end_share), factors_(factors) {
+    std::fill(factors_, factors_ + static_cast<std::size_t>(hi - lo + 1) * kCdValues, 0.0);
   }
 
   void eliminate_from_first(int k) {
@@ -102,41 +104,55 @@ class TwistedFactors {
     c[kCdS + 1] = zi[2];
   }
 
-  // The coefficient of u + ratio v in r per node; the fixed vertical DOFs appended to `fixed_dofs`.
-  std::vector<double> finish(int n, std::vector<int>& fixed_dofs) {
+  // The coefficient of u + ratio v in r per node; the fixed vertical DOFs appended to `fixed_dofs`
+  // (when given).
+  void finish(int n, std::vector<int>* fixed_dofs) {
     for (int i = 0; i < n; ++i) {
       const bool fx = fixed(i);
-      if (fx) fixed_dofs.push_back(w_.w_dof + i);
-      at(i)[kCdU] = fx ? 1.0 : shift_ * m_.mass[w_.w_dof + i];
+      if (fx && fixed_dofs) fixed_dofs->push_back(dof(i));
+      at(i)[kCdU] = fx ? 1.0 : shift_ * m_.mass[dof(i)];
     }
-    return std::move(factors_);
   }
 
  private:
-  bool fixed(int i) const { return m_.inv_mass[w_.w_dof + i] == 0.0; }
-  double* at(int i) { return factors_.data() + static_cast<std::size_t>(i) * kCdValues; }
+  int node(int i) const { return lo_ + i; }
+  int dof(int i) const { return w_.w_dof + lo_ + i; }
+  bool fixed(int i) const { return m_.inv_mass[dof(i)] == 0.0; }
+  double* at(int i) { return factors_ + static_cast<std::size_t>(i) * kCdValues; }
+  // The diagonal block's band entry v (0: ww, 1: wt, 2: tt) at range node i, less the end shares.
+  double band(int i, const std::vector<double>& entry, int v) const {
+    double e = entry[node(i)];
+    if (share_) {
+      if (i == 0) e -= share_[v];
+      if (node(i) == hi_) e -= share_[3 + v];
+    }
+    return e;
+  }
   // Blocks of D + K: A_i on node i (a fixed node's vertical row the identity), U_i from node i to
   // i + 1 and L_i from node i + 1 to i (the vertical row of a fixed node zero in both).
   void diag(int i, double* a) const {
     const bool fx = fixed(i);
-    a[0] = fx ? 1.0 : shift_ * m_.mass[w_.w_dof + i] + w_.d_ww[i];
-    a[1] = fx ? 0.0 : w_.d_wt[i];
-    a[2] = w_.d_wt[i];
-    a[3] = w_.d_tt[i];
+    const double wt = band(i, w_.d_wt, 1);
+    a[0] = fx ? 1.0 : shift_ * m_.mass[dof(i)] + band(i, w_.d_ww, 0);
+    a[1] = fx ? 0.0 : wt;
+    a[2] = wt;
+    a[3] = band(i, w_.d_tt, 2);
   }
   void upper(int i, double* u) const {  // rows i, cols i + 1
     const bool fx = fixed(i);
-    u[0] = fx ? 0.0 : w_.e_ww[i];
-    u[1] = fx ? 0.0 : w_.e_wt[i];
-    u[2] = w_.e_tw[i];
-    u[3] = w_.e_tt[i];
+    const int g = node(i);
+    u[0] = fx ? 0.0 : w_.e_ww[g];
+    u[1] = fx ? 0.0 : w_.e_wt[g];
+    u[2] = w_.e_tw[g];
+    u[3] = w_.e_tt[g];
   }
   void lower(int i, double* l) const {  // rows i + 1, cols i
     const bool fx = fixed(i + 1);
-    l[0] = fx ? 0.0 : w_.e_ww[i];
-    l[1] = fx ? 0.0 : w_.e_tw[i];
-    l[2] = w_.e_wt[i];
-    l[3] = w_.e_tt[i];
+    const int g = node(i);
+    l[0] = fx ? 0.0 : w_.e_ww[g];
+    l[1] = fx ? 0.0 : w_.e_tw[g];
+    l[2] = w_.e_wt[g];
+    l[3] = w_.e_tt[g];
   }
   // One side's elimination toward k: pivot a_i = A_i - M_i B (M_i = C S_prev, the coupling C
   // into node i from its predecessor and B back), S_i = a_i^-1; in the node's places the
@@ -165,50 +181,69 @@ class TwistedFactors {
   const Model& m_;
   const Wire& w_;
   double shift_;
-  std::vector<double> factors_;
+  int lo_, hi_;
+  const double* share_;  // null: no end shares (a whole wire)
+  double* factors_;
   Mat2 a_{}, a_prev_{}, s_prev_{}, mm_{}, tmp_{}, cpl_{}, back_{};
   Mat2 top_a_{}, top_s_{};  // S~_{k-1} and S_{k-1}
 };
 
-// One wire's factors, kCdValues per node in line order (the packs take them in the twisted order);
-// its fixed vertical DOFs appended to `fixed_dofs`. D = shift M.
-std::vector<double> wire_factors(const Model& m, const Wire& w, double shift, std::vector<int>& fixed_dofs) {
-  const int n = w.nodes(), k = centred_meeting_node(n);
-  TwistedFactors f(m, w, shift);
+// The factors of nodes lo..hi into `factors` (kCdValues per node in line order; the packs take
+// them in the twisted order), less the end shares when given (factor_centred_range); its fixed
+// vertical DOFs appended to `fixed_dofs` when given. D = shift M.
+void range_factors(const Model& m, const Wire& w, double shift, int lo, int hi, const double* end_share,
+                   double* factors, std::vector<int>* fixed_dofs) {
+  const int n = hi - lo + 1, k = centred_meeting_node(n);
+  TwistedFactors f(m, w, shift, lo, hi, end_share, factors);
   f.eliminate_from_first(k);
   f.eliminate_from_last(n, k);
   f.meet(n, k);
-  return f.finish(n, fixed_dofs);
+  f.finish(n, fixed_dofs);
+}
+
+// A lane's factors (line order, n nodes) laid out in the twisted order of a pack of `lanes`
+// lanes: pair j (top node j, bottom node n - 1 - extra - j) in 2L lanes, the top's lanes first;
+// the meeting node and the extra bottom node (when n is even) alone, in L lanes.
+void lay_out_lane(const double* factors, int n, int lanes, int lane, double* twin, double* single) {
+  const int L = lanes, k = centred_meeting_node(n), top = k, extra = (n - 1 - k) - top;
+  auto value = [&](int i, int v) { return factors[static_cast<std::size_t>(i) * kCdValues + v]; };
+  for (int j = 0; j < top; ++j)
+    for (int v = 0; v < kCdValues; ++v) {
+      double* t = twin + (static_cast<std::size_t>(j) * kCdValues + v) * 2 * L;
+      t[lane] = value(j, v);
+      t[L + lane] = value(n - 1 - extra - j, v);
+    }
+  for (int v = 0; v < kCdValues; ++v) {
+    single[v * L + lane] = value(k, v);
+    single[(kCdValues + v) * L + lane] = extra ? value(n - 1, v) : 0.0;
+  }
 }
 
 }  // namespace
 
+double centred_shift(const Model& m) { return 2.0 / (m.beta * m.dt) + m.alpha / m.beta; }
+
 void factor_centred_damping(const Model& m, WirePacks& packs) {
-  const double shift = 2.0 / (m.beta * m.dt) + m.alpha / m.beta;
+  const double shift = centred_shift(m);
   packs.centred_fixed_dofs.clear();
   packs.centred_v_ratio = (2.0 / m.dt) / shift;
-  // The packs: pair j of the twisted order (top node j, bottom node n - 1 - (bottom - top) - j,
-  // both eliminated at step j and substituted at step top - 1 - j) in 2L lanes, the top's lanes
-  // first; the meeting node and the extra bottom node (when n is even) alone, in L lanes.
+  std::vector<double> factors;
   for (WireLanes& p : packs.packs) {
-    const int L = p.lanes, n = p.nodes, k = centred_meeting_node(n), top = k, extra = (n - 1 - k) - top;
+    const int L = p.lanes, n = p.nodes, top = centred_meeting_node(n);
     p.centred_twin.assign(static_cast<std::size_t>(top) * kCdValues * 2 * L, 0.0);
     p.centred_single.assign(2 * kCdValues * static_cast<std::size_t>(L), 0.0);
+    factors.assign(static_cast<std::size_t>(n) * kCdValues, 0.0);
     for (int lane = 0; lane < L; ++lane) {
-      const std::vector<double> factors = wire_factors(m, m.wires[p.wire[lane]], shift, packs.centred_fixed_dofs);
-      auto value = [&](int i, int v) { return factors[static_cast<std::size_t>(i) * kCdValues + v]; };
-      for (int j = 0; j < top; ++j)
-        for (int v = 0; v < kCdValues; ++v) {
-          double* t = p.centred_twin.data() + (static_cast<std::size_t>(j) * kCdValues + v) * 2 * L;
-          t[lane] = value(j, v);
-          t[L + lane] = value(n - 1 - extra - j, v);
-        }
-      for (int v = 0; v < kCdValues; ++v) {
-        p.centred_single[v * L + lane] = value(k, v);
-        p.centred_single[(kCdValues + v) * L + lane] = extra ? value(n - 1, v) : 0.0;
-      }
+      range_factors(m, m.wires[p.wire[lane]], shift, 0, n - 1, nullptr, factors.data(), &packs.centred_fixed_dofs);
+      lay_out_lane(factors.data(), n, L, lane, p.centred_twin.data(), p.centred_single.data());
     }
   }
+}
+
+void factor_centred_range(const Model& m, const WireLanes& pack, int lane, int lo, int hi, const double end_share[6],
+                          double* scratch, double* twin, double* single) {
+  range_factors(m, m.wires[pack.wire[lane]], centred_shift(m), lo, hi, end_share, scratch, nullptr);
+  lay_out_lane(scratch, hi - lo + 1, pack.lanes, lane, twin, single);
 }
 
 }  // namespace catenary_sim
