@@ -109,6 +109,12 @@ TEST(Allocation, ThreeDimensionalStepNeverAllocatesAndRepeatsItsBits) {
                              {test_scenes::kReferenceEndless,
                               {"stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]", "wind.speed=20",
                                "wind.turbulence.intensity=0.15", "alignment.radius=1200"}}};
+  // The same with the centred damping step in both planes.
+  const std::size_t half_step_cases = cases.size();
+  for (std::size_t k = 0; k < half_step_cases; ++k) {
+    cases.push_back(cases[k]);
+    cases.back().overrides.push_back("numerics.damping=centred");
+  }
   for (Case& c : cases) {
     c.overrides.insert(c.overrides.end(), sway.begin(), sway.end());
     const Scene scene = load_scene_file(c.file, c.overrides);

@@ -644,12 +644,20 @@ struct EndlessAndFinite {
 
 }  // namespace
 
-TEST(Lateral, WindowGivesTheFullLinesContactPoint) {
+// The window and the endless line with either damping step: the half-step, and the centred step
+// (both planes solve their wires' part in the window, the lateral one at its own dt).
+class LateralDamping : public ::testing::TestWithParam<const char*> {
+ protected:
+  std::string damping() const { return std::string("numerics.damping=") + GetParam(); }
+};
+
+TEST_P(LateralDamping, WindowGivesTheFullLinesContactPoint) {
   // Stagger +-0.3 m, messenger over the track centre, a steady 20 m/s cross wind, the pantograph
   // swaying 3 cm at 0.8 Hz, on 16 spans (the window holds about 5: both ends cut for most of it).
   const std::string scene = test_scenes::kReference3d;
   const std::vector<std::string> pass = {"numerics.preset=balanced", "line.span_count=16", "wind.turbulence=null",
-                                         "pantograph_head.sway.amplitude=0.03", "pantograph_head.sway.frequency=0.8"};
+                                         "pantograph_head.sway.amplitude=0.03", "pantograph_head.sway.frequency=0.8",
+                                         damping()};
   std::vector<std::string> windowed = pass;
   windowed.push_back("numerics.window=auto");
   Simulation a(load_scene_file(scene, pass)), b(load_scene_file(scene, windowed));
@@ -675,7 +683,7 @@ TEST(Lateral, WindowGivesTheFullLinesContactPoint) {
   EXPECT_GT(outside, 1000);
 }
 
-TEST(Lateral, InATurbulentWindTheWindowKeepsTheWholeLinesLateralPlane) {
+TEST_P(LateralDamping, InATurbulentWindTheWindowKeepsTheWholeLinesLateralPlane) {
   // As WindowGivesTheFullLinesContactPoint, now in the turbulent wind of reference_55m_3d.yaml. A
   // span entering a window at rest in the mean wind would lack the gusts' motion built up over
   // the lateral modes' decay (about 9 s, against the window's 1-2 s lead): on a finite line the
@@ -683,7 +691,8 @@ TEST(Lateral, InATurbulentWindTheWindowKeepsTheWholeLinesLateralPlane) {
   // same 1 mm (the vertical plane alone is windowed: its far ends' echoes reach the droppers' pull).
   const std::string scene = test_scenes::kReference3d;
   const std::vector<std::string> pass = {"numerics.preset=balanced", "line.span_count=16",
-                                         "pantograph_head.sway.amplitude=0.03", "pantograph_head.sway.frequency=0.8"};
+                                         "pantograph_head.sway.amplitude=0.03", "pantograph_head.sway.frequency=0.8",
+                                         damping()};
   std::vector<std::string> windowed = pass;
   windowed.push_back("numerics.window=auto");
   Simulation a(load_scene_file(scene, pass)), b(load_scene_file(scene, windowed));
@@ -696,10 +705,10 @@ TEST(Lateral, InATurbulentWindTheWindowKeepsTheWholeLinesLateralPlane) {
   EXPECT_LT(worst, kSameContactPoint);
 }
 
-TEST(Lateral, EndlessLineGivesTheFiniteLinesContactPoint) {
+TEST_P(LateralDamping, EndlessLineGivesTheFiniteLinesContactPoint) {
   // As EndlessLineDamping.MovingTheBlockBackIsExact, now staggered and swaying (EndlessAndFinite) in a
   // steady 20 m/s cross wind.
-  EndlessAndFinite lines({"wind.speed=20"});
+  EndlessAndFinite lines({"wind.speed=20", damping()});
   Simulation &a = lines.endless, &b = lines.finite;
   ASSERT_TRUE(a.model().endless);
   ASSERT_TRUE(a.model().lateral);
@@ -716,6 +725,8 @@ TEST(Lateral, EndlessLineGivesTheFiniteLinesContactPoint) {
   // step with the stagger puts the wires 0.6 m off and the leans' stretch by centimetres).
   EXPECT_NEAR(total_contact_force(a.model(), a.state(), 0), total_contact_force(b.model(), b.state(), 0), 0.6);
 }
+
+INSTANTIATE_TEST_SUITE_P(Damping, LateralDamping, ::testing::Values("half_step", "centred"));
 
 TEST(Lateral, GustLeadGivesTheEndlessLineTheFiniteLinesTurbulentMotion) {
   // The endless reference line against a finite 66-span one, staggered and swaying as in

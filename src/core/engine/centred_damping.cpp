@@ -226,23 +226,42 @@ __attribute__((always_inline)) inline bool sweep(int n, const double* twin, cons
 #define CATENARY_SIM_CLONES
 #endif
 
-CATENARY_SIM_CLONES bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s, int lo, int hi,
-                                            const double* twin, const double* single) {
+CATENARY_SIM_CLONES bool centred_sweep(const WireLanes& pack, const CentredSweep& c) {
   const double *u[2], *v[2];
   double *f[2], *un[2], *vn[2], *acc[2];
   for (int k = 0; k < pack.lanes; ++k) {
-    const int d = m.wires[pack.wire[k]].w_dof + lo;  // the range's node 0
-    u[k] = s.u.data() + d;
-    v[k] = s.v.data() + d;
-    f[k] = s.work->force.data() + d;
-    un[k] = s.work->u_next.data() + d;
-    vn[k] = s.work->v_next.data() + d;
-    acc[k] = s.accel.data() + d;
+    const int d = c.first_dof[k];
+    u[k] = c.u + d;
+    v[k] = c.v + d;
+    f[k] = c.f + d;
+    un[k] = c.u_next + d;
+    vn[k] = c.v_next + d;
+    acc[k] = c.accel + d;
   }
-  const CentredArgs args{u, v, f, un, vn, acc, m.dt, m.wire_packs->centred_v_ratio, 2.0 / m.beta, m.scene.numerics.divergence_limit};
-  double* rec = s.work->sweep.data() + kSweepRecord * pack.offset;
-  const int n = hi - lo + 1;
-  return pack.lanes == 2 ? sweep<2>(n, twin, single, args, rec) : sweep<1>(n, twin, single, args, rec);
+  const CentredArgs args{u, v, f, un, vn, acc, c.dt, c.v_ratio, 2.0 / c.beta, c.limit};
+  return pack.lanes == 2 ? sweep<2>(c.nodes, c.twin, c.single, args, c.record)
+                         : sweep<1>(c.nodes, c.twin, c.single, args, c.record);
+}
+
+bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s, int lo, int hi, const double* twin,
+                        const double* single) {
+  CentredSweep c;
+  for (int k = 0; k < pack.lanes; ++k) c.first_dof[k] = m.wires[pack.wire[k]].w_dof + lo;  // the range's node 0
+  c.nodes = hi - lo + 1;
+  c.u = s.u.data();
+  c.v = s.v.data();
+  c.f = s.work->force.data();
+  c.u_next = s.work->u_next.data();
+  c.v_next = s.work->v_next.data();
+  c.accel = s.accel.data();
+  c.dt = m.dt;
+  c.v_ratio = m.wire_packs->centred_v_ratio;
+  c.beta = m.beta;
+  c.limit = m.scene.numerics.divergence_limit;
+  c.twin = twin;
+  c.single = single;
+  c.record = s.work->sweep.data() + kSweepRecord * pack.offset;
+  return centred_sweep(pack, c);
 }
 
 bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s) {

@@ -17,6 +17,22 @@
 
 namespace catenary_sim {
 
+// One pack's solve and update in either plane: its lanes' nodes first_dof[lane] ..
+// first_dof[lane] + nodes - 1 of the plane's arrays (u, v, f with the load and point forces,
+// written: u_next, v_next, accel), the factors of that range (twin, single) and the step's
+// records (4 values per node and lane). Returns true if a new displacement is beyond the limit
+// or not a number.
+struct CentredSweep {
+  int first_dof[2] = {0, 0};
+  int nodes = 0;
+  const double *u = nullptr, *v = nullptr;
+  double *f = nullptr, *u_next = nullptr, *v_next = nullptr, *accel = nullptr;
+  double dt = 0.0, v_ratio = 0.0, beta = 0.0, limit = 0.0;  // v_ratio: (2 / dt) / D per mass
+  const double *twin = nullptr, *single = nullptr;
+  double* record = nullptr;
+};
+bool centred_sweep(const WireLanes& pack, const CentredSweep& sweep);
+
 // One wire pack's solve and update (both wires in lanes): reads u, v and the point forces in
 // state.force (zeroing them there for the next step), writes u_next, v_next and accel. Returns
 // true if a new displacement is beyond the limit or not a number.

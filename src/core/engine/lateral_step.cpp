@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "catenary_sim/core/engine/state.hpp"
+#include "engine/centred_damping.hpp"
 #include "engine/lateral_window.hpp"
 #include "engine/lateral_wind.hpp"
 #include "engine/lateral_workspace.hpp"
@@ -73,6 +74,19 @@ LateralState make_lateral_state(const Model& m) {
   work.cut_node.assign(2 * kCutLayer * m.wires.size(), 0);
   work.cut_force.assign(work.cut_node.size(), 0.0);
   work.window_points.assign(work.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size(), 0);
+  if (lat.windowed && !lat.centred_twin.empty()) {
+    // A window's range has at most its wires' nodes: the whole wires' layout sizes it.
+    std::size_t twin = 0, single = 0;
+    for (std::size_t pk = 0; pk < lat.centred_twin.size(); ++pk) {
+      work.centred_twin_at.push_back(twin);
+      work.centred_single_at.push_back(single);
+      twin += lat.centred_twin[pk].size();
+      single += lat.centred_single[pk].size();
+    }
+    work.centred_twin.assign(twin, 0.0);
+    work.centred_single.assign(single, 0.0);
+    work.centred_scratch.assign(static_cast<std::size_t>(longest) * kCdValues, 0.0);
+  }
   return s;
 }
 
@@ -231,6 +245,81 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
   return false;
 }
 
+// One lateral substep with centred damping (engine/centred_damping.hpp, in the lateral plane at its
+// own dt): the load, the wind's drag on the wire's velocity v_{n-1/2} (aerodynamic damping, explicit
+// as in the half-step), the window's forces, springs and pendulums on z = y + beta v, then per pack
+// the wires' solve for zeta (their Rayleigh damping, alpha M + beta K, taken at the step's middle)
+// and the update. The new values go to y_next, v_next and are swapped in (copied back in the
+// window) when all are inside the divergence limit; else the state keeps the last good substep and
+// this returns true.
+bool centred_substep(const Model& m, State& s, bool windowed) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
+  const double beta = m.beta;
+  const double* load = lat.load.data();
+  const double* y = ls.y.data();
+  const double* v = ls.v.data();
+  double* f = lw.f.data();
+  over_stepped(m, s, windowed, [&](int i0, int i1) {
+    if (lat.windy) {
+      const double* cw = lat.wind_coefficient.data();
+      const double* W = ls.wind_speed.data();
+      for (int i = i0; i < i1; ++i) {
+        const double vn = W[i] - v[i];
+        f[i] = load[i] + cw[i] * vn * std::fabs(vn);
+      }
+    } else {
+      for (int i = i0; i < i1; ++i) f[i] = load[i];
+    }
+  });
+  if (windowed) add_window_forces(m, s, v, f);
+  add_springs_and_pendulums(m, s, windowed, y, [y, v, beta](int i) { return y[i] + beta * v[i]; }, f);
+  for (int d : lat.centred_held) f[d] = 0.0;  // a held node's row is zeta = y
+  const std::vector<WireLanes>& packs = packs_of(m);
+  bool out = false;
+  for (std::size_t pk = 0; pk < packs.size(); ++pk) {
+    const WireLanes& p = packs[pk];
+    const WireWindow& ww = ls.window[p.wire[0]];
+    const int lo = windowed ? ww.lo : 0, hi = windowed ? ww.hi : p.nodes - 1;
+    if (hi < lo) continue;
+    CentredSweep c;
+    for (int k = 0; k < p.lanes; ++k) c.first_dof[k] = lat.wires[p.wire[k]].w_dof + lo;
+    c.nodes = hi - lo + 1;
+    c.u = y;
+    c.v = v;
+    c.f = f;
+    c.u_next = lw.y_next.data();
+    c.v_next = lw.v_next.data();
+    c.accel = lw.accel.data();
+    c.dt = lat.dt;
+    c.v_ratio = lat.centred_v_ratio;
+    c.beta = beta;
+    c.limit = m.scene.numerics.divergence_limit;
+    c.twin = windowed ? lw.centred_twin.data() + lw.centred_twin_at[pk] : lat.centred_twin[pk].data();
+    c.single = windowed ? lw.centred_single.data() + lw.centred_single_at[pk] : lat.centred_single[pk].data();
+    c.record = lw.sweep.data() + kSweepRecord * p.offset;
+    out |= centred_sweep(p, c);
+  }
+  if (out) return true;
+  if (windowed) {  // outside the window the new buffers hold nothing current: copy the window back
+    double* yw = ls.y.data();
+    double* vw = ls.v.data();
+    const double* yn = lw.y_next.data();
+    const double* vn = lw.v_next.data();
+    over_stepped(m, s, true, [&](int i0, int i1) {
+      for (int i = i0; i < i1; ++i) {
+        yw[i] = yn[i];
+        vw[i] = vn[i];
+      }
+    });
+    return false;
+  }
+  ls.y.swap(lw.y_next);  // O(1)
+  ls.v.swap(lw.v_next);
+  return false;
+}
+
 // One lateral substep, the generic step (what the fused one computes, bit for bit: test_lateral):
 // the force on z = y + beta v with the load, damping and the wind's drag on the wire's velocity
 // (aerodynamic damping), the band, the window's forces, springs and pendulums, then the update.
@@ -306,7 +395,10 @@ StepStatus lateral_step(const Model& m, State& s) {
   for (int sub = 0; sub < lat.substeps; ++sub) {
     refresh_wind_if_due(m, s, t0 + sub * h, windowed);
     const bool fused = !lat.planes.empty() && (!windowed || lw.window_fused);
-    if (fused ? fused_substep(m, s, windowed) : generic_substep(m, s, windowed)) {
+    const bool failed = !lat.centred_twin.empty() ? centred_substep(m, s, windowed)
+                        : fused                   ? fused_substep(m, s, windowed)
+                                                  : generic_substep(m, s, windowed);
+    if (failed) {
       ls.diverged = true;
       s.status = StepStatus::kDiverged;
       return s.status;

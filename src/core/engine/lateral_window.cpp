@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "engine/lateral_wind.hpp"
+#include "model/centred_factors.hpp"
 #include "engine/lateral_workspace.hpp"
 #include "engine/window.hpp"
 #include "engine/wire_lanes.hpp"
@@ -86,6 +87,26 @@ void list_window_points(const Model& m, State& s, int first, double xa, double x
   lw.window_point_count = q;
 }
 
+// The centred damping step's factors of each pack's window range (both lanes share it: a pack's
+// wires are on the same node stations), in the lateral plane.
+void factor_centred_window(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
+  const std::vector<WireLanes>& packs = packs_of(m);
+  const CentredPlane plane{&lat.wires, lat.mass.data(), lat.inv_mass.data(), centred_shift(m, lat.dt)};
+  for (std::size_t pk = 0; pk < packs.size(); ++pk) {
+    const WireLanes& p = packs[pk];
+    for (int lane = 0; lane < p.lanes; ++lane) {
+      const WireWindow& ww = ls.window[p.wire[lane]];
+      if (ww.hi < ww.lo) continue;
+      const double share[6] = {ww.lo_ww, ww.lo_wt, ww.lo_tt, ww.hi_ww, ww.hi_wt, ww.hi_tt};  // 0 where not cut
+      factor_centred_range(plane, p, lane, ww.lo, ww.hi, share, lw.centred_scratch.data(),
+                           lw.centred_twin.data() + lw.centred_twin_at[pk], lw.centred_single.data() + lw.centred_single_at[pk]);
+    }
+  }
+}
+
 }  // namespace
 
 // The moving window (numerics.window): the lateral plane steps the vertical plane's window
@@ -123,6 +144,7 @@ void sync_window(const Model& m, State& s) {
     if (p.lanes == 2 && (ls.window[p.wire[0]].lo != ls.window[p.wire[1]].lo || ls.window[p.wire[0]].hi != ls.window[p.wire[1]].hi))
       lw.window_fused = false;
   if (lw.window_fused) interleave_window_factors(packs_of(m), ls.window, lw.sweep_factors.data());
+  if (!lat.centred_twin.empty()) factor_centred_window(m, s);
   list_window_points(m, s, first, xa, xb);
 }
 

@@ -44,6 +44,11 @@ struct LateralWorkspace {
   std::vector<int> window_points;
   int window_point_count = 0;
   bool window_fused = false;  // the fused step can take the window (every wire's range two nodes or more)
+  // The centred damping step in the window: per pack the factors of its range, laid out as
+  // LateralModel::centred_twin and centred_single (at centred_twin_at[pack] and
+  // centred_single_at[pack]), rebuilt by sync_window; scratch for one wire's range.
+  std::vector<double> centred_twin, centred_single, centred_scratch;
+  std::vector<std::size_t> centred_twin_at, centred_single_at;
 };
 
 }  // namespace catenary_sim

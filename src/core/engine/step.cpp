@@ -42,6 +42,7 @@ StepStatus step_both_planes(const Model& m, State& s) {
   bool two_wire_packs = true;  // (sweep_pack_pair's four lanes)
   for (const WireLanes& p : packs_of(m)) two_wire_packs &= p.lanes == 2;
   ls.work->join = !lat.planes.empty() && two_wire_packs && lat.substeps == 1 && !m.scene.numerics.windowed() &&
+                  m.scene.numerics.damping != DampingStep::kCentred &&
             s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty();
   // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
   // the vertical step's s.time += dt), refreshed now for the sweep (lateral_step then finds it

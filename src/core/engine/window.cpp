@@ -125,13 +125,14 @@ namespace {
 void factor_centred_window(const Model& m, State& s) {
   StepWorkspace& w = *s.work;
   const std::vector<WireLanes>& packs = packs_of(m);
+  const CentredPlane plane{&m.wires, m.mass.data(), m.inv_mass.data(), centred_shift(m, m.dt)};
   for (std::size_t pk = 0; pk < packs.size(); ++pk) {
     const WireLanes& p = packs[pk];
     for (int lane = 0; lane < p.lanes; ++lane) {
       const WireWindow& ww = s.window[p.wire[lane]];
       if (ww.hi < ww.lo) continue;
       const double share[6] = {ww.lo_ww, ww.lo_wt, ww.lo_tt, ww.hi_ww, ww.hi_wt, ww.hi_tt};  // 0 where not cut
-      factor_centred_range(m, p, lane, ww.lo, ww.hi, share, w.centred_scratch.data(), w.centred_twin.data() + w.centred_twin_at[pk],
+      factor_centred_range(plane, p, lane, ww.lo, ww.hi, share, w.centred_scratch.data(), w.centred_twin.data() + w.centred_twin_at[pk],
                            w.centred_single.data() + w.centred_single_at[pk]);
     }
   }

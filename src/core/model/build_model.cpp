@@ -488,7 +488,6 @@ void choose_time_step(const Scene& scene, Model& m) {
     std::string why;
     if (scene.numerics.integrator != Integrator::kExplicit) why = "numerics.integrator explicit";
     else if (scene.numerics.rotary_inertia != RotaryInertia::kCondensed) why = "numerics.rotary_inertia condensed";
-    else if (scene.lateral()) why = "a 2-D line (no stagger, curve or wind): the lateral plane steps with half_step";
     else if (!(m.beta > 0.0)) why = "damping.beta > 0 (it solves for u + beta v; with beta 0 half_step has the same limit)";
     if (!why.empty()) throw SceneError("numerics.damping = 'centred': needs " + why + "; allowed otherwise: half_step");
   }

@@ -41,8 +41,9 @@ namespace {
 // k, from node n - 1 up to it, then the meeting node.
 class TwistedFactors {
  public:
-  TwistedFactors(const Model& m, const Wire& w, double shift, int lo, int hi, const double* end_share, double* factors)
-      : m_(m), w_(w), shift_(shift), lo_(lo), hi_(hi), share_(end_share), factors_(factors) {
+  TwistedFactors(const Wire& w, const double* mass, const double* inv_mass, double shift, int lo, int hi,
+                 const double* end_share, double* factors)
+      : w_(w), mass_(mass), inv_mass_(inv_mass), shift_(shift), lo_(lo), hi_(hi), share_(end_share), factors_(factors) {
     std::fill(factors_, factors_ + static_cast<std::size_t>(hi - lo + 1) * kCdValues, 0.0);
   }
 
@@ -110,14 +111,14 @@ class TwistedFactors {
     for (int i = 0; i < n; ++i) {
       const bool fx = fixed(i);
       if (fx && fixed_dofs) fixed_dofs->push_back(dof(i));
-      at(i)[kCdU] = fx ? 1.0 : shift_ * m_.mass[dof(i)];
+      at(i)[kCdU] = fx ? 1.0 : shift_ * mass_[dof(i)];
     }
   }
 
  private:
   int node(int i) const { return lo_ + i; }
   int dof(int i) const { return w_.w_dof + lo_ + i; }
-  bool fixed(int i) const { return m_.inv_mass[dof(i)] == 0.0; }
+  bool fixed(int i) const { return inv_mass_[dof(i)] == 0.0; }
   double* at(int i) { return factors_ + static_cast<std::size_t>(i) * kCdValues; }
   // The diagonal block's band entry v (0: ww, 1: wt, 2: tt) at range node i, less the end shares.
   double band(int i, const std::vector<double>& entry, int v) const {
@@ -133,7 +134,7 @@ class TwistedFactors {
   void diag(int i, double* a) const {
     const bool fx = fixed(i);
     const double wt = band(i, w_.d_wt, 1);
-    a[0] = fx ? 1.0 : shift_ * m_.mass[dof(i)] + band(i, w_.d_ww, 0);
+    a[0] = fx ? 1.0 : shift_ * mass_[dof(i)] + band(i, w_.d_ww, 0);
     a[1] = fx ? 0.0 : wt;
     a[2] = wt;
     a[3] = band(i, w_.d_tt, 2);
@@ -178,8 +179,8 @@ class TwistedFactors {
     std::copy(si, si + 4, s_prev_);
   }
 
-  const Model& m_;
   const Wire& w_;
+  const double *mass_, *inv_mass_;  // per DOF of the plane w_.w_dof numbers
   double shift_;
   int lo_, hi_;
   const double* share_;  // null: no end shares (a whole wire)
@@ -191,10 +192,10 @@ class TwistedFactors {
 // The factors of nodes lo..hi into `factors` (kCdValues per node in line order; the packs take
 // them in the twisted order), less the end shares when given (factor_centred_range); its fixed
 // vertical DOFs appended to `fixed_dofs` when given. D = shift M.
-void range_factors(const Model& m, const Wire& w, double shift, int lo, int hi, const double* end_share,
-                   double* factors, std::vector<int>* fixed_dofs) {
+void range_factors(const Wire& w, const double* mass, const double* inv_mass, double shift, int lo, int hi,
+                   const double* end_share, double* factors, std::vector<int>* fixed_dofs) {
   const int n = hi - lo + 1, k = centred_meeting_node(n);
-  TwistedFactors f(m, w, shift, lo, hi, end_share, factors);
+  TwistedFactors f(w, mass, inv_mass, shift, lo, hi, end_share, factors);
   f.eliminate_from_first(k);
   f.eliminate_from_last(n, k);
   f.meet(n, k);
@@ -221,10 +222,10 @@ void lay_out_lane(const double* factors, int n, int lanes, int lane, double* twi
 
 }  // namespace
 
-double centred_shift(const Model& m) { return 2.0 / (m.beta * m.dt) + m.alpha / m.beta; }
+double centred_shift(const Model& m, double dt) { return 2.0 / (m.beta * dt) + m.alpha / m.beta; }
 
 void factor_centred_damping(const Model& m, WirePacks& packs) {
-  const double shift = centred_shift(m);
+  const double shift = centred_shift(m, m.dt);
   packs.centred_fixed_dofs.clear();
   packs.centred_v_ratio = (2.0 / m.dt) / shift;
   std::vector<double> factors;
@@ -234,15 +235,17 @@ void factor_centred_damping(const Model& m, WirePacks& packs) {
     p.centred_single.assign(2 * kCdValues * static_cast<std::size_t>(L), 0.0);
     factors.assign(static_cast<std::size_t>(n) * kCdValues, 0.0);
     for (int lane = 0; lane < L; ++lane) {
-      range_factors(m, m.wires[p.wire[lane]], shift, 0, n - 1, nullptr, factors.data(), &packs.centred_fixed_dofs);
+      range_factors(m.wires[p.wire[lane]], m.mass.data(), m.inv_mass.data(), shift, 0, n - 1, nullptr, factors.data(),
+                    &packs.centred_fixed_dofs);
       lay_out_lane(factors.data(), n, L, lane, p.centred_twin.data(), p.centred_single.data());
     }
   }
 }
 
-void factor_centred_range(const Model& m, const WireLanes& pack, int lane, int lo, int hi, const double end_share[6],
-                          double* scratch, double* twin, double* single) {
-  range_factors(m, m.wires[pack.wire[lane]], centred_shift(m), lo, hi, end_share, scratch, nullptr);
+void factor_centred_range(const CentredPlane& plane, const WireLanes& pack, int lane, int lo, int hi,
+                          const double end_share[6], double* scratch, double* twin, double* single) {
+  range_factors((*plane.wires)[pack.wire[lane]], plane.mass, plane.inv_mass, plane.shift, lo, hi, end_share, scratch,
+                nullptr);
   lay_out_lane(scratch, hi - lo + 1, pack.lanes, lane, twin, single);
 }
 

@@ -19,19 +19,29 @@ namespace catenary_sim {
 enum { kCdG, kCdS = 4, kCdP = 6, kCdU = 10, kCdValues };
 int centred_meeting_node(int nodes);
 
-// D per unit mass: 2 / (beta dt) + alpha / beta.
-double centred_shift(const Model& m);
+// D per unit mass for a step dt: 2 / (beta dt) + alpha / beta.
+double centred_shift(const Model& m, double dt);
 
 // Fills the packs' WireLanes::centred_* and WirePacks::centred_* (every wire is in a pack) for
 // m.dt; needs beta > 0.
 void factor_centred_damping(const Model& m, WirePacks& packs);
 
-// The factors of one lane of `pack` over its wire's nodes lo..hi (a moving window), laid out as
-// WireLanes::centred_twin and centred_single are, for the range's hi - lo + 1 nodes. `end_share`:
-// the outer elements' shares of the end nodes' diagonal blocks left out where a window cuts the
-// wire (ww, wt, tt at lo, then at hi; 0 at an uncut end), as in the window's band force.
-// `scratch` holds kCdValues per node of the range. No allocation.
-void factor_centred_range(const Model& m, const WireLanes& pack, int lane, int lo, int hi, const double end_share[6],
-                          double* scratch, double* twin, double* single);
+// A plane's wires for the centred step: the vertical plane's (Model::wires, mass, inv_mass) or the
+// lateral plane's (LateralModel), with D per unit mass for the plane's step (centred_shift).
+struct CentredPlane {
+  const std::vector<Wire>* wires = nullptr;
+  const double* mass = nullptr;      // kg per DOF of the plane (Wire::w_dof numbers them)
+  const double* inv_mass = nullptr;  // 0 on a held node, whose row is zeta = u
+  double shift = 0.0;
+};
+
+// The factors of one lane of `pack` over its wire's nodes lo..hi in `plane` (the whole wire, or a
+// moving window's part), laid out as WireLanes::centred_twin and centred_single are, for the
+// range's hi - lo + 1 nodes. `end_share`: null, or the outer elements' shares of the end nodes'
+// diagonal blocks left out where a window cuts the wire (ww, wt, tt at lo, then at hi; 0 at an
+// uncut end), as in the window's band force. `scratch` holds kCdValues per node of the range. No
+// allocation.
+void factor_centred_range(const CentredPlane& plane, const WireLanes& pack, int lane, int lo, int hi,
+                          const double end_share[6], double* scratch, double* twin, double* single);
 
 }  // namespace catenary_sim

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "catenary_sim/core/model/beam.hpp"
+#include "model/centred_factors.hpp"
 #include "model/normal_errors.hpp"
 #include "model/wire_packs.hpp"
 
@@ -335,7 +336,9 @@ void set_static_states(const Model& m, LateralModel* lat) {
 // plane); it takes as many substeps of the vertical dt as it needs.
 void set_substeps(const Model& m, LateralModel* lat) {
   lat->omega_max = lateral_omega_max(m, *lat);
-  const double xi = 0.5 * (m.alpha / std::max(lat->omega_max, 1e-9) + m.beta * lat->omega_max);
+  // The centred step takes the wires' Rayleigh damping implicitly: its limit is the undamped one.
+  const bool centred = m.scene.numerics.damping == DampingStep::kCentred;
+  const double xi = centred ? 0.0 : 0.5 * (m.alpha / std::max(lat->omega_max, 1e-9) + m.beta * lat->omega_max);
   const double dt_crit = lat->omega_max > 0.0 ? 2.0 / lat->omega_max * (std::sqrt(1.0 + xi * xi) - xi)
                                                : std::numeric_limits<double>::infinity();
   lat->substeps = std::max(1, static_cast<int>(std::ceil(m.dt / (0.9 * dt_crit))));
@@ -344,6 +347,25 @@ void set_substeps(const Model& m, LateralModel* lat) {
                      " s) would need " + std::to_string(lat->substeps) + " substeps of dt " + fmt(m.dt) +
                      " s; allowed at most 1000: lower the lateral support stiffnesses");
   lat->dt = m.dt / lat->substeps;
+}
+
+// The centred damping step's factors of the lateral plane's whole wires (LateralModel::centred_*).
+void factor_lateral_centred(const Model& m, LateralModel& lat) {
+  const CentredPlane plane{&lat.wires, lat.mass.data(), lat.inv_mass.data(), centred_shift(m, lat.dt)};
+  lat.centred_v_ratio = (2.0 / lat.dt) / plane.shift;
+  lat.centred_held.clear();
+  for (int i = 0; i < lat.n; ++i)
+    if (lat.inv_mass[i] == 0.0) lat.centred_held.push_back(i);
+  std::vector<double> scratch;
+  for (const WireLanes& p : packs_of(m)) {
+    const int L = p.lanes;
+    std::vector<double> twin(p.centred_twin.size(), 0.0), single(p.centred_single.size(), 0.0);
+    scratch.assign(static_cast<std::size_t>(p.nodes) * kCdValues, 0.0);
+    for (int lane = 0; lane < L; ++lane)
+      factor_centred_range(plane, p, lane, 0, p.nodes - 1, nullptr, scratch.data(), twin.data(), single.data());
+    lat.centred_twin.push_back(std::move(twin));
+    lat.centred_single.push_back(std::move(single));
+  }
 }
 
 // For the moving window: the wires' elastic force in the static state, and the springs in line order.
@@ -532,6 +554,7 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   set_static_states(m, lat.get());
   set_substeps(m, lat.get());
   build_lateral_packs(m, *lat);
+  if (sc.numerics.damping == DampingStep::kCentred) factor_lateral_centred(m, *lat);
   prepare_window(lat.get());
   return lat;
 }

@@ -515,11 +515,11 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   read_output(top, s);
   read_lateral_parts(top, s);
   top.finish();
-  // The reference rung's centred damping steps a 2-D line (whole, windowed or endless) with the
-  // explicit scheme and beta > 0 (NumericsSpec::damping); elsewhere (a 3-D line) the rung is
-  // h = 0.1 m with the half-step damping, the finest its explicit dt allows at a reference's cost
-  // (docs/benchmark_history.md, "Choosing the reference rung").
-  if (reference_defaults && (s.lateral() || !(s.rayleigh_beta > 0.0) ||
+  // The reference rung's centred damping steps the explicit scheme with beta > 0
+  // (NumericsSpec::damping); elsewhere the rung is h = 0.1 m with the half-step damping, the finest
+  // its explicit dt allows at a reference's cost (docs/benchmark_history.md, "Choosing the
+  // reference rung").
+  if (reference_defaults && (!(s.rayleigh_beta > 0.0) ||
                              s.numerics.integrator != Integrator::kExplicit ||
                              s.numerics.rotary_inertia != RotaryInertia::kCondensed)) {
     s.numerics.element_length = 0.1;

@@ -124,6 +124,13 @@ struct LateralModel {
   // point forces (springs, pendulums) with where the sweep leaves their band force. No planes
   // (the vertical step not fused: implicit, or rotations as DOFs): the generic step.
   std::vector<std::vector<double>> planes;
+  // The centred damping step (NumericsSpec::damping centred; empty otherwise): per pack the factors
+  // of the lateral plane's solve at its own dt, laid out as WireLanes::centred_twin and
+  // centred_single (the same band, the lateral masses and held nodes); the held DOFs (inv_mass 0),
+  // whose row is zeta = y; (2 / dt) / D per mass.
+  std::vector<std::vector<double>> centred_twin, centred_single;
+  std::vector<int> centred_held;
+  double centred_v_ratio = 0.0;
   std::vector<int> point_nodes;
   std::vector<int> sweep_force_at;  // per lateral DOF: where the sweep leaves its band force (fused step)
   // Moving window (numerics.window; the vertical plane's window, State::window: the lateral waves
