@@ -3,9 +3,12 @@
 // refined with it); every candidate's 0-20 Hz statistics (mean, std, max, min) and 0-200 Hz max are
 // compared with it, with its wall time, on the reference scene at 250 and 300 km/h.
 //   bench_reference_rung [scene=config/reference_55m.yaml] [csv=reference_rung.csv] [finest_h=0.03125]
-//                        [all|centred|window|richardson] [field=value ...]
+//                        [all|centred|window|3d|richardson] [field=value ...]
 // `window`: the rung with a moving window (numerics.window auto, also the endless line's), against
 // the finest solution in the same window, beside the half-step h = 0.1 m rung it replaces there.
+// `3d`: the same candidates on a 3-D line, the finest solution with centred damping in both planes
+// (at h = 0.03125 m the half-step's dt falls to 2.4 us, 17x below the centred step's, whose limit
+// is the half-step's: CentredDamping.*ConvergesAtSecondOrderToTheHalfStepsLimit, the 2-D table).
 // Further field=value overrides apply to every pass, the finest included (e.g. train.end=1100 on
 // the endless line).
 // Errors as in bench_speed_accuracy: relative to the finest value (the min relative to the mean).
@@ -52,7 +55,7 @@ int main(int argc, char** argv) {
          {"implicit h=0.125 dt=0.5ms", {"numerics.integrator=implicit", "numerics.element_length=0.125", "numerics.dt=0.0005"}},
          {"implicit h=0.0625 dt=0.5ms",
           {"numerics.integrator=implicit", "numerics.element_length=0.0625", "numerics.dt=0.0005"}}});
-  if (mode == "window")
+  if (mode == "window" || mode == "3d")
     candidates = {
         {"half-step h=0.1 (the window's rung before)", {"numerics.element_length=0.1", "numerics.damping=half_step"}},
         {"centred h=0.0625 (the rung)", {"numerics.element_length=0.0625", "numerics.damping=centred"}},
@@ -104,7 +107,8 @@ int main(int argc, char** argv) {
       fine.dt = k[6];
       fine.wall = k[7];
     } else {
-      std::vector<std::string> ov = {"numerics.element_length=" + finest_h, "numerics.damping=half_step"};
+      std::vector<std::string> ov = {"numerics.element_length=" + finest_h,
+                                     mode == "3d" ? "numerics.damping=centred" : "numerics.damping=half_step"};
       ov.insert(ov.end(), every.begin(), every.end());
       fine = run_pass(path, ov, kmh);
       std::ofstream out(csv_path + ".finest", std::ios::app);
