@@ -34,21 +34,26 @@ double wire_energy(const Model& m, const State& s) {
   return e;
 }
 
+// The window's accuracy budget against a line that goes on: 1 % in mean, std and max relative;
+// the min relative to the mean (a small number whose relative change means little).
+void expect_within_window_budget(const PantographStatistics& win, const PantographStatistics& ref) {
+  EXPECT_NEAR(win.filtered.mean, ref.filtered.mean, 0.01 * ref.filtered.mean);
+  EXPECT_NEAR(win.filtered.std_dev, ref.filtered.std_dev, 0.01 * ref.filtered.std_dev);
+  EXPECT_NEAR(win.filtered.max, ref.filtered.max, 0.01 * ref.filtered.max);
+  EXPECT_NEAR(win.filtered.min, ref.filtered.min, 0.01 * ref.filtered.mean);
+}
+
 }  // namespace
 
 TEST(Window, StatisticsMatchTheFullLine) {
   // 20 spans at 300 km/h, balanced preset: the window (auto: 3.8 spans ahead, 2 behind) against the
   // full line, over spans 4-15: the window stands for a line that goes on, so the statistics are
   // taken where the full line's anchors are out of reach (near them the full line's reflections
-  // are real and the window's are not). The window's accuracy budget is 1 %: mean, std and max relative;
-  // the min relative to the mean (it is a small number whose relative change means little).
+  // are real and the window's are not), within the window's budget.
   const PantographStatistics full = pass({"line.span_count=20", "numerics.preset=balanced", "output.analysis_spans=[4,16]"});
   const PantographStatistics win =
       pass({"line.span_count=20", "numerics.preset=balanced", "output.analysis_spans=[4,16]", "numerics.window=auto"});
-  EXPECT_NEAR(win.filtered.mean, full.filtered.mean, 0.01 * full.filtered.mean);
-  EXPECT_NEAR(win.filtered.std_dev, full.filtered.std_dev, 0.01 * full.filtered.std_dev);
-  EXPECT_NEAR(win.filtered.max, full.filtered.max, 0.01 * full.filtered.max);
-  EXPECT_NEAR(win.filtered.min, full.filtered.min, 0.01 * full.filtered.mean);
+  expect_within_window_budget(win, full);
 }
 
 // The same on the stitched twin: a window edge on a support cuts the stitch wire there (its
@@ -60,10 +65,7 @@ TEST(Window, StitchedLineStatisticsMatchTheFullLine) {
   windowed.push_back("numerics.window=auto");
   const PantographStatistics full = pass(base, test_scenes::kReferenceStitched);
   const PantographStatistics win = pass(windowed, test_scenes::kReferenceStitched);
-  EXPECT_NEAR(win.filtered.mean, full.filtered.mean, 0.01 * full.filtered.mean);
-  EXPECT_NEAR(win.filtered.std_dev, full.filtered.std_dev, 0.01 * full.filtered.std_dev);
-  EXPECT_NEAR(win.filtered.max, full.filtered.max, 0.01 * full.filtered.max);
-  EXPECT_NEAR(win.filtered.min, full.filtered.min, 0.01 * full.filtered.mean);
+  expect_within_window_budget(win, full);
 }
 
 // The same with the centred damping step (numerics.damping centred), which solves the band of
@@ -75,10 +77,7 @@ TEST(Window, CentredDampingStatisticsMatchTheFullLine) {
   std::vector<std::string> windowed = base;
   windowed.push_back("numerics.window=auto");
   const PantographStatistics full = pass(base), win = pass(windowed);
-  EXPECT_NEAR(win.filtered.mean, full.filtered.mean, 0.01 * full.filtered.mean);
-  EXPECT_NEAR(win.filtered.std_dev, full.filtered.std_dev, 0.01 * full.filtered.std_dev);
-  EXPECT_NEAR(win.filtered.max, full.filtered.max, 0.01 * full.filtered.max);
-  EXPECT_NEAR(win.filtered.min, full.filtered.min, 0.01 * full.filtered.mean);
+  expect_within_window_budget(win, full);
 }
 
 // A window that holds the whole line from the start (its ends on the anchors, nothing cut) is the
@@ -128,10 +127,7 @@ TEST(Window, AutoLengthsFollowTheSpeed) {
   window_lengths(probe.model(), 150 / 3.6, &ahead_150, &behind_150);
   EXPECT_GT(ahead_350, ahead_150);
   EXPECT_LT(behind_350, behind_150);
-  EXPECT_NEAR(win.filtered.mean, ref.filtered.mean, 0.01 * ref.filtered.mean);
-  EXPECT_NEAR(win.filtered.std_dev, ref.filtered.std_dev, 0.01 * ref.filtered.std_dev);
-  EXPECT_NEAR(win.filtered.max, ref.filtered.max, 0.01 * ref.filtered.max);
-  EXPECT_NEAR(win.filtered.min, ref.filtered.min, 0.01 * ref.filtered.mean);
+  expect_within_window_budget(win, ref);
 }
 
 TEST(Window, EndsLetAPulseOut) {

@@ -178,6 +178,28 @@ void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const do
   }
 }
 
+// The substep's new values (y_next, v_next) into the state once all are good: swapped in, or in
+// the window copied back (outside it the new buffers hold nothing current).
+void commit_substep(const Model& m, State& s, bool windowed) {
+  LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
+  if (!windowed) {
+    ls.y.swap(lw.y_next);  // O(1)
+    ls.v.swap(lw.v_next);
+    return;
+  }
+  double* y = ls.y.data();
+  double* v = ls.v.data();
+  const double* yn = lw.y_next.data();
+  const double* vn = lw.v_next.data();
+  over_stepped(m, s, true, [&](int i0, int i1) {
+    for (int i = i0; i < i1; ++i) {
+      y[i] = yn[i];
+      v[i] = vn[i];
+    }
+  });
+}
+
 // One lateral substep fused as the vertical plane's (wire_lanes.hpp): per pack one sweep pair for
 // z, the condensed rotations, the band force with the load, damping and the wind's drag, and the
 // update; then the nodes with point forces (steady arms and
@@ -229,19 +251,7 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
     });
     if (bad) return true;
   }
-  if (windowed) {  // outside the window the new buffers hold nothing current: copy the window back
-    double* yw = ls.y.data();
-    double* vw = ls.v.data();
-    over_stepped(m, s, true, [&](int i0, int i1) {
-      for (int i = i0; i < i1; ++i) {
-        yw[i] = yn[i];
-        vw[i] = vn[i];
-      }
-    });
-    return false;
-  }
-  ls.y.swap(lw.y_next);  // O(1)
-  ls.v.swap(lw.v_next);
+  commit_substep(m, s, windowed);
   return false;
 }
 
@@ -302,21 +312,7 @@ bool centred_substep(const Model& m, State& s, bool windowed) {
     out |= centred_sweep(p, c);
   }
   if (out) return true;
-  if (windowed) {  // outside the window the new buffers hold nothing current: copy the window back
-    double* yw = ls.y.data();
-    double* vw = ls.v.data();
-    const double* yn = lw.y_next.data();
-    const double* vn = lw.v_next.data();
-    over_stepped(m, s, true, [&](int i0, int i1) {
-      for (int i = i0; i < i1; ++i) {
-        yw[i] = yn[i];
-        vw[i] = vn[i];
-      }
-    });
-    return false;
-  }
-  ls.y.swap(lw.y_next);  // O(1)
-  ls.v.swap(lw.v_next);
+  commit_substep(m, s, windowed);
   return false;
 }
 

@@ -87,24 +87,13 @@ void list_window_points(const Model& m, State& s, int first, double xa, double x
   lw.window_point_count = q;
 }
 
-// The centred damping step's factors of each pack's window range (both lanes share it: a pack's
-// wires are on the same node stations), in the lateral plane.
+// The lateral plane's centred factors of its window (factor_centred_windows).
 void factor_centred_window(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
-  LateralState& ls = s.lateral;
-  LateralWorkspace& lw = *ls.work;
-  const std::vector<WireLanes>& packs = packs_of(m);
+  LateralWorkspace& lw = *s.lateral.work;
   const CentredPlane plane{&lat.wires, lat.mass.data(), lat.inv_mass.data(), centred_shift(m, lat.dt)};
-  for (std::size_t pk = 0; pk < packs.size(); ++pk) {
-    const WireLanes& p = packs[pk];
-    for (int lane = 0; lane < p.lanes; ++lane) {
-      const WireWindow& ww = ls.window[p.wire[lane]];
-      if (ww.hi < ww.lo) continue;
-      const double share[6] = {ww.lo_ww, ww.lo_wt, ww.lo_tt, ww.hi_ww, ww.hi_wt, ww.hi_tt};  // 0 where not cut
-      factor_centred_range(plane, p, lane, ww.lo, ww.hi, share, lw.centred_scratch.data(),
-                           lw.centred_twin.data() + lw.centred_twin_at[pk], lw.centred_single.data() + lw.centred_single_at[pk]);
-    }
-  }
+  factor_centred_windows(plane, packs_of(m), s.lateral.window, lw.centred_scratch.data(), lw.centred_twin.data(),
+                         lw.centred_twin_at, lw.centred_single.data(), lw.centred_single_at);
 }
 
 }  // namespace

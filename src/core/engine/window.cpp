@@ -118,24 +118,29 @@ void interleave_window_factors(const std::vector<WireLanes>& packs, const std::v
     }
 }
 
-namespace {
-
-// The centred damping step's factors of each pack's window range (both lanes share it: a pack's
-// wires are on the same node stations).
-void factor_centred_window(const Model& m, State& s) {
-  StepWorkspace& w = *s.work;
-  const std::vector<WireLanes>& packs = packs_of(m);
-  const CentredPlane plane{&m.wires, m.mass.data(), m.inv_mass.data(), centred_shift(m, m.dt)};
+void factor_centred_windows(const CentredPlane& plane, const std::vector<WireLanes>& packs,
+                            const std::vector<WireWindow>& windows, double* scratch, double* twin,
+                            const std::vector<std::size_t>& twin_at, double* single,
+                            const std::vector<std::size_t>& single_at) {
   for (std::size_t pk = 0; pk < packs.size(); ++pk) {
     const WireLanes& p = packs[pk];
     for (int lane = 0; lane < p.lanes; ++lane) {
-      const WireWindow& ww = s.window[p.wire[lane]];
+      const WireWindow& ww = windows[p.wire[lane]];
       if (ww.hi < ww.lo) continue;
       const double share[6] = {ww.lo_ww, ww.lo_wt, ww.lo_tt, ww.hi_ww, ww.hi_wt, ww.hi_tt};  // 0 where not cut
-      factor_centred_range(plane, p, lane, ww.lo, ww.hi, share, w.centred_scratch.data(), w.centred_twin.data() + w.centred_twin_at[pk],
-                           w.centred_single.data() + w.centred_single_at[pk]);
+      factor_centred_range(plane, p, lane, ww.lo, ww.hi, share, scratch, twin + twin_at[pk], single + single_at[pk]);
     }
   }
+}
+
+namespace {
+
+// The vertical plane's centred factors of its window (factor_centred_windows).
+void factor_centred_window(const Model& m, State& s) {
+  StepWorkspace& w = *s.work;
+  const CentredPlane plane{&m.wires, m.mass.data(), m.inv_mass.data(), centred_shift(m, m.dt)};
+  factor_centred_windows(plane, packs_of(m), s.window, w.centred_scratch.data(), w.centred_twin.data(), w.centred_twin_at,
+                         w.centred_single.data(), w.centred_single_at);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/engine/state.hpp"
+#include "model/centred_factors.hpp"
 #include "model/wire_packs.hpp"
 
 namespace catenary_sim {
@@ -19,6 +20,15 @@ void set_wire_window(const Wire& wire, double a, double b, WireWindow& window);
 // node range), laid out as WireLanes::factors at the pack's offset.
 void interleave_window_factors(const std::vector<WireLanes>& packs, const std::vector<WireWindow>& windows,
                                double* sweep_factors);
+
+// The centred damping step's factors of each pack's window range in `plane` (both lanes share it:
+// a pack's wires are on the same node stations), pack k's at twin + twin_at[k] and single +
+// single_at[k], laid out as WireLanes::centred_twin and centred_single; `scratch` for one wire's
+// range. No allocation.
+void factor_centred_windows(const CentredPlane& plane, const std::vector<WireLanes>& packs,
+                            const std::vector<WireWindow>& windows, double* scratch, double* twin,
+                            const std::vector<std::size_t>& twin_at, double* single,
+                            const std::vector<std::size_t>& single_at);
 
 // Whether DOF `dof` (numbered by `wires`' w_dof) lies in its wire's window.
 bool in_windows(const std::vector<Wire>& wires, const std::vector<WireWindow>& windows, int dof);
