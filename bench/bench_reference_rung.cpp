@@ -7,7 +7,7 @@
 // `window`: the rung with a moving window (numerics.window auto, also the endless line's), against
 // the finest solution in the same window, beside the half-step h = 0.1 m rung it replaces there.
 // `3d`: the same candidates on a 3-D line, the finest solution with centred damping in both planes
-// (at h = 0.03125 m the half-step's dt falls to 2.4 us, 17x below the centred step's, whose limit
+// (at h = 0.03125 m the half-step's dt falls to 2.4 us, 9x below the centred step's, whose limit
 // is the half-step's: CentredDamping.*ConvergesAtSecondOrderToTheHalfStepsLimit, the 2-D table).
 // Further field=value overrides apply to every pass, the finest included (e.g. train.end=1100 on
 // the endless line).
@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
           {"numerics.integrator=implicit", "numerics.element_length=0.0625", "numerics.dt=0.0005"}}});
   if (mode == "window" || mode == "3d")
     candidates = {
-        {"half-step h=0.1 (the window's rung before)", {"numerics.element_length=0.1", "numerics.damping=half_step"}},
+        {"half-step h=0.1 (the rung it replaces here)", {"numerics.element_length=0.1", "numerics.damping=half_step"}},
         {"centred h=0.0625 (the rung)", {"numerics.element_length=0.0625", "numerics.damping=centred"}},
     };
   if (mode == "centred")
