@@ -726,16 +726,14 @@ TEST_P(LateralDamping, EndlessLineGivesTheFiniteLinesContactPoint) {
   EXPECT_NEAR(total_contact_force(a.model(), a.state(), 0), total_contact_force(b.model(), b.state(), 0), 0.6);
 }
 
-INSTANTIATE_TEST_SUITE_P(Damping, LateralDamping, ::testing::Values("half_step", "centred"));
-
-TEST(Lateral, GustLeadGivesTheEndlessLineTheFiniteLinesTurbulentMotion) {
+TEST_P(LateralDamping, GustLeadGivesTheEndlessLineTheFiniteLinesTurbulentMotion) {
   // The endless reference line against a finite 66-span one, staggered and swaying as in
   // EndlessAndFinite, in the same turbulent 20 m/s cross wind: both fields start at station 0
   // with the same time grid, so they are one realisation where both reach (make_wind_field draws
   // point by point). The block starts at station 0: with the train front at 500 m the collector
   // is in span 9, the block's home at the balanced preset (asserted through the offset).
   const std::vector<std::string> common = {"train.start=500", "train.end=3300", "wind.speed=20",
-                                           "wind.turbulence.intensity=0.15", "wind.turbulence.seed=3"};
+                                           "wind.turbulence.intensity=0.15", "wind.turbulence.seed=3", damping()};
   auto endless_scene = [&](const std::vector<std::string>& extra) {
     std::vector<std::string> ov = common;
     ov.insert(ov.end(), extra.begin(), extra.end());
@@ -795,6 +793,8 @@ TEST(Lateral, GustLeadGivesTheEndlessLineTheFiniteLinesTurbulentMotion) {
   // Without the lead the spans enter with 1-2 s of gusts: a difference of the motion's order.
   EXPECT_GT(without, bound) << "turbulent motion " << motion << " m rms";
 }
+
+INSTANTIATE_TEST_SUITE_P(Damping, LateralDamping, ::testing::Values("half_step", "centred"));
 
 TEST(Lateral, EndlessLineReportsTheBlowOffPerSpanByStation) {
   // In a turbulent wind, each span's blow-off varies with its gusts: the recorder must give the
