@@ -179,15 +179,16 @@ TEST(CentredDamping, RunsAtTheUndampedLimitWhereTheHalfStepDiverges) {
 // the state keeps its last good step (nothing diverged is passed on). A wire released from 1.5 m
 // below its design shape (limit 1 m) must stop at the first step, in every lane of the kernel:
 // the pinned wire alone (a pack of one wire, pairs in two lanes) and the reference catenary (two
-// wires, pairs in four lanes), once downward and once upward.
+// wires, pairs in four lanes), whole and in a moving window, once downward and once upward; and
+// the lateral plane of a 3-D line, whose substep keeps its last good y.
 TEST(CentredDamping, StopsAtADisplacementBeyondTheLimitOfEitherSign) {
   for (double sign : {-1.0, 1.0}) {
-    for (const char* line : {"wire", "catenary"}) {
-      SCOPED_TRACE(std::string(line) + (sign < 0 ? " downward" : " upward"));
-      const Model m = std::string(line) == "wire"
-                          ? damped_wire("centred", 0.5, 2e-4, 0.25)
-                          : build_model(load_scene_file(kDir + "reference_55m.yaml",
-                                                        {"numerics.element_length=0.25", "numerics.damping=centred"}));
+    for (const std::string line : {"wire", "catenary", "catenary in a window"}) {
+      SCOPED_TRACE(line + (sign < 0 ? " downward" : " upward"));
+      std::vector<std::string> o{"numerics.element_length=0.25", "numerics.damping=centred"};
+      if (line == "catenary in a window") o.push_back("numerics.window=auto");
+      const Model m = line == "wire" ? damped_wire("centred", 0.5, 2e-4, 0.25)
+                                     : build_model(load_scene_file(kDir + "reference_55m.yaml", o));
       Model limited = m;
       limited.scene.numerics.divergence_limit = 1.0;
       State s = make_state(limited);
@@ -198,6 +199,21 @@ TEST(CentredDamping, StopsAtADisplacementBeyondTheLimitOfEitherSign) {
       EXPECT_GE(s.diverged_dof, 0);
       EXPECT_TRUE(s.u == before);
       EXPECT_EQ(s.steps, 0);
+    }
+    for (const bool windowed : {false, true}) {
+      SCOPED_TRACE(std::string(windowed ? "lateral plane in a window" : "lateral plane") + (sign < 0 ? " leftward" : " rightward"));
+      std::vector<std::string> o{"numerics.element_length=0.25", "numerics.damping=centred", "wind.turbulence=null",
+                                 "numerics.divergence_limit=1"};
+      if (windowed) o.push_back("numerics.window=auto");
+      const Model m = build_model(load_scene_file(kDir + "reference_55m_3d.yaml", o));
+      ASSERT_EQ(m.lateral->windowed, windowed);
+      State s = make_state(m);
+      for (int i = 0; i < m.lateral->n; ++i)
+        if (m.lateral->inv_mass[i] != 0.0) s.lateral.y[i] = 1.5 * sign;
+      const Eigen::VectorXd before = s.lateral.y;
+      EXPECT_EQ(step(m, s), StepStatus::kDiverged);
+      EXPECT_TRUE(s.lateral.diverged);
+      EXPECT_TRUE(s.lateral.y == before);
     }
   }
 }
