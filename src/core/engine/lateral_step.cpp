@@ -68,7 +68,7 @@ LateralState make_lateral_state(const Model& m) {
     s.window[wi].tt_lower.assign(lat.wires[wi].nodes(), 0.0);
     s.window[wi].tt_inv_pivot.assign(lat.wires[wi].nodes(), 0.0);
   }
-  if (lat.windowed && !lat.planes.empty()) work.sweep_factors.assign(2 * sweep_size(m), 0.0);
+  if (lat.windowed && !lat.planes.empty() && lat.centred_twin.empty()) work.sweep_factors.assign(2 * sweep_size(m), 0.0);
   work.window_springs.assign(lat.springs.size(), 0);
   work.window_droppers.assign(lat.pendulums.size(), 0);
   work.cut_node.assign(2 * kCutLayer * m.wires.size(), 0);

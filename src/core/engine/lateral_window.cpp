@@ -132,8 +132,10 @@ void sync_window(const Model& m, State& s) {
   for (const WireLanes& p : packs_of(m))
     if (p.lanes == 2 && (ls.window[p.wire[0]].lo != ls.window[p.wire[1]].lo || ls.window[p.wire[0]].hi != ls.window[p.wire[1]].hi))
       lw.window_fused = false;
-  if (lw.window_fused) interleave_window_factors(packs_of(m), ls.window, lw.sweep_factors.data());
+  // The window's factors for the substep that reads them (lateral_step): the centred solve's, or
+  // the fused sweep's.
   if (!lat.centred_twin.empty()) factor_centred_window(m, s);
+  else if (lw.window_fused) interleave_window_factors(packs_of(m), ls.window, lw.sweep_factors.data());
   list_window_points(m, s, first, xa, xb);
 }
 

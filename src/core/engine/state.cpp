@@ -47,8 +47,8 @@ State make_state(const Model& m) {
     s.work->v_next = Eigen::VectorXd::Zero(m.n_dof);
     s.work->sweep.assign(kSweepRecord * sweep_size(m), 0.0);
     s.work->point_node.assign(m.collectors.size() * m.contact_wires.size() * m.max_contact_nodes, 0);
-    if (m.scene.numerics.windowed()) {
-      s.work->sweep_factors.assign(2 * sweep_size(m), 0.0);
+    if (m.scene.numerics.windowed() && m.scene.numerics.damping != DampingStep::kCentred) {
+      s.work->sweep_factors.assign(2 * sweep_size(m), 0.0);  // (the half-step sweep's window factors)
     }
   }
   int max_nodes = 1;

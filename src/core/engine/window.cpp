@@ -179,8 +179,10 @@ void update_window(const Model& m, State& s) {
         s.v[w.w_dof + i] = 0.0;
       }
   }
-  interleave_window_factors(packs_of(m), s.window, s.work->sweep_factors.data());
+  // The window's factors for the step that reads them: the centred solve's, or the half-step
+  // sweep's LDL^T of K_theta_theta.
   if (m.scene.numerics.damping == DampingStep::kCentred) factor_centred_window(m, s);
+  else interleave_window_factors(packs_of(m), s.window, s.work->sweep_factors.data());
   // Index lists sized once in make_state (a copied State keeps their size): no allocation. Only
   // the droppers and supports between the window's ends are looked at, so moving the window costs
   // what the window holds, not the line.
