@@ -24,10 +24,10 @@ void clear_point_forces(const Model& m, State& s, bool windowed, double* f) {
   for (const Pantograph& p : m.pantographs)
     for (int ci : p.collectors) {
       const double xc = s.front - p.position + m.collectors[ci].offset;
-      for (int wi : m.contact_wires) {
-        const Wire& w = m.wires[wi];
-        const int cnt = contact_weights(w, m.rub_length, xc, s.work->weight_node.data(), s.work->weight.data());
-        for (int a = 0; a < cnt; ++a) f[w.w_dof + s.work->weight_node[a]] = load[w.w_dof + s.work->weight_node[a]];
+      for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+        const Wire& w = m.wires[m.contact_wires[wk]];
+        const ContactPatch cp = contact_patch(m, *s.work, ci, wk, xc);
+        for (int a = 0; a < cp.count; ++a) f[w.w_dof + cp.node[a]] = load[w.w_dof + cp.node[a]];
       }
     }
 }

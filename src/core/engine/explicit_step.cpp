@@ -71,30 +71,21 @@ bool sweep_packs(const Model& m, State& s, bool windowed) {
 }
 
 // The nodes with point forces: the contact wire's nodes under every collector (contact_forces'
-// weights), listed once per step into StepWorkspace::point_node; returns how many. A node may come more
-// than once.
+// patches), listed once per step into StepWorkspace::point_node; returns how many. A node may come
+// more than once.
 int list_contact_nodes(const Model& m, State& s, bool windowed) {
   int contacts = 0;
   int* contact_node = s.work->point_node.data();
   for (const Pantograph& p : m.pantographs)
     for (int ci : p.collectors) {
       const double xc = s.front - p.position + m.collectors[ci].offset;
-      for (int cw : m.contact_wires) {
-        const Wire& w = m.wires[cw];
-        // The nodes contact_weights gives weights to (without the weights: no sin, cos).
-        int first = 0, last = -1;
-        const double x0 = w.x.front(), x1 = w.x.back();
-        if (m.rub_length <= 0.0) {
-          if (xc >= x0 && xc <= x1) last = (first = w.element_at(xc)) + 1;
-        } else {
-          const double a = xc - 0.5 * m.rub_length, b = xc + 0.5 * m.rub_length;
-          if (!(b <= x0 || a >= x1)) {
-            first = w.element_at(a);
-            last = w.element_at(b) + 1;
-          }
+      for (std::size_t wk = 0; wk < m.contact_wires.size(); ++wk) {
+        const int cw = m.contact_wires[wk];
+        const ContactPatch cp = contact_patch(m, *s.work, ci, wk, xc);
+        for (int a = 0; a < cp.count; ++a) {
+          const int i = cp.node[a];
+          if (!windowed || (i >= s.window[cw].lo && i <= s.window[cw].hi)) contact_node[contacts++] = m.wires[cw].w_dof + i;
         }
-        for (int i = first; i <= last; ++i)
-          if (!windowed || (i >= s.window[cw].lo && i <= s.window[cw].hi)) contact_node[contacts++] = w.w_dof + i;
       }
     }
   return contacts;

@@ -10,6 +10,18 @@
 
 namespace catenary_sim {
 
+ContactPatch contact_patch(const Model& m, StepWorkspace& work, int ci, std::size_t wk, double xc) {
+  const std::size_t idx = static_cast<std::size_t>(ci) * m.contact_wires.size() + wk;
+  const std::size_t at = idx * static_cast<std::size_t>(m.max_contact_nodes);
+  int* node = work.patch_node.data() + at;
+  double* weight = work.patch_weight.data() + at;
+  if (!(work.patch_x[idx] == xc)) {
+    work.patch_count[idx] = contact_weights(m.wires[m.contact_wires[wk]], m.rub_length, xc, node, weight);
+    work.patch_x[idx] = xc;
+  }
+  return ContactPatch{work.patch_count[idx], node, weight};
+}
+
 void contact_forces(const Model& m, State& s, const double* u, double* f) {
   const std::size_t nw = m.contact_wires.size();
   for (std::size_t pi = 0; pi < m.pantographs.size(); ++pi) {
@@ -25,11 +37,11 @@ void contact_forces(const Model& m, State& s, const double* u, double* f) {
       double lowest = std::numeric_limits<double>::infinity();
       for (std::size_t wk = 0; wk < nw; ++wk) {
         const Wire& w = m.wires[m.contact_wires[wk]];
-        const int cnt = contact_weights(w, m.rub_length, xc, s.work->weight_node.data(), s.work->weight.data());
+        const ContactPatch cp = contact_patch(m, *s.work, ci, wk, xc);
         double yw = 0.0;
-        for (int a = 0; a < cnt; ++a) yw += s.work->weight[a] * (w.height[s.work->weight_node[a]] + u[w.w_dof + s.work->weight_node[a]]);
-        s.collector_height[ci * nw + wk] = cnt ? yw : std::nan("");
-        if (cnt) lowest = std::min(lowest, yw);
+        for (int a = 0; a < cp.count; ++a) yw += cp.weight[a] * (w.height[cp.node[a]] + u[w.w_dof + cp.node[a]]);
+        s.collector_height[ci * nw + wk] = cp.count ? yw : std::nan("");
+        if (cp.count) lowest = std::min(lowest, yw);
       }
       // A force-driven collector (moving force, external rig) pushes the lowest wire(s) under it,
       // shared equally among wires within 1 mm of the lowest (a twin contact wire).
@@ -48,9 +60,9 @@ void contact_forces(const Model& m, State& s, const double* u, double* f) {
         s.contact_force[idx] = fc;
         if (fc == 0.0 || !f) continue;
         const Wire& w = m.wires[m.contact_wires[wk]];
-        const int cnt = contact_weights(w, m.rub_length, xc, s.work->weight_node.data(), s.work->weight.data());
+        const ContactPatch cp = contact_patch(m, *s.work, ci, wk, xc);
         if (!p.moving_force) f[col.dof] -= fc;
-        for (int a = 0; a < cnt; ++a) f[w.w_dof + s.work->weight_node[a]] += fc * s.work->weight[a];
+        for (int a = 0; a < cp.count; ++a) f[w.w_dof + cp.node[a]] += fc * cp.weight[a];
       }
     }
   }

@@ -17,6 +17,21 @@ namespace catenary_sim {
 // Writes state.contact_force and state.collector_height; adds the forces to f unless f is null.
 void contact_forces(const Model& m, State& s, const double* u, double* f);
 
+struct StepWorkspace;
+
+// The contact patch of collector `ci` on the `wk`-th contact wire at station xc: the nodes and
+// weights of eq. 12-13 (contact_weights), kept in the step's workspace per collector and wire and
+// found again only when xc moves. A step needs them at one train position up to four times (the
+// nodes it redoes, the heights, the forces, the lateral contact point), and the observation that
+// ends a step finds those the next step starts with; their bisections and each element's sine and
+// cosine are much of a small model's fixed cost per step. The same numbers, bit for bit.
+struct ContactPatch {
+  int count = 0;
+  const int* node = nullptr;  // wire node indices
+  const double* weight = nullptr;
+};
+ContactPatch contact_patch(const Model& m, StepWorkspace& work, int ci, std::size_t wk, double xc);
+
 // A 3-D line whose state has its lateral plane (make_state gives it one; a state whose lateral
 // plane was cleared by hand steps its vertical plane alone, the droppers without a lean).
 inline bool leaning(const Model& m, const State& s) { return m.lateral && !s.lateral.dropper_stretch.empty(); }

@@ -39,7 +39,8 @@ int contact_corrections(const Model& m, State& s) {
         if (!(s.contact_force[ci * nw + wk] > 0.0)) continue;
         const Wire& w = m.wires[m.contact_wires[wk]];
         const double xc = s.front - p.position + m.collectors[ci].offset;
-        const int cnt = contact_weights(w, m.rub_length, xc, s.work->weight_node.data(), s.work->weight.data());
+        const ContactPatch cp = contact_patch(m, *s.work, ci, wk, xc);
+        const int cnt = cp.count;
         double* y = s.work->contact_solve.data() + static_cast<std::size_t>(active) * n;
         std::fill(y, y + n, 0.0);
         int* gi = s.work->correction_g_index.data() + active * stride;
@@ -47,8 +48,8 @@ int contact_corrections(const Model& m, State& s) {
         gi[0] = m.collectors[ci].dof;
         gv[0] = 1.0;
         for (int a = 0; a < cnt; ++a) {
-          gi[a + 1] = w.w_dof + s.work->weight_node[a];
-          gv[a + 1] = -s.work->weight[a];
+          gi[a + 1] = w.w_dof + cp.node[a];
+          gv[a + 1] = -cp.weight[a];
         }
         s.work->correction_g_count[active] = cnt + 1;
         s.work->correction_factor[active] = 0.25 * m.dt * m.dt * m.contact_stiffness;

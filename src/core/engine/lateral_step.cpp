@@ -9,6 +9,7 @@
 
 #include "catenary_sim/core/engine/state.hpp"
 #include "engine/centred_damping.hpp"
+#include "engine/forces.hpp"
 #include "engine/lateral_window.hpp"
 #include "engine/lateral_wind.hpp"
 #include "engine/lateral_workspace.hpp"
@@ -53,8 +54,6 @@ LateralState make_lateral_state(const Model& m) {
   s.wind_points.assign(std::max(0, lat.field.held), 0.0);
   if (m.endless) s.wind_field.reset(lat.field);  // (nothing for a steady wind)
   if (lat.windy) s.wind_speed = lat.wind_speed * lat.wind_normal;  // the mean wind until the field's first refresh
-  work.weight_node.assign(m.max_contact_nodes, 0);
-  work.weight.assign(m.max_contact_nodes, 0.0);
   s.contact_lateral.assign(m.collectors.size() * m.contact_wires.size(), std::nan(""));
   s.collector_lateral.assign(m.collectors.size(), std::nan(""));
   s.pantograph_lateral.assign(m.pantographs.size(), 0.0);
@@ -97,7 +96,6 @@ namespace {
 bool contact_points(const Model& m, State& s, bool record) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
-  LateralWorkspace& lw = *ls.work;
   const PantographHeadSpec& head = m.scene.pantograph_head;
   const double sway = head.sway(s.time);  // the contact point on the strip is wire minus pantograph
   const std::size_t nw = m.contact_wires.size();
@@ -111,13 +109,13 @@ bool contact_points(const Model& m, State& s, bool record) {
       double best_force = 0.0;
       int running = -1;
       for (std::size_t wk = 0; wk < nw; ++wk) {
-        const Wire& w = lat.wires[m.contact_wires[wk]];
-        const int cnt = contact_weights(w, m.rub_length, xc, lw.weight_node.data(), lw.weight.data());
+        const Wire& w = lat.wires[m.contact_wires[wk]];  // (the vertical plane's nodes: the same patch)
+        const ContactPatch cp = contact_patch(m, *s.work, ci, wk, xc);
         double y = 0.0;
-        for (int a = 0; a < cnt; ++a) y += lw.weight[a] * ls.y[w.w_dof + lw.weight_node[a]];
-        ls.contact_lateral[ci * nw + wk] = cnt ? y - sway : std::nan("");
+        for (int a = 0; a < cp.count; ++a) y += cp.weight[a] * ls.y[w.w_dof + cp.node[a]];
+        ls.contact_lateral[ci * nw + wk] = cp.count ? y - sway : std::nan("");
         const double fc = s.contact_force[ci * nw + wk];
-        if (cnt && fc > best_force) {
+        if (cp.count && fc > best_force) {
           best_force = fc;
           running = static_cast<int>(wk);
         }

@@ -23,10 +23,8 @@ struct LateralWorkspace {
   std::vector<double> sweep;
   bool join = false, joined = false, joined_outside = false;
   std::int64_t joined_steps = 0;  // diagnostic: steps whose lateral sweep the vertical step took along
-  // Condensed rotations of one wire, and the eq. 12 weights of one contact point.
+  // Condensed rotations of one wire.
   std::vector<double> theta;
-  std::vector<int> weight_node;
-  std::vector<double> weight;
   // Per dropper: 1 where the lean acts on its tension, 0 outside the vertical plane's window
   // (set from State::window_droppers at every windowed step; all 1 without a window).
   std::vector<double> lean_weight;

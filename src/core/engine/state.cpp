@@ -67,8 +67,11 @@ State make_state(const Model& m) {
     s.work->centred_scratch.assign(static_cast<std::size_t>(max_nodes) * kCdValues, 0.0);
   }
   s.work->theta.assign(max_nodes, 0.0);
-  s.work->weight_node.assign(m.max_contact_nodes, 0);
-  s.work->weight.assign(m.max_contact_nodes, 0.0);
+  const std::size_t patches = m.collectors.size() * m.contact_wires.size();
+  s.work->patch_x.assign(patches, std::nan(""));
+  s.work->patch_count.assign(patches, 0);
+  s.work->patch_node.assign(patches * m.max_contact_nodes, 0);
+  s.work->patch_weight.assign(patches * m.max_contact_nodes, 0.0);
   s.contact_force.assign(m.collectors.size() * m.contact_wires.size(), 0.0);
   s.collector_height.assign(m.collectors.size() * m.contact_wires.size(), 0.0);
   s.dropper_slack.assign(m.droppers.size(), 0);

@@ -37,10 +37,14 @@ struct StepWorkspace {
   std::vector<int> correction_g_index, correction_g_count;
   std::vector<double> correction_g_value, correction_factor, correction_small;
   std::vector<const double*> correction_solve;
-  // Condensed rotations of one wire, and the eq. 12 weights of one contact point.
+  // Condensed rotations of one wire.
   std::vector<double> theta;
-  std::vector<int> weight_node;
-  std::vector<double> weight;
+  // Per collector and contact wire (ci * contact wires + wk): the station the contact patch below
+  // was found for (NaN: none yet), its node count, and max_contact_nodes nodes and weights
+  // (contact_patch, forces.hpp).
+  std::vector<double> patch_x;
+  std::vector<int> patch_count, patch_node;
+  std::vector<double> patch_weight;
 };
 
 }  // namespace catenary_sim
