@@ -95,9 +95,10 @@ std::string Simulation::status_message() const {
           where = "pantograph " + p.name + " mass " + std::to_string(d - p.first_dof);
         else if (!p.moving_force && d >= p.first_dof && d < p.first_dof + p.dof_count())
           where = "pantograph " + p.name + " head " + std::to_string(d - p.first_dof - p.masses_count());
-      s << "diverged at t = " << state_.time << " s: displacement of " << where << " is "
-        << state_.u[d] << " m (limit " << model_.scene.numerics.divergence_limit
-        << " m); the run was stopped. " << divergence_cause();
+      // The step's rejected value: the state kept the last good one, within the limit.
+      s << "diverged at t = " << state_.time << " s: displacement of " << where << " reached "
+        << state_.diverged_displacement << " m (limit " << model_.scene.numerics.divergence_limit
+        << " m); the run was stopped at the last step within it. " << divergence_cause();
       break;
     }
   }
@@ -133,6 +134,16 @@ std::string Simulation::divergence_cause() const {
     s << "Likely cause: numerics.divergence_limit = " << limit << " m is within the line's own displacements (its static "
       << "state already reaches " << moved << " m): the limit stopped the run, not an instability; raise it (5 m by "
       << "default)";
+    return s.str();
+  }
+  // A limit lowered to within the pass's own motion (the contact wire rises by centimetres to
+  // decimetres under the pantographs): the step that stopped the run went past it by less than the
+  // limit itself, as a smooth motion does (a NaN or a jump beyond twice the limit is not that).
+  const double reached = std::fabs(state_.diverged_displacement);
+  if (limit < NumericsSpec{}.divergence_limit && std::isfinite(reached) && reached < 2.0 * limit) {
+    s << "Likely cause: numerics.divergence_limit = " << limit << " m, below its default of "
+      << NumericsSpec{}.divergence_limit << " m, is within reach of the line's own motion under the pass: the "
+      << "displacement passed it by " << reached - limit << " m in one step; raise it if the pass may move that far";
     return s.str();
   }
   const double ratio = model_.dt / model_.dt_critical;

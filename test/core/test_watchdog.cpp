@@ -23,6 +23,13 @@ TEST(Watchdog, RunawayDisplacementStopsTheRun) {
   const std::string msg = sim.status_message();
   EXPECT_NE(msg.find("diverged at t = "), std::string::npos) << msg;
   EXPECT_NE(msg.find("limit 0.01 m"), std::string::npos) << msg;
+  // The message gives the value the rejected step reached, beyond the limit (not the last good
+  // step's, which is within it).
+  const double reached = sim.state().diverged_displacement;
+  EXPECT_GT(std::fabs(reached), 0.01);
+  const std::size_t at = msg.find("reached ");
+  ASSERT_NE(at, std::string::npos) << msg;
+  EXPECT_GT(std::fabs(std::stod(msg.substr(at + 8))), 0.01) << msg;
   // The state keeps the last good step: nothing beyond the limit is passed on.
   EXPECT_LE(sim.state().u.cwiseAbs().maxCoeff(), 0.01);
   const double t = sim.state().time;

@@ -84,13 +84,14 @@ StepStatus centred_damping_step(const Model& m, State& s) {
     s.status = StepStatus::kDiverged;
     if (windowed) {
       s.diverged_dof = last_beyond(m, s, true);
-      return s.status;
+    } else {
+      for (int i = 0; i < n; ++i)
+        if (!(std::fabs(un[i]) <= limit)) {
+          s.diverged_dof = i;
+          break;
+        }
     }
-    for (int i = 0; i < n; ++i)
-      if (!(std::fabs(un[i]) <= limit)) {
-        s.diverged_dof = i;
-        break;
-      }
+    if (s.diverged_dof >= 0) s.diverged_displacement = un[s.diverged_dof];
     return s.status;
   }
   if (windowed) {

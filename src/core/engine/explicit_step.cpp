@@ -140,16 +140,17 @@ int explicit_fused_update(const Model& m, State& s, bool windowed) {
   return outside ? last_beyond(m, s, windowed) : -1;
 }
 
-StepStatus diverged(State& s, int dof) {
+StepStatus diverged(State& s, int dof, const double* u_new) {
   s.status = StepStatus::kDiverged;
   s.diverged_dof = dof;
+  s.diverged_displacement = u_new[dof];
   return s.status;
 }
 
 // The fused step's end: the new values swapped in (or copied back in the window) once all are good.
 StepStatus fused_step(const Model& m, State& s, bool windowed) {
   const int bad = explicit_fused_update(m, s, windowed);
-  if (bad >= 0) return diverged(s, bad);
+  if (bad >= 0) return diverged(s, bad, s.work->u_next.data());
   if (windowed) {
     commit_window(m, s, s.work->u_next.data(), s.work->v_next.data());
   } else {
@@ -199,7 +200,7 @@ StepStatus generic_step(const Model& m, State& s, bool windowed) {
   } else {
     update(0, n);
   }
-  if (bad >= 0) return diverged(s, bad);
+  if (bad >= 0) return diverged(s, bad, u_new);
   if (windowed) {
     commit_window(m, s, u_new, v_new);
   } else {

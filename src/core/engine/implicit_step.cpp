@@ -243,6 +243,7 @@ StepStatus implicit_step(const Model& m, State& s) {
   if (bad >= 0) {
     s.status = StepStatus::kDiverged;
     s.diverged_dof = bad;
+    s.diverged_displacement = u_new[bad];
     return s.status;
   }
   s.v.swap(s.work->force);  // O(1): swaps the buffers, no copy, no allocation

@@ -114,6 +114,9 @@ struct State {
 
   StepStatus status = StepStatus::kOk;
   int diverged_dof = -1;
+  // m: what the rejected step gave diverged_dof (beyond numerics.divergence_limit, or NaN); the
+  // state itself keeps the last good step.
+  double diverged_displacement = 0.0;
   bool active_set_full = false;  // implicit: more droppers slack at once than it takes out (kDiverged)
 
   // Moving window (numerics.window): the supports it spans and what it integrates.
