@@ -21,6 +21,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../test/support/scenes.hpp"
+#include "guarded_main.hpp"
 
 using namespace catenary_sim;
 
@@ -37,7 +38,7 @@ double rss_mb() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   double hours = 2.0, report = 600.0;
   std::string scene = test_scenes::kReferenceEndless;
   std::vector<std::string> overrides = {"numerics.preset=fast", "output.sample_rate=0.001", "train.speed_kmh=300"};
@@ -106,3 +107,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_endless_soak", argc, argv, bench_main); }

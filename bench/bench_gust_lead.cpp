@@ -20,6 +20,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "../test/support/scenes.hpp"
+#include "guarded_main.hpp"
 
 using namespace catenary_sim;
 
@@ -51,7 +52,7 @@ struct Run {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   const int seeds = argc > 1 ? std::max(1, std::atoi(argv[1])) : 4;
   const std::vector<std::string> leads = {"0", "5", "10", "auto", "30"};
   std::printf("endless line in a turbulent wind against the finite line, balanced, 300 km/h; turbulent motion of the "
@@ -112,3 +113,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_gust_lead", argc, argv, bench_main); }

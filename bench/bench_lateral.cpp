@@ -24,6 +24,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../test/support/scenes.hpp"
+#include "guarded_main.hpp"
 
 using namespace catenary_sim;
 
@@ -111,7 +112,7 @@ void turbulent_motion(int seed, std::vector<std::string> windy) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
   const int long_spans = argc > 2 ? std::max(0, std::atoi(argv[2])) : 100;
   const std::string path = test_scenes::kReference;
@@ -177,3 +178,5 @@ int main(int argc, char** argv) {
   for (int seed = 1; seed <= (argc > 3 ? std::atoi(argv[3]) : 0); ++seed) turbulent_motion(seed, windy);
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_lateral", argc, argv, bench_main); }

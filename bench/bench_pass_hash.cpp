@@ -17,10 +17,11 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
+#include "guarded_main.hpp"
 
 using namespace catenary_sim;
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: bench_pass_hash SCENE [field=value ...]\n");
     return 2;
@@ -54,3 +55,5 @@ int main(int argc, char** argv) {
               wall / steps / sim.model().n_dof * 1e9, static_cast<unsigned long long>(hash));
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_pass_hash", argc, argv, bench_main); }

@@ -14,10 +14,11 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../test/support/scenes.hpp"
+#include "guarded_main.hpp"
 
 using namespace catenary_sim;
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
   const std::string path = argc > 2 ? argv[2] : test_scenes::kReference;
   std::printf("%-34s %6s %9s %7s %10s %10s %8s\n", "variant", "DOFs", "dt_ms", "steps", "wall_med_s", "wall_min_s", "RTF_med");
@@ -78,3 +79,5 @@ int main(int argc, char** argv) {
               medians[1] / medians[0], medians[2] / medians[0], medians[2] / medians[1]);
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_reference_pass", argc, argv, bench_main); }

@@ -24,11 +24,12 @@
 #include <vector>
 
 #include "pass_errors.hpp"
+#include "guarded_main.hpp"
 
 using bench::PassResult;
 using bench::run_pass;
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   const std::string path = argc > 1 ? argv[1] : bench::kReferenceScene;
   const std::string csv_path = argc > 2 ? argv[2] : "reference_rung.csv";
   const std::string finest_h = argc > 3 ? argv[3] : "0.03125";
@@ -158,3 +159,5 @@ int main(int argc, char** argv) {
   std::printf("\nwrote %s\n", csv_path.c_str());
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_reference_rung", argc, argv, bench_main); }

@@ -11,11 +11,12 @@
 #include <vector>
 
 #include "pass_errors.hpp"
+#include "guarded_main.hpp"
 
 using bench::PassResult;
 using bench::run_pass;
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   const std::string path = argc > 1 ? argv[1] : bench::kReferenceScene;
   const std::string csv_path = argc > 2 ? argv[2] : "speed_accuracy.csv";
   std::ofstream csv(csv_path);
@@ -48,3 +49,5 @@ int main(int argc, char** argv) {
   std::printf("\nwrote %s\n", csv_path.c_str());
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_speed_accuracy", argc, argv, bench_main); }

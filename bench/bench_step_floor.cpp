@@ -22,6 +22,7 @@
 #include "../test/support/scenes.hpp"
 #include "../src/core/engine/wire_lanes.hpp"  // the step's kernel, timed alone
 #include "../src/core/engine/step_workspace.hpp"
+#include "guarded_main.hpp"
 
 using namespace catenary_sim;
 
@@ -199,7 +200,7 @@ std::vector<Floor> floors_of(const Model& m, const State& s0) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 7;
   const std::string path = argc > 2 ? argv[2] : test_scenes::kReference;
   const std::string preset = argc > 3 ? argv[3] : "accurate";
@@ -295,3 +296,5 @@ int main(int argc, char** argv) {
               rows[0].walls.front() / rows[1].walls.front());
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_step_floor", argc, argv, bench_main); }

@@ -11,8 +11,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include "guarded_main.hpp"
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   const double rate = argc > 1 ? std::atof(argv[1]) : 1000.0;
   const double seconds = argc > 2 ? std::atof(argv[2]) : 20.0;
   if (!(rate >= 1.0 && rate <= 100000.0) || !(seconds > 0.0 && seconds <= 3600.0)) {
@@ -47,3 +48,5 @@ int main(int argc, char** argv) {
               n, rate, 1e6 * sum / n, 1e3 * max, late[0], late[1], late[2], late[3], late[1] / seconds);
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_timer_jitter", argc, argv, bench_main); }

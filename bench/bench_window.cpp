@@ -12,6 +12,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../test/support/scenes.hpp"
+#include "guarded_main.hpp"
 
 using namespace catenary_sim;
 
@@ -40,7 +41,7 @@ Run run(std::vector<std::string> ov, const std::string& scene = test_scenes::kRe
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   const int spans = argc > 1 ? std::atoi(argv[1]) : 100;
   const std::string n = "line.span_count=" + std::to_string(spans);
   const std::string section = "output.analysis_spans=[4," + std::to_string(spans - 4) + "]";
@@ -83,3 +84,5 @@ int main(int argc, char** argv) {
               1e3 * endless.wall / endless.sim_time, spans, 1e3 * endless_long.wall / endless_long.sim_time, 10 * spans);
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_window", argc, argv, bench_main); }

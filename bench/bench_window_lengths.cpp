@@ -18,6 +18,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../test/support/scenes.hpp"
+#include "guarded_main.hpp"
 
 using namespace catenary_sim;
 
@@ -44,7 +45,7 @@ void print_change(double kmh, const char* varied, double ahead, double behind, c
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int bench_main(int argc, char** argv) {
   std::vector<double> speeds = {150, 250, 300, 350};
   if (argc > 1) {
     speeds.clear();
@@ -78,3 +79,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return bench::guarded_main("bench_window_lengths", argc, argv, bench_main); }
