@@ -103,12 +103,19 @@ TEST(Allocation, ThreeDimensionalStepNeverAllocatesAndRepeatsItsBits) {
   struct Case {
     std::string file;
     std::vector<std::string> overrides;
+    bool endless = false;  // the file's line made endless (test_scenes::endless_scene)
   };
+  // The stitched 3-D line too: its clamps in plan on the whole line, in the window and on the
+  // endless block (whose moves hand each stitch wire's lateral state on).
+  const std::string stitched = test_scenes::kReferenceStitched3d;
   std::vector<Case> cases = {{three_d, {}}, {three_d, {"numerics.window=auto"}},
                              {three_d, {"numerics.window=auto", "wind.turbulence=null"}},
                              {test_scenes::kReferenceEndless,
                               {"stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]", "wind.speed=20",
-                               "wind.turbulence.intensity=0.15", "alignment.radius=1200"}}};
+                               "wind.turbulence.intensity=0.15", "alignment.radius=1200"}},
+                             {stitched, {}},
+                             {stitched, {"numerics.window=auto", "wind.turbulence=null"}},
+                             {stitched, {"numerics.window=auto", "numerics.preset=balanced", "train.start=1650", "train.end=5500"}, true}};
   // The same with the centred damping step in both planes.
   const std::size_t half_step_cases = cases.size();
   for (std::size_t k = 0; k < half_step_cases; ++k) {
@@ -117,7 +124,7 @@ TEST(Allocation, ThreeDimensionalStepNeverAllocatesAndRepeatsItsBits) {
   }
   for (Case& c : cases) {
     c.overrides.insert(c.overrides.end(), sway.begin(), sway.end());
-    const Scene scene = load_scene_file(c.file, c.overrides);
+    const Scene scene = c.endless ? test_scenes::endless_scene(c.file, c.overrides) : load_scene_file(c.file, c.overrides);
     Simulation a(scene), b(scene);
     ASSERT_TRUE(a.model().lateral);
     a.step();

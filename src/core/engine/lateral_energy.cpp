@@ -16,7 +16,8 @@ double dropper_potential(const Dropper& d, double e) {
   return d.static_tension * e + 0.5 * d.stiffness * e * e;
 }
 
-// The lateral plane's energy without the droppers: kinetic, wires and supports, less the loads.
+// The lateral plane's energy without the droppers: kinetic, wires, supports and stitch wires'
+// clamps, less the loads.
 double lateral_wire_energy(const Model& m, const State& s) {
   const LateralModel& lat = *m.lateral;
   const int n = lat.n;
@@ -25,6 +26,11 @@ double lateral_wire_energy(const Model& m, const State& s) {
   const double* y = s.lateral.y.data();
   for (const Wire& w : lat.wires) wire_elastic_force(w, y, f.data(), theta.data());  // f = -K y
   for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * y[sp.dof];
+  for (const LateralClamp& c : lat.clamps) {  // (a stitch wire's clamps: k (y_m - y_s)^2 / 2)
+    const double d = c.stiffness * (y[c.messenger] - y[c.stitch]);
+    f[c.stitch] += d;
+    f[c.messenger] -= d;
+  }
   double e = 0.0;
   for (int i = 0; i < n; ++i)
     e += 0.5 * lat.mass[i] * s.lateral.v[i] * s.lateral.v[i] * (lat.inv_mass[i] > 0.0) - 0.5 * y[i] * f[i] -

@@ -70,9 +70,10 @@ LateralState make_lateral_state(const Model& m) {
   if (lat.windowed && !lat.planes.empty() && lat.centred_twin.empty()) work.sweep_factors.assign(2 * sweep_size(m), 0.0);
   work.window_springs.assign(lat.springs.size(), 0);
   work.window_droppers.assign(lat.pendulums.size(), 0);
+  work.window_clamps.assign(lat.clamps.size(), 0);
   work.cut_node.assign(2 * kCutLayer * m.wires.size(), 0);
   work.cut_force.assign(work.cut_node.size(), 0.0);
-  work.window_points.assign(work.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size(), 0);
+  work.window_points.assign(work.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size() + 2 * lat.clamps.size(), 0);
   if (lat.windowed && !lat.centred_twin.empty()) {
     // A window's range has at most its wires' nodes: the whole wires' layout sizes it.
     std::size_t twin = 0, single = 0;
@@ -144,11 +145,11 @@ void lateral_observe(const Model& m, State& s) {
 
 namespace {
 
-// The springs (steady arms, messenger supports) and the droppers' pendulums on f, at
-// z = y + beta v (`z_at`), over the window's lists or the whole line: the pendulums at the
-// droppers' tension now with their lean's share (two-way coupling, lateral.hpp), 0 when slack, and
-// each lean summed into dropper_stretch for the next vertical step. The fused and the generic
-// step share it, so they do the same operations.
+// The springs (steady arms, messenger supports), the droppers' pendulums and the stitch wires'
+// clamps on f, at z = y + beta v (`z_at`), over the window's lists or the whole line: the
+// pendulums at the droppers' tension now with their lean's share (two-way coupling, lateral.hpp),
+// 0 when slack, and each lean summed into dropper_stretch for the next vertical step; the clamps
+// bilateral, never slack. The fused and the generic step share it, so they do the same operations.
 template <class ZAt>
 void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const double* y, ZAt z_at, double* f) {
   const LateralModel& lat = *m.lateral;
@@ -173,6 +174,13 @@ void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const do
     const double df = k * (z_at(p.messenger) - z_at(p.contact));
     f[p.contact] += df;
     f[p.messenger] -= df;
+  }
+  const int n_clamps = windowed ? lw.window_clamp_count : static_cast<int>(lat.clamps.size());
+  for (int j = 0; j < n_clamps; ++j) {
+    const LateralClamp& c = lat.clamps[windowed ? lw.window_clamps[j] : j];
+    const double df = c.stiffness * (z_at(c.messenger) - z_at(c.stitch));
+    f[c.stitch] += df;
+    f[c.messenger] -= df;
   }
 }
 
@@ -414,8 +422,35 @@ void shift_lateral_block(const Model& m, State& s) {
   LateralState& ls = s.lateral;
   LateralWorkspace& lw = *ls.work;
   const bool windowed = lat.windowed;  // (an endless line always is)
+  // A stitched line's stitch wires, one per support: each takes the window's state of the one
+  // `endless_shift_spans` supports on, as the vertical plane's (shift_endless_block; the stagger
+  // repeats with the move, so their static states are alike); its other nodes, and the last ones,
+  // are in the static state under the mean wind at rest, their window empty until sync_window.
+  const std::vector<int>& stitch = m.sections.front().stitch_wires;
+  for (std::size_t j = 0; j < stitch.size(); ++j) {
+    const Wire& w = lat.wires[stitch[j]];
+    WireWindow& ww = ls.window[stitch[j]];
+    const int o = w.w_dof;
+    for (int i = std::max(0, ww.lo); i <= ww.hi; ++i) {
+      ls.y[o + i] = lat.initial[o + i];
+      ls.v[o + i] = 0.0;
+    }
+    ww.lo = 0;
+    ww.hi = -1;
+    if (j + m.endless_shift_spans >= stitch.size()) continue;
+    const int src = lat.wires[stitch[j + m.endless_shift_spans]].w_dof;
+    const WireWindow& from = ls.window[stitch[j + m.endless_shift_spans]];
+    for (int i = std::max(0, from.lo); i <= from.hi; ++i) {
+      ls.y[o + i] = ls.y[src + i];
+      ls.v[o + i] = ls.v[src + i];
+      if (lat.windy) ls.wind_speed[o + i] = ls.wind_speed[src + i];
+    }
+    ww.lo = from.lo;
+    ww.hi = from.hi;
+  }
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     const Wire& w = lat.wires[wi];
+    if (w.is_stitch_wire) continue;
     const int ns = m.endless_shift_spans * m.span_nodes[wi], o = w.w_dof, nn = w.nodes();
     // The nodes stepped: the window (outside it they are in the static state), as the vertical
     // plane moves its window (shift_endless_block).

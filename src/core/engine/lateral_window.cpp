@@ -58,14 +58,15 @@ void move_wire_window(const Model& m, State& s, std::size_t wi, int first, doubl
     for (int i = std::max(lo_end + 1, hi - kCutLayer + 1); i <= hi; ++i) add_cut(i);
 }
 
-// The springs and pendulums (droppers) between the window's end supports whose nodes it holds,
-// and the fused step's nodes with point forces: the cut layers, springs, pendulums.
+// The springs, pendulums (droppers) and stitch wires' clamps between the window's end supports
+// whose nodes it holds, and the fused step's nodes with point forces: the cut layers, springs,
+// pendulums, clamps.
 void list_window_points(const Model& m, State& s, int first, double xa, double xb) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
   LateralWorkspace& lw = *ls.work;
   auto inside = [&](int dof) { return in_windows(lat.wires, ls.window, dof); };
-  lw.window_spring_count = lw.window_dropper_count = 0;
+  lw.window_spring_count = lw.window_dropper_count = lw.window_clamp_count = 0;
   if (first >= 0) {
     lw.window_spring_count = select_between(
         lat.spring_order, lat.spring_order_x, xa, xb, [&](int k) { return inside(lat.springs[k].dof); },
@@ -74,8 +75,11 @@ void list_window_points(const Model& m, State& s, int first, double xa, double x
         m.dropper_order, m.dropper_order_x, xa, xb,
         [&](int k) { return inside(lat.pendulums[k].contact) && inside(lat.pendulums[k].messenger); },
         lw.window_droppers.data());
+    lw.window_clamp_count = select_between(
+        m.clamp_order, m.clamp_order_x, xa, xb,
+        [&](int k) { return inside(lat.clamps[k].stitch) && inside(lat.clamps[k].messenger); }, lw.window_clamps.data());
   }
-  // The fused step's nodes with point forces: the cut layers, springs, pendulums.
+  // The fused step's nodes with point forces: the cut layers, springs, pendulums, clamps.
   int q = 0;
   for (int j = 0; j < lw.cut_count; ++j) lw.window_points[q++] = lw.cut_node[j];
   for (int j = 0; j < lw.window_spring_count; ++j) lw.window_points[q++] = lat.springs[lw.window_springs[j]].dof;
@@ -83,6 +87,11 @@ void list_window_points(const Model& m, State& s, int first, double xa, double x
     const LateralPendulum& p = lat.pendulums[lw.window_droppers[j]];
     lw.window_points[q++] = p.contact;
     lw.window_points[q++] = p.messenger;
+  }
+  for (int j = 0; j < lw.window_clamp_count; ++j) {
+    const LateralClamp& c = lat.clamps[lw.window_clamps[j]];
+    lw.window_points[q++] = c.stitch;
+    lw.window_points[q++] = c.messenger;
   }
   lw.window_point_count = q;
 }
@@ -104,7 +113,7 @@ void factor_centred_window(const Model& m, State& s) {
 // LateralModel::gust_lead seconds of travel further ahead, so that a span has felt the gusts that
 // long when the pantograph reaches it. When it moved, the nodes that left it return to the static
 // state under the mean wind at rest (as the vertical plane's to u = 0), the nodes that entered
-// get the wind of the last refresh, and the lists are rebuilt: springs and pendulums in the
+// get the wind of the last refresh, and the lists are rebuilt: springs, pendulums and clamps in the
 // window, and at each cut the static force of the elements left out (-K initial of the whole line
 // less the window's), so that the static state stays at rest in the window as outside it. Costs
 // what the window holds (bisection for the springs and droppers), not the line.

@@ -29,13 +29,14 @@ struct LateralWorkspace {
   // (set from State::window_droppers at every windowed step; all 1 without a window).
   std::vector<double> lean_weight;
   // The moving window's lists, rebuilt by sync_window from its placement (LateralState::window):
-  // the factors interleaved for the fused step; the springs and the droppers' pendulums in it
-  // (first *_count entries; pendulum k is dropper k); the static force (N) of the left-out elements
-  // on the nodes near the cuts; the nodes with point forces for the fused step.
+  // the factors interleaved for the fused step; the springs, the droppers' pendulums and the
+  // stitch wires' clamps in it (first *_count entries; pendulum k is dropper k, clamp k
+  // Model::clamps[k]); the static force (N) of the left-out elements on the nodes near the cuts;
+  // the nodes with point forces for the fused step.
   bool window_dirty = true;  // lists and factors to rebuild (the endless block moved, or none yet)
   std::vector<double> sweep_factors;
-  std::vector<int> window_springs, window_droppers;
-  int window_spring_count = 0, window_dropper_count = 0;
+  std::vector<int> window_springs, window_droppers, window_clamps;
+  int window_spring_count = 0, window_dropper_count = 0, window_clamp_count = 0;
   std::vector<int> cut_node;
   std::vector<double> cut_force;
   int cut_count = 0;

@@ -35,8 +35,9 @@ double stagger_at(const Scene& s, bool contact, long support) {
   return st.at(p, static_cast<std::size_t>(((support % n) + n) % n));
 }
 
-// f -= K_lateral z over all wires, springs and pendulums (pendulum stiffness from `tension`, per
-// dropper, or the static tension when null). theta: scratch of the longest wire's nodes.
+// f -= K_lateral z over all wires, springs, pendulums and stitch wires' clamps (pendulum
+// stiffness from `tension`, per dropper, or the static tension when null). theta: scratch of the
+// longest wire's nodes.
 void elastic_force(const Model& m, const LateralModel& lat, const double* tension, const double* z, double* f,
                    double* theta) {
   for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, theta);
@@ -47,6 +48,11 @@ void elastic_force(const Model& m, const LateralModel& lat, const double* tensio
     const double d = k * (z[p.messenger] - z[p.contact]);
     f[p.contact] += d;
     f[p.messenger] -= d;
+  }
+  for (const LateralClamp& c : lat.clamps) {
+    const double d = c.stiffness * (z[c.messenger] - z[c.stitch]);
+    f[c.stitch] += d;
+    f[c.messenger] -= d;
   }
 }
 
@@ -114,6 +120,10 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
   for (const LateralPendulum& p : lat.pendulums) {
     add(p.contact);
     add(p.messenger);
+  }
+  for (const LateralClamp& c : lat.clamps) {
+    add(c.stitch);
+    add(c.messenger);
   }
 }
 
@@ -252,6 +262,14 @@ void add_pendulums(const Model& m, LateralModel* lat) {
   }
 }
 
+// The stitch wires' clamps in plan: the vertical plane's springs (Model::clamps) between the same
+// two nodes.
+void add_clamps(const Model& m, LateralModel* lat) {
+  for (const WireClamp& c : m.clamps)
+    lat->clamps.push_back(
+        LateralClamp{lateral_dof_of(m, *lat, c.messenger_dof), lateral_dof_of(m, *lat, c.stitch_dof), c.stiffness});
+}
+
 // Wind: the normal component of the mean wind on each node's wire, following the track's heading,
 // and the turbulent field along the line.
 void add_wind(const Model& m, const WindSpec& ws, LateralModel* lat) {
@@ -265,7 +283,7 @@ void add_wind(const Model& m, const WindSpec& ws, LateralModel* lat) {
   double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo;
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     const Wire& w = m.wires[wi];
-    const WireDragSpec& d = w.is_contact_wire ? ws.contact_wire : ws.messenger;
+    const WireDragSpec& d = w.is_contact_wire ? ws.contact_wire : w.is_stitch_wire ? ws.stitch_wire : ws.messenger;
     const int nn = w.nodes();
     for (int i = 0; i < nn; ++i) {
       const int a = lat->wires[wi].w_dof + i;
@@ -386,7 +404,7 @@ void prepare_window(LateralModel* lat) {
 
 // The lateral plane's stiffness with the rotations as unknowns (y_i at i, theta_i at n + i):
 // add(i, j, value) for every entry of the wires' bands, the support springs and the droppers as
-// pendulums at their static tension.
+// pendulums at their static tension, the stitch wires' clamps.
 template <class Add>
 void add_stiffness(const Model& m, const LateralModel& lat, Add&& add) {
   const int n = lat.n;
@@ -418,6 +436,12 @@ void add_stiffness(const Model& m, const LateralModel& lat, Add&& add) {
     add(p.messenger, p.messenger, k);
     add(p.contact, p.messenger, -k);
     add(p.messenger, p.contact, -k);
+  }
+  for (const LateralClamp& c : lat.clamps) {
+    add(c.stitch, c.stitch, c.stiffness);
+    add(c.messenger, c.messenger, c.stiffness);
+    add(c.stitch, c.messenger, -c.stiffness);
+    add(c.messenger, c.stitch, -c.stiffness);
   }
 }
 
@@ -474,6 +498,7 @@ std::vector<RegistrationLateral> registration_lateral(const Model& m, const std:
   LateralModel lat;
   add_wires_and_supports(m, &lat);
   add_pendulums(m, &lat);
+  add_clamps(m, &lat);
   const int n = lat.n, N = 2 * n;
   auto lateral_dof = [&](int vertical) { return lateral_dof_of(m, lat, vertical); };
   // Every support held (rows y_i = 0), then each asked node let go in turn: its stiffness is the
@@ -536,6 +561,8 @@ double gust_lead_time(const Scene& sc) {
   };
   double slowest = sigma(w.contact_wire, sc.contact_wire.linear_mass);
   if (sc.messenger) slowest = std::min(slowest, sigma(w.messenger, sc.messenger->linear_mass));
+  for (const SectionSpec& sec : sc.sections)
+    if (sec.stitch_wire) slowest = std::min(slowest, sigma(w.stitch_wire, sec.stitch_wire->linear_mass));
   return slowest > kGustLeadDecays / kAutoGustLeadMax ? kGustLeadDecays / slowest : kAutoGustLeadMax;
 }
 
@@ -544,6 +571,7 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   auto lat = std::make_shared<LateralModel>();
   add_wires_and_supports(m, lat.get());
   add_pendulums(m, lat.get());
+  add_clamps(m, lat.get());
   if (sc.wind) add_wind(m, *sc.wind, lat.get());
   lat->windowed = sc.numerics.windowed() && (m.endless || lat->field.empty() || sc.numerics.gust_lead.has_value());
   lat->gust_lead = lat->windowed ? gust_lead_time(sc) : 0.0;

@@ -281,8 +281,7 @@ void validate_rigid(const Scene& s) {
          "the end ramp's rise in m, [0, 2]: eq. 6-8 derive it from a tensioned wire's sag, a rigid profile has none");
 }
 
-// Stitch wires: hung from a messenger around intermediate supports, each within its spans, on a
-// 2-D line (the lateral plane does not carry them).
+// Stitch wires: hung from a messenger around intermediate supports, each within its spans.
 void validate_stitched(const Scene& s) {
   const bool any = std::any_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.stitch_wire.has_value(); });
   if (!any) return;
@@ -299,9 +298,6 @@ void validate_stitched(const Scene& s) {
       fail(f + ".length", fmt(sec.stitch_wire->length),
            "(0, " + fmt(shortest) + ") m: shorter than the section's shortest span, so that each clamp lies in its span");
   }
-  if (s.lateral())
-    fail("stagger/alignment/wind/pantograph_head.sway", "(given with stitch_wire)",
-         "none: the stitch wire's lateral plane is not modelled (a 2-D line only)");
 }
 
 // A compound catenary: messenger, droppers to the auxiliary messenger, hangers to one contact wire,

@@ -7,9 +7,10 @@
 // acts on a wire of tension T as the distributed lateral load T kappa (the wire is straight in
 // plan, so in the curved frame T (y'' + kappa) + q = 0): the chords between supports come out of
 // the statics, and the steady arms carry the pull-off T x (change of direction).
-// Droppers are pendulums of stiffness S / l (tension over length) between the messenger and the
-// contact wire; steady arms and messenger supports are lateral springs (or rigid) at the
-// stagger; anchors are rigid. Wind pushes each node with 0.5 rho Cd d h V|V|, V the wind's
+// Droppers are pendulums of stiffness S / l (tension over length) between the messenger (or the
+// stitch wire they hang from) and the contact wire; steady arms and messenger supports are
+// lateral springs (or rigid) at the stagger; anchors are rigid; a stitch wire's clamps are
+// springs between its ends and the messenger (LateralClamp). Wind pushes each node with 0.5 rho Cd d h V|V|, V the wind's
 // speed normal to the wire less the node's lateral velocity (aerodynamic damping included).
 //
 // Two-way coupling through the droppers' geometry (docs/model_and_numerics.md, "Coupling"): a
@@ -46,6 +47,14 @@ struct LateralPendulum {
   double lean0_sq = 0.0;           // m^2, dy0^2: the lean in the static state under the mean wind
 };
 
+// A stitch wire's end clamped to the messenger (Model::clamps, the same index): in plan the same
+// stiff bilateral spring as in the vertical plane, between the two lateral nodes. The stitch wire
+// has no support of its own: sideways it hangs from its two clamps (and its droppers' pendulums).
+struct LateralClamp {
+  int messenger = 0, stitch = 0;  // lateral indices
+  double stiffness = 0.0;         // N/m
+};
+
 // The stretch a dropper gets from its lean (the header comment), y the lateral positions.
 inline double lean_stretch(const LateralPendulum& p, const double* y) {
   const double dy = y[p.messenger] - y[p.contact];
@@ -77,6 +86,7 @@ struct LateralModel {
   Eigen::VectorXd load;            // N, constant: the curve's T kappa h and the springs' k stagger
   std::vector<LateralSpring> springs;
   std::vector<LateralPendulum> pendulums;
+  std::vector<LateralClamp> clamps;  // clamp k is Model::clamps[k]
   std::vector<LateralSupport> supports;
   Eigen::VectorXd calm;     // m, static lateral positions without wind
   Eigen::VectorXd initial;  // m, static under the mean wind (the pass starts here)

@@ -385,6 +385,8 @@ struct WindSpec {
   double direction = 90.0;   // deg, of the wind's velocity from the track direction at station 0, + counter-clockwise (90: toward +)
   double air_density = 1.225;  // kg/m^3
   WireDragSpec contact_wire{0.012, 1.0}, messenger{0.0105, 1.0};
+  // A stitch wire's (StitchWireSpec): Bz II 35 mm^2, 7 strands of 2.5 mm (DIN 48201-2), 7.5 mm.
+  WireDragSpec stitch_wire{0.0075, 1.0};
   std::optional<TurbulenceSpec> turbulence;
   std::optional<double> blow_off_limit;  // m, largest lateral blow-off of the contact wire the report accepts
 };
