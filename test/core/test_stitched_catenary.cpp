@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "catenary_sim/core/engine/initial_state.hpp"
+#include "catenary_sim/core/engine/lateral_energy.hpp"
 #include "catenary_sim/core/model/build_model.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
@@ -27,6 +29,7 @@
 #include "../support/design_equilibrium.hpp"
 #include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
+#include "engine/forces.hpp"
 
 namespace cs = catenary_sim;
 
@@ -569,3 +572,33 @@ TEST_P(StitchedLateralDamping, EndlessLineGivesTheFiniteLinesLateralPlane) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Damping, StitchedLateralDamping, ::testing::Values("half_step", "centred"));
+
+// line_energy is the potential of the step's forces on a stitched line: at a state off the
+// static one, its derivative along each DOF the stitch wires' clamps join (central differences,
+// exact for the quadratic potentials of wires, supports, taut droppers and clamps up to rounding)
+// is minus the force assemble_force gives there, undamped and at rest. A term of the clamps left
+// out of the energy (their static force, hundreds of newtons, or k e) shows as that much force.
+// Tolerance 1e-3 N: the rounding of energies of about 1e3 J differenced over 2e-6 m is ~1e-7 N.
+TEST(StitchedCatenary, LineEnergyIsThePotentialOfTheStepsForces) {
+  using namespace catenary_sim;
+  Model m = build_model(
+      load_scene_file(test_scenes::kReferenceStitched, {"line.span_count=3", "damping.alpha=0", "damping.beta=0", "pantographs=[]"}));
+  ASSERT_FALSE(m.clamps.empty());
+  State s = make_state(m);
+  solve_initial_state(m, s);
+  for (int i = 0; i < m.n_catenary_dof; ++i)
+    if (m.inv_mass[i] > 0.0) s.u[i] += 1e-3 * std::sin(0.37 * i);
+  s.v.setZero();
+  Eigen::VectorXd z(m.n_dof), f(m.n_dof);
+  assemble_force(m, s, s.u.data(), s.v.data(), z.data(), f.data());
+  const double h = 1e-6;
+  auto slope = [&](int i) {
+    State p = s;
+    p.u[i] += h;
+    const double up = line_energy(m, p);
+    p.u[i] -= 2.0 * h;
+    return (up - line_energy(m, p)) / (2.0 * h);
+  };
+  for (const WireClamp& c : m.clamps)
+    for (int i : {c.stitch_dof, c.messenger_dof}) EXPECT_NEAR(slope(i), -f[i], 1e-3) << "DOF " << i;
+}

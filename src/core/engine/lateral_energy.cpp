@@ -53,7 +53,8 @@ double lateral_energy(const Model& m, const State& s) {
 
 double line_energy(const Model& m, const State& s) {
   // The vertical plane: 0.5 v M v + 0.5 u K u - load . u over the wires (rotations as DOFs or
-  // condensed) and their supports; the droppers' V(e) with the lean's share when 3-D.
+  // condensed) and their supports; the droppers' V(e) with the lean's share when 3-D; the stitch
+  // wires' clamps.
   const int nc = m.n_catenary_dof;
   Eigen::VectorXd f = Eigen::VectorXd::Zero(m.n_dof);
   int longest = 1;
@@ -68,6 +69,12 @@ double line_energy(const Model& m, const State& s) {
   for (std::size_t k = 0; k < m.droppers.size(); ++k) {
     const Dropper& d = m.droppers[k];
     e += dropper_potential(d, u[d.messenger_dof] - u[d.contact_dof]);
+  }
+  // The stitch wires' clamps: the force static_force + k e on the stitch wire's end, e its stretch
+  // from the messenger (forces.hpp), is -dV/du_s of V(e) = static_force e + k e^2 / 2.
+  for (const WireClamp& c : m.clamps) {
+    const double stretch = u[c.messenger_dof] - u[c.stitch_dof];
+    e += c.static_force * stretch + 0.5 * c.stiffness * stretch * stretch;
   }
   if (m.lateral) e += lateral_energy(m, s);
   return e;
