@@ -21,6 +21,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../test/support/scenes.hpp"
+#include "bench_cli.hpp"
 #include "guarded_main.hpp"
 
 using namespace catenary_sim;
@@ -39,24 +40,24 @@ double rss_mb() {
 }  // namespace
 
 static int bench_main(int argc, char** argv) {
+  CLI::App app{"Soak of an endless pass as a live node runs it for hours: the recorders' bytes, the resident set and "
+               "the statistics' wall time every REPORT simulated seconds.",
+               "bench_endless_soak"};
   double hours = 2.0, report = 600.0;
   std::string scene = test_scenes::kReferenceEndless;
+  std::vector<std::string> given;
+  // A year of simulated time is more than any soak.
+  app.add_option("--hours", hours, "simulated time, h")
+      ->check(bench::kFinite & bench::positive_up_to(8760.0))
+      ->capture_default_str();
+  app.add_option("--report", report, "simulated seconds between the report's lines")
+      ->check(bench::kFinite & bench::positive_up_to(8760.0 * 3600.0))
+      ->capture_default_str();
+  app.add_option("--scene", scene, "scene YAML of an endless line")->check(CLI::ExistingFile)->capture_default_str();
+  bench::add_overrides(app, given, "overrides of the scene's fields, after the fast rung at 300 km/h");
+  CLI11_PARSE(app, argc, argv);
   std::vector<std::string> overrides = {"numerics.preset=fast", "output.sample_rate=0.001", "train.speed_kmh=300"};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--hours" && i + 1 < argc) hours = std::atof(argv[++i]);
-    else if (a == "--report" && i + 1 < argc) report = std::atof(argv[++i]);
-    else if (a == "--scene" && i + 1 < argc) scene = argv[++i];
-    else if (a.find('=') != std::string::npos) overrides.push_back(a);
-    else {
-      std::fprintf(stderr, "usage: bench_endless_soak [--hours H] [--report S] [--scene FILE] [field=value ...]\n");
-      return 2;
-    }
-  }
-  if (!(hours > 0.0) || !(report > 0.0)) {
-    std::fprintf(stderr, "bench_endless_soak: --hours and --report must be > 0\n");
-    return 2;
-  }
+  overrides.insert(overrides.end(), given.begin(), given.end());
   // The pass long enough for the soak (train.end at the scene's speed, with a span to spare).
   {
     const Scene probe = load_scene_file(scene, overrides);

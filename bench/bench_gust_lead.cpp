@@ -20,6 +20,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "../test/support/scenes.hpp"
+#include "bench_cli.hpp"
 #include "guarded_main.hpp"
 
 using namespace catenary_sim;
@@ -53,7 +54,14 @@ struct Run {
 }  // namespace
 
 static int bench_main(int argc, char** argv) {
-  const int seeds = argc > 1 ? std::max(1, std::atoi(argv[1])) : 4;
+  CLI::App app{"The endless line in a turbulent wind: what the lateral plane's gust lead (numerics.gust_lead) buys "
+               "and costs.",
+               "bench_gust_lead"};
+  int seeds = 4;
+  app.add_option("seeds", seeds, "seeds of the turbulent wind, each a row per lead")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
   const std::vector<std::string> leads = {"0", "5", "10", "auto", "30"};
   std::printf("endless line in a turbulent wind against the finite line, balanced, 300 km/h; turbulent motion of the "
               "contact point (mm)\n");

@@ -24,6 +24,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../test/support/scenes.hpp"
+#include "bench_cli.hpp"
 #include "guarded_main.hpp"
 
 using namespace catenary_sim;
@@ -113,8 +114,18 @@ void turbulent_motion(int seed, std::vector<std::string> windy) {
 }  // namespace
 
 static int bench_main(int argc, char** argv) {
-  const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
-  const int long_spans = argc > 2 ? std::max(0, std::atoi(argv[2])) : 100;
+  CLI::App app{"The 3-D line's cost: the reference pass as the 2-D model and with a lateral plane, then the "
+               "moving window on a long line and the turbulent motion with and without it.",
+               "bench_lateral"};
+  int reps = 5, long_spans = 100, seeds = 0;
+  bench::add_repetitions(app, reps);
+  app.add_option("long_spans", long_spans, "spans of the long line the window runs on (0 skips it)")
+      ->check(CLI::Range(0, 10000))
+      ->capture_default_str();
+  app.add_option("seeds", seeds, "seeds of the turbulent wind for the contact point's motion (0 skips it)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
   const std::string path = test_scenes::kReference;
   struct Variant {
     std::string label;
@@ -175,7 +186,7 @@ static int bench_main(int argc, char** argv) {
   std::vector<std::string> steady = stagger;
   steady.push_back("wind.speed=20");
   if (long_spans > 0) run_windowed(reps, long_spans, steady, windy);
-  for (int seed = 1; seed <= (argc > 3 ? std::atoi(argv[3]) : 0); ++seed) turbulent_motion(seed, windy);
+  for (int seed = 1; seed <= seeds; ++seed) turbulent_motion(seed, windy);
   return 0;
 }
 

@@ -6,7 +6,7 @@
 //       -o /tmp/bench_pass_hash_base
 // (the flags of the package's Release build; add -DBENCH_PASS_HASH_2D_ONLY for a checkout older
 // than the 3-D line, e.g. 25f35a6).
-//   bench_pass_hash SCENE [--set-style overrides...]
+//   bench_pass_hash SCENE [field=value ...]
 // Prints the steps, the FNV-1a hash of u, v and the contact forces over every step (and, with a
 // lateral plane, of its y and v: a 2-D scene's hash is what it was before the 3-D line), and the
 // wall time of the stepping (model building and statics not included).
@@ -17,17 +17,21 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
+#include "bench_cli.hpp"
 #include "guarded_main.hpp"
 
 using namespace catenary_sim;
 
 static int bench_main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_pass_hash SCENE [field=value ...]\n");
-    return 2;
-  }
-  std::vector<std::string> overrides(argv + 2, argv + argc);
-  Simulation sim(load_scene_file(argv[1], overrides));
+  CLI::App app{"One pass, timed, with a hash of the state after every step: two builds or machines compared bit for "
+               "bit and for speed.",
+               "bench_pass_hash"};
+  std::string path;
+  std::vector<std::string> overrides;
+  app.add_option("scene", path, "scene YAML")->required()->check(CLI::ExistingFile);
+  bench::add_overrides(app, overrides, "overrides of the scene's fields (as simulate_pass --set)");
+  CLI11_PARSE(app, argc, argv);
+  Simulation sim(load_scene_file(path, overrides));
   std::uint64_t hash = 1469598103934665603ull;
   auto mix = [&](const double* p, std::size_t n) {
     const unsigned char* c = reinterpret_cast<const unsigned char*>(p);
@@ -38,7 +42,7 @@ static int bench_main(int argc, char** argv) {
   long steps = 0;
   while (sim.step() == StepStatus::kOk) ++steps;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  Simulation again(load_scene_file(argv[1], overrides));
+  Simulation again(load_scene_file(path, overrides));
   while (again.step() == StepStatus::kOk) {
     const State& s = again.state();
     mix(s.u.data(), s.u.size());

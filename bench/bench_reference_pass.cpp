@@ -14,13 +14,20 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../test/support/scenes.hpp"
+#include "bench_cli.hpp"
 #include "guarded_main.hpp"
 
 using namespace catenary_sim;
 
 static int bench_main(int argc, char** argv) {
-  const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
-  const std::string path = argc > 2 ? argv[2] : test_scenes::kReference;
+  CLI::App app{"Times the reference pass (300 km/h, h = 0.25 m, explicit) beside its lumped-rotary-inertia variant "
+               "and with the recorders, in one process.",
+               "bench_reference_pass"};
+  int reps = 5;
+  std::string path = test_scenes::kReference;
+  bench::add_repetitions(app, reps);
+  bench::add_scene(app, path);
+  CLI11_PARSE(app, argc, argv);
   std::printf("%-34s %6s %9s %7s %10s %10s %8s\n", "variant", "DOFs", "dt_ms", "steps", "wall_med_s", "wall_min_s", "RTF_med");
   struct Variant {
     std::string label;

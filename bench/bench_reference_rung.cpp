@@ -3,7 +3,7 @@
 // refined with it); every candidate's 0-20 Hz statistics (mean, std, max, min) and 0-200 Hz max are
 // compared with it, with its wall time, on the reference scene at 250 and 300 km/h.
 //   bench_reference_rung [scene=config/reference_55m.yaml] [csv=reference_rung.csv] [finest_h=0.03125]
-//                        [all|centred|window|3d|richardson] [field=value ...]
+//                        [mode=explicit|all|centred|window|3d|richardson] [field=value ...]
 // `window`: the rung with a moving window (numerics.window auto, also the endless line's), against
 // the finest solution in the same window, beside the half-step h = 0.1 m rung it replaces there.
 // `3d`: the same candidates on a 3-D line, the finest solution with centred damping in both planes
@@ -24,22 +24,38 @@
 #include <vector>
 
 #include "pass_errors.hpp"
+#include "bench_cli.hpp"
 #include "guarded_main.hpp"
 
 using bench::PassResult;
 using bench::run_pass;
 
 static int bench_main(int argc, char** argv) {
-  const std::string path = argc > 1 ? argv[1] : bench::kReferenceScene;
-  const std::string csv_path = argc > 2 ? argv[2] : "reference_rung.csv";
-  const std::string finest_h = argc > 3 ? argv[3] : "0.03125";
+  CLI::App app{"Choosing the `reference` rung: candidates against a still finer solution, on the reference scene at "
+               "250 and 300 km/h.",
+               "bench_reference_rung"};
+  std::string path = bench::kReferenceScene, csv_path = "reference_rung.csv", finest_h = "0.03125", mode = "explicit";
+  std::vector<std::string> overrides;
+  bench::add_scene(app, path);
+  app.add_option("csv", csv_path, "CSV written, a row per speed and candidate (the finest solution's in <csv>.finest)")
+      ->type_name("FILE")
+      ->capture_default_str();
+  // (kept as written: it is printed and kept in <csv>.finest as given)
+  app.add_option("finest_h", finest_h, "element length of the finest solution, m (numerics.element_length)")
+      ->check(bench::kFinite & CLI::Range(0.01, 10.0))
+      ->capture_default_str();
+  app.add_option("mode", mode, "the candidates: explicit, all (explicit and the first five measured), centred (damping), "
+                 "window, 3d, or richardson (extrapolated from two explicit meshes)")
+      ->check(CLI::IsMember({"explicit", "all", "centred", "window", "3d", "richardson"}))
+      ->capture_default_str();
+  bench::add_overrides(app, overrides, "overrides of every pass's scene fields, the finest's included");
+  CLI11_PARSE(app, argc, argv);
   std::ofstream csv(csv_path);
   csv << bench::kCsvHeader;
-  // The first five were measured first (BENCHMARKS.md); the rest refine the explicit scheme's dt
-  // at h = 0.125 m and try h = 0.1 m. Give `all` as 4th argument for the first five too, or
-  // `centred` for the explicit step with centred damping (numerics.damping) beside the half-step
-  // rungs it replaces.
-  const std::string mode = argc > 4 ? argv[4] : "";
+  // `explicit`: the first five were measured first (BENCHMARKS.md); the rest refine the explicit
+  // scheme's dt at h = 0.125 m and try h = 0.1 m. `all` for the first five too, or `centred` for
+  // the explicit step with centred damping (numerics.damping) beside the half-step rungs it
+  // replaces.
   const bool all = mode == "all";
   std::vector<std::pair<std::string, std::vector<std::string>>> candidates = {
       {"explicit h=0.125", {"numerics.element_length=0.125"}},
@@ -74,7 +90,7 @@ static int bench_main(int argc, char** argv) {
   // Overrides of every pass: the window's, then the command line's.
   std::vector<std::string> every;
   if (mode == "window") every.push_back("numerics.window=auto");
-  for (int i = 5; i < argc; ++i) every.push_back(argv[i]);
+  every.insert(every.end(), overrides.begin(), overrides.end());
   for (auto& [label, ov] : candidates) ov.insert(ov.end(), every.begin(), every.end());
   // Finest statistics kept from an earlier run: kmh -> mean, std, max, min, max200, dofs, dt, wall.
   std::map<double, std::vector<double>> kept;
@@ -91,8 +107,8 @@ static int bench_main(int argc, char** argv) {
   // Richardson extrapolation of the statistics from two explicit meshes (h_a < h_b): the
   // explicit scheme's error in a statistic is c h^2 + O(h^4) here (its dt falls with h, so the
   // time error is of higher order), so S_a + (S_a - S_b) / ((h_b / h_a)^2 - 1) cancels the h^2 term.
-  // Give `richardson` as 4th argument to measure these instead of the candidates above.
-  const bool richardson = argc > 4 && std::string(argv[4]) == "richardson";
+  // Give `richardson` as mode to measure these instead of the candidates above.
+  const bool richardson = mode == "richardson";
   const std::vector<std::pair<double, double>> pairs = {{0.125, 0.25}, {0.1, 0.2}, {0.1, 0.125}, {0.0625, 0.125}};
   if (richardson) candidates.clear();
   for (double kmh : {250.0, 300.0}) {

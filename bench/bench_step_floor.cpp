@@ -22,6 +22,7 @@
 #include "../test/support/scenes.hpp"
 #include "../src/core/engine/wire_lanes.hpp"  // the step's kernel, timed alone
 #include "../src/core/engine/step_workspace.hpp"
+#include "bench_cli.hpp"
 #include "guarded_main.hpp"
 
 using namespace catenary_sim;
@@ -201,9 +202,16 @@ std::vector<Floor> floors_of(const Model& m, const State& s0) {
 }  // namespace
 
 static int bench_main(int argc, char** argv) {
-  const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 7;
-  const std::string path = argc > 2 ? argv[2] : test_scenes::kReference;
-  const std::string preset = argc > 3 ? argv[3] : "accurate";
+  CLI::App app{"The explicit step against its floor, the minimal fused kernel of one step at the scene's sizes.",
+               "bench_step_floor"};
+  int reps = 7;
+  std::string path = test_scenes::kReference, preset = "accurate";
+  bench::add_repetitions(app, reps);
+  bench::add_scene(app, path);
+  app.add_option("preset", preset, "numerics.preset of the pass")
+      ->check(CLI::IsMember(bench::kPresets))
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
   const Scene scene = load_scene_file(path, {"train.speed_kmh=300", "numerics.preset=" + preset});
   const Simulation proto(scene);
   const Model& m = proto.model();

@@ -11,16 +11,20 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include "bench_cli.hpp"
 #include "guarded_main.hpp"
 
 static int bench_main(int argc, char** argv) {
-  const double rate = argc > 1 ? std::atof(argv[1]) : 1000.0;
-  const double seconds = argc > 2 ? std::atof(argv[2]) : 20.0;
-  if (!(rate >= 1.0 && rate <= 100000.0) || !(seconds > 0.0 && seconds <= 3600.0)) {
-    std::fprintf(stderr, "bench_timer_jitter: rate %g Hz (allowed 1 to 100000) or seconds %g (allowed (0, 3600]) "
-                 "rejected\n", rate, seconds);
-    return 2;
-  }
+  CLI::App app{"How late a bare periodic thread wakes up on this machine: the floor under the HIL loop's overruns.",
+               "bench_timer_jitter"};
+  double rate = 1000.0, seconds = 20.0;
+  app.add_option("rate", rate, "wake-ups per second, Hz")
+      ->check(bench::kFinite & CLI::Range(1.0, 100000.0))
+      ->capture_default_str();
+  app.add_option("seconds", seconds, "s of wall clock")
+      ->check(bench::kFinite & bench::positive_up_to(3600.0))
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
   prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);
   const long period_ns = static_cast<long>(1e9 / rate);
   const long n = static_cast<long>(seconds * rate);

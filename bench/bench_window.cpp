@@ -12,6 +12,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../test/support/scenes.hpp"
+#include "bench_cli.hpp"
 #include "guarded_main.hpp"
 
 using namespace catenary_sim;
@@ -42,7 +43,13 @@ Run run(std::vector<std::string> ov, const std::string& scene = test_scenes::kRe
 }  // namespace
 
 static int bench_main(int argc, char** argv) {
-  const int spans = argc > 1 ? std::atoi(argv[1]) : 100;
+  CLI::App app{"The moving window on a long line: the full line against numerics.window=auto, then the endless "
+               "line over as many spans and ten times as many.",
+               "bench_window"};
+  int spans = 100;
+  // At least 9: the statistics are over spans 4 to spans - 4. The endless line runs ten times as far.
+  app.add_option("spans", spans, "spans of the long line")->check(CLI::Range(9, 1000))->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
   const std::string n = "line.span_count=" + std::to_string(spans);
   const std::string section = "output.analysis_spans=[4," + std::to_string(spans - 4) + "]";
   const Run full = run({n, "numerics.preset=balanced", section});

@@ -18,6 +18,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../test/support/scenes.hpp"
+#include "bench_cli.hpp"
 #include "guarded_main.hpp"
 
 using namespace catenary_sim;
@@ -43,16 +44,45 @@ void print_change(double kmh, const char* varied, double ahead, double behind, c
   std::fflush(stdout);
 }
 
+// The speeds of a comma-separated list (km/h) into *speeds; an error message, or empty.
+std::string read_speeds(const std::string& text, std::vector<double>* speeds) {
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (item.empty() || used != item.size() || !(v > 0.0 && v <= 3.6 * kMaxTrainSpeed))
+      return "'" + item + "' is not a speed in (0, " + std::to_string(static_cast<int>(3.6 * kMaxTrainSpeed)) + "] km/h";
+    speeds->push_back(v);
+  }
+  return speeds->empty() ? "no speed given" : std::string();
+}
+
 }  // namespace
 
 static int bench_main(int argc, char** argv) {
-  std::vector<double> speeds = {150, 250, 300, 350};
-  if (argc > 1) {
-    speeds.clear();
-    std::stringstream in(argv[1]);
-    std::string item;
-    while (std::getline(in, item, ',')) speeds.push_back(std::stod(item));
-  }
+  CLI::App app{"How long the moving window must be, ahead and behind, against train speed: the data behind "
+               "`numerics.window: auto`.",
+               "bench_window_lengths"};
+  std::string speed_list = "150,250,300,350", rows;
+  app.add_option("speeds_kmh", speed_list, "train speeds, km/h, comma separated")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            std::vector<double> v;
+            return read_speeds(text, &v);
+          },
+          "KMH,..."))
+      ->capture_default_str();
+  app.add_option("rows", rows, "auto: only the auto rule's rows (default: the window lengths varied too)")
+      ->check(CLI::IsMember({"auto"}));
+  CLI11_PARSE(app, argc, argv);
+  std::vector<double> speeds;
+  read_speeds(speed_list, &speeds);
   const double span = 55.0;
   const std::vector<double> aheads = {1.0, 1.5, 2.0, 2.5, 3.0, 4.0}, behinds = {1.0, 2.0, 3.0, 4.0, 6.0};
   const double generous_ahead = 5.0, generous_behind = 14.0;  // spans
@@ -67,7 +97,7 @@ static int bench_main(int argc, char** argv) {
       return run(ov);
     };
     const ForceStatistics ref = window(generous_ahead, generous_behind);
-    const bool sweep = argc <= 2 || std::string(argv[2]) != "auto";
+    const bool sweep = rows != "auto";
     for (double a : sweep ? aheads : std::vector<double>{}) print_change(kmh, "ahead", a, generous_behind, window(a, generous_behind), ref);
     for (double b : sweep ? behinds : std::vector<double>{}) print_change(kmh, "behind", generous_ahead, b, window(generous_ahead, b), ref);
     std::vector<std::string> ov = base;
