@@ -45,3 +45,28 @@ TEST(Watchdog, NaNIsCaughtOnTheStepItAppears) {
   EXPECT_EQ(s.time, sim.state().time);  // time did not advance past the bad step
   EXPECT_GE(s.diverged_dof, 0);
 }
+
+// A NaN in the lateral plane of a 3-D line stops the run at the lateral step it appears in, and
+// the lateral state keeps its last good values (nothing diverged is passed on), whichever
+// lateral step the numerics take: the fused sweep (the default), the centred damping step, and
+// the generic step of an implicit vertical plane or of rotations as DOFs.
+TEST(Watchdog, LateralNaNLeavesTheLastGoodLateralState) {
+  for (const std::vector<std::string>& numerics :
+       {std::vector<std::string>{}, {"numerics.damping=centred"}, {"numerics.integrator=implicit"},
+        {"numerics.rotary_inertia=lumped"}}) {
+    std::vector<std::string> o{"line.span_count=4", "stagger.contact_wire=[0.3,-0.3]", "wind.speed=20"};
+    o.insert(o.end(), numerics.begin(), numerics.end());
+    Simulation sim(load_scene_file(test_scenes::kReference, o));
+    const Model& m = sim.model();
+    ASSERT_TRUE(m.lateral);
+    State s = sim.state();
+    const int node = m.lateral->wires[0].w_dof + m.lateral->wires[0].nodes() * 3 / 8;  // mid-span
+    ASSERT_GT(m.lateral->inv_mass[node], 0.0);
+    s.lateral.v[node] = std::nan("");
+    const Eigen::VectorXd y_before = s.lateral.y;
+    EXPECT_EQ(step(m, s), StepStatus::kDiverged) << numerics.size();
+    EXPECT_TRUE(s.lateral.diverged);
+    EXPECT_TRUE(s.lateral.y.allFinite()) << (numerics.empty() ? "fused" : numerics[0]);
+    EXPECT_TRUE(s.lateral.y == y_before) << (numerics.empty() ? "fused" : numerics[0]);
+  }
+}

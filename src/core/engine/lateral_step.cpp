@@ -324,8 +324,9 @@ bool centred_substep(const Model& m, State& s, bool windowed) {
 
 // One lateral substep, the generic step (what the fused one computes, bit for bit: test_lateral):
 // the force on z = y + beta v with the load, damping and the wind's drag on the wire's velocity
-// (aerodynamic damping), the band, the window's forces, springs and pendulums, then the update.
-// True if a new displacement left the divergence limit.
+// (aerodynamic damping), the band, the window's forces, springs and pendulums, then the update
+// into y_next, v_next, swapped in (copied back in the window) when all are good. True if a new
+// displacement left the divergence limit: the state keeps the last good substep.
 bool generic_substep(const Model& m, State& s, bool windowed) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
@@ -337,8 +338,8 @@ bool generic_substep(const Model& m, State& s, bool windowed) {
   double* f = lw.f.data();
   double* z = lw.z.data();
   const double limit = m.scene.numerics.divergence_limit;
-  double* y = ls.y.data();
-  double* v = ls.v.data();
+  const double* y = ls.y.data();
+  const double* v = ls.v.data();
   over_stepped(m, s, windowed, [&](int i0, int i1) {
     if (lat.windy) {
       const double* cw = lat.wind_coefficient.data();
@@ -362,16 +363,20 @@ bool generic_substep(const Model& m, State& s, bool windowed) {
     for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, lw.theta.data());
   }
   add_springs_and_pendulums(m, s, windowed, y, [z](int i) { return z[i]; }, f);
+  double* yn = lw.y_next.data();
+  double* vn = lw.v_next.data();
   int out = 0;  // an integer OR vectorises where a max over doubles (NaN rules) does not
   over_stepped(m, s, windowed, [&](int i0, int i1) {
     for (int i = i0; i < i1; ++i) {
       const double a = inv_mass[i] * f[i];  // eq. 20-21, in the fused sweep's order
-      v[i] += h * a;
-      y[i] += h * v[i];
-      out |= !(std::fabs(y[i]) <= limit);  // also NaN
+      vn[i] = v[i] + h * a;
+      yn[i] = y[i] + h * vn[i];
+      out |= !(std::fabs(yn[i]) <= limit);  // also NaN
     }
   });
-  return out;
+  if (out) return true;
+  commit_substep(m, s, windowed);
+  return false;
 }
 
 }  // namespace
