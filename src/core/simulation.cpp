@@ -79,9 +79,23 @@ std::string Simulation::status_message() const {
         break;
       }
       if (state_.lateral.diverged) {
-        s << "diverged at t = " << state_.time << " s: a lateral displacement left the divergence limit ("
-          << model_.scene.numerics.divergence_limit << " m); the run was stopped. Check the lateral stiffnesses "
-          << "(stagger.steady_arm_stiffness, messenger_support_stiffness) and the wind";
+        std::string where = "a wire";
+        const int node = state_.lateral.diverged_node;
+        for (std::size_t wi = 0; model_.lateral && node >= 0 && wi < model_.lateral->wires.size(); ++wi) {
+          const Wire& w = model_.lateral->wires[wi];
+          if (node >= w.w_dof && node < w.w_dof + w.nodes())
+            where = model_.wires[wi].name + " at x = " + std::to_string(w.x[node - w.w_dof] + state_.line_offset) + " m";
+        }
+        s << "diverged at t = " << state_.time << " s: the lateral position of " << where << " reached "
+          << state_.lateral.diverged_position << " m (limit " << model_.scene.numerics.divergence_limit
+          << " m); the run was stopped at the last step within it. ";
+        const double limit = model_.scene.numerics.divergence_limit;
+        if (model_.lateral && node >= 0 && !(std::fabs(model_.lateral->initial[node]) <= limit))
+          s << "Likely cause: numerics.divergence_limit = " << limit << " m is below the line's own lateral positions "
+            << "(the stagger, curves and the mean wind's blow-off put this node at " << model_.lateral->initial[node]
+            << " m at rest); the limit bounds positions from the track centre: raise it";
+        else
+          s << "Check the lateral stiffnesses (stagger.steady_arm_stiffness, messenger_support_stiffness) and the wind";
         break;
       }
       const int d = state_.diverged_dof;

@@ -68,5 +68,20 @@ TEST(Watchdog, LateralNaNLeavesTheLastGoodLateralState) {
     EXPECT_TRUE(s.lateral.diverged);
     EXPECT_TRUE(s.lateral.y.allFinite()) << (numerics.empty() ? "fused" : numerics[0]);
     EXPECT_TRUE(s.lateral.y == y_before) << (numerics.empty() ? "fused" : numerics[0]);
+    // The message names where, and the value the rejected substep gave.
+    // (a solve along the wire spreads the NaN over it: the first DOF beyond is the wire's first
+    // stepped one or the NaN's own)
+    EXPECT_GE(s.lateral.diverged_node, m.lateral->wires[0].w_dof);
+    EXPECT_LE(s.lateral.diverged_node, node);
+    EXPECT_TRUE(std::isnan(s.lateral.diverged_position));
   }
+  // Through Simulation: a lateral limit inside the stagger (+-0.3 m) stops the first step, and the
+  // message names the contact wire at a support and a position beyond the limit.
+  Simulation sim(load_scene_file(test_scenes::kReference, {"line.span_count=4", "stagger.contact_wire=[0.3,-0.3]",
+                                                           "numerics.divergence_limit=0.2"}));
+  EXPECT_EQ(sim.step(), StepStatus::kDiverged);
+  const std::string msg = sim.status_message();
+  EXPECT_NE(msg.find("lateral position of contact_wire at x = "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("below the line's own lateral positions"), std::string::npos) << msg;
+  EXPECT_GT(std::fabs(sim.state().lateral.diverged_position), 0.2) << msg;
 }

@@ -407,6 +407,16 @@ StepStatus lateral_step(const Model& m, State& s) {
                                                   : generic_substep(m, s, windowed);
     if (failed) {
       ls.diverged = true;
+      const double* yn = lw.y_next.data();  // (every substep leaves its rejected values there)
+      const double limit = m.scene.numerics.divergence_limit;
+      ls.diverged_node = -1;
+      over_stepped(m, s, windowed, [&](int i0, int i1) {
+        for (int i = i0; i < i1 && ls.diverged_node < 0; ++i)
+          if (!(std::fabs(yn[i]) <= limit)) {
+            ls.diverged_node = i;
+            ls.diverged_position = yn[i];
+          }
+      });
       s.status = StepStatus::kDiverged;
       return s.status;
     }

@@ -73,6 +73,10 @@ struct LateralState {
   ReservedVector<DewirementEvent> events;  // the pass's first ones; room for all reserved, kept by copies
   std::int64_t events_total = 0;           // dewirements of the pass, kept or not
   bool diverged = false;                   // the lateral step left the divergence limit
+  // Where: the first lateral DOF (LateralModel index) beyond the limit in the rejected substep,
+  // and the position (m, or NaN) that substep gave it; the state keeps the last good substep.
+  int diverged_node = -1;
+  double diverged_position = 0.0;
   bool dewired_stop = false;               // a dewirement stopped the pass (on_dewirement: stop)
 
   // The step's buffers, lists and caches (engine/lateral_workspace.hpp, private to the engine),
