@@ -437,32 +437,28 @@ void shift_lateral_block(const Model& m, State& s) {
   LateralState& ls = s.lateral;
   LateralWorkspace& lw = *ls.work;
   const bool windowed = lat.windowed;  // (an endless line always is)
-  // A stitched line's stitch wires, one per support: each takes the window's state of the one
-  // `endless_shift_spans` supports on, as the vertical plane's (shift_endless_block; the stagger
-  // repeats with the move, so their static states are alike); its other nodes, and the last ones,
-  // are in the static state under the mean wind at rest, their window empty until sync_window.
-  const std::vector<int>& stitch = m.sections.front().stitch_wires;
-  for (std::size_t j = 0; j < stitch.size(); ++j) {
-    const Wire& w = lat.wires[stitch[j]];
-    WireWindow& ww = ls.window[stitch[j]];
-    const int o = w.w_dof;
+  // A stitched line's stitch wires (hand_over_stitch_wires): the window's state handed over (the
+  // stagger repeats with the move, so their static states are alike); the nodes it leaves, and the
+  // last wires', to the static state under the mean wind at rest.
+  auto to_rest = [&](int wire, const WireWindow& ww) {
+    const int o = lat.wires[wire].w_dof;
     for (int i = std::max(0, ww.lo); i <= ww.hi; ++i) {
       ls.y[o + i] = lat.initial[o + i];
       ls.v[o + i] = 0.0;
     }
-    ww.lo = 0;
-    ww.hi = -1;
-    if (j + m.endless_shift_spans >= stitch.size()) continue;
-    const int src = lat.wires[stitch[j + m.endless_shift_spans]].w_dof;
-    const WireWindow& from = ls.window[stitch[j + m.endless_shift_spans]];
-    for (int i = std::max(0, from.lo); i <= from.hi; ++i) {
-      ls.y[o + i] = ls.y[src + i];
-      ls.v[o + i] = ls.v[src + i];
-      if (lat.windy) ls.wind_speed[o + i] = ls.wind_speed[src + i];
-    }
-    ww.lo = from.lo;
-    ww.hi = from.hi;
-  }
+  };
+  hand_over_stitch_wires(
+      m, ls.window,
+      [&](int to, int from, const WireWindow& fw) {
+        to_rest(to, ls.window[to]);
+        const int o = lat.wires[to].w_dof, src = lat.wires[from].w_dof;
+        for (int i = std::max(0, fw.lo); i <= fw.hi; ++i) {
+          ls.y[o + i] = ls.y[src + i];
+          ls.v[o + i] = ls.v[src + i];
+          if (lat.windy) ls.wind_speed[o + i] = ls.wind_speed[src + i];
+        }
+      },
+      to_rest);
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     const Wire& w = lat.wires[wi];
     if (w.is_stitch_wire) continue;

@@ -22,30 +22,21 @@ void shift_endless_block(const Model& m, State& s) {
   double* u = s.u.data();
   double* v = s.v.data();
   double* a = s.accel.data();
-  // A stitched line's stitch wires, one per support: each takes the state and window of the one
-  // `spans` supports on (in order: the destination is always behind the source); the last ones
-  // return to the static state, their window empty until update_window sets it.
-  const std::vector<int>& stitch = m.sections.front().stitch_wires;
-  for (std::size_t j = 0; j < stitch.size(); ++j) {
-    const Wire& w = m.wires[stitch[j]];
-    WireWindow& ww = s.window[stitch[j]];
-    const int w0 = w.w_dof;
-    if (j + spans < stitch.size()) {
-      const int src = m.wires[stitch[j + spans]].w_dof;
-      for (int i = 0; i < w.nodes(); ++i) {
-        u[w0 + i] = u[src + i];
-        v[w0 + i] = v[src + i];
-        a[w0 + i] = a[src + i];
-      }
-      const WireWindow& from = s.window[stitch[j + spans]];
-      ww.lo = from.lo;
-      ww.hi = from.hi;
-    } else {
-      for (int i = 0; i < w.nodes(); ++i) u[w0 + i] = v[w0 + i] = a[w0 + i] = 0.0;
-      ww.lo = 0;
-      ww.hi = -1;
-    }
-  }
+  // A stitched line's stitch wires: the whole wire handed over, or back to u = 0 at rest.
+  hand_over_stitch_wires(
+      m, s.window,
+      [&](int to, int from, const WireWindow&) {
+        const int w0 = m.wires[to].w_dof, src = m.wires[from].w_dof;
+        for (int i = 0; i < m.wires[to].nodes(); ++i) {
+          u[w0 + i] = u[src + i];
+          v[w0 + i] = v[src + i];
+          a[w0 + i] = a[src + i];
+        }
+      },
+      [&](int wire, const WireWindow&) {
+        const int w0 = m.wires[wire].w_dof;
+        for (int i = 0; i < m.wires[wire].nodes(); ++i) u[w0 + i] = v[w0 + i] = a[w0 + i] = 0.0;
+      });
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     WireWindow& ww = s.window[wi];
     if (ww.hi < ww.lo || m.wires[wi].is_stitch_wire) continue;

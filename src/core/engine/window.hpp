@@ -55,6 +55,30 @@ void update_window(const Model& model, State& state);
 // (shift_lateral_block), the train too, and adds the distance to State::line_offset. No allocation.
 void shift_endless_block(const Model& model, State& state);
 
+// A move of the endless block for a stitched line's stitch wires (one per support), in either
+// plane's `windows`: each takes the state and window of the one `endless_shift_spans` supports on,
+// in order, so that the destination is always behind the source (take(to, from, from's window),
+// before `to`'s window changes); the last ones return to the static state (rest(wire, its window))
+// with their window empty until the window is placed again.
+template <class Take, class Rest>
+void hand_over_stitch_wires(const Model& m, std::vector<WireWindow>& windows, Take&& take, Rest&& rest) {
+  const std::vector<int>& stitch = m.sections.front().stitch_wires;
+  const std::size_t spans = static_cast<std::size_t>(m.endless_shift_spans);
+  for (std::size_t j = 0; j < stitch.size(); ++j) {
+    WireWindow& ww = windows[stitch[j]];
+    if (j + spans < stitch.size()) {
+      const WireWindow& from = windows[stitch[j + spans]];
+      take(stitch[j], stitch[j + spans], from);
+      ww.lo = from.lo;
+      ww.hi = from.hi;
+    } else {
+      rest(stitch[j], ww);
+      ww.lo = 0;
+      ww.hi = -1;
+    }
+  }
+}
+
 // Calls fn(dof) on the window's cut ends, supports and droppers (each DOF in the window by
 // construction of its lists), or on every support and dropper of the line.
 template <class Fn>
