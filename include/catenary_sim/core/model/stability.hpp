@@ -7,8 +7,9 @@
 namespace catenary_sim {
 
 // Highest eigenfrequency (rad/s) of M^-1 K with every dropper and contact active, by power
-// iteration on the symmetrised operator M^-1/2 K M^-1/2 (DOFs held rigidly are left out).
-double highest_eigenfrequency(const Model& model, int iterations = 3000);
+// iteration on the symmetrised operator M^-1/2 K M^-1/2 (DOFs held rigidly are left out). With
+// `explicit_part`, of the K the explicit step takes at q_n (apply_stiffness).
+double highest_eigenfrequency(const Model& model, int iterations = 3000, bool explicit_part = false);
 
 // dt_crit = (2 / w_max) (sqrt(1 + xi^2) - xi), xi = alpha / (2 w_max) + beta w_max / 2.
 double critical_time_step(double omega_max, double alpha, double beta);
