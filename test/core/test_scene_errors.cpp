@@ -336,6 +336,23 @@ TEST(SceneErrors, FieldsThatCannotActAreRefused) {
   EXPECT_EQ(error_of_3d({"pantographs.0.collectors=[{offset: 0.0, working_width: 1.0}]"}), "");
 }
 
+// numerics.springs: a value of the two, and implicit only where the explicit half-step takes it;
+// a preset's implicit default gives way where the scene asks for the others.
+TEST(SceneErrors, SpringsAtTheMiddleOnlyWithTheHalfStep) {
+  EXPECT_MENTIONS(error_of({"numerics.springs=trapezoidal"}), "numerics.springs", "trapezoidal", "explicit", "implicit");
+  EXPECT_MENTIONS(error_of({"numerics.springs=implicit", "numerics.damping=centred"}), "numerics.springs", "implicit",
+                  "centred");
+  EXPECT_MENTIONS(error_of({"numerics.springs=implicit", "numerics.integrator=implicit"}), "numerics.springs",
+                  "implicit integrator");
+  EXPECT_EQ(error_of({"numerics.springs=implicit"}), "");
+  EXPECT_EQ(error_of({"numerics.preset=fast", "numerics.damping=centred"}), "");
+  EXPECT_EQ(error_of({"numerics.preset=balanced", "numerics.integrator=implicit"}), "");
+  EXPECT_EQ(load_scene_file(kReference, {"numerics.preset=fast", "numerics.damping=centred"}).numerics.springs,
+            PointSprings::kExplicit);
+  EXPECT_EQ(load_scene_file(kReference, {"numerics.preset=fast"}).numerics.springs, PointSprings::kImplicit);
+  EXPECT_EQ(load_scene_file(kReference, {"numerics.preset=accurate"}).numerics.springs, PointSprings::kExplicit);
+}
+
 // The centred step's estimate is no bound at the estimate itself (the reference diverged at a
 // safety factor of 0.99 with it): a dt that close is refused up front, not found by a divergence.
 TEST(SceneErrors, CentredStepKeepsItsMargin) {
