@@ -32,8 +32,10 @@ static int bench_main(int argc, char** argv) {
     const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {
         {"fast", {"numerics.preset=fast"}},
         {"fast + window", {"numerics.preset=fast", "numerics.window=auto"}},
+        {"fast (springs explicit)", {"numerics.preset=fast", "numerics.springs=explicit"}},
         {"balanced", {"numerics.preset=balanced"}},
         {"balanced + window", {"numerics.preset=balanced", "numerics.window=auto"}},
+        {"balanced (springs explicit)", {"numerics.preset=balanced", "numerics.springs=explicit"}},
         {"accurate", {"numerics.preset=accurate"}},
         {"accurate + window", {"numerics.preset=accurate", "numerics.window=auto"}},
         {"implicit h=0.25 dt=1ms", {"numerics.integrator=implicit", "numerics.dt=0.001"}},
@@ -42,12 +44,12 @@ static int bench_main(int argc, char** argv) {
     std::printf("\n%.0f km/h (reference: %d DOFs, dt %.4f ms, %.2f s wall, %.1fx real time; std %.2f N, max %.2f N, 200 Hz max %.2f N)\n",
                 kmh, ref.dofs, ref.dt * 1e3, ref.wall, ref.rtf, ref.s20.filtered.std_dev, ref.s20.filtered.max,
                 ref.s200.filtered.max);
-    std::printf("%-26s %6s %8s %8s %8s | %7s %7s %7s %7s | %8s\n", "variant", "DOFs", "dt_ms", "wall_s", "RTF", "mean%",
+    std::printf("%-28s %6s %8s %8s %8s | %7s %7s %7s %7s | %8s\n", "variant", "DOFs", "dt_ms", "wall_s", "RTF", "mean%",
                 "std%", "max%", "min%", "max200%");
     for (const auto& [label, ov] : variants) {
       const PassResult r = run_pass(path, ov, kmh, 3);
       const bench::StatErrors e = bench::stat_errors(r, ref);
-      std::printf("%-26s %6d %8.4f %8.4f %8.1f | %7.2f %7.2f %7.2f %7.2f | %8.2f\n", label.c_str(), r.dofs, r.dt * 1e3,
+      std::printf("%-28s %6d %8.4f %8.4f %8.1f | %7.2f %7.2f %7.2f %7.2f | %8.2f\n", label.c_str(), r.dofs, r.dt * 1e3,
                   r.wall, r.rtf, e.mean, e.std_dev, e.max, e.min, e.max200);
       bench::csv_row(csv, kmh, label, r.dofs, r.dt, r.wall, r.rtf, e);
     }
