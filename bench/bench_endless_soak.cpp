@@ -78,6 +78,9 @@ static int bench_main(int argc, char** argv) {
   std::printf("%12s %10s %14s %14s %10s %14s %8s\n", "simulated_s", "wall_s", "recorder_B", "lateral_B", "rss_MB",
               "statistics_ms", "rtf");
   std::fflush(stdout);
+  double section_start = 0.0, section_end = 0.0;
+  analysis_section(m, &section_start, &section_end);
+  bool analysed = false;
   const auto t0 = std::chrono::steady_clock::now();
   double next = report;
   while (sim.state().time < hours * 3600.0) {
@@ -102,10 +105,26 @@ static int bench_main(int argc, char** argv) {
                 sim.state().time / wall);
     std::fflush(stdout);
     if (st.empty() || !(st[0].filtered.mean == st[0].filtered.mean)) {
-      std::fprintf(stderr, "bench_endless_soak: no statistics\n");
+      // The statistics start with the analysis section (the pass's spans but two at each end) and
+      // need a span of it for the filter: an early report has none yet, a later one must.
+      const double rear = sim.state().front + sim.state().line_offset + m.rear_collector_offset;
+      if (rear < section_start + m.endless_span) {
+        std::printf("# no statistics yet: the analysis section starts at %.0f m, the rearmost collector is at %.0f m\n",
+                    section_start, rear);
+        continue;
+      }
+      std::fprintf(stderr,
+                   "bench_endless_soak: no statistics at t = %.1f s, with the rearmost collector at %.0f m, a span past "
+                   "the analysis section's start at %.0f m\n",
+                   sim.state().time, rear, section_start);
       return 1;
     }
+    analysed = true;
   }
+  if (!analysed)
+    std::printf("# the soak ended before the analysis section's first span (from %.0f m): no statistics were timed; "
+                "raise --hours\n",
+                section_start);
   return 0;
 }
 
