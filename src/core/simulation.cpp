@@ -81,10 +81,9 @@ std::string Simulation::status_message() const {
       if (state_.lateral.diverged) {
         std::string where = "a wire";
         const int node = state_.lateral.diverged_node;
-        for (std::size_t wi = 0; model_.lateral && node >= 0 && wi < model_.lateral->wires.size(); ++wi) {
+        if (const int wi = model_.lateral && node >= 0 ? wire_holding(model_.lateral->wires, node) : -1; wi >= 0) {
           const Wire& w = model_.lateral->wires[wi];
-          if (node >= w.w_dof && node < w.w_dof + w.nodes())
-            where = model_.wires[wi].name + " at x = " + std::to_string(w.x[node - w.w_dof] + state_.line_offset) + " m";
+          where = model_.wires[wi].name + " at x = " + std::to_string(w.x[node - w.w_dof] + state_.line_offset) + " m";
         }
         s << "diverged at t = " << state_.time << " s: the lateral position of " << where << " reached "
           << state_.lateral.diverged_position << " m (limit " << model_.scene.numerics.divergence_limit

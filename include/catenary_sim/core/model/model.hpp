@@ -206,13 +206,15 @@ struct Model {
   std::shared_ptr<const LateralModel> lateral;
 };
 
-// The index in Model::wires of the wire one of whose nodes is the vertical DOF `dof`; -1 for a
-// pantograph's DOF.
-inline int wire_holding(const Model& m, int dof) {
-  for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
-    if (dof >= m.wires[wi].w_dof && dof < m.wires[wi].w_dof + m.wires[wi].nodes()) return static_cast<int>(wi);
+// The index in `wires` of the wire one of whose nodes is the DOF `dof` of their plane (Model::wires
+// and the vertical DOFs, or LateralModel::wires and the lateral ones, which keep the same order);
+// -1 for a pantograph's DOF.
+inline int wire_holding(const std::vector<Wire>& wires, int dof) {
+  for (std::size_t wi = 0; wi < wires.size(); ++wi)
+    if (dof >= wires[wi].w_dof && dof < wires[wi].w_dof + wires[wi].nodes()) return static_cast<int>(wi);
   return -1;
 }
+inline int wire_holding(const Model& m, int dof) { return wire_holding(m.wires, dof); }
 
 }  // namespace catenary_sim
 
