@@ -32,10 +32,10 @@ static int bench_main(int argc, char** argv) {
     const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {
         {"fast", {"numerics.preset=fast"}},
         {"fast + window", {"numerics.preset=fast", "numerics.window=auto"}},
-        {"fast (springs explicit)", {"numerics.preset=fast", "numerics.springs=explicit"}},
+        {"fast + supports implicit", {"numerics.preset=fast", "numerics.supports=implicit"}},
         {"balanced", {"numerics.preset=balanced"}},
         {"balanced + window", {"numerics.preset=balanced", "numerics.window=auto"}},
-        {"balanced (springs explicit)", {"numerics.preset=balanced", "numerics.springs=explicit"}},
+        {"balanced + supports implicit", {"numerics.preset=balanced", "numerics.supports=implicit"}},
         {"accurate", {"numerics.preset=accurate"}},
         {"accurate + window", {"numerics.preset=accurate", "numerics.window=auto"}},
         {"implicit h=0.25 dt=1ms", {"numerics.integrator=implicit", "numerics.dt=0.001"}},

@@ -150,12 +150,14 @@ TEST(FusedStep, MatchesTheGenericStepBitForBit) {
       {"reference_55m_two_sections.yaml", {}, 3000},
       {"reference_55m_stitched.yaml", {}, 3000},  // stitch wires: packs of one, clamps as point forces
       {"reference_55m_stitched.yaml", {"numerics.window=auto"}, 3000},  // the window's clamp lists
-      {"reference_55m.yaml", {"numerics.preset=fast", "train.speed_kmh=250"}, 2000},  // springs at the step's middle
-      {"reference_55m.yaml", {"numerics.preset=fast", "numerics.window=auto"}, 2000},  // and their window lists
-      {"reference_55m_endless.yaml", {"numerics.preset=balanced"}, 3000},
-      {"reference_55m_stitched.yaml", {"numerics.preset=balanced"}, 2000},
-      {"twin", {"numerics.preset=fast"}, 2000},  // a messenger node with two droppers: those stay explicit
-      {"compound_catenary.yaml", {"numerics.preset=fast"}, 2000},
+      {"reference_55m.yaml", {"numerics.preset=fast", "train.speed_kmh=250"}, 2000},
+      // The supports at the step's middle, and their window lists.
+      {"reference_55m.yaml", {"numerics.supports=implicit", "numerics.preset=fast"}, 2000},
+      {"reference_55m.yaml", {"numerics.supports=implicit", "numerics.preset=fast", "numerics.window=auto"}, 2000},
+      {"reference_55m_endless.yaml", {"numerics.supports=implicit", "numerics.preset=balanced"}, 3000},
+      {"reference_55m_stitched.yaml", {"numerics.supports=implicit", "numerics.preset=balanced"}, 2000},
+      {"twin", {"numerics.supports=implicit", "numerics.preset=fast"}, 2000},
+      {"compound_catenary.yaml", {"numerics.supports=implicit", "numerics.preset=fast"}, 2000},
       {"reference_55m.yaml", {"numerics.element_length=0.1"}, 1500},
       {"twin", {}, 2000},
       {"twin", {"numerics.window=auto", "train.speed_kmh=250"}, 3000},

@@ -336,21 +336,20 @@ TEST(SceneErrors, FieldsThatCannotActAreRefused) {
   EXPECT_EQ(error_of_3d({"pantographs.0.collectors=[{offset: 0.0, working_width: 1.0}]"}), "");
 }
 
-// numerics.springs: a value of the two, and implicit only where the explicit half-step takes it;
-// a preset's implicit default gives way where the scene asks for the others.
-TEST(SceneErrors, SpringsAtTheMiddleOnlyWithTheHalfStep) {
-  EXPECT_MENTIONS(error_of({"numerics.springs=trapezoidal"}), "numerics.springs", "trapezoidal", "explicit", "implicit");
-  EXPECT_MENTIONS(error_of({"numerics.springs=implicit", "numerics.damping=centred"}), "numerics.springs", "implicit",
+// numerics.supports: a value of the two, and implicit only where the explicit half-step takes it;
+// explicit unless asked, whatever the preset.
+TEST(SceneErrors, SupportsAtTheMiddleOnlyWithTheHalfStep) {
+  EXPECT_MENTIONS(error_of({"numerics.supports=trapezoidal"}), "numerics.supports", "trapezoidal", "explicit", "implicit");
+  EXPECT_MENTIONS(error_of({"numerics.supports=implicit", "numerics.damping=centred"}), "numerics.supports", "implicit",
                   "centred");
-  EXPECT_MENTIONS(error_of({"numerics.springs=implicit", "numerics.integrator=implicit"}), "numerics.springs",
+  EXPECT_MENTIONS(error_of({"numerics.supports=implicit", "numerics.integrator=implicit"}), "numerics.supports",
                   "implicit integrator");
-  EXPECT_EQ(error_of({"numerics.springs=implicit"}), "");
-  EXPECT_EQ(error_of({"numerics.preset=fast", "numerics.damping=centred"}), "");
-  EXPECT_EQ(error_of({"numerics.preset=balanced", "numerics.integrator=implicit"}), "");
-  EXPECT_EQ(load_scene_file(kReference, {"numerics.preset=fast", "numerics.damping=centred"}).numerics.springs,
-            PointSprings::kExplicit);
-  EXPECT_EQ(load_scene_file(kReference, {"numerics.preset=fast"}).numerics.springs, PointSprings::kImplicit);
-  EXPECT_EQ(load_scene_file(kReference, {"numerics.preset=accurate"}).numerics.springs, PointSprings::kExplicit);
+  EXPECT_EQ(error_of({"numerics.supports=implicit"}), "");
+  for (const char* preset : {"fast", "balanced", "accurate", "reference"})
+    EXPECT_EQ(load_scene_file(kReference, {std::string("numerics.preset=") + preset}).numerics.supports,
+              SupportSprings::kExplicit)
+        << preset;
+  EXPECT_EQ(load_scene_file(kReference, {"numerics.supports=implicit"}).numerics.supports, SupportSprings::kImplicit);
 }
 
 // The centred step's estimate is no bound at the estimate itself (the reference diverged at a

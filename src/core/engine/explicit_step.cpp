@@ -92,56 +92,33 @@ int list_contact_nodes(const Model& m, State& s, bool windowed) {
   return contacts;
 }
 
-// numerics.springs implicit: the supports' and taut droppers' springs at the step's middle. The
-// explicit update took each spring's force k (q_n + beta v_{n-1/2}); the trapezoidal rule takes
+// numerics.supports implicit: the supports' springs at the step's middle. The explicit update
+// took each support's force k (q_n + beta v_{n-1/2}); the trapezoidal rule takes
 // k ((q_{n+1} + 2 q_n + q_{n-1}) / 4 + beta (v_{n+1/2} + v_{n-1/2}) / 2), which is that force plus
-// c a with c = k (dt^2/4 + beta dt/2) (Model::spring_step_inertia) and a the new acceleration
-// (v_{n+1/2} - v_{n-1/2}) / dt. So M a = F becomes (M + c g g^T) a = F for a spring of direction
-// g: on one node a = F / (m + c), on a dropper's two (a, b) the relative acceleration
-// r = a_a - a_b is divided by 1 + c (1/m_a + 1/m_b) and each node gives back its share. A held
-// end has 1/m = 0. Nodes carry at most one such spring (mark_springs_at_middle), so each
-// correction is closed and the order does not matter. It runs on the accelerations the update
-// wrote (acc), then redoes the nodes' update; a dropper slack at q_n has no spring to correct.
-// Returns the highest corrected DOF beyond the divergence limit (also NaN), or -1.
-int springs_at_middle(const Model& m, const State& s, bool windowed, const double* u, const double* v, double* un,
+// c a with c = k (dt^2/4 + beta dt/2) (Model::support_step_inertia) and a the node's new
+// acceleration (v_{n+1/2} - v_{n-1/2}) / dt. So m a = F becomes (m + c) a = F on the support's
+// node: the update's acceleration divided by 1 + c / m, and the node's update redone. A node
+// carries one support (mark_supports_at_middle), so each correction is closed and the order does
+// not matter. Returns the highest corrected DOF beyond the divergence limit (also NaN), or -1.
+int supports_at_middle(const Model& m, const State& s, bool windowed, const double* u, const double* v, double* un,
                        double* vn, double* acc) {
-  if (m.spring_step_inertia.empty()) return -1;
+  if (m.support_step_inertia.empty()) return -1;
   const double dt = m.dt, limit = m.scene.numerics.divergence_limit;
   const double* im = m.inv_mass.data();
   int beyond = -1;
-  auto redo = [&](int i) {
+  auto support = [&](int k) {
+    const double c = m.support_step_inertia[k];
+    if (!(c > 0.0)) return;
+    const int i = m.springs[k].dof;
+    acc[i] /= 1.0 + c * im[i];
     vn[i] = v[i] + dt * acc[i];
     un[i] = u[i] + dt * vn[i];
     if (!(std::fabs(un[i]) <= limit)) beyond = std::max(beyond, i);
   };
-  auto spring = [&](int k) {
-    const double c = m.spring_step_inertia[k];
-    if (!(c > 0.0)) return;
-    const int i = m.springs[k].dof;
-    acc[i] /= 1.0 + c * im[i];
-    redo(i);
-  };
-  auto dropper = [&](int k) {
-    const double c = m.dropper_step_inertia[k];
-    if (!(c > 0.0) || s.dropper_slack[k]) return;
-    const Dropper& d = m.droppers[k];
-    const int a = d.contact_dof, b = d.messenger_dof;
-    const double r = (acc[a] - acc[b]) / (1.0 + c * (im[a] + im[b]));
-    if (im[a] > 0.0) {
-      acc[a] -= c * im[a] * r;
-      redo(a);
-    }
-    if (im[b] > 0.0) {
-      acc[b] += c * im[b] * r;
-      redo(b);
-    }
-  };
   if (windowed) {
-    for (int j = 0; j < s.window_spring_count; ++j) spring(s.window_springs[j]);
-    for (int j = 0; j < s.window_dropper_count; ++j) dropper(s.window_droppers[j]);
+    for (int j = 0; j < s.window_spring_count; ++j) support(s.window_springs[j]);
   } else {
-    for (std::size_t k = 0; k < m.springs.size(); ++k) spring(static_cast<int>(k));
-    for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(static_cast<int>(k));
+    for (std::size_t k = 0; k < m.springs.size(); ++k) support(static_cast<int>(k));
   }
   return beyond;
 }
@@ -189,7 +166,7 @@ int explicit_fused_update(const Model& m, State& s, bool windowed) {
   for_each_point(m, s, windowed, [&](int i) { update(i, force_at(i)); });  // the contact nodes last: theirs has the contact
   for (int q = 0; q < contacts; ++q) update(contact_node[q], f[contact_node[q]]);
   for (int i = m.n_catenary_dof; i < m.n_dof; ++i) update(i, f[i]);
-  outside |= springs_at_middle(m, s, windowed, u, v, un, vn, acc) >= 0;
+  outside |= supports_at_middle(m, s, windowed, u, v, un, vn, acc) >= 0;
   // The displacement check: the sweeps' flag is only a hint (they saw the nodes before the point
   // forces), so on a flag, or a pantograph or point beyond the limit, every new value is scanned
   // in the generic step's order.
@@ -256,7 +233,7 @@ StepStatus generic_step(const Model& m, State& s, bool windowed) {
   } else {
     update(0, n);
   }
-  if (springs_at_middle(m, s, windowed, u, v, u_new, v_new, acc) >= 0 || (bad >= 0 && !m.spring_step_inertia.empty())) {
+  if (supports_at_middle(m, s, windowed, u, v, u_new, v_new, acc) >= 0 || (bad >= 0 && !m.support_step_inertia.empty())) {
     // The corrected nodes moved: the last DOF beyond the limit among the final values.
     bad = -1;
     auto scan = [&](int i0, int i1) {

@@ -476,29 +476,17 @@ void set_train_travel(const Scene& scene, double endless_front, Model& m) {
   }
 }
 
-// numerics.springs implicit: which support springs and droppers the explicit step takes at its
-// middle, marked with a positive Model::spring_step_inertia / dropper_step_inertia (the value is
-// set once dt is known). Only those whose free nodes carry no other such spring: each then is a
-// closed-form correction of its one or two nodes' update; the others stay explicit, in the
-// stability estimate.
-void mark_springs_at_middle(Model& m) {
+// numerics.supports implicit: which support springs the explicit step takes at its middle, marked
+// with a positive Model::support_step_inertia (the value is set once dt is known): those on a free
+// node that no other support shares, so that each is a closed-form correction of its node's
+// update. (The droppers stay explicit: a tension-only spring at the step's middle with its slack
+// switch at q_n chatters, taut and slack by turns, at the fast rung's dt.)
+void mark_supports_at_middle(Model& m) {
   std::vector<int> count(m.n_dof, 0);
-  auto free_dof = [&](int dof) { return m.inv_mass[dof] > 0.0; };
-  for (const SupportSpring& sp : m.springs)
-    if (free_dof(sp.dof)) ++count[sp.dof];
-  for (const Dropper& d : m.droppers)
-    for (int dof : {d.contact_dof, d.messenger_dof})
-      if (free_dof(dof)) ++count[dof];
-  auto alone = [&](int dof) { return !free_dof(dof) || count[dof] == 1; };
-  m.spring_step_inertia.assign(m.springs.size(), 0.0);
-  m.dropper_step_inertia.assign(m.droppers.size(), 0.0);
+  for (const SupportSpring& sp : m.springs) ++count[sp.dof];
+  m.support_step_inertia.assign(m.springs.size(), 0.0);
   for (std::size_t k = 0; k < m.springs.size(); ++k)
-    if (free_dof(m.springs[k].dof) && alone(m.springs[k].dof)) m.spring_step_inertia[k] = 1.0;
-  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
-    const Dropper& d = m.droppers[k];
-    if ((free_dof(d.contact_dof) || free_dof(d.messenger_dof)) && alone(d.contact_dof) && alone(d.messenger_dof))
-      m.dropper_step_inertia[k] = 1.0;
-  }
+    if (m.inv_mass[m.springs[k].dof] > 0.0 && count[m.springs[k].dof] == 1) m.support_step_inertia[k] = 1.0;
 }
 
 // The explicit stability limit (validation.md section 5) and the step, or the implicit matrix.
@@ -526,7 +514,7 @@ void choose_time_step(const Scene& scene, Model& m) {
     m.implicit = newmark_matrix(m, m.dt);
     return;
   }
-  if (scene.numerics.springs == PointSprings::kImplicit) mark_springs_at_middle(m);
+  if (scene.numerics.supports == SupportSprings::kImplicit) mark_supports_at_middle(m);
   compute_stability_limit(m);
   if (scene.numerics.dt) {
     if (*scene.numerics.dt > m.dt_critical)
@@ -537,13 +525,11 @@ void choose_time_step(const Scene& scene, Model& m) {
   } else {
     m.dt = scene.numerics.safety_factor * m.dt_critical;
   }
-  // Each spring at the step's middle: k (dt^2/4 + beta dt/2), the trapezoidal rule's share of its
+  // Each support at the step's middle: k (dt^2/4 + beta dt/2), the trapezoidal rule's share of its
   // stiffness and the centred share of its damping beta k (explicit_step.cpp).
-  auto inertia = [&](double k) { return k * (0.25 * m.dt * m.dt + 0.5 * m.beta * m.dt); };
-  for (std::size_t k = 0; k < m.spring_step_inertia.size(); ++k)
-    if (m.spring_step_inertia[k] > 0.0) m.spring_step_inertia[k] = inertia(m.springs[k].stiffness);
-  for (std::size_t k = 0; k < m.dropper_step_inertia.size(); ++k)
-    if (m.dropper_step_inertia[k] > 0.0) m.dropper_step_inertia[k] = inertia(m.droppers[k].stiffness);
+  for (std::size_t k = 0; k < m.support_step_inertia.size(); ++k)
+    if (m.support_step_inertia[k] > 0.0)
+      m.support_step_inertia[k] = m.springs[k].stiffness * (0.25 * m.dt * m.dt + 0.5 * m.beta * m.dt);
 }
 
 Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) {

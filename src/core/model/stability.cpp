@@ -50,7 +50,7 @@ void compute_stability_limit(Model& m) {
   // A Rayleigh quotient can only underestimate omega_max; the 0.2 % margin covers what the
   // iteration has not converged (measured: 3e-4 after 400 iterations on the HRZ variant), so the
   // refusal of a user dt is on the safe side.
-  // The springs taken at the step's middle (numerics.springs implicit) are left out: with them the
+  // The supports taken at the step's middle (numerics.supports implicit) are left out: with them the
   // step is central differences on the mass M + (dt^2/4) K_I and the stiffness K_E + K_I, stable
   // for dt < 2 / omega_max(K_E, M) whatever K_I (explicit_step.cpp).
   m.omega_max = 1.002 * highest_eigenfrequency(m, 3000, true);

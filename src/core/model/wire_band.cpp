@@ -131,16 +131,12 @@ void wire_elastic_force(const Wire& wire, const double* z, double* f, double* th
 void apply_stiffness(const Model& m, double front, const double* x, double* y, double* scratch, bool explicit_part) {
   std::fill(y, y + m.n_dof, 0.0);
   for (const Wire& w : m.wires) wire_elastic_force(w, x, y, scratch);  // y = -K x so far
-  auto at_middle = [explicit_part](const std::vector<double>& inertia, std::size_t k) {
-    return explicit_part && !inertia.empty() && inertia[k] > 0.0;
-  };
+  const bool skip = explicit_part && !m.support_step_inertia.empty();
   for (std::size_t k = 0; k < m.springs.size(); ++k) {
     const SupportSpring& s = m.springs[k];
-    if (!at_middle(m.spring_step_inertia, k)) y[s.dof] -= s.stiffness * x[s.dof];
+    if (!(skip && m.support_step_inertia[k] > 0.0)) y[s.dof] -= s.stiffness * x[s.dof];
   }
-  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
-    const Dropper& d = m.droppers[k];
-    if (at_middle(m.dropper_step_inertia, k)) continue;
+  for (const Dropper& d : m.droppers) {
     const double t = d.stiffness * (x[d.messenger_dof] - x[d.contact_dof]);
     y[d.contact_dof] += t;
     y[d.messenger_dof] -= t;

@@ -450,19 +450,17 @@ bool read_numerics(Reader& top, Scene& s) {
   if (dmp == "half_step") s.numerics.damping = DampingStep::kHalfStep;
   else if (dmp == "centred") s.numerics.damping = DampingStep::kCentred;
   else fail("numerics.damping", "'" + dmp + "'", "one of: half_step (C v at v_{n-1/2}, eq. 19-21), centred (C v at (v_{n+1/2} + v_{n-1/2}) / 2)");
-  // The supports' and droppers' springs at the step's middle where the explicit half-step allows
-  // it: the fast and balanced rungs, whose light nodes (1 m and 0.5 m of wire) put the messenger
-  // supports' and droppers' frequencies above the wires' (explicit_step.cpp).
+  // The supports' springs at the step's middle, where the explicit half-step runs (explicit_step.cpp).
   const bool middle_allowed = s.numerics.integrator == Integrator::kExplicit && s.numerics.damping == DampingStep::kHalfStep;
-  const std::string spr = r.text("springs", middle_allowed && (preset == "fast" || preset == "balanced") ? "implicit" : "explicit");
-  if (spr == "explicit") s.numerics.springs = PointSprings::kExplicit;
-  else if (spr == "implicit") s.numerics.springs = PointSprings::kImplicit;
-  else fail("numerics.springs", "'" + spr + "'", "one of: explicit (at q_n, eq. 19-21), implicit (at the step's middle, the trapezoidal rule)");
-  if (s.numerics.springs == PointSprings::kImplicit && !middle_allowed)
-    fail("numerics.springs", "'implicit'",
+  const std::string spr = r.text("supports", "explicit");
+  if (spr == "explicit") s.numerics.supports = SupportSprings::kExplicit;
+  else if (spr == "implicit") s.numerics.supports = SupportSprings::kImplicit;
+  else fail("numerics.supports", "'" + spr + "'", "one of: explicit (at q_n, eq. 19-21), implicit (at the step's middle, the trapezoidal rule)");
+  if (s.numerics.supports == SupportSprings::kImplicit && !middle_allowed)
+    fail("numerics.supports", "'implicit'",
          s.numerics.integrator != Integrator::kExplicit
              ? "explicit with the implicit integrator (its matrix holds every spring already)"
-             : "explicit with numerics.damping centred (the springs at the step's middle go with the half-step damping)");
+             : "explicit with numerics.damping centred (the supports at the step's middle go with the half-step damping)");
   s.numerics.divergence_limit = r.number("divergence_limit", 0.0, 1000.0, 5.0, true);
   s.numerics.allow_supercritical = r.boolean("allow_supercritical", false);
   read_window(r, s);

@@ -172,10 +172,10 @@ struct Model {
   double omega_max = 0.0;       // rad/s, highest eigenfrequency of the assembled system
   double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction (inf: implicit)
   double dt = 0.0;              // s, the step in use
-  // numerics.springs implicit: per support spring and per dropper, the inertia k (dt^2/4 + beta dt/2)
-  // (kg) its force at the step's middle adds to its nodes' update (explicit_step.cpp), 0 for those
-  // left explicit (a node shared with another such spring); empty when every spring is explicit.
-  std::vector<double> spring_step_inertia, dropper_step_inertia;
+  // numerics.supports implicit: per support spring (springs), the inertia k (dt^2/4 + beta dt/2)
+  // (kg) its force at the step's middle adds to its node's update (explicit_step.cpp), 0 where it
+  // stays explicit (a held node); empty when every support is explicit.
+  std::vector<double> support_step_inertia;
   std::shared_ptr<const ImplicitMatrix> implicit;  // set when the integrator is implicit
   // Explicit with condensed rotations: the wires packed side by side for the fused step, their
   // copies in SIMD lanes and where the sweep leaves each DOF's results (their layout is the
