@@ -45,7 +45,7 @@ int steady_arm_dof(const Model& m, double x) {
 }  // namespace
 
 // Supports ten times the reference's (5e6 N/m on the messenger) on the fast rung's 1 m elements
-// would bound dt at about 0.9 ms taken at q_n; at the step's middle they do not: the rung's dt
+// would bound dt at about 0.7 ms taken at q_n; at the step's middle they do not: the rung's dt
 // is set by the droppers (2.5 ms) and lies well beyond the explicit limit of the whole system, and
 // the pass runs to its end. The same model with the supports at q_n at that dt diverges, so the
 // stability is the scheme's, not the scene's. The estimate of the rest is a bound: the pass runs
@@ -118,7 +118,7 @@ TEST(SupportsAtMiddle, StableWhateverTheSupportsStiffness) {
 
 // Second order in dt, and no less accurate than the explicit step: the uplift at a steady arm over
 // the first 1.5 s of a pass at 200 km/h (the pantograph passes two supports) on the fast rung with
-// supports of 5e6 N/m, at dt = 2 ms (beyond the 0.9 ms the supports at q_n allow), 1 ms and 0.5 ms,
+// supports of 5e6 N/m, at dt = 2 ms (beyond the 0.78 ms the supports at q_n allow), 1 ms and 0.5 ms,
 // against the explicit step at 62.5 us (its own error some 1/60 of the scheme's at 0.5 ms).
 // Halving dt divides a second-order error by 4 and a first-order one by 2; droppers going slack
 // are switched at a step, a local error of first order at each switch, which pulls the ratio below
