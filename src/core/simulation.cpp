@@ -25,6 +25,14 @@ const Scene& speed_checked(const Scene& scene) {
   return scene;
 }
 
+// Where a DOF of a plane (its `wires`) is: "<wire> at x = <station> m", "" for a pantograph's.
+std::string wire_at(const std::vector<Wire>& wires, int dof, double line_offset) {
+  const int wi = wire_holding(wires, dof);
+  if (wi < 0) return "";
+  const Wire& w = wires[wi];
+  return w.name + " at x = " + std::to_string(w.x[dof - w.w_dof] + line_offset) + " m";
+}
+
 }  // namespace
 
 Simulation::Simulation(const Scene& scene) : model_(build_model(speed_checked(scene))) {
@@ -79,12 +87,9 @@ std::string Simulation::status_message() const {
         break;
       }
       if (state_.lateral.diverged) {
-        std::string where = "a wire";
         const int node = state_.lateral.diverged_node;
-        if (const int wi = model_.lateral && node >= 0 ? wire_holding(model_.lateral->wires, node) : -1; wi >= 0) {
-          const Wire& w = model_.lateral->wires[wi];
-          where = model_.wires[wi].name + " at x = " + std::to_string(w.x[node - w.w_dof] + state_.line_offset) + " m";
-        }
+        std::string where = model_.lateral && node >= 0 ? wire_at(model_.lateral->wires, node, state_.line_offset) : "";
+        if (where.empty()) where = "a wire";
         s << "diverged at t = " << state_.time << " s: the lateral position of " << where << " reached "
           << state_.lateral.diverged_position << " m (limit " << model_.scene.numerics.divergence_limit
           << " m); the run was stopped at the last step within it. ";
@@ -98,11 +103,8 @@ std::string Simulation::status_message() const {
         break;
       }
       const int d = state_.diverged_dof;
-      std::string where = "DOF " + std::to_string(d);
-      if (const int wi = wire_holding(model_, d); wi >= 0) {
-        const Wire& w = model_.wires[wi];
-        where = w.name + " at x = " + std::to_string(w.x[d - w.w_dof] + state_.line_offset) + " m";
-      }
+      std::string where = wire_at(model_.wires, d, state_.line_offset);
+      if (where.empty()) where = "DOF " + std::to_string(d);
       for (const Pantograph& p : model_.pantographs)
         if (!p.moving_force && d >= p.first_dof && d < p.first_dof + p.masses_count())
           where = "pantograph " + p.name + " mass " + std::to_string(d - p.first_dof);

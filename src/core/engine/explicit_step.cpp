@@ -233,21 +233,9 @@ StepStatus generic_step(const Model& m, State& s, bool windowed) {
   } else {
     update(0, n);
   }
-  if (supports_at_middle(m, s, windowed, u, v, u_new, v_new, acc) >= 0 || (bad >= 0 && !m.support_step_inertia.empty())) {
-    // The corrected nodes moved: the last DOF beyond the limit among the final values.
-    bad = -1;
-    auto scan = [&](int i0, int i1) {
-      for (int i = i0; i < i1; ++i)
-        if (!(std::fabs(u_new[i]) <= limit)) bad = i;
-    };
-    if (windowed) {
-      for (std::size_t wi = 0; wi < m.wires.size(); ++wi)
-        scan(m.wires[wi].w_dof + s.window[wi].lo, m.wires[wi].w_dof + s.window[wi].hi + 1);
-      scan(m.n_catenary_dof, n);
-    } else {
-      scan(0, n);
-    }
-  }
+  // The supports' corrected nodes moved: the last DOF beyond the limit among the final values.
+  if (supports_at_middle(m, s, windowed, u, v, u_new, v_new, acc) >= 0 || (bad >= 0 && !m.support_step_inertia.empty()))
+    bad = last_beyond(m, s, windowed, u_new);
   if (bad >= 0) return diverged(s, bad, u_new);
   if (windowed) {
     commit_window(m, s, u_new, v_new);

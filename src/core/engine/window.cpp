@@ -197,8 +197,8 @@ bool in_windows(const std::vector<Wire>& wires, const std::vector<WireWindow>& w
   return false;
 }
 
-int last_beyond(const Model& m, const State& s, bool windowed) {
-  const double* un = s.work->u_next.data();
+int last_beyond(const Model& m, const State& s, bool windowed, const double* u_new) {
+  const double* un = u_new ? u_new : s.work->u_next.data();
   const double limit = m.scene.numerics.divergence_limit;
   auto beyond = [&](int i) { return !(std::fabs(un[i]) <= limit); };
   int bad = -1;

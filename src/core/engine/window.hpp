@@ -114,10 +114,10 @@ void for_each_point(const Model& m, const State& s, bool windowed, Fn&& fn) {
   }
 }
 
-// The index of the last new displacement (StepWorkspace::u_next) beyond the divergence limit (or
-// not a number), scanned in the generic step's order over the window's nodes or every DOF; -1 if
-// none.
-int last_beyond(const Model& model, const State& state, bool windowed);
+// The index of the last new displacement (`u_new`, by default StepWorkspace::u_next) beyond the
+// divergence limit (or not a number), scanned in the generic step's order over the window's nodes
+// or every DOF; -1 if none.
+int last_beyond(const Model& model, const State& state, bool windowed, const double* u_new = nullptr);
 
 // Copies the window's new values back (outside the window the new buffers hold nothing current).
 void commit_window(const Model& model, State& state, const double* u_new, const double* v_new);
