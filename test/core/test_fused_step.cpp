@@ -157,7 +157,17 @@ TEST(FusedStep, MatchesTheGenericStepBitForBit) {
       {"reference_55m_endless.yaml", {"numerics.supports=implicit", "numerics.preset=balanced"}, 3000},
       {"reference_55m_stitched.yaml", {"numerics.supports=implicit", "numerics.preset=balanced"}, 2000},
       {"twin", {"numerics.supports=implicit", "numerics.preset=fast"}, 2000},
-      {"compound_catenary.yaml", {"numerics.supports=implicit", "numerics.preset=fast"}, 2000},
+      {"compound_catenary.yaml", {"numerics.supports=implicit", "numerics.preset=fast", "numerics.droppers=explicit"}, 2000},
+      {"compound_catenary.yaml", {"numerics.preset=fast"}, 2000},
+      // The droppers and clamps at the step's middle too (the fast preset on a 2-D line), and their
+      // window lists; the stitched line's clamps; a compound line's droppers and hangers.
+      {"reference_55m.yaml", {"numerics.preset=fast", "numerics.window=auto"}, 2000},
+      {"reference_55m_endless.yaml", {"numerics.preset=fast"}, 2000},
+      {"reference_55m_stitched.yaml", {"numerics.preset=fast"}, 2000},
+      {"reference_55m_stitched.yaml", {"numerics.preset=fast", "numerics.window=auto"}, 2000},
+      {"reference_55m_two_pantographs.yaml", {"numerics.preset=fast"}, 2000},
+      {"reference_55m.yaml", {"numerics.droppers=implicit", "numerics.preset=balanced"}, 2000},
+      {"twin", {"numerics.preset=fast"}, 2000},
       {"reference_55m.yaml", {"numerics.element_length=0.1"}, 1500},
       {"twin", {}, 2000},
       {"twin", {"numerics.window=auto", "train.speed_kmh=250"}, 3000},
@@ -194,14 +204,16 @@ TEST(FusedStep, MatchesTheGenericStepBitForBit) {
 
 TEST(FusedStep, StopsAtTheSameDivergedDof) {
   // dt above the stability limit on purpose (the watchdog's case): both steps stop at the same
-  // step and name the same DOF, and the state keeps the last good step; with the supports at the
-  // step's middle too, whose corrected nodes both steps scan again.
-  for (const char* supports : {"explicit", "implicit"}) {
-    SCOPED_TRACE(supports);
+  // step and name the same DOF, and the state keeps the last good step; with the supports, and then
+  // the droppers, at the step's middle too, whose corrected nodes both steps scan again.
+  for (const char* springs : {"explicit", "supports", "droppers"}) {
+    SCOPED_TRACE(springs);
+    const std::string middle = springs == std::string("explicit") ? "explicit" : "implicit";
     const Scene scene = load_scene_file(kDir + "reference_55m.yaml",
-                                        {"numerics.element_length=1.0", std::string("numerics.supports=") + supports});
+                                        {"numerics.element_length=1.0", "numerics.supports=" + middle,
+                                         std::string("numerics.droppers=") + (springs == std::string("droppers") ? "implicit" : "explicit")});
     Model fused = build_model(scene);
-    fused.dt *= 1.5;  // beyond the limit: only a test may do this (build_model refuses it)
+    fused.dt *= 2.5;  // beyond the limit: only a test may do this (build_model refuses it)
     Model generic = fused;
     generic.wire_packs.reset();
     State a = make_state(fused), b = make_state(generic);

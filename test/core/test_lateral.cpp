@@ -116,7 +116,10 @@ TEST(Lateral, VerticalResultsAreBitIdenticalWhenNoDropperLeans) {
   // no stagger, no curve and no wind nothing moves the wires sideways (the sway moves only the
   // pantograph), so dy = dy0 = 0 at every step, the lean's stretch is exactly 0, and the vertical
   // results are the 2-D model's bit for bit (elastic steady arms and the lateral contact included).
-  const std::vector<std::string> base{"line.span_count=5", "numerics.preset=fast", "output.analysis_spans=[1,4]"};
+  // One scheme in both: the fast preset takes a 2-D line's supports and droppers at the step's
+  // middle, a 3-D line's at q_n.
+  const std::vector<std::string> base{"line.span_count=5", "numerics.preset=fast", "output.analysis_spans=[1,4]",
+                                      "numerics.supports=explicit", "numerics.droppers=explicit"};
   std::vector<std::string> with = base;
   for (const char* o : {"stagger.contact_wire=[0.0]", "stagger.steady_arm_stiffness=20000",
                         "pantograph_head.sway.amplitude=0.05", "pantograph_head.sway.frequency=0.7"})
@@ -156,7 +159,10 @@ TEST(Lateral, StaggerAndGustsChangeTheContactForceThroughTheLean) {
   // asserted with no margin). The pantograph's mean force is its uplift in both models (its
   // momentum balance over the pass), so the mean changes by far less than the force's spread.
   // Asserted: the change is there, the height change stays under delta_max, the mean stays.
-  const std::vector<std::string> base{"line.span_count=6", "numerics.preset=fast", "output.analysis_spans=[1,5]"};
+  // One scheme in both: the fast preset takes a 2-D line's supports and droppers at the step's
+  // middle, a 3-D line's at q_n.
+  const std::vector<std::string> base{"line.span_count=6", "numerics.preset=fast", "output.analysis_spans=[1,5]",
+                                      "numerics.supports=explicit", "numerics.droppers=explicit"};
   auto with = [&](bool gusts) {
     std::vector<std::string> o = base;
     for (const char* x : {"stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]"}) o.push_back(x);

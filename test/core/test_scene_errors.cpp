@@ -336,20 +336,37 @@ TEST(SceneErrors, FieldsThatCannotActAreRefused) {
   EXPECT_EQ(error_of_3d({"pantographs.0.collectors=[{offset: 0.0, working_width: 1.0}]"}), "");
 }
 
-// numerics.supports: a value of the two, and implicit only where the explicit half-step takes it;
-// explicit unless asked, whatever the preset.
-TEST(SceneErrors, SupportsAtTheMiddleOnlyWithTheHalfStep) {
-  EXPECT_MENTIONS(error_of({"numerics.supports=trapezoidal"}), "numerics.supports", "trapezoidal", "explicit", "implicit");
-  EXPECT_MENTIONS(error_of({"numerics.supports=implicit", "numerics.damping=centred"}), "numerics.supports", "implicit",
-                  "centred");
-  EXPECT_MENTIONS(error_of({"numerics.supports=implicit", "numerics.integrator=implicit"}), "numerics.supports",
-                  "implicit integrator");
-  EXPECT_EQ(error_of({"numerics.supports=implicit"}), "");
-  for (const char* preset : {"fast", "balanced", "accurate", "reference"})
-    EXPECT_EQ(load_scene_file(kReference, {std::string("numerics.preset=") + preset}).numerics.supports,
-              SupportSprings::kExplicit)
-        << preset;
-  EXPECT_EQ(load_scene_file(kReference, {"numerics.supports=implicit"}).numerics.supports, SupportSprings::kImplicit);
+// numerics.supports and numerics.droppers: a value of the two, and implicit only where the explicit
+// half-step takes it; explicit unless asked, but for the fast preset on a 2-D line (where the scheme
+// takes them), whose default is implicit.
+TEST(SceneErrors, SpringsAtTheMiddleOnlyWithTheHalfStep) {
+  for (const char* field : {"numerics.supports", "numerics.droppers"}) {
+    SCOPED_TRACE(field);
+    EXPECT_MENTIONS(error_of({std::string(field) + "=trapezoidal"}), field, "trapezoidal", "explicit", "implicit");
+    EXPECT_MENTIONS(error_of({std::string(field) + "=implicit", "numerics.damping=centred"}), field, "implicit", "centred");
+    EXPECT_MENTIONS(error_of({std::string(field) + "=implicit", "numerics.integrator=implicit"}), field, "implicit integrator");
+    EXPECT_EQ(error_of({std::string(field) + "=implicit"}), "");
+  }
+  auto numerics = [](const std::vector<std::string>& o) { return load_scene_file(kReference, o).numerics; };
+  for (const char* preset : {"balanced", "accurate", "reference"}) {
+    const NumericsSpec n = numerics({std::string("numerics.preset=") + preset});
+    EXPECT_EQ(n.supports, SpringStep::kExplicit) << preset;
+    EXPECT_EQ(n.droppers, SpringStep::kExplicit) << preset;
+  }
+  EXPECT_EQ(numerics({"numerics.supports=implicit"}).supports, SpringStep::kImplicit);
+  EXPECT_EQ(numerics({"numerics.droppers=implicit"}).droppers, SpringStep::kImplicit);
+  // The fast preset: both at the middle on a 2-D line, both at q_n on a 3-D one, and where a field
+  // is given, as given; with the centred damping or the implicit integrator, at q_n without a refusal.
+  EXPECT_EQ(numerics({"numerics.preset=fast"}).supports, SpringStep::kImplicit);
+  EXPECT_EQ(numerics({"numerics.preset=fast"}).droppers, SpringStep::kImplicit);
+  const NumericsSpec lateral = load_scene_file(test_scenes::kConfigDir + "reference_55m_3d.yaml", {"numerics.preset=fast"}).numerics;
+  EXPECT_EQ(lateral.supports, SpringStep::kExplicit);
+  EXPECT_EQ(lateral.droppers, SpringStep::kExplicit);
+  EXPECT_EQ(numerics({"numerics.preset=fast", "numerics.droppers=explicit"}).droppers, SpringStep::kExplicit);
+  for (const char* other : {"numerics.damping=centred", "numerics.integrator=implicit"}) {
+    EXPECT_EQ(error_of({"numerics.preset=fast", other}), "") << other;
+    EXPECT_EQ(numerics({"numerics.preset=fast", other}).droppers, SpringStep::kExplicit) << other;
+  }
 }
 
 // The centred step's estimate is no bound at the estimate itself (the reference diverged at a

@@ -1,6 +1,7 @@
 // The supports' springs at the explicit step's middle (numerics.supports implicit): the step is then central differences on the mass M + (dt^2/4 + beta dt/2) K_S,
 // stable for dt below 2 / omega_max of the rest alone, and still second order in dt
-// (src/core/engine/explicit_step.cpp).
+// (src/core/engine/explicit_step.cpp). The droppers stay at q_n here (test_droppers_at_middle takes
+// them to the middle too).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -51,17 +52,17 @@ int steady_arm_dof(const Model& m, double x) {
 // stability is the scheme's, not the scene's. The estimate of the rest is a bound: the pass runs
 // at the estimate itself too.
 TEST(SupportsAtMiddle, StableBeyondTheLimitTheSupportsWouldSet) {
-  const std::vector<std::string> stiff = {"numerics.preset=fast", "numerics.supports=implicit", "messenger_supports.stiffness=5e6"};
+  const std::vector<std::string> stiff = {"numerics.preset=fast", "numerics.supports=implicit", "numerics.droppers=explicit", "messenger_supports.stiffness=5e6"};
   const Model m = build_model(load_scene_file(kDir + "reference_55m.yaml", stiff));
-  ASSERT_EQ(m.support_step_inertia.size(), m.springs.size());
+  ASSERT_EQ(m.support_at_middle.size(), m.springs.size());
   for (std::size_t k = 0; k < m.springs.size(); ++k)
-    EXPECT_EQ(m.support_step_inertia[k] > 0.0, m.inv_mass[m.springs[k].dof] > 0.0) << "support " << k;
+    EXPECT_EQ(m.support_at_middle[k] != 0, m.inv_mass[m.springs[k].dof] > 0.0) << "support " << k;
   // The explicit limit with the supports at q_n (no contact bound: a lower omega, a longer dt).
   const double whole = critical_time_step(highest_eigenfrequency(m), m.alpha, m.beta);
   EXPECT_GT(m.dt, 2.0 * whole) << "dt " << m.dt << " s, the whole system's explicit limit " << whole << " s";
   EXPECT_EQ(run(m, 100000), StepStatus::kFinished);
   Model all_explicit = m;  // the same dt with the supports at q_n
-  all_explicit.support_step_inertia.assign(m.springs.size(), 0.0);
+  all_explicit.support_at_middle.assign(m.springs.size(), 0);
   EXPECT_EQ(run(all_explicit, 100000), StepStatus::kDiverged);
   std::vector<std::string> at_estimate = stiff;
   at_estimate.push_back("numerics.safety_factor=1");
@@ -75,9 +76,9 @@ TEST(SupportsAtMiddle, StableBeyondTheLimitTheSupportsWouldSet) {
 // the explicit step. Checked to round-off (1e-9 of the terms) mid-pass, the pantograph under the
 // line.
 TEST(SupportsAtMiddle, TheCorrectionIsTheTrapezoidalRule) {
-  const Model mid = build_model(load_scene_file(kDir + "reference_55m.yaml", {"numerics.preset=fast", "numerics.supports=implicit"}));
+  const Model mid = build_model(load_scene_file(kDir + "reference_55m.yaml", {"numerics.preset=fast", "numerics.supports=implicit", "numerics.droppers=explicit"}));
   Model expl = mid;
-  expl.support_step_inertia.assign(mid.springs.size(), 0.0);
+  expl.support_at_middle.assign(mid.springs.size(), 0);
   State s = make_state(mid);
   solve_initial_state(mid, s);
   for (int k = 0; k < 600; ++k) ASSERT_EQ(step(mid, s), StepStatus::kOk);
@@ -108,10 +109,10 @@ TEST(SupportsAtMiddle, TheCorrectionIsTheTrapezoidalRule) {
 // keep the fast rung's dt and run. Their damping beta k is centred too: taken at v_{n-1/2} alone it
 // would need dt below (2 / omega)(sqrt(1 + xi^2) - xi) with omega near 2 / dt, which fails.
 TEST(SupportsAtMiddle, StableWhateverTheSupportsStiffness) {
-  const std::vector<std::string> o = {"numerics.preset=fast", "numerics.supports=implicit", "messenger_supports.stiffness=1e9",
+  const std::vector<std::string> o = {"numerics.preset=fast", "numerics.supports=implicit", "numerics.droppers=explicit", "messenger_supports.stiffness=1e9",
                                       "steady_arms.stiffness=1e9"};
   const Model stiff = build_model(load_scene_file(kDir + "reference_55m.yaml", o));
-  const Model usual = build_model(load_scene_file(kDir + "reference_55m.yaml", {"numerics.preset=fast", "numerics.supports=implicit"}));
+  const Model usual = build_model(load_scene_file(kDir + "reference_55m.yaml", {"numerics.preset=fast", "numerics.supports=implicit", "numerics.droppers=explicit"}));
   EXPECT_NEAR(stiff.dt, usual.dt, 0.05 * usual.dt);  // (the contact's bound moves a little with the arms)
   EXPECT_EQ(run(stiff, 100000), StepStatus::kFinished);
 }
@@ -126,7 +127,7 @@ TEST(SupportsAtMiddle, StableWhateverTheSupportsStiffness) {
 // where the explicit step is stable too, the supports at the middle may add at most half of that
 // step's own error.
 TEST(SupportsAtMiddle, ConvergeAtSecondOrderToTheExplicitStep) {
-  const std::vector<std::string> base = {"numerics.preset=fast", "numerics.supports=implicit", "train.speed_kmh=200", "messenger_supports.stiffness=5e6"};
+  const std::vector<std::string> base = {"numerics.preset=fast", "numerics.supports=implicit", "numerics.droppers=explicit", "train.speed_kmh=200", "messenger_supports.stiffness=5e6"};
   const double h1 = 0.002;
   ASSERT_GT(build_model(load_scene_file(kDir + "reference_55m.yaml", base)).dt, h1);
   auto trace = [&](double h, const char* supports) {
@@ -170,7 +171,7 @@ TEST(SupportsAtMiddle, EveryShippedLineRunsAtTheFastAndBalancedRungs) {
   for (const char* preset : {"fast", "balanced"})
     for (const std::string& f : files) {
       SCOPED_TRACE(f + " " + preset);
-      std::vector<std::string> o = {std::string("numerics.preset=") + preset, "numerics.supports=implicit"};
+      std::vector<std::string> o = {std::string("numerics.preset=") + preset, "numerics.supports=implicit", "numerics.droppers=explicit"};
       if (f == "reference_55m_endless.yaml") o.push_back("train.end=2000");
       Simulation sim(load_scene_file(kDir + f, o));
       StepStatus st = StepStatus::kOk;
@@ -178,7 +179,7 @@ TEST(SupportsAtMiddle, EveryShippedLineRunsAtTheFastAndBalancedRungs) {
       EXPECT_EQ(st, StepStatus::kFinished) << sim.status_message();
       EXPECT_TRUE(sim.state().u.allFinite());
     }
-  Simulation twin(test_scenes::twin_contact_wire({"numerics.preset=fast", "numerics.supports=implicit"}));
+  Simulation twin(test_scenes::twin_contact_wire({"numerics.preset=fast", "numerics.supports=implicit", "numerics.droppers=explicit"}));
   StepStatus st = StepStatus::kOk;
   for (long k = 0; k < 2000000 && st == StepStatus::kOk; ++k) st = twin.step();
   EXPECT_EQ(st, StepStatus::kFinished) << twin.status_message();

@@ -95,22 +95,21 @@ int list_contact_nodes(const Model& m, State& s, bool windowed) {
 // numerics.supports implicit: the supports' springs at the step's middle. The explicit update
 // took each support's force k (q_n + beta v_{n-1/2}); the trapezoidal rule takes
 // k ((q_{n+1} + 2 q_n + q_{n-1}) / 4 + beta (v_{n+1/2} + v_{n-1/2}) / 2), which is that force plus
-// c a with c = k (dt^2/4 + beta dt/2) (Model::support_step_inertia) and a the node's new
-// acceleration (v_{n+1/2} - v_{n-1/2}) / dt. So m a = F becomes (m + c) a = F on the support's
-// node: the update's acceleration divided by 1 + c / m, and the node's update redone. A node
-// carries one support (mark_supports_at_middle), so each correction is closed and the order does
-// not matter. Returns the highest corrected DOF beyond the divergence limit (also NaN), or -1.
+// c a with c = k (dt^2/4 + beta dt/2) (middle_inertia) and a the node's new acceleration
+// (v_{n+1/2} - v_{n-1/2}) / dt. So m a = F becomes (m + c) a = F on the support's node: the
+// update's acceleration divided by 1 + c / m, and the node's update redone. A node carries one
+// support (mark_springs_at_middle), so each correction is closed and the order does not matter.
+// Returns the highest corrected DOF beyond the divergence limit (also NaN), or -1.
 int supports_at_middle(const Model& m, const State& s, bool windowed, const double* u, const double* v, double* un,
                        double* vn, double* acc) {
-  if (m.support_step_inertia.empty()) return -1;
+  if (m.support_at_middle.empty()) return -1;
   const double dt = m.dt, limit = m.scene.numerics.divergence_limit;
   const double* im = m.inv_mass.data();
   int beyond = -1;
   auto support = [&](int k) {
-    const double c = m.support_step_inertia[k];
-    if (!(c > 0.0)) return;
+    if (!m.support_at_middle[k]) return;
     const int i = m.springs[k].dof;
-    acc[i] /= 1.0 + c * im[i];
+    acc[i] /= 1.0 + middle_inertia(m, m.springs[k].stiffness) * im[i];
     vn[i] = v[i] + dt * acc[i];
     un[i] = u[i] + dt * vn[i];
     if (!(std::fabs(un[i]) <= limit)) beyond = std::max(beyond, i);
@@ -121,6 +120,76 @@ int supports_at_middle(const Model& m, const State& s, bool windowed, const doub
     for (std::size_t k = 0; k < m.springs.size(); ++k) support(static_cast<int>(k));
   }
   return beyond;
+}
+
+// numerics.droppers implicit: the droppers and the stitch wires' clamps at the step's middle. The
+// update so far left each of them out (add_wire_point_forces), so acc holds its nodes'
+// accelerations a0 without it. At the middle its force is T = T_n + c (a_m - a_l), T_n = T0 +
+// k (z_m - z_l) the explicit step's (z = q_n + beta v_{n-1/2}, the lean's share on a 3-D line), c =
+// k (dt^2/4 + beta dt/2) as for a support, and a the new accelerations of its upper (messenger) and
+// lower (contact wire, auxiliary, stitch wire) ends, a = a0 -/+ T / m. Solved:
+// T = (T_n + c (a0_m - a0_l)) / (1 + c (1/m_m + 1/m_l)). A dropper works only in tension: where that
+// T is not positive it is slack, carries nothing, and a = a0 is then consistent (its stretch at the
+// middle, T's numerator / k, is not positive). So the switch is decided inside the step on the
+// tension it acts with, a complementarity per dropper with one solution; decided at q_n instead, a
+// dropper at this dt goes taut and slack by turns. A clamp is bilateral. No node carries two such
+// corrections (mark_springs_at_middle), so each is closed. Writes the droppers' tensions to
+// State::dropper_tension; returns the highest corrected DOF beyond the divergence limit, or -1.
+int links_at_middle(const Model& m, State& s, bool windowed, const double* u, const double* v, double* un, double* vn,
+                    double* acc) {
+  if (m.dropper_at_middle.empty()) return -1;
+  const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
+  const double* im = m.inv_mass.data();
+  const double* lean = leaning(m, s) ? s.lateral.dropper_stretch.data() : nullptr;
+  int beyond = -1;
+  auto redo = [&](int i) {
+    vn[i] = v[i] + dt * acc[i];
+    un[i] = u[i] + dt * vn[i];
+    if (!(std::fabs(un[i]) <= limit)) beyond = std::max(beyond, i);
+  };
+  // The force at the middle of a link of stiffness k, force t0 at zero stretch and the lean's share
+  // `lean_stretch`, from its upper end `a` to its lower end `l`.
+  auto middle_force = [&](int a, int l, double k, double t0, double lean_stretch) {
+    const double stretch = (u[a] + beta * v[a]) - (u[l] + beta * v[l]) + lean_stretch;
+    const double c = middle_inertia(m, k);
+    return (t0 + k * stretch + c * (acc[a] - acc[l])) / (1.0 + c * (im[a] + im[l]));
+  };
+  auto apply = [&](int a, int l, double t) {
+    acc[l] += im[l] * t;
+    acc[a] -= im[a] * t;
+    redo(l);
+    redo(a);
+  };
+  auto dropper = [&](int k) {
+    if (!m.dropper_at_middle[k]) return;
+    const Dropper& d = m.droppers[k];
+    const double t = middle_force(d.messenger_dof, d.contact_dof, d.stiffness, d.static_tension, lean ? lean[k] : 0.0);
+    const bool taut = t > 0.0;
+    s.dropper_slack[k] = !taut;
+    s.dropper_tension[k] = taut ? t : 0.0;
+    if (taut) apply(d.messenger_dof, d.contact_dof, t);
+  };
+  auto clamp = [&](int k) {
+    if (!m.clamp_at_middle[k]) return;
+    const WireClamp& c = m.clamps[k];
+    apply(c.messenger_dof, c.stitch_dof, middle_force(c.messenger_dof, c.stitch_dof, c.stiffness, c.static_force, 0.0));
+  };
+  if (windowed) {
+    for (int j = 0; j < s.window_dropper_count; ++j) dropper(s.window_droppers[j]);
+    for (int j = 0; j < s.window_clamp_count; ++j) clamp(s.window_clamps[j]);
+  } else {
+    for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(static_cast<int>(k));
+    for (std::size_t k = 0; k < m.clamps.size(); ++k) clamp(static_cast<int>(k));
+  }
+  return beyond;
+}
+
+// The springs at the step's middle (supports, then droppers and clamps: they share no node), after
+// every DOF's explicit update. Returns the highest corrected DOF beyond the divergence limit, or -1.
+int springs_at_middle(const Model& m, State& s, bool windowed, const double* u, const double* v, double* un, double* vn,
+                      double* acc) {
+  const int supports = supports_at_middle(m, s, windowed, u, v, un, vn, acc);
+  return std::max(supports, links_at_middle(m, s, windowed, u, v, un, vn, acc));
 }
 
 // The explicit step with the wires packed (Model::wire_packs): one fused sweep pair per pack
@@ -166,7 +235,7 @@ int explicit_fused_update(const Model& m, State& s, bool windowed) {
   for_each_point(m, s, windowed, [&](int i) { update(i, force_at(i)); });  // the contact nodes last: theirs has the contact
   for (int q = 0; q < contacts; ++q) update(contact_node[q], f[contact_node[q]]);
   for (int i = m.n_catenary_dof; i < m.n_dof; ++i) update(i, f[i]);
-  outside |= supports_at_middle(m, s, windowed, u, v, un, vn, acc) >= 0;
+  outside |= springs_at_middle(m, s, windowed, u, v, un, vn, acc) >= 0;
   // The displacement check: the sweeps' flag is only a hint (they saw the nodes before the point
   // forces), so on a flag, or a pantograph or point beyond the limit, every new value is scanned
   // in the generic step's order.
@@ -233,8 +302,9 @@ StepStatus generic_step(const Model& m, State& s, bool windowed) {
   } else {
     update(0, n);
   }
-  // The supports' corrected nodes moved: the last DOF beyond the limit among the final values.
-  if (supports_at_middle(m, s, windowed, u, v, u_new, v_new, acc) >= 0 || (bad >= 0 && !m.support_step_inertia.empty()))
+  // The springs' corrected nodes moved: the last DOF beyond the limit among the final values.
+  const bool middle = !m.support_at_middle.empty() || !m.dropper_at_middle.empty();
+  if (springs_at_middle(m, s, windowed, u, v, u_new, v_new, acc) >= 0 || (bad >= 0 && middle))
     bad = last_beyond(m, s, windowed, u_new);
   if (bad >= 0) return diverged(s, bad, u_new);
   if (windowed) {

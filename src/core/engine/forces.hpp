@@ -45,7 +45,10 @@ template <bool kLean, class ForceAt, class ZAt>
 void add_wire_point_forces(const Model& m, State& s, const double* u, const double* v, ForceAt f, ZAt z,
                            bool given_slack) {
   const double* lean = kLean ? s.lateral.dropper_stretch.data() : nullptr;
+  // Droppers at the step's middle (numerics.droppers implicit) act after the update (explicit_step.cpp).
+  const std::uint8_t* at_middle = m.dropper_at_middle.empty() ? nullptr : m.dropper_at_middle.data();
   auto dropper = [&](std::size_t k) {
+    if (at_middle && at_middle[k]) return;
     // Droppers work only in tension; the switch is decided on the elastic stretch.
     const Dropper& d = m.droppers[k];
     auto z_stretch = [&] {
@@ -70,8 +73,11 @@ void add_wire_point_forces(const Model& m, State& s, const double* u, const doub
     f(d.contact_dof) += t;
     f(d.messenger_dof) -= t;
   };
-  // Stitch wires' clamps: bilateral, never slack.
-  auto clamp = [&](const WireClamp& c) {
+  // Stitch wires' clamps: bilateral, never slack (at the step's middle, explicit_step.cpp).
+  const std::uint8_t* clamp_middle = m.clamp_at_middle.empty() ? nullptr : m.clamp_at_middle.data();
+  auto clamp = [&](std::size_t k) {
+    if (clamp_middle && clamp_middle[k]) return;
+    const WireClamp& c = m.clamps[k];
     const double t = c.static_force + c.stiffness * (z(c.messenger_dof) - z(c.stitch_dof));
     f(c.stitch_dof) += t;
     f(c.messenger_dof) -= t;
@@ -91,11 +97,11 @@ void add_wire_point_forces(const Model& m, State& s, const double* u, const doub
       f(sp.dof) -= sp.stiffness * z(sp.dof);
     }
     for (int j = 0; j < s.window_dropper_count; ++j) dropper(static_cast<std::size_t>(s.window_droppers[j]));
-    for (int j = 0; j < s.window_clamp_count; ++j) clamp(m.clamps[s.window_clamps[j]]);
+    for (int j = 0; j < s.window_clamp_count; ++j) clamp(static_cast<std::size_t>(s.window_clamps[j]));
   } else {
     for (const SupportSpring& sp : m.springs) f(sp.dof) -= sp.stiffness * z(sp.dof);
     for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(k);
-    for (const WireClamp& c : m.clamps) clamp(c);
+    for (std::size_t k = 0; k < m.clamps.size(); ++k) clamp(k);
   }
 }
 

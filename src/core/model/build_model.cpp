@@ -476,17 +476,37 @@ void set_train_travel(const Scene& scene, double endless_front, Model& m) {
   }
 }
 
-// numerics.supports implicit: which support springs the explicit step takes at its middle, marked
-// with a positive Model::support_step_inertia (the value is set once dt is known): those on a free
-// node that no other support shares, so that each is a closed-form correction of its node's
-// update. (The droppers stay explicit: a tension-only spring at the step's middle with its slack
-// switch at q_n chatters, taut and slack by turns, at the fast rung's dt.)
-void mark_supports_at_middle(Model& m) {
+// numerics.supports / numerics.droppers implicit: which support springs, droppers and stitch wires'
+// clamps the explicit step takes at its middle (Model::support_at_middle, dropper_at_middle,
+// clamp_at_middle), each a closed-form correction of its nodes' update (explicit_step.cpp). A
+// support on a free node that no other support shares; a dropper or clamp with a free end whose
+// nodes no other spring at the middle shares (their corrections would be coupled), on a 2-D line.
+// The rest stay at q_n and the stability limit keeps them.
+void mark_springs_at_middle(const Scene& scene, Model& m) {
+  const NumericsSpec& num = scene.numerics;
   std::vector<int> count(m.n_dof, 0);
-  for (const SupportSpring& sp : m.springs) ++count[sp.dof];
-  m.support_step_inertia.assign(m.springs.size(), 0.0);
-  for (std::size_t k = 0; k < m.springs.size(); ++k)
-    if (m.inv_mass[m.springs[k].dof] > 0.0 && count[m.springs[k].dof] == 1) m.support_step_inertia[k] = 1.0;
+  if (num.supports == SpringStep::kImplicit) {
+    for (const SupportSpring& sp : m.springs) ++count[sp.dof];
+    m.support_at_middle.assign(m.springs.size(), 0);
+    for (std::size_t k = 0; k < m.springs.size(); ++k)
+      m.support_at_middle[k] = m.inv_mass[m.springs[k].dof] > 0.0 && count[m.springs[k].dof] == 1;
+  }
+  // A 3-D line keeps its droppers and clamps at q_n: the lateral plane's substeps load each leaning
+  // dropper with its elastic tension at q_n and the lean's change (lateral_step.cpp), which a
+  // dropper at the middle does not carry.
+  if (num.droppers != SpringStep::kImplicit || scene.lateral()) return;
+  std::vector<std::uint8_t> held(m.n_dof, 0);  // a node whose update another middle correction redoes
+  for (std::size_t k = 0; k < m.support_at_middle.size(); ++k)
+    if (m.support_at_middle[k]) held[m.springs[k].dof] = 1;
+  auto take = [&](int a, int c) {
+    if (held[a] || held[c] || !(m.inv_mass[a] > 0.0 || m.inv_mass[c] > 0.0)) return false;
+    held[a] = held[c] = 1;
+    return true;
+  };
+  m.dropper_at_middle.assign(m.droppers.size(), 0);
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) m.dropper_at_middle[k] = take(m.droppers[k].messenger_dof, m.droppers[k].contact_dof);
+  m.clamp_at_middle.assign(m.clamps.size(), 0);
+  for (std::size_t k = 0; k < m.clamps.size(); ++k) m.clamp_at_middle[k] = take(m.clamps[k].messenger_dof, m.clamps[k].stitch_dof);
 }
 
 // The explicit stability limit (validation.md section 5) and the step, or the implicit matrix.
@@ -514,7 +534,7 @@ void choose_time_step(const Scene& scene, Model& m) {
     m.implicit = newmark_matrix(m, m.dt);
     return;
   }
-  if (scene.numerics.supports == SupportSprings::kImplicit) mark_supports_at_middle(m);
+  mark_springs_at_middle(scene, m);
   compute_stability_limit(m);
   if (scene.numerics.dt) {
     if (*scene.numerics.dt > m.dt_critical)
@@ -525,11 +545,6 @@ void choose_time_step(const Scene& scene, Model& m) {
   } else {
     m.dt = scene.numerics.safety_factor * m.dt_critical;
   }
-  // Each support at the step's middle: k (dt^2/4 + beta dt/2), the trapezoidal rule's share of its
-  // stiffness and the centred share of its damping beta k (explicit_step.cpp).
-  for (std::size_t k = 0; k < m.support_step_inertia.size(); ++k)
-    if (m.support_step_inertia[k] > 0.0)
-      m.support_step_inertia[k] = m.springs[k].stiffness * (0.25 * m.dt * m.dt + 0.5 * m.beta * m.dt);
 }
 
 Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) {

@@ -50,9 +50,10 @@ void compute_stability_limit(Model& m) {
   // A Rayleigh quotient can only underestimate omega_max; the 0.2 % margin covers what the
   // iteration has not converged (measured: 3e-4 after 400 iterations on the HRZ variant), so the
   // refusal of a user dt is on the safe side.
-  // The supports taken at the step's middle (numerics.supports implicit) are left out: with them the
-  // step is central differences on the mass M + (dt^2/4) K_I and the stiffness K_E + K_I, stable
-  // for dt < 2 / omega_max(K_E, M) whatever K_I (explicit_step.cpp).
+  // The supports and droppers taken at the step's middle (numerics.supports, numerics.droppers
+  // implicit) are left out: with them the step is central differences on the mass M + (dt^2/4) K_I
+  // and the stiffness K_E + K_I, stable for dt < 2 / omega_max(K_E, M) whatever K_I
+  // (explicit_step.cpp). A slack dropper only takes its K_I away.
   m.omega_max = 1.002 * highest_eigenfrequency(m, 3000, true);
   // The contacts move along the wire: where one meets a light node its frequency is highest, and
   // the power iteration sees it only where the train starts. Add every contact's worst case as a

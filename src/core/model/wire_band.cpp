@@ -131,17 +131,23 @@ void wire_elastic_force(const Wire& wire, const double* z, double* f, double* th
 void apply_stiffness(const Model& m, double front, const double* x, double* y, double* scratch, bool explicit_part) {
   std::fill(y, y + m.n_dof, 0.0);
   for (const Wire& w : m.wires) wire_elastic_force(w, x, y, scratch);  // y = -K x so far
-  const bool skip = explicit_part && !m.support_step_inertia.empty();
+  const bool skip_supports = explicit_part && !m.support_at_middle.empty();
+  const bool skip_droppers = explicit_part && !m.dropper_at_middle.empty();
   for (std::size_t k = 0; k < m.springs.size(); ++k) {
     const SupportSpring& s = m.springs[k];
-    if (!(skip && m.support_step_inertia[k] > 0.0)) y[s.dof] -= s.stiffness * x[s.dof];
+    if (!(skip_supports && m.support_at_middle[k])) y[s.dof] -= s.stiffness * x[s.dof];
   }
-  for (const Dropper& d : m.droppers) {
+  for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+    if (skip_droppers && m.dropper_at_middle[k]) continue;
+    const Dropper& d = m.droppers[k];
     const double t = d.stiffness * (x[d.messenger_dof] - x[d.contact_dof]);
     y[d.contact_dof] += t;
     y[d.messenger_dof] -= t;
   }
-  for (const WireClamp& c : m.clamps) {
+  const bool skip_clamps = explicit_part && !m.clamp_at_middle.empty();
+  for (std::size_t k = 0; k < m.clamps.size(); ++k) {
+    if (skip_clamps && m.clamp_at_middle[k]) continue;
+    const WireClamp& c = m.clamps[k];
     const double t = c.stiffness * (x[c.messenger_dof] - x[c.stitch_dof]);
     y[c.stitch_dof] += t;
     y[c.messenger_dof] -= t;

@@ -112,11 +112,20 @@ namespace {
 // a leaning dropper is a stiff link along itself, so the vertical plane gives way to a change of
 // lean by about as much (u_m - u_c ~ -lean), and the vertical stretch alone would read k times
 // the lean's change (60 N per 0.3 mm) as force or slack the dropper does not have.
+// A dropper at the step's middle (numerics.droppers implicit) reports the tension it acted with
+// over the last step (State::dropper_tension).
+inline double middle_tension(const Model& m, std::size_t k, const State& s) {
+  return s.dropper_tension.empty() || !m.dropper_at_middle[k] ? std::nan("") : s.dropper_tension[k];
+}
+
 inline double dropper_force(const Model& m, std::size_t k, const State& s, bool* slack) {
   const Dropper& d = m.droppers[k];
-  double stretch = s.u[d.messenger_dof] - s.u[d.contact_dof];
-  if (m.lateral && !s.lateral.dropper_stretch.empty()) stretch += s.lateral.dropper_stretch[k];
-  const double t = d.static_tension + d.stiffness * stretch;
+  double t = middle_tension(m, k, s);
+  if (std::isnan(t)) {
+    double stretch = s.u[d.messenger_dof] - s.u[d.contact_dof];
+    if (m.lateral && !s.lateral.dropper_stretch.empty()) stretch += s.lateral.dropper_stretch[k];
+    t = d.static_tension + d.stiffness * stretch;
+  }
   *slack = !(t > 0.0);
   return *slack ? 0.0 : t;
 }
@@ -181,9 +190,12 @@ void PassRecorder::record_whole(const Model& m, const State& s) {
   const double* u = s.u.data();
   const double* lean = m.lateral && !s.lateral.dropper_stretch.empty() ? s.lateral.dropper_stretch.data() : nullptr;
   for (DropperTrack& t : droppers_) {
-    double stretch = u[t.messenger_dof] - u[t.contact_dof];
-    if (lean) stretch += lean[t.index];
-    const double tension = t.static_tension + t.stiffness * stretch;
+    double tension = middle_tension(m, t.index, s);
+    if (std::isnan(tension)) {
+      double stretch = u[t.messenger_dof] - u[t.contact_dof];
+      if (lean) stretch += lean[t.index];
+      tension = t.static_tension + t.stiffness * stretch;
+    }
     const bool slack = !(tension > 0.0);
     const double f = slack ? 0.0 : tension;
     t.max = std::max(t.max, f);

@@ -402,8 +402,9 @@ void read_gust_lead(Reader& r, Scene& s) {
 }
 
 // numerics: the fidelity ladder. Returns whether the reference preset's own element length and
-// damping apply (neither given).
-bool read_numerics(Reader& top, Scene& s) {
+// damping apply (neither given); `springs_by_preset`: whether the fast preset chose the supports' and
+// droppers' step (neither given).
+bool read_numerics(Reader& top, Scene& s, bool* springs_by_preset) {
   bool reference_defaults = false;
   if (!top.has("numerics")) return reference_defaults;
   Reader r(top.child("numerics"), "numerics");
@@ -450,17 +451,30 @@ bool read_numerics(Reader& top, Scene& s) {
   if (dmp == "half_step") s.numerics.damping = DampingStep::kHalfStep;
   else if (dmp == "centred") s.numerics.damping = DampingStep::kCentred;
   else fail("numerics.damping", "'" + dmp + "'", "one of: half_step (C v at v_{n-1/2}, eq. 19-21), centred (C v at (v_{n+1/2} + v_{n-1/2}) / 2)");
-  // The supports' springs at the step's middle, where the explicit half-step runs (explicit_step.cpp).
+  // The supports' springs and the droppers at the step's middle, where the explicit half-step runs
+  // (explicit_step.cpp).
   const bool middle_allowed = s.numerics.integrator == Integrator::kExplicit && s.numerics.damping == DampingStep::kHalfStep;
-  const std::string spr = r.text("supports", "explicit");
-  if (spr == "explicit") s.numerics.supports = SupportSprings::kExplicit;
-  else if (spr == "implicit") s.numerics.supports = SupportSprings::kImplicit;
-  else fail("numerics.supports", "'" + spr + "'", "one of: explicit (at q_n, eq. 19-21), implicit (at the step's middle, the trapezoidal rule)");
-  if (s.numerics.supports == SupportSprings::kImplicit && !middle_allowed)
-    fail("numerics.supports", "'implicit'",
-         s.numerics.integrator != Integrator::kExplicit
-             ? "explicit with the implicit integrator (its matrix holds every spring already)"
-             : "explicit with numerics.damping centred (the supports at the step's middle go with the half-step damping)");
+  // The fast rung takes them at the middle by default (where the scheme allows it, on a 2-D line:
+  // scene_from_yaml): its dt is then set by the wires' 1 m elements instead of the supports' and
+  // droppers' springs on light nodes.
+  const bool middle_default = preset == "fast" && middle_allowed;
+  *springs_by_preset = middle_default && !r.has("supports") && !r.has("droppers");
+  auto spring_step = [&](const char* key) {
+    const std::string field = std::string("numerics.") + key;
+    const std::string v = r.text(key, middle_default ? "implicit" : "explicit");
+    SpringStep step = SpringStep::kExplicit;
+    if (v == "implicit") step = SpringStep::kImplicit;
+    else if (v != "explicit")
+      fail(field, "'" + v + "'", "one of: explicit (at q_n, eq. 19-21), implicit (at the step's middle, the trapezoidal rule)");
+    if (step == SpringStep::kImplicit && !middle_allowed)
+      fail(field, "'implicit'",
+           s.numerics.integrator != Integrator::kExplicit
+               ? "explicit with the implicit integrator (its matrix holds every spring already)"
+               : "explicit with numerics.damping centred (the springs at the step's middle go with the half-step damping)");
+    return step;
+  };
+  s.numerics.supports = spring_step("supports");
+  s.numerics.droppers = spring_step("droppers");
   s.numerics.divergence_limit = r.number("divergence_limit", 0.0, 1000.0, 5.0, true);
   s.numerics.allow_supercritical = r.boolean("allow_supercritical", false);
   read_window(r, s);
@@ -521,11 +535,16 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   read_contact(top, s);
   read_pantographs(top, s);
   read_train(top, s);
-  reference_defaults = read_numerics(top, s);
+  bool springs_by_preset = false;  // preset fast, supports and droppers at the step's middle
+  reference_defaults = read_numerics(top, s, &springs_by_preset);
   read_imperfections(top, s, base_dir);
   read_output(top, s);
   read_lateral_parts(top, s);
   top.finish();
+  // A 3-D line's fast rung keeps its supports and droppers at q_n: its droppers stay there anyway
+  // (mark_springs_at_middle), and the supports alone at the middle move its dropper forces further
+  // from the finer rungs' (BENCHMARKS.md, the fidelity ladder).
+  if (springs_by_preset && s.lateral()) s.numerics.supports = s.numerics.droppers = SpringStep::kExplicit;
   // The reference rung's centred damping steps the explicit scheme with beta > 0
   // (NumericsSpec::damping); elsewhere the rung is h = 0.1 m with the half-step damping, the finest
   // its explicit dt allows at a reference's cost (docs/benchmark_history.md, "Choosing the

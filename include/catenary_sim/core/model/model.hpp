@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -172,10 +173,10 @@ struct Model {
   double omega_max = 0.0;       // rad/s, highest eigenfrequency of the assembled system
   double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction (inf: implicit)
   double dt = 0.0;              // s, the step in use
-  // numerics.supports implicit: per support spring (springs), the inertia k (dt^2/4 + beta dt/2)
-  // (kg) its force at the step's middle adds to its node's update (explicit_step.cpp), 0 where it
-  // stays explicit (a held node); empty when every support is explicit.
-  std::vector<double> support_step_inertia;
+  // numerics.supports / numerics.droppers implicit: 1 for each support spring (springs), dropper
+  // (droppers) and stitch wire's clamp (clamps) the explicit step takes at its middle
+  // (explicit_step.cpp), 0 for those it takes at q_n; empty when all are at q_n.
+  std::vector<std::uint8_t> support_at_middle, dropper_at_middle, clamp_at_middle;
   std::shared_ptr<const ImplicitMatrix> implicit;  // set when the integrator is implicit
   // Explicit with condensed rotations: the wires packed side by side for the fused step, their
   // copies in SIMD lanes and where the sweep leaves each DOF's results (their layout is the
@@ -215,6 +216,13 @@ inline int wire_holding(const std::vector<Wire>& wires, int dof) {
   return -1;
 }
 inline int wire_holding(const Model& m, int dof) { return wire_holding(m.wires, dof); }
+
+// The inertia (kg) a spring of stiffness k taken at the explicit step's middle adds to its nodes'
+// update: k (dt^2/4 + beta dt/2), the trapezoidal rule's share of its stiffness and the centred
+// share of its damping beta k (explicit_step.cpp).
+inline double middle_inertia(const Model& m, double stiffness) {
+  return stiffness * (0.25 * m.dt * m.dt + 0.5 * m.beta * m.dt);
+}
 
 }  // namespace catenary_sim
 

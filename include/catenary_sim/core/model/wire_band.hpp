@@ -15,8 +15,9 @@ void assemble_band(Wire& w, const std::vector<double>& ei_factor);
 // y = K x for the linear part of the system with every dropper and contact active (the collectors
 // at the train position `front`): used for the stability limit and by tests. x and y have n_dof
 // entries; `scratch` must have room for the condensed rotations (max wire nodes). With
-// `explicit_part`, the supports' springs taken at the step's middle (Model::support_step_inertia
-// nonzero) are left out: the explicit step's stability is that of the rest.
+// `explicit_part`, the supports' springs, droppers and clamps taken at the step's middle
+// (Model::support_at_middle, dropper_at_middle, clamp_at_middle) are left out: the explicit step's stability is
+// that of the rest.
 void apply_stiffness(const Model& model, double front, const double* x, double* y, double* scratch,
                      bool explicit_part = false);
 

@@ -70,7 +70,8 @@ struct PantographStatistics {
 };
 
 // One dropper of the analysis section over the whole pass: its force (elastic tension, 0 when
-// slack, as the integrator decides) and its rainflow-counted ranges.
+// slack, as the integrator decides; a dropper at the step's middle, the tension it acted with) and
+// its rainflow-counted ranges.
 struct DropperStatistics {
   double station = 0.0;  // m
   int span = 0;          // span index along the line

@@ -209,11 +209,13 @@ enum class Integrator { kExplicit, kImplicit };
 // dt; kCentred on (v_{n+1/2} + v_{n-1/2}) / 2, a banded solve per step and the undamped limit.
 enum class DampingStep { kHalfStep, kCentred };
 
-// The supports' springs (steady arms, messenger supports) in the explicit step
-// (NumericsSpec::supports): kExplicit takes their force at q_n (eq. 19-21), so a stiff support on
-// its light node can set dt; kImplicit at the step's middle (the trapezoidal rule, their damping
-// centred), which has no stability limit of its own: dt is then set by the rest.
-enum class SupportSprings { kExplicit, kImplicit };
+// The supports' springs (steady arms, messenger supports; NumericsSpec::supports) and the droppers
+// (NumericsSpec::droppers) in the explicit step: kExplicit takes their force at q_n (eq. 19-21), so
+// a stiff spring on its light nodes can set dt; kImplicit at the step's middle (the trapezoidal
+// rule, their damping centred), which has no stability limit of its own: dt is then set by the
+// rest. A dropper at the middle is slack where the tension the middle gives it would be
+// compressive (explicit_step.cpp).
+enum class SpringStep { kExplicit, kImplicit };
 
 constexpr double kMaxGustLead = 60.0;  // s, numerics.gust_lead
 
@@ -232,7 +234,8 @@ struct NumericsSpec {
   double safety_factor = 0.9;    // for automatic dt
   RotaryInertia rotary_inertia = RotaryInertia::kCondensed;
   DampingStep damping = DampingStep::kHalfStep;
-  SupportSprings supports = SupportSprings::kExplicit;
+  SpringStep supports = SpringStep::kExplicit;
+  SpringStep droppers = SpringStep::kExplicit;
   double divergence_limit = 5.0;  // m: any displacement beyond this stops the run as diverged
   // Moving window: only the spans from `window_behind` m behind the rearmost pantograph to
   // `window_ahead` m ahead of the foremost are integrated (snapped outward to supports); the rest
