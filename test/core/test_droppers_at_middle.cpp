@@ -16,24 +16,15 @@
 #include "catenary_sim/core/model/stability.hpp"
 #include "catenary_sim/core/output/pass_recorder.hpp"
 #include "../support/scenes.hpp"
+#include "../support/stepping.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
 const std::string& kDir = test_scenes::kConfigDir;
-
-// Steps a built model from its static state; returns the status it stopped with.
-StepStatus run(const Model& m, long max_steps, std::vector<double>* trace = nullptr, int dof = -1) {
-  State s = make_state(m);
-  solve_initial_state(m, s);
-  for (long k = 0; k < max_steps; ++k) {
-    const StepStatus st = step(m, s);
-    if (st != StepStatus::kOk) return st;
-    if (trace) trace->push_back(s.u[dof]);
-  }
-  return StepStatus::kOk;
-}
+using test_stepping::run_from_static;
+using test_stepping::run_to_end;
 
 // The same model with every dropper and clamp at q_n (the supports as they were).
 Model links_at_qn(const Model& m) {
@@ -62,8 +53,8 @@ TEST(DroppersAtMiddle, StableBeyondTheLimitTheDroppersWouldSet) {
   // The explicit limit with the droppers at q_n (no contact bound: a lower omega, a longer dt).
   const double limit = critical_time_step(highest_eigenfrequency(at_qn, 3000, true), m.alpha, m.beta);
   EXPECT_GT(m.dt, 1.5 * limit) << "dt " << m.dt << " s, the droppers' explicit limit " << limit << " s";
-  EXPECT_EQ(run(m, 100000), StepStatus::kFinished);
-  EXPECT_EQ(run(at_qn, 100000), StepStatus::kDiverged);
+  EXPECT_EQ(run_from_static(m, 100000), StepStatus::kFinished);
+  EXPECT_EQ(run_from_static(at_qn, 100000), StepStatus::kDiverged);
 }
 
 // The step is the trapezoidal rule for each dropper, with the tension-only law as a
@@ -136,7 +127,7 @@ TEST(DroppersAtMiddle, StableWhateverTheDroppersStiffness) {
   const Model usual = build_model(load_scene_file(kDir + "reference_55m.yaml", {"numerics.preset=fast"}));
   const Model stiff = build_model(load_scene_file(kDir + "reference_55m.yaml", {"numerics.preset=fast", "droppers.axial_stiffness=2e7"}));
   EXPECT_NEAR(stiff.dt, usual.dt, 0.05 * usual.dt);
-  EXPECT_EQ(run(stiff, 100000), StepStatus::kFinished);
+  EXPECT_EQ(run_from_static(stiff, 100000), StepStatus::kFinished);
 }
 
 // Second order in dt: the contact wire's height at mid-span over the first 1.5 s of a pass at
@@ -161,20 +152,11 @@ TEST(DroppersAtMiddle, ConvergeAtSecondOrderToTheExplicitStep) {
     o.push_back(std::string("numerics.droppers=") + droppers);
     const Model m = build_model(load_scene_file(kDir + "reference_55m.yaml", o));
     std::vector<double> u;
-    EXPECT_EQ(run(m, std::lround(1.5 / h), &u, m.wires[m.contact_wires[0]].w_dof + node), StepStatus::kOk);
+    EXPECT_EQ(run_from_static(m, std::lround(1.5 / h), &u, m.wires[m.contact_wires[0]].w_dof + node), StepStatus::kOk);
     return u;
   };
   const std::vector<double> ref = trace(h1 / 64, "explicit");
-  // rms difference at the common instants (every `stride` reference steps).
-  auto error = [&](const std::vector<double>& u, int stride) {
-    double sum = 0.0;
-    int n = 0;
-    for (std::size_t k = 0; k < u.size() && (k + 1) * stride <= ref.size(); ++k, ++n) {
-      const double d = u[k] - ref[(k + 1) * stride - 1];
-      sum += d * d;
-    }
-    return std::sqrt(sum / n);
-  };
+  auto error = [&](const std::vector<double>& u, int stride) { return test_stepping::rms_against(u, ref, stride); };
   const double e1 = error(trace(h1, "implicit"), 64), e2 = error(trace(h1 / 2, "implicit"), 32);
   const double e4 = error(trace(h1 / 4, "implicit"), 16);
   std::printf("errors %.3g m at 4 ms, %.3g m at 2 ms, %.3g m at 1 ms\n", e1, e2, e4);
@@ -241,15 +223,11 @@ TEST(DroppersAtMiddle, EveryShippedLineRunsAtTheFastAndBalancedRungs) {
       if (f == "reference_55m_endless.yaml") o.push_back("train.end=2000");
       Simulation sim(load_scene_file(kDir + f, o));
       EXPECT_GT(std::count(sim.model().dropper_at_middle.begin(), sim.model().dropper_at_middle.end(), 1), 0);
-      StepStatus st = StepStatus::kOk;
-      for (long k = 0; k < 2000000 && st == StepStatus::kOk; ++k) st = sim.step();
-      EXPECT_EQ(st, StepStatus::kFinished) << sim.status_message();
+      EXPECT_EQ(run_to_end(sim), StepStatus::kFinished) << sim.status_message();
       EXPECT_TRUE(sim.state().u.allFinite());
     }
   Simulation twin(test_scenes::twin_contact_wire({"numerics.preset=fast"}));
-  StepStatus st = StepStatus::kOk;
-  for (long k = 0; k < 2000000 && st == StepStatus::kOk; ++k) st = twin.step();
-  EXPECT_EQ(st, StepStatus::kFinished) << twin.status_message();
+  EXPECT_EQ(run_to_end(twin), StepStatus::kFinished) << twin.status_message();
 }
 
 // The stitched line's clamps go to the middle with its droppers: its fast rung's dt is then no
@@ -262,6 +240,6 @@ TEST(DroppersAtMiddle, TheStitchWiresClampsGoToTheMiddleToo) {
   clamps_at_qn.clamp_at_middle.clear();
   const double limit = critical_time_step(highest_eigenfrequency(clamps_at_qn, 3000, true), mid.alpha, mid.beta);
   EXPECT_GT(mid.dt, 1.5 * limit) << "dt " << mid.dt << " s; the clamps at q_n allow " << limit << " s";
-  EXPECT_EQ(run(mid, 100000), StepStatus::kFinished);
-  EXPECT_EQ(run(clamps_at_qn, 100000), StepStatus::kDiverged);
+  EXPECT_EQ(run_from_static(mid, 100000), StepStatus::kFinished);
+  EXPECT_EQ(run_from_static(clamps_at_qn, 100000), StepStatus::kDiverged);
 }

@@ -15,24 +15,15 @@
 #include "catenary_sim/core/engine/initial_state.hpp"
 #include "catenary_sim/core/model/stability.hpp"
 #include "../support/scenes.hpp"
+#include "../support/stepping.hpp"
 
 using namespace catenary_sim;
 
 namespace {
 
 const std::string& kDir = test_scenes::kConfigDir;
-
-// Steps a built model from its static state; returns the status it stopped with.
-StepStatus run(const Model& m, long max_steps, std::vector<double>* trace = nullptr, int dof = -1) {
-  State s = make_state(m);
-  solve_initial_state(m, s);
-  for (long k = 0; k < max_steps; ++k) {
-    const StepStatus st = step(m, s);
-    if (st != StepStatus::kOk) return st;
-    if (trace) trace->push_back(s.u[dof]);
-  }
-  return StepStatus::kOk;
-}
+using test_stepping::run_from_static;
+using test_stepping::run_to_end;
 
 // The contact wire's DOF at the steady arm nearest station x.
 int steady_arm_dof(const Model& m, double x) {
@@ -60,13 +51,13 @@ TEST(SupportsAtMiddle, StableBeyondTheLimitTheSupportsWouldSet) {
   // The explicit limit with the supports at q_n (no contact bound: a lower omega, a longer dt).
   const double whole = critical_time_step(highest_eigenfrequency(m), m.alpha, m.beta);
   EXPECT_GT(m.dt, 2.0 * whole) << "dt " << m.dt << " s, the whole system's explicit limit " << whole << " s";
-  EXPECT_EQ(run(m, 100000), StepStatus::kFinished);
+  EXPECT_EQ(run_from_static(m, 100000), StepStatus::kFinished);
   Model all_explicit = m;  // the same dt with the supports at q_n
   all_explicit.support_at_middle.assign(m.springs.size(), 0);
-  EXPECT_EQ(run(all_explicit, 100000), StepStatus::kDiverged);
+  EXPECT_EQ(run_from_static(all_explicit, 100000), StepStatus::kDiverged);
   std::vector<std::string> at_estimate = stiff;
   at_estimate.push_back("numerics.safety_factor=1");
-  EXPECT_EQ(run(build_model(load_scene_file(kDir + "reference_55m.yaml", at_estimate)), 100000), StepStatus::kFinished);
+  EXPECT_EQ(run_from_static(build_model(load_scene_file(kDir + "reference_55m.yaml", at_estimate)), 100000), StepStatus::kFinished);
 }
 
 // The correction is the trapezoidal rule: from the same state, the step with the supports at the
@@ -114,7 +105,7 @@ TEST(SupportsAtMiddle, StableWhateverTheSupportsStiffness) {
   const Model stiff = build_model(load_scene_file(kDir + "reference_55m.yaml", o));
   const Model usual = build_model(load_scene_file(kDir + "reference_55m.yaml", {"numerics.preset=fast", "numerics.supports=implicit", "numerics.droppers=explicit"}));
   EXPECT_NEAR(stiff.dt, usual.dt, 0.05 * usual.dt);  // (the contact's bound moves a little with the arms)
-  EXPECT_EQ(run(stiff, 100000), StepStatus::kFinished);
+  EXPECT_EQ(run_from_static(stiff, 100000), StepStatus::kFinished);
 }
 
 // Second order in dt, and no less accurate than the explicit step: the uplift at a steady arm over
@@ -138,20 +129,11 @@ TEST(SupportsAtMiddle, ConvergeAtSecondOrderToTheExplicitStep) {
     o.push_back(std::string("numerics.supports=") + supports);
     const Model m = build_model(load_scene_file(kDir + "reference_55m.yaml", o));
     std::vector<double> u;
-    EXPECT_EQ(run(m, std::lround(1.5 / h), &u, steady_arm_dof(m, 110.0 + 55.0)), StepStatus::kOk);
+    EXPECT_EQ(run_from_static(m, std::lround(1.5 / h), &u, steady_arm_dof(m, 110.0 + 55.0)), StepStatus::kOk);
     return u;
   };
   const std::vector<double> ref = trace(h1 / 32, "explicit");
-  // rms difference at the common instants (every `stride` reference steps).
-  auto error = [&](const std::vector<double>& u, int stride) {
-    double sum = 0.0;
-    int n = 0;
-    for (std::size_t k = 0; k < u.size() && (k + 1) * stride <= ref.size(); ++k, ++n) {
-      const double d = u[k] - ref[(k + 1) * stride - 1];
-      sum += d * d;
-    }
-    return std::sqrt(sum / n);
-  };
+  auto error = [&](const std::vector<double>& u, int stride) { return test_stepping::rms_against(u, ref, stride); };
   const double e1 = error(trace(h1, "implicit"), 32), e2 = error(trace(h1 / 2, "implicit"), 16);
   const double e4 = error(trace(h1 / 4, "implicit"), 8), explicit4 = error(trace(h1 / 4, "explicit"), 8);
   EXPECT_GT(e1 / e2, 2.8) << "errors " << e1 << " m at 2 ms, " << e2 << " m at 1 ms";
@@ -174,13 +156,9 @@ TEST(SupportsAtMiddle, EveryShippedLineRunsAtTheFastAndBalancedRungs) {
       std::vector<std::string> o = {std::string("numerics.preset=") + preset, "numerics.supports=implicit", "numerics.droppers=explicit"};
       if (f == "reference_55m_endless.yaml") o.push_back("train.end=2000");
       Simulation sim(load_scene_file(kDir + f, o));
-      StepStatus st = StepStatus::kOk;
-      for (long k = 0; k < 2000000 && st == StepStatus::kOk; ++k) st = sim.step();
-      EXPECT_EQ(st, StepStatus::kFinished) << sim.status_message();
+      EXPECT_EQ(run_to_end(sim), StepStatus::kFinished) << sim.status_message();
       EXPECT_TRUE(sim.state().u.allFinite());
     }
   Simulation twin(test_scenes::twin_contact_wire({"numerics.preset=fast", "numerics.supports=implicit", "numerics.droppers=explicit"}));
-  StepStatus st = StepStatus::kOk;
-  for (long k = 0; k < 2000000 && st == StepStatus::kOk; ++k) st = twin.step();
-  EXPECT_EQ(st, StepStatus::kFinished) << twin.status_message();
+  EXPECT_EQ(run_to_end(twin), StepStatus::kFinished) << twin.status_message();
 }
