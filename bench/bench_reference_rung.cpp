@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "catenary_sim/core/output/output_files.hpp"
 #include "pass_errors.hpp"
 #include "bench_cli.hpp"
 #include "guarded_main.hpp"
@@ -50,7 +51,9 @@ static int bench_main(int argc, char** argv) {
       ->capture_default_str();
   bench::add_overrides(app, overrides, "overrides of every pass's scene fields, the finest's included");
   CLI11_PARSE(app, argc, argv);
-  std::ofstream csv(csv_path);
+  // The CSV is written whole at the end (write_file_atomically): a run stopped early leaves the
+  // previous file as it was (the finest passes' statistics are kept as they come, in .finest).
+  std::ostringstream csv;
   csv << bench::kCsvHeader;
   // `explicit`: the first five were measured first (BENCHMARKS.md); the rest refine the explicit
   // scheme's dt at h = 0.125 m and try h = 0.1 m. `all` for the first five too, or `centred` for
@@ -172,6 +175,7 @@ static int bench_main(int argc, char** argv) {
       bench::csv_row(csv, kmh, label.str(), a.dofs + b.dofs, a.dt, wall, a.rtf * a.wall / wall, e);
     }
   }
+  catenary_sim::write_file_atomically(csv_path, csv.str());
   std::printf("\nwrote %s\n", csv_path.c_str());
   return 0;
 }
