@@ -92,52 +92,29 @@ int list_contact_nodes(const Model& m, State& s, bool windowed) {
   return contacts;
 }
 
-// numerics.supports implicit: the supports' springs at the step's middle. The explicit update
-// took each support's force k (q_n + beta v_{n-1/2}); the trapezoidal rule takes
-// k ((q_{n+1} + 2 q_n + q_{n-1}) / 4 + beta (v_{n+1/2} + v_{n-1/2}) / 2), which is that force plus
-// c a with c = k (dt^2/4 + beta dt/2) (middle_inertia) and a the node's new acceleration
-// (v_{n+1/2} - v_{n-1/2}) / dt. So m a = F becomes (m + c) a = F on the support's node: the
-// update's acceleration divided by 1 + c / m, and the node's update redone. A node carries one
-// support (mark_springs_at_middle), so each correction is closed and the order does not matter.
-// Returns the highest corrected DOF beyond the divergence limit (also NaN), or -1.
-int supports_at_middle(const Model& m, const State& s, bool windowed, const double* u, const double* v, double* un,
-                       double* vn, double* acc) {
-  if (m.support_at_middle.empty()) return -1;
-  const double dt = m.dt, limit = m.scene.numerics.divergence_limit;
-  const double* im = m.inv_mass.data();
-  int beyond = -1;
-  auto support = [&](int k) {
-    if (!m.support_at_middle[k]) return;
-    const int i = m.springs[k].dof;
-    acc[i] /= 1.0 + middle_inertia(m, m.springs[k].stiffness) * im[i];
-    vn[i] = v[i] + dt * acc[i];
-    un[i] = u[i] + dt * vn[i];
-    if (!(std::fabs(un[i]) <= limit)) beyond = std::max(beyond, i);
-  };
-  if (windowed) {
-    for (int j = 0; j < s.window_spring_count; ++j) support(s.window_springs[j]);
-  } else {
-    for (std::size_t k = 0; k < m.springs.size(); ++k) support(static_cast<int>(k));
-  }
-  return beyond;
-}
-
-// numerics.droppers implicit: the droppers and the stitch wires' clamps at the step's middle. The
-// update so far left each of them out (add_wire_point_forces), so acc holds its nodes'
-// accelerations a0 without it. At the middle its force is T = T_n + c (a_m - a_l), T_n = T0 +
-// k (z_m - z_l) the explicit step's (z = q_n + beta v_{n-1/2}, the lean's share on a 3-D line), c =
-// k (dt^2/4 + beta dt/2) as for a support, and a the new accelerations of its upper (messenger) and
-// lower (contact wire, auxiliary, stitch wire) ends, a = a0 -/+ T / m. Solved:
-// T = (T_n + c (a0_m - a0_l)) / (1 + c (1/m_m + 1/m_l)). A dropper works only in tension: where that
-// T is not positive it is slack, carries nothing, and a = a0 is then consistent (its stretch at the
-// middle, T's numerator / k, is not positive). So the switch is decided inside the step on the
-// tension it acts with, a complementarity per dropper with one solution; decided at q_n instead, a
-// dropper at this dt goes taut and slack by turns. A clamp is bilateral. No node carries two such
-// corrections (mark_springs_at_middle), so each is closed. Writes the droppers' tensions to
-// State::dropper_tension; returns the highest corrected DOF beyond the divergence limit, or -1.
-int links_at_middle(const Model& m, State& s, bool windowed, const double* u, const double* v, double* un, double* vn,
-                    double* acc) {
-  if (m.dropper_at_middle.empty()) return -1;
+// numerics.supports / numerics.droppers implicit: the springs at the step's middle (the
+// trapezoidal rule), after every DOF's explicit update. A spring's force there is its force at q_n
+// plus c a, with c = k (dt^2/4 + beta dt/2) (middle_inertia: the stiffness at
+// (q_{n+1} + 2 q_n + q_{n-1}) / 4, the damping beta k at (v_{n+1/2} + v_{n-1/2}) / 2) and a the new
+// acceleration (v_{n+1/2} - v_{n-1/2}) / dt of its nodes.
+// - A support (steady arm, messenger support): the update took its force at q_n, so m a = F
+//   becomes (m + c) a = F on its node: the acceleration divided by 1 + c / m.
+// - A dropper or a stitch wire's clamp: the update left it out (add_wire_point_forces), so acc
+//   holds its ends' accelerations a0 without it. Its force at the middle is T = T_n + c (a_m - a_l),
+//   T_n = T0 + k (z_m - z_l) the explicit step's (z = q_n + beta v_{n-1/2}, the lean's share on a
+//   3-D line), a the new accelerations of its upper (messenger) and lower (contact wire, auxiliary,
+//   stitch wire) ends, a = a0 -/+ T / m. Solved: T = (T_n + c (a0_m - a0_l)) / (1 + c (1/m_m + 1/m_l)).
+//   A dropper works only in tension: where that T is not positive it is slack, carries nothing,
+//   and a = a0 is then consistent (its stretch at the middle, T's numerator / k, is not positive).
+//   So the switch is decided inside the step on the tension it acts with, a complementarity per
+//   dropper with one solution; decided at q_n instead, a dropper at this dt goes taut and slack by
+//   turns. A clamp is bilateral.
+// No node carries two such corrections (mark_springs_at_middle), so each is closed and the order
+// does not matter. Writes the droppers' tensions to State::dropper_tension; returns the highest
+// corrected DOF beyond the divergence limit (also NaN), or -1.
+int springs_at_middle(const Model& m, State& s, bool windowed, const double* u, const double* v, double* un, double* vn,
+                      double* acc) {
+  if (m.support_at_middle.empty() && m.dropper_at_middle.empty()) return -1;
   const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
   const double* im = m.inv_mass.data();
   const double* lean = leaning(m, s) ? s.lateral.dropper_stretch.data() : nullptr;
@@ -146,6 +123,12 @@ int links_at_middle(const Model& m, State& s, bool windowed, const double* u, co
     vn[i] = v[i] + dt * acc[i];
     un[i] = u[i] + dt * vn[i];
     if (!(std::fabs(un[i]) <= limit)) beyond = std::max(beyond, i);
+  };
+  auto support = [&](int k) {
+    if (!m.support_at_middle[k]) return;
+    const int i = m.springs[k].dof;
+    acc[i] /= 1.0 + middle_inertia(m, m.springs[k].stiffness) * im[i];
+    redo(i);
   };
   // The force at the middle of a link of stiffness k, force t0 at zero stretch and the lean's share
   // `lean_stretch`, from its upper end `a` to its lower end `l`.
@@ -174,22 +157,17 @@ int links_at_middle(const Model& m, State& s, bool windowed, const double* u, co
     const WireClamp& c = m.clamps[k];
     apply(c.messenger_dof, c.stitch_dof, middle_force(c.messenger_dof, c.stitch_dof, c.stiffness, c.static_force, 0.0));
   };
+  const bool supports = !m.support_at_middle.empty(), links = !m.dropper_at_middle.empty();
   if (windowed) {
-    for (int j = 0; j < s.window_dropper_count; ++j) dropper(s.window_droppers[j]);
-    for (int j = 0; j < s.window_clamp_count; ++j) clamp(s.window_clamps[j]);
+    for (int j = 0; supports && j < s.window_spring_count; ++j) support(s.window_springs[j]);
+    for (int j = 0; links && j < s.window_dropper_count; ++j) dropper(s.window_droppers[j]);
+    for (int j = 0; links && j < s.window_clamp_count; ++j) clamp(s.window_clamps[j]);
   } else {
-    for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(static_cast<int>(k));
-    for (std::size_t k = 0; k < m.clamps.size(); ++k) clamp(static_cast<int>(k));
+    for (std::size_t k = 0; supports && k < m.springs.size(); ++k) support(static_cast<int>(k));
+    for (std::size_t k = 0; links && k < m.droppers.size(); ++k) dropper(static_cast<int>(k));
+    for (std::size_t k = 0; links && k < m.clamps.size(); ++k) clamp(static_cast<int>(k));
   }
   return beyond;
-}
-
-// The springs at the step's middle (supports, then droppers and clamps: they share no node), after
-// every DOF's explicit update. Returns the highest corrected DOF beyond the divergence limit, or -1.
-int springs_at_middle(const Model& m, State& s, bool windowed, const double* u, const double* v, double* un, double* vn,
-                      double* acc) {
-  const int supports = supports_at_middle(m, s, windowed, u, v, un, vn, acc);
-  return std::max(supports, links_at_middle(m, s, windowed, u, v, un, vn, acc));
 }
 
 // The explicit step with the wires packed (Model::wire_packs): one fused sweep pair per pack
