@@ -113,18 +113,15 @@ namespace {
 // lean by about as much (u_m - u_c ~ -lean), and the vertical stretch alone would read k times
 // the lean's change (60 N per 0.3 mm) as force or slack the dropper does not have.
 // A dropper at the step's middle (numerics.droppers implicit) reports the tension it acted with
-// over the last step (State::dropper_tension).
-inline double middle_tension(const Model& m, std::size_t k, const State& s) {
-  return s.dropper_tension.empty() || !m.dropper_at_middle[k] ? std::nan("") : s.dropper_tension[k];
-}
-
-inline double dropper_force(const Model& m, std::size_t k, const State& s, bool* slack) {
-  const Dropper& d = m.droppers[k];
-  double t = middle_tension(m, k, s);
+// over the last step (State::dropper_tension; NaN before the first step, when the elastic tension
+// is the one). The dropper `k`'s data come from its track (DropperTrack), not the model's list.
+inline double dropper_force(const Model& m, const State& s, std::size_t k, int messenger_dof, int contact_dof,
+                            double static_tension, double stiffness, bool* slack) {
+  double t = s.dropper_tension.empty() || !m.dropper_at_middle[k] ? std::nan("") : s.dropper_tension[k];
   if (std::isnan(t)) {
-    double stretch = s.u[d.messenger_dof] - s.u[d.contact_dof];
+    double stretch = s.u[messenger_dof] - s.u[contact_dof];
     if (m.lateral && !s.lateral.dropper_stretch.empty()) stretch += s.lateral.dropper_stretch[k];
-    t = d.static_tension + d.stiffness * stretch;
+    t = static_tension + stiffness * stretch;
   }
   *slack = !(t > 0.0);
   return *slack ? 0.0 : t;
@@ -164,7 +161,8 @@ void PassRecorder::record(const Model& m, const State& s) {
     Row dr{s.time, {}};
     dr.values.reserve(droppers_.size());
     bool slack = false;
-    for (const DropperTrack& t : droppers_) dr.values.push_back(dropper_force(m, t.index, s, &slack));
+    for (const DropperTrack& t : droppers_)
+      dr.values.push_back(dropper_force(m, s, t.index, t.messenger_dof, t.contact_dof, t.static_tension, t.stiffness, &slack));
     dropper_rows_.push_back(std::move(dr));
   }
   Row row{s.time, {}};
@@ -185,19 +183,11 @@ void PassRecorder::record(const Model& m, const State& s) {
 
 void PassRecorder::record_whole(const Model& m, const State& s) {
   const std::size_t np = m.pantographs.size(), nw = m.contact_wires.size();
-  // dropper_force() with the dropper's data at hand in its track: the same numbers, without the
-  // model's dropper list in the cache at every step.
-  const double* u = s.u.data();
-  const double* lean = m.lateral && !s.lateral.dropper_stretch.empty() ? s.lateral.dropper_stretch.data() : nullptr;
+  // dropper_force() with the dropper's data at hand in its track: without the model's dropper list
+  // in the cache at every step.
   for (DropperTrack& t : droppers_) {
-    double tension = middle_tension(m, t.index, s);
-    if (std::isnan(tension)) {
-      double stretch = u[t.messenger_dof] - u[t.contact_dof];
-      if (lean) stretch += lean[t.index];
-      tension = t.static_tension + t.stiffness * stretch;
-    }
-    const bool slack = !(tension > 0.0);
-    const double f = slack ? 0.0 : tension;
+    bool slack = false;
+    const double f = dropper_force(m, s, t.index, t.messenger_dof, t.contact_dof, t.static_tension, t.stiffness, &slack);
     t.max = std::max(t.max, f);
     t.min = std::min(t.min, f);
     t.slack += slack;
