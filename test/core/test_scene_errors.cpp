@@ -363,6 +363,10 @@ TEST(SceneErrors, SpringsAtTheMiddleOnlyWithTheHalfStep) {
   EXPECT_EQ(lateral.supports, SpringStep::kExplicit);
   EXPECT_EQ(lateral.droppers, SpringStep::kExplicit);
   EXPECT_EQ(numerics({"numerics.preset=fast", "numerics.droppers=explicit"}).droppers, SpringStep::kExplicit);
+  // A 3-D line's lateral plane loads its droppers with their tension at q_n: refused there.
+  EXPECT_MENTIONS(error_of_3d({"numerics.droppers=implicit"}), "numerics.droppers", "implicit", "3-D line");
+  EXPECT_EQ(error_of_3d({"numerics.supports=implicit"}), "");
+  EXPECT_EQ(error_of_3d({"numerics.preset=fast", "numerics.supports=implicit"}), "");  // droppers: the preset's q_n
   for (const char* other : {"numerics.damping=centred", "numerics.integrator=implicit"}) {
     EXPECT_EQ(error_of({"numerics.preset=fast", other}), "") << other;
     EXPECT_EQ(numerics({"numerics.preset=fast", other}).droppers, SpringStep::kExplicit) << other;

@@ -480,10 +480,9 @@ void set_train_travel(const Scene& scene, double endless_front, Model& m) {
 // clamps the explicit step takes at its middle (Model::support_at_middle, dropper_at_middle,
 // clamp_at_middle), each a closed-form correction of its nodes' update (explicit_step.cpp). A
 // support on a free node that no other support shares; a dropper or clamp with a free end whose
-// nodes no other spring at the middle shares (their corrections would be coupled), on a 2-D line.
-// The rest stay at q_n and the stability limit keeps them.
-void mark_springs_at_middle(const Scene& scene, Model& m) {
-  const NumericsSpec& num = scene.numerics;
+// nodes no other spring at the middle shares (their corrections would be coupled). The rest stay at
+// q_n and the stability limit keeps them.
+void mark_springs_at_middle(const NumericsSpec& num, Model& m) {
   std::vector<int> count(m.n_dof, 0);
   if (num.supports == SpringStep::kImplicit) {
     for (const SupportSpring& sp : m.springs) ++count[sp.dof];
@@ -491,10 +490,7 @@ void mark_springs_at_middle(const Scene& scene, Model& m) {
     for (std::size_t k = 0; k < m.springs.size(); ++k)
       m.support_at_middle[k] = m.inv_mass[m.springs[k].dof] > 0.0 && count[m.springs[k].dof] == 1;
   }
-  // A 3-D line keeps its droppers and clamps at q_n: the lateral plane's substeps load each leaning
-  // dropper with its elastic tension at q_n and the lean's change (lateral_step.cpp), which a
-  // dropper at the middle does not carry.
-  if (num.droppers != SpringStep::kImplicit || scene.lateral()) return;
+  if (num.droppers != SpringStep::kImplicit) return;  // (refused on a 3-D line: validate_scene.cpp)
   std::vector<std::uint8_t> held(m.n_dof, 0);  // a node whose update another middle correction redoes
   for (std::size_t k = 0; k < m.support_at_middle.size(); ++k)
     if (m.support_at_middle[k]) held[m.springs[k].dof] = 1;
@@ -534,7 +530,7 @@ void choose_time_step(const Scene& scene, Model& m) {
     m.implicit = newmark_matrix(m, m.dt);
     return;
   }
-  mark_springs_at_middle(scene, m);
+  mark_springs_at_middle(scene.numerics, m);
   compute_stability_limit(m);
   if (scene.numerics.dt) {
     if (*scene.numerics.dt > m.dt_critical)

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scene/read_imperfections.hpp"
@@ -402,9 +403,9 @@ void read_gust_lead(Reader& r, Scene& s) {
 }
 
 // numerics: the fidelity ladder. Returns whether the reference preset's own element length and
-// damping apply (neither given); `springs_by_preset`: whether the fast preset chose the supports' and
-// droppers' step (neither given).
-bool read_numerics(Reader& top, Scene& s, bool* springs_by_preset) {
+// damping apply (neither given); `springs_by_preset`: the supports' and the droppers' step, each
+// whether the fast preset chose it (not given).
+bool read_numerics(Reader& top, Scene& s, std::pair<bool, bool>* springs_by_preset) {
   bool reference_defaults = false;
   if (!top.has("numerics")) return reference_defaults;
   Reader r(top.child("numerics"), "numerics");
@@ -458,7 +459,7 @@ bool read_numerics(Reader& top, Scene& s, bool* springs_by_preset) {
   // scene_from_yaml): its dt is then set by the wires' 1 m elements instead of the supports' and
   // droppers' springs on light nodes.
   const bool middle_default = preset == "fast" && middle_allowed;
-  *springs_by_preset = middle_default && !r.has("supports") && !r.has("droppers");
+  *springs_by_preset = {middle_default && !r.has("supports"), middle_default && !r.has("droppers")};
   auto spring_step = [&](const char* key) {
     const std::string field = std::string("numerics.") + key;
     const std::string v = r.text(key, middle_default ? "implicit" : "explicit");
@@ -535,16 +536,18 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   read_contact(top, s);
   read_pantographs(top, s);
   read_train(top, s);
-  bool springs_by_preset = false;  // preset fast, supports and droppers at the step's middle
+  std::pair<bool, bool> springs_by_preset;  // the supports' and droppers' step chosen by the fast preset
   reference_defaults = read_numerics(top, s, &springs_by_preset);
   read_imperfections(top, s, base_dir);
   read_output(top, s);
   read_lateral_parts(top, s);
   top.finish();
-  // A 3-D line's fast rung keeps its supports and droppers at q_n: its droppers stay there anyway
-  // (mark_springs_at_middle), and the supports alone at the middle move its dropper forces further
-  // from the finer rungs' (BENCHMARKS.md, the fidelity ladder).
-  if (springs_by_preset && s.lateral()) s.numerics.supports = s.numerics.droppers = SpringStep::kExplicit;
+  // A 3-D line's fast rung keeps its supports and droppers at q_n: its droppers cannot go to the
+  // middle (validate_scene.cpp), and the supports alone there move its dropper forces further from
+  // the finer rungs' (BENCHMARKS.md, the fidelity ladder). The preset's default needs the whole
+  // scene to know the line is 3-D.
+  if (s.lateral() && springs_by_preset.first) s.numerics.supports = SpringStep::kExplicit;
+  if (s.lateral() && springs_by_preset.second) s.numerics.droppers = SpringStep::kExplicit;
   // The reference rung's centred damping steps the explicit scheme with beta > 0
   // (NumericsSpec::damping); elsewhere the rung is h = 0.1 m with the half-step damping, the finest
   // its explicit dt allows at a reference's cost (docs/benchmark_history.md, "Choosing the

@@ -192,6 +192,11 @@ void validate_lateral(const Scene& s, double line) {
     for (std::size_t h = 0; h < s.pantographs[i].heads.size(); ++h)
       check_strips(s.pantographs[i].heads[h].collectors, pf + ".heads[" + std::to_string(h) + "].collectors");
   }
+  // A 3-D line's lateral substeps load each leaning dropper with its elastic tension at q_n and the
+  // lean's change (lateral_step.cpp), which a dropper at the step's middle does not carry.
+  if (s.lateral() && s.numerics.droppers == SpringStep::kImplicit)
+    fail("numerics.droppers", "'implicit' (on a 3-D line)",
+         "explicit on a 3-D line (its lateral plane loads the leaning droppers with their tension at q_n)");
   // An endless line repeats its block of spans: a stagger pattern repeats with it (the block
   // moves by whole patterns), and so does one radius for the whole line; a curve placed by
   // station or a list per support does not.
