@@ -330,6 +330,26 @@ TEST(SceneErrors, FieldsThatCannotActAreRefused) {
   EXPECT_MENTIONS(error_of({"numerics.gust_lead=5"}), "numerics.gust_lead", "5", "wind.turbulence", "numerics.window");
   EXPECT_MENTIONS(error_of_3d({"numerics.gust_lead=5"}), "numerics.gust_lead", "numerics.window");
   EXPECT_EQ(error_of_3d({"numerics.gust_lead=5", "numerics.window=auto"}), "");
+  // So does how the lead is stepped; implicit is one solve per wire, which a stitch wire's clamps
+  // would join to the messenger's.
+  EXPECT_MENTIONS(error_of_3d({"numerics.gust_lead_step=implicit"}), "numerics.gust_lead_step", "'implicit'",
+                  "numerics.window");
+  EXPECT_MENTIONS(error_of({"numerics.gust_lead_step=explicit", "numerics.window=auto"}), "numerics.gust_lead_step",
+                  "wind.turbulence");
+  EXPECT_MENTIONS(error_of_3d({"numerics.gust_lead_step=sideways", "numerics.window=auto"}), "numerics.gust_lead_step",
+                  "'sideways'", "implicit", "explicit");
+  EXPECT_MENTIONS(error_of_3d({"numerics.gust_lead_step=[implicit]", "numerics.window=auto"}),
+                  "numerics.gust_lead_step", "not a scalar");
+  for (const char* step : {"implicit", "explicit"})
+    EXPECT_EQ(error_of_3d({std::string("numerics.gust_lead_step=") + step, "numerics.window=auto"}), "") << step;
+  std::string stitched;
+  try {
+    Simulation sim(load_scene_file(test_scenes::scene_path("reference_55m_stitched_3d.yaml"),
+                                   {"numerics.window=auto", "numerics.gust_lead_step=implicit"}));
+  } catch (const SceneError& e) {
+    stitched = e.what();
+  }
+  EXPECT_MENTIONS(stitched, "numerics.gust_lead_step", "'implicit'", "stitch wires", "explicit");
   // A strip's working width needs a 3-D line.
   EXPECT_MENTIONS(error_of({"pantographs.0.collectors=[{offset: 0.0, working_width: 1.0}]"}),
                   "pantographs[0].collectors[0].working_width", "only on a 3-D line");

@@ -73,6 +73,9 @@ bool same_lateral(const State& a, const State& b, std::string* what) {
                "window supports");
   for (std::size_t w = 0; w < x.window.size() && w < y.window.size(); ++w)
     d |= differs(x.window[w].lo != y.window[w].lo || x.window[w].hi != y.window[w].hi, "window nodes");
+  d |= differs(x.lead_y != y.lead_y || x.lead_v != y.lead_v || x.lead_y_before != y.lead_y_before ||
+                   x.lead_v_before != y.lead_v_before || x.lead_time != y.lead_time,
+               "gust lead");
   // (NaN where a collector is off the wires: compared as bits)
   d |= differs(x.collector_lateral.size() != y.collector_lateral.size() ||
                    std::memcmp(x.collector_lateral.data(), y.collector_lateral.data(),
@@ -117,6 +120,11 @@ TEST_P(ThreeDimensionalStateCopy, InTurbulentWindStepsAsItsOriginal) {
   drop("dropper_stretch", [&](State& d) { d.lateral.dropper_stretch = fresh.lateral.dropper_stretch; });
   drop("wind_speed", [&](State& d) { d.lateral.wind_speed = fresh.lateral.wind_speed; });
   drop("next_wind_update", [&](State& d) { d.lateral.next_wind_update = fresh.lateral.next_wind_update; });
+  ASSERT_GT(m.lateral->lead_every, 0);  // the gust lead stepped on its own: its state travels too
+  drop("lead_y", [&](State& d) { d.lateral.lead_y = fresh.lateral.lead_y; });
+  drop("lead_v", [&](State& d) { d.lateral.lead_v = fresh.lateral.lead_v; });
+  drop("lead_y_before", [&](State& d) { d.lateral.lead_y_before = fresh.lateral.lead_y_before; });
+  drop("lead_time", [&](State& d) { d.lateral.lead_time = fresh.lateral.lead_time; });
   State reference(original);
   const double offset = original.line_offset;
   const int first_support = original.lateral.window_first_support;

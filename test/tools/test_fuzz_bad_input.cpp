@@ -337,6 +337,7 @@ TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
       {r3, "pantograph_head.sway={times: [1, 0], lateral: [0, 0]}", {"pantograph_head.sway.times[1]"}},
       {r3, "pantograph_head.sway={amplitude: 0.1, times: [0]}", {"pantograph_head.sway"}},
       {r3, "numerics.gust_lead=5", {"numerics.gust_lead"}},
+      {r3, "numerics.gust_lead_step=5", {"numerics.gust_lead_step"}},
       // heads
       {heads, "pantographs.0.heads.0.stiffness=0", {"pantographs[0].heads[0].stiffness"}},
       {heads, "pantographs.0.heads.0.collectors.0.offset=5", {"pantographs[0].heads[0].collectors[0].offset"}},
@@ -346,6 +347,7 @@ TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
       {heads, "pantographs.0.heads.0.aero_coefficient=-1", {"pantographs[0].heads[0].aero_coefficient"}},
       // where a field cannot act, the speed limit, the offline external pantograph
       {kReference, "numerics.gust_lead=5", {"numerics.gust_lead"}},
+      {kReference, "numerics.gust_lead_step=explicit", {"numerics.gust_lead_step"}},
       {kReference, "pantographs.0.collectors=[{offset: 0, working_width: 1}]", {"pantographs[0].collectors[0].working_width"}},
       {kReference, "train.speed_kmh=800", {"train.speed_kmh"}},
       {kReference, "train={speed: 130}", {"train.speed_kmh"}},

@@ -9,7 +9,9 @@
 
 #include "catenary_sim/core/engine/state.hpp"
 #include "engine/centred_damping.hpp"
+#include "model/centred_factors.hpp"
 #include "engine/forces.hpp"
+#include "engine/lateral_lead.hpp"
 #include "engine/lateral_window.hpp"
 #include "engine/lateral_wind.hpp"
 #include "engine/lateral_workspace.hpp"
@@ -73,6 +75,41 @@ LateralState make_lateral_state(const Model& m) {
   work.window_clamps.assign(lat.clamps.size(), 0);
   work.cut_node.assign(2 * kCutLayer * m.wires.size(), 0);
   work.cut_force.assign(work.cut_node.size(), 0.0);
+  if (lat.lead_every > 0) {
+    s.lead_y = s.lead_y_before = lat.initial;
+    s.lead_v = s.lead_v_before = Eigen::VectorXd::Zero(lat.n);
+    s.lead_window.resize(lat.wires.size());
+    for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+      s.lead_window[wi].tt_lower.assign(lat.wires[wi].nodes(), 0.0);
+      s.lead_window[wi].tt_inv_pivot.assign(lat.wires[wi].nodes(), 0.0);
+    }
+    work.lead_droppers.assign(lat.pendulums.size(), 0);
+    work.lead_cut_node.assign(2 * kCutLayer * m.wires.size(), 0);
+    work.lead_cut_force.assign(work.lead_cut_node.size(), 0.0);
+    work.lead_held.assign(lat.n, 0);
+    work.lead_extra_node.assign(lat.n, 0);
+    work.lead_extra_diag.assign(lat.n, 0.0);
+    work.lead_dashpot_node.assign(2 * lat.wires.size(), 0);
+    work.lead_dashpot.assign(2 * lat.wires.size(), 0.0);
+    work.lead_plane_mass = lat.lead_mass;
+    work.lead_f = work.lead_y_next = work.lead_v_next = work.lead_accel = work.lead_wind = Eigen::VectorXd::Zero(lat.n);
+    work.lead_points.assign(std::max(0, lat.field.held), 0.0);
+    if (m.endless) {
+      work.lead_wind_point.assign(lat.n, 0);
+      work.lead_wind_weight.assign(lat.n, 0.0);
+    }
+    std::size_t twin = 0, single = 0;
+    for (const WireLanes& p : packs_of(m)) {  // (a range has at most its wires' nodes)
+      work.lead_twin_at.push_back(twin);
+      work.lead_single_at.push_back(single);
+      twin += static_cast<std::size_t>(centred_meeting_node(p.nodes)) * kCdValues * 2 * p.lanes;
+      single += 2 * kCdValues * static_cast<std::size_t>(p.lanes);
+    }
+    work.lead_twin.assign(twin, 0.0);
+    work.lead_single.assign(single, 0.0);
+    work.lead_scratch.assign(static_cast<std::size_t>(longest) * kCdValues, 0.0);
+    work.lead_record.assign(kSweepRecord * sweep_size(m), 0.0);
+  }
   work.window_points.assign(work.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size() + 2 * lat.clamps.size(), 0);
   if (lat.windowed && !lat.centred_twin.empty()) {
     // A window's range has at most its wires' nodes: the whole wires' layout sizes it.
@@ -379,6 +416,34 @@ bool generic_substep(const Model& m, State& s, bool windowed) {
   return false;
 }
 
+// A substep (or, `lead`, a step of the implicit gust lead) left the divergence limit: the first
+// DOF beyond it among the rejected values (every step leaves them in its new buffer) reported.
+StepStatus lateral_diverged(const Model& m, State& s, bool lead) {
+  LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
+  ls.diverged = true;
+  const double* yn = lead ? lw.lead_y_next.data() : lw.y_next.data();
+  const double limit = m.scene.numerics.divergence_limit;
+  ls.diverged_node = -1;
+  auto first_beyond = [&](int i0, int i1) {
+    for (int i = i0; i < i1 && ls.diverged_node < 0; ++i)
+      if (!(std::fabs(yn[i]) <= limit)) {
+        ls.diverged_node = i;
+        ls.diverged_position = yn[i];
+      }
+  };
+  if (lead) {
+    for (std::size_t wi = 0; wi < m.lateral->wires.size(); ++wi) {
+      const WireWindow& ww = ls.lead_window[wi];
+      if (ww.hi >= ww.lo) first_beyond(m.lateral->wires[wi].w_dof + ww.lo, m.lateral->wires[wi].w_dof + ww.hi + 1);
+    }
+  } else {
+    over_stepped(m, s, m.lateral->windowed, first_beyond);
+  }
+  s.status = StepStatus::kDiverged;
+  return s.status;
+}
+
 }  // namespace
 
 StepStatus lateral_step(const Model& m, State& s) {
@@ -398,28 +463,18 @@ StepStatus lateral_step(const Model& m, State& s) {
     for (int j = 0; j < s.window_dropper_count; ++j) lw.lean_weight[s.window_droppers[j]] = 1.0;
   }
   const bool windowed = lat.windowed;
+  // The implicit gust lead up to this step's start, so that the nodes the window reaches take its
+  // state then; then placed ahead of the window as it stands.
+  if (lat.lead_every > 0 && advance_lead(m, s, t0)) return lateral_diverged(m, s, true);
   if (windowed) sync_window(m, s);
+  if (lat.lead_every > 0) sync_lead(m, s);
   for (int sub = 0; sub < lat.substeps; ++sub) {
     refresh_wind_if_due(m, s, t0 + sub * h, windowed);
     const bool fused = !lat.planes.empty() && (!windowed || lw.window_fused);
     const bool failed = !lat.centred_twin.empty() ? centred_substep(m, s, windowed)
                         : fused                   ? fused_substep(m, s, windowed)
                                                   : generic_substep(m, s, windowed);
-    if (failed) {
-      ls.diverged = true;
-      const double* yn = lw.y_next.data();  // (every substep leaves its rejected values there)
-      const double limit = m.scene.numerics.divergence_limit;
-      ls.diverged_node = -1;
-      over_stepped(m, s, windowed, [&](int i0, int i1) {
-        for (int i = i0; i < i1 && ls.diverged_node < 0; ++i)
-          if (!(std::fabs(yn[i]) <= limit)) {
-            ls.diverged_node = i;
-            ls.diverged_position = yn[i];
-          }
-      });
-      s.status = StepStatus::kDiverged;
-      return s.status;
-    }
+    if (failed) return lateral_diverged(m, s, false);
   }
   const double per_substep = 1.0 / lat.substeps;
   for (double& e : ls.dropper_stretch) e *= per_substep;
@@ -490,6 +545,7 @@ void shift_lateral_block(const Model& m, State& s) {
     }
   }
   lw.window_dirty = true;  // the lists and factors hold the old DOFs (the node ranges already match)
+  if (lat.lead_every > 0) shift_lead(m, s);
   set_dropper_stretch(m, s);  // the droppers' lean moved with the block
   if (lat.windy && !lat.field.empty()) {
     // The spans entering ahead take the wind of the last refresh at their stations (sync_window):

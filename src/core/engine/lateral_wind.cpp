@@ -8,14 +8,6 @@
 
 namespace catenary_sim {
 
-namespace {
-
-// Share of the turbulent field's sample time (1 / (4 max_frequency)) between refreshes of the
-// wind on the nodes: 0.01 s at 5 Hz, whose hold costs the field sinc^2(f 0.01 s), 0.8 % at 5 Hz.
-constexpr double kWindUpdate = 0.2;
-
-}  // namespace
-
 const WindFieldBuffer& field_values(const Model& m, const State& s) {
   return m.endless ? s.lateral.wind_field : m.lateral->field_values;
 }
@@ -26,11 +18,13 @@ void extend_endless_field(const Model& m, State& s, double offset) {
 }
 
 void refresh_wind(const Model& m, State& s, int i0, int i1) {
+  wind_on_nodes(m, s, s.lateral.wind_points.data(), i0, i1, s.lateral.wind_speed.data());
+}
+
+void wind_on_nodes(const Model& m, const State& s, const double* wp, int i0, int i1, double* W) {
   const LateralModel& lat = *m.lateral;
-  const double* wp = s.lateral.wind_points.data();
   const double U = lat.wind_speed;
   const double* sn = lat.wind_normal.data();
-  double* W = s.lateral.wind_speed.data();
   if (m.endless) {
     // The block's nodes at their stations along the line now, from the points held from `first`
     // (which cover the block: extend_endless_field).
@@ -66,7 +60,7 @@ void refresh_wind_if_due(const Model& m, State& s, double t, bool windowed) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
   if (!lat.windy || lat.field.empty() || !(t + 1e-12 >= ls.next_wind_update)) return;
-  ls.next_wind_update = t + kWindUpdate * lat.field.dt;
+  ls.next_wind_update = t + kWindRefreshShare * lat.field.dt;
   ls.wind_time = t;
   if (m.endless) extend_endless_field(m, s, s.line_offset);
   field_values(m, s).at_time(lat.field, t, ls.wind_points.data());

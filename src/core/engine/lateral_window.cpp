@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/lateral_lead.hpp"
 #include "engine/lateral_wind.hpp"
 #include "model/centred_factors.hpp"
 #include "engine/lateral_workspace.hpp"
@@ -12,6 +13,25 @@
 #include "engine/wire_lanes.hpp"
 
 namespace catenary_sim {
+
+int add_cut_forces(const Model& m, std::size_t wi, const WireWindow& ww, int* node, double* force, int count, double* f,
+                   double* theta) {
+  const LateralModel& lat = *m.lateral;
+  const Wire& w = lat.wires[wi];
+  const int o = w.w_dof, lo = ww.lo, hi = ww.hi;
+  if (hi < lo || (!ww.cut_lo && !ww.cut_hi)) return count;
+  for (int i = lo; i <= hi; ++i) f[o + i] = 0.0;
+  wire_elastic_force_window(w, ww, lat.initial.data(), f, theta);
+  auto add_cut = [&](int i) {
+    node[count] = o + i;
+    force[count++] = lat.static_elastic_force[o + i] - f[o + i];
+  };
+  const int lo_end = ww.cut_lo ? std::min(hi, lo + kCutLayer - 1) : lo - 1;
+  for (int i = lo; i <= lo_end; ++i) add_cut(i);
+  if (ww.cut_hi)
+    for (int i = std::max(lo_end + 1, hi - kCutLayer + 1); i <= hi; ++i) add_cut(i);
+  return count;
+}
 
 namespace {
 
@@ -40,22 +60,18 @@ void move_wire_window(const Model& m, State& s, std::size_t wi, int first, doubl
       y[o + i] = lat.initial[o + i];
       v[o + i] = 0.0;
     }
+  // The nodes the window reaches in the implicit gust lead take its state now.
+  if (lat.lead_every > 0) {
+    const WireWindow& lead = ls.lead_window[wi];
+    for (int i = std::max(lo, lead.lo); i <= std::min(hi, lead.hi); ++i)
+      if (i < old_lo || i > old_hi) lead_state_at(m, s, o + i, s.time - m.dt, &y[o + i], &v[o + i]);
+  }
   if (turbulent)
     for (int i = lo; i <= hi; ++i)
       if (i < old_lo || i > old_hi) refresh_wind(m, s, o + i, o + i + 1);
   if (hi < lo) return;
   if (hi == lo) lw.window_fused = false;  // (as the vertical step: the sweep needs two nodes)
-  if (!ww.cut_lo && !ww.cut_hi) return;
-  for (int i = lo; i <= hi; ++i) f[o + i] = 0.0;
-  wire_elastic_force_window(w, ww, lat.initial.data(), f, lw.theta.data());
-  auto add_cut = [&](int i) {
-    lw.cut_node[lw.cut_count] = o + i;
-    lw.cut_force[lw.cut_count++] = lat.static_elastic_force[o + i] - f[o + i];
-  };
-  const int lo_end = ww.cut_lo ? std::min(hi, lo + kCutLayer - 1) : lo - 1;
-  for (int i = lo; i <= lo_end; ++i) add_cut(i);
-  if (ww.cut_hi)
-    for (int i = std::max(lo_end + 1, hi - kCutLayer + 1); i <= hi; ++i) add_cut(i);
+  lw.cut_count = add_cut_forces(m, wi, ww, lw.cut_node.data(), lw.cut_force.data(), lw.cut_count, f, lw.theta.data());
 }
 
 // The springs, pendulums (droppers) and stitch wires' clamps between the window's end supports
@@ -111,9 +127,11 @@ void factor_centred_window(const Model& m, State& s) {
 // (State::window, which update_window moved before this step; the lateral waves run at the same
 // sqrt(T/rhoA), so the same window holds their echoes) and, in a turbulent wind, a lead of
 // LateralModel::gust_lead seconds of travel further ahead, so that a span has felt the gusts that
-// long when the pantograph reaches it. When it moved, the nodes that left it return to the static
-// state under the mean wind at rest (as the vertical plane's to u = 0), the nodes that entered
-// get the wind of the last refresh, and the lists are rebuilt: springs, pendulums and clamps in the
+// long when the pantograph reaches it (unless the lead is stepped on its own: lateral_lead.hpp).
+// When it moved, the nodes that left it return to the static state under the mean wind at rest
+// (as the vertical plane's to u = 0), the nodes that entered get the wind of the last refresh and
+// the implicit lead's state where it holds them (else they are at rest in the static state), and
+// the lists are rebuilt: springs, pendulums and clamps in the
 // window, and at each cut the static force of the elements left out (-K initial of the whole line
 // less the window's), so that the static state stays at rest in the window as outside it. Costs
 // what the window holds (bisection for the springs and droppers), not the line.
@@ -124,7 +142,7 @@ void sync_window(const Model& m, State& s) {
   const std::vector<double>& sx = m.support_x;
   const int first = s.window_first_support;
   int last = s.window_last_support;
-  if (first >= 0 && lat.gust_lead > 0.0) {
+  if (first >= 0 && lat.gust_lead > 0.0 && lat.lead_every == 0) {  // (the implicit lead steps on its own)
     const double hi_x = sx[last] + lat.gust_lead * std::fabs(s.speed);  // the lead, snapped outward to a support
     last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x - 1e-6) - sx.begin());
     last = std::min(last, static_cast<int>(sx.size()) - 1);

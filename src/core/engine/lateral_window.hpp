@@ -28,6 +28,12 @@ void over_stepped(const Model& m, const State& s, bool windowed, Body&& body) {
     }
 }
 
+// The static force of the elements a window `ww` of lateral wire `wi` leaves out, on the nodes of
+// its cut layers: appended to node/force from `count`, the new count returned; f and theta are
+// scratch (f over the window's nodes is overwritten).
+int add_cut_forces(const Model& m, std::size_t wi, const WireWindow& ww, int* node, double* force, int count, double* f,
+                   double* theta);
+
 // Moves the lateral window with the vertical one (and its lead), rebuilding its lists only when it
 // moved (lateral_window.cpp).
 void sync_window(const Model& m, State& s);

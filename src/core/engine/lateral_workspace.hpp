@@ -48,6 +48,31 @@ struct LateralWorkspace {
   // centred_single_at[pack]), rebuilt by sync_window; scratch for one wire's range.
   std::vector<double> centred_twin, centred_single, centred_scratch;
   std::vector<std::size_t> centred_twin_at, centred_single_at;
+  // The implicit gust lead's step (lateral_lead.cpp), rebuilt by sync_lead when the lead moved:
+  // the pendulums in it, its cuts' static force, the diagonal D + springs + pendulums + the cuts'
+  // dashpots over the shift (LateralModel::lead_mass and the dashpots) and the nodes where it
+  // exceeds M (their extra times the shift), the held nodes, per pack its factors laid
+  // out as centred_twin and centred_single; each lead step's force, new values, wind and the
+  // field's points at its middle, and the solve's records.
+  bool lead_dirty = true;
+  std::vector<int> lead_droppers;
+  int lead_dropper_count = 0;
+  std::vector<int> lead_cut_node, lead_held, lead_extra_node, lead_dashpot_node;
+  std::vector<double> lead_extra_diag, lead_dashpot;  // N/m: D's share of a node's diagonal extra; N s/m / lead_beta
+  int lead_held_count = 0, lead_extra_count = 0, lead_dashpot_count = 0;
+  std::vector<double> lead_cut_force;
+  int lead_cut_count = 0;
+  Eigen::VectorXd lead_plane_mass, lead_f, lead_y_next, lead_v_next, lead_accel, lead_wind;
+  std::vector<double> lead_points, lead_twin, lead_single, lead_scratch, lead_record;
+  std::vector<std::size_t> lead_twin_at, lead_single_at;
+  // An endless line's lead: per DOF the field point before its station and the weight of the next
+  // (WindField::locate, clamped to the held points as wind_on_nodes does), for the line offset,
+  // the first held point and the placement they were found for.
+  std::vector<int> lead_wind_point;
+  std::vector<double> lead_wind_weight;
+  double lead_wind_offset = 0.0;
+  int lead_wind_first = -1;
+  bool lead_wind_stale = true;
 };
 
 }  // namespace catenary_sim

@@ -566,6 +566,31 @@ double gust_lead_time(const Scene& sc) {
   return slowest > kGustLeadDecays / kAutoGustLeadMax ? kGustLeadDecays / slowest : kAutoGustLeadMax;
 }
 
+int default_lead_every(const Model& m, const LateralModel& lat) {
+  const std::optional<LeadStep>& step = m.scene.numerics.gust_lead_step;
+  if (!lat.windowed || !(lat.gust_lead > 0.0) || lat.field.empty() || packs_of(m).empty()) return 0;
+  if (step ? *step == LeadStep::kExplicit : !lat.clamps.empty()) return 0;
+  return std::max(1, static_cast<int>(std::floor(kWindRefreshShare * lat.field.dt / m.dt + 1e-9)));
+}
+
+void set_lead_step(const Model& m, LateralModel& lat, int every) {
+  lat.lead_every = every;
+  if (every <= 0) return;
+  lat.lead_dt = every * m.dt;
+  lat.lead_beta = 0.5 * lat.lead_dt + m.beta;
+  lat.lead_shift = (2.0 / lat.lead_dt + m.alpha) / lat.lead_beta;
+  lat.lead_v_ratio = (2.0 / lat.lead_dt) / lat.lead_shift;
+  // The springs and each pendulum's own end on the diagonal (the pendulums at their static
+  // tension, as outside the vertical window), divided by shift: D + their stiffness.
+  lat.lead_mass = lat.mass;
+  for (const LateralSpring& sp : lat.springs) lat.lead_mass[sp.dof] += sp.stiffness / lat.lead_shift;
+  for (const LateralPendulum& p : lat.pendulums) {
+    const double k = std::max(0.0, m.droppers[p.dropper].static_tension) * p.inv_length;
+    lat.lead_mass[p.contact] += k / lat.lead_shift;
+    lat.lead_mass[p.messenger] += k / lat.lead_shift;
+  }
+}
+
 std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   const Scene& sc = m.scene;
   auto lat = std::make_shared<LateralModel>();
@@ -584,6 +609,7 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   build_lateral_packs(m, *lat);
   if (sc.numerics.damping == DampingStep::kCentred) factor_lateral_centred(m, *lat);
   prepare_window(lat.get());
+  set_lead_step(m, *lat, default_lead_every(m, *lat));
   return lat;
 }
 

@@ -113,20 +113,31 @@ void LateralRecorder::record(const Model& m, const State& s) {
     const double* calm = lat.calm.data();
     // On an endless line, block span j is the line's span j + the spans the block has moved.
     const long moved = m.endless ? std::lround(s.line_offset / endless_span_) - first_line_span_ : 0;
+    // Where the lateral plane is stepped: its window and, stepped on its own, the gust lead ahead
+    // of it (LateralState::lead_y, at the lead's last step).
+    const bool lead = lat.lead_every > 0 && !s.lateral.lead_window.empty();
     for (const BlowOffRange& r : blow_off_ranges_) {
-      int b = r.begin, e = r.end;
-      if (windowed) {
-        b = std::max(b, s.lateral.window[r.wire].lo);
-        e = std::min(e, s.lateral.window[r.wire].hi + 1);
-      }
       const long k = r.span + moved;
-      if (b >= e || k < 0 || k >= static_cast<long>(max_blow_off_.size())) continue;
+      if (k < 0 || k >= static_cast<long>(max_blow_off_.size())) continue;
       const int o = lat.wires[r.wire].w_dof;
       double most = max_blow_off_[k];
-      for (int i = o + b; i < o + e; ++i) {
-        const double d = std::fabs(y[i] - calm[i]);
-        most = d > most ? d : most;
+      bool seen = false;
+      auto scan = [&](int b, int e, const double* at) {
+        for (int i = o + b; i < o + e; ++i) {
+          const double d = std::fabs(at[i] - calm[i]);
+          most = d > most ? d : most;
+        }
+        seen |= b < e;
+      };
+      if (windowed) {
+        scan(std::max(r.begin, s.lateral.window[r.wire].lo), std::min(r.end, s.lateral.window[r.wire].hi + 1), y);
+        if (lead)
+          scan(std::max(r.begin, s.lateral.lead_window[r.wire].lo), std::min(r.end, s.lateral.lead_window[r.wire].hi + 1),
+               s.lateral.lead_y.data());
+      } else {
+        scan(r.begin, r.end, y);
       }
+      if (!seen) continue;
       max_blow_off_[k] = most;
       if (m.endless) line_static_blow_off_[k] = block_static_blow_off_[r.span];
     }

@@ -402,6 +402,18 @@ void read_gust_lead(Reader& r, Scene& s) {
   }
 }
 
+// numerics.gust_lead_step: implicit or explicit (absent: auto, LeadStep).
+void read_gust_lead_step(Reader& r, Scene& s) {
+  if (!r.has("gust_lead_step")) return;
+  const std::string v = r.text("gust_lead_step", "");
+  if (v == "implicit") s.numerics.gust_lead_step = LeadStep::kImplicit;
+  else if (v == "explicit") s.numerics.gust_lead_step = LeadStep::kExplicit;
+  else
+    fail("numerics.gust_lead_step", "'" + v + "'",
+         "one of: implicit (the lead on its own, the trapezoidal rule at the wind's refresh interval), explicit (with "
+         "the lateral window, at its dt)");
+}
+
 // numerics: the fidelity ladder. Returns whether the reference preset's own element length and
 // damping apply (neither given); `springs_by_preset`: the supports' and the droppers' step, each
 // whether the fast preset chose it (not given).
@@ -480,6 +492,7 @@ bool read_numerics(Reader& top, Scene& s, std::pair<bool, bool>* springs_by_pres
   s.numerics.allow_supercritical = r.boolean("allow_supercritical", false);
   read_window(r, s);
   read_gust_lead(r, s);
+  read_gust_lead_step(r, s);
   r.finish();
   return reference_defaults;
 }

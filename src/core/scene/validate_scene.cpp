@@ -111,6 +111,19 @@ void validate_acting_fields(const Scene& s) {
     fail("numerics.gust_lead", fmt(*s.numerics.gust_lead),
          "only with a turbulent wind (wind.turbulence) and the moving window (numerics.window): it is how much further "
          "ahead the lateral window reaches; remove it here");
+  if (s.numerics.gust_lead_step) {
+    const std::string v = *s.numerics.gust_lead_step == LeadStep::kImplicit ? "'implicit'" : "'explicit'";
+    if (!(s.wind && s.wind->turbulence && s.numerics.windowed()))
+      fail("numerics.gust_lead_step", v,
+           "only with a turbulent wind (wind.turbulence) and the moving window (numerics.window), where the lateral "
+           "plane has a gust lead; remove it here");
+    bool stitched = false;
+    for (const SectionSpec& sec : s.sections) stitched |= sec.stitch_wire.has_value();
+    if (stitched && *s.numerics.gust_lead_step == LeadStep::kImplicit)
+      fail("numerics.gust_lead_step", v,
+           "explicit on a line with stitch wires (their stiff clamps join the messenger's and the stitch wire's "
+           "solves, which the implicit lead takes one wire at a time)");
+  }
   if (!s.lateral())
     for (std::size_t i = 0; i < s.pantographs.size(); ++i) {
       const PantographSpec& p = s.pantographs[i];

@@ -55,12 +55,23 @@ struct LateralState {
 
   // Moving window's placement, for observers (lateral_statistics counts the blow-off where it
   // steps): the part of each wire the lateral plane steps (node ranges, with their factors), from
-  // the vertical plane's window's first support to its last or, with a gust lead
-  // (LateralModel::gust_lead), a support further ahead; outside, the nodes stay in the static
+  // the vertical plane's window's first support to its last or, with a gust lead stepped with the
+  // window (LateralModel::gust_lead, lead_every 0), a support further ahead; outside (and in an
+  // implicit lead, which has its own state below), the nodes stay in the static
   // state under the mean wind, at rest. Support indices into Model::support_x, -1: none yet. The
   // step derives it from State::window (sync_window; test_state: a copy without it steps the same).
   std::vector<WireWindow> window;
   int window_first_support = -1, window_last_support = -1;
+
+  // The implicit gust lead (LateralModel::lead_every > 0, engine/lateral_lead.hpp): each wire from
+  // the lateral window's front support to the lead's end, stepped on its own: positions (m) and
+  // velocities (m/s) at lead_time and one lead step before it, between which the window takes a
+  // node's state when it reaches it; the lead's placement as the window's (lead_first_support is
+  // the window's last).
+  Eigen::VectorXd lead_y, lead_v, lead_y_before, lead_v_before;
+  double lead_time = 0.0;  // s
+  std::vector<WireWindow> lead_window;
+  int lead_first_support = -1, lead_last_support = -1;
 
   // Outputs of the last step. Per collector x contact wire: the contact point's lateral position
   // on the strip (m, wire minus pantograph), NaN where the collector is not under that wire.

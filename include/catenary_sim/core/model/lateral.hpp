@@ -98,9 +98,19 @@ struct LateralModel {
   // lateral modes' decay (about 9 s, against the window's lead of 1-2 s: 9-16 % less rms across the
   // strip, BENCHMARKS.md). An endless line is always windowed, with a gust lead in a turbulent wind.
   bool windowed = false;
-  // s: in a turbulent wind, how long ahead of the vertical window's front the lateral window
-  // reaches, as time of travel at the train's speed (numerics.gust_lead; 0 otherwise).
+  // s: in a turbulent wind, how long ahead of the vertical window's front the lateral plane is
+  // stepped (the gust lead), as time of travel at the train's speed (numerics.gust_lead; 0
+  // otherwise): by the lateral window itself, or on its own (lead_every below).
   double gust_lead = 0.0;
+  // The implicit gust lead (NumericsSpec::gust_lead_step, engine/lateral_lead.hpp): 0 when the lead
+  // is stepped with the window; else the vertical steps per lead step, whose dt is the wind's
+  // refresh interval. The lead takes the trapezoidal rule: per wire (D + K) zeta = r, D = shift M,
+  // shift = (2 / dt + alpha) / (dt / 2 + beta), lead_beta = dt / 2 + beta, lead_v_ratio =
+  // (2 / dt) / shift; lead_mass is M with the springs' and the pendulums' own stiffness (at the
+  // droppers' static tension) over shift on the diagonal, so that the solve takes them implicitly.
+  int lead_every = 0;
+  double lead_dt = 0.0, lead_shift = 0.0, lead_beta = 0.0, lead_v_ratio = 0.0;
+  Eigen::VectorXd lead_mass;
   double wind_speed = 0.0;
   Eigen::VectorXd wind_coefficient, wind_normal;
   WindField field;                 // turbulence (empty: steady wind)
@@ -159,6 +169,17 @@ struct LateralModel {
 // at most kAutoGustLeadMax; auto on a finite line 0 (its whole lateral plane is stepped).
 double gust_lead_time(const Scene& scene);
 constexpr double kGustLeadDecays = 2.0, kAutoGustLeadMax = 30.0;  // s
+// Share of the turbulent field's sample time (1 / (4 max_frequency)) between refreshes of the wind
+// on the nodes: 0.01 s at 5 Hz, whose hold costs the field sinc^2(f 0.01 s), 0.8 % at 5 Hz. The
+// implicit gust lead steps at this interval.
+constexpr double kWindRefreshShare = 0.2;
+
+// The implicit gust lead's step (LateralModel::lead_*): how many vertical steps a lead step takes
+// where the scene steps its lead implicitly (a turbulent wind's lead, the fused packs, no stitch
+// wires' clamps, whose stiffness joins two wires' solves), else 0: the wind's refresh interval in
+// whole vertical steps. set_lead_step sets the lead's fields for `every` (0: no implicit lead).
+int default_lead_every(const Model& model, const LateralModel& lat);
+void set_lead_step(const Model& model, LateralModel& lat, int every);
 
 // What a steady arm at a support node meets sideways (HingedArmSpec), for any line, 2-D ones too:
 // `stiffness` (N/m), the wire's lateral stiffness there with that support alone let go and every

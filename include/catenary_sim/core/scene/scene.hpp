@@ -219,6 +219,11 @@ enum class SpringStep { kExplicit, kImplicit };
 
 constexpr double kMaxGustLead = 60.0;  // s, numerics.gust_lead
 
+// How the lateral plane's gust lead (NumericsSpec::gust_lead) is stepped: kExplicit with the
+// lateral window, at its dt; kImplicit on its own, the trapezoidal rule at the wind's refresh
+// interval, handed over to the window as the window reaches it (engine/lateral_lead.hpp).
+enum class LeadStep { kImplicit, kExplicit };
+
 // The centred step's dt estimate (stability.cpp) takes the supports' and droppers' explicit
 // damping one node at a time, not coupled with the wires' band, so it is no bound at the estimate
 // itself: the reference line diverged at 0.99 of it and ran at 0.98. Its dt stays below this share.
@@ -250,6 +255,9 @@ struct NumericsSpec {
   // endless line is two decay times of the slowest wire's lateral motion, and on a finite line
   // the whole line (no lateral window).
   std::optional<double> gust_lead;
+  // How the gust lead is stepped. Empty: auto, implicit unless the line has stitch wires (their
+  // stiff clamps join two wires' solves, which the lead's one solve per wire cannot take).
+  std::optional<LeadStep> gust_lead_step;
   // A train faster than the contact wire's wave speed (train_speed_limit) runs only with this set.
   bool allow_supercritical = false;
 };
