@@ -3,9 +3,10 @@
 // turbulent 20 m/s cross wind, balanced preset, 300 km/h, train front from 500 m to 5500 m, against
 // a finite 104-span line whose whole lateral plane is stepped, in the same realisation of the wind
 // (both fields start at station 0 with the same time grid; make_wind_field draws point by point).
-// Per seed and lead: the contact point's turbulent motion (its position less that of the finite
-// line in the steady mean wind), rms on the finite line and on the endless one, and the rms of
-// their difference, over the stations the pantograph reaches after the longest lead has run its
+// The leads stepped on their own (numerics.gust_lead_step implicit), and the auto lead once more
+// stepped with the lateral window (explicit). Per seed and lead: the contact point's turbulent
+// motion (its position less that of the finite line in the steady mean wind), rms on the finite
+// line and on the endless one, and the rms of their difference, over the stations the pantograph reaches after the longest lead has run its
 // course; then each run's wall time per simulated second (the runs of one seed interleaved, so
 // they compare as ratios; the 2-D endless line for scale).
 //   bench_gust_lead [seeds=4]
@@ -80,6 +81,11 @@ static int bench_main(int argc, char** argv) {
       std::vector<std::string> ov = windy(seed);
       ov.push_back("numerics.gust_lead=" + lead);
       add("endless, gust_lead " + lead, scene(true, ov));
+    }
+    {
+      std::vector<std::string> ov = windy(seed);
+      ov.push_back("numerics.gust_lead_step=explicit");
+      add("endless, auto, explicit", scene(true, ov));
     }
     add("endless 2-D", scene(true, {}));
     double longest = 0.0;
