@@ -32,7 +32,7 @@ inline std::vector<int> sample_nodes(const Wire& w, double resolution) {
 // Lateral position (m, + left of the track centre line) of node i of wire wi now; 0 on a 2-D line.
 inline double node_lateral(const Model& m, const State& s, std::size_t wi, int i) {
   if (!m.lateral || s.lateral.y.size() != m.lateral->n) return 0.0;
-  return s.lateral.y[m.lateral->wires[wi].w_dof + i];
+  return lateral_position(m, s, m.lateral->wires[wi].w_dof + i);
 }
 
 // The pantograph head's centre across the track (sway); 0 on a 2-D line.

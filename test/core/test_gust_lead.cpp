@@ -139,3 +139,58 @@ TEST(GustLead, ConvergesAtSecondOrderInItsStep) {
   EXPECT_GT(worst[0] / worst[1], 3.0);
   EXPECT_GT(worst[1] / worst[2], 3.0);
 }
+
+TEST(GustLead, SkinsSeeTheLeadsWires) {
+  // The wires a skin draws (lateral_position): in the window the lateral state, in the implicit
+  // lead the lead's state at the state's time (the lateral state holds the static state there).
+  Simulation sim(windy_endless({"train.end=900"}));
+  const Model& m = sim.model();
+  const LateralModel& lat = *m.lateral;
+  for (int k = 0; k < 1200; ++k) ASSERT_EQ(sim.step(), StepStatus::kOk);
+  const State& s = sim.state();
+  double moved = 0.0;
+  int checked = 0;
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    const int o = lat.wires[wi].w_dof;
+    const WireWindow &win = s.lateral.window[wi], &lead = s.lateral.lead_window[wi];
+    ASSERT_LT(win.lo, win.hi);
+    ASSERT_EQ(lead.lo, win.hi);  // the lead from the window's front support on
+    for (int i = win.lo; i <= win.hi; ++i) EXPECT_EQ(lateral_position(m, s, o + i), s.lateral.y[o + i]);
+    for (int i = lead.lo + 1; i <= lead.hi; ++i) {
+      double y = 0.0, v = 0.0;
+      lead_state_at(m, s, o + i, s.time, &y, &v);
+      EXPECT_EQ(lateral_position(m, s, o + i), y);
+      EXPECT_EQ(s.lateral.y[o + i], lat.initial[o + i]);
+      moved = std::max(moved, std::fabs(y - lat.initial[o + i]));
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000);
+  EXPECT_GT(moved, 1e-3);  // the gusts move the lead's wires by millimetres in 1.9 s
+}
+
+TEST(GustLead, AResetThatKeepsTheTimeRestartsTheLeadThere) {
+  // Simulation::reset keeps the clock by default, and the initial state's lead is at time 0: the
+  // lead must go on from the reset state at the clock's time, not step the whole time since 0 (a
+  // live node reset after an hour would stall for minutes).
+  Simulation sim(windy_endless({}));
+  const Model& m = sim.model();
+  for (int k = 0; k < 1501; ++k) ASSERT_EQ(sim.step(), StepStatus::kOk);  // (not a whole number of lead steps)
+  ASSERT_NE(1501 % m.lateral->lead_every, 0);
+  const double t = sim.state().time;
+  sim.reset();
+  ASSERT_EQ(sim.state().time, t);
+  ASSERT_EQ(sim.step(), StepStatus::kOk);
+  const LateralState& ls = sim.state().lateral;
+  // One vertical step later the lead restarted at the reset's time (the step's start), without a
+  // step for the time it missed (from 0 its steps would end elsewhere in its grid), and is in the
+  // static state (the reset's).
+  EXPECT_NEAR(ls.lead_time, t, 1e-9);
+  double worst = 0.0;
+  for (std::size_t wi = 0; wi < m.lateral->wires.size(); ++wi) {
+    const WireWindow& ww = ls.lead_window[wi];
+    const int o = m.lateral->wires[wi].w_dof;
+    for (int i = o + ww.lo; i <= o + ww.hi; ++i) worst = std::max(worst, std::fabs(ls.lead_y[i] - m.lateral->initial[i]));
+  }
+  EXPECT_LT(worst, 1e-4);  // a step of gusts moves the wires by micrometres, 2 s of them by millimetres
+}

@@ -556,6 +556,18 @@ void shift_lateral_block(const Model& m, State& s) {
   }
 }
 
+double lateral_position(const Model& m, const State& s, int dof) {
+  const LateralModel& lat = *m.lateral;
+  const LateralState& ls = s.lateral;
+  if (lat.lead_every > 0 && !ls.lead_window.empty() && !in_windows(lat.wires, ls.window, dof) &&
+      in_windows(lat.wires, ls.lead_window, dof)) {
+    double y = 0.0, v = 0.0;
+    lead_state_at(m, s, dof, s.time, &y, &v);
+    return y;
+  }
+  return ls.y[dof];
+}
+
 void set_dropper_stretch(const Model& m, State& s) {
   for (const LateralPendulum& p : m.lateral->pendulums)
     s.lateral.dropper_stretch[p.dropper] = lean_stretch(p, s.lateral.y.data());

@@ -112,6 +112,11 @@ StepStatus lateral_step(const Model& model, State& state);
 // start in the static state. No allocation.
 void shift_lateral_block(const Model& model, State& state);
 
+// Lateral position (m) of lateral DOF `dof` now, for skins that draw or publish the wires: the
+// lateral state's, or where an implicit gust lead steps the node outside the window, the lead's
+// (interpolated to the state's time).
+double lateral_position(const Model& model, const State& state, int dof);
+
 // Sets LateralState::dropper_stretch from the current y (after y was set by hand, or moved).
 void set_dropper_stretch(const Model& model, State& state);
 
