@@ -210,12 +210,7 @@ void sync_lead(const Model& m, State& s) {
   LateralWorkspace& lw = *ls.work;
   const std::vector<double>& sx = m.support_x;
   const int first = ls.window_last_support;
-  int last = first;
-  if (first >= 0) {
-    const double hi_x = sx[first] + lat.gust_lead * std::fabs(s.speed);  // snapped outward to a support
-    last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x - 1e-6) - sx.begin());
-    last = std::min(last, static_cast<int>(sx.size()) - 1);
-  }
+  const int last = first >= 0 ? gust_lead_end(m, s, first) : first;
   if (first == ls.lead_first_support && last == ls.lead_last_support && !lw.lead_dirty) return;
   lw.lead_dirty = false;
   ls.lead_first_support = first;

@@ -135,6 +135,13 @@ void factor_centred_window(const Model& m, State& s) {
 // window, and at each cut the static force of the elements left out (-K initial of the whole line
 // less the window's), so that the static state stays at rest in the window as outside it. Costs
 // what the window holds (bisection for the springs and droppers), not the line.
+int gust_lead_end(const Model& m, const State& s, int from) {
+  const std::vector<double>& sx = m.support_x;
+  const double hi_x = sx[from] + m.lateral->gust_lead * std::fabs(s.speed);  // snapped outward to a support
+  const int last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x - 1e-6) - sx.begin());
+  return std::min(last, static_cast<int>(sx.size()) - 1);
+}
+
 void sync_window(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
@@ -142,11 +149,7 @@ void sync_window(const Model& m, State& s) {
   const std::vector<double>& sx = m.support_x;
   const int first = s.window_first_support;
   int last = s.window_last_support;
-  if (first >= 0 && lat.gust_lead > 0.0 && lat.lead_every == 0) {  // (the implicit lead steps on its own)
-    const double hi_x = sx[last] + lat.gust_lead * std::fabs(s.speed);  // the lead, snapped outward to a support
-    last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x - 1e-6) - sx.begin());
-    last = std::min(last, static_cast<int>(sx.size()) - 1);
-  }
+  if (first >= 0 && lat.gust_lead > 0.0 && lat.lead_every == 0) last = gust_lead_end(m, s, last);  // (an implicit lead steps on its own)
   if (first == ls.window_first_support && last == ls.window_last_support && !lw.window_dirty) return;
   lw.window_dirty = false;
   ls.window_first_support = first;

@@ -34,6 +34,10 @@ void over_stepped(const Model& m, const State& s, bool windowed, Body&& body) {
 int add_cut_forces(const Model& m, std::size_t wi, const WireWindow& ww, int* node, double* force, int count, double* f,
                    double* theta);
 
+// The support the gust lead reaches from support `from` (LateralModel::gust_lead seconds of travel
+// at the state's speed, snapped outward to a support, at most the line's last).
+int gust_lead_end(const Model& m, const State& s, int from);
+
 // Moves the lateral window with the vertical one (and its lead), rebuilding its lists only when it
 // moved (lateral_window.cpp).
 void sync_window(const Model& m, State& s);
