@@ -57,8 +57,8 @@ double lay_endless_block(Scene& scene, Model& m) {
   collector_extent(scene, &lead, &rear);
   auto spans_for = [&](double length) { return static_cast<int>(std::ceil(length / span - 1e-9)); };
   const int margin = endless_margin(scene), behind = spans_for(std::max(behind_slow, behind_fast)) + 1;
-  // In a turbulent wind the lateral plane's window reaches a gust lead further (lateral.hpp),
-  // snapped outward to a support once more.
+  // In a turbulent wind the lateral plane is stepped a gust lead further ahead (lateral.hpp: by
+  // its window, or on its own), snapped outward to a support once more.
   const double gusts = gust_lead_time(scene) * std::max(scene.train_speed, kMaxTrainSpeed);
   const int ahead = spans_for(std::max(ahead_slow, ahead_fast) + gusts) + (gusts > 0.0 ? 2 : 1);
   const int train = spans_for(lead - rear);

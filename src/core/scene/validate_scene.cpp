@@ -110,7 +110,7 @@ void validate_acting_fields(const Scene& s) {
   if (s.numerics.gust_lead && !(s.wind && s.wind->turbulence && s.numerics.windowed()))
     fail("numerics.gust_lead", fmt(*s.numerics.gust_lead),
          "only with a turbulent wind (wind.turbulence) and the moving window (numerics.window): it is how much further "
-         "ahead the lateral window reaches; remove it here");
+         "ahead of the vertical window the lateral plane is stepped; remove it here");
   if (s.numerics.gust_lead_step) {
     const std::string v = *s.numerics.gust_lead_step == LeadStep::kImplicit ? "'implicit'" : "'explicit'";
     if (!(s.wind && s.wind->turbulence && s.numerics.windowed()))

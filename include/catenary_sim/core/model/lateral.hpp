@@ -162,7 +162,7 @@ struct LateralModel {
   std::vector<double> spring_order_x;
 };
 
-// s: how far ahead of the vertical window the lateral plane's window reaches, as time of travel
+// s: how far ahead of the vertical window the lateral plane is stepped, as time of travel
 // (LateralModel::gust_lead): 0 without a turbulent wind or a window; numerics.gust_lead when given;
 // auto on an endless line two decay times 1 / sigma of the slowest wire's lateral motion,
 // sigma = rho Cd d U_n / (2 m') + alpha / 2 (the drag's aerodynamic damping and eq. 5's mass term),

@@ -249,7 +249,7 @@ struct NumericsSpec {
   double window_ahead = 0.0, window_behind = 0.0;
   bool window_auto = false;
   bool windowed() const { return window_auto || window_ahead > 0.0; }
-  // 3-D line in a turbulent wind with the window: the lateral plane's window reaches this many
+  // 3-D line in a turbulent wind with the window: the lateral plane is stepped this many
   // seconds of travel further ahead than the vertical one, so that a span has felt the gusts that
   // long when the pantograph reaches it (lateral.hpp, gust_lead_time). Empty: auto, which on an
   // endless line is two decay times of the slowest wire's lateral motion, and on a finite line
