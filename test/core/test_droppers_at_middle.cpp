@@ -244,3 +244,31 @@ TEST(DroppersAtMiddle, TheStitchWiresClampsGoToTheMiddleToo) {
   EXPECT_EQ(run_from_static(mid, 100000), StepStatus::kFinished);
   EXPECT_EQ(run_from_static(clamps_at_qn, 100000), StepStatus::kDiverged);
 }
+
+TEST(DroppersAtMiddle, ADropperTheWindowLeftReportsItsStaticState) {
+  // With the moving window a dropper behind it is back in the static state (u = 0): what it
+  // reports must be that state's elastic tension (dropper_tension NaN), not the tension it acted
+  // with in its last step in the window, which a recorder would otherwise count on for the rest
+  // of the pass (slack, if it left slack).
+  Simulation sim(load_scene_file(kDir + "reference_55m.yaml", {"numerics.preset=fast", "numerics.window=auto"}));
+  const Model& m = sim.model();
+  ASSERT_FALSE(m.dropper_at_middle.empty());
+  long behind = 0, inside = 0;
+  while (sim.step() == StepStatus::kOk) {
+    const State& s = sim.state();
+    std::vector<char> in(m.droppers.size(), 0);
+    for (int j = 0; j < s.window_dropper_count; ++j) in[s.window_droppers[j]] = 1;
+    for (std::size_t k = 0; k < m.droppers.size(); ++k) {
+      if (!m.dropper_at_middle[k]) continue;
+      if (in[k]) {
+        ASSERT_FALSE(std::isnan(s.dropper_tension[k])) << "dropper " << k << " in the window at t = " << s.time;
+        ++inside;
+      } else if (m.droppers[k].x < m.support_x[s.window_first_support]) {
+        ASSERT_TRUE(std::isnan(s.dropper_tension[k])) << "dropper " << k << " behind the window at t = " << s.time;
+        ++behind;
+      }
+    }
+  }
+  EXPECT_GT(behind, 1000);  // the window left droppers behind it during the pass
+  EXPECT_GT(inside, 1000);
+}

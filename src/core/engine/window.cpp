@@ -178,6 +178,11 @@ void update_window(const Model& m, State& s) {
   // the droppers and supports between the window's ends are looked at, so moving the window costs
   // what the window holds, not the line.
   auto inside = [&](int dof) { return in_windows(m.wires, s.window, dof); };
+  // The droppers taken at the step's middle report the tension they acted with while the window
+  // steps them; the ones it leaves are back in the static state, whose elastic tension is the one
+  // (NaN: State::dropper_tension). Those it still holds get theirs again in this step.
+  if (!s.dropper_tension.empty())
+    for (int j = 0; j < s.window_dropper_count; ++j) s.dropper_tension[s.window_droppers[j]] = std::nan("");
   s.window_dropper_count = select_between(
       m.dropper_order, m.dropper_order_x, a, b,
       [&](int k) { return inside(m.droppers[k].contact_dof) && inside(m.droppers[k].messenger_dof); },

@@ -113,8 +113,8 @@ namespace {
 // lean by about as much (u_m - u_c ~ -lean), and the vertical stretch alone would read k times
 // the lean's change (60 N per 0.3 mm) as force or slack the dropper does not have.
 // A dropper at the step's middle (numerics.droppers implicit) reports the tension it acted with
-// over the last step (State::dropper_tension; NaN before the first step, when the elastic tension
-// is the one). The dropper `k`'s data come from its track (DropperTrack), not the model's list.
+// over the last step (State::dropper_tension; NaN before the first step and once a moving window
+// has left it, when the elastic tension is the one). The dropper `k`'s data come from its track (DropperTrack), not the model's list.
 inline double dropper_force(const Model& m, const State& s, std::size_t k, int messenger_dof, int contact_dof,
                             double static_tension, double stiffness, bool* slack) {
   double t = s.dropper_tension.empty() || !m.dropper_at_middle[k] ? std::nan("") : s.dropper_tension[k];

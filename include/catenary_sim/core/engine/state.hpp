@@ -80,8 +80,9 @@ struct State {
   std::vector<double> collector_height;  // m, weighted wire height under each collector (eq. 12)
   std::vector<std::uint8_t> dropper_slack;  // 1 where the dropper carried no tension
   // N, per dropper taken at the step's middle (Model::dropper_at_middle): the tension it carried
-  // over the last step, the trapezoidal rule's (NaN before the first step, where the elastic
-  // tension at u is the one); empty when every dropper is taken at q_n.
+  // over the last step, the trapezoidal rule's (NaN before the first step and where a moving
+  // window has left it, where the elastic tension at u is the one); empty when every dropper is
+  // taken at q_n.
   std::vector<double> dropper_tension;
 
   // Contact force (N) of collector `collector` (Model::collectors) on contact wire `wire`
