@@ -191,6 +191,9 @@ void Simulation::reset(bool keep_time) {
   if (keep_time) {
     state_.time = t;
     state_.steps = n;
+    // The implicit gust lead's own clock with it: it goes on from the initial state at that time
+    // (from 0 the next step would step it over the whole time since).
+    state_.lateral.lead_time = t;
   }
 }
 

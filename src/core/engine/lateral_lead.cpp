@@ -196,9 +196,6 @@ bool advance_lead(const Model& m, State& s, double t) {
     rebuild_lead(m, s, m.support_x[ls.lead_first_support], m.support_x[ls.lead_last_support]);
     ls.work->lead_dirty = false;
   }
-  // A clock that moved on without the lead (a reset that keeps the time, a state set by hand):
-  // the lead goes on from its state at that time rather than stepping up to it.
-  if (ls.lead_time < t - (1.0 + 1e-9) * dt) ls.lead_time = t;
   while (ls.lead_time < t - 1e-9 * dt)
     if (lead_step(m, s)) return true;
   return false;
