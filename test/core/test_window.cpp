@@ -80,6 +80,22 @@ TEST(Window, CentredDampingStatisticsMatchTheFullLine) {
   expect_within_window_budget(win, full);
 }
 
+// Two tension sections with an overlap: the window reaches the second section's wires where they
+// begin, on the support at its front, before it holds any element of them. Once it does, they
+// take part as any wire does; the pass matches the whole line within the same budget, at the
+// half-step and the centred damping.
+TEST(Window, OverlapStatisticsMatchTheFullLine) {
+  for (const std::vector<std::string>& base : std::vector<std::vector<std::string>>{
+           {}, {"numerics.preset=balanced", "numerics.damping=centred"}}) {
+    SCOPED_TRACE(base.empty() ? "accurate" : "balanced, centred");
+    std::vector<std::string> windowed = base;
+    windowed.push_back("numerics.window=auto");
+    const PantographStatistics full = pass(base, test_scenes::kReferenceTwoSections);
+    const PantographStatistics win = pass(windowed, test_scenes::kReferenceTwoSections);
+    expect_within_window_budget(win, full);
+  }
+}
+
 // A window that holds the whole line from the start (its ends on the anchors, nothing cut) is the
 // whole line: with the centred step its solve, point forces and update must then give the whole
 // line's contact force at every step. The two differ only in the order the point forces are

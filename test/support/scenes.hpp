@@ -38,6 +38,7 @@ inline const std::string kReferenceTwoHeads = CATENARY_SIM_SOURCE_DIR "/config/r
 inline const std::string kReferenceTwoPantographs =
     CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_pantographs.yaml";
 inline const std::string kReferenceStitched = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_stitched.yaml";
+inline const std::string kReferenceTwoSections = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_two_sections.yaml";
 inline const std::string kReferenceStitched3d = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_stitched_3d.yaml";
 inline const std::string kCompound = CATENARY_SIM_SOURCE_DIR "/config/compound_catenary.yaml";
 inline const std::string kReferenceHingedArms = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_hinged_arms.yaml";

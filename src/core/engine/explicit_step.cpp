@@ -20,12 +20,10 @@ namespace catenary_sim {
 
 namespace {
 
-// Whether the fused sweeps can take this state: a pack's window needs two nodes or more, the
-// same range in both lanes.
+// Whether the fused sweeps can take this state: a pack's window has the same range in both lanes
+// (and two nodes or more, as every wire's window has: set_wire_window).
 bool packs_take_window(const Model& m, const State& s, bool windowed) {
   if (!windowed) return true;
-  for (const WireWindow& ww : s.window)
-    if (ww.hi == ww.lo) return false;
   for (const WireLanes& p : packs_of(m))
     if (p.lanes == 2 && (s.window[p.wire[0]].lo != s.window[p.wire[1]].lo || s.window[p.wire[0]].hi != s.window[p.wire[1]].hi))
       return false;

@@ -70,7 +70,6 @@ void move_wire_window(const Model& m, State& s, std::size_t wi, int first, doubl
     for (int i = lo; i <= hi; ++i)
       if (i < old_lo || i > old_hi) refresh_wind(m, s, o + i, o + i + 1);
   if (hi < lo) return;
-  if (hi == lo) lw.window_fused = false;  // (as the vertical step: the sweep needs two nodes)
   lw.cut_count = add_cut_forces(m, wi, ww, lw.cut_node.data(), lw.cut_force.data(), lw.cut_count, f, lw.theta.data());
 }
 

@@ -42,7 +42,7 @@ struct LateralWorkspace {
   int cut_count = 0;
   std::vector<int> window_points;
   int window_point_count = 0;
-  bool window_fused = false;  // the fused step can take the window (every wire's range two nodes or more)
+  bool window_fused = false;  // the fused step can take the window (a pack's lanes over the same range)
   // The centred damping step in the window: per pack the factors of its range, laid out as
   // LateralModel::centred_twin and centred_single (at centred_twin_at[pack] and
   // centred_single_at[pack]), rebuilt by sync_window; scratch for one wire's range.

@@ -62,6 +62,10 @@ void set_wire_window(const Wire& w, double a, double b, WireWindow& ww) {
   const int n = w.nodes();
   ww.lo = static_cast<int>(std::lower_bound(w.x.begin(), w.x.end(), a - 1e-9) - w.x.begin());
   ww.hi = static_cast<int>(std::upper_bound(w.x.begin(), w.x.end(), b + 1e-9) - w.x.begin()) - 1;
+  // A wire whose end node alone lies in the window (a section starting at its front support) has
+  // no element there: nothing in the window acts on that node, and its rotation's pivot would be
+  // 0. It takes part once the window holds an element of it.
+  if (ww.hi == ww.lo) ww.hi = ww.lo - 1;
   if (ww.hi < ww.lo) return;
   ww.cut_lo = ww.lo > 0;
   ww.cut_hi = ww.hi < n - 1;

@@ -13,7 +13,8 @@ namespace catenary_sim {
 
 // One wire's window over the supports at stations a <= b: its node range, the cut ends' share of
 // the band and the LDL^T factors of its K_theta_theta (the vertical plane's window, and the lateral
-// plane's, which may reach further ahead: lateral.cpp).
+// plane's, which may reach further ahead: lateral.cpp). Empty (hi < lo) unless it holds an element
+// of the wire: two nodes or more.
 void set_wire_window(const Wire& wire, double a, double b, WireWindow& window);
 
 // The windows' factors interleaved per pack for the fused step (both lanes of a pack share the
