@@ -148,6 +148,8 @@ TEST(FusedStep, MatchesTheGenericStepBitForBit) {
       {"reference_55m_endless.yaml", {}, 4000},
       {"reference_55m_two_pantographs.yaml", {}, 3000},
       {"reference_55m_two_sections.yaml", {}, 3000},
+      // The window reaching the second section's wires (at about step 3200).
+      {"reference_55m_two_sections.yaml", {"numerics.window=auto"}, 4500},
       {"reference_55m_stitched.yaml", {}, 3000},  // stitch wires: packs of one, clamps as point forces
       {"reference_55m_stitched.yaml", {"numerics.window=auto"}, 3000},  // the window's clamp lists
       {"reference_55m.yaml", {"numerics.preset=fast", "train.speed_kmh=250"}, 2000},
