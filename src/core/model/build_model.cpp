@@ -508,9 +508,15 @@ void mark_springs_at_middle(const NumericsSpec& num, Model& m) {
 // The explicit stability limit (validation.md section 5) and the step, or the implicit matrix.
 void choose_time_step(const Scene& scene, Model& m) {
   if (scene.numerics.windowed() &&
-      (scene.numerics.integrator != Integrator::kExplicit || scene.numerics.rotary_inertia != RotaryInertia::kCondensed))
-    throw SceneError("numerics.window: needs numerics.integrator explicit with rotary_inertia condensed (the window "
-                     "integrates node ranges of the condensed band)");
+      (scene.numerics.integrator != Integrator::kExplicit || scene.numerics.rotary_inertia != RotaryInertia::kCondensed)) {
+    const bool implicit = scene.numerics.integrator != Integrator::kExplicit;
+    throw SceneError(std::string("scene field ") +
+                     (implicit ? "'numerics.integrator' = 'implicit': allowed 'explicit'"
+                               : "'numerics.rotary_inertia' = 'lumped': allowed 'condensed'") +
+                     (scene.endless ? " on an endless line (line.endless), which runs in the moving window"
+                                    : " with numerics.window") +
+                     " (the window integrates node ranges of the condensed band)");
+  }
   if (scene.numerics.damping == DampingStep::kCentred) {
     // The centred step solves each wire's band (or its window's part) with the rotations
     // condensed, for u + beta v.
