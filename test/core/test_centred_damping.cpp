@@ -18,6 +18,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/engine/initial_state.hpp"
+#include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
 
 using namespace catenary_sim;
@@ -356,14 +357,7 @@ TEST(CentredDamping, LateralPlaneConvergesToTheHalfStepsLimit) {
 // (d) Bad input: the field, the value and what is allowed; the reference preset keeps a step that
 // goes where the centred one does not.
 TEST(CentredDamping, RefusesWhatItCannotStepAndTheReferencePresetFallsBack) {
-  auto message = [](const std::string& file, const std::vector<std::string>& o) {
-    try {
-      build_model(load_scene_file(kDir + file, o));
-    } catch (const SceneError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto message = [](const std::string& file, const std::vector<std::string>& o) { return test_scenes::refusal_of(kDir + file, o); };
   const std::string bogus = message("reference_55m.yaml", {"numerics.damping=implicit"});
   EXPECT_NE(bogus.find("numerics.damping"), std::string::npos) << bogus;
   EXPECT_NE(bogus.find("implicit"), std::string::npos) << bogus;

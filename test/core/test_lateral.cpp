@@ -15,6 +15,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/engine/initial_state.hpp"
 #include "catenary_sim/core/model/wind_field.hpp"
+#include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
 #include "engine/lateral_workspace.hpp"  // (the window's and the joint sweep's diagnostics)
 
@@ -1160,14 +1161,7 @@ TEST(Lateral, RandomStaggerErrorsHaveTheirStdAndLeaveTheOtherDraws) {
 }
 
 TEST(Lateral, StaggerErrorsBadInputNamesTheField) {
-  auto error_of = [](const std::vector<std::string>& o) {
-    try {
-      build_model(load_scene_file(test_scenes::kReference, o));
-    } catch (const SceneError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
-  };
+  auto error_of = [](const std::vector<std::string>& o) { return test_scenes::refusal_of(test_scenes::kReference, o); };
   EXPECT_NE(error_of({"imperfections.stagger_std=0.02"}).find("imperfections.stagger_std"), std::string::npos);
   EXPECT_NE(error_of({"stagger.contact_wire=[0.3,-0.3]", "imperfections.stagger_std=-0.02"}).find("imperfections.stagger_std"),
             std::string::npos);

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "catenary_sim/core/simulation.hpp"
+#include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
 
 using namespace catenary_sim;
@@ -17,14 +18,7 @@ namespace {
 
 using test_scenes::kReference;
 
-std::string error_of(const std::vector<std::string>& overrides) {
-  try {
-    Simulation sim(load_scene_file(kReference, overrides));
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const std::vector<std::string>& overrides) { return test_scenes::refusal_of(kReference, overrides); }
 
 std::string error_of_yaml(const std::string& yaml) {
   try {
@@ -180,14 +174,7 @@ namespace {
 
 using test_scenes::kReference3d;
 
-std::string error_of_3d(const std::vector<std::string>& overrides) {
-  try {
-    Simulation sim(load_scene_file(kReference3d, overrides));
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of_3d(const std::vector<std::string>& overrides) { return test_scenes::refusal_of(kReference3d, overrides); }
 
 // The reference scene's text with `line` put in place of its first line ("name: ...").
 std::string reference_with_first_line(const std::string& line) {
@@ -342,13 +329,8 @@ TEST(SceneErrors, FieldsThatCannotActAreRefused) {
                   "numerics.gust_lead_step", "not a scalar");
   for (const char* step : {"implicit", "explicit"})
     EXPECT_EQ(error_of_3d({std::string("numerics.gust_lead_step=") + step, "numerics.window=auto"}), "") << step;
-  std::string stitched;
-  try {
-    Simulation sim(load_scene_file(test_scenes::scene_path("reference_55m_stitched_3d.yaml"),
-                                   {"numerics.window=auto", "numerics.gust_lead_step=implicit"}));
-  } catch (const SceneError& e) {
-    stitched = e.what();
-  }
+  const std::string stitched = test_scenes::refusal_of(test_scenes::scene_path("reference_55m_stitched_3d.yaml"),
+                                                       {"numerics.window=auto", "numerics.gust_lead_step=implicit"});
   EXPECT_MENTIONS(stitched, "numerics.gust_lead_step", "'implicit'", "stitch wires", "explicit");
   // A strip's working width needs a 3-D line.
   EXPECT_MENTIONS(error_of({"pantographs.0.collectors=[{offset: 0.0, working_width: 1.0}]"}),

@@ -8,6 +8,7 @@
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
+#include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
 
 using namespace catenary_sim;
@@ -179,21 +180,14 @@ TEST(Window, EndsLetAPulseOut) {
 // The window needs the explicit step with condensed rotations: the field the scene set is named
 // with its value, what is allowed, and why the window is on.
 TEST(Window, RefusedWithTheImplicitIntegratorOrLumpedRotations) {
-  auto message = [](const std::string& scene, const std::vector<std::string>& overrides) {
-    try {
-      Simulation sim(load_scene_file(scene, overrides));
-    } catch (const SceneError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(accepted)");
-  };
-  const std::string implicit = message(test_scenes::kReference, {"numerics.window=auto", "numerics.integrator=implicit"});
+  using test_scenes::refusal_of;
+  const std::string implicit = refusal_of(test_scenes::kReference, {"numerics.window=auto", "numerics.integrator=implicit"});
   EXPECT_NE(implicit.find("'numerics.integrator' = 'implicit': allowed 'explicit' with numerics.window"), std::string::npos)
       << implicit;
-  const std::string lumped = message(test_scenes::kReference, {"numerics.window=auto", "numerics.rotary_inertia=lumped"});
+  const std::string lumped = refusal_of(test_scenes::kReference, {"numerics.window=auto", "numerics.rotary_inertia=lumped"});
   EXPECT_NE(lumped.find("'numerics.rotary_inertia' = 'lumped': allowed 'condensed' with numerics.window"), std::string::npos)
       << lumped;
-  const std::string endless = message(test_scenes::kReferenceEndless, {"numerics.integrator=implicit"});
+  const std::string endless = refusal_of(test_scenes::kReferenceEndless, {"numerics.integrator=implicit"});
   EXPECT_NE(endless.find("'numerics.integrator' = 'implicit': allowed 'explicit' on an endless line"), std::string::npos)
       << endless;
 }

@@ -1,11 +1,15 @@
-// A scene that must be refused, and the field its message must name (gtest). Header-only.
+// A scene that must be refused, and the field its message must name (gtest); what a scene file
+// with overrides is refused with. Header-only.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <string>
 
+#include <vector>
+
 #include "catenary_sim/core/scene/scene.hpp"
+#include "catenary_sim/core/simulation.hpp"
 
 namespace test_scenes {
 
@@ -16,6 +20,17 @@ inline void expect_refused(const std::string& yaml, const std::string& field) {
   } catch (const catenary_sim::SceneError& e) {
     EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
   }
+}
+
+// The message a scene file with `overrides` (--set style) is refused with, when it is read or
+// built into a simulation; "" when it is accepted.
+inline std::string refusal_of(const std::string& file, const std::vector<std::string>& overrides) {
+  try {
+    catenary_sim::Simulation sim(catenary_sim::load_scene_file(file, overrides));
+  } catch (const catenary_sim::SceneError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 }  // namespace test_scenes
