@@ -50,7 +50,7 @@ void rebuild_lead(const Model& m, State& s, double xa, double xb) {
                                        lw.lead_f.data(), lw.theta.data());
     for (int i = ww.lo; i <= ww.hi; ++i) mass[o + i] = lat.lead_mass[o + i];
     const double c = impedance(lat.wires[wi]) / lat.lead_beta;
-    for (int i : {ww.cut_lo ? o + ww.lo : -1, ww.cut_hi && ww.hi != ww.lo ? o + ww.hi : -1})
+    for (int i : {ww.cut_lo ? o + ww.lo : -1, ww.cut_hi ? o + ww.hi : -1})
       if (i >= 0 && im[i] != 0.0) {
         mass[i] += c / lat.lead_shift;
         lw.lead_dashpot_node[lw.lead_dashpot_count] = i;
