@@ -116,6 +116,20 @@ TEST(Allocation, ThreeDimensionalStepNeverAllocatesAndRepeatsItsBits) {
                              {stitched, {}},
                              {stitched, {"numerics.window=auto", "wind.turbulence=null"}},
                              {stitched, {"numerics.window=auto", "numerics.preset=balanced", "train.start=1650", "train.end=5500"}, true}};
+  // Hinged steady arms held across the track, their registrations moving with the uplift and the
+  // wire's answer acting on the arms: on the whole line, in the window and on the endless block.
+  const std::vector<std::string> hinged = {"steady_arms.stiffness=null", "steady_arms.mass=null", "steady_arms.length=1.15",
+                                           "steady_arms.linear_mass=0.78", "steady_arms.clamp_mass=0.46",
+                                           "stagger.steady_arm_stiffness=null", "wind.turbulence=null"};
+  for (std::vector<std::string> ov : {std::vector<std::string>{}, std::vector<std::string>{"numerics.window=auto"}}) {
+    ov.insert(ov.end(), hinged.begin(), hinged.end());
+    cases.push_back({three_d, ov});
+  }
+  {
+    std::vector<std::string> ov = {"stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]", "wind.speed=20"};
+    ov.insert(ov.end(), hinged.begin(), hinged.end() - 1);
+    cases.push_back({test_scenes::kReferenceEndless, ov});
+  }
   // The same with the centred damping step in both planes.
   const std::size_t half_step_cases = cases.size();
   for (std::size_t k = 0; k < half_step_cases; ++k) {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/engine/state.hpp"
 
@@ -40,7 +41,9 @@ inline bool leaning(const Model& m, const State& s) { return m.lateral && !s.lat
 // over the last lateral step (LateralState::dropper_stretch, lateral.hpp). It is added to the
 // elastic stretch of u + beta v undamped: the lean's Rayleigh share beta k dy dy'/l is second
 // order in the lateral motion, and the vertical step then reads no lateral velocity. The 2-D
-// line (kLean false) does exactly the work it did before.
+// line (kLean false) does exactly the work it did before. The hinged arms' registrations then
+// take the wire's lateral force on their arms' ends (LateralState::registration_force, from the
+// last lateral step) last.
 template <bool kLean, class ForceAt, class ZAt>
 void add_wire_point_forces(const Model& m, State& s, const double* u, const double* v, ForceAt f, ZAt z,
                            bool given_slack) {
@@ -102,6 +105,16 @@ void add_wire_point_forces(const Model& m, State& s, const double* u, const doub
     for (const SupportSpring& sp : m.springs) f(sp.dof) -= sp.stiffness * z(sp.dof);
     for (std::size_t k = 0; k < m.droppers.size(); ++k) dropper(k);
     for (std::size_t k = 0; k < m.clamps.size(); ++k) clamp(k);
+  }
+  if constexpr (kLean) {
+    const std::vector<LateralRegistration>& regs = m.lateral->registrations;
+    const double* arm = s.lateral.registration_force.data();
+    const bool windowed = m.scene.numerics.windowed();
+    for (std::size_t j = 0; j < regs.size(); ++j) {
+      const LateralRegistration& r = regs[j];
+      if (windowed && !(r.node >= s.window[r.wire].lo && r.node <= s.window[r.wire].hi)) continue;
+      f(r.vertical) += arm[j];
+    }
   }
 }
 

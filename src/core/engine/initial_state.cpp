@@ -17,6 +17,7 @@ void solve_initial_state(const Model& m, State& s, bool roof_springs) {
   const Eigen::VectorXd u = solve_static_equilibrium(m, pantograph_loads(m, s), roof_springs);
   s.u = u;  // into the state's own storage: its size is the model's
   s.v.setZero();  // eq. 24
+  if (m.lateral && !s.lateral.registration_force.empty()) place_registrations(m, s);
 }
 
 }  // namespace catenary_sim

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <vector>
 
+#include "engine/lateral_workspace.hpp"
+
 namespace catenary_sim {
 
 namespace {
@@ -47,6 +49,22 @@ double lateral_energy(const Model& m, const State& s) {
     const Dropper& d = m.droppers[p.dropper];
     const double ez = u[d.messenger_dof] - u[d.contact_dof];
     e += dropper_potential(d, ez + lean_stretch(p, s.lateral.y.data())) - dropper_potential(d, ez);
+  }
+  // The hinged arms' registrations (LateralRegistration), their arms' ends moved out by T: a
+  // spring's energy is k (y - stagger - T)^2 / 2, where the sum above took k (y - stagger)^2 / 2;
+  // and the wires' energy above falls by F0 T to first order as the registration moves out with
+  // their static pull F0, a force on the arm (F0 T'(u)) that the step leaves to the design statics
+  // (the arm's f0 and F_h / (a cos^3 theta0) in k_A): added back.
+  const LateralModel& lat = *m.lateral;
+  const std::vector<double>& pull0 = s.lateral.work->registration_pull0;
+  for (std::size_t j = 0; j < lat.registrations.size(); ++j) {
+    const LateralRegistration& r = lat.registrations[j];
+    const double travel = s.lateral.registration_travel[j];
+    if (r.spring >= 0) {
+      const LateralSpring& sp = lat.springs[r.spring];
+      e += sp.stiffness * travel * (0.5 * travel - (s.lateral.y[r.dof] - sp.anchor));
+    }
+    e += pull0[j] * travel;
   }
   return e;
 }

@@ -38,6 +38,57 @@ void update_head_wind(const Model& m, State& s, const WindFieldBuffer* field, co
 
 template class DeepCopied<LateralWorkspace>;  // LateralState::work
 
+namespace {
+
+// Nodes each side of a registration over which its band force condenses the rotations: the
+// rotations' coupling decays by about 0.2 per element (K_theta_theta's off-diagonal over its
+// diagonal, 2 EI / h - T h / 30 against 8 EI / h + 4 T h / 15 for a contact wire), so the rest of
+// the wire would change that force by some 0.2^8, 3e-6 of it.
+constexpr int kRegistrationReach = 8;
+
+// N, the lateral force on registration `r` (LateralRegistration) from everything but its arm, at
+// the lateral state now: held, the wire's band over kRegistrationReach nodes each side (f = -K y,
+// elastic: what the static pull-off is), the load at the node (a curve's T kappa h), the wind's
+// drag on it and its droppers' pendulums; on a spring, the spring's pull k (y - anchor - travel)
+// with `travel` the anchor's. `u`: the vertical plane's displacements (null: 0, the design state).
+double registration_pull(const Model& m, LateralState& ls, const double* u, const LateralRegistration& r, double travel) {
+  const LateralModel& lat = *m.lateral;
+  const double* y = ls.y.data();
+  if (r.spring >= 0) {
+    const LateralSpring& sp = lat.springs[r.spring];
+    return sp.stiffness * (y[r.dof] - sp.anchor - travel);
+  }
+  LateralWorkspace& lw = *ls.work;
+  const Wire& w = lat.wires[r.wire];
+  const int lo = std::max(0, r.node - kRegistrationReach), hi = std::min(w.nodes() - 1, r.node + kRegistrationReach);
+  WireWindow& range = lw.registration_range;
+  set_wire_window(w, w.x[lo], w.x[hi], range);
+  double* f = lw.registration_band.data();
+  std::fill(f + w.w_dof + lo, f + w.w_dof + hi + 1, 0.0);
+  wire_elastic_force_window(w, range, y, f, lw.theta.data());
+  double pull = lat.load[r.dof] + f[r.dof];
+  if (lat.windy) {
+    const double vn = ls.wind_speed[r.dof] - ls.v[r.dof];
+    pull += lat.wind_coefficient[r.dof] * vn * std::fabs(vn);
+  }
+  for (int j : r.pendulums) {  // as add_springs_and_pendulums, at y
+    const LateralPendulum& p = lat.pendulums[j];
+    const Dropper& d = m.droppers[p.dropper];
+    const double stretch = (u ? u[d.messenger_dof] - u[d.contact_dof] : 0.0) + lean_stretch(p, y);
+    const double tension = d.static_tension + d.stiffness * stretch;
+    pull += std::max(0.0, tension) * p.inv_length * (y[p.messenger] - y[p.contact]);
+  }
+  return pull;
+}
+
+// tan(theta) of the arm with its end raised by u: d(travel)/du, side apart.
+double arm_tan(const LateralRegistration& r, double u) {
+  const double sin_theta = std::clamp(r.sin0 - u / r.length, -1.0, 1.0);
+  return sin_theta / std::sqrt(1.0 - sin_theta * sin_theta);
+}
+
+}  // namespace
+
 LateralState make_lateral_state(const Model& m) {
   const LateralModel& lat = *m.lateral;
   LateralState s;
@@ -62,12 +113,21 @@ LateralState make_lateral_state(const Model& m) {
   s.off_strip.assign(m.collectors.size(), 0);
   s.events.reserve(kMaxDewirementEvents);
   s.dropper_stretch.assign(m.droppers.size(), 0.0);
+  s.registration_travel.assign(lat.registrations.size(), 0.0);  // (u = 0: the arms as built)
+  s.registration_force.assign(lat.registrations.size(), 0.0);
   work.lean_weight.assign(m.droppers.size(), 1.0);
   for (const LateralPendulum& p : lat.pendulums) s.dropper_stretch[p.dropper] = lean_stretch(p, s.y.data());  // 0: y is initial
   s.window.resize(lat.wires.size());
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     s.window[wi].tt_lower.assign(lat.wires[wi].nodes(), 0.0);
     s.window[wi].tt_inv_pivot.assign(lat.wires[wi].nodes(), 0.0);
+  }
+  if (!lat.registrations.empty()) {
+    work.registration_band.assign(lat.n, 0.0);
+    work.registration_range.tt_lower.assign(longest, 0.0);
+    work.registration_range.tt_inv_pivot.assign(longest, 0.0);
+    // (At rest in the static state under the mean wind, with every arm as built.)
+    for (const LateralRegistration& r : lat.registrations) work.registration_pull0.push_back(registration_pull(m, s, nullptr, r, 0.0));
   }
   if (lat.windowed && !lat.planes.empty() && lat.centred_twin.empty()) work.sweep_factors.assign(2 * sweep_size(m), 0.0);
   work.window_springs.assign(lat.springs.size(), 0);
@@ -196,6 +256,14 @@ void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const do
   for (int j = 0; j < n_springs; ++j) {
     const LateralSpring& sp = lat.springs[windowed ? lw.window_springs[j] : j];
     f[sp.dof] -= sp.stiffness * z_at(sp.dof);
+  }
+  // A hinged arm's registration on its spring: the anchor moved by the arm's end's travel, the
+  // load's k stagger and k travel (outside the window nothing is stepped).
+  const double* travel = ls.registration_travel.data();
+  for (std::size_t j = 0; j < lat.registrations.size(); ++j) {
+    const LateralRegistration& r = lat.registrations[j];
+    if (r.spring < 0 || (windowed && !(r.node >= ls.window[r.wire].lo && r.node <= ls.window[r.wire].hi))) continue;
+    f[r.dof] += lat.springs[r.spring].stiffness * travel[j];
   }
   const double* u = s.u.data();
   double* stretch = ls.dropper_stretch.data();
@@ -444,6 +512,46 @@ StepStatus lateral_diverged(const Model& m, State& s, bool lead) {
   return s.status;
 }
 
+// The hinged arms' registrations (LateralModel::registrations), both ways. A lateral step reads
+// the u the vertical step has just reached (the droppers' lean too: lateral.hpp): at its start
+// each registration point is put where its arm's end is at that u (place_at_arms; held, the node
+// at rest there through the step's substeps; on a spring, its anchor), and the wire's lateral
+// force on it, averaged over the substeps as the lean's stretch is (add_registration_pulls),
+// acts on the arm's end in the next vertical step, (F - F0) side tan(theta(u))
+// (set_registration_forces). Every force of both planes is so taken at one configuration, which
+// keeps the partitioned step symplectic (line_energy is conserved), and the arm's end is on its
+// circle whenever a step ends.
+void place_at_arms(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  for (std::size_t j = 0; j < lat.registrations.size(); ++j) {
+    const LateralRegistration& r = lat.registrations[j];
+    ls.registration_travel[j] = registration_travel(r, s.u[r.vertical]);
+    if (r.spring < 0) {
+      ls.y[r.dof] = lat.initial[r.dof] + ls.registration_travel[j];
+      ls.v[r.dof] = 0.0;
+    }
+    ls.registration_force[j] = 0.0;  // (the sum of the step's pulls from here)
+  }
+}
+
+void add_registration_pulls(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  for (std::size_t j = 0; j < lat.registrations.size(); ++j)
+    ls.registration_force[j] += registration_pull(m, ls, s.u.data(), lat.registrations[j], ls.registration_travel[j]);
+}
+
+void set_registration_forces(const Model& m, State& s, int pulls) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  const double* pull0 = ls.work->registration_pull0.data();
+  for (std::size_t j = 0; j < lat.registrations.size(); ++j) {
+    const LateralRegistration& r = lat.registrations[j];
+    ls.registration_force[j] = (ls.registration_force[j] / pulls - pull0[j]) * r.side * arm_tan(r, s.u[r.vertical]);
+  }
+}
+
 }  // namespace
 
 StepStatus lateral_step(const Model& m, State& s) {
@@ -468,8 +576,11 @@ StepStatus lateral_step(const Model& m, State& s) {
   if (lat.lead_every > 0 && advance_lead(m, s, t0)) return lateral_diverged(m, s, true);
   if (windowed) sync_window(m, s);
   if (lat.lead_every > 0) sync_lead(m, s);
+  const bool arms = !lat.registrations.empty();
+  if (arms) place_at_arms(m, s);
   for (int sub = 0; sub < lat.substeps; ++sub) {
     refresh_wind_if_due(m, s, t0 + sub * h, windowed);
+    if (arms) add_registration_pulls(m, s);
     const bool fused = !lat.planes.empty() && (!windowed || lw.window_fused);
     const bool failed = !lat.centred_twin.empty() ? centred_substep(m, s, windowed)
                         : fused                   ? fused_substep(m, s, windowed)
@@ -478,6 +589,7 @@ StepStatus lateral_step(const Model& m, State& s) {
   }
   const double per_substep = 1.0 / lat.substeps;
   for (double& e : ls.dropper_stretch) e *= per_substep;
+  if (arms) set_registration_forces(m, s, lat.substeps);
   update_head_wind(m, s, &field_values(m, s), ls.wind_points.data());
   const bool left = contact_points(m, s, true);
   if (left && m.scene.pantograph_head.on_dewirement == DewirementAction::kStop) {
@@ -525,8 +637,11 @@ void shift_lateral_block(const Model& m, State& s) {
     // Upward, the destination below the source. Held nodes (supports at the stagger, which
     // repeats with the block's move) keep their value. The wind moves along: a node's station
     // along the line is the one the node ns above had.
+    // A hinged arm's held registration moves with its arm: shifted as the free nodes
+    // (then put where its arm's end is, below).
+    auto moves = [&](int d) { return lat.inv_mass[d] > 0.0 || (!lat.registration_of.empty() && lat.registration_of[d] >= 0); };
     for (int i = std::max(lo, ns); i <= hi; ++i) {
-      if (lat.inv_mass[o + i - ns] > 0.0) {
+      if (moves(o + i - ns)) {
         ls.y[o + i - ns] = ls.y[o + i];
         ls.v[o + i - ns] = ls.v[o + i];
       }
@@ -535,7 +650,7 @@ void shift_lateral_block(const Model& m, State& s) {
     // The nodes the move leaves (the spans entering at the far end of the block or window) are
     // at rest in the static state under the mean wind, as the vertical plane's at u = 0.
     for (int i = std::max({0, lo, hi - ns + 1}); i <= hi; ++i)
-      if (lat.inv_mass[o + i] > 0.0) {
+      if (moves(o + i)) {
         ls.y[o + i] = lat.initial[o + i];
         ls.v[o + i] = 0.0;
       }
@@ -547,6 +662,12 @@ void shift_lateral_block(const Model& m, State& s) {
   lw.window_dirty = true;  // the lists and factors hold the old DOFs (the node ranges already match)
   if (lat.lead_every > 0) shift_lead(m, s);
   set_dropper_stretch(m, s);  // the droppers' lean moved with the block
+  // The arms' ends and forces from the moved state and u (shift_endless_block moved it first).
+  if (!lat.registrations.empty()) {
+    place_at_arms(m, s);
+    add_registration_pulls(m, s);
+    set_registration_forces(m, s, 1);
+  }
   if (lat.windy && !lat.field.empty()) {
     // The spans entering ahead take the wind of the last refresh at their stations (sync_window):
     // the field generated that far (the caller moves line_offset on by the shift after this), and
@@ -566,6 +687,25 @@ double lateral_position(const Model& m, const State& s, int dof) {
     return y;
   }
   return ls.y[dof];
+}
+
+void place_registrations(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  place_at_arms(m, s);
+  bool moved = false;
+  for (double t : ls.registration_travel) moved |= t != 0.0;
+  if (moved) {
+    // The lateral statics with the registrations moved (the static state under the mean wind when
+    // none is), at rest, so that the wire's answer on each arm starts as it goes on.
+    Eigen::VectorXd y;
+    solve_lateral_statics(m, lat, true, &y, nullptr, &ls.registration_travel);
+    ls.y = y;
+    ls.v.setZero();
+    set_dropper_stretch(m, s);
+  }
+  add_registration_pulls(m, s);
+  set_registration_forces(m, s, 1);
 }
 
 void set_dropper_stretch(const Model& m, State& s) {

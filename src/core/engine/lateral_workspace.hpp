@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "catenary_sim/core/engine/wire_window.hpp"
+
 namespace catenary_sim {
 
 struct LateralWorkspace {
@@ -28,6 +30,11 @@ struct LateralWorkspace {
   // Per dropper: 1 where the lean acts on its tension, 0 outside the vertical plane's window
   // (set from State::window_droppers at every windowed step; all 1 without a window).
   std::vector<double> lean_weight;
+  // Hinged arms' registrations (registration_pull, lateral_step.cpp): per registration the
+  // wire's lateral force on it in the state the pass starts from (N, F0, set by
+  // make_lateral_state); scratch for the band's force (per DOF) and its local range's factors.
+  std::vector<double> registration_pull0, registration_band;
+  WireWindow registration_range;
   // The moving window's lists, rebuilt by sync_window from its placement (LateralState::window):
   // the factors interleaved for the fused step; the springs, the droppers' pendulums and the
   // stitch wires' clamps in it (first *_count entries; pendulum k is dropper k, clamp k

@@ -190,9 +190,11 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
 // drop out, and that is eq. 4's k_A. The end's speed is z' / cos(theta0) (it moves out as it
 // rises), so the arm's inertia on the wire's node is its tip mass (m_a / 3 + m_c) / cos^2 theta0;
 // the share tan^2 theta0 of it has no weight (design_statics adds it to the node's mass and to f0
-// alike).
+// alike). On a 3-D line (`in_plan`) the lateral plane moves the arm's end and its reaction acts
+// back on the arm (LateralRegistration, lateral.hpp), which is the k_w tan^2 theta0 share as the
+// wires give it at each instant: k_A keeps only F_h / (a cos^3 theta0).
 void set_hinged_arm(const HingedArmSpec& arm, double g, const RegistrationLateral& wire, const std::string& field,
-                    SupportSpring& sp) {
+                    bool in_plan, SupportSpring& sp) {
   const double pull_off = arm.pull_off ? *arm.pull_off : wire.pull_off;
   const double bracket = sp.static_force + arm.linear_mass * arm.length * g / 6.0;
   const double theta = std::atan2(bracket, pull_off);
@@ -218,6 +220,10 @@ void set_hinged_arm(const HingedArmSpec& arm, double g, const RegistrationLatera
   sp.arm_pull_off = pull_off;
   sp.arm_pull_side = wire.side;
   sp.stiffness = pull_off / (arm.length * c * c * c) + wire.stiffness * t * t;
+  if (in_plan) {
+    sp.arm_lateral_share = wire.stiffness * t * t;
+    sp.stiffness -= sp.arm_lateral_share;
+  }
   sp.arm_tip_mass = arm.tip_mass() / (c * c);
 }
 
@@ -262,7 +268,9 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
     const int section = wire_of(m, sp.dof).section;
     const std::string pre = scene.sections.size() > 1 ? "sections[" + std::to_string(section) + "]." : "";
     const HingedArmSpec& arm = *scene.sections[section].steady_arms->hinged_arm;
-    set_hinged_arm(arm, scene.gravity, wire[q], pre + "steady_arms", sp);
+    // (The arms a 3-D line's lateral plane moves: pulled to one side, LateralModel::registrations.)
+    const bool in_plan = scene.lateral() && wire[q].side != 0.0;
+    set_hinged_arm(arm, scene.gravity, wire[q], pre + "steady_arms", in_plan, sp);
     // The tip's sideways share of inertia: mass without weight, so the preload carries it too.
     const double sideways = sp.arm_tip_mass - arm.tip_mass();
     m.mass[sp.dof] += sideways;

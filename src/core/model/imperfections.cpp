@@ -95,7 +95,7 @@ void apply_imperfections(const Scene& scene, Model& m, const std::vector<bool>& 
     const double e = !im.support_height_errors.empty() ? im.support_height_errors[j]
                      : im.support_height_std > 0.0     ? arm_normal.next(im.support_height_std)
                                                        : 0.0;
-    m.load[m.springs[arms[j]].dof] += m.springs[arms[j]].stiffness * e;
+    m.load[m.springs[arms[j]].dof] += m.springs[arms[j]].static_stiffness() * e;
   }
   const double g = scene.gravity;
   const IrregularitySpec& ir = im.contact_wire_irregularity;

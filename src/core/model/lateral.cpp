@@ -240,6 +240,40 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
   for (int i = 0; i < n; ++i) lat->inv_mass[i] = fixed[i] ? 0.0 : 1.0 / lat->mass[i];
 }
 
+// The hinged steady arms' registrations (LateralRegistration): every intermediate support of a
+// contact wire whose vertical spring is a hinged arm pulled to one side. Section ends (anchors)
+// stay put.
+void add_registrations(const Model& m, LateralModel* lat) {
+  std::vector<int> arm_at(m.n_dof, -1);  // per vertical DOF: its hinged arm in Model::springs
+  for (std::size_t k = 0; k < m.springs.size(); ++k)
+    if (m.springs[k].hinged_arm() && m.springs[k].arm_pull_side != 0.0) arm_at[m.springs[k].dof] = static_cast<int>(k);
+  for (const LateralSupport& sup : lat->supports) {
+    const Wire& w = m.wires[sup.wire];
+    if (!w.is_contact_wire || sup.anchor) continue;
+    const int vertical = w.w_dof + sup.node, k = arm_at[vertical];
+    if (k < 0) continue;
+    const SupportSpring& sp = m.springs[k];
+    LateralRegistration r;
+    r.dof = lat->wires[sup.wire].w_dof + sup.node;
+    r.vertical = vertical;
+    for (std::size_t j = 0; j < lat->springs.size(); ++j)
+      if (lat->springs[j].dof == r.dof) r.spring = static_cast<int>(j);
+    r.wire = sup.wire;
+    r.node = sup.node;
+    r.support_spring = k;
+    r.length = sp.arm_length;
+    r.sin0 = std::sin(sp.arm_inclination);
+    r.cos0 = std::cos(sp.arm_inclination);
+    r.side = sp.arm_pull_side;
+    for (std::size_t j = 0; j < lat->pendulums.size(); ++j)
+      if (lat->pendulums[j].contact == r.dof) r.pendulums.push_back(static_cast<int>(j));
+    lat->registrations.push_back(r);
+  }
+  if (lat->registrations.empty()) return;
+  lat->registration_of.assign(lat->n, -1);
+  for (std::size_t j = 0; j < lat->registrations.size(); ++j) lat->registration_of[lat->registrations[j].dof] = static_cast<int>(j);
+}
+
 // The lateral DOF of a wire node's vertical DOF (-1: not a wire node).
 int lateral_dof_of(const Model& m, const LateralModel& lat, int vertical) {
   const int wi = wire_holding(m, vertical);
@@ -448,7 +482,7 @@ void add_stiffness(const Model& m, const LateralModel& lat, Add&& add) {
 }  // namespace
 
 void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wind, Eigen::VectorXd* y_out,
-                           std::vector<double>* force_on_support) {
+                           std::vector<double>* force_on_support, const std::vector<double>* registration_travel) {
   // Full system with the rotations as unknowns: y_i at i, theta_i at n + i. Rigid nodes are
   // eliminated (their rows become y_i = stagger); the unconstrained matrix gives the reactions.
   const int n = lat.n, N = 2 * n;
@@ -465,6 +499,13 @@ void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wi
       const int i = lat.wires[s.wire].w_dof + s.node;
       fixed[i] = true;
       fixed_value[i] = s.stagger;
+    }
+  if (registration_travel)
+    for (std::size_t j = 0; j < lat.registrations.size(); ++j) {
+      const LateralRegistration& r = lat.registrations[j];
+      const double travel = (*registration_travel)[j];
+      if (r.spring >= 0) F[r.dof] += lat.springs[r.spring].stiffness * travel;  // its anchor moved
+      else fixed_value[r.dof] += travel;
     }
   std::vector<Eigen::Triplet<double>> full, reduced;
   Eigen::VectorXd Fr = F;
@@ -597,6 +638,7 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   add_wires_and_supports(m, lat.get());
   add_pendulums(m, lat.get());
   add_clamps(m, lat.get());
+  add_registrations(m, lat.get());
   if (sc.wind) add_wind(m, *sc.wind, lat.get());
   lat->windowed = sc.numerics.windowed() && (m.endless || lat->field.empty() || sc.numerics.gust_lead.has_value());
   lat->gust_lead = lat->windowed ? gust_lead_time(sc) : 0.0;

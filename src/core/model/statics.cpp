@@ -92,7 +92,7 @@ struct StaticSystem {
 void add_line(const Model& m, const StaticUnknowns& q, const ActiveSet& active, StaticSystem& sys) {
   sys.r.head(m.n_dof) = m.load;
   for (std::size_t i = 0; i < m.wires.size(); ++i) add_wire_band(sys.t, m.wires[i], m.wires[i].w_dof, q.theta0[i]);
-  for (const SupportSpring& s : m.springs) sys.t.emplace_back(s.dof, s.dof, s.stiffness);
+  for (const SupportSpring& s : m.springs) sys.t.emplace_back(s.dof, s.dof, s.static_stiffness());
   for (std::size_t k = 0; k < m.droppers.size(); ++k) {
     const Dropper& d = m.droppers[k];
     if (active.dropper_on[k]) add_spring(sys.t, sys.r, d.messenger_dof, d.contact_dof, d.stiffness, -d.static_tension);

@@ -513,10 +513,11 @@ LineStatistics PassRecorder::line_statistics(const Model& m) const {
     for (const SupportSpring& sp : m.springs)
       if (sp.hinged_arm() && same_arm(sp.x)) {
         a.hinged = true;
-        a.stiffness = sp.stiffness;
+        a.stiffness = sp.static_stiffness();  // k_A, with the share a 3-D line's lateral plane gives
         a.pull_off = sp.arm_pull_off;
         a.inclination = sp.arm_inclination;
         a.inclination_at_max_uplift = sp.arm_inclination_at(up);
+        a.registration_travel = sp.arm_length * (std::cos(a.inclination_at_max_uplift) - std::cos(sp.arm_inclination));
         break;
       }
     ls.steady_arms.push_back(a);

@@ -155,6 +155,7 @@ void put_line(Json& j, const Model& m, const std::vector<PantographStatistics>& 
       arm["pull_off_N"] = a.pull_off;
       arm["inclination_rad"] = a.inclination;
       arm["inclination_at_max_uplift_rad"] = a.inclination_at_max_uplift;
+      arm["registration_travel_m"] = a.registration_travel;
     }
     arms.push_back(arm);
   }

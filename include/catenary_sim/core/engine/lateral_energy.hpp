@@ -9,8 +9,9 @@ namespace catenary_sim {
 
 // Lateral energy without wind: 0.5 v M v + 0.5 y K y - load . y of the wires and lateral supports,
 // plus what the lean adds to the droppers' potential at the current vertical state,
-// V(e_z + e_lean) - V(e_z) (J); constant in an undamped, windless free motion of the lateral
-// plane alone (the vertical one held).
+// V(e_z + e_lean) - V(e_z), and for a hinged arm's registration its spring's energy to the moved
+// anchor and F0 times the travel (LateralRegistration) (J); constant in an undamped, windless
+// free motion of the lateral plane alone (the vertical one held).
 double lateral_energy(const Model& model, const State& state);
 
 // Energy of the whole line, both planes, the droppers' shared potential V(e) counted once:

@@ -43,6 +43,14 @@ struct LateralState {
   // m, per dropper (Model::droppers): its lean's stretch averaged over the last lateral step's
   // substeps, which the next vertical step adds to the dropper's vertical stretch.
   std::vector<double> dropper_stretch;
+  // m, per hinged arm's registration (LateralModel::registrations): the arm's end's sideways
+  // travel from the stagger (registration_travel) at the u the last lateral step read, where that
+  // step put the registration point (a held node; a spring's anchor).
+  std::vector<double> registration_travel;
+  // N, per registration: the vertical force the wire's lateral force puts on its arm's end,
+  // (F - F0) side tan(theta) (LateralRegistration), averaged over the last lateral step's
+  // substeps; the next vertical step adds it on the registration's vertical DOF.
+  std::vector<double> registration_force;
 
   // The wind held between its refreshes (a turbulent wind; steady: the mean wind throughout).
   Eigen::VectorXd wind_speed;     // m/s, per node: the wind's speed normal to the wire now
@@ -116,6 +124,11 @@ void shift_lateral_block(const Model& model, State& state);
 // lateral state's, or where an implicit gust lead steps the node outside the window, the lead's
 // (interpolated to the state's time).
 double lateral_position(const Model& model, const State& state, int dof);
+
+// A 3-D line's hinged arms with the vertical plane's u of a static state (the initial state's):
+// each registration point where its arm's end is, the lateral plane at rest in its statics with
+// them there (under the mean wind), and the wire's answer on each arm from it. Allocates.
+void place_registrations(const Model& model, State& state);
 
 // Sets LateralState::dropper_stretch from the current y (after y was set by hand, or moved).
 void set_dropper_stretch(const Model& model, State& state);

@@ -25,6 +25,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -74,6 +76,38 @@ struct LateralSupport {
   double pull_off = 0.0, pull_off_wind = 0.0;
 };
 
+// A hinged steady arm's registration on a 3-D line (SupportSpring::hinged_arm at an intermediate
+// support of a contact wire, pulled to one side): as the arm's end rises by u it turns toward
+// horizontal and moves out by registration_travel(u), away from its hinge, toward the side the
+// wire pulls. Both ways: the lateral step moves the registration point (the held node, or its
+// spring's anchor) with the arm's end, and the wire's lateral force F on it acts back on the arm,
+// whose end it moves by d(travel)/du = side tan(theta) per metre of uplift: by virtual work a
+// vertical force (F - F0) side tan(theta) on the registration's vertical DOF, F0 the force in the
+// state the pass starts from (its static part F0 side tan(theta) is the design statics' f0 and
+// F_h / (a cos^3 theta0) in k_A; quasi-statically F - F0 = -k_w travel, the k_w tan^2 theta0 a
+// 2-D line puts in k_A, design_statics.cpp).
+struct LateralRegistration {
+  int dof = 0;          // lateral index of the registration node
+  int vertical = 0;     // its vertical DOF (SupportSpring::dof): u there is the arm's uplift
+  int spring = -1;      // index into LateralModel::springs; -1: held (inv_mass 0)
+  int wire = 0, node = 0;  // the contact wire (Model::wires) and its node, for the moving window
+  int support_spring = 0;  // index into Model::springs
+  double length = 0.0;     // m, a
+  double sin0 = 0.0, cos0 = 0.0;  // of the arm's inclination below the hinge at the assembly, theta0
+  double side = 0.0;       // +1 / -1: the side the wire pulls (SupportSpring::arm_pull_side)
+  std::vector<int> pendulums;  // the droppers' pendulums (LateralModel::pendulums) hung at the node
+};
+
+// m, the arm's end's sideways travel with its end raised by u: side a (cos(theta) - cos(theta0)),
+// sin(theta) = sin(theta0) - u / a, to first order side tan(theta0) u. Written as
+// side u (sin(theta0) + sin(theta)) / (cos(theta) + cos(theta0)) (the difference of the cosines
+// without its cancellation): exactly 0 at u = 0.
+inline double registration_travel(const LateralRegistration& r, double u) {
+  const double s = std::clamp(r.sin0 - u / r.length, -1.0, 1.0);
+  const double c = std::sqrt(1.0 - s * s);
+  return r.side * ((r.sin0 - s) * r.length) * ((r.sin0 + s) / (c + r.cos0));
+}
+
 // The values per node and lane of LateralModel::planes ([node][value][lane]): the lateral plane's
 // load, its mass-proportional damping alpha m, inverse mass and the wind drag coefficient
 // cw = 0.5 rho Cd d h (the fused step reads them as PackSweep::plane).
@@ -88,6 +122,10 @@ struct LateralModel {
   std::vector<LateralPendulum> pendulums;
   std::vector<LateralClamp> clamps;  // clamp k is Model::clamps[k]
   std::vector<LateralSupport> supports;
+  // The hinged steady arms' registrations (empty without hinged arms, or on no 3-D line), and per
+  // lateral DOF its entry there, -1 elsewhere (empty when there are none).
+  std::vector<LateralRegistration> registrations;
+  std::vector<int> registration_of;
   Eigen::VectorXd calm;     // m, static lateral positions without wind
   Eigen::VectorXd initial;  // m, static under the mean wind (the pass starts here)
   // Wind: per node 0.5 rho Cd d h (kg/m) and the sine of the wind's angle to the wire.
@@ -198,8 +236,10 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& model);
 
 // Lateral static state of the wires (y: n entries) under the constant loads, the droppers at their
 // static tension, with (mean wind) or without wind; `force_on_support` (optional, per
-// LateralModel::supports) receives the lateral force of each wire on its supports.
+// LateralModel::supports) receives the lateral force of each wire on its supports;
+// `registration_travel` (optional, per LateralModel::registrations) moves each hinged arm's
+// registration point (its held node, or its spring's anchor) out by that much.
 void solve_lateral_statics(const Model& model, const LateralModel& lat, bool with_wind, Eigen::VectorXd* y,
-                           std::vector<double>* force_on_support);
+                           std::vector<double>* force_on_support, const std::vector<double>* registration_travel = nullptr);
 
 }  // namespace catenary_sim

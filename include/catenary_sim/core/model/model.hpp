@@ -94,6 +94,11 @@ struct SupportSpring {
   double arm_tip_mass = 0.0;  // kg, its inertia on the wire's node (HingedArmSpec::tip_mass / cos^2)
   // The side the wire pulls the arm's end toward (+1: + y, to the left; -1), 0 on a 2-D line.
   double arm_pull_side = 0.0;
+  // N/m: on a 3-D line, the share k_w tan^2 theta0 of the arm's k_A that the lateral plane gives
+  // the vertical one through its registration (LateralRegistration) and `stiffness` leaves out;
+  // 0 otherwise. Static solves, which have no lateral plane, take static_stiffness().
+  double arm_lateral_share = 0.0;
+  double static_stiffness() const { return stiffness + arm_lateral_share; }
   bool hinged_arm() const { return arm_length > 0.0; }
   // The arm's inclination with its tip raised by `uplift` (m): sin(theta) = sin(theta0) - u / a.
   double arm_inclination_at(double uplift) const {

@@ -93,6 +93,9 @@ struct SteadyArmStatistics {
   double stiffness = 0.0;  // N/m
   double pull_off = 0.0;   // N
   double inclination = 0.0, inclination_at_max_uplift = 0.0;
+  // m, the arm's end's sideways travel at the largest uplift, a (cos(theta) - cos(theta0)), out
+  // toward the wire's pull: on a 3-D line the lateral plane moves the registration point by it.
+  double registration_travel = 0.0;
 };
 
 struct LineStatistics {
