@@ -45,28 +45,54 @@ namespace {
 // diagonal, 2 EI / h - T h / 30 against 8 EI / h + 4 T h / 15 for a contact wire), so the rest of
 // the wire would change that force by some 0.2^8, 3e-6 of it.
 constexpr int kRegistrationReach = 8;
+constexpr int kRegistrationRow = 2 * kRegistrationReach + 1;
 
-// N, the lateral force on registration `r` (LateralRegistration) from everything but its arm, at
-// the lateral state now: held, the wire's band over kRegistrationReach nodes each side (f = -K y,
-// elastic: what the static pull-off is), the load at the node (a curve's T kappa h), the wind's
-// drag on it and its droppers' pendulums; on a spring, the spring's pull k (y - anchor - travel)
-// with `travel` the anchor's. `u`: the vertical plane's displacements (null: 0, the design state).
-double registration_pull(const Model& m, LateralState& ls, const double* u, const LateralRegistration& r, double travel) {
+// The wire's band force (f = -K y) at a held registration's node as a row over the nodes within
+// kRegistrationReach of it (fewer at the wire's ends): the band over that range, rotations
+// condensed there (its ends free, as a window's cut), applied to each node's unit displacement.
+// Into the workspace's registration_first, _count and _row (kRegistrationRow values each).
+void set_registration_row(const Model& m, LateralState& ls, int j) {
   const LateralModel& lat = *m.lateral;
+  const LateralRegistration& r = lat.registrations[j];
+  LateralWorkspace& lw = *ls.work;
+  const Wire& w = lat.wires[r.wire];
+  const int lo = std::max(0, r.node - kRegistrationReach), hi = std::min(w.nodes() - 1, r.node + kRegistrationReach);
+  WireWindow range;
+  range.tt_lower.assign(w.nodes(), 0.0);
+  range.tt_inv_pivot.assign(w.nodes(), 0.0);
+  set_wire_window(w, w.x[lo], w.x[hi], range);
+  Eigen::VectorXd unit = Eigen::VectorXd::Zero(lat.n), f(lat.n);
+  std::vector<double> theta(w.nodes());
+  lw.registration_first[j] = w.w_dof + lo;
+  lw.registration_count[j] = hi - lo + 1;
+  for (int i = lo; i <= hi; ++i) {
+    unit[w.w_dof + i] = 1.0;
+    f.setZero();
+    wire_elastic_force_window(w, range, unit.data(), f.data(), theta.data());
+    lw.registration_row[j * kRegistrationRow + (i - lo)] = f[r.dof];
+    unit[w.w_dof + i] = 0.0;
+  }
+}
+
+// N, the lateral force on registration `j` (LateralModel::registrations) from everything but its
+// arm, at the lateral state now: held, the wire's band (its row, set_registration_row; elastic,
+// as the static pull-off is), the load at the node (a curve's T kappa h), the wind's drag on it
+// and its droppers' pendulums; on a spring, the spring's pull k (y - anchor - travel) with
+// `travel` the anchor's. `u`: the vertical plane's displacements (null: 0, the design state).
+double registration_pull(const Model& m, const LateralState& ls, const double* u, int j, double travel) {
+  const LateralModel& lat = *m.lateral;
+  const LateralRegistration& r = lat.registrations[j];
   const double* y = ls.y.data();
   if (r.spring >= 0) {
     const LateralSpring& sp = lat.springs[r.spring];
     return sp.stiffness * (y[r.dof] - sp.anchor - travel);
   }
-  LateralWorkspace& lw = *ls.work;
-  const Wire& w = lat.wires[r.wire];
-  const int lo = std::max(0, r.node - kRegistrationReach), hi = std::min(w.nodes() - 1, r.node + kRegistrationReach);
-  WireWindow& range = lw.registration_range;
-  set_wire_window(w, w.x[lo], w.x[hi], range);
-  double* f = lw.registration_band.data();
-  std::fill(f + w.w_dof + lo, f + w.w_dof + hi + 1, 0.0);
-  wire_elastic_force_window(w, range, y, f, lw.theta.data());
-  double pull = lat.load[r.dof] + f[r.dof];
+  const LateralWorkspace& lw = *ls.work;
+  const double* row = lw.registration_row.data() + j * kRegistrationRow;
+  const double* near = y + lw.registration_first[j];
+  double band = 0.0;
+  for (int k = 0; k < lw.registration_count[j]; ++k) band += row[k] * near[k];
+  double pull = lat.load[r.dof] + band;
   if (lat.windy) {
     const double vn = ls.wind_speed[r.dof] - ls.v[r.dof];
     pull += lat.wind_coefficient[r.dof] * vn * std::fabs(vn);
@@ -123,11 +149,14 @@ LateralState make_lateral_state(const Model& m) {
     s.window[wi].tt_inv_pivot.assign(lat.wires[wi].nodes(), 0.0);
   }
   if (!lat.registrations.empty()) {
-    work.registration_band.assign(lat.n, 0.0);
-    work.registration_range.tt_lower.assign(longest, 0.0);
-    work.registration_range.tt_inv_pivot.assign(longest, 0.0);
+    const int nr = static_cast<int>(lat.registrations.size());
+    work.registration_first.assign(nr, 0);
+    work.registration_count.assign(nr, 0);
+    work.registration_row.assign(static_cast<std::size_t>(nr) * kRegistrationRow, 0.0);
+    for (int j = 0; j < nr; ++j)
+      if (lat.registrations[j].spring < 0) set_registration_row(m, s, j);
     // (At rest in the static state under the mean wind, with every arm as built.)
-    for (const LateralRegistration& r : lat.registrations) work.registration_pull0.push_back(registration_pull(m, s, nullptr, r, 0.0));
+    for (int j = 0; j < nr; ++j) work.registration_pull0.push_back(registration_pull(m, s, nullptr, j, 0.0));
   }
   if (lat.windowed && !lat.planes.empty() && lat.centred_twin.empty()) work.sweep_factors.assign(2 * sweep_size(m), 0.0);
   work.window_springs.assign(lat.springs.size(), 0);
@@ -539,7 +568,7 @@ void add_registration_pulls(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
   for (std::size_t j = 0; j < lat.registrations.size(); ++j)
-    ls.registration_force[j] += registration_pull(m, ls, s.u.data(), lat.registrations[j], ls.registration_travel[j]);
+    ls.registration_force[j] += registration_pull(m, ls, s.u.data(), static_cast<int>(j), ls.registration_travel[j]);
 }
 
 void set_registration_forces(const Model& m, State& s, int pulls) {

@@ -9,8 +9,6 @@
 #include <cstdint>
 #include <vector>
 
-#include "catenary_sim/core/engine/wire_window.hpp"
-
 namespace catenary_sim {
 
 struct LateralWorkspace {
@@ -30,11 +28,12 @@ struct LateralWorkspace {
   // Per dropper: 1 where the lean acts on its tension, 0 outside the vertical plane's window
   // (set from State::window_droppers at every windowed step; all 1 without a window).
   std::vector<double> lean_weight;
-  // Hinged arms' registrations (registration_pull, lateral_step.cpp): per registration the
-  // wire's lateral force on it in the state the pass starts from (N, F0, set by
-  // make_lateral_state); scratch for the band's force (per DOF) and its local range's factors.
-  std::vector<double> registration_pull0, registration_band;
-  WireWindow registration_range;
+  // Hinged arms' registrations (registration_pull, lateral_step.cpp), set by make_lateral_state:
+  // per registration the wire's lateral force on it in the state the pass starts from (N, F0),
+  // and where held its band force's row (N/m per node, registration_count of them from the DOF
+  // registration_first on).
+  std::vector<double> registration_pull0, registration_row;
+  std::vector<int> registration_first, registration_count;
   // The moving window's lists, rebuilt by sync_window from its placement (LateralState::window):
   // the factors interleaved for the fused step; the springs, the droppers' pendulums and the
   // stitch wires' clamps in it (first *_count entries; pendulum k is dropper k, clamp k
