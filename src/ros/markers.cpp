@@ -264,9 +264,11 @@ void add_supports(visualization_msgs::MarkerArray& out, const Drawing& d) {
     if (sp.hinged_arm()) {
       // A hinged arm as built: the registration tube from the mast to the hinge, which stands
       // a cos(theta0) against the wire's pull (on a 2-D line toward the mast) and a sin(theta0)
-      // above the wire; the arm from the hinge to the clamp on the wire.
+      // above the wire as built; the arm from the hinge to the clamp on the wire (on a 3-D line
+      // the clamp has moved out with the arm's end, the hinge has not).
       const double away = sp.arm_pull_side != 0.0 ? -sp.arm_pull_side : 1.0;
-      const double yh = y + away * sp.arm_length * std::cos(sp.arm_inclination);
+      const double out = sp.arm_pull_side != 0.0 && m.lateral ? sp.arm_end_travel(s.u[sp.dof]) : 0.0;
+      const double yh = y + away * (sp.arm_length * std::cos(sp.arm_inclination) + out);
       const double zh = z0 + sp.arm_length * std::sin(sp.arm_inclination);
       arms.points.push_back(point(x, y_mast, zh));
       arms.points.push_back(point(x, yh, zh));

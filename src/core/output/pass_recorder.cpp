@@ -517,7 +517,7 @@ LineStatistics PassRecorder::line_statistics(const Model& m) const {
         a.pull_off = sp.arm_pull_off;
         a.inclination = sp.arm_inclination;
         a.inclination_at_max_uplift = sp.arm_inclination_at(up);
-        a.registration_travel = sp.arm_length * (std::cos(a.inclination_at_max_uplift) - std::cos(sp.arm_inclination));
+        a.registration_travel = sp.arm_end_travel(up);
         break;
       }
     ls.steady_arms.push_back(a);

@@ -98,14 +98,10 @@ struct LateralRegistration {
   std::vector<int> pendulums;  // the droppers' pendulums (LateralModel::pendulums) hung at the node
 };
 
-// m, the arm's end's sideways travel with its end raised by u: side a (cos(theta) - cos(theta0)),
-// sin(theta) = sin(theta0) - u / a, to first order side tan(theta0) u. Written as
-// side u (sin(theta0) + sin(theta)) / (cos(theta) + cos(theta0)) (the difference of the cosines
-// without its cancellation): exactly 0 at u = 0.
+// m, the arm's end's sideways travel from the stagger with its end raised by u: side
+// a (cos(theta) - cos(theta0)) (hinged_arm_travel, model.hpp).
 inline double registration_travel(const LateralRegistration& r, double u) {
-  const double s = std::clamp(r.sin0 - u / r.length, -1.0, 1.0);
-  const double c = std::sqrt(1.0 - s * s);
-  return r.side * ((r.sin0 - s) * r.length) * ((r.sin0 + s) / (c + r.cos0));
+  return r.side * hinged_arm_travel(r.length, r.sin0, r.cos0, u);
 }
 
 // The values per node and lane of LateralModel::planes ([node][value][lane]): the lateral plane's

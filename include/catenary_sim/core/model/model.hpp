@@ -77,6 +77,16 @@ struct WireClamp {
 constexpr double kStitchClampStiffness = 2e5;
 
 // An elastic support: steady arm on the contact wire (eq. 4) or messenger support spring.
+// m, a hinged arm's end's travel out, away from its hinge, with the end raised by u: a (cos(theta)
+// - cos(theta0)), sin(theta) = sin(theta0) - u / a, to first order tan(theta0) u; a the length,
+// sin0 and cos0 of theta0, its inclination below the hinge. Written as
+// u (sin(theta0) + sin(theta)) / (cos(theta) + cos(theta0)) (the difference of the cosines without
+// its cancellation): exactly 0 at u = 0.
+inline double hinged_arm_travel(double a, double sin0, double cos0, double u) {
+  const double s = std::clamp(sin0 - u / a, -1.0, 1.0);
+  return ((sin0 - s) * a) * ((sin0 + s) / (std::sqrt(1.0 - s * s) + cos0));
+}
+
 struct SupportSpring {
   int dof = 0;
   double stiffness = 0.0;     // N/m
@@ -103,6 +113,11 @@ struct SupportSpring {
   // The arm's inclination with its tip raised by `uplift` (m): sin(theta) = sin(theta0) - u / a.
   double arm_inclination_at(double uplift) const {
     return std::asin(std::clamp(std::sin(arm_inclination) - uplift / arm_length, -1.0, 1.0));
+  }
+  // m, how far the arm's end has moved out, away from its hinge, with its tip raised by `uplift`
+  // (on a 3-D line toward arm_pull_side): hinged_arm_travel below.
+  double arm_end_travel(double uplift) const {
+    return hinged_arm_travel(arm_length, std::sin(arm_inclination), std::cos(arm_inclination), uplift);
   }
 };
 
