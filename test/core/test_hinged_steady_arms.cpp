@@ -185,15 +185,10 @@ TEST(HingedSteadyArms, IsTheSpringOfItsStiffnessAndTipMass) {
 // reports the same pull-off at the same support (one statics: 1e-9).
 TEST(HingedSteadyArms, OnA3dLineThePullOffIsTheStaggersAndTheCurves) {
   auto line = [](const std::function<void(YAML::Node&)>& edit) {
-    return cs::build_model(test_scenes::edited_scene("reference_55m_3d.yaml", [&](YAML::Node& root) {
+    return cs::build_model(test_scenes::edited_scene("reference_55m_3d_hinged_arms.yaml", [&](YAML::Node& root) {
       root["line"]["span_count"] = 6;
       root.remove("wind");
       root["stagger"].remove("messenger");
-      YAML::Node arms;
-      arms["length"] = 1.15;
-      arms["linear_mass"] = 0.78;
-      arms["clamp_mass"] = 0.46;
-      root["steady_arms"] = arms;
       edit(root);
     }));
   };
@@ -237,18 +232,13 @@ TEST(HingedSteadyArms, OnA3dLineThePullOffIsTheStaggersAndTheCurves) {
 
 namespace {
 
-// reference_55m_3d.yaml on 6 spans with the hinged arms of docs/hinged_steady_arms.md, without
-// wind (nothing else moves a registration sideways), at the balanced preset; `edit` after.
+// reference_55m_3d_hinged_arms.yaml on 6 spans without wind (nothing else moves a registration
+// sideways), at the balanced preset; `edit` after.
 cs::Scene three_d_line_with_arms(const std::function<void(YAML::Node&)>& edit) {
-  return test_scenes::edited_scene("reference_55m_3d.yaml", [&](YAML::Node& root) {
+  return test_scenes::edited_scene("reference_55m_3d_hinged_arms.yaml", [&](YAML::Node& root) {
     root["line"]["span_count"] = 6;
     root["numerics"]["preset"] = "balanced";
     root.remove("wind");
-    YAML::Node arms;
-    arms["length"] = 1.15;
-    arms["linear_mass"] = 0.78;
-    arms["clamp_mass"] = 0.46;
-    root["steady_arms"] = arms;
     edit(root);
   });
 }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <numeric>
 
@@ -358,6 +359,39 @@ TEST(Lateral, EnergyBoundedWithoutDamping) {
   EXPECT_LT(std::fabs(lateral_energy(m, s) - e0), 0.3 * pluck);
 }
 
+namespace {
+
+// The reference line with `overrides`, at dt (s; 0: its own).
+Model reference_at(std::vector<std::string> overrides, double dt) {
+  if (dt > 0.0) overrides.push_back("numerics.dt=" + std::to_string(dt));
+  return build_model(load_scene_file(test_scenes::kReference, overrides));
+}
+
+// Both planes' undamped free motion for 1 s from `s`, whose line_energy exceeds the static state's
+// `e_static` by the pluck: the worst |E - E0|, the drift of E's mean from the first 0.2 s to the
+// last, and the largest share of the pluck that `passed_on` (J, of the state) reaches.
+struct FreeMotion {
+  double dt, pluck, worst, share, drift;
+};
+FreeMotion free_motion(const Model& m, State& s, double e_static, const std::function<double(const State&)>& passed_on) {
+  const double e0 = line_energy(m, s);
+  FreeMotion r{m.dt, e0 - e_static, 0.0, 0.0, 0.0};
+  const int steps = static_cast<int>(std::lround(1.0 / m.dt)), window = steps / 5;
+  double first = 0.0, last = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    EXPECT_EQ(step(m, s), StepStatus::kOk);  // both planes
+    const double e = line_energy(m, s);
+    r.worst = std::max(r.worst, std::fabs(e - e0));
+    if (k < window) first += e / window;
+    if (k >= steps - window) last += e / window;
+    r.share = std::max(r.share, passed_on(s) / r.pluck);
+  }
+  r.drift = last - first;
+  return r;
+}
+
+}  // namespace
+
 TEST(Lateral, CoupledEnergyIsConserved) {
   // Both planes free, undamped, windless, no pantograph: stagger +-0.3 m under a straight
   // messenger (the droppers lean up to 0.3 m), a lateral pluck of the contact wire. The lean
@@ -373,13 +407,8 @@ TEST(Lateral, CoupledEnergyIsConserved) {
   const std::vector<std::string> scene{"line.span_count=3", "numerics.preset=balanced", "damping.alpha=0", "damping.beta=0",
                                        "pantographs=[]", "stagger.contact_wire=[0.3,-0.3]", "stagger.messenger=[0.0]",
                                        "stagger.steady_arm_stiffness=20000"};
-  struct Run {
-    double dt, pluck, worst, vertical_share, drift;
-  };
   auto run = [&](double dt) {
-    std::vector<std::string> o = scene;
-    if (dt > 0.0) o.push_back("numerics.dt=" + std::to_string(dt));
-    Model m = build_model(load_scene_file(test_scenes::kReference, o));
+    Model m = reference_at(scene, dt);
     State s = make_state(m);
     solve_initial_state(m, s);
     s.lateral = make_lateral_state(m);
@@ -388,31 +417,20 @@ TEST(Lateral, CoupledEnergyIsConserved) {
     for (int i = 0; i < cw.nodes(); ++i)
       if (m.lateral->inv_mass[i] > 0.0) s.lateral.y[i] += 0.05 * std::exp(-std::pow((cw.x[i] - 80.0) / 3.0, 2));
     set_dropper_stretch(m, s);
-    const double e0 = line_energy(m, s);
-    Run r{m.dt, e0 - e_static, 0.0, 0.0, 0.0};
-    const int steps = static_cast<int>(std::lround(1.0 / m.dt)), window = steps / 5;
-    double first = 0.0, last = 0.0;
-    for (int k = 0; k < steps; ++k) {
-      EXPECT_EQ(step(m, s), StepStatus::kOk);  // both planes
-      const double e = line_energy(m, s);
-      r.worst = std::max(r.worst, std::fabs(e - e0));
-      if (k < window) first += e / window;
-      if (k >= steps - window) last += e / window;
-      // The vertical plane's kinetic energy: what the lean passed on.
+    // The vertical plane's kinetic energy: what the lean passed on.
+    return free_motion(m, s, e_static, [&m](const State& st) {
       double kinetic = 0.0;
-      for (int i = 0; i < m.n_catenary_dof; ++i) kinetic += 0.5 * m.mass[i] * s.v[i] * s.v[i];
-      r.vertical_share = std::max(r.vertical_share, kinetic / r.pluck);
-    }
-    r.drift = last - first;
-    return r;
+      for (int i = 0; i < m.n_catenary_dof; ++i) kinetic += 0.5 * m.mass[i] * st.v[i] * st.v[i];
+      return kinetic;
+    });
   };
-  const Run a = run(0.0);
-  const Run b = run(0.5 * a.dt);
+  const FreeMotion a = run(0.0);
+  const FreeMotion b = run(0.5 * a.dt);
   std::printf("pluck %.3f J; dt %.3e s: worst |E-E0| %.4f J, drift %.2e J, vertical kinetic up to %.3f of the pluck; "
               "dt %.3e s: worst %.4f J, drift %.2e J\n",
-              a.pluck, a.dt, a.worst, a.drift, a.vertical_share, b.dt, b.worst, b.drift);
+              a.pluck, a.dt, a.worst, a.drift, a.share, b.dt, b.worst, b.drift);
   ASSERT_GT(a.pluck, 0.0);
-  EXPECT_GT(a.vertical_share, 0.01);
+  EXPECT_GT(a.share, 0.01);
   EXPECT_LT(a.worst, 0.3 * a.pluck);
   EXPECT_GT(a.worst / b.worst, 1.6);
   EXPECT_LT(std::fabs(a.drift), a.worst);
@@ -442,13 +460,8 @@ TEST(Lateral, WithHingedArmsTheCoupledEnergyIsConserved) {
                                    "steady_arms.stiffness=null", "steady_arms.mass=null", "steady_arms.length=1.15",
                                    "steady_arms.linear_mass=0.78", "steady_arms.clamp_mass=0.46"};
     if (!held) scene.push_back("stagger.steady_arm_stiffness=20000");
-    struct Run {
-      double dt, pluck, worst, lateral_share, drift;
-    };
     auto run = [&](double dt) {
-      std::vector<std::string> o = scene;
-      if (dt > 0.0) o.push_back("numerics.dt=" + std::to_string(dt));
-      Model m = build_model(load_scene_file(test_scenes::kReference, o));
+      Model m = reference_at(scene, dt);
       State s = make_state(m);
       solve_initial_state(m, s);
       EXPECT_EQ(m.lateral->registrations.size(), 2u);
@@ -457,31 +470,21 @@ TEST(Lateral, WithHingedArmsTheCoupledEnergyIsConserved) {
       for (int i = 0; i < cw.nodes(); ++i)
         if (m.inv_mass[cw.w_dof + i] > 0.0) s.u[cw.w_dof + i] += 0.0005 * std::exp(-std::pow((cw.x[i] - 110.0) / 6.0, 2));
       place_registrations(m, s);  // (the lateral plane at rest in its statics with the arms' ends moved)
-      const double e0 = line_energy(m, s);
-      Run r{m.dt, e0 - e_static, 0.0, 0.0, 0.0};
-      const int steps = static_cast<int>(std::lround(1.0 / m.dt)), window = steps / 5;
-      double first = 0.0, last = 0.0;
-      for (int k = 0; k < steps; ++k) {
-        EXPECT_EQ(step(m, s), StepStatus::kOk);
-        const double e = line_energy(m, s);
-        r.worst = std::max(r.worst, std::fabs(e - e0));
-        if (k < window) first += e / window;
-        if (k >= steps - window) last += e / window;
-        double kinetic = 0.0;  // the lateral plane's: what the arms passed on
+      // The lateral plane's kinetic energy: what the arms passed on.
+      return free_motion(m, s, e_static, [&m](const State& st) {
+        double kinetic = 0.0;
         for (int i = 0; i < m.lateral->n; ++i)
-          if (m.lateral->inv_mass[i] > 0.0) kinetic += 0.5 * m.lateral->mass[i] * s.lateral.v[i] * s.lateral.v[i];
-        r.lateral_share = std::max(r.lateral_share, kinetic / r.pluck);
-      }
-      r.drift = last - first;
-      return r;
+          if (m.lateral->inv_mass[i] > 0.0) kinetic += 0.5 * m.lateral->mass[i] * st.lateral.v[i] * st.lateral.v[i];
+        return kinetic;
+      });
     };
-    const Run a = run(0.0);
-    const Run b = run(0.5 * a.dt);
+    const FreeMotion a = run(0.0);
+    const FreeMotion b = run(0.5 * a.dt);
     std::printf("%s: pluck %.3e J; dt %.3e s: worst |E-E0| %.3e J, drift %.2e J, lateral kinetic up to %.4f of the pluck; "
                 "dt %.3e s: worst %.3e J, drift %.2e J\n",
-                held ? "held" : "on springs", a.pluck, a.dt, a.worst, a.drift, a.lateral_share, b.dt, b.worst, b.drift);
+                held ? "held" : "on springs", a.pluck, a.dt, a.worst, a.drift, a.share, b.dt, b.worst, b.drift);
     ASSERT_GT(a.pluck, 0.0);
-    EXPECT_GT(a.lateral_share, 0.001);
+    EXPECT_GT(a.share, 0.001);
     EXPECT_LT(a.worst, a.pluck);
     EXPECT_GT(a.worst / b.worst, 1.6);
     EXPECT_LT(std::fabs(a.drift), 0.002 * a.pluck);
