@@ -97,8 +97,8 @@ double registration_pull(const Model& m, const LateralState& ls, const double* u
     const double vn = ls.wind_speed[r.dof] - ls.v[r.dof];
     pull += lat.wind_coefficient[r.dof] * vn * std::fabs(vn);
   }
-  for (int j : r.pendulums) {  // as add_springs_and_pendulums, at y
-    const LateralPendulum& p = lat.pendulums[j];
+  for (int q : r.pendulums) {  // as add_springs_and_pendulums, at y
+    const LateralPendulum& p = lat.pendulums[q];
     const Dropper& d = m.droppers[p.dropper];
     const double stretch = (u ? u[d.messenger_dof] - u[d.contact_dof] : 0.0) + lean_stretch(p, y);
     const double tension = d.static_tension + d.stiffness * stretch;
