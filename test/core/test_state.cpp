@@ -68,6 +68,7 @@ bool same_lateral(const State& a, const State& b, std::string* what) {
   d |= differs(x.y != y.y || x.v != y.v, "lateral y, v");
   d |= differs(x.dropper_stretch != y.dropper_stretch, "dropper_stretch");
   d |= differs(x.registration_travel != y.registration_travel, "registration_travel");
+  d |= differs(x.registration_force != y.registration_force, "registration_force");
   d |= differs(x.wind_speed != y.wind_speed || x.wind_points != y.wind_points, "wind_speed, wind_points");
   d |= differs(x.next_wind_update != y.next_wind_update || x.wind_time != y.wind_time, "wind refresh times");
   d |= differs(x.window_first_support != y.window_first_support || x.window_last_support != y.window_last_support,

@@ -581,6 +581,12 @@ void set_registration_forces(const Model& m, State& s, int pulls) {
   }
 }
 
+// registration_force from the wire's pull in the lateral state as it is (no substeps to average).
+void set_registration_forces_now(const Model& m, State& s) {
+  add_registration_pulls(m, s);
+  set_registration_forces(m, s, 1);
+}
+
 }  // namespace
 
 StepStatus lateral_step(const Model& m, State& s) {
@@ -666,11 +672,8 @@ void shift_lateral_block(const Model& m, State& s) {
     // Upward, the destination below the source. Held nodes (supports at the stagger, which
     // repeats with the block's move) keep their value. The wind moves along: a node's station
     // along the line is the one the node ns above had.
-    // A hinged arm's held registration moves with its arm: shifted as the free nodes
-    // (then put where its arm's end is, below).
-    auto moves = [&](int d) { return lat.inv_mass[d] > 0.0 || (!lat.registration_of.empty() && lat.registration_of[d] >= 0); };
     for (int i = std::max(lo, ns); i <= hi; ++i) {
-      if (moves(o + i - ns)) {
+      if (lat.inv_mass[o + i - ns] > 0.0) {
         ls.y[o + i - ns] = ls.y[o + i];
         ls.v[o + i - ns] = ls.v[o + i];
       }
@@ -679,7 +682,7 @@ void shift_lateral_block(const Model& m, State& s) {
     // The nodes the move leaves (the spans entering at the far end of the block or window) are
     // at rest in the static state under the mean wind, as the vertical plane's at u = 0.
     for (int i = std::max({0, lo, hi - ns + 1}); i <= hi; ++i)
-      if (moves(o + i)) {
+      if (lat.inv_mass[o + i] > 0.0) {
         ls.y[o + i] = lat.initial[o + i];
         ls.v[o + i] = 0.0;
       }
@@ -691,11 +694,11 @@ void shift_lateral_block(const Model& m, State& s) {
   lw.window_dirty = true;  // the lists and factors hold the old DOFs (the node ranges already match)
   if (lat.lead_every > 0) shift_lead(m, s);
   set_dropper_stretch(m, s);  // the droppers' lean moved with the block
-  // The arms' ends and forces from the moved state and u (shift_endless_block moved it first).
+  // The hinged arms' registrations (held ones were left with the held nodes) where their arms'
+  // ends are at the moved u (shift_endless_block moved it first), and the wire's answer there.
   if (!lat.registrations.empty()) {
     place_at_arms(m, s);
-    add_registration_pulls(m, s);
-    set_registration_forces(m, s, 1);
+    set_registration_forces_now(m, s);
   }
   if (lat.windy && !lat.field.empty()) {
     // The spans entering ahead take the wind of the last refresh at their stations (sync_window):
@@ -733,8 +736,7 @@ void place_registrations(const Model& m, State& s) {
     ls.v.setZero();
     set_dropper_stretch(m, s);
   }
-  add_registration_pulls(m, s);
-  set_registration_forces(m, s, 1);
+  set_registration_forces_now(m, s);
 }
 
 void set_dropper_stretch(const Model& m, State& s) {

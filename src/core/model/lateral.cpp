@@ -260,7 +260,6 @@ void add_registrations(const Model& m, LateralModel* lat) {
       if (lat->springs[j].dof == r.dof) r.spring = static_cast<int>(j);
     r.wire = sup.wire;
     r.node = sup.node;
-    r.support_spring = k;
     r.length = sp.arm_length;
     r.sin0 = std::sin(sp.arm_inclination);
     r.cos0 = std::cos(sp.arm_inclination);
@@ -269,9 +268,6 @@ void add_registrations(const Model& m, LateralModel* lat) {
       if (lat->pendulums[j].contact == r.dof) r.pendulums.push_back(static_cast<int>(j));
     lat->registrations.push_back(r);
   }
-  if (lat->registrations.empty()) return;
-  lat->registration_of.assign(lat->n, -1);
-  for (std::size_t j = 0; j < lat->registrations.size(); ++j) lat->registration_of[lat->registrations[j].dof] = static_cast<int>(j);
 }
 
 // The lateral DOF of a wire node's vertical DOF (-1: not a wire node).

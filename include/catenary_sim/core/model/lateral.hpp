@@ -91,7 +91,6 @@ struct LateralRegistration {
   int vertical = 0;     // its vertical DOF (SupportSpring::dof): u there is the arm's uplift
   int spring = -1;      // index into LateralModel::springs; -1: held (inv_mass 0)
   int wire = 0, node = 0;  // the contact wire (Model::wires) and its node, for the moving window
-  int support_spring = 0;  // index into Model::springs
   double length = 0.0;     // m, a
   double sin0 = 0.0, cos0 = 0.0;  // of the arm's inclination below the hinge at the assembly, theta0
   double side = 0.0;       // +1 / -1: the side the wire pulls (SupportSpring::arm_pull_side)
@@ -118,10 +117,8 @@ struct LateralModel {
   std::vector<LateralPendulum> pendulums;
   std::vector<LateralClamp> clamps;  // clamp k is Model::clamps[k]
   std::vector<LateralSupport> supports;
-  // The hinged steady arms' registrations (empty without hinged arms, or on no 3-D line), and per
-  // lateral DOF its entry there, -1 elsewhere (empty when there are none).
+  // The hinged steady arms' registrations (empty without hinged arms, or on no 3-D line).
   std::vector<LateralRegistration> registrations;
-  std::vector<int> registration_of;
   Eigen::VectorXd calm;     // m, static lateral positions without wind
   Eigen::VectorXd initial;  // m, static under the mean wind (the pass starts here)
   // Wind: per node 0.5 rho Cd d h (kg/m) and the sine of the wind's angle to the wire.
