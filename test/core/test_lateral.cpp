@@ -16,9 +16,10 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/core/engine/initial_state.hpp"
 #include "catenary_sim/core/model/wind_field.hpp"
+#include "catenary_sim/core/model/wire_band.hpp"
 #include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
-#include "engine/lateral_workspace.hpp"  // (the window's and the joint sweep's diagnostics)
+#include "engine/lateral_workspace.hpp"  // (the window's and the joint sweep's diagnostics, the registrations' rows)
 
 using namespace catenary_sim;
 
@@ -1381,13 +1382,63 @@ TEST(Lateral, FusedStepIsTheGenericStepBitForBit) {
   EXPECT_GT(expect_fused_is_generic(windowed, &windowed_fused), 5000);
   EXPECT_GT(windowed_fused, 5000);  // the fused step took the window
   // Hinged steady arms held across the track, each registration put where its arm's end is and
-  // the wire's answer acting on the arm: the same bits.
+  // the wire's answer acting on the arm: the same bits, the joint sweep taking the registrations
+  // where the last step put them at every step; and in the moving window.
+  const std::vector<std::string> arms = {"steady_arms.stiffness=null", "steady_arms.mass=null",
+                                         "steady_arms.length=1.15", "steady_arms.linear_mass=0.78",
+                                         "steady_arms.clamp_mass=0.46", "stagger.steady_arm_stiffness=null"};
   std::vector<std::string> hinged = line;
-  hinged.insert(hinged.end(), {"steady_arms.stiffness=null", "steady_arms.mass=null", "steady_arms.length=1.15",
-                               "steady_arms.linear_mass=0.78", "steady_arms.clamp_mass=0.46",
-                               "stagger.steady_arm_stiffness=null"});
+  hinged.insert(hinged.end(), arms.begin(), arms.end());
   windowed_fused = 0;
   EXPECT_GT(expect_fused_is_generic(hinged, &windowed_fused), 1000);
+  Simulation hinged_joint(load_scene_file(test_scenes::kReference3d, hinged));
+  ASSERT_FALSE(hinged_joint.model().lateral->registrations.empty());
+  while (hinged_joint.step() == StepStatus::kOk) {
+  }
+  EXPECT_EQ(hinged_joint.state().lateral.work->joined_steps, hinged_joint.state().steps);
+  std::vector<std::string> hinged_windowed = windowed;
+  hinged_windowed.insert(hinged_windowed.end(), arms.begin(), arms.end());
+  windowed_fused = 0;
+  EXPECT_GT(expect_fused_is_generic(hinged_windowed, &windowed_fused), 5000);
+  EXPECT_GT(windowed_fused, 5000);
+}
+
+TEST(Lateral, AHeldRegistrationsRowIsItsWholeWiresBandForce) {
+  // A held registration's row (set_registration_row: the band over kRegistrationReach nodes each
+  // side, rotations condensed there) serves twice: the wire's force on the registration, and the
+  // force on those nodes when the registration moves (the joint sweep takes it where the last step
+  // put it). Against the whole wire's band, rotations condensed over all of it: the force on each
+  // node from a unit move of the registration. The rotations' coupling decays by about 0.2 per
+  // element, so the cut changes the row by some 0.2^8 = 3e-6 of its largest value: 1e-5 of it,
+  // and every node beyond the row feels less than that.
+  const std::vector<std::string> arms = {"steady_arms.stiffness=null", "steady_arms.mass=null",
+                                         "steady_arms.length=1.15", "steady_arms.linear_mass=0.78",
+                                         "steady_arms.clamp_mass=0.46", "stagger.steady_arm_stiffness=null",
+                                         "line.span_count=4"};
+  Simulation sim(load_scene_file(test_scenes::kReference3d, arms));
+  const LateralModel& lat = *sim.model().lateral;
+  const LateralWorkspace& lw = *sim.state().lateral.work;
+  ASSERT_EQ(lat.registrations.size(), 3u);  // the 3 intermediate supports
+  for (std::size_t j = 0; j < lat.registrations.size(); ++j) {
+    const LateralRegistration& r = lat.registrations[j];
+    ASSERT_LT(r.spring, 0);
+    const Wire& w = lat.wires[r.wire];
+    std::vector<double> unit(lat.n, 0.0), f(lat.n, 0.0), theta(w.nodes());
+    unit[r.dof] = 1.0;
+    wire_elastic_force(w, unit.data(), f.data(), theta.data());
+    double largest = 0.0;
+    for (int i = 0; i < w.nodes(); ++i) largest = std::max(largest, std::fabs(f[w.w_dof + i]));
+    const int first = lw.registration_first[j], count = lw.registration_count[j];
+    EXPECT_EQ(count, kRegistrationRow);
+    const double* row = lw.registration_row.data() + j * kRegistrationRow;
+    for (int i = 0; i < w.nodes(); ++i) {
+      const int dof = w.w_dof + i;
+      if (dof >= first && dof < first + count)
+        EXPECT_NEAR(row[dof - first], f[dof], 1e-5 * largest) << "registration " << j << ", node " << i;
+      else
+        EXPECT_LT(std::fabs(f[dof]), 1e-5 * largest) << "registration " << j << ", node " << i;
+    }
+  }
 }
 
 TEST(Lateral, EachStripHasItsOwnWorkingWidth) {

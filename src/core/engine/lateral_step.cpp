@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "catenary_sim/core/engine/state.hpp"
 #include "engine/centred_damping.hpp"
@@ -40,13 +41,6 @@ template class DeepCopied<LateralWorkspace>;  // LateralState::work
 
 namespace {
 
-// Nodes each side of a registration over which its band force condenses the rotations: the
-// rotations' coupling decays by about 0.2 per element (K_theta_theta's off-diagonal over its
-// diagonal, 2 EI / h - T h / 30 against 8 EI / h + 4 T h / 15 for a contact wire), so the rest of
-// the wire would change that force by some 0.2^8, 3e-6 of it.
-constexpr int kRegistrationReach = 8;
-constexpr int kRegistrationRow = 2 * kRegistrationReach + 1;
-
 // The wire's band force (f = -K y) at a held registration's node as a row over the nodes within
 // kRegistrationReach of it (fewer at the wire's ends): the band over that range, rotations
 // condensed there (its ends free, as a window's cut), applied to each node's unit displacement.
@@ -56,7 +50,8 @@ void set_registration_row(const Model& m, LateralState& ls, int j) {
   const LateralRegistration& r = lat.registrations[j];
   LateralWorkspace& lw = *ls.work;
   const Wire& w = lat.wires[r.wire];
-  const int lo = std::max(0, r.node - kRegistrationReach), hi = std::min(w.nodes() - 1, r.node + kRegistrationReach);
+  int lo = 0, hi = 0;
+  registration_reach(r, w.nodes(), &lo, &hi);
   WireWindow range;
   range.tt_lower.assign(w.nodes(), 0.0);
   range.tt_inv_pivot.assign(w.nodes(), 0.0);
@@ -153,6 +148,7 @@ LateralState make_lateral_state(const Model& m) {
     work.registration_first.assign(nr, 0);
     work.registration_count.assign(nr, 0);
     work.registration_row.assign(static_cast<std::size_t>(nr) * kRegistrationRow, 0.0);
+    work.registration_swept.assign(nr, 0.0);
     for (int j = 0; j < nr; ++j)
       if (lat.registrations[j].spring < 0) set_registration_row(m, s, j);
     // (At rest in the static state under the mean wind, with every arm as built.)
@@ -199,7 +195,9 @@ LateralState make_lateral_state(const Model& m) {
     work.lead_scratch.assign(static_cast<std::size_t>(longest) * kCdValues, 0.0);
     work.lead_record.assign(kSweepRecord * sweep_size(m), 0.0);
   }
-  work.window_points.assign(work.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size() + 2 * lat.clamps.size(), 0);
+  work.window_points.assign(work.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size() + 2 * lat.clamps.size() +
+                                kRegistrationRow * lat.registrations.size(),
+                            0);
   if (lat.windowed && !lat.centred_twin.empty()) {
     // A window's range has at most its wires' nodes: the whole wires' layout sizes it.
     std::size_t twin = 0, single = 0;
@@ -287,12 +285,28 @@ void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const do
     f[sp.dof] -= sp.stiffness * z_at(sp.dof);
   }
   // A hinged arm's registration on its spring: the anchor moved by the arm's end's travel, the
-  // load's k stagger and k travel (outside the window nothing is stepped).
+  // load's k stagger and k travel (outside the window nothing is stepped). Held, moved by d since
+  // the band sweep took it (place_at_arms): -K d on its row's nodes, the row's values being the
+  // band's -K (symmetric), as if the sweep had seen it moved.
   const double* travel = ls.registration_travel.data();
+  const double* swept = lw.registration_swept.data();
   for (std::size_t j = 0; j < lat.registrations.size(); ++j) {
     const LateralRegistration& r = lat.registrations[j];
-    if (r.spring < 0 || (windowed && !(r.node >= ls.window[r.wire].lo && r.node <= ls.window[r.wire].hi))) continue;
-    f[r.dof] += lat.springs[r.spring].stiffness * travel[j];
+    const WireWindow& ww = ls.window[r.wire];
+    if (windowed && !(r.node >= ww.lo && r.node <= ww.hi)) continue;
+    if (r.spring >= 0) {
+      f[r.dof] += lat.springs[r.spring].stiffness * travel[j];
+      continue;
+    }
+    const double d = y[r.dof] - swept[j];
+    if (d == 0.0) continue;
+    const int first = lw.registration_first[j], count = lw.registration_count[j];
+    const int w0 = lat.wires[r.wire].w_dof;
+    const int k0 = windowed ? std::max(0, w0 + ww.lo - first) : 0;
+    const int k1 = windowed ? std::min(count, w0 + ww.hi + 1 - first) : count;
+    const double* row = lw.registration_row.data() + j * kRegistrationRow;
+    for (int k = k0; k < k1; ++k)
+      if (first + k != r.dof) f[first + k] += row[k] * d;
   }
   const double* u = s.u.data();
   double* stretch = ls.dropper_stretch.data();
@@ -340,6 +354,24 @@ void commit_substep(const Model& m, State& s, bool windowed) {
   });
 }
 
+// Each held registration's y swapped with where the band sweep takes it (registration_swept).
+void swap_swept_registrations(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  double* swept = ls.work->registration_swept.data();
+  for (std::size_t j = 0; j < lat.registrations.size(); ++j)
+    if (lat.registrations[j].spring < 0) std::swap(ls.y[lat.registrations[j].dof], swept[j]);
+}
+
+// The band sweeps from here on take each held registration where it is.
+void sweep_registrations_where_they_are(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  double* swept = ls.work->registration_swept.data();
+  for (std::size_t j = 0; j < lat.registrations.size(); ++j)
+    if (lat.registrations[j].spring < 0) swept[j] = ls.y[lat.registrations[j].dof];
+}
+
 // One lateral substep fused as the vertical plane's (wire_lanes.hpp): per pack one sweep pair for
 // z, the condensed rotations, the band force with the load, damping and the wind's drag, and the
 // update; then the nodes with point forces (steady arms and
@@ -361,11 +393,15 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
   // The band sweeps: taken along by this step's vertical sweeps (step_both_planes), else here.
   const int joined = lw.joined;  // (its records then in the joint layout: joint_record_index)
   bool outside = joined && lw.joined_outside;
-  if (!joined)
+  if (!joined) {
+    // (Held registrations where the joint sweep would have seen them: the same bits either way.)
+    swap_swept_registrations(m, s);
     for (std::size_t pk = 0; pk < packs_of(m).size(); ++pk) {
       PackSweep a;
       if (setup_lateral_sweep(m, s, pk, windowed, a)) outside |= sweep_pack(a);
     }
+    swap_swept_registrations(m, s);
+  }
   lw.joined = false;
   // Point forces on the band forces the sweep left in its records, as the generic step adds them.
   double* f = lw.f.data();
@@ -490,12 +526,18 @@ bool generic_substep(const Model& m, State& s, bool windowed) {
       }
     }
   });
+  // The band at each held registration where the fused step's sweep takes it (fused_substep).
+  const double* swept = lw.registration_swept.data();
+  for (std::size_t j = 0; j < lat.registrations.size(); ++j)
+    if (lat.registrations[j].spring < 0) z[lat.registrations[j].dof] = swept[j] + beta * v[lat.registrations[j].dof];
   if (windowed) {
     for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) wire_elastic_force_window(lat.wires[wi], ls.window[wi], z, f, lw.theta.data());
     add_window_forces(m, s, v, f);
   } else {
     for (const Wire& w : lat.wires) wire_elastic_force(w, z, f, lw.theta.data());
   }
+  for (const LateralRegistration& r : lat.registrations)
+    if (r.spring < 0) z[r.dof] = y[r.dof] + beta * v[r.dof];
   add_springs_and_pendulums(m, s, windowed, y, [z](int i) { return z[i]; }, f);
   double* yn = lw.y_next.data();
   double* vn = lw.v_next.data();
@@ -549,7 +591,9 @@ StepStatus lateral_diverged(const Model& m, State& s, bool lead) {
 // acts on the arm's end in the next vertical step, (F - F0) side tan(theta(u))
 // (set_registration_forces). Every force of both planes is so taken at one configuration, which
 // keeps the partitioned step symplectic (line_energy is conserved), and the arm's end is on its
-// circle whenever a step ends.
+// circle whenever a step ends. The first substep's band sweep takes a held registration where the
+// last step put it (registration_swept: so the vertical step can take that sweep along before
+// this step places it, step.cpp), and the point forces add its move's share on its row's nodes.
 void place_at_arms(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
@@ -557,6 +601,7 @@ void place_at_arms(const Model& m, State& s) {
     const LateralRegistration& r = lat.registrations[j];
     ls.registration_travel[j] = registration_travel(r, s.u[r.vertical]);
     if (r.spring < 0) {
+      ls.work->registration_swept[j] = ls.y[r.dof];  // (where this step's joint sweep took it)
       ls.y[r.dof] = lat.initial[r.dof] + ls.registration_travel[j];
       ls.v[r.dof] = 0.0;
     }
@@ -612,15 +657,21 @@ StepStatus lateral_step(const Model& m, State& s) {
   if (windowed) sync_window(m, s);
   if (lat.lead_every > 0) sync_lead(m, s);
   const bool arms = !lat.registrations.empty();
-  if (arms) place_at_arms(m, s);
+  const bool centred = !lat.centred_twin.empty();
+  if (arms) {
+    place_at_arms(m, s);
+    // The centred step's solve takes the band at the registrations as placed (no joint sweep).
+    if (centred) sweep_registrations_where_they_are(m, s);
+  }
   for (int sub = 0; sub < lat.substeps; ++sub) {
     refresh_wind_if_due(m, s, t0 + sub * h, windowed);
     if (arms) add_registration_pulls(m, s);
     const bool fused = !lat.planes.empty() && (!windowed || lw.window_fused);
-    const bool failed = !lat.centred_twin.empty() ? centred_substep(m, s, windowed)
-                        : fused                   ? fused_substep(m, s, windowed)
-                                                  : generic_substep(m, s, windowed);
+    const bool failed = centred ? centred_substep(m, s, windowed)
+                        : fused ? fused_substep(m, s, windowed)
+                                : generic_substep(m, s, windowed);
     if (failed) return lateral_diverged(m, s, false);
+    if (arms) sweep_registrations_where_they_are(m, s);
   }
   const double per_substep = 1.0 / lat.substeps;
   for (double& e : ls.dropper_stretch) e *= per_substep;

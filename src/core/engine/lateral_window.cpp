@@ -75,7 +75,7 @@ void move_wire_window(const Model& m, State& s, std::size_t wi, int first, doubl
 
 // The springs, pendulums (droppers) and stitch wires' clamps between the window's end supports
 // whose nodes it holds, and the fused step's nodes with point forces: the cut layers, springs,
-// pendulums, clamps.
+// pendulums, clamps, held registrations' rows.
 void list_window_points(const Model& m, State& s, int first, double xa, double xb) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
@@ -94,7 +94,8 @@ void list_window_points(const Model& m, State& s, int first, double xa, double x
         m.clamp_order, m.clamp_order_x, xa, xb,
         [&](int k) { return inside(lat.clamps[k].stitch) && inside(lat.clamps[k].messenger); }, lw.window_clamps.data());
   }
-  // The fused step's nodes with point forces: the cut layers, springs, pendulums, clamps.
+  // The fused step's nodes with point forces: the cut layers, springs, pendulums, clamps, held
+  // registrations' rows.
   int q = 0;
   for (int j = 0; j < lw.cut_count; ++j) lw.window_points[q++] = lw.cut_node[j];
   for (int j = 0; j < lw.window_spring_count; ++j) lw.window_points[q++] = lat.springs[lw.window_springs[j]].dof;
@@ -107,6 +108,13 @@ void list_window_points(const Model& m, State& s, int first, double xa, double x
     const LateralClamp& c = lat.clamps[lw.window_clamps[j]];
     lw.window_points[q++] = c.stitch;
     lw.window_points[q++] = c.messenger;
+  }
+  for (const LateralRegistration& r : lat.registrations) {
+    if (r.spring >= 0) continue;
+    const WireWindow& ww = ls.window[r.wire];
+    int lo = 0, hi = 0;
+    registration_reach(r, lat.wires[r.wire].nodes(), &lo, &hi);
+    for (int i = std::max(lo, ww.lo); i <= std::min(hi, ww.hi); ++i) lw.window_points[q++] = lat.wires[r.wire].w_dof + i;
   }
   lw.window_point_count = q;
 }

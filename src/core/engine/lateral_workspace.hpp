@@ -34,6 +34,10 @@ struct LateralWorkspace {
   // registration_first on).
   std::vector<double> registration_pull0, registration_row;
   std::vector<int> registration_first, registration_count;
+  // m, per registration: where a held one was when the band sweep of the step's first substep
+  // took it (the last step's place; the joint sweep runs before this step places it), so that the
+  // point forces add row x (y - swept) on its row's nodes; equal to y once no sweep lags.
+  std::vector<double> registration_swept;
   // The moving window's lists, rebuilt by sync_window from its placement (LateralState::window):
   // the factors interleaved for the fused step; the springs, the droppers' pendulums and the
   // stitch wires' clamps in it (first *_count entries; pendulum k is dropper k, clamp k

@@ -28,13 +28,14 @@ StepStatus vertical_step(const Model& m, State& s) {
 namespace {
 
 // The vertical step, then the lateral one. Where both planes sweep every node of the same
-// two-wire packs (no window, one lateral substep, both fused, no hinged arms' registrations, which
-// the lateral step moves to the vertical step's new u before its sweep), the vertical step runs the lateral
+// two-wire packs (no window, one lateral substep, both fused), the vertical step runs the lateral
 // step's band sweep with its own, both planes in four lanes (sweep_pack_pair: the band and its
 // factors are the same both ways, loaded once, and each band operation does both planes). The
 // lateral sweep reads nothing the vertical step changes (the lateral state, the wind of the
 // step's start, the shared band and factors), and each lane does its own plane's operations, so
-// the results are those of the vertical step then lateral_step, to the bit.
+// the results are those of the vertical step then lateral_step, to the bit. (Hinged arms'
+// registrations, which the lateral step moves to the new u, are swept where the last step put
+// them in either case; the point forces add the move: lateral_step.cpp.)
 StepStatus step_both_planes(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
@@ -44,8 +45,7 @@ StepStatus step_both_planes(const Model& m, State& s) {
   for (const WireLanes& p : packs_of(m)) two_wire_packs &= p.lanes == 2;
   ls.work->join = !lat.planes.empty() && two_wire_packs && lat.substeps == 1 && !m.scene.numerics.windowed() &&
                   m.scene.numerics.damping != DampingStep::kCentred &&
-            s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty() &&
-            lat.registrations.empty();
+            s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty();
   // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
   // the vertical step's s.time += dt), refreshed now for the sweep (lateral_step then finds it
   // done: the same values, once).

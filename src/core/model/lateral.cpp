@@ -125,6 +125,14 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
     add(c.stitch);
     add(c.messenger);
   }
+  // A held registration and its row's nodes: the sweep may see it where the last step put it,
+  // the point forces then add its move's share (add_springs_and_pendulums, lateral_step.cpp).
+  for (const LateralRegistration& r : lat.registrations) {
+    if (r.spring >= 0) continue;
+    int lo = 0, hi = 0;
+    registration_reach(r, lat.wires[r.wire].nodes(), &lo, &hi);
+    for (int i = lo; i <= hi; ++i) add(lat.wires[r.wire].w_dof + i);
+  }
 }
 
 

@@ -103,6 +103,21 @@ inline double registration_travel(const LateralRegistration& r, double u) {
   return r.side * hinged_arm_travel(r.length, r.sin0, r.cos0, u);
 }
 
+// Nodes each side of a held registration over which the wire's band force at it is taken, its
+// rotations condensed there (the engine's row, registration_pull): the rotations' coupling decays
+// by about 0.2 per element (K_theta_theta's off-diagonal over its diagonal, 2 EI / h - T h / 30
+// against 8 EI / h + 4 T h / 15 for a contact wire), so the rest of the wire would change that
+// force by some 0.2^8, 3e-6 of it. The same row, K being symmetric, gives the force on each of
+// those nodes when the registration moves.
+constexpr int kRegistrationReach = 8;
+constexpr int kRegistrationRow = 2 * kRegistrationReach + 1;
+
+// The wire's nodes [*lo, *hi] of a held registration's row, on a wire of `nodes` nodes.
+inline void registration_reach(const LateralRegistration& r, int nodes, int* lo, int* hi) {
+  *lo = std::max(0, r.node - kRegistrationReach);
+  *hi = std::min(nodes - 1, r.node + kRegistrationReach);
+}
+
 // The values per node and lane of LateralModel::planes ([node][value][lane]): the lateral plane's
 // load, its mass-proportional damping alpha m, inverse mass and the wind drag coefficient
 // cw = 0.5 rho Cd d h (the fused step reads them as PackSweep::plane).
