@@ -83,6 +83,7 @@ bool same_lateral(const State& a, const State& b, std::string* what) {
                    std::memcmp(x.collector_lateral.data(), y.collector_lateral.data(),
                                sizeof(double) * x.collector_lateral.size()) != 0,
                "collector_lateral");
+  d |= differs(x.collector_wire != y.collector_wire, "collector_wire");
   d |= differs(a.head_wind != b.head_wind || a.contact_force != b.contact_force, "head_wind, contact_force");
   return !d;
 }

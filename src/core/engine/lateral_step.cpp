@@ -130,6 +130,7 @@ LateralState make_lateral_state(const Model& m) {
   if (lat.windy) s.wind_speed = lat.wind_speed * lat.wind_normal;  // the mean wind until the field's first refresh
   s.contact_lateral.assign(m.collectors.size() * m.contact_wires.size(), std::nan(""));
   s.collector_lateral.assign(m.collectors.size(), std::nan(""));
+  s.collector_wire.assign(m.collectors.size(), -1);
   s.pantograph_lateral.assign(m.pantographs.size(), 0.0);
   s.off_strip.assign(m.collectors.size(), 0);
   s.events.reserve(kMaxDewirementEvents);
@@ -248,6 +249,7 @@ bool contact_points(const Model& m, State& s, bool record) {
       if (running < 0) lowest_design_height(m, xc, &running);  // not touching: the wire it meets first
       const double yc = running >= 0 ? ls.contact_lateral[ci * nw + running] : std::nan("");
       ls.collector_lateral[ci] = yc;
+      ls.collector_wire[ci] = running;
       const bool off = std::fabs(yc) > m.collectors[ci].half_working_width;  // false for NaN
       if (off && !ls.off_strip[ci] && record) {
         left = true;

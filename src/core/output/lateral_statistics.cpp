@@ -88,7 +88,8 @@ void LateralRecorder::record(const Model& m, const State& s) {
       t.min = std::min(t.min, y);
       t.max = std::max(t.max, y);
       t.outside += std::fabs(y) > col.half_working_width;
-      if (t.any && !std::isnan(t.prev_y) && s.time > t.prev_t) {
+      // (On one wire: at an overlap the running wire changes, and the point jumps between them.)
+      if (t.any && !std::isnan(t.prev_y) && s.time > t.prev_t && s.lateral.collector_wire[c] == t.prev_wire) {
         const double v = std::fabs(y - t.prev_y) / (s.time - t.prev_t);
         t.sweep += v;
         t.sweep_max = std::max(t.sweep_max, v);
@@ -103,6 +104,7 @@ void LateralRecorder::record(const Model& m, const State& s) {
     t.any = true;
     t.prev_t = s.time;
     t.prev_y = y;
+    t.prev_wire = s.lateral.collector_wire[c];
     t.station = x;
     t.lateral = y;
   }

@@ -86,6 +86,7 @@ struct LateralState {
   std::vector<double> contact_lateral;
   // m, per collector: on the running wire (the one it touches, else the lowest), NaN if none.
   std::vector<double> collector_lateral;
+  std::vector<int> collector_wire;  // per collector: that wire (index into Model::contact_wires), -1 if none
   std::vector<double> pantograph_lateral;  // m, per pantograph (sway)
   // Per collector: outside the working width now (a dewirement is a change of it: state too).
   std::vector<std::uint8_t> off_strip;

@@ -19,7 +19,8 @@ struct LateralContactStatistics {
   int collector = 0;
   std::size_t samples = 0, contact_samples = 0;  // steps in the section; those with contact force
   double mean = 0.0, std_dev = 0.0, min = 0.0, max = 0.0;  // m across the strip (+ left)
-  double sweep_mean = 0.0, sweep_max = 0.0;  // m/s, |d(lateral)/dt| (the rate the contact point crosses the strip)
+  double sweep_mean = 0.0, sweep_max = 0.0;  // m/s, |d(lateral)/dt| (the rate the contact point crosses the strip),
+                                             // on one wire (a hand-over to another wire is a jump, not a sweep)
   // Share (%) of the contact time (steps with contact force) per bin of width `bin` from `from`,
   // over the head's horn width: the strips' wear distribution.
   double from = 0.0, bin = 0.0;
@@ -69,6 +70,7 @@ class LateralRecorder {
     std::vector<double> histogram;  // steps with contact per bin
     bool any = false;               // a step recorded (prev_* valid)
     double prev_t = 0.0, prev_y = 0.0, station = 0.0, lateral = 0.0;  // the last step's
+    int prev_wire = -1;
   };
   std::vector<ContactTrack> contacts_;
   double x0_ = 0.0, x1_ = 0.0, hist_from_ = 0.0, hist_bin_ = 0.0;
