@@ -11,10 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "catenary_sim/core/engine/lateral_step.hpp"
 #include "catenary_sim/core/model/build_model.hpp"
 #include "catenary_sim/core/model/contact_geometry.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/output/lateral_statistics.hpp"
 #include "catenary_sim/core/output/pass_recorder.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
@@ -178,7 +181,7 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
   refused(with("conductor_rail:\n", "conductor_rail:\n  tension: 1000\n"), "conductor_rail.tension");
   refused(with("span_count: 3", "span_count: 1"), "spans");
   refused(with("numerics:\n", "numerics:\n  window: auto\n"), "numerics.window");
-  refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\n", "stagger");
+  refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\nwind: {speed: 20, contact_wire: {diameter: 0.012}}\n", "wind");
   refused(y + "imperfections:\n  contact_wire_wear:\n    section_loss: 0.1\n", "imperfections.contact_wire_wear");
   // Two rigid sections need the end ramp's rise.
   const std::string two =
@@ -370,4 +373,82 @@ TEST(RigidConductorRail, TwoPantographsEachPressWithTheirUplift) {
     const double uplift = scene.pantographs[p].net_uplift(scene.train_speed);
     EXPECT_NEAR(sum[p] / count[p], uplift, 0.02 * uplift) << scene.pantographs[p].name;
   }
+}
+
+// (f) A 3-D line: the profile held at its stagger at every support, with no tension and nothing
+// across the track to load it, takes the static line of a continuous beam forced through the
+// stagger points. For the zigzag +-s on equal spans L every support is a mirror plane (its
+// neighbours on both sides at the other stagger), so the slope is 0 there and each span is the
+// cubic y = s_a + (s_b - s_a)(3 xi^2 - 2 xi^3), whose shear 12 EI (s_b - s_a) / L^3 changes sign
+// at each support: a pull-off of 24 EI |s_b - s_a| / L^3 = 48 EI s / L^3, toward the track centre.
+// The pinned ends disturb this by 2 - sqrt(3) = 0.27 per span (the three-moment equation's
+// decay): 0.27^14 = 1e-8 of it at the middle spans of 30. Beam elements hold a cubic exactly, so
+// what is left is round-off: 1e-9 m on the line, 1e-6 of the pull-off.
+TEST(RigidConductorRail, OnA3dLineAZigzagBendsTheProfileAsAContinuousBeam) {
+  const double s = 0.2;
+  const cs::Scene scene = cs::load_scene_string(rail_yaml(30, 5e6, 0.25, "stagger:\n  contact_wire: [0.2, -0.2]\n"));
+  cs::Simulation sim(scene);
+  const cs::Model& m = sim.model();
+  ASSERT_TRUE(m.lateral);
+  const cs::LateralModel& lat = *m.lateral;
+  ASSERT_EQ(lat.wires.size(), 1u);
+  const cs::Wire& w = lat.wires[0];
+  int checked = 0;
+  for (int i = 0; i < w.nodes(); ++i) {
+    if (w.x[i] < 140.0 - 1e-9 || w.x[i] > 160.0 + 1e-9) continue;  // spans 14 and 15
+    const int span = std::min(15, static_cast<int>(std::floor(w.x[i] / kSpan + 1e-9)));
+    const double sa = span % 2 ? -s : s, sb = -sa, xi = w.x[i] / kSpan - span;
+    EXPECT_NEAR(lat.calm[w.w_dof + i], sa + (sb - sa) * (3 * xi * xi - 2 * xi * xi * xi), 1e-9) << "x " << w.x[i];
+    ++checked;
+  }
+  EXPECT_EQ(checked, 81);  // 0.25 m elements over 20 m
+  const double pull_off = 48.0 * kEI * s / (kSpan * kSpan * kSpan);  // 2688 N
+  int supports = 0;
+  for (const cs::LateralSupport& sup : lat.supports) {
+    if (sup.x < 120.0 - 1e-9 || sup.x > 180.0 + 1e-9) continue;
+    EXPECT_NEAR(std::fabs(sup.pull_off), pull_off, 1e-6 * pull_off) << "support at " << sup.x;
+    EXPECT_LT(sup.pull_off * sup.stagger, 0.0) << "support at " << sup.x;  // toward the centre
+    ++supports;
+  }
+  EXPECT_EQ(supports, 7);
+}
+
+// (g) Nothing joins a rail's two planes: no droppers lean, no hinged arm turns, and the strip is
+// flat across its working width. So on a 3-D line (rigid_conductor_rail_3d.yaml, the reference
+// scene with a stagger) the vertical pass is the 2-D line's, to the bit, while the contact point
+// runs across the strip between the staggers: +-0.2 m at the supports, where the slope is 0 by
+// symmetry (within 0.1 mm at the steps nearest them). On one profile it moves at the train's
+// speed times the profile's slope in plan, which a beam through the stagger points keeps within
+// 1.5x its chords' 0.01: under 3 x 0.01 x 33.3 m/s = 1 m/s, where a hand-over between the
+// joint's two profiles would jump at some 50 m/s.
+TEST(RigidConductorRail, OnA3dLineTheVerticalPassIsThe2dLinesAndTheContactPointFollowsTheStagger) {
+  cs::Simulation flat(cs::load_scene_file(test_scenes::scene_path("rigid_conductor_rail.yaml")));
+  cs::Simulation staggered(cs::load_scene_file(test_scenes::scene_path("rigid_conductor_rail_3d.yaml")));
+  ASSERT_FALSE(flat.model().lateral);
+  ASSERT_TRUE(staggered.model().lateral);
+  cs::LateralRecorder recorder(staggered.model());
+  recorder.record(staggered.model(), staggered.state());
+  double lowest = 1.0, highest = -1.0;
+  long steps = 0;
+  while (!flat.finished() && !staggered.finished()) {
+    ASSERT_EQ(flat.step(), cs::StepStatus::kOk);
+    ASSERT_EQ(staggered.step(), cs::StepStatus::kOk);
+    recorder.record(staggered.model(), staggered.state());
+    ++steps;
+    ASSERT_TRUE(flat.state().u == staggered.state().u) << "step " << steps;
+    ASSERT_TRUE(flat.state().v == staggered.state().v) << "step " << steps;
+    for (double y : staggered.state().lateral.contact_lateral)
+      if (!std::isnan(y)) {
+        lowest = std::min(lowest, y);
+        highest = std::max(highest, y);
+      }
+  }
+  EXPECT_TRUE(flat.finished() && staggered.finished());
+  EXPECT_GT(steps, 100000);
+  EXPECT_NEAR(lowest, -0.2, 1e-4);
+  EXPECT_NEAR(highest, 0.2, 1e-4);
+  const cs::LateralStatistics stats = recorder.statistics(staggered.model(), staggered.state());
+  ASSERT_EQ(stats.contacts.size(), 1u);
+  EXPECT_GT(stats.contacts[0].sweep_max, 0.1);
+  EXPECT_LT(stats.contacts[0].sweep_max, 1.0);
 }

@@ -286,9 +286,13 @@ void validate_rigid(const Scene& s) {
   if (s.numerics.windowed())
     fail("numerics.window", "(given with conductor_rail)",
          "off: the window's absorbing ends are matched to a tensioned wire's waves, a tension-free profile has none");
-  if (s.lateral())
-    fail("stagger/alignment/wind/pantograph_head.sway", "(given with conductor_rail)",
-         "none: the profile's lateral plane is not modelled (a 2-D line only)");
+  // On a 3-D line the profile's lateral plane is the vertical one's beam (the wire's EI both ways):
+  // held at its stagger at every support, with no tension and no cross load it keeps its static
+  // line, whatever its lateral EI. Wind would load it through a drag the scene gives only for wires.
+  if (s.wind)
+    fail("wind", "(given with conductor_rail)",
+         "none: a conductor rail's profile has no drag data (wind.contact_wire describes a round wire); "
+         "a 3-D rail line takes stagger, alignment and pantograph_head.sway");
   // Wear thins the contact wire alone; the model's beam is profile and wire together, whose
   // mass and EI a worn wire changes by another law (not modelled).
   if (s.imperfections.contact_wire_wear.any())
