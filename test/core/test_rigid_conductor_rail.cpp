@@ -452,3 +452,44 @@ TEST(RigidConductorRail, OnA3dLineTheVerticalPassIsThe2dLinesAndTheContactPointF
   EXPECT_GT(stats.contacts[0].sweep_max, 0.1);
   EXPECT_LT(stats.contacts[0].sweep_max, 1.0);
 }
+
+// (h) Moved from its static line the profile's lateral plane swings. Plucked in the span mode of
+// a continuous beam on equal spans held at every support (sin(pi x / L) in each span, the sign
+// alternating, so that each support sees the same slope on both sides; the pinned ends too), it
+// swings at a simply supported span's frequency omega = pi^2 / L^2 sqrt(EI / m) = 19.4 rad/s
+// (3.1 Hz), whatever the stagger it swings about. Tolerance 0.1 %: the elements (40 to a span)
+// shift so long a mode by well under 1e-4, the step ((omega dt)^2 / 24, omega dt = 2e-3) and the
+// light Rayleigh damping (xi = 1.3e-3, the damped frequency lower by xi^2 / 2) by under 1e-6; the
+// period is read from zero crossings interpolated within a step over 5 periods.
+TEST(RigidConductorRail, OnA3dLineAPluckedProfileSwingsAtItsSpanFrequency) {
+  const double amplitude = 1e-3;
+  const std::string extra =
+      "stagger:\n  contact_wire: [0.2, -0.2]\n"
+      "pantographs:\n  - name: force\n    type: moving_force\n    static_uplift: 100.0\n"
+      "train:\n  speed: 1.0\n  start: 0.0\n  end: 20.0\n";
+  cs::Simulation sim(cs::load_scene_string(rail_yaml(6, 5e6, 0.25, extra)));
+  const cs::Model& m = sim.model();
+  ASSERT_TRUE(m.lateral && m.lateral->still);
+  const cs::LateralModel& lat = *m.lateral;
+  const cs::Wire& w = lat.wires[0];
+  cs::State s = sim.state();
+  for (int i = 0; i < w.nodes(); ++i) {
+    const int span = std::min(5, static_cast<int>(std::floor(w.x[i] / kSpan + 1e-9)));
+    s.lateral.y[w.w_dof + i] += (span % 2 ? -1.0 : 1.0) * amplitude * std::sin(M_PI * (w.x[i] / kSpan - span));
+  }
+  int probe = 0;  // mid-span of span 2
+  while (w.x[probe] < 25.0 - 1e-9) ++probe;
+  const int dof = w.w_dof + probe;
+  std::vector<double> up_crossings;
+  double before = s.lateral.y[dof] - lat.initial[dof];
+  while (s.time < 2.0) {
+    ASSERT_EQ(cs::step(m, s), cs::StepStatus::kOk);
+    const double now = s.lateral.y[dof] - lat.initial[dof];
+    if (before < 0.0 && now >= 0.0) up_crossings.push_back(s.time - m.dt * now / (now - before));
+    before = now;
+  }
+  ASSERT_GE(up_crossings.size(), 5u);
+  const double period = (up_crossings.back() - up_crossings.front()) / (up_crossings.size() - 1);
+  const double omega = M_PI * M_PI / (kSpan * kSpan) * std::sqrt(kEI / kRhoA);
+  EXPECT_NEAR(2.0 * M_PI / period, omega, 0.001 * omega) << "period " << period << " s";
+}

@@ -660,12 +660,15 @@ StepStatus lateral_step(const Model& m, State& s) {
   if (lat.lead_every > 0) sync_lead(m, s);
   const bool arms = !lat.registrations.empty();
   const bool centred = !lat.centred_twin.empty();
+  // A still plane at rest in its static state (a rigid rail's) would only gather round-off: left
+  // there. Moved from it (a pluck), it is stepped.
+  const bool resting = lat.still && ls.v.isZero(0.0) && ls.y == lat.initial;
   if (arms) {
     place_at_arms(m, s);
     // The centred step's solve takes the band at the registrations as placed (no joint sweep).
     if (centred) sweep_registrations_where_they_are(m, s);
   }
-  for (int sub = 0; sub < lat.substeps; ++sub) {
+  for (int sub = 0; sub < (resting ? 0 : lat.substeps); ++sub) {
     refresh_wind_if_due(m, s, t0 + sub * h, windowed);
     if (arms) add_registration_pulls(m, s);
     const bool fused = !lat.planes.empty() && (!windowed || lw.window_fused);
