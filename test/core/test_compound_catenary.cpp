@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "catenary_sim/core/model/build_model.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/model/model_memory.hpp"
 #include "catenary_sim/core/model/statics.hpp"
@@ -245,7 +246,8 @@ TEST(CompoundCatenary, BadInputIsRefusedByName) {
   refused(with("droppers: {positions: [5.0, 15.0], axial_stiffness: 200000}\n", ""), "auxiliary_messenger");
   refused(with("line: {", "contact_wire_count: 2\nline: {"), "contact_wire_count");
   refused(y + "stitch_wire: {length: 8.0, tension: 3500, linear_mass: 0.31}\n", "stitch_wire");
-  refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\n", "stagger");
+  refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\nwind: {speed: 20, auxiliary_messenger: {diameter: 0.5}}\n",
+          "wind.auxiliary_messenger.diameter");
   refused(with("line: {span_length: 20.0, span_count: 2, encumbrance: 1.5}", "line: {encumbrance: 1.5}") +
               "sections:\n  - {span_length: 20.0, span_count: 2, auxiliary_messenger: none,\n"
               "     hangers: {positions: [2.5], axial_stiffness: 200000}}\n",
@@ -329,4 +331,45 @@ TEST(CompoundCatenary, TheEndlessBlockCarriesTheAuxiliary) {
   const double endless = rms_apart(ga, gb), sensitivity = rms_apart(gc, gb);
   EXPECT_GT(sensitivity, 0.0);
   EXPECT_LT(endless, 2.0 * sensitivity) << "the finite line against itself nudged: " << sensitivity << " N";
+}
+
+// (g) On a 3-D line the auxiliary runs above the contact wire: held in plan at the contact wire's
+// stagger at every support (vertically free there), the messenger above them both when its
+// stagger is not given. Every wire of the strings' line is then held at the same points and
+// loaded alike, so every dropper and hanger hangs plumb in the static state: no lean, to
+// round-off (1e-9 m: the lateral statics' solve of stiffnesses 1e3-1e6 N/m).
+TEST(CompoundCatenary, OnA3dLineTheAuxiliaryRunsAboveTheContactWire) {
+  const double s = 0.2;
+  cs::Simulation sim(cs::load_scene_string(strings_yaml(0.25) + "stagger:\n  contact_wire: [0.2, -0.2]\n"));
+  const cs::Model& m = sim.model();
+  ASSERT_TRUE(m.lateral);
+  const cs::LateralModel& lat = *m.lateral;
+  int hangers = 0, droppers = 0;
+  for (const cs::LateralPendulum& p : lat.pendulums) {
+    const cs::Dropper& d = m.droppers[p.dropper];
+    EXPECT_NEAR(lat.calm[p.messenger], lat.calm[p.contact], 1e-9) << (d.hanger ? "hanger" : "dropper") << " at "
+                                                                   << lat.node_x[p.contact];
+    (d.hanger ? hangers : droppers) += 1;
+  }
+  EXPECT_EQ(hangers, 8);
+  EXPECT_EQ(droppers, 4);
+  // The messenger above the track centre: the droppers lean from it to the auxiliary, which the
+  // supports keep at the contact wire's stagger and the stiff short hangers (S / l with l = 0.15 m
+  // against the droppers' ~1.4 m) keep over the contact wire between them: each hanger leans
+  // less than a tenth of the droppers' largest lean.
+  cs::Simulation centred(cs::load_scene_string(strings_yaml(0.25) + "stagger:\n  contact_wire: [0.2, -0.2]\n  messenger: [0.0]\n"));
+  const cs::Model& mc = centred.model();
+  const cs::LateralModel& lc = *mc.lateral;
+  double dropper_lean = 0.0, hanger_lean = 0.0;
+  for (const cs::LateralPendulum& p : lc.pendulums) {
+    const double lean = std::fabs(lc.calm[p.messenger] - lc.calm[p.contact]);
+    double& largest = mc.droppers[p.dropper].hanger ? hanger_lean : dropper_lean;
+    largest = std::max(largest, lean);
+  }
+  EXPECT_GT(dropper_lean, 0.05);
+  EXPECT_LT(hanger_lean, 0.1 * dropper_lean);
+  for (const cs::LateralSupport& sup : lc.supports) {
+    if (!mc.wires[sup.wire].is_auxiliary_messenger) continue;
+    EXPECT_NEAR(sup.stagger, std::fmod(sup.x, 40.0) < 1.0 ? s : -s, 1e-12) << "support at " << sup.x;
+  }
 }

@@ -238,7 +238,11 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
       s.node = w.support_nodes[k];
       s.x = w.x[s.node];
       s.line_support = line_support(m, s.x);
-      s.stagger = stagger_at(sc, w.is_contact_wire, s.line_support + support_offset) +
+      // A compound line's auxiliary runs above the contact wire it hangs by its short hangers:
+      // held in plan at the contact wire's stagger at every support (vertically it passes them
+      // free, hung by its droppers), so that the hangers hang plumb and the droppers above take
+      // any lean toward the messenger.
+      s.stagger = stagger_at(sc, w.is_contact_wire || w.is_auxiliary_messenger, s.line_support + support_offset) +
                   (w.is_contact_wire ? stagger_error[s.line_support] : 0.0);  // (no errors on an endless line)
       s.anchor = k == 0 || k == ns - 1;
       const std::optional<double>& spring = w.is_contact_wire ? arm_k : msup_k;
@@ -329,7 +333,10 @@ void add_wind(const Model& m, const WindSpec& ws, LateralModel* lat) {
   double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo;
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     const Wire& w = m.wires[wi];
-    const WireDragSpec& d = w.is_contact_wire ? ws.contact_wire : w.is_stitch_wire ? ws.stitch_wire : ws.messenger;
+    const WireDragSpec& d = w.is_contact_wire           ? ws.contact_wire
+                            : w.is_stitch_wire          ? ws.stitch_wire
+                            : w.is_auxiliary_messenger  ? ws.auxiliary_messenger
+                                                        : ws.messenger;
     const int nn = w.nodes();
     for (int i = 0; i < nn; ++i) {
       const int a = lat->wires[wi].w_dof + i;
@@ -614,8 +621,11 @@ double gust_lead_time(const Scene& sc) {
   };
   double slowest = sigma(w.contact_wire, sc.contact_wire.linear_mass);
   if (sc.messenger) slowest = std::min(slowest, sigma(w.messenger, sc.messenger->linear_mass));
-  for (const SectionSpec& sec : sc.sections)
+  for (const SectionSpec& sec : sc.sections) {
     if (sec.stitch_wire) slowest = std::min(slowest, sigma(w.stitch_wire, sec.stitch_wire->linear_mass));
+    if (sec.auxiliary_messenger)
+      slowest = std::min(slowest, sigma(w.auxiliary_messenger, sec.auxiliary_messenger->linear_mass));
+  }
   return slowest > kGustLeadDecays / kAutoGustLeadMax ? kGustLeadDecays / slowest : kAutoGustLeadMax;
 }
 

@@ -91,6 +91,7 @@ void read_wind(Reader& top, Scene& s) {
   drag("contact_wire", w.contact_wire);
   drag("messenger", w.messenger);
   drag("stitch_wire", w.stitch_wire);
+  drag("auxiliary_messenger", w.auxiliary_messenger);
   if (r.has("turbulence")) {
     Reader q(r.child("turbulence"), "wind.turbulence");
     TurbulenceSpec t;

@@ -322,8 +322,7 @@ void validate_stitched(const Scene& s) {
   }
 }
 
-// A compound catenary: messenger, droppers to the auxiliary messenger, hangers to one contact wire,
-// on a 2-D line (the lateral plane does not carry the auxiliary).
+// A compound catenary: messenger, droppers to the auxiliary messenger, hangers to one contact wire.
 void validate_compound(const Scene& s) {
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
@@ -344,11 +343,6 @@ void validate_compound(const Scene& s) {
       fail(pre + "contact_wire_count", std::to_string(sec.contact_wire_count), "1 on a compound catenary (its hangers hold one contact wire)");
     if (sec.stitch_wire) fail(pre + "stitch_wire", "(given with auxiliary_messenger)", "none: a line is stitched or compound, not both");
   }
-  const bool any = std::any_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.auxiliary_messenger.has_value(); });
-  if (!any) return;
-  if (s.lateral())
-    fail("stagger/alignment/wind/pantograph_head.sway", "(given with auxiliary_messenger)",
-         "none: the auxiliary messenger's lateral plane is not modelled (a 2-D line only)");
 }
 
 void validate(const Scene& s) {

@@ -405,6 +405,9 @@ struct WindSpec {
   WireDragSpec contact_wire{0.012, 1.0}, messenger{0.0105, 1.0};
   // A stitch wire's (StitchWireSpec): Bz II 35 mm^2, 7 strands of 2.5 mm (DIN 48201-2), 7.5 mm.
   WireDragSpec stitch_wire{0.0075, 1.0};
+  // A compound line's auxiliary messenger (AuxiliaryMessengerSpec): 150 mm^2 stranded, 19 strands
+  // of 3.17 mm, five strands across: 15.9 mm.
+  WireDragSpec auxiliary_messenger{0.0159, 1.0};
   std::optional<TurbulenceSpec> turbulence;
   std::optional<double> blow_off_limit;  // m, largest lateral blow-off of the contact wire the report accepts
 };
