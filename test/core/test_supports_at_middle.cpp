@@ -146,7 +146,7 @@ TEST(SupportsAtMiddle, ConvergeAtSecondOrderToTheExplicitStep) {
 // endless line) without diverging, and a twin contact wire too.
 TEST(SupportsAtMiddle, EveryShippedLineRunsAtTheFastAndBalancedRungs) {
   const std::vector<std::string> files = {"reference_55m.yaml",  "reference_55m_stitched.yaml", "reference_55m_stitched_3d.yaml",
-                                          "compound_catenary.yaml", "reference_55m_two_sections.yaml",
+                                          "compound_catenary.yaml", "compound_catenary_3d.yaml", "reference_55m_two_sections.yaml",
                                           "reference_55m_two_pantographs.yaml", "reference_55m_two_heads.yaml",
                                           "reference_55m_3d.yaml", "reference_55m_hinged_arms.yaml", "reference_55m_3d_hinged_arms.yaml",
                                           "reference_55m_endless.yaml"};  // (the rail's scenes: centred damping)
