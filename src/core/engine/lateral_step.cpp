@@ -678,6 +678,7 @@ StepStatus lateral_step(const Model& m, State& s) {
     if (failed) return lateral_diverged(m, s, false);
     if (arms) sweep_registrations_where_they_are(m, s);
   }
+  lw.joined = false;  // (a resting plane leaves unused a sweep the vertical step took along)
   const double per_substep = 1.0 / lat.substeps;
   for (double& e : ls.dropper_stretch) e *= per_substep;
   if (arms) set_registration_forces(m, s, lat.substeps);
