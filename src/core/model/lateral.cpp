@@ -1,5 +1,6 @@
 #include "util/format.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
+#include "catenary_sim/core/model/stability.hpp"
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -56,33 +57,17 @@ void elastic_force(const Model& m, const LateralModel& lat, const double* tensio
   }
 }
 
-// Highest eigenfrequency of M^-1 K on the free nodes (the bound the explicit step must respect):
-// power iteration on the symmetric M^-1/2 K M^-1/2 from the saw-tooth, the shape of a wire's
-// highest mode, as for the vertical plane (highest_eigenfrequency, stability.cpp). Its Rayleigh
-// quotient rises monotonically toward lambda_max and can only underestimate it; stopped once
-// settled, with the vertical plane's 0.2 % margin for what has not converged.
+// Highest eigenfrequency of M^-1 K on the free nodes (the bound the explicit step must respect),
+// as the vertical plane's (power_iteration_omega), with its 0.2 % margin for what the iteration
+// has not converged.
 double lateral_omega_max(const Model& m, const LateralModel& lat) {
-  const int n = lat.n;
-  Eigen::VectorXd s = lat.inv_mass.cwiseSqrt(), x(n), y(n), scaled(n);
-  std::vector<double> theta(n);
-  for (int i = 0; i < n; ++i) x[i] = s[i] > 0.0 ? ((i % 2) ? 1.0 : -1.0) * (1.0 + 0.1 * std::sin(0.7 * i)) : 0.0;
-  double lambda = 0.0, checkpoint = 0.0;
-  for (int it = 0; it < 3000; ++it) {
-    if (it % 50 == 49) {
-      if (lambda - checkpoint <= 1e-10 * lambda) break;
-      checkpoint = lambda;
-    }
-    const double nx = x.norm();
-    if (!(nx > 0.0)) break;
-    x /= nx;
-    scaled = s.cwiseProduct(x);
-    y.setZero();
-    elastic_force(m, lat, nullptr, scaled.data(), y.data(), theta.data());
-    y = -s.cwiseProduct(y);
-    lambda = x.dot(y);
-    x.swap(y);
-  }
-  return 1.002 * std::sqrt(std::max(0.0, lambda));
+  std::vector<double> theta(lat.n);
+  const Eigen::VectorXd s = lat.inv_mass.cwiseSqrt();
+  return 1.002 * power_iteration_omega(lat.n, s.data(), 3000, [&](const double* x, double* y) {
+    std::fill(y, y + lat.n, 0.0);
+    elastic_force(m, lat, nullptr, x, y, theta.data());  // (f -= K x)
+    for (int i = 0; i < lat.n; ++i) y[i] = -y[i];
+  });
 }
 
 // The fused step's planes: per vertical pack (Model::wire_packs, wires on the same stations side

@@ -7,37 +7,14 @@
 namespace catenary_sim {
 
 double highest_eigenfrequency(const Model& m, int iterations, bool explicit_part) {
-  const int n = m.n_dof;
   int max_nodes = 1;
   for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
-  std::vector<double> x(n), y(n), tmp(n), scratch(max_nodes);
-  Eigen::VectorXd s = m.inv_mass.cwiseSqrt();  // M^-1/2, 0 on rigid DOFs
-  // Start from the saw-tooth (+1, -1, ...) pattern, the shape of a wire's highest mode, with a
-  // deterministic aperiodic perturbation so that no mode is missed.
-  for (int i = 0; i < n; ++i) x[i] = s[i] > 0.0 ? ((i % 2) ? 1.0 : -1.0) * (1.0 + 0.1 * std::sin(0.7 * i)) : 0.0;
-  double lambda = 0.0, checkpoint = 0.0;
+  std::vector<double> scratch(max_nodes);
+  const Eigen::VectorXd s = m.inv_mass.cwiseSqrt();  // M^-1/2, 0 on rigid DOFs
   const double front = m.train_start;
-  for (int it = 0; it < iterations; ++it) {
-    // The Rayleigh quotient rises monotonically toward lambda_max: stop once it has settled.
-    if (it % 50 == 49) {
-      if (lambda - checkpoint <= 1e-10 * lambda) break;
-      checkpoint = lambda;
-    }
-    double norm = 0.0;
-    for (int i = 0; i < n; ++i) norm += x[i] * x[i];
-    norm = std::sqrt(norm);
-    if (norm == 0.0) return 0.0;
-    for (int i = 0; i < n; ++i) tmp[i] = s[i] * x[i] / norm;
-    apply_stiffness(m, front, tmp.data(), y.data(), scratch.data(), explicit_part);
-    double rq = 0.0;
-    for (int i = 0; i < n; ++i) {
-      y[i] *= s[i];
-      rq += y[i] * x[i] / norm;
-    }
-    lambda = rq;
-    x.swap(y);
-  }
-  return std::sqrt(std::max(lambda, 0.0));
+  return power_iteration_omega(m.n_dof, s.data(), iterations, [&](const double* x, double* y) {
+    apply_stiffness(m, front, x, y, scratch.data(), explicit_part);
+  });
 }
 
 double critical_time_step(double w, double alpha, double beta) {

@@ -2,9 +2,47 @@
 // eigenfrequency of the assembled system and the critical time step it allows.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 #include "catenary_sim/core/model/model.hpp"
 
 namespace catenary_sim {
+
+// Highest eigenfrequency (rad/s) of M^-1 K over n DOFs by power iteration on the symmetrised
+// M^-1/2 K M^-1/2, `inv_sqrt_mass` its M^-1/2 (0 on rigidly held DOFs, left out), apply(x, y)
+// writing y = K x. It starts from the saw-tooth (+1, -1, ...), the shape of a wire's highest mode,
+// perturbed aperiodically so that no mode is missed; its Rayleigh quotient rises monotonically
+// toward lambda_max, so it stops once that has settled (or after `iterations`), an estimate from
+// below. Both planes' stability limits take it (highest_eigenfrequency; lateral.cpp).
+template <class ApplyK>
+double power_iteration_omega(int n, const double* inv_sqrt_mass, int iterations, ApplyK apply) {
+  const double* s = inv_sqrt_mass;
+  std::vector<double> x(n), y(n), tmp(n);
+  for (int i = 0; i < n; ++i) x[i] = s[i] > 0.0 ? ((i % 2) ? 1.0 : -1.0) * (1.0 + 0.1 * std::sin(0.7 * i)) : 0.0;
+  double lambda = 0.0, checkpoint = 0.0;
+  for (int it = 0; it < iterations; ++it) {
+    if (it % 50 == 49) {
+      if (lambda - checkpoint <= 1e-10 * lambda) break;
+      checkpoint = lambda;
+    }
+    double norm = 0.0;
+    for (int i = 0; i < n; ++i) norm += x[i] * x[i];
+    norm = std::sqrt(norm);
+    if (norm == 0.0) return 0.0;
+    for (int i = 0; i < n; ++i) tmp[i] = s[i] * x[i] / norm;
+    apply(tmp.data(), y.data());
+    double rq = 0.0;
+    for (int i = 0; i < n; ++i) {
+      y[i] *= s[i];
+      rq += y[i] * x[i] / norm;
+    }
+    lambda = rq;
+    x.swap(y);
+  }
+  return std::sqrt(std::max(lambda, 0.0));
+}
 
 // Highest eigenfrequency (rad/s) of M^-1 K with every dropper and contact active, by power
 // iteration on the symmetrised operator M^-1/2 K M^-1/2 (DOFs held rigidly are left out). With
