@@ -530,8 +530,10 @@ bool generic_substep(const Model& m, State& s, bool windowed) {
   });
   // The band at each held registration where the fused step's sweep takes it (fused_substep).
   const double* swept = lw.registration_swept.data();
-  for (std::size_t j = 0; j < lat.registrations.size(); ++j)
-    if (lat.registrations[j].spring < 0) z[lat.registrations[j].dof] = swept[j] + beta * v[lat.registrations[j].dof];
+  for (std::size_t j = 0; j < lat.registrations.size(); ++j) {
+    const LateralRegistration& r = lat.registrations[j];
+    if (r.spring < 0) z[r.dof] = swept[j] + beta * v[r.dof];
+  }
   if (windowed) {
     for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) wire_elastic_force_window(lat.wires[wi], ls.window[wi], z, f, lw.theta.data());
     add_window_forces(m, s, v, f);
@@ -660,9 +662,11 @@ StepStatus lateral_step(const Model& m, State& s) {
   if (lat.lead_every > 0) sync_lead(m, s);
   const bool arms = !lat.registrations.empty();
   const bool centred = !lat.centred_twin.empty();
-  // A still plane at rest in its static state (a rigid rail's) would only gather round-off: left
-  // there. Moved from it (a pluck), it is stepped.
-  const bool resting = lat.still && ls.v.isZero(0.0) && ls.y == lat.initial;
+  // A plane that nothing loads but its constant load (no wind, no droppers, whose tension moves
+  // with the vertical plane, no hinged arms: a rigid rail's), at rest in its static state, would
+  // only gather round-off: left there. Moved from it (a pluck), it is stepped.
+  const bool still = !lat.windy && lat.pendulums.empty() && lat.registrations.empty();
+  const bool resting = still && ls.v.isZero(0.0) && ls.y == lat.initial;
   if (arms) {
     place_at_arms(m, s);
     // The centred step's solve takes the band at the registrations as placed (no joint sweep).

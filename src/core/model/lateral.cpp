@@ -654,7 +654,6 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   lat->half_horn_width = 0.5 * head.horn_width;
 
   set_static_states(m, lat.get());
-  lat->still = !lat->windy && lat->pendulums.empty() && lat->registrations.empty();
   set_substeps(m, lat.get());
   build_lateral_packs(m, *lat);
   if (sc.numerics.damping == DampingStep::kCentred) factor_lateral_centred(m, *lat);

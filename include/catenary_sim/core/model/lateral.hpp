@@ -138,10 +138,6 @@ struct LateralModel {
   Eigen::VectorXd initial;  // m, static under the mean wind (the pass starts here)
   // Wind: per node 0.5 rho Cd d h (kg/m) and the sine of the wind's angle to the wire.
   bool windy = false;
-  // Nothing loads the plane but its constant load: no wind, no droppers (whose tension moves with
-  // the vertical plane) and no hinged arms (a rigid rail). At rest in its static state it stays
-  // there, and the lateral step leaves it so (lateral_step).
-  bool still = false;
   // The lateral plane steps only the moving window (numerics.window), except in a turbulent wind on
   // a finite line without numerics.gust_lead: there it steps the whole line, because a span
   // entering the window at rest in the mean wind would lack the motion the gusts built up over the
