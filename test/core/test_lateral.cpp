@@ -1346,8 +1346,9 @@ namespace {
 // Steps a pass with the fused lateral step and a copy of the model without its planes (the
 // generic step) side by side; every lateral value must agree to the bit, and every vertical one
 // (step() may sweep both planes at once where the model has planes). Returns the steps taken.
-int expect_fused_is_generic(const std::vector<std::string>& overrides, int* windowed_fused_steps) {
-  Simulation a(load_scene_file(test_scenes::kReference3d, overrides));
+int expect_fused_is_generic(const std::vector<std::string>& overrides, int* windowed_fused_steps,
+                            const std::string& path = test_scenes::kReference3d) {
+  Simulation a(load_scene_file(path, overrides));
   EXPECT_TRUE(a.model().lateral);
   if (!a.model().lateral) return 0;
   if (a.model().lateral->planes.empty()) {
@@ -1433,6 +1434,20 @@ TEST(Lateral, FusedStepIsTheGenericStepBitForBit) {
   windowed_fused = 0;
   EXPECT_GT(expect_fused_is_generic(hinged_windowed, &windowed_fused), 5000);
   EXPECT_GT(windowed_fused, 5000);
+  // The compound line (its 3-D scene: gusty wind, sway): the auxiliary, a wire of its own on its
+  // stations, is a pack of one lane, swept with its lateral plane in two lanes beside the pairs'
+  // four, at every step.
+  const std::string compound = test_scenes::scene_path("compound_catenary_3d.yaml");
+  const std::vector<std::string> short_line = {"line.span_count=4"};
+  windowed_fused = 0;
+  EXPECT_GT(expect_fused_is_generic(short_line, &windowed_fused, compound), 1000);
+  Simulation compound_joint(load_scene_file(compound, short_line));
+  bool lone = false;
+  for (int p = 0; p < wire_pack_count(compound_joint.model()); ++p) lone |= wire_pack_lanes(compound_joint.model(), p) == 1;
+  EXPECT_TRUE(lone);
+  while (compound_joint.step() == StepStatus::kOk) {
+  }
+  EXPECT_EQ(compound_joint.state().lateral.work->joined_steps, compound_joint.state().steps);
 }
 
 TEST(Lateral, AHeldRegistrationsRowIsItsWholeWiresBandForce) {

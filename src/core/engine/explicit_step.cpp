@@ -41,7 +41,7 @@ bool sweep_packs(const Model& m, State& s, bool windowed) {
   const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
   bool outside = false;
   // The lateral step's band sweep taken along (step_both_planes): both planes' records then in the
-  // joint layout (LateralWorkspace::sweep, joint_record_index).
+  // joint layout (LateralWorkspace::sweep, WirePacks::dof_joint_force).
   const bool join = m.lateral && s.lateral.work->join;
   bool lateral_outside = false;
   for (std::size_t pk = 0; pk < m.wire_packs->packs.size(); ++pk) {
@@ -191,11 +191,10 @@ int explicit_fused_update(const Model& m, State& s, bool windowed) {
   // its records (where z is too), in the generic step's order; the contact nodes then take their
   // force so far into the force vector, where the pantographs' contact adds to it.
   double* rec = join ? s.lateral.work->sweep.data() : s.work->sweep.data();
-  const int* f_at = m.wire_packs->dof_sweep_force.data();
-  const int* z_at = m.wire_packs->dof_sweep_z.data();
-  const int joint = join;
-  auto force_at = [rec, f_at, joint](int i) -> double& { return rec[joint_record_index(f_at[i], joint, false)]; };
-  auto z_rec = [rec, z_at, joint](int i) { return rec[joint_record_index(z_at[i], joint, false)]; };
+  const int* f_at = join ? m.wire_packs->dof_joint_force.data() : m.wire_packs->dof_sweep_force.data();
+  const int* z_at = join ? m.wire_packs->dof_joint_z.data() : m.wire_packs->dof_sweep_z.data();
+  auto force_at = [rec, f_at](int i) -> double& { return rec[f_at[i]]; };
+  auto z_rec = [rec, z_at](int i) { return rec[z_at[i]]; };
   if (leaning(m, s)) add_wire_point_forces<true>(m, s, u, v, force_at, z_rec, false);
   else add_wire_point_forces<false>(m, s, u, v, force_at, z_rec, false);
   for (int q = 0; q < contacts; ++q) f[contact_node[q]] = force_at(contact_node[q]);

@@ -393,7 +393,7 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
   double* vn = lw.v_next.data();
   double* acc = lw.accel.data();
   // The band sweeps: taken along by this step's vertical sweeps (step_both_planes), else here.
-  const int joined = lw.joined;  // (its records then in the joint layout: joint_record_index)
+  const bool joined = lw.joined;  // (its records then in the joint layout: LateralModel::joint_force_at)
   bool outside = joined && lw.joined_outside;
   if (!joined) {
     // (Held registrations where the joint sweep would have seen them: the same bits either way.)
@@ -408,10 +408,10 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
   // Point forces on the band forces the sweep left in its records, as the generic step adds them.
   double* f = lw.f.data();
   const double* rec = joined ? lw.sweep.data() : s.work->sweep.data();
-  const int* at = lat.sweep_force_at.data();
+  const int* at = joined ? lat.joint_force_at.data() : lat.sweep_force_at.data();
   const int* points = windowed ? lw.window_points.data() : lat.point_nodes.data();
   const int np = windowed ? lw.window_point_count : static_cast<int>(lat.point_nodes.size());
-  for (int q = 0; q < np; ++q) f[points[q]] = rec[joint_record_index(at[points[q]], joined, true)];
+  for (int q = 0; q < np; ++q) f[points[q]] = rec[at[points[q]]];
   if (windowed) add_window_forces(m, s, v, f);
   add_springs_and_pendulums(m, s, windowed, y, [y, v, beta](int i) { return y[i] + beta * v[i]; }, f);
   const double* im = lat.inv_mass.data();

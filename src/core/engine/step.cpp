@@ -27,9 +27,9 @@ StepStatus vertical_step(const Model& m, State& s) {
 
 namespace {
 
-// The vertical step, then the lateral one. Where both planes sweep every node of the same
-// two-wire packs (no window, one lateral substep, both fused), the vertical step runs the lateral
-// step's band sweep with its own, both planes in four lanes (sweep_pack_pair: the band and its
+// The vertical step, then the lateral one. Where both planes sweep every node of the same packs
+// (no window, one lateral substep, both fused), the vertical step runs the lateral step's band
+// sweep with its own, both planes in twice a pack's lanes (sweep_pack_pair: the band and its
 // factors are the same both ways, loaded once, and each band operation does both planes). The
 // lateral sweep reads nothing the vertical step changes (the lateral state, the wind of the
 // step's start, the shared band and factors), and each lane does its own plane's operations, so
@@ -41,9 +41,7 @@ StepStatus step_both_planes(const Model& m, State& s) {
   LateralState& ls = s.lateral;
   // Both planes sweep every node of the same packs: no window, one lateral step a vertical one,
   // both fused, and the step will be taken (not the pass's end).
-  bool two_wire_packs = true;  // (sweep_pack_pair's four lanes)
-  for (const WireLanes& p : packs_of(m)) two_wire_packs &= p.lanes == 2;
-  ls.work->join = !lat.planes.empty() && two_wire_packs && lat.substeps == 1 && !m.scene.numerics.windowed() &&
+  ls.work->join = !lat.planes.empty() && lat.substeps == 1 && !m.scene.numerics.windowed() &&
                   m.scene.numerics.damping != DampingStep::kCentred &&
             s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty();
   // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after

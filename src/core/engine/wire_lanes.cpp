@@ -337,28 +337,48 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   return !OnePlane<L, Plane, Drag>::inside(s.ok);  // some new displacement beyond the limit or NaN
 }
 
-// Both planes of a two-wire pack in four lanes, [vertical: wire 0, wire 1; lateral: wire 0,
-// wire 1]: the band and its factors are the same both ways (a round wire bends alike), so each
+// Both planes of an L-wire pack in 2L lanes, [vertical: wire 0 (, wire 1); lateral: wire 0 (,
+// wire 1)]: the band and its factors are the same both ways (a round wire bends alike), so each
 // coefficient is loaded once for both and every band operation does both planes at once; each
 // plane's state, load, damping, inverse mass and wind are its own (OnePlane's, in halves), the
-// records interleaved per node [value][4 lanes] (joint_record_index).
-template <bool Drag>
-struct TwoPlanes {
+// records interleaved per node [value][2L lanes] (WirePacks::dof_joint_force).
+template <int L>
+struct Halves;
+template <>
+struct Halves<1> {
+  using T = Double2;
+  using Half = double;
+  static T both(Half a, Half b) { return T{a, b}; }
+  static Half low(T x) { return x[0]; }
+  static Half high(T x) { return x[1]; }
+};
+template <>
+struct Halves<2> {
   using T = Double4;
-  using Half = Lane<2>::T;
+  using Half = Double2;
+  static T both(Half a, Half b) { return __builtin_shufflevector(a, b, 0, 1, 2, 3); }
+  static Half low(T x) { return __builtin_shufflevector(x, x, 0, 1); }
+  static Half high(T x) { return __builtin_shufflevector(x, x, 2, 3); }
+};
+
+template <int L, bool Drag>
+struct TwoPlanes : Halves<L> {
+  using H = Halves<L>;
+  using T = typename H::T;
+  using Half = typename H::Half;
+  using H::both;
+  using H::high;
+  using H::low;
   struct Mask {
-    Lane<2>::Mask vertical, lateral;
+    typename Lane<L>::Mask vertical, lateral;
   };
   static constexpr int NR = kSweepRecord;
-  OnePlane<2, false, false> vp;
-  OnePlane<2, true, Drag> lp;
+  OnePlane<L, false, false> vp;
+  OnePlane<L, true, Drag> lp;
   double* rec;
   T beta, dt, ww_lo, wt_lo, ww_hi, wt_hi;
   int lo, hi;
 
-  static T both(Half a, Half b) { return __builtin_shufflevector(a, b, 0, 1, 2, 3); }
-  static Half low(T x) { return __builtin_shufflevector(x, x, 0, 1); }
-  static Half high(T x) { return __builtin_shufflevector(x, x, 2, 3); }
   TwoPlanes(const PackSweep& a, const PackSweep& b, double* joint_record)
       : vp(a), lp(b), rec(joint_record), beta(both(vp.beta, lp.beta)), dt(both(vp.dt, lp.dt)),
         ww_lo(both(vp.ww_lo, lp.ww_lo)), wt_lo(both(vp.wt_lo, lp.wt_lo)), ww_hi(both(vp.ww_hi, lp.ww_hi)),
@@ -378,11 +398,11 @@ struct TwoPlanes {
   }
   __attribute__((always_inline)) T get(int i, int k) const {
     T x;
-    std::memcpy(&x, rec + (static_cast<std::ptrdiff_t>(i) * NR + k) * 4, sizeof x);
+    std::memcpy(&x, rec + (static_cast<std::ptrdiff_t>(i) * NR + k) * 2 * L, sizeof x);
     return x;
   }
   __attribute__((always_inline)) void set(int i, int k, T x) {
-    std::memcpy(rec + (static_cast<std::ptrdiff_t>(i) * NR + k) * 4, &x, sizeof x);
+    std::memcpy(rec + (static_cast<std::ptrdiff_t>(i) * NR + k) * 2 * L, &x, sizeof x);
   }
   __attribute__((always_inline)) T inv_mass(int i) const { return both(vp.inv_mass(i), lp.inv_mass(i)); }
   __attribute__((always_inline)) T init(int i, T vi) const { return both(vp.init(i, low(vi)), lp.init(i, high(vi))); }
@@ -410,17 +430,17 @@ struct TwoPlanes {
     vp.update2(i, low(a0), low(a1), ok.vertical);
     lp.update2(i, high(a0), high(a1), ok.lateral);
   }
-  static Mask all() { return Mask{Lane<2>::all(), Lane<2>::all()}; }
+  static Mask all() { return Mask{Lane<L>::all(), Lane<L>::all()}; }
 };
 
-// The vertical plane's sweep `a` and the lateral plane's `b` on the same two-wire pack and nodes.
-template <bool Drag>
+// The vertical plane's sweep `a` and the lateral plane's `b` on the same L-wire pack and nodes.
+template <int L, bool Drag>
 __attribute__((always_inline)) inline bool sweep_pair(const PackSweep& a, const PackSweep& b, double* joint_record,
                                                       bool* b_outside) {
-  Sweeper<TwoPlanes<Drag>> s(a, b, joint_record);
+  Sweeper<TwoPlanes<L, Drag>> s(a, b, joint_record);
   drive(s);
-  *b_outside = !Lane<2>::ok(s.ok.lateral);
-  return !Lane<2>::ok(s.ok.vertical);
+  *b_outside = !Lane<L>::ok(s.ok.lateral);
+  return !Lane<L>::ok(s.ok.vertical);
 }
 
 }  // namespace
@@ -440,7 +460,9 @@ CATENARY_SIM_CLONES bool sweep_pack(const PackSweep& a) {
 }
 
 CATENARY_SIM_CLONES bool sweep_pack_pair(const PackSweep& a, const PackSweep& b, double* joint_record, bool* b_outside) {
-  return b.wind[0] ? sweep_pair<true>(a, b, joint_record, b_outside) : sweep_pair<false>(a, b, joint_record, b_outside);
+  if (a.pack->lanes == 2)
+    return b.wind[0] ? sweep_pair<2, true>(a, b, joint_record, b_outside) : sweep_pair<2, false>(a, b, joint_record, b_outside);
+  return b.wind[0] ? sweep_pair<1, true>(a, b, joint_record, b_outside) : sweep_pair<1, false>(a, b, joint_record, b_outside);
 }
 
 bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const std::vector<WireWindow>* windows,

@@ -45,20 +45,14 @@ struct PackSweep {
 bool sweep_pack(const PackSweep& sweep);
 
 // The vertical plane's sweep `vertical` and the lateral plane's `lateral` (PackSweep::plane set)
-// of the same two-wire pack over the same nodes, in four lanes (the band and its factors are the
-// same both ways: loaded once, and every band operation does both planes): each plane gets what
-// sweep_pack gives it alone, to the bit (lane by lane the same operations), but both planes'
-// records are interleaved in `joint_record` (the pack's, per node [value][4 lanes]: see
-// joint_record_index) instead of at their PackSweep::record. Returns the vertical sweep's flag,
-// the lateral's in `lateral_outside`.
+// of the same pack (one wire or two) over the same nodes, in twice its lanes (the band and its
+// factors are the same both ways: loaded once, and every band operation does both planes): each
+// plane gets what sweep_pack gives it alone, to the bit (lane by lane the same operations), but
+// both planes' records are interleaved in `joint_record` (the pack's, per node [value][the
+// vertical plane's lanes, then the lateral plane's]: WirePacks::dof_joint_force and
+// LateralModel::joint_force_at find them) instead of at their PackSweep::record. Returns the
+// vertical sweep's flag, the lateral's in `lateral_outside`.
 bool sweep_pack_pair(const PackSweep& vertical, const PackSweep& lateral, double* joint_record, bool* lateral_outside);
-
-// Where a record of StepWorkspace::sweep's layout (index r, e.g. WirePacks::dof_sweep_force) is in the
-// joint records of sweep_pack_pair: the pack's two lanes become four, the vertical plane's first.
-// joint 0: r itself (the plane's own records).
-inline int joint_record_index(int r, int joint, bool lateral) {
-  return (r << joint) - (r & joint) + (lateral ? 2 * joint : 0);
-}
 
 // Sets up pack p's sweep over `windows` (per wire of `wires`, their factors interleaved in
 // `window_factors`: the vertical plane's State::window or the lateral plane's own; null: the whole

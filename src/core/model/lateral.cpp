@@ -77,6 +77,7 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
   lat.planes.clear();
   lat.point_nodes.clear();
   lat.sweep_force_at.clear();
+  lat.joint_force_at.clear();
   if (!m.wire_packs) return;  // the vertical step is not fused: neither is this one
   for (const WireLanes& p : m.wire_packs->packs) {
     const int L = p.lanes;
@@ -98,11 +99,16 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
     lat.planes.push_back(std::move(plane));
   }
   // The band force of lateral node i of wire wi lies where the vertical sweep leaves that of the
-  // wire's vertical node i.
+  // wire's vertical node i; in the joint records, the pack's lanes further on.
   lat.sweep_force_at.assign(lat.n, 0);
-  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi)
-    for (int i = 0; i < lat.wires[wi].nodes(); ++i)
+  lat.joint_force_at.assign(lat.n, 0);
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    const int lanes = m.wire_packs->packs[m.wire_packs->wire_pack[wi]].lanes;
+    for (int i = 0; i < lat.wires[wi].nodes(); ++i) {
       lat.sweep_force_at[lat.wires[wi].w_dof + i] = m.wire_packs->dof_sweep_force[m.wires[wi].w_dof + i];
+      lat.joint_force_at[lat.wires[wi].w_dof + i] = m.wire_packs->dof_joint_force[m.wires[wi].w_dof + i] + lanes;
+    }
+  }
   std::vector<char> listed(lat.n, 0);
   auto add = [&](int i) {
     if (listed[i]) return;

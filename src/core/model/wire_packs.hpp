@@ -41,8 +41,11 @@ struct WirePacks {
   std::vector<int> wire_pack, wire_lane;  // per wire (Model::wires): its pack and lane
   std::vector<int> centred_fixed_dofs;    // the wires' fixed vertical DOFs (centred damping step)
   double centred_v_ratio = 0.0;           // (2 / dt) / D_i per mass (centred damping step)
-  // Per catenary DOF: where the sweep leaves its band force and its z in StepWorkspace::sweep.
-  std::vector<int> dof_sweep_force, dof_sweep_z;
+  // Per catenary DOF: where the sweep leaves its band force and its z in StepWorkspace::sweep;
+  // and where the vertical step's sweep with the lateral plane's taken along (sweep_pack_pair)
+  // leaves them, in the joint records (2 kSweepRecord values per node-lane: the pack's at twice
+  // its offset, per node [value][the vertical plane's lanes, then the lateral plane's]).
+  std::vector<int> dof_sweep_force, dof_sweep_z, dof_joint_force, dof_joint_z;
   std::size_t sweep_size = 0;  // node-lanes of all packs (StepWorkspace::sweep holds 4 values for each)
 };
 

@@ -198,7 +198,9 @@ struct LateralModel {
   std::vector<int> centred_held;
   double centred_v_ratio = 0.0;
   std::vector<int> point_nodes;
-  std::vector<int> sweep_force_at;  // per lateral DOF: where the sweep leaves its band force (fused step)
+  // Per lateral DOF: where the sweep leaves its band force (fused step), in StepWorkspace::sweep's
+  // layout and in the joint records of the vertical step's sweep (WirePacks::dof_joint_force).
+  std::vector<int> sweep_force_at, joint_force_at;
   // Moving window (numerics.window; the vertical plane's window, State::window: the lateral waves
   // run at the same sqrt(T/rhoA)): -K initial over the whole line, so that the window's cut ends
   // get the force of the elements left out in the static state (outside, the wires stay there);
