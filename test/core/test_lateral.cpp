@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <numeric>
+#include <set>
 
 #include "catenary_sim/core/engine/lateral_energy.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
@@ -1339,6 +1340,101 @@ TEST(Lateral, StaggerErrorsBadInputNamesTheField) {
             std::string::npos);
   EXPECT_NE(error_of({"stagger.contact_wire=[0.3,-0.3]", "imperfections.stagger_seed=1.5"}).find("imperfections.stagger_seed"),
             std::string::npos);
+}
+
+TEST(Lateral, AnOverlapsContactWiresRunSideBySideAtItsSeparation) {
+  // overlap.lateral_separation s on the two-section reference line (one transition span, its
+  // supports at 495 and 550 m shared by both sections), staggered +-0.2 m. (a) At a shared support
+  // each section's wires are held s/2 to either side of the stagger, the ending section's (the
+  // first) to + of it; every other support keeps its stagger. (b) No messenger stagger is given,
+  // so each messenger is held where its contact wire is and the droppers hang plumb: each contact
+  // wire runs along the chord between its held points, up to the tensioned beam's rounding of the
+  // kink at an in-running support (StaggerErrorsMoveTheRegistration's bound c = |slope change| /
+  // (lambda - 2 / L), lambda = sqrt(T / EI); an anchor has no kink). The two wires' chords through
+  // the transition span are s apart at both ends, so the wires run side by side s apart within
+  // the two wires' c (1.3 mm each here; without the separation they would be 0.2 m off it).
+  const double s = 0.2, L = 55.0;
+  const std::vector<std::string> base{"stagger.contact_wire=[0.2,-0.2]"};
+  std::vector<std::string> apart = base;
+  apart.push_back("overlap.lateral_separation=0.2");
+  const Model m = build_model(load_scene_file(test_scenes::kReferenceTwoSections, apart));
+  const Model m0 = build_model(load_scene_file(test_scenes::kReferenceTwoSections, base));
+  ASSERT_TRUE(m.lateral && m0.lateral);
+  ASSERT_EQ(m.lateral->supports.size(), m0.lateral->supports.size());
+  const Eigen::VectorXd& y = m.lateral->calm;
+  // (a) Which sections hold a wire at each line support, then every support's move.
+  std::vector<std::set<int>> sections(m.support_x.size());
+  for (const LateralSupport& a : m.lateral->supports) sections[a.line_support].insert(m.wires[a.wire].section);
+  int shared = 0;
+  for (std::size_t k = 0; k < m.lateral->supports.size(); ++k) {
+    const LateralSupport &a = m.lateral->supports[k], &b = m0.lateral->supports[k];
+    ASSERT_EQ(a.line_support, b.line_support);
+    const std::set<int>& here = sections[a.line_support];
+    const int section = m.wires[a.wire].section;
+    const double expected = here.size() < 2 ? 0.0 : (section == *here.begin() ? 0.5 * s : -0.5 * s);
+    shared += here.size() == 2 && m.wires[a.wire].is_contact_wire;
+    EXPECT_NEAR(a.stagger - b.stagger, expected, 1e-12) << m.wires[a.wire].name << " at " << a.x << " m";
+    if (a.rigid) {
+      EXPECT_NEAR(y[m.lateral->wires[a.wire].w_dof + a.node], a.stagger, 1e-12);  // held there
+    }
+  }
+  EXPECT_EQ(shared, 4);  // both contact wires at both supports of the transition span
+  // (b) Each contact wire's chord over the transition span and its bound c.
+  struct Run {
+    const Wire* wire;
+    double y0, y1, c;  // held at 495 and 550 m
+  };
+  std::vector<Run> runs;
+  for (int cw : m.contact_wires) {
+    const Wire& w = m.lateral->wires[cw];
+    std::map<double, const LateralSupport*> held;  // by station
+    for (const LateralSupport& a : m.lateral->supports)
+      if (a.wire == cw) held[a.x] = &a;
+    ASSERT_TRUE(held.count(495.0) && held.count(550.0));
+    const double lambda = std::sqrt(w.spec.tension / w.spec.bending_stiffness);
+    double kink = 0.0;
+    for (double x : {495.0, 550.0}) {
+      const auto it = held.find(x);
+      if (it->second->anchor) continue;
+      const double in = (it->second->stagger - std::prev(it)->second->stagger) / L;
+      const double out = (std::next(it)->second->stagger - it->second->stagger) / L;
+      kink = std::max(kink, std::fabs(out - in));
+    }
+    runs.push_back({&w, held[495.0]->stagger, held[550.0]->stagger, kink / (lambda - 2.0 / L)});
+  }
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_NEAR(runs[0].y0 - runs[1].y0, s, 1e-12);
+  EXPECT_NEAR(runs[0].y1 - runs[1].y1, s, 1e-12);
+  EXPECT_GT(runs[0].c + runs[1].c, 5e-4);  // a real kink: the bound is not vacuous
+  int compared = 0;
+  double worst = 0.0;
+  const Wire &first = *runs[0].wire, &second = *runs[1].wire;
+  for (int i = 0; i < first.nodes(); ++i) {
+    const double x = first.x[i];
+    if (x < 495.0 + 3.0 || x > 550.0 - 3.0) continue;  // clear of the kinks' rounding at the supports
+    const auto it = std::lower_bound(second.x.begin(), second.x.end(), x - 1e-9);
+    ASSERT_TRUE(it != second.x.end() && std::fabs(*it - x) < 1e-9) << "no node of the second wire at " << x << " m";
+    const int j = static_cast<int>(it - second.x.begin());
+    worst = std::max(worst, std::fabs((y[first.w_dof + i] - y[second.w_dof + j]) - s));
+    ++compared;
+  }
+  EXPECT_GT(compared, 150);  // every 0.25 m over 49 m
+  EXPECT_LT(worst, 1.05 * (runs[0].c + runs[1].c));
+}
+
+TEST(Lateral, AnOverlapsSeparationBadInputNamesTheField) {
+  auto error_of = [](const std::vector<std::string>& o) {
+    return test_scenes::refusal_of(test_scenes::kReferenceTwoSections, o);
+  };
+  // Beyond its range; on a 2-D line (no positions in plan); and a contact wire put outside the
+  // pantograph head's working width (+-0.6 m) at a shared support: 0.5 + 0.25 / 2.
+  EXPECT_NE(error_of({"stagger.contact_wire=[0.2,-0.2]", "overlap.lateral_separation=1.5"}).find("overlap.lateral_separation"),
+            std::string::npos);
+  EXPECT_NE(error_of({"overlap.lateral_separation=0.2"}).find("overlap.lateral_separation"), std::string::npos);
+  const std::string wide = error_of({"stagger.contact_wire=[0.5,-0.5]", "overlap.lateral_separation=0.25"});
+  EXPECT_NE(wide.find("overlap.lateral_separation"), std::string::npos) << wide;
+  EXPECT_NE(wide.find("working width"), std::string::npos) << wide;
+  EXPECT_TRUE(error_of({"stagger.contact_wire=[0.5,-0.5]", "overlap.lateral_separation=0.15"}).empty());
 }
 
 namespace {

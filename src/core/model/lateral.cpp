@@ -36,6 +36,30 @@ double stagger_at(const Scene& s, bool contact, long support) {
   return st.at(p, static_cast<std::size_t>(((support % n) + n) % n));
 }
 
+// overlap.lateral_separation: at a support two sections share, each section's wires held s/2 to
+// either side of the stagger, the ending section's (the earlier: the later one shares the support)
+// to + of it for s > 0; 0 where one section alone is held. `section` per line support: the lowest
+// and highest section with a wire held there.
+struct OverlapSides {
+  std::vector<int> first, last;
+  double half = 0.0;
+  OverlapSides(const Model& m, const std::vector<Wire>& wires) {
+    if (m.scene.overlap) half = 0.5 * m.scene.overlap->lateral_separation;
+    first.assign(m.support_x.size(), std::numeric_limits<int>::max());
+    last.assign(m.support_x.size(), -1);
+    for (const Wire& w : wires)
+      for (int node : w.support_nodes) {
+        const int j = line_support(m, w.x[node]);
+        first[j] = std::min(first[j], w.section);
+        last[j] = std::max(last[j], w.section);
+      }
+  }
+  double offset(int line_support, int section) const {
+    if (half == 0.0 || first[line_support] == last[line_support]) return 0.0;
+    return section < last[line_support] ? half : -half;
+  }
+};
+
 // f -= K_lateral z over all wires, springs, pendulums and stitch wires' clamps (pendulum
 // stiffness from `tension`, per dropper, or the static tension when null). theta: scratch of the
 // longest wire's nodes.
@@ -198,6 +222,8 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
   const std::optional<double> arm_k = sc.stagger ? sc.stagger->steady_arm_stiffness : std::nullopt;
   const std::optional<double> msup_k = sc.stagger ? sc.stagger->messenger_support_stiffness : std::nullopt;
   std::vector<bool> fixed(n, false);
+  const OverlapSides overlap(m, m.wires);
+  const double half_width = 0.5 * sc.pantograph_head.working_width;
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     const Wire& w = m.wires[wi];
     const Wire& l = lat->wires[wi];
@@ -234,7 +260,13 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
       // free, hung by its droppers), so that the hangers hang plumb and the droppers above take
       // any lean toward the messenger.
       s.stagger = stagger_at(sc, w.is_contact_wire || w.is_auxiliary_messenger, s.line_support + support_offset) +
-                  (w.is_contact_wire ? stagger_error[s.line_support] : 0.0);  // (no errors on an endless line)
+                  (w.is_contact_wire ? stagger_error[s.line_support] : 0.0) +  // (no errors on an endless line)
+                  overlap.offset(s.line_support, w.section);
+      if (w.is_contact_wire && overlap.offset(s.line_support, w.section) != 0.0 && !(std::fabs(s.stagger) < half_width))
+        throw SceneError("scene field 'overlap.lateral_separation' = " + fmt(sc.overlap->lateral_separation) +
+                         " m puts the contact wire of section " + std::to_string(w.section) + " at " + fmt(s.stagger) +
+                         " m at the support at station " + fmt(s.x) + " m: keep it inside the pantograph head's working width, |y| < " +
+                         fmt(half_width) + " m (pantograph_head.working_width / 2)");
       s.anchor = k == 0 || k == ns - 1;
       const std::optional<double>& spring = w.is_contact_wire ? arm_k : msup_k;
       s.rigid = s.anchor || !spring;

@@ -330,6 +330,7 @@ void read_overlap(Reader& top, Scene& s) {
     o.spans = static_cast<int>(k);
     if (r.has("support_rise")) o.support_rise = r.number("support_rise", 0.0, 2.0);
     if (r.has("design_force")) o.design_force = r.number("design_force", 0.0, 2000.0, std::nullopt, true);
+    o.lateral_separation = r.number("lateral_separation", -1.0, 1.0, 0.0);
     r.finish();
     s.overlap = o;
   } else if (s.sections.size() > 1) {

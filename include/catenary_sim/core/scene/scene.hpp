@@ -200,6 +200,10 @@ struct OverlapSpec {
   int spans = 1;                       // transition spans shared by consecutive sections
   std::optional<double> support_rise;  // d of eq. 8, m; empty: eq. 6-8 with E measured on the model
   std::optional<double> design_force;  // F of eq. 6, N; empty: the mean static uplift of the pantographs (else 100 N)
+  // On a 3-D line, m: at a support both sections share, each section's wires are held half of it
+  // to either side of the stagger, the ending section's to the left (+) of it for a positive
+  // value, so that through the transition spans the two contact wires run side by side.
+  double lateral_separation = 0.0;
 };
 
 enum class RotaryInertia { kCondensed, kLumped };
