@@ -100,6 +100,34 @@ TEST_F(PassReport, ThreeDimensionalLineAddsTheLateralSection) {
        at = page.find("src='data:image/png;base64,", at + 1))
     ++images;
   EXPECT_EQ(images, 8u);  // the seven sections of a 2-D pass and the lateral one
+  // Windless, with each messenger over its contact wire: the droppers hang plumb and the wires
+  // move across the track by micrometres at most (blow_off.csv: under 1e-6 m), so the page says
+  // so instead of drawing bars of nothing.
+  EXPECT_NE(page.find("no blow-off"), std::string::npos);
+  EXPECT_NE(page.find("coupled two-way through the droppers"), std::string::npos);
+}
+
+// In a wind the lateral page has its blow-off per span; on a rail nothing joins the planes and the
+// page says that too.
+TEST_F(PassReport, TheLateralPageSaysWhatMovesTheWiresAndWhatJoinsThePlanes) {
+  const std::string windy = dir_ + "/windy", rail = dir_ + "/rail";
+  const ChildRun w = run_child({kSimulatePass, "--scene", test_scenes::kReference3d, "--out", windy, "--speed", "250",
+                                "--set", "line.span_count=6", "--set", "numerics.element_length=0.5", "--report",
+                                "--no-progress"},
+                               dir_ + "/windy_log.txt", 300.0);
+  ASSERT_FALSE(w.hung);
+  ASSERT_EQ(w.exit_code, 0) << w.out;
+  const std::string blown = slurp(windy + "/report.html");
+  EXPECT_NE(blown.find("and the blow-off per span"), std::string::npos);
+  EXPECT_EQ(blown.find("no blow-off"), std::string::npos);
+  const ChildRun r = run_child({kSimulatePass, "--scene", test_scenes::scene_path("rigid_conductor_rail_3d.yaml"), "--out",
+                                rail, "--report", "--no-progress"},
+                               dir_ + "/rail_log.txt", 300.0);
+  ASSERT_FALSE(r.hung);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const std::string still = slurp(rail + "/report.html");
+  EXPECT_NE(still.find("no blow-off"), std::string::npos);
+  EXPECT_NE(still.find("coupled to nothing"), std::string::npos);
 }
 
 // Hinged steady arms: the statistics table gives their k_A, pull-off and inclinations, as

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 namespace catenary_sim {
 
@@ -231,7 +232,17 @@ std::string lateral_statistics_json(const Model& m, const LateralStatistics& st)
   const Scene& sc = m.scene;
   j["working_width_m"] = sc.pantograph_head.working_width;
   j["horn_width_m"] = sc.pantograph_head.horn_width;
-  j["coupling"] = "two-way through the droppers: their tension sets the lateral pendulums, their lean's stretch (dy^2 - dy0^2) / (2 l) their vertical force";
+  // What joins the two planes on this line, in words for the report.
+  std::string coupling;
+  if (!lat.pendulums.empty())
+    coupling = "two-way through the droppers: their tension sets the lateral pendulums, their lean's stretch "
+               "(dy^2 - dy0^2) / (2 l) their vertical force";
+  if (!lat.registrations.empty())
+    coupling += std::string(coupling.empty() ? "" : "; ") +
+                "two-way through the hinged steady arms: each registration is where its arm's end is, and the "
+                "wire's lateral pull turns the arm";
+  if (coupling.empty()) coupling = "to nothing: no dropper or hinged arm joins the planes, so the vertical pass is the 2-D line's";
+  j["coupling"] = coupling;
   j["lateral_dofs"] = lat.n;
   j["lateral_substeps"] = lat.substeps;
   Json contacts = Json::array();
