@@ -110,22 +110,20 @@ TEST_F(PassReport, ThreeDimensionalLineAddsTheLateralSection) {
 // In a wind the lateral page has its blow-off per span; on a rail nothing joins the planes and the
 // page says that too.
 TEST_F(PassReport, TheLateralPageSaysWhatMovesTheWiresAndWhatJoinsThePlanes) {
-  const std::string windy = dir_ + "/windy", rail = dir_ + "/rail";
-  const ChildRun w = run_child({kSimulatePass, "--scene", test_scenes::kReference3d, "--out", windy, "--speed", "250",
-                                "--set", "line.span_count=6", "--set", "numerics.element_length=0.5", "--report",
-                                "--no-progress"},
-                               dir_ + "/windy_log.txt", 300.0);
-  ASSERT_FALSE(w.hung);
-  ASSERT_EQ(w.exit_code, 0) << w.out;
-  const std::string blown = slurp(windy + "/report.html");
+  // simulate_pass --report on `scene` with `extra` arguments into `name`; its page.
+  auto page_of = [&](const std::string& scene, const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = {kSimulatePass, "--scene", scene, "--out", dir_ + "/" + name, "--report", "--no-progress"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const ChildRun r = run_child(args, dir_ + "/" + name + "_log.txt", 300.0);
+    EXPECT_FALSE(r.hung);
+    EXPECT_EQ(r.exit_code, 0) << r.out;
+    return slurp(dir_ + "/" + name + "/report.html");
+  };
+  const std::string blown = page_of(test_scenes::kReference3d, "windy",
+                                    {"--speed", "250", "--set", "line.span_count=6", "--set", "numerics.element_length=0.5"});
   EXPECT_NE(blown.find("and the blow-off per span"), std::string::npos);
   EXPECT_EQ(blown.find("no blow-off"), std::string::npos);
-  const ChildRun r = run_child({kSimulatePass, "--scene", test_scenes::scene_path("rigid_conductor_rail_3d.yaml"), "--out",
-                                rail, "--report", "--no-progress"},
-                               dir_ + "/rail_log.txt", 300.0);
-  ASSERT_FALSE(r.hung);
-  ASSERT_EQ(r.exit_code, 0) << r.out;
-  const std::string still = slurp(rail + "/report.html");
+  const std::string still = page_of(test_scenes::scene_path("rigid_conductor_rail_3d.yaml"), "rail", {});
   EXPECT_NE(still.find("no blow-off"), std::string::npos);
   EXPECT_NE(still.find("coupled to nothing"), std::string::npos);
 }
