@@ -38,8 +38,8 @@ double stagger_at(const Scene& s, bool contact, long support) {
 
 // overlap.lateral_separation: at a support two sections share, each section's wires held s/2 to
 // either side of the stagger, the ending section's (the earlier: the later one shares the support)
-// to + of it for s > 0; 0 where one section alone is held. `section` per line support: the lowest
-// and highest section with a wire held there.
+// to + of it for s > 0; 0 where one section alone is held. `first`, `last`: per line support, the
+// lowest and highest section with a wire held there.
 struct OverlapSides {
   std::vector<int> first, last;
   double half = 0.0;
