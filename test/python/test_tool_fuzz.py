@@ -40,10 +40,11 @@ def refused(r, *words):
 @pytest.fixture(scope="module")
 def passes(tmp_path_factory):
     """Two short passes of six 55 m spans (as test_pass_report): the 2-D line and the 3-D one
-    (stagger), whose lateral files the report draws too."""
+    (stagger and a steady 20 m/s cross wind, so that there is blow-off to draw), whose lateral files
+    the report draws too."""
     base = tmp_path_factory.mktemp("passes")
     out = {}
-    for name, extra in (("2d", []), ("3d", ["--set", "stagger.contact_wire=[0.3,-0.3]"])):
+    for name, extra in (("2d", []), ("3d", ["--set", "stagger.contact_wire=[0.3,-0.3]", "--set", "wind.speed=20"])):
         d = str(base / name)
         r = subprocess.run([os.path.join(DEVEL, "simulate_pass"), "--scene", REFERENCE, "--out", d, "--speed", "250",
                             "--set", "line.span_count=6", "--set", "numerics.element_length=0.5", "--no-progress",
