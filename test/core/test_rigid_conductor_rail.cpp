@@ -30,15 +30,18 @@ namespace {
 
 constexpr double kRhoA = 7.27, kEI = 2.8e5, kG = 9.81, kSpan = 10.0;
 
-// A one-section rigid rail of `spans` equal spans; `extra` is appended (pantographs, train, ...).
-std::string rail_yaml(int spans, double support_stiffness, double element, const std::string& extra = "") {
+// A one-section rigid rail of `spans` equal spans; `extra` is appended (pantographs, train, ...);
+// lateral_ei > 0: the profile's own bending stiffness across the track.
+std::string rail_yaml(int spans, double support_stiffness, double element, const std::string& extra = "",
+                      double lateral_ei = 0.0) {
   std::ostringstream y;
   y.precision(10);
   y << "name: rail\n"
     << "line:\n  span_length: " << kSpan << "\n  span_count: " << spans << "\n"
     << "conductor_rail:\n  linear_mass: " << kRhoA << "\n  bending_stiffness: " << kEI
-    << "\n  support_stiffness: " << support_stiffness << "\n"
-    << "contact:\n  rub_length: 0.0\n"
+    << "\n  support_stiffness: " << support_stiffness << "\n";
+  if (lateral_ei > 0.0) y << "  lateral_bending_stiffness: " << lateral_ei << "\n";
+  y << "contact:\n  rub_length: 0.0\n"
     << "numerics:\n  element_length: " << element << "\n"
     << extra;
   return y.str();
@@ -183,6 +186,11 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
   refused(with("numerics:\n", "numerics:\n  window: auto\n"), "numerics.window");
   refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\nwind: {speed: 20, contact_wire: {diameter: 0.012}}\n", "wind");
   refused(y + "imperfections:\n  contact_wire_wear:\n    section_loss: 0.1\n", "imperfections.contact_wire_wear");
+  const std::string stagger = "stagger:\n  contact_wire: [0.2, -0.2]\n";
+  std::string negative = rail_yaml(3, 5e6, 0.25, stagger, 1e5);
+  negative.replace(negative.find("lateral_bending_stiffness: 100000"), 33, "lateral_bending_stiffness: -1");
+  refused(negative, "conductor_rail.lateral_bending_stiffness");
+  refused(rail_yaml(3, 5e6, 0.25, "", 1e5), "conductor_rail.lateral_bending_stiffness");  // a 2-D line
   // Two rigid sections need the end ramp's rise.
   const std::string two =
       "name: two\nline: {}\nconductor_rail: {linear_mass: 7.27, bending_stiffness: 2.8e5, support_stiffness: 5e6}\n"
@@ -384,9 +392,11 @@ TEST(RigidConductorRail, TwoPantographsEachPressWithTheirUplift) {
 // The pinned ends disturb this by 2 - sqrt(3) = 0.27 per span (the three-moment equation's
 // decay): 0.27^14 = 1e-8 of it at the middle spans of 30. Beam elements hold a cubic exactly, so
 // what is left is round-off: 1e-9 m on the line, 1e-6 of the pull-off.
-TEST(RigidConductorRail, OnA3dLineAZigzagBendsTheProfileAsAContinuousBeam) {
-  const double s = 0.2;
-  const cs::Scene scene = cs::load_scene_string(rail_yaml(30, 5e6, 0.25, "stagger:\n  contact_wire: [0.2, -0.2]\n"));
+namespace {
+
+void zigzag_bends_as_a_continuous_beam(double lateral_ei) {
+  const double s = 0.2, ei = lateral_ei > 0.0 ? lateral_ei : kEI;
+  const cs::Scene scene = cs::load_scene_string(rail_yaml(30, 5e6, 0.25, "stagger:\n  contact_wire: [0.2, -0.2]\n", lateral_ei));
   cs::Simulation sim(scene);
   const cs::Model& m = sim.model();
   ASSERT_TRUE(m.lateral);
@@ -402,7 +412,7 @@ TEST(RigidConductorRail, OnA3dLineAZigzagBendsTheProfileAsAContinuousBeam) {
     ++checked;
   }
   EXPECT_EQ(checked, 81);  // 0.25 m elements over 20 m
-  const double pull_off = 48.0 * kEI * s / (kSpan * kSpan * kSpan);  // 2688 N
+  const double pull_off = 48.0 * ei * s / (kSpan * kSpan * kSpan);  // 2688 N with the vertical EI
   int supports = 0;
   for (const cs::LateralSupport& sup : lat.supports) {
     if (sup.x < 120.0 - 1e-9 || sup.x > 180.0 + 1e-9) continue;
@@ -411,6 +421,17 @@ TEST(RigidConductorRail, OnA3dLineAZigzagBendsTheProfileAsAContinuousBeam) {
     ++supports;
   }
   EXPECT_EQ(supports, 7);
+}
+
+}  // namespace
+
+TEST(RigidConductorRail, OnA3dLineAZigzagBendsTheProfileAsAContinuousBeam) {
+  // With the vertical EI across the track too, and with a lateral EI of its own (half: the line is
+  // the same cubic, the pull-off half).
+  for (const double lateral_ei : {0.0, 0.5 * kEI}) {
+    SCOPED_TRACE(lateral_ei > 0.0 ? "lateral EI of its own" : "the vertical EI");
+    zigzag_bends_as_a_continuous_beam(lateral_ei);
+  }
 }
 
 // (g) Nothing joins a rail's two planes: no droppers lean, no hinged arm turns, and the strip is
@@ -461,15 +482,21 @@ TEST(RigidConductorRail, OnA3dLineTheVerticalPassIsThe2dLinesAndTheContactPointF
 // shift so long a mode by well under 1e-4, the step ((omega dt)^2 / 24, omega dt = 2e-3) and the
 // light Rayleigh damping (xi = 1.3e-3, the damped frequency lower by xi^2 / 2) by under 1e-6; the
 // period is read from zero crossings interpolated within a step over 5 periods.
-TEST(RigidConductorRail, OnA3dLineAPluckedProfileSwingsAtItsSpanFrequency) {
-  const double amplitude = 1e-3;
+// With a lateral EI of its own (conductor_rail.lateral_bending_stiffness, here half the vertical
+// one) the profile swings at pi^2 / L^2 sqrt(EI_lateral / m), a factor 1 / sqrt(2) lower, in the
+// generic lateral step (the fused sweep runs on the vertical band).
+namespace {
+
+void plucked_profile_swings_at_its_span_frequency(double lateral_ei) {
+  const double amplitude = 1e-3, ei = lateral_ei > 0.0 ? lateral_ei : kEI;
   const std::string extra =
       "stagger:\n  contact_wire: [0.2, -0.2]\n"
       "pantographs:\n  - name: force\n    type: moving_force\n    static_uplift: 100.0\n"
       "train:\n  speed: 1.0\n  start: 0.0\n  end: 20.0\n";
-  cs::Simulation sim(cs::load_scene_string(rail_yaml(6, 5e6, 0.25, extra)));
+  cs::Simulation sim(cs::load_scene_string(rail_yaml(6, 5e6, 0.25, extra, lateral_ei)));
   const cs::Model& m = sim.model();
   ASSERT_TRUE(m.lateral && !m.lateral->windy && m.lateral->pendulums.empty() && m.lateral->registrations.empty());
+  EXPECT_EQ(m.lateral->planes.empty(), lateral_ei > 0.0);
   const cs::LateralModel& lat = *m.lateral;
   const cs::Wire& w = lat.wires[0];
   cs::State s = sim.state();
@@ -482,7 +509,7 @@ TEST(RigidConductorRail, OnA3dLineAPluckedProfileSwingsAtItsSpanFrequency) {
   const int dof = w.w_dof + probe;
   std::vector<double> up_crossings;
   double before = s.lateral.y[dof] - lat.initial[dof];
-  while (s.time < 2.0) {
+  while (s.time < 2.0 * std::sqrt(kEI / ei)) {  // (6 periods)
     ASSERT_EQ(cs::step(m, s), cs::StepStatus::kOk);
     const double now = s.lateral.y[dof] - lat.initial[dof];
     if (before < 0.0 && now >= 0.0) up_crossings.push_back(s.time - m.dt * now / (now - before));
@@ -490,6 +517,15 @@ TEST(RigidConductorRail, OnA3dLineAPluckedProfileSwingsAtItsSpanFrequency) {
   }
   ASSERT_GE(up_crossings.size(), 5u);
   const double period = (up_crossings.back() - up_crossings.front()) / (up_crossings.size() - 1);
-  const double omega = M_PI * M_PI / (kSpan * kSpan) * std::sqrt(kEI / kRhoA);
+  const double omega = M_PI * M_PI / (kSpan * kSpan) * std::sqrt(ei / kRhoA);
   EXPECT_NEAR(2.0 * M_PI / period, omega, 0.001 * omega) << "period " << period << " s";
+}
+
+}  // namespace
+
+TEST(RigidConductorRail, OnA3dLineAPluckedProfileSwingsAtItsSpanFrequency) {
+  for (const double lateral_ei : {0.0, 0.5 * kEI}) {
+    SCOPED_TRACE(lateral_ei > 0.0 ? "lateral EI of its own" : "the vertical EI");
+    plucked_profile_swings_at_its_span_frequency(lateral_ei);
+  }
 }

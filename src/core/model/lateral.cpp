@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "catenary_sim/core/model/beam.hpp"
+#include "catenary_sim/core/model/wire_band.hpp"
 #include "model/centred_factors.hpp"
 #include "model/normal_errors.hpp"
 #include "model/wire_packs.hpp"
@@ -103,6 +104,10 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
   lat.sweep_force_at.clear();
   lat.joint_force_at.clear();
   if (!m.wire_packs) return;  // the vertical step is not fused: neither is this one
+  // The fused sweep runs on the vertical packs' band: a wire bending otherwise across the track (a
+  // rail's profile with its own lateral EI) takes the generic lateral step.
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi)
+    if (lat.wires[wi].spec.bending_stiffness != m.wires[wi].spec.bending_stiffness) return;
   for (const WireLanes& p : m.wire_packs->packs) {
     const int L = p.lanes;
     std::vector<double> plane(static_cast<std::size_t>(p.nodes) * kPlaneValues * L, 0.0);
@@ -198,8 +203,9 @@ std::vector<double> stagger_errors(const Model& m) {
   return e;
 }
 
-// The lateral wires (the vertical ones' band, rotations condensed), their masses, the curve's load
-// and the supports in plan: rigid at the stagger, or springs pulling toward it.
+// The lateral wires (the vertical ones' band, or a rail profile's own across the track; rotations
+// condensed), their masses, the curve's load and the supports in plan: rigid at the stagger, or
+// springs pulling toward it.
 void add_wires_and_supports(const Model& m, LateralModel* lat) {
   const Scene& sc = m.scene;
   const std::vector<double> stagger_error = stagger_errors(m);
@@ -208,6 +214,14 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
     Wire l = w;
     l.w_dof = off;
     l.theta_dof = -1;  // massless rotations, condensed (assemble_band always factorises K_tt)
+    // A rail's profile bends across the track with its own EI where the scene gives it (the round
+    // wires alike both ways); the plane then has a band of its own (no fused sweep on the vertical
+    // packs' band: build_lateral_packs).
+    const std::optional<double>& lateral_ei = sc.sections[w.section].rail_lateral_bending_stiffness;
+    if (lateral_ei && *lateral_ei != w.spec.bending_stiffness) {
+      l.spec.bending_stiffness = *lateral_ei;
+      assemble_band(l, {});
+    }
     off += w.nodes();
     lat->wires.push_back(std::move(l));
   }

@@ -84,6 +84,8 @@ void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
   sec.contact_wire = ContactWireSpec{};
   sec.contact_wire.linear_mass = c.number("linear_mass", 0.0, 100.0, std::nullopt, true);
   sec.contact_wire.bending_stiffness = c.number("bending_stiffness", 0.0, 1e8, std::nullopt, true);
+  if (c.has("lateral_bending_stiffness"))
+    sec.rail_lateral_bending_stiffness = c.number("lateral_bending_stiffness", 0.0, 1e8, std::nullopt, true);
   SupportSpec support;
   support.stiffness = c.number("support_stiffness", 0.0, 1e10, std::nullopt, true);
   support.mass = c.number("support_mass", 0.0, 1000.0, 0.0);

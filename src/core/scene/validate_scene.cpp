@@ -124,6 +124,14 @@ void validate_acting_fields(const Scene& s) {
            "explicit on a line with stitch wires (their stiff clamps join the messenger's and the stitch wire's "
            "solves, which the implicit lead takes one wire at a time)");
   }
+  if (!s.lateral())
+    for (std::size_t i = 0; i < s.sections.size(); ++i)
+      if (s.sections[i].rail_lateral_bending_stiffness)
+        fail((s.sections.size() > 1 ? "sections[" + std::to_string(i) + "]." : std::string()) +
+                 "conductor_rail.lateral_bending_stiffness",
+             fmt(*s.sections[i].rail_lateral_bending_stiffness),
+             "only on a 3-D line (stagger, alignment or pantograph_head.sway): a 2-D line does not bend the "
+             "profile across the track");
   if (!s.lateral() && s.overlap && s.overlap->lateral_separation != 0.0)
     fail("overlap.lateral_separation", fmt(s.overlap->lateral_separation),
          "0 on a 2-D line, or a 3-D line (stagger, alignment, wind or pantograph_head.sway) that has the wires' "

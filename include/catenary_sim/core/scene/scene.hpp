@@ -190,6 +190,9 @@ struct SectionSpec {
   // intermediate support by `steady_arms` (the supports' spring and mass); no messenger, droppers
   // or presag. Read from the section's `conductor_rail` fields.
   bool rigid = false;
+  // The profile's bending stiffness across the track (conductor_rail.lateral_bending_stiffness),
+  // N m^2: the lateral plane's EI on a 3-D line; empty: its vertical one (contact_wire's).
+  std::optional<double> rail_lateral_bending_stiffness;
   bool first_span_transition = false;  // default: true where a previous section overlaps it
   bool last_span_transition = false;   // default: true where a next section overlaps it
   double length() const;
