@@ -44,11 +44,11 @@ double stagger_at(const Scene& s, bool contact, long support) {
 struct OverlapSides {
   std::vector<int> first, last;
   double half = 0.0;
-  OverlapSides(const Model& m, const std::vector<Wire>& wires) {
+  explicit OverlapSides(const Model& m) {
     if (m.scene.overlap) half = 0.5 * m.scene.overlap->lateral_separation;
     first.assign(m.support_x.size(), std::numeric_limits<int>::max());
     last.assign(m.support_x.size(), -1);
-    for (const Wire& w : wires)
+    for (const Wire& w : m.wires)
       for (int node : w.support_nodes) {
         const int j = line_support(m, w.x[node]);
         first[j] = std::min(first[j], w.section);
@@ -236,7 +236,7 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
   const std::optional<double> arm_k = sc.stagger ? sc.stagger->steady_arm_stiffness : std::nullopt;
   const std::optional<double> msup_k = sc.stagger ? sc.stagger->messenger_support_stiffness : std::nullopt;
   std::vector<bool> fixed(n, false);
-  const OverlapSides overlap(m, m.wires);
+  const OverlapSides overlap(m);
   const double half_width = 0.5 * sc.pantograph_head.working_width;
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     const Wire& w = m.wires[wi];
@@ -273,10 +273,11 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
       // held in plan at the contact wire's stagger at every support (vertically it passes them
       // free, hung by its droppers), so that the hangers hang plumb and the droppers above take
       // any lean toward the messenger.
+      const double apart = overlap.offset(s.line_support, w.section);
       s.stagger = stagger_at(sc, w.is_contact_wire || w.is_auxiliary_messenger, s.line_support + support_offset) +
                   (w.is_contact_wire ? stagger_error[s.line_support] : 0.0) +  // (no errors on an endless line)
-                  overlap.offset(s.line_support, w.section);
-      if (w.is_contact_wire && overlap.offset(s.line_support, w.section) != 0.0 && !(std::fabs(s.stagger) < half_width))
+                  apart;
+      if (w.is_contact_wire && apart != 0.0 && !(std::fabs(s.stagger) < half_width))
         throw SceneError("scene field 'overlap.lateral_separation' = " + fmt(sc.overlap->lateral_separation) +
                          " m puts the contact wire of section " + std::to_string(w.section) + " at " + fmt(s.stagger) +
                          " m at the support at station " + fmt(s.x) + " m: keep it inside the pantograph head's working width, |y| < " +
