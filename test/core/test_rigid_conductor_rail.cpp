@@ -1,7 +1,9 @@
 // Rigid overhead conductor rail (docs/rigid_conductor_rail.md): the profile with its clamped
 // contact wire is a beam without tension on elastic supports. Its statics against the
 // three-moment equation of a continuous beam, the elastic support against a beam on a central
-// spring, a slow moving force against the statics, bad input, and a pass over the reference scene.
+// spring, a slow moving force against the statics, bad input, a pass over the reference scene,
+// and on a 3-D line the profile in plan: its line through the stagger points, its swing, the
+// steady wind's bending.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -184,7 +186,21 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
   refused(with("conductor_rail:\n", "conductor_rail:\n  tension: 1000\n"), "conductor_rail.tension");
   refused(with("span_count: 3", "span_count: 1"), "spans");
   refused(with("numerics:\n", "numerics:\n  window: auto\n"), "numerics.window");
-  refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\nwind: {speed: 20, contact_wire: {diameter: 0.012}}\n", "wind");
+  // The wind's drag on the profile: its height and coefficient in range, and drag blocks only for
+  // the wires the line has (a rail-only line has no tensioned contact wire, a catenary no profile).
+  refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\nwind: {speed: 20, contact_wire: {diameter: 0.012}}\n",
+          "wind.contact_wire");
+  refused(y + "wind: {speed: 20, conductor_rail: {height: 0}}\n", "wind.conductor_rail.height");
+  refused(y + "wind: {speed: 20, conductor_rail: {height: 0.6}}\n", "wind.conductor_rail.height");
+  refused(y + "wind: {speed: 20, conductor_rail: {diameter: 0.1}}\n", "wind.conductor_rail.diameter");
+  refused(y + "wind: {speed: 20, conductor_rail: {height: 0.11, drag_coefficient: 3.5}}\n",
+          "wind.conductor_rail.drag_coefficient");
+  refused(y + "wind: {speed: 20, messenger: {diameter: 0.0105}}\n", "wind.messenger");
+  const std::string catenary = "name: c\nline: {spans: [50.0, 50.0]}\ncontact_wire: {linear_mass: 1.35, tension: 20000}\n";
+  refused(catenary + "wind: {speed: 20, conductor_rail: {height: 0.11}}\n", "wind.conductor_rail");
+  refused(catenary + "wind: {speed: 20, stitch_wire: {diameter: 0.0075}}\n", "wind.stitch_wire");
+  refused(catenary + "wind: {speed: 20, auxiliary_messenger: {diameter: 0.0159}}\n", "wind.auxiliary_messenger");
+  EXPECT_NO_THROW(cs::load_scene_string(y + "wind: {speed: 20, conductor_rail: {height: 0.11, drag_coefficient: 2.0}}\n"));
   refused(y + "imperfections:\n  contact_wire_wear:\n    section_loss: 0.1\n", "imperfections.contact_wire_wear");
   const std::string stagger = "stagger:\n  contact_wire: [0.2, -0.2]\n";
   std::string negative = rail_yaml(3, 5e6, 0.25, stagger, 1e5);
@@ -527,5 +543,67 @@ TEST(RigidConductorRail, OnA3dLineAPluckedProfileSwingsAtItsSpanFrequency) {
   for (const double lateral_ei : {0.0, 0.5 * kEI}) {
     SCOPED_TRACE(lateral_ei > 0.0 ? "lateral EI of its own" : "the vertical EI");
     plucked_profile_swings_at_its_span_frequency(lateral_ei);
+  }
+}
+
+// (i) A steady cross wind on a 3-D rail: the profile, held at every support, takes the drag
+// q = 0.5 rho Cd h V^2 per metre on the height h it shows the wind (wind.conductor_rail). On equal
+// spans every interior support is a mirror plane of the load, so the slope is 0 there and each
+// span bends as a beam clamped at both ends: y = q L^4 / (24 EI) xi^2 (1 - xi)^2, q L^4 / (384 EI)
+// at mid-span (11 mm here), and each support takes q L more, downwind. The load is lumped on the nodes, q h
+// on each; on equal elements that is the consistent load at every node inside the wire (the
+// elements' end moments q h^2 / 12 cancel), and beam elements are exact at their nodes under a
+// consistent load, so what is left is the pinned ends' disturbance, 0.27 per span (0.27^14 = 1e-8
+// at the middle of 30), and round-off: 1e-9 m on the line, 1e-6 of the supports' q L. With a
+// lateral EI of its own (half) the blow-off doubles and the supports' share stays q L.
+// Nothing else acts sideways, so a pass keeps the profile on that line (1e-9 m): the step's drag
+// is the statics'.
+namespace {
+
+void steady_wind_bends_the_profile_as_a_clamped_span(double lateral_ei) {
+  const double speed = 30.0, rho = 1.225, height = 0.11, cd = 2.0, ei = lateral_ei > 0.0 ? lateral_ei : kEI;
+  std::ostringstream wind;
+  wind << "wind:\n  speed: " << speed << "\n  conductor_rail: {height: " << height << ", drag_coefficient: " << cd << "}\n"
+       << "pantographs:\n  - name: force\n    type: moving_force\n    static_uplift: 100.0\n"
+       << "train:\n  speed: 30.0\n  start: 130.0\n  end: 170.0\n";
+  cs::Simulation sim(cs::load_scene_string(rail_yaml(30, 5e6, 0.25, wind.str(), lateral_ei)));
+  const cs::Model& m = sim.model();
+  ASSERT_TRUE(m.lateral && m.lateral->windy);
+  const cs::LateralModel& lat = *m.lateral;
+  ASSERT_EQ(lat.wires.size(), 1u);
+  const cs::Wire& w = lat.wires[0];
+  const double q = 0.5 * rho * cd * height * speed * speed;  // 121 N/m, toward +y
+  int checked = 0;
+  for (int i = 0; i < w.nodes(); ++i) {
+    if (w.x[i] < 140.0 - 1e-9 || w.x[i] > 160.0 + 1e-9) continue;  // spans 14 and 15
+    const double xi = w.x[i] / kSpan - std::floor(w.x[i] / kSpan + 1e-9);
+    const double expected = q * std::pow(kSpan, 4) / (24.0 * ei) * xi * xi * (1 - xi) * (1 - xi);
+    EXPECT_NEAR(lat.initial[w.w_dof + i] - lat.calm[w.w_dof + i], expected, 1e-9) << "x " << w.x[i];
+    ++checked;
+  }
+  EXPECT_EQ(checked, 81);
+  int supports = 0;
+  for (const cs::LateralSupport& sup : lat.supports) {
+    if (sup.x < 120.0 - 1e-9 || sup.x > 180.0 + 1e-9) continue;
+    // (pull_off: the profile's force on the support, here downwind)
+    EXPECT_NEAR(sup.pull_off_wind - sup.pull_off, q * kSpan, 1e-6 * q * kSpan) << "support at " << sup.x;
+    ++supports;
+  }
+  EXPECT_EQ(supports, 7);
+  cs::State s = sim.state();
+  cs::StepStatus status = cs::StepStatus::kOk;
+  while (s.front < 170.0 && status == cs::StepStatus::kOk) status = cs::step(m, s);
+  ASSERT_EQ(status, cs::StepStatus::kOk);
+  double off = 0.0;
+  for (int i = 0; i < lat.n; ++i) off = std::max(off, std::fabs(s.lateral.y[i] - lat.initial[i]));
+  EXPECT_LT(off, 1e-9);
+}
+
+}  // namespace
+
+TEST(RigidConductorRail, OnA3dLineASteadyWindBendsEachSpanAsAClampedBeam) {
+  for (const double lateral_ei : {0.0, 0.5 * kEI}) {
+    SCOPED_TRACE(lateral_ei > 0.0 ? "lateral EI of its own" : "the vertical EI");
+    steady_wind_bends_the_profile_as_a_clamped_span(lateral_ei);
   }
 }

@@ -371,10 +371,11 @@ void add_wind(const Model& m, const WindSpec& ws, LateralModel* lat) {
   double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo;
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     const Wire& w = m.wires[wi];
-    const WireDragSpec& d = w.is_contact_wire           ? ws.contact_wire
-                            : w.is_stitch_wire          ? ws.stitch_wire
-                            : w.is_auxiliary_messenger  ? ws.auxiliary_messenger
-                                                        : ws.messenger;
+    const WireDragSpec& d = sc.sections[w.section].rigid ? ws.conductor_rail
+                            : w.is_contact_wire          ? ws.contact_wire
+                            : w.is_stitch_wire           ? ws.stitch_wire
+                            : w.is_auxiliary_messenger   ? ws.auxiliary_messenger
+                                                         : ws.messenger;
     const int nn = w.nodes();
     for (int i = 0; i < nn; ++i) {
       const int a = lat->wires[wi].w_dof + i;

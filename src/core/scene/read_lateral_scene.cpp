@@ -81,17 +81,20 @@ void read_wind(Reader& top, Scene& s) {
   w.speed = r.number("speed", 0.0, 70.0);
   w.direction = r.number("direction", -360.0, 360.0, 90.0);
   w.air_density = r.number("air_density", 0.0, 2.0, 1.225, true);
-  auto drag = [&](const char* key, WireDragSpec& d) {
+  // A wire's width is its diameter; a rail's profile meets the wind with its height.
+  auto drag = [&](const char* key, WireDragSpec& d, const char* width = "diameter", double widest = 0.1) {
     if (!r.has(key)) return;
     Reader q(r.child(key), std::string("wind.") + key);
-    d.diameter = q.number("diameter", 0.0, 0.1, d.diameter, true);
+    d.diameter = q.number(width, 0.0, widest, d.diameter, true);
     d.drag_coefficient = q.number("drag_coefficient", 0.0, 3.0, d.drag_coefficient);
     q.finish();
+    w.drag_given.emplace_back(key);
   };
   drag("contact_wire", w.contact_wire);
   drag("messenger", w.messenger);
   drag("stitch_wire", w.stitch_wire);
   drag("auxiliary_messenger", w.auxiliary_messenger);
+  drag("conductor_rail", w.conductor_rail, "height", 0.5);
   if (r.has("turbulence")) {
     Reader q(r.child("turbulence"), "wind.turbulence");
     TurbulenceSpec t;

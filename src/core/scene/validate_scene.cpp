@@ -132,6 +132,26 @@ void validate_acting_fields(const Scene& s) {
              fmt(*s.sections[i].rail_lateral_bending_stiffness),
              "only on a 3-D line (stagger, alignment or pantograph_head.sway): a 2-D line does not bend the "
              "profile across the track");
+  if (s.wind) {
+    // A drag block for a wire the line does not have would load nothing.
+    auto has = [&](const std::string& kind) {
+      return std::any_of(s.sections.begin(), s.sections.end(), [&](const SectionSpec& sec) {
+        if (kind == "conductor_rail") return sec.rigid;
+        if (kind == "contact_wire") return !sec.rigid;
+        if (kind == "messenger") return sec.messenger.has_value();
+        if (kind == "stitch_wire") return sec.stitch_wire.has_value();
+        return sec.auxiliary_messenger.has_value();
+      });
+    };
+    for (const std::string& kind : s.wind->drag_given)
+      if (!has(kind))
+        fail("wind." + kind, "(given)",
+             "a drag block for a wire the line has: no section has " +
+                 (kind == "contact_wire" ? std::string("a tensioned contact wire (a rail's profile takes wind.conductor_rail)")
+                                         : kind == "conductor_rail" ? std::string("a conductor_rail (a tensioned contact wire takes wind.contact_wire)")
+                                                                    : "a " + kind) +
+                 "; remove it here");
+  }
   if (!s.lateral() && s.overlap && s.overlap->lateral_separation != 0.0)
     fail("overlap.lateral_separation", fmt(s.overlap->lateral_separation),
          "0 on a 2-D line, or a 3-D line (stagger, alignment, wind or pantograph_head.sway) that has the wires' "
@@ -298,13 +318,6 @@ void validate_rigid(const Scene& s) {
   if (s.numerics.windowed())
     fail("numerics.window", "(given with conductor_rail)",
          "off: the window's absorbing ends are matched to a tensioned wire's waves, a tension-free profile has none");
-  // On a 3-D line the profile's lateral plane is the vertical one's beam (the wire's EI both ways):
-  // held at its stagger at every support, with no tension and no cross load it keeps its static
-  // line, whatever its lateral EI. Wind would load it through a drag the scene gives only for wires.
-  if (s.wind)
-    fail("wind", "(given with conductor_rail)",
-         "none: a conductor rail's profile has no drag data (wind.contact_wire describes a round wire); "
-         "a 3-D rail line takes stagger, alignment and pantograph_head.sway");
   // Wear thins the contact wire alone; the model's beam is profile and wire together, whose
   // mass and EI a worn wire changes by another law (not modelled).
   if (s.imperfections.contact_wire_wear.any())
