@@ -340,8 +340,8 @@ void print_line(const Scene& scene, const LineStatistics& line) {
 }
 
 void print_lateral(const Scene& scene, const Model& m, const LateralStatistics& ls) {
-  std::cout << std::setprecision(3) << "3-D line (lateral plane, coupled through the droppers): working width +-"
-            << 0.5 * scene.pantograph_head.working_width << " m\n";
+  std::cout << std::setprecision(3) << "3-D line (lateral plane coupled " << lateral_coupling(m).substr(0, lateral_coupling(m).find(':'))
+            << "): working width +-" << 0.5 * scene.pantograph_head.working_width << " m\n";
   for (const LateralContactStatistics& c : ls.contacts)
     std::cout << "  " << c.pantograph << " contact point across the strip: mean " << c.mean << " m, range " << c.min
               << " .. " << c.max << " m, sweep speed mean " << c.sweep_mean << " m/s (max " << c.sweep_max
@@ -357,11 +357,17 @@ void print_lateral(const Scene& scene, const Model& m, const LateralStatistics& 
   std::cout << "  blow-off of the contact wire: static " << worst_static << " m, max " << worst << " m";
   if (scene.wind && scene.wind->blow_off_limit)
     std::cout << "; " << exceeded << " of " << ls.spans.size() << " spans above the limit of " << *scene.wind->blow_off_limit << " m";
-  double pull = 0.0;
+  // The registrations' pull-off: the still line's, and under the mean wind where there is one.
+  // (steady arms on a catenary, the suspension clamps on a rail)
+  double pull = 0.0, pull_wind = 0.0;
   for (const LateralSupport& s : m.lateral->supports)
-    if (!s.anchor && m.wires[s.wire].is_contact_wire) pull = std::max(pull, std::fabs(s.pull_off));
-  std::cout << "\n  largest steady-arm pull-off " << std::setprecision(1) << pull << " N; dewirements: "
-            << ls.events_total << "\n";
+    if (!s.anchor && m.wires[s.wire].is_contact_wire) {
+      pull = std::max(pull, std::fabs(s.pull_off));
+      pull_wind = std::max(pull_wind, std::fabs(s.pull_off_wind));
+    }
+  std::cout << "\n  largest pull-off at a registration " << std::setprecision(1) << pull << " N";
+  if (m.lateral->windy) std::cout << " (" << pull_wind << " N in the mean wind)";
+  std::cout << "; dewirements: " << ls.events_total << "\n";
 }
 
 // The summary on stdout: the pass, per pantograph its statistics, the line's.

@@ -224,15 +224,9 @@ LateralStatistics LateralRecorder::statistics(const Model& m, const State& s) co
   return out;
 }
 
-std::string lateral_statistics_json(const Model& m, const LateralStatistics& st) {
-  using Json = nlohmann::json;
-  Json j;
-  if (!m.lateral) return "null";
+std::string lateral_coupling(const Model& m) {
+  if (!m.lateral) return "";
   const LateralModel& lat = *m.lateral;
-  const Scene& sc = m.scene;
-  j["working_width_m"] = sc.pantograph_head.working_width;
-  j["horn_width_m"] = sc.pantograph_head.horn_width;
-  // What joins the two planes on this line, in words for the report.
   std::string coupling;
   if (!lat.pendulums.empty())
     coupling = "two-way through the droppers: their tension sets the lateral pendulums, their lean's stretch "
@@ -242,7 +236,18 @@ std::string lateral_statistics_json(const Model& m, const LateralStatistics& st)
                 "two-way through the hinged steady arms: each registration is where its arm's end is, and the "
                 "wire's lateral pull turns the arm";
   if (coupling.empty()) coupling = "to nothing: no dropper or hinged arm joins the planes, so the vertical pass is the 2-D line's";
-  j["coupling"] = coupling;
+  return coupling;
+}
+
+std::string lateral_statistics_json(const Model& m, const LateralStatistics& st) {
+  using Json = nlohmann::json;
+  Json j;
+  if (!m.lateral) return "null";
+  const LateralModel& lat = *m.lateral;
+  const Scene& sc = m.scene;
+  j["working_width_m"] = sc.pantograph_head.working_width;
+  j["horn_width_m"] = sc.pantograph_head.horn_width;
+  j["coupling"] = lateral_coupling(m);
   j["lateral_dofs"] = lat.n;
   j["lateral_substeps"] = lat.substeps;
   Json contacts = Json::array();

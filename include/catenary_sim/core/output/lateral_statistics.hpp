@@ -93,4 +93,8 @@ class LateralRecorder {
 // The "lateral" object of stats.json (JSON text).
 std::string lateral_statistics_json(const Model& model, const LateralStatistics& stats);
 
+// What joins a 3-D line's two planes, in words (stats.json's lateral.coupling, the summaries):
+// the droppers, the hinged steady arms, or nothing. "" on a 2-D line.
+std::string lateral_coupling(const Model& model);
+
 }  // namespace catenary_sim
