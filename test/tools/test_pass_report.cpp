@@ -123,9 +123,16 @@ TEST_F(PassReport, TheLateralPageSaysWhatMovesTheWiresAndWhatJoinsThePlanes) {
                                     {"--speed", "250", "--set", "line.span_count=6", "--set", "numerics.element_length=0.5"});
   EXPECT_NE(blown.find("and the blow-off per span"), std::string::npos);
   EXPECT_EQ(blown.find("no blow-off"), std::string::npos);
-  const std::string still = page_of(test_scenes::scene_path("rigid_conductor_rail_3d.yaml"), "rail", {});
+  EXPECT_NE(blown.find("<h2 id='droppers'>"), std::string::npos);
+  const std::string rail = test_scenes::scene_path("rigid_conductor_rail_3d.yaml");
+  const std::string still = page_of(rail, "rail", {});
   EXPECT_NE(still.find("no blow-off"), std::string::npos);
   EXPECT_NE(still.find("coupled to nothing"), std::string::npos);
+  EXPECT_EQ(still.find("<h2 id='droppers'>"), std::string::npos);  // a rail has none to draw
+  // Wind on the profile: blown off between its supports, still coupled to nothing.
+  const std::string windy_rail = page_of(rail, "windy_rail", {"--set", "wind.speed=30"});
+  EXPECT_NE(windy_rail.find("and the blow-off per span"), std::string::npos);
+  EXPECT_NE(windy_rail.find("coupled to nothing"), std::string::npos);
 }
 
 // Hinged steady arms: the statistics table gives their k_A, pull-off and inclinations, as
