@@ -329,6 +329,9 @@ TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
       {r3, "wind.turbulence.max_frequency=1e9", {"wind.turbulence.max_frequency"}},
       {r3, "wind.turbulence.seed=-1", {"wind.turbulence.seed"}},
       {r3, "wind.blow_off_limit=0", {"wind.blow_off_limit"}},
+      {r3, "wind.conductor_rail.height=0.11", {"wind.conductor_rail"}},  // a catenary has no profile
+      {test_scenes::scene_path("rigid_conductor_rail_3d.yaml"), "wind={speed: 10, conductor_rail: {height: .nan}}", {"wind.conductor_rail.height"}},
+      {test_scenes::scene_path("rigid_conductor_rail_3d.yaml"), "wind={speed: 10, messenger: {diameter: 0.01}}", {"wind.messenger"}},
       // the pantograph head across the track
       {r3, "pantograph_head.histogram_bin=1e-8", {"pantograph_head.histogram_bin"}},
       {r3, "pantograph_head.histogram_bin=1e-300", {"pantograph_head.histogram_bin"}},
