@@ -13,6 +13,7 @@
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/model/stability.hpp"
 #include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/model/wire_band.hpp"
 #include "model/centred_factors.hpp"
 #include "model/design_statics.hpp"
 #include "model/endless_block.hpp"
@@ -169,7 +170,7 @@ void mesh_wires(const Scene& scene, const std::vector<double>& rise_first, const
         dof += static_cast<int>(x.size());
       }
       for (double sx : section_supports[si]) w.support_nodes.push_back(node_at(x, sx));
-      assemble_band(w, {});
+      assemble_band(w, transition_piece_factors(scene, w));
       if (auxiliary) {  // (not among info.wires, which the droppers hold or hang from)
         info.auxiliary = static_cast<int>(m.wires.size());
         m.wires.push_back(std::move(w));

@@ -216,11 +216,12 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
     l.theta_dof = -1;  // massless rotations, condensed (assemble_band always factorises K_tt)
     // A rail's profile bends across the track with its own EI where the scene gives it (the round
     // wires alike both ways); the plane then has a band of its own (no fused sweep on the vertical
-    // packs' band: build_lateral_packs).
+    // packs' band: build_lateral_packs). Its transition pieces soften it across the track in the
+    // same proportion.
     const std::optional<double>& lateral_ei = sc.sections[w.section].rail_lateral_bending_stiffness;
     if (lateral_ei && *lateral_ei != w.spec.bending_stiffness) {
       l.spec.bending_stiffness = *lateral_ei;
-      assemble_band(l, {});
+      assemble_band(l, transition_piece_factors(sc, w));
     }
     off += w.nodes();
     lat->wires.push_back(std::move(l));

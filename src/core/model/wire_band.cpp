@@ -8,10 +8,28 @@
 
 #include "catenary_sim/core/model/beam.hpp"
 #include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
 
 namespace catenary_sim {
 
-// ei_factor: per element, a multiplier of EI (a worn contact wire); empty = the wire's EI.
+std::vector<double> transition_piece_factors(const Scene& scene, const Wire& w) {
+  const std::size_t si = static_cast<std::size_t>(w.section);
+  const bool first = transition_piece_at_start(scene, si), last = transition_piece_at_end(scene, si);
+  if (!w.is_contact_wire || !(first || last)) return {};
+  const SectionSpec& sec = scene.sections[si];
+  const SectionSpec::TransitionPiece& piece = *sec.rail_transition_piece;
+  const double at_end = piece.end_bending_stiffness / sec.contact_wire.bending_stiffness;
+  std::vector<double> factor(w.nodes() - 1, 1.0);
+  for (int e = 0; e + 1 < w.nodes(); ++e) {
+    const double mid = 0.5 * (w.x[e] + w.x[e + 1]);
+    const double s = std::min(first ? mid - w.x.front() : 1e300, last ? w.x.back() - mid : 1e300);
+    if (s < piece.length) factor[e] = at_end + (1.0 - at_end) * s / piece.length;
+  }
+  return factor;
+}
+
+// ei_factor: per element, a multiplier of EI (a worn contact wire, a rail's transition piece);
+// empty = the wire's EI.
 void assemble_band(Wire& w, const std::vector<double>& ei_factor) {
   const int n = w.nodes();
   w.d_ww.assign(n, 0.0);

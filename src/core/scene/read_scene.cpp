@@ -86,6 +86,14 @@ void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
   sec.contact_wire.bending_stiffness = c.number("bending_stiffness", 0.0, 1e8, std::nullopt, true);
   if (c.has("lateral_bending_stiffness"))
     sec.rail_lateral_bending_stiffness = c.number("lateral_bending_stiffness", 0.0, 1e8, std::nullopt, true);
+  if (c.has("transition_piece")) {
+    Reader t(c.child("transition_piece"), pre + "conductor_rail.transition_piece");
+    SectionSpec::TransitionPiece piece;
+    piece.length = t.number("length", 0.0, 50.0, std::nullopt, true);
+    piece.end_bending_stiffness = t.number("end_bending_stiffness", 0.0, 1e8, std::nullopt, true);
+    t.finish();
+    sec.rail_transition_piece = piece;
+  }
   SupportSpec support;
   support.stiffness = c.number("support_stiffness", 0.0, 1e10, std::nullopt, true);
   support.mass = c.number("support_mass", 0.0, 1000.0, 0.0);

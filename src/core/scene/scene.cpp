@@ -38,6 +38,14 @@ TrainSpeedLimit train_speed_limit(const Scene& scene) {
   return l;
 }
 
+bool transition_piece_at_start(const Scene& scene, std::size_t i) {
+  return scene.sections[i].rail_transition_piece && i > 0 && !scene.sections[i - 1].rigid;
+}
+
+bool transition_piece_at_end(const Scene& scene, std::size_t i) {
+  return scene.sections[i].rail_transition_piece && i + 1 < scene.sections.size() && !scene.sections[i + 1].rigid;
+}
+
 double wind_field_points(const Scene& scene) {
   if (!scene.wind || !scene.wind->turbulence) return 0.0;
   // The stretch whose points the field holds at once: a finite line's whole length; an endless

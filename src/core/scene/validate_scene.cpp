@@ -323,6 +323,24 @@ void validate_rigid(const Scene& s) {
   if (s.imperfections.contact_wire_wear.any())
     fail("imperfections.contact_wire_wear", "(given with conductor_rail)",
          "none: the wear law scales the whole beam, a rail's beam is mostly the aluminium profile");
+  for (std::size_t i = 0; i < s.sections.size(); ++i) {
+    const SectionSpec& sec = s.sections[i];
+    if (!sec.rail_transition_piece) continue;
+    const std::string f = (s.sections.size() > 1 ? "sections[" + std::to_string(i) + "]." : "") + "conductor_rail.transition_piece";
+    const SectionSpec::TransitionPiece& piece = *sec.rail_transition_piece;
+    if (piece.end_bending_stiffness > sec.contact_wire.bending_stiffness)
+      fail(f + ".end_bending_stiffness", fmt(piece.end_bending_stiffness),
+           "at most the profile's bending_stiffness (" + fmt(sec.contact_wire.bending_stiffness) +
+               " N m^2): the piece is the profile made softer toward its end");
+    const bool first = transition_piece_at_start(s, i), last = transition_piece_at_end(s, i);
+    if (!first && !last)
+      fail(f, "(given)",
+           "a rail section joined to a catenary section, the piece lying at that joint: no catenary section "
+           "joins this one; remove it here");
+    const double room = std::min(first ? sec.spans.front() : 1e300, last ? sec.spans.back() : 1e300);
+    if (piece.length > room + 1e-9)
+      fail(f + ".length", fmt(piece.length), "(0, " + fmt(room) + "] m: within the end span it lies in");
+  }
   if (s.sections.size() > 1 && !(s.overlap && s.overlap->support_rise))
     fail("overlap.support_rise", "(missing with conductor_rail)",
          "the end ramp's rise in m, [0, 2]: eq. 6-8 derive it from a tensioned wire's sag, a rigid profile has none");

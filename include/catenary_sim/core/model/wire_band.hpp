@@ -6,11 +6,17 @@
 namespace catenary_sim {
 
 struct Model;
+struct Scene;
 struct Wire;
 
 // Assembles the wire's K band and the LDL^T factors of its K_theta_theta. ei_factor: per element,
 // a multiplier of EI (a worn contact wire); empty = the wire's EI.
 void assemble_band(Wire& w, const std::vector<double>& ei_factor);
+
+// A rail profile's EI factors along its transition pieces (SectionSpec::rail_transition_piece):
+// per element, EI(s) / EI at its middle, s from the profile's end, rising linearly from
+// end_bending_stiffness / EI at s = 0 to 1 at s = length; empty where the wire has none.
+std::vector<double> transition_piece_factors(const Scene& scene, const Wire& w);
 
 // y = K x for the linear part of the system with every dropper and contact active (the collectors
 // at the train position `front`): used for the stability limit and by tests. x and y have n_dof

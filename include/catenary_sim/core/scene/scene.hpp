@@ -193,6 +193,15 @@ struct SectionSpec {
   // The profile's bending stiffness across the track (conductor_rail.lateral_bending_stiffness),
   // N m^2: the lateral plane's EI on a 3-D line; empty: its vertical one (contact_wire's).
   std::optional<double> rail_lateral_bending_stiffness;
+  // A flexible transition piece at each end of the rail section where a catenary section joins
+  // it: over `length` from the profile's end its EI rises linearly from `end_bending_stiffness`
+  // to the profile's (both planes in proportion), so that the pantograph meets a gradual, not a
+  // sudden, change of stiffness.
+  struct TransitionPiece {
+    double length = 0.0;                 // m
+    double end_bending_stiffness = 0.0;  // N m^2, at the profile's end
+  };
+  std::optional<TransitionPiece> rail_transition_piece;
   bool first_span_transition = false;  // default: true where a previous section overlaps it
   bool last_span_transition = false;   // default: true where a next section overlaps it
   double length() const;
@@ -510,6 +519,11 @@ constexpr double kMaxHistogramBins = 10000.0;
 constexpr double kMaxWindFieldPoints = 100000.0;
 // Points of the turbulent wind field over the stretch of line the pass covers; 0 without turbulence.
 double wind_field_points(const Scene& scene);
+
+// Whether section i's conductor_rail.transition_piece lies at its start (end): where a catenary
+// section joins the rail section there.
+bool transition_piece_at_start(const Scene& scene, std::size_t i);
+bool transition_piece_at_end(const Scene& scene, std::size_t i);
 
 // A scene is a few kB of YAML: a file above this is refused before it is read whole.
 constexpr std::size_t kMaxSceneFileBytes = std::size_t{16} << 20;
