@@ -144,6 +144,14 @@ TEST(SceneErrors, FilesSyntaxAndOverrides) {
   EXPECT_MENTIONS(error_of_yaml("- just\n- a list\n"), "YAML map");
   EXPECT_MENTIONS(error_of({"no_equals_sign"}), "no_equals_sign", "key.path=value");
   EXPECT_MENTIONS(error_of({"pantographs.7.static_uplift=1"}), "index 7 out of range");
+  // A list entry as the messages name it (pantographs[0]) sets what pantographs.0 does; an index
+  // in brackets that is not digits after a name is refused.
+  EXPECT_EQ(load_scene_file(kReference, {"pantographs[0].static_uplift=150"}).pantographs[0].static_uplift, 150.0);
+  EXPECT_EQ(load_scene_file(test_scenes::kReference3d, {"stagger.contact_wire[1]=-0.25"}).stagger->contact_wire.at(1), -0.25);
+  EXPECT_MENTIONS(error_of({"pantographs[7].static_uplift=1"}), "index 7 out of range");
+  for (const char* bad : {"pantographs[x].static_uplift=1", "pantographs[].static_uplift=1", "[0].name=a",
+                          "pantographs[0]static_uplift=1", "pantographs.[0].static_uplift=1", "pantographs[0=1"})
+    EXPECT_MENTIONS(error_of({bad}), "list index in brackets");
 }
 
 TEST(Commands, RejectedCommandsLeaveTheStateAsItWas) {

@@ -26,7 +26,25 @@ void apply_override(YAML::Node root, const std::string& assignment) {
     return SceneError("override '" + assignment + "': " + why);
   };
   if (eq == std::string::npos || eq == 0) throw bad("expected key.path=value, e.g. numerics.element_length=0.125");
-  const std::string key = assignment.substr(0, eq);
+  // A list entry as the error messages name it, name[i], is name.i: a field named in an error can
+  // be set as it is written there.
+  const std::string written = assignment.substr(0, eq);
+  std::string key;
+  for (std::size_t i = 0; i < written.size(); ++i) {
+    if (written[i] != '[') {
+      key += written[i];
+      continue;
+    }
+    const std::size_t close = written.find(']', i);
+    const std::string digits = close == std::string::npos ? "" : written.substr(i + 1, close - i - 1);
+    const char after = close == std::string::npos || close + 1 >= written.size() ? '.' : written[close + 1];
+    if (i == 0 || written[i - 1] == '.' || digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos ||
+        (after != '.' && after != '['))
+      throw bad("a list index in brackets is digits after a field's name, as in sections[1].span_count "
+                "(or sections.1.span_count)");
+    key += "." + digits;
+    i = close;
+  }
   YAML::Node value;
   try {
     value = YAML::Load(assignment.substr(eq + 1));
