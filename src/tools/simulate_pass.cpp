@@ -340,7 +340,8 @@ void print_line(const Scene& scene, const LineStatistics& line) {
 }
 
 void print_lateral(const Scene& scene, const Model& m, const LateralStatistics& ls) {
-  std::cout << std::setprecision(3) << "3-D line (lateral plane coupled " << lateral_coupling(m).substr(0, lateral_coupling(m).find(':'))
+  const std::string coupling = lateral_coupling(m);  // "how: why"; the summary gives the how
+  std::cout << std::setprecision(3) << "3-D line (lateral plane coupled " << coupling.substr(0, coupling.find(':'))
             << "): working width +-" << 0.5 * scene.pantograph_head.working_width << " m\n";
   for (const LateralContactStatistics& c : ls.contacts)
     std::cout << "  " << c.pantograph << " contact point across the strip: mean " << c.mean << " m, range " << c.min
