@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "catenary_sim/core/engine/lateral_step.hpp"
+#include "catenary_sim/core/engine/step.hpp"
 #include "catenary_sim/core/model/build_model.hpp"
 #include "catenary_sim/core/model/contact_geometry.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
@@ -27,6 +28,7 @@
 #include "catenary_sim/core/simulation.hpp"
 #include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
+#include "engine/lateral_workspace.hpp"  // (the joint solve's count of steps)
 
 namespace cs = catenary_sim;
 
@@ -608,6 +610,81 @@ TEST(RigidConductorRail, OnA3dLineASteadyWindBendsEachSpanAsAClampedBeam) {
     SCOPED_TRACE(lateral_ei > 0.0 ? "lateral EI of its own" : "the vertical EI");
     steady_wind_bends_the_profile_as_a_clamped_span(lateral_ei);
   }
+}
+
+// On a 3-D line in wind, the vertical step's solve of each section's profile takes the profile's
+// lateral plane along in a second lane (LateralModel::centred_joint_twin, step.cpp). Each lane does
+// its own plane's IEEE operations with its own factors, and the lateral forces it solves with (the
+// load, the drag of the wind at the step's start, the supports' springs) read nothing the vertical
+// step changes, so the pass must be that of the two planes' solves one after the other (a copy of
+// the model without the joint factors) to the bit: in a turbulent cross wind (the wind refreshed
+// at each step's start either way) with the profile's vertical EI across the track, and with a
+// lateral EI of its own (the lanes' factors differ). A lateral plane leaving the divergence limit
+// is reported as the lateral plane's, at the same step and node.
+namespace {
+
+// Steps `scene` with the joint solve and a copy of its model without it side by side; every value
+// of both planes, the status and a lateral divergence's node must agree. Returns the steps taken,
+// and the last step's status in `last`.
+int expect_joint_solve_is_two_solves(const cs::Scene& scene, cs::StepStatus* last) {
+  cs::Simulation joint(scene);
+  const cs::Model& m = joint.model();
+  EXPECT_TRUE(m.lateral);
+  if (!m.lateral) return 0;
+  EXPECT_FALSE(m.lateral->centred_joint_twin.empty());
+  cs::Model apart = m;
+  auto lat = std::make_shared<cs::LateralModel>(*apart.lateral);
+  lat->centred_joint_twin.clear();
+  lat->centred_joint_single.clear();
+  apart.lateral = lat;
+  cs::State a = joint.state();
+  int steps = 0;
+  while (true) {
+    const cs::StepStatus sj = joint.step();
+    const cs::StepStatus sa = cs::step(apart, a);
+    const cs::State& j = joint.state();
+    EXPECT_EQ(sj, sa);
+    EXPECT_EQ(j.lateral.diverged, a.lateral.diverged);
+    EXPECT_EQ(j.lateral.diverged_node, a.lateral.diverged_node);
+    EXPECT_EQ(j.diverged_dof, a.diverged_dof);
+    *last = sj;
+    if (sj != cs::StepStatus::kOk || sa != cs::StepStatus::kOk) break;
+    ++steps;
+    for (int i = 0; i < m.n_dof; ++i)
+      if (j.u[i] != a.u[i] || j.v[i] != a.v[i]) {
+        ADD_FAILURE() << "DOF " << i << " step " << steps << ": u " << j.u[i] << " / " << a.u[i];
+        return steps;
+      }
+    for (int i = 0; i < m.lateral->n; ++i)
+      if (j.lateral.y[i] != a.lateral.y[i] || j.lateral.v[i] != a.lateral.v[i]) {
+        ADD_FAILURE() << "lateral node " << i << " step " << steps << ": y " << j.lateral.y[i] << " / " << a.lateral.y[i];
+        return steps;
+      }
+  }
+  // Every step taken solved both planes at once, the one that left the limit too.
+  EXPECT_EQ(joint.state().lateral.work->joined_steps, steps + (*last == cs::StepStatus::kDiverged ? 1 : 0));
+  return steps;
+}
+
+}  // namespace
+
+TEST(RigidConductorRail, OnA3dLineInWindOneSolveOfBothPlanesIsTheTwoSolvesBitForBit) {
+  const std::vector<std::string> wind = {"sections[0].span_count=5", "sections[1].span_count=5", "wind.speed=30",
+                                         "wind.turbulence.intensity=0.15", "wind.turbulence.length_scale=50",
+                                         "wind.turbulence.seed=1"};
+  const std::string path = test_scenes::scene_path("rigid_conductor_rail_3d.yaml");
+  cs::StepStatus last = cs::StepStatus::kOk;
+  EXPECT_GT(expect_joint_solve_is_two_solves(cs::load_scene_file(path, wind), &last), 20000);
+  EXPECT_EQ(last, cs::StepStatus::kFinished);
+  std::vector<std::string> own_ei = wind;
+  own_ei.push_back("conductor_rail.lateral_bending_stiffness=1.4e5");
+  EXPECT_GT(expect_joint_solve_is_two_solves(cs::load_scene_file(path, own_ei), &last), 20000);
+  EXPECT_EQ(last, cs::StepStatus::kFinished);
+  // The stagger (0.2 m) and the first span's gusty blow-off reach 0.21 m after some 2 s.
+  std::vector<std::string> beyond = wind;
+  beyond.push_back("numerics.divergence_limit=0.21");
+  EXPECT_GT(expect_joint_solve_is_two_solves(cs::load_scene_file(path, beyond), &last), 100);
+  EXPECT_EQ(last, cs::StepStatus::kDiverged);
 }
 
 // (j) A transition piece (conductor_rail.transition_piece) where a catenary joins the rail: over

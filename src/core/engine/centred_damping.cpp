@@ -1,5 +1,7 @@
 #include "engine/centred_damping.hpp"
 
+#include "catenary_sim/core/engine/lateral_step.hpp"
+#include "engine/lateral_workspace.hpp"
 #include "engine/step_workspace.hpp"
 #include "engine/wire_lanes.hpp"
 
@@ -180,7 +182,7 @@ __attribute__((always_inline)) inline T half(T2 x, int h) {
 // The pack's twisted block elimination: from both ends toward node k at once (pairs of nodes in
 // 2L lanes), the meeting node k, then outward from k in pairs.
 template <int L>
-__attribute__((always_inline)) inline bool sweep(int n, const double* twin, const double* single, const CentredArgs& args,
+__attribute__((always_inline)) inline int sweep(int n, const double* twin, const double* single, const CentredArgs& args,
                                                  double* rec) {
   typedef typename Lanes<L>::T T;
   typedef typename Lanes<2 * L>::T T2;
@@ -213,7 +215,15 @@ __attribute__((always_inline)) inline bool sweep(int n, const double* twin, cons
     T xw = half<L, T>(yw, 1), xt = half<L, T>(yt, 1);
     one.substitute(single + kCdValues * L, n - 1, n - 1, xw, xt, rec_extra);
   }
-  return !(Lanes<L>::all(one.ok) && Lanes<2 * L>::all(two.ok));
+  // Bit k: lane k left the limit (at the meeting node, or in a pair's top or bottom half).
+  int beyond = 0;
+  for (int lane = 0; lane < L; ++lane) {
+    bool ok = two.ok[lane] != 0 && two.ok[L + lane] != 0;
+    if constexpr (L == 1) ok &= one.ok;
+    else ok &= one.ok[lane] != 0;
+    beyond |= static_cast<int>(!ok) << lane;
+  }
+  return beyond;
 }
 
 }  // namespace
@@ -226,34 +236,30 @@ __attribute__((always_inline)) inline bool sweep(int n, const double* twin, cons
 #define CATENARY_SIM_CLONES
 #endif
 
-CATENARY_SIM_CLONES bool centred_sweep(const WireLanes& pack, const CentredSweep& c) {
+CATENARY_SIM_CLONES int centred_sweep(const CentredSweep& c) {
   const double *u[2], *v[2];
   double *f[2], *un[2], *vn[2], *acc[2];
-  for (int k = 0; k < pack.lanes; ++k) {
-    const int d = c.first_dof[k];
-    u[k] = c.u + d;
-    v[k] = c.v + d;
-    f[k] = c.f + d;
-    un[k] = c.u_next + d;
-    vn[k] = c.v_next + d;
-    acc[k] = c.accel + d;
+  for (int k = 0; k < c.lanes; ++k) {
+    u[k] = c.lane[k].u;
+    v[k] = c.lane[k].v;
+    f[k] = c.lane[k].f;
+    un[k] = c.lane[k].u_next;
+    vn[k] = c.lane[k].v_next;
+    acc[k] = c.lane[k].accel;
   }
   const CentredArgs args{u, v, f, un, vn, acc, c.dt, c.v_ratio, 2.0 / c.beta, c.limit};
-  return pack.lanes == 2 ? sweep<2>(c.nodes, c.twin, c.single, args, c.record)
-                         : sweep<1>(c.nodes, c.twin, c.single, args, c.record);
+  return c.lanes == 2 ? sweep<2>(c.nodes, c.twin, c.single, args, c.record)
+                      : sweep<1>(c.nodes, c.twin, c.single, args, c.record);
 }
 
 bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s, int lo, int hi, const double* twin,
                         const double* single) {
+  const CentredArrays plane{s.u.data(), s.v.data(), s.work->force.data(), s.work->u_next.data(), s.work->v_next.data(),
+                            s.accel.data()};
   CentredSweep c;
-  for (int k = 0; k < pack.lanes; ++k) c.first_dof[k] = m.wires[pack.wire[k]].w_dof + lo;  // the range's node 0
+  c.lanes = pack.lanes;
+  for (int k = 0; k < pack.lanes; ++k) c.lane[k] = plane.at(m.wires[pack.wire[k]].w_dof + lo);  // the range's node 0
   c.nodes = hi - lo + 1;
-  c.u = s.u.data();
-  c.v = s.v.data();
-  c.f = s.work->force.data();
-  c.u_next = s.work->u_next.data();
-  c.v_next = s.work->v_next.data();
-  c.accel = s.accel.data();
   c.dt = m.dt;
   c.v_ratio = m.wire_packs->centred_v_ratio;
   c.beta = m.beta;
@@ -261,7 +267,31 @@ bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s, int lo,
   c.twin = twin;
   c.single = single;
   c.record = s.work->sweep.data() + kSweepRecord * pack.offset;
-  return centred_sweep(pack, c);
+  return centred_sweep(c) != 0;
+}
+
+int centred_sweep_both_planes(const Model& m, std::size_t pk, State& s) {
+  const WireLanes& pack = packs_of(m)[pk];
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
+  const CentredArrays vertical{s.u.data(), s.v.data(), s.work->force.data(), s.work->u_next.data(),
+                               s.work->v_next.data(), s.accel.data()};
+  const CentredArrays lateral{ls.y.data(), ls.v.data(), lw.f.data(), lw.y_next.data(), lw.v_next.data(),
+                              lw.accel.data()};
+  CentredSweep c;
+  c.lanes = 2;
+  c.lane[0] = vertical.at(m.wires[pack.wire[0]].w_dof);
+  c.lane[1] = lateral.at(lat.wires[pack.wire[0]].w_dof);
+  c.nodes = pack.nodes;
+  c.dt = m.dt;  // the lateral plane's too: one substep (LateralModel::centred_joint_twin)
+  c.v_ratio = m.wire_packs->centred_v_ratio;
+  c.beta = m.beta;
+  c.limit = m.scene.numerics.divergence_limit;
+  c.twin = lat.centred_joint_twin[pk].data();
+  c.single = lat.centred_joint_single[pk].data();
+  c.record = lw.sweep.data() + 2 * kSweepRecord * pack.offset;  // (both planes' room: make_lateral_state)
+  return centred_sweep(c);
 }
 
 bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s) {

@@ -17,26 +17,39 @@
 
 namespace catenary_sim {
 
-// One pack's solve and update in either plane: its lanes' nodes first_dof[lane] ..
-// first_dof[lane] + nodes - 1 of the plane's arrays (u, v, f with the load and point forces,
-// written: u_next, v_next, accel), the factors of that range (twin, single) and the step's
-// records (4 values per node and lane). Returns true if a new displacement is beyond the limit
-// or not a number.
-struct CentredSweep {
-  int first_dof[2] = {0, 0};
-  int nodes = 0;
+// A plane's arrays as one lane of a sweep reads and writes them, from the lane's first node on:
+// u, v, f (the load and point forces), and the new values u_next, v_next, accel.
+struct CentredArrays {
   const double *u = nullptr, *v = nullptr;
   double *f = nullptr, *u_next = nullptr, *v_next = nullptr, *accel = nullptr;
+  CentredArrays at(int dof) const { return {u + dof, v + dof, f + dof, u_next + dof, v_next + dof, accel + dof}; }
+};
+
+// One solve and update in one or two lanes: a pack's wires in either plane, or one wire's
+// vertical and lateral planes at once (the factors of each lane its own), each lane `nodes` nodes
+// from lane[k] on, with the factors of that range (twin, single) and the step's records (4 values
+// per node and lane). The lanes share dt, the velocity ratio (2 / dt) / D per mass, beta and the
+// limit. Returns a bit per lane (bit k: lane k) whose new displacements left the limit or are not
+// numbers; 0 when all are good.
+struct CentredSweep {
+  int lanes = 1;
+  CentredArrays lane[2];
+  int nodes = 0;
   double dt = 0.0, v_ratio = 0.0, beta = 0.0, limit = 0.0;  // v_ratio: (2 / dt) / D per mass
   const double *twin = nullptr, *single = nullptr;
   double* record = nullptr;
 };
-bool centred_sweep(const WireLanes& pack, const CentredSweep& sweep);
+int centred_sweep(const CentredSweep& sweep);
 
 // One wire pack's solve and update (both wires in lanes): reads u, v and the point forces in
 // state.force (zeroing them there for the next step), writes u_next, v_next and accel. Returns
 // true if a new displacement is beyond the limit or not a number.
 bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s);
+// One lone wire's (pack `pack`) vertical plane in lane 0 and lateral plane in lane 1, with
+// LateralModel::centred_joint_*: the vertical values as centred_sweep_pack reads and writes them,
+// the lateral ones as the lateral centred substep does (its forces in LateralWorkspace::f). Returns
+// centred_sweep's bits: 1 the vertical plane left the limit, 2 the lateral plane.
+int centred_sweep_both_planes(const Model& m, std::size_t pack, State& s);
 // The same over the pack's nodes lo..hi (a moving window, both lanes the same range) with that
 // range's factors (factor_centred_range).
 bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s, int lo, int hi, const double* twin,

@@ -5,7 +5,9 @@
 #include <cmath>
 
 #include "engine/centred_damping.hpp"
+#include "catenary_sim/core/engine/lateral_step.hpp"
 #include "engine/forces.hpp"
+#include "engine/lateral_workspace.hpp"
 #include "engine/step_workspace.hpp"
 #include "engine/train_motion.hpp"
 #include "engine/window.hpp"
@@ -46,6 +48,31 @@ bool sweep_window(const Model& m, State& s) {
   return out;
 }
 
+// Each pack's solve over its whole wires; a lone wire's lateral plane taken along in a second lane
+// where the lateral step set its forces for it (take_centred_solve_along), that plane's
+// divergence hint left for lateral_step. Returns the vertical plane's.
+bool sweep_packs(const Model& m, State& s) {
+  const std::vector<WireLanes>& packs = packs_of(m);
+  const bool join = m.lateral && s.lateral.work->join;
+  bool out = false, lateral_out = false;
+  for (std::size_t pk = 0; pk < packs.size(); ++pk) {
+    if (join && !m.lateral->centred_joint_twin[pk].empty()) {
+      const int beyond = centred_sweep_both_planes(m, pk, s);
+      out |= (beyond & 1) != 0;
+      lateral_out |= (beyond & 2) != 0;
+    } else {
+      out |= centred_sweep_pack(m, packs[pk], s);
+    }
+  }
+  if (join) {
+    LateralWorkspace& lw = *s.lateral.work;
+    lw.joined = true;
+    lw.joined_outside = lateral_out;
+    ++lw.joined_steps;
+  }
+  return out;
+}
+
 }  // namespace
 
 StepStatus centred_damping_step(const Model& m, State& s) {
@@ -70,8 +97,7 @@ StepStatus centred_damping_step(const Model& m, State& s) {
   double* vn = s.work->v_next.data();
   bool out = false;
   if (windowed) out = sweep_window(m, s);
-  else
-    for (const WireLanes& p : packs_of(m)) out |= centred_sweep_pack(m, p, s);
+  else out = sweep_packs(m, s);
   clear_point_forces(m, s, windowed, f);
   const double* im = m.inv_mass.data();
   for (int i = nc; i < n; ++i) {

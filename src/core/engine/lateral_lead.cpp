@@ -151,15 +151,11 @@ bool lead_step(const Model& m, State& s) {
     const WireLanes& p = packs[pk];
     const WireWindow& ww = ls.lead_window[p.wire[0]];
     if (ww.hi < ww.lo) continue;
+    const CentredArrays plane{y, v, f, lw.lead_y_next.data(), lw.lead_v_next.data(), lw.lead_accel.data()};
     CentredSweep c;
-    for (int k = 0; k < p.lanes; ++k) c.first_dof[k] = lat.wires[p.wire[k]].w_dof + ww.lo;
+    c.lanes = p.lanes;
+    for (int k = 0; k < p.lanes; ++k) c.lane[k] = plane.at(lat.wires[p.wire[k]].w_dof + ww.lo);
     c.nodes = ww.hi - ww.lo + 1;
-    c.u = y;
-    c.v = v;
-    c.f = f;
-    c.u_next = lw.lead_y_next.data();
-    c.v_next = lw.lead_v_next.data();
-    c.accel = lw.lead_accel.data();
     c.dt = dt;
     c.v_ratio = ratio;
     c.beta = bp;
@@ -167,7 +163,7 @@ bool lead_step(const Model& m, State& s) {
     c.twin = lw.lead_twin.data() + lw.lead_twin_at[pk];
     c.single = lw.lead_single.data() + lw.lead_single_at[pk];
     c.record = lw.lead_record.data() + kSweepRecord * p.offset;
-    centred_sweep(p, c);
+    centred_sweep(c);
   }
   double* yn = lw.lead_y_next.data();
   const double* vn = lw.lead_v_next.data();

@@ -433,22 +433,17 @@ bool fused_substep(const Model& m, State& s, bool windowed) {
   return false;
 }
 
-// One lateral substep with centred damping (engine/centred_damping.hpp, in the lateral plane at its
-// own dt): the load, the wind's drag on the wire's velocity v_{n-1/2} (aerodynamic damping, explicit
-// as in the half-step), the window's forces, springs and pendulums on z = y + beta v, then per pack
-// the wires' solve for zeta (their Rayleigh damping, alpha M + beta K, taken at the step's middle)
-// and the update. The new values go to y_next, v_next and are swapped in (copied back in the
-// window) when all are inside the divergence limit; else the state keeps the last good substep and
-// this returns true.
-bool centred_substep(const Model& m, State& s, bool windowed) {
+// The forces of a lateral substep with centred damping: the load, the wind's drag on the wire's
+// velocity v_{n-1/2} (aerodynamic damping, explicit as in the half-step), the window's forces,
+// springs and pendulums on z = y + beta v, 0 on a held node (its row is zeta = y).
+void centred_forces(const Model& m, State& s, bool windowed) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
-  LateralWorkspace& lw = *ls.work;
   const double beta = m.beta;
   const double* load = lat.load.data();
   const double* y = ls.y.data();
   const double* v = ls.v.data();
-  double* f = lw.f.data();
+  double* f = ls.work->f.data();
   over_stepped(m, s, windowed, [&](int i0, int i1) {
     if (lat.windy) {
       const double* cw = lat.wind_coefficient.data();
@@ -463,31 +458,43 @@ bool centred_substep(const Model& m, State& s, bool windowed) {
   });
   if (windowed) add_window_forces(m, s, v, f);
   add_springs_and_pendulums(m, s, windowed, y, [y, v, beta](int i) { return y[i] + beta * v[i]; }, f);
-  for (int d : lat.centred_held) f[d] = 0.0;  // a held node's row is zeta = y
+  for (int d : lat.centred_held) f[d] = 0.0;
+}
+
+// One lateral substep with centred damping (engine/centred_damping.hpp, in the lateral plane at its
+// own dt): its forces (centred_forces), then per pack the wires' solve for zeta (their Rayleigh
+// damping, alpha M + beta K, taken at the step's middle) and the update. Where the vertical step
+// took the solve along (take_centred_solve_along), only the packs it left. The new values go to
+// y_next, v_next and are swapped in (copied back in the window) when all are inside the divergence
+// limit; else the state keeps the last good substep and this returns true.
+bool centred_substep(const Model& m, State& s, bool windowed) {
+  const LateralModel& lat = *m.lateral;
+  LateralState& ls = s.lateral;
+  LateralWorkspace& lw = *ls.work;
+  const bool joined = lw.joined;
+  lw.joined = false;
+  if (!joined) centred_forces(m, s, windowed);
+  const CentredArrays plane{ls.y.data(), ls.v.data(), lw.f.data(), lw.y_next.data(), lw.v_next.data(), lw.accel.data()};
   const std::vector<WireLanes>& packs = packs_of(m);
-  bool out = false;
+  bool out = joined && lw.joined_outside;
   for (std::size_t pk = 0; pk < packs.size(); ++pk) {
+    if (joined && !lat.centred_joint_twin[pk].empty()) continue;
     const WireLanes& p = packs[pk];
     const WireWindow& ww = ls.window[p.wire[0]];
     const int lo = windowed ? ww.lo : 0, hi = windowed ? ww.hi : p.nodes - 1;
     if (hi < lo) continue;
     CentredSweep c;
-    for (int k = 0; k < p.lanes; ++k) c.first_dof[k] = lat.wires[p.wire[k]].w_dof + lo;
+    c.lanes = p.lanes;
+    for (int k = 0; k < p.lanes; ++k) c.lane[k] = plane.at(lat.wires[p.wire[k]].w_dof + lo);
     c.nodes = hi - lo + 1;
-    c.u = y;
-    c.v = v;
-    c.f = f;
-    c.u_next = lw.y_next.data();
-    c.v_next = lw.v_next.data();
-    c.accel = lw.accel.data();
     c.dt = lat.dt;
     c.v_ratio = lat.centred_v_ratio;
-    c.beta = beta;
+    c.beta = m.beta;
     c.limit = m.scene.numerics.divergence_limit;
     c.twin = windowed ? lw.centred_twin.data() + lw.centred_twin_at[pk] : lat.centred_twin[pk].data();
     c.single = windowed ? lw.centred_single.data() + lw.centred_single_at[pk] : lat.centred_single[pk].data();
     c.record = lw.sweep.data() + kSweepRecord * p.offset;
-    out |= centred_sweep(p, c);
+    out |= centred_sweep(c) != 0;
   }
   if (out) return true;
   commit_substep(m, s, windowed);
@@ -693,6 +700,18 @@ StepStatus lateral_step(const Model& m, State& s) {
     s.status = StepStatus::kDewired;
   }
   return s.status;
+}
+
+bool take_centred_solve_along(const Model& m, State& s) {
+  const LateralModel& lat = *m.lateral;
+  // Without wind (and so, here, without anything that loads the plane) lateral_step leaves a
+  // resting plane as it is, or steps a moved one alone.
+  if (lat.centred_joint_twin.empty() || !lat.windy || lat.lead_every > 0) return false;
+  // The wind of the lateral step's start, t0 as lateral_step computes it (after the vertical
+  // step's s.time += dt), refreshed now (lateral_step then finds it done: the same values, once).
+  refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
+  centred_forces(m, s, false);
+  return true;
 }
 
 void shift_lateral_block(const Model& m, State& s) {

@@ -35,19 +35,28 @@ namespace {
 // step's start, the shared band and factors), and each lane does its own plane's operations, so
 // the results are those of the vertical step then lateral_step, to the bit. (Hinged arms'
 // registrations, which the lateral step moves to the new u, are swept where the last step put
-// them in either case; the point forces add the move: lateral_step.cpp.)
+// them in either case; the point forces add the move: lateral_step.cpp.) With centred damping the
+// solve of each lone wire (a rigid rail's profile) takes its lateral plane in a second lane, the
+// lateral forces set before the vertical step (take_centred_solve_along): they read only the
+// lateral state and the wind of the step's start, so the results are again those of the two
+// steps one after the other, to the bit.
 StepStatus step_both_planes(const Model& m, State& s) {
   const LateralModel& lat = *m.lateral;
   LateralState& ls = s.lateral;
   // Both planes sweep every node of the same packs: no window, one lateral step a vertical one,
   // both fused, and the step will be taken (not the pass's end).
-  ls.work->join = !lat.planes.empty() && lat.substeps == 1 && !m.scene.numerics.windowed() &&
-                  m.scene.numerics.damping != DampingStep::kCentred &&
-            s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end && !ls.dropper_stretch.empty();
-  // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
-  // the vertical step's s.time += dt), refreshed now for the sweep (lateral_step then finds it
-  // done: the same values, once).
-  if (ls.work->join) refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
+  const bool taken = s.status == StepStatus::kOk && s.front + s.line_offset < m.train_end;
+  if (m.scene.numerics.damping == DampingStep::kCentred) {
+    // With centred damping the lateral forces go into the solve: set before the vertical step.
+    ls.work->join = taken && take_centred_solve_along(m, s);
+  } else {
+    ls.work->join = !lat.planes.empty() && lat.substeps == 1 && !m.scene.numerics.windowed() && taken &&
+                    !ls.dropper_stretch.empty();
+    // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
+    // the vertical step's s.time += dt), refreshed now for the sweep (lateral_step then finds it
+    // done: the same values, once).
+    if (ls.work->join) refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
+  }
   const StepStatus st = vertical_step(m, s);
   ls.work->join = false;
   if (st != StepStatus::kOk) {

@@ -477,6 +477,26 @@ void factor_lateral_centred(const Model& m, LateralModel& lat) {
     lat.centred_twin.push_back(std::move(twin));
     lat.centred_single.push_back(std::move(single));
   }
+  // Both planes of a lone wire in one solve (LateralModel::centred_joint_twin): the lanes share
+  // dt, so one substep a step; the lateral forces must be ready before the vertical step; both
+  // planes over the whole wire (no window in either).
+  if (lat.substeps != 1 || m.scene.numerics.windowed() || !lat.pendulums.empty() || !lat.registrations.empty()) return;
+  const CentredPlane vertical{&m.wires, m.mass.data(), m.inv_mass.data(), centred_shift(m, m.dt)};
+  for (const WireLanes& p : packs_of(m)) {
+    std::vector<double> twin, single;
+    if (p.lanes == 1) {
+      WireLanes both = p;  // the wire twice: lane 0 in the vertical plane, lane 1 in the lateral one
+      both.lanes = 2;
+      both.wire[1] = p.wire[0];
+      twin.assign(2 * p.centred_twin.size(), 0.0);
+      single.assign(2 * p.centred_single.size(), 0.0);
+      scratch.assign(static_cast<std::size_t>(p.nodes) * kCdValues, 0.0);
+      factor_centred_range(vertical, both, 0, 0, p.nodes - 1, nullptr, scratch.data(), twin.data(), single.data());
+      factor_centred_range(plane, both, 1, 0, p.nodes - 1, nullptr, scratch.data(), twin.data(), single.data());
+    }
+    lat.centred_joint_twin.push_back(std::move(twin));
+    lat.centred_joint_single.push_back(std::move(single));
+  }
 }
 
 // For the moving window: the wires' elastic force in the static state, and the springs in line order.
