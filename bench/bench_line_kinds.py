@@ -4,6 +4,9 @@
   bench/bench_line_kinds.py [--reps 7] [--preset accurate]
                             [--scenes config/reference_55m.yaml,config/reference_55m_stitched.yaml,...]
 
+A scene may carry --set overrides after '@', one per '@' (values without commas):
+config/rigid_conductor_rail_3d.yaml@wind.speed=30 is the 3-D rail in a 30 m/s cross wind.
+
 simulate_pass runs each scene in turn, --reps rounds, the scenes alternating within each round so
 that the machine's load moves them alike. Each run gives stats.json's wall_time_s (the stepping of
 the pass alone), dofs and steps; the cost is wall_time_s / (dofs x steps) in ns. Printed per scene:
@@ -24,9 +27,18 @@ DEFAULT_SCENES = ["config/reference_55m.yaml", "config/reference_55m_stitched.ya
                   "config/rigid_conductor_rail.yaml", "config/compound_catenary.yaml"]
 
 
-def run_once(scene, preset, out):
+def split_entry(entry):
+    """'file@field=value@...' into the file and its --set overrides."""
+    path, *overrides = entry.split("@")
+    return path, overrides
+
+
+def run_once(entry, preset, out):
+    scene, overrides = split_entry(entry)
     args = [SIMULATE_PASS, "--scene", scene, "--set", f"numerics.preset={preset}", "--out", out, "--quiet",
             "--no-progress"]
+    for o in overrides:
+        args += ["--set", o]
     r = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600, cwd=ROOT)
     if r.returncode != 0:
         sys.exit(f"{' '.join(args)} failed ({r.returncode}):\n{r.stdout[-2000:]}")
@@ -39,14 +51,19 @@ def main():
     ap.add_argument("--reps", type=int, default=7, help="rounds over the scenes (1-1000)")
     ap.add_argument("--preset", default="accurate", choices=["fast", "balanced", "accurate", "reference"])
     ap.add_argument("--scenes", default=",".join(DEFAULT_SCENES),
-                    help="comma-separated scene files; the first is the one the others are compared with")
+                    help="comma-separated scene files, each with --set overrides after '@' (file@field=value); "
+                         "the first is the one the others are compared with")
     a = ap.parse_args()
     if not 1 <= a.reps <= 1000:
         ap.error(f"--reps {a.reps}: allowed 1-1000")
     scenes = [s for s in a.scenes.split(",") if s]
     for s in scenes:
-        if not os.path.isfile(os.path.join(ROOT, s)):
-            ap.error(f"--scenes: no file '{s}' (paths relative to the repository)")
+        path, overrides = split_entry(s)
+        if not os.path.isfile(os.path.join(ROOT, path)):
+            ap.error(f"--scenes: no file '{path}' (paths relative to the repository)")
+        for o in overrides:
+            if "=" not in o:
+                ap.error(f"--scenes: override '{o}' of '{path}' is not field=value")
     if not os.access(SIMULATE_PASS, os.X_OK):
         sys.exit(f"no {SIMULATE_PASS}: build first (SKIP_SETUP=1 scripts/build)")
     cost = {s: [] for s in scenes}
@@ -59,12 +76,13 @@ def main():
                 last[s] = st
     base, base_min = statistics.median(cost[scenes[0]]), min(cost[scenes[0]])
     print(f"preset {a.preset}, {a.reps} rounds; cost = pass wall / (DOFs x steps)")
-    print(f"{'scene':40s} {'DOFs':>6s} {'steps':>6s} {'dt (ms)':>8s} {'median ns':>10s} {'min ns':>8s} {'/ first':>8s} "
+    width = max(40, *(len(s) for s in scenes))
+    print(f"{'scene':{width}s} {'DOFs':>6s} {'steps':>6s} {'dt (ms)':>8s} {'median ns':>10s} {'min ns':>8s} {'/ first':>8s} "
           f"{'min / first min':>15s}")
     for s in scenes:
         med = statistics.median(cost[s])
         st = last[s]
-        print(f"{s:40s} {st['dofs']:6d} {st['steps']:6d} {st['dt_s'] * 1e3:8.4f} {med:10.3f} {min(cost[s]):8.3f} "
+        print(f"{s:{width}s} {st['dofs']:6d} {st['steps']:6d} {st['dt_s'] * 1e3:8.4f} {med:10.3f} {min(cost[s]):8.3f} "
               f"{med / base:8.3f} {min(cost[s]) / base_min:15.3f}")
 
 
