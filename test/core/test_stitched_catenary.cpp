@@ -251,7 +251,20 @@ TEST(StitchedCatenary, BadInputIsRefusedByName) {
     return s;
   };
   refused(with("length: 8.0", "length: 0"), "stitch_wire.length");
-  refused(with("length: 8.0", "length: 20.0"), "stitch_wire.length");  // not shorter than the span
+  // Each clamp within its span, length / 2 from its support: the two spans of a 2-span section are
+  // its end spans, one clamp each (length < 2 x 20 m); the inner span of 3 holds two (< 20 m).
+  auto stitch_length = [](std::string yaml, const std::string& length) {
+    return yaml.replace(yaml.find("length: 8.0"), 11, "length: " + length);
+  };
+  refused(stitch_length(y, "40.0"), "stitch_wire.length");
+  EXPECT_NO_THROW(cs::Simulation(cs::load_scene_string(stitch_length(y, "36.0"))));
+  std::string inner;
+  try {
+    cs::load_scene_string(stitch_length(with("span_count: 2", "span_count: 3"), "20.0"));
+  } catch (const cs::SceneError& e) {
+    inner = e.what();
+  }
+  for (const char* word : {"stitch_wire.length", "(0, 20) m", "span 1, 20 m"}) EXPECT_NE(inner.find(word), std::string::npos) << inner;
   refused(with("tension: 3500", "tension: -1"), "stitch_wire.tension");
   refused(with("linear_mass: 0.31", "linear_mass: 0.31, colour: red"), "stitch_wire.colour");
   refused(with("span_count: 2", "span_count: 1"), "stitch_wire");

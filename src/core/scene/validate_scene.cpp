@@ -358,10 +358,29 @@ void validate_stitched(const Scene& s) {
       fail(f, "(given)", "a stitch wire hangs from a messenger and carries droppers: add messenger and droppers or remove it");
     if (sec.spans.size() < 2 && !s.endless)  // (an endless line's one span repeats: supports on both sides)
       fail(f, "(given on a section of 1 span)", "a section with intermediate supports (2 spans or more): a stitch wire hangs around one");
-    const double shortest = *std::min_element(sec.spans.begin(), sec.spans.end());
-    if (!(sec.stitch_wire->length < shortest))
+    // Each span holds the clamps of the stitch wires at its intermediate supports, length / 2 from
+    // the support: an inner span two, which must not meet (length < span), a section's end span
+    // one (length < 2 span), so that a stitched line may end on short spans (toward a portal, a
+    // joint with a rail). An endless line's one span repeats: inner.
+    const std::size_t n = sec.spans.size();
+    double allowed = 1e300;
+    std::size_t limiting = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool inner = s.endless || (i > 0 && i + 1 < n);
+      const double room = inner ? sec.spans[i] : 2.0 * sec.spans[i];
+      if (room < allowed) {
+        allowed = room;
+        limiting = i;
+      }
+    }
+    if (!(sec.stitch_wire->length < allowed)) {
+      const bool inner = s.endless || (limiting > 0 && limiting + 1 < n);
       fail(f + ".length", fmt(sec.stitch_wire->length),
-           "(0, " + fmt(shortest) + ") m: shorter than the section's shortest span, so that each clamp lies in its span");
+           "(0, " + fmt(allowed) + ") m: each clamp within its span, " + fmt(0.5 * sec.stitch_wire->length) +
+               " m from its support (span " + std::to_string(limiting) + ", " + fmt(sec.spans[limiting]) + " m, holds " +
+               (inner ? "the clamps of the stitch wires at both its supports" : "one clamp, the section ending there") +
+               ")");
+    }
   }
 }
 
