@@ -265,6 +265,30 @@ TEST(StitchedCatenary, BadInputIsRefusedByName) {
     inner = e.what();
   }
   for (const char* word : {"stitch_wire.length", "(0, 20) m", "span 1, 20 m"}) EXPECT_NE(inner.find(word), std::string::npos) << inner;
+  // at_supports: the intermediate supports that carry one, whole numbers from 1 to the spans less
+  // one, increasing; a support left out frees its spans' room (3 spans, the inner one holding the
+  // clamp of support 1 alone: length up to twice it).
+  const std::string three_spans = with("span_count: 2", "span_count: 3");
+  auto at = [&](const std::string& base, const std::string& list) {
+    std::string yaml = base;
+    return yaml.replace(yaml.find("linear_mass: 0.31}"), 18, "linear_mass: 0.31, at_supports: " + list + "}");
+  };
+  refused(at(y, "[0]"), "stitch_wire.at_supports");
+  refused(at(y, "[2]"), "stitch_wire.at_supports");           // 2 spans: support 1 only
+  refused(at(three_spans, "[2, 1]"), "stitch_wire.at_supports[1]");
+  refused(at(three_spans, "[1, 1]"), "stitch_wire.at_supports[1]");
+  refused(at(y, "[1.5]"), "stitch_wire.at_supports[0]");
+  refused(at(y, "[]"), "stitch_wire.at_supports");
+  refused(at(y, "one"), "stitch_wire.at_supports");
+  refused(stitch_length(at(three_spans, "[1]"), "40.0"), "stitch_wire.length");
+  EXPECT_NO_THROW(cs::Simulation(cs::load_scene_string(stitch_length(at(three_spans, "[1]"), "36.0"))));
+  // The endless line's one span repeats: every support carries one.
+  try {
+    test_scenes::endless_scene(test_scenes::kReferenceStitched, {"numerics.window=auto", "stitch_wire.at_supports=[1]"});
+    ADD_FAILURE() << "at_supports accepted on the endless line";
+  } catch (const cs::SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("stitch_wire.at_supports"), std::string::npos) << e.what();
+  }
   refused(with("tension: 3500", "tension: -1"), "stitch_wire.tension");
   refused(with("linear_mass: 0.31", "linear_mass: 0.31, colour: red"), "stitch_wire.colour");
   refused(with("span_count: 2", "span_count: 1"), "stitch_wire");

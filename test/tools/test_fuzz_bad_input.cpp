@@ -332,6 +332,12 @@ TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
       {r3, "wind.conductor_rail.height=0.11", {"wind.conductor_rail"}},  // a catenary has no profile
       {test_scenes::scene_path("rigid_conductor_rail_3d.yaml"), "wind={speed: 10, conductor_rail: {height: .nan}}", {"wind.conductor_rail.height"}},
       {test_scenes::scene_path("rigid_conductor_rail_3d.yaml"), "wind={speed: 10, messenger: {diameter: 0.01}}", {"wind.messenger"}},
+      // the stitch wires' supports
+      {test_scenes::scene_path("stitched_catenary_to_rigid_rail.yaml"), "sections[0].stitch_wire.at_supports=[5, 6]",
+       {"sections[0].stitch_wire.at_supports"}},
+      {test_scenes::kReferenceStitched, "stitch_wire.at_supports=[.nan]", {"stitch_wire.at_supports[0]"}},
+      {test_scenes::kReferenceStitched, "stitch_wire.at_supports=[1e300]", {"stitch_wire.at_supports[0]"}},
+      {test_scenes::kReferenceStitched, "stitch_wire.at_supports={1: 2}", {"stitch_wire.at_supports"}},
       // the pantograph head across the track
       {r3, "pantograph_head.histogram_bin=1e-8", {"pantograph_head.histogram_bin"}},
       {r3, "pantograph_head.histogram_bin=1e-300", {"pantograph_head.histogram_bin"}},

@@ -41,8 +41,8 @@ std::vector<double> mesh_section(const SectionSpec& sec, double element_length, 
       for (double p : sec.hangers->positions[i]) breaks.push_back(x0 + p);
     if (sec.stitch_wire) {  // the clamps of the stitch wires at the span's intermediate supports
       const double half = 0.5 * sec.stitch_wire->length;
-      if (i > 0) breaks.push_back(x0 + half);
-      if (i + 1 < nspan) breaks.push_back(x0 + sec.spans[i] - half);
+      if (i > 0 && sec.stitch_wire->at(static_cast<int>(i))) breaks.push_back(x0 + half);
+      if (i + 1 < nspan && sec.stitch_wire->at(static_cast<int>(i) + 1)) breaks.push_back(x0 + sec.spans[i] - half);
     }
     if (sec.hangers || sec.stitch_wire) {  // (droppers alone are in order: validate_sections)
       std::sort(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end());
@@ -121,6 +121,7 @@ void add_stitch_wires(const StitchWireSpec& st, int section, const std::vector<d
   spec.bending_stiffness = st.bending_stiffness;
   spec.tension = st.tension;
   for (std::size_t k = 1; k + 1 < supports.size(); ++k) {
+    if (!st.at(static_cast<int>(k))) continue;  // held as on a simple line
     const int lo = node_at(x, supports[k] - 0.5 * st.length), hi = node_at(x, supports[k] + 0.5 * st.length);
     Wire w;
     w.name = "stitch_wire" + suffix + "_" + std::to_string(k);

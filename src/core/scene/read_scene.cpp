@@ -124,6 +124,17 @@ void read_stitch_wire(Reader& r, const std::string& pre, SectionSpec& sec) {
   st.linear_mass = w.number("linear_mass", 0.0, 10.0, std::nullopt, true);
   st.bending_stiffness = w.number("bending_stiffness", 0.0, 1e4, 0.0);
   st.clamp_mass = w.number("clamp_mass", 0.0, 10.0, 0.0);
+  if (w.has("at_supports")) {
+    const std::vector<double> at = w.numbers("at_supports", 1.0, 1e6);
+    const std::string f = w.field("at_supports");
+    if (at.empty()) fail(f, "[]", "the intermediate supports (1, 2, ...) that carry one; stitch_wire: none for no stitch wire");
+    for (std::size_t i = 0; i < at.size(); ++i) {
+      if (at[i] != std::floor(at[i])) fail(f + "[" + std::to_string(i) + "]", fmt(at[i]), "a whole support number (1: after the first span)");
+      if (i > 0 && !(at[i] > at[i - 1]))
+        fail(f + "[" + std::to_string(i) + "]", fmt(at[i]), "above " + fmt(at[i - 1]) + ": support numbers in increasing order, each once");
+      st.at_supports.push_back(static_cast<int>(at[i]));
+    }
+  }
   w.finish();
   sec.stitch_wire = st;
 }

@@ -358,28 +358,38 @@ void validate_stitched(const Scene& s) {
       fail(f, "(given)", "a stitch wire hangs from a messenger and carries droppers: add messenger and droppers or remove it");
     if (sec.spans.size() < 2 && !s.endless)  // (an endless line's one span repeats: supports on both sides)
       fail(f, "(given on a section of 1 span)", "a section with intermediate supports (2 spans or more): a stitch wire hangs around one");
-    // Each span holds the clamps of the stitch wires at its intermediate supports, length / 2 from
-    // the support: an inner span two, which must not meet (length < span), a section's end span
-    // one (length < 2 span), so that a stitched line may end on short spans (toward a portal, a
-    // joint with a rail). An endless line's one span repeats: inner.
+    const StitchWireSpec& st = *sec.stitch_wire;
     const std::size_t n = sec.spans.size();
+    if (!st.at_supports.empty()) {
+      if (s.endless)
+        fail(f + ".at_supports", "(given on the endless line)", "absent: the endless line's one span repeats, every support carries one");
+      if (st.at_supports.back() > static_cast<int>(n) - 1)
+        fail(f + ".at_supports", std::to_string(st.at_supports.back()),
+             "an intermediate support of the section, 1 to " + std::to_string(n - 1) + " (its " + std::to_string(n) + " spans)");
+    }
+    // Each span holds the clamps of the stitch wires at its supports that carry one, length / 2
+    // from the support: where both do, they must not meet (length < span), where one does, it
+    // lies within the span (length < 2 span), so that a stitched line may end on short spans
+    // (toward a portal, a joint with a rail). The section's end supports carry none; an endless
+    // line's one span repeats, both its supports carrying one.
+    auto carries = [&](std::size_t k) { return s.endless || (k > 0 && k < n && st.at(static_cast<int>(k))); };
     double allowed = 1e300;
     std::size_t limiting = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const bool inner = s.endless || (i > 0 && i + 1 < n);
-      const double room = inner ? sec.spans[i] : 2.0 * sec.spans[i];
+      const int clamps = carries(i) + carries(i + 1);
+      if (clamps == 0) continue;
+      const double room = clamps == 2 ? sec.spans[i] : 2.0 * sec.spans[i];
       if (room < allowed) {
         allowed = room;
         limiting = i;
       }
     }
-    if (!(sec.stitch_wire->length < allowed)) {
-      const bool inner = s.endless || (limiting > 0 && limiting + 1 < n);
-      fail(f + ".length", fmt(sec.stitch_wire->length),
-           "(0, " + fmt(allowed) + ") m: each clamp within its span, " + fmt(0.5 * sec.stitch_wire->length) +
-               " m from its support (span " + std::to_string(limiting) + ", " + fmt(sec.spans[limiting]) + " m, holds " +
-               (inner ? "the clamps of the stitch wires at both its supports" : "one clamp, the section ending there") +
-               ")");
+    if (!(st.length < allowed)) {
+      const bool both = carries(limiting) && carries(limiting + 1);
+      fail(f + ".length", fmt(st.length),
+           "(0, " + fmt(allowed) + ") m: each clamp within its span, " + fmt(0.5 * st.length) + " m from its support (span " +
+               std::to_string(limiting) + ", " + fmt(sec.spans[limiting]) + " m, holds " +
+               (both ? "the clamps of the stitch wires at both its supports" : "one clamp") + ")");
     }
   }
 }

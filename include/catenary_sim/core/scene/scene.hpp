@@ -3,6 +3,7 @@
 // optional, so a scene may be a single tensioned wire between two supports under a moving force.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -69,6 +70,13 @@ struct StitchWireSpec {
   double linear_mass = 0.0;        // kg/m
   double bending_stiffness = 0.0;  // EI, N m^2
   double clamp_mass = 0.0;         // kg, each clamp on the messenger (lumped on the messenger node)
+  // The section's intermediate supports that carry one (1: the support after its first span), in
+  // increasing order; empty: every one. A support left out is held as on a simple line (e.g. the
+  // last before a tunnel portal, to stiffen the line where a rigid rail takes over).
+  std::vector<int> at_supports;
+  bool at(int support) const {
+    return at_supports.empty() || std::find(at_supports.begin(), at_supports.end(), support) != at_supports.end();
+  }
 };
 
 // A steady (registration) arm as built: a bar hinged at the registration tube, its tip clamped to
