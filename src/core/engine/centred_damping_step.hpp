@@ -13,8 +13,8 @@ namespace catenary_sim {
 StepStatus centred_damping_step(const Model& m, State& s);
 
 // A 3-D line's lateral centred substep taken along by the vertical step (step.cpp; in
-// lateral_step.cpp): where the model has both planes' factors (LateralModel::centred_joint_twin)
-// and wind loads the plane, the lateral forces of the step's start (the wind refreshed for it) are
+// lateral_step.cpp): where the model has both planes' factors (LateralModel::centred_joint_twin,
+// built only where the solve can be taken along), the lateral forces of the step's start (the wind refreshed for it) are
 // set now, and the vertical step's solve of each lone wire then solves its lateral plane in a
 // second lane; lateral_step solves the rest. False (nothing done) where it cannot.
 bool take_centred_solve_along(const Model& m, State& s);

@@ -703,10 +703,7 @@ StepStatus lateral_step(const Model& m, State& s) {
 }
 
 bool take_centred_solve_along(const Model& m, State& s) {
-  const LateralModel& lat = *m.lateral;
-  // Without wind (and so, here, without anything that loads the plane) lateral_step leaves a
-  // resting plane as it is, or steps a moved one alone.
-  if (lat.centred_joint_twin.empty() || !lat.windy || lat.lead_every > 0) return false;
+  if (m.lateral->centred_joint_twin.empty()) return false;
   // The wind of the lateral step's start, t0 as lateral_step computes it (after the vertical
   // step's s.time += dt), refreshed now (lateral_step then finds it done: the same values, once).
   refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);

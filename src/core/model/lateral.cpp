@@ -479,8 +479,11 @@ void factor_lateral_centred(const Model& m, LateralModel& lat) {
   }
   // Both planes of a lone wire in one solve (LateralModel::centred_joint_twin): the lanes share
   // dt, so one substep a step; the lateral forces must be ready before the vertical step; both
-  // planes over the whole wire (no window in either).
-  if (lat.substeps != 1 || m.scene.numerics.windowed() || !lat.pendulums.empty() || !lat.registrations.empty()) return;
+  // planes over the whole wire (no window in either, and so no gust lead). Without wind nothing
+  // else loads such a plane, and lateral_step leaves it at rest or steps a moved one alone.
+  if (!lat.windy || lat.substeps != 1 || m.scene.numerics.windowed() || !lat.pendulums.empty() ||
+      !lat.registrations.empty())
+    return;
   const CentredPlane vertical{&m.wires, m.mass.data(), m.inv_mass.data(), centred_shift(m, m.dt)};
   for (const WireLanes& p : packs_of(m)) {
     std::vector<double> twin, single;

@@ -196,9 +196,9 @@ struct LateralModel {
   // whose row is zeta = y; (2 / dt) / D per mass.
   std::vector<std::vector<double>> centred_twin, centred_single;
   // The same solve taken along by the vertical step's (step.cpp), both planes of one wire in two
-  // lanes, where nothing in the lateral forces reads the vertical step's result (no droppers'
-  // pendulums, no hinged arms), the plane takes one substep a step at the vertical dt and has no
-  // window: per pack of one wire its factors with the vertical plane's in lane 0 and the lateral
+  // lanes, where wind loads the plane, nothing in the lateral forces reads the vertical step's
+  // result (no droppers' pendulums, no hinged arms), the plane takes one substep a step at the
+  // vertical dt and has no window: per pack of one wire its factors with the vertical plane's in lane 0 and the lateral
   // plane's in lane 1, laid out as centred_twin (empty for a pack of two wires); empty otherwise.
   std::vector<std::vector<double>> centred_joint_twin, centred_joint_single;
   std::vector<int> centred_held;
