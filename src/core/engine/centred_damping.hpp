@@ -50,6 +50,13 @@ bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s);
 // the lateral ones as the lateral centred substep does (its forces in LateralWorkspace::f). Returns
 // centred_sweep's bits: 1 the vertical plane left the limit, 2 the lateral plane.
 int centred_sweep_both_planes(const Model& m, std::size_t pack, State& s);
+
+// Whether pack `pack`'s lateral solve is one the vertical step takes along
+// (LateralModel::centred_joint_twin exists for it): centred_sweep_both_planes solves it, the
+// lateral step then leaves it.
+inline bool joins_centred(const Model& m, std::size_t pack) {
+  return m.lateral && pack < m.lateral->centred_joint_twin.size() && !m.lateral->centred_joint_twin[pack].empty();
+}
 // The same over the pack's nodes lo..hi (a moving window, both lanes the same range) with that
 // range's factors (factor_centred_range).
 bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s, int lo, int hi, const double* twin,

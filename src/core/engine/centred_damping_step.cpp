@@ -56,7 +56,7 @@ bool sweep_packs(const Model& m, State& s) {
   const bool join = m.lateral && s.lateral.work->join;
   bool out = false, lateral_out = false;
   for (std::size_t pk = 0; pk < packs.size(); ++pk) {
-    if (join && !m.lateral->centred_joint_twin[pk].empty()) {
+    if (join && joins_centred(m, pk)) {
       const int beyond = centred_sweep_both_planes(m, pk, s);
       out |= (beyond & 1) != 0;
       lateral_out |= (beyond & 2) != 0;

@@ -478,7 +478,7 @@ bool centred_substep(const Model& m, State& s, bool windowed) {
   const std::vector<WireLanes>& packs = packs_of(m);
   bool out = joined && lw.joined_outside;
   for (std::size_t pk = 0; pk < packs.size(); ++pk) {
-    if (joined && !lat.centred_joint_twin[pk].empty()) continue;
+    if (joined && joins_centred(m, pk)) continue;
     const WireLanes& p = packs[pk];
     const WireWindow& ww = ls.window[p.wire[0]];
     const int lo = windowed ? ww.lo : 0, hi = windowed ? ww.hi : p.nodes - 1;
@@ -704,9 +704,7 @@ StepStatus lateral_step(const Model& m, State& s) {
 
 bool take_centred_solve_along(const Model& m, State& s) {
   if (m.lateral->centred_joint_twin.empty()) return false;
-  // The wind of the lateral step's start, t0 as lateral_step computes it (after the vertical
-  // step's s.time += dt), refreshed now (lateral_step then finds it done: the same values, once).
-  refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
+  refresh_wind_before_joint_step(m, s);
   centred_forces(m, s, false);
   return true;
 }

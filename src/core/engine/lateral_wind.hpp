@@ -26,4 +26,11 @@ void wind_on_nodes(const Model& m, const State& s, const double* points, int i0,
 // moving wire is taken every step.
 void refresh_wind_if_due(const Model& m, State& s, double t, bool windowed);
 
+// The same, before the vertical step, for a sweep that takes the lateral plane along: the wind of
+// the lateral step's start, t0 as lateral_step computes it after the vertical step's s.time += dt
+// (the same rounding), so that lateral_step then finds the refresh done (the same values, once).
+inline void refresh_wind_before_joint_step(const Model& m, State& s) {
+  refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
+}
+
 }  // namespace catenary_sim

@@ -52,10 +52,7 @@ StepStatus step_both_planes(const Model& m, State& s) {
   } else {
     ls.work->join = !lat.planes.empty() && lat.substeps == 1 && !m.scene.numerics.windowed() && taken &&
                     !ls.dropper_stretch.empty();
-    // The lateral step's wind is that of the step's start, t0 as lateral_step computes it (after
-    // the vertical step's s.time += dt), refreshed now for the sweep (lateral_step then finds it
-    // done: the same values, once).
-    if (ls.work->join) refresh_wind_if_due(m, s, (s.time + m.dt) - m.dt, false);
+    if (ls.work->join) refresh_wind_before_joint_step(m, s);
   }
   const StepStatus st = vertical_step(m, s);
   ls.work->join = false;
