@@ -33,4 +33,14 @@ inline std::string refusal_of(const std::string& file, const std::vector<std::st
   return "";
 }
 
+// The same for a scene given as YAML text.
+inline std::string refusal_of_yaml(const std::string& yaml, const std::vector<std::string>& overrides = {}) {
+  try {
+    catenary_sim::Simulation sim(catenary_sim::load_scene_string(yaml, overrides));
+  } catch (const catenary_sim::SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 }  // namespace test_scenes

@@ -44,14 +44,18 @@ inline const std::string kCompound = CATENARY_SIM_SOURCE_DIR "/config/compound_c
 inline const std::string kReferenceHingedArms = CATENARY_SIM_SOURCE_DIR "/config/reference_55m_hinged_arms.yaml";
 
 // A shipped scene of one section of equal spans as an endless line: its `line.span_count` left
-// out, `line.endless: true` (give numerics.window among the overrides).
-inline catenary_sim::Scene endless_scene(const std::string& path, const std::vector<std::string>& overrides) {
+// out, `line.endless: true` (give numerics.window among the overrides): its YAML text, and the
+// scene read from it.
+inline std::string endless_yaml(const std::string& path) {
   YAML::Node root = YAML::LoadFile(path);
   root["line"].remove("span_count");
   root["line"]["endless"] = true;
   std::ostringstream yaml;
   yaml << root;
-  return catenary_sim::load_scene_string(yaml.str(), overrides);
+  return yaml.str();
+}
+inline catenary_sim::Scene endless_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  return catenary_sim::load_scene_string(endless_yaml(path), overrides);
 }
 inline const std::string kCalpeExample = CATENARY_SIM_SOURCE_DIR "/config/calpe_example.yaml";
 
