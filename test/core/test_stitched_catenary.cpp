@@ -54,8 +54,11 @@ std::string network_yaml(double element) {
 
 // The same line as a network of strings: each wire a chain of nodes at its stations (fixed ones
 // at the rigid supports), T / l between neighbours; droppers and clamps as springs. Solved for a
-// force F up at the contact wire's node at `probe` (a station of the chain).
-double network_uplift(const cs::Model& m, double probe, double F) {
+// force F up at the contact wire's node at `probe` (a station of the chain). `spans` spans of 20 m
+// with droppers at 2 m and 18 m of each; a stitch wire of length L at each support x of
+// `stitches` ({x, L}), its clamps at x -/+ L / 2, the droppers strictly between them on it.
+double network_uplift(const cs::Model& m, double probe, double F, int spans = 2,
+                      const std::vector<std::pair<double, double>>& stitches = {{20.0, 8.0}}) {
   std::map<std::string, int> id;
   auto node = [&](const std::string& name) {
     const auto it = id.find(name);
@@ -77,16 +80,35 @@ double network_uplift(const cs::Model& m, double probe, double F) {
       links.push_back({a, b, T / (xs[i + 1] - xs[i])});
     }
   };
-  std::vector<double> cx{2.0, 18.0, 22.0, 38.0};
+  std::vector<double> supports, droppers;
+  for (int k = 0; k <= spans; ++k) supports.push_back(20.0 * k);
+  for (int k = 0; k < spans; ++k) droppers.insert(droppers.end(), {20.0 * k + 2.0, 20.0 * k + 18.0});
+  std::vector<double> cx = droppers;
   if (std::find(cx.begin(), cx.end(), probe) == cx.end()) cx.push_back(probe);
-  chain("c", cx, {0.0, 20.0, 40.0}, kTc);
-  chain("m", {2.0, 16.0, 24.0, 38.0}, {0.0, 20.0, 40.0}, kTm);
-  chain("s", {16.0, 18.0, 22.0, 24.0}, {}, kTs);
-  for (const cs::Dropper& d : m.droppers) {
-    const bool on_stitch = d.x > 16.0 && d.x < 24.0;
-    links.push_back({node("c" + std::to_string(d.x)), node((on_stitch ? "s" : "m") + std::to_string(d.x)), d.stiffness});
+  chain("c", cx, supports, kTc);
+  // The stitch wire a dropper at xd hangs from (-1: the messenger).
+  auto stitch_of = [&](double xd) {
+    for (std::size_t j = 0; j < stitches.size(); ++j)
+      if (std::fabs(xd - stitches[j].first) < 0.5 * stitches[j].second) return static_cast<int>(j);
+    return -1;
+  };
+  std::vector<double> mx;
+  for (double xd : droppers)
+    if (stitch_of(xd) < 0) mx.push_back(xd);
+  for (std::size_t j = 0; j < stitches.size(); ++j) {
+    const double a = stitches[j].first - 0.5 * stitches[j].second, b = stitches[j].first + 0.5 * stitches[j].second;
+    mx.insert(mx.end(), {a, b});
+    std::vector<double> sx{a, b};
+    for (double xd : droppers)
+      if (stitch_of(xd) == static_cast<int>(j)) sx.push_back(xd);
+    chain("s" + std::to_string(j) + "_", sx, {}, kTs);
+    for (double x : {a, b}) links.push_back({node("m" + std::to_string(x)), node("s" + std::to_string(j) + "_" + std::to_string(x)), cs::kStitchClampStiffness});
   }
-  for (double x : {16.0, 24.0}) links.push_back({node("m" + std::to_string(x)), node("s" + std::to_string(x)), cs::kStitchClampStiffness});
+  chain("m", mx, supports, kTm);
+  for (const cs::Dropper& d : m.droppers) {
+    const int j = stitch_of(d.x);
+    links.push_back({node("c" + std::to_string(d.x)), node((j >= 0 ? "s" + std::to_string(j) + "_" : std::string("m")) + std::to_string(d.x)), d.stiffness});
+  }
   const int n = static_cast<int>(id.size());
   Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n, n);
   for (const Link& l : links) {
@@ -124,6 +146,36 @@ TEST(StitchedCatenary, StaticsMatchAStringNetwork) {
     EXPECT_LT(ec / ef, 5.0) << "probe at " << x << " m: the error is not first order in h";
     EXPECT_NEAR((4.0 * uf - uc) / 3.0, expected, 5e-4 * expected) << "probe at " << x << " m";
   }
+}
+
+// (a') A stitch wire of its own length at each support (`lengths`): three spans of 20 m, 8 m of
+// stitch wire at the first intermediate support (clamps at 16 and 24 m) and 6 m at the second
+// (37 and 43 m), against the string network with the same wires; the same tolerances as (a).
+// Each stitch wire carries the droppers between its own clamps.
+TEST(StitchedCatenary, EachSupportsOwnStitchWireLengthMatchesTheStringNetwork) {
+  const double F = 100.0;
+  auto yaml = [](double element) {
+    std::string y = network_yaml(element);
+    y.replace(y.find("span_count: 2"), 13, "span_count: 3");
+    y.replace(y.find("length: 8.0"), 11, "lengths: [8.0, 6.0]");
+    return y;
+  };
+  const cs::ElasticityProbe coarse(cs::load_scene_string(yaml(0.2)), F);
+  const cs::ElasticityProbe fine(cs::load_scene_string(yaml(0.05)), F);
+  ASSERT_EQ(fine.model().clamps.size(), 4u);
+  const std::vector<std::pair<double, double>> stitches{{20.0, 8.0}, {40.0, 6.0}};
+  for (double x : {10.0, 18.0, 22.0, 30.0, 38.0, 42.0, 50.0}) {
+    const double expected = network_uplift(fine.model(), x, F, 3, stitches);
+    const double uc = coarse.uplift(x).at(0), uf = fine.uplift(x).at(0);
+    EXPECT_LT(std::fabs(uf - expected) / expected, 5e-3) << "probe at " << x << " m: " << uf << " against " << expected;
+    EXPECT_NEAR((4.0 * uf - uc) / 3.0, expected, 5e-4 * expected) << "probe at " << x << " m";
+  }
+  // Written as one length for every support, lengths gives the model that length gives.
+  std::string same = network_yaml(0.2);
+  same.replace(same.find("length: 8.0"), 11, "lengths: [8.0]");
+  const cs::ElasticityProbe one(cs::load_scene_string(same), F);
+  const cs::ElasticityProbe uniform(cs::load_scene_string(network_yaml(0.2)), F);
+  for (double x : {18.0, 30.0}) EXPECT_EQ(one.uplift(x).at(0), uniform.uplift(x).at(0)) << "probe at " << x << " m";
 }
 
 namespace {
@@ -281,6 +333,24 @@ TEST(StitchedCatenary, BadInputIsRefusedByName) {
   const std::string endless = test_scenes::refusal_of_yaml(test_scenes::endless_yaml(test_scenes::kReferenceStitched),
                                                             {"numerics.window=auto", "stitch_wire.at_supports=[1]"});
   EXPECT_NE(endless.find("stitch_wire.at_supports"), std::string::npos) << "endless line: " << endless;
+  // lengths: one per carrying support, each support's clamps within its spans; not with length.
+  auto lengths = [](std::string yaml, const std::string& list) {
+    return yaml.replace(yaml.find("length: 8.0"), 11, "lengths: " + list);
+  };
+  refused(lengths(y, "[8.0, 8.0]"), "stitch_wire.lengths");  // 2 spans: one support
+  refused(lengths(y, "[]"), "stitch_wire.lengths");
+  refused(lengths(y, "[0.0]"), "stitch_wire.lengths[0]");
+  refused(lengths(y, "[8.0]") + "stitch_wire: {length: 8.0}\n", "stitch_wire");
+  refused(with("length: 8.0", "length: 8.0, lengths: [8.0]"), "stitch_wire.length");
+  // 3 spans of 20 m: the inner span holds the halves of both supports' stitch wires (10 + 11 m).
+  const std::string too_long = test_scenes::refusal_of_yaml(lengths(three_spans, "[20.0, 22.0]"));
+  for (const char* word : {"stitch_wire.lengths[", "span 1", "10 + 11 m"}) EXPECT_NE(too_long.find(word), std::string::npos) << too_long;
+  EXPECT_EQ(test_scenes::refusal_of_yaml(lengths(three_spans, "[20.0, 18.0]")), "");
+  EXPECT_EQ(test_scenes::refusal_of_yaml(lengths(at(three_spans, "[2]"), "[38.0]")), "");  // one clamp a span: < 2 x 20 m
+  refused(lengths(at(three_spans, "[2]"), "[20.0, 20.0]"), "stitch_wire.lengths");
+  const std::string endless_lengths = test_scenes::refusal_of_yaml(
+      test_scenes::endless_yaml(test_scenes::kReferenceStitched), {"numerics.window=auto", "stitch_wire.length=null", "stitch_wire.lengths=[18.0]"});
+  EXPECT_NE(endless_lengths.find("stitch_wire.lengths"), std::string::npos) << "endless line: " << endless_lengths;
   refused(with("tension: 3500", "tension: -1"), "stitch_wire.tension");
   refused(with("linear_mass: 0.31", "linear_mass: 0.31, colour: red"), "stitch_wire.colour");
   refused(with("span_count: 2", "span_count: 1"), "stitch_wire");

@@ -338,6 +338,11 @@ TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
       {test_scenes::kReferenceStitched, "stitch_wire.at_supports=[.nan]", {"stitch_wire.at_supports[0]"}},
       {test_scenes::kReferenceStitched, "stitch_wire.at_supports=[1e300]", {"stitch_wire.at_supports[0]"}},
       {test_scenes::kReferenceStitched, "stitch_wire.at_supports={1: 2}", {"stitch_wire.at_supports"}},
+      // each support's own stitch-wire length
+      {test_scenes::kReferenceStitched, "stitch_wire={lengths: [.nan], tension: 3500, linear_mass: 0.31}", {"stitch_wire.lengths[0]"}},
+      {test_scenes::kReferenceStitched, "stitch_wire={lengths: [1e300], tension: 3500, linear_mass: 0.31}", {"stitch_wire.lengths[0]"}},
+      {test_scenes::kReferenceStitched, "stitch_wire={lengths: {1: 2}, tension: 3500, linear_mass: 0.31}", {"stitch_wire.lengths"}},
+      {test_scenes::kReferenceStitched, "stitch_wire.lengths=[18, 18]", {"stitch_wire.length"}},
       // the pantograph head across the track
       {r3, "pantograph_head.histogram_bin=1e-8", {"pantograph_head.histogram_bin"}},
       {r3, "pantograph_head.histogram_bin=1e-300", {"pantograph_head.histogram_bin"}},

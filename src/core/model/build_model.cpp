@@ -40,9 +40,10 @@ std::vector<double> mesh_section(const SectionSpec& sec, double element_length, 
     if (sec.hangers)  // a compound line's
       for (double p : sec.hangers->positions[i]) breaks.push_back(x0 + p);
     if (sec.stitch_wire) {  // the clamps of the stitch wires at the span's intermediate supports
-      const double half = 0.5 * sec.stitch_wire->length;
-      if (i > 0 && sec.stitch_wire->at(static_cast<int>(i))) breaks.push_back(x0 + half);
-      if (i + 1 < nspan && sec.stitch_wire->at(static_cast<int>(i) + 1)) breaks.push_back(x0 + sec.spans[i] - half);
+      const StitchWireSpec& st = *sec.stitch_wire;
+      const int a = static_cast<int>(i), b = a + 1;
+      if (i > 0 && st.at(a)) breaks.push_back(x0 + 0.5 * st.length_at(a));
+      if (i + 1 < nspan && st.at(b)) breaks.push_back(x0 + sec.spans[i] - 0.5 * st.length_at(b));
     }
     if (sec.hangers || sec.stitch_wire) {  // (droppers alone are in order: validate_sections)
       std::sort(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end());
@@ -122,7 +123,8 @@ void add_stitch_wires(const StitchWireSpec& st, int section, const std::vector<d
   spec.tension = st.tension;
   for (std::size_t k = 1; k + 1 < supports.size(); ++k) {
     if (!st.at(static_cast<int>(k))) continue;  // held as on a simple line
-    const int lo = node_at(x, supports[k] - 0.5 * st.length), hi = node_at(x, supports[k] + 0.5 * st.length);
+    const double half = 0.5 * st.length_at(static_cast<int>(k));
+    const int lo = node_at(x, supports[k] - half), hi = node_at(x, supports[k] + half);
     Wire w;
     w.name = "stitch_wire" + suffix + "_" + std::to_string(k);
     w.section = section;

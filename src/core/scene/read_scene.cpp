@@ -119,7 +119,14 @@ void read_stitch_wire(Reader& r, const std::string& pre, SectionSpec& sec) {
   }
   Reader w(r.child("stitch_wire"), pre + "stitch_wire");
   StitchWireSpec st;
-  st.length = w.number("length", 0.0, 100.0, std::nullopt, true);
+  if (w.has("lengths")) {
+    if (w.has("length"))
+      fail(w.field("length"), "(given with lengths)", "one of them: length for every support, or lengths, one per support that carries one");
+    st.lengths = w.numbers("lengths", 0.0, 100.0, true);
+    if (st.lengths.empty()) fail(w.field("lengths"), "[]", "one length (m, > 0) per support that carries a stitch wire");
+  } else {
+    st.length = w.number("length", 0.0, 100.0, std::nullopt, true);
+  }
   st.tension = w.number("tension", 0.0, 1e5, std::nullopt, true);
   st.linear_mass = w.number("linear_mass", 0.0, 10.0, std::nullopt, true);
   st.bending_stiffness = w.number("bending_stiffness", 0.0, 1e4, 0.0);

@@ -367,6 +367,30 @@ void validate_stitched(const Scene& s) {
         fail(f + ".at_supports", std::to_string(st.at_supports.back()),
              "an intermediate support of the section, 1 to " + std::to_string(n - 1) + " (its " + std::to_string(n) + " spans)");
     }
+    if (!st.lengths.empty()) {
+      if (s.endless)
+        fail(f + ".lengths", "(given on the endless line)", "absent: the endless line's one span repeats, give length");
+      const std::size_t carrying = st.at_supports.empty() ? n - 1 : st.at_supports.size();
+      if (st.lengths.size() != carrying)
+        fail(f + ".lengths", std::to_string(st.lengths.size()) + " lengths",
+             std::to_string(carrying) + ", one per support that carries a stitch wire (" +
+                 (st.at_supports.empty() ? "supports 1 to " + std::to_string(n - 1) : "at_supports") + ")");
+      // Each clamp within its span: the halves of the stitch wires at a span's two supports must
+      // not meet, a lone one lies within the span.
+      auto carries_k = [&](std::size_t k) { return k > 0 && k < n && st.at(static_cast<int>(k)); };
+      for (std::size_t i = 0; i < n; ++i) {
+        const double a = carries_k(i) ? 0.5 * st.length_at(static_cast<int>(i)) : 0.0;
+        const double b = carries_k(i + 1) ? 0.5 * st.length_at(static_cast<int>(i) + 1) : 0.0;
+        if (a + b < sec.spans[i]) continue;
+        const int support = static_cast<int>(b > 0.0 ? i + 1 : i);
+        fail(f + ".lengths[" + std::to_string(st.length_index(support)) + "]", fmt(st.length_at(support)),
+             "a length whose clamps stay within span " + std::to_string(i) + " (" + fmt(sec.spans[i]) + " m): " +
+                 (a > 0.0 && b > 0.0 ? "half the stitch wires' lengths at supports " + std::to_string(i) + " and " +
+                                           std::to_string(i + 1) + " together (" + fmt(a) + " + " + fmt(b) + " m) below the span"
+                                     : "half its length below the span"));
+      }
+      continue;
+    }
     // Each span holds the clamps of the stitch wires at its supports that carry one, length / 2
     // from the support: where both do, they must not meet (length < span), where one does, it
     // lies within the span (length < 2 span), so that a stitched line may end on short spans

@@ -74,8 +74,23 @@ struct StitchWireSpec {
   // increasing order; empty: every one. A support left out is held as on a simple line (e.g. the
   // last before a tunnel portal, to stiffen the line where a rigid rail takes over).
   std::vector<int> at_supports;
+  // Each carrying support's own length, in the order of the supports that carry one (at_supports,
+  // or every intermediate support); empty: `length` at every one (a shorter stitch wire where a
+  // span shortens, at a portal or an overlap).
+  std::vector<double> lengths;
   bool at(int support) const {
     return at_supports.empty() || std::find(at_supports.begin(), at_supports.end(), support) != at_supports.end();
+  }
+  // The entry of `lengths` for `support` (one that carries one): its place among the carrying supports.
+  std::size_t length_index(int support) const {
+    return at_supports.empty()
+               ? static_cast<std::size_t>(support - 1)
+               : static_cast<std::size_t>(std::find(at_supports.begin(), at_supports.end(), support) - at_supports.begin());
+  }
+  // The length of the stitch wire at `support` (one that carries one).
+  double length_at(int support) const {
+    const std::size_t k = length_index(support);
+    return k < lengths.size() ? lengths[k] : length;
   }
 };
 
