@@ -445,8 +445,9 @@ __attribute__((always_inline)) inline bool sweep_pair(const PackSweep& a, const 
 
 // A pack of two wires and a lone wire on the same nodes (a compound line's contact wire and
 // messenger, and its auxiliary; a twin contact wire's second wire) in one loop, on what A and B
-// read and write (OnePlane): the lone wire's sweep runs in the pair's waiting time (its recurrences, y = r - l y forward and
-// theta = y / d - l theta backward, are chains of dependent operations) instead of after it.
+// read and write (OnePlane): the lone wire shares the pair's loop instead of paying one of its
+// own, and its recurrences (y = r - l y forward, theta = y / d - l theta backward, chains of
+// dependent operations) overlap the pair's (0.94-0.97 of the two loops' time, BENCHMARKS.md).
 // Each lane does its own pack's operations in their order: the bits of the sweeps one after the
 // other.
 template <class X, class Y>

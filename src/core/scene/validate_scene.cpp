@@ -367,6 +367,9 @@ void validate_stitched(const Scene& s) {
         fail(f + ".at_supports", std::to_string(st.at_supports.back()),
              "an intermediate support of the section, 1 to " + std::to_string(n - 1) + " (its " + std::to_string(n) + " spans)");
     }
+    // The supports that carry one: an endless line's one span repeats, both its supports carrying
+    // one; a section's end supports carry none.
+    auto carries = [&](std::size_t k) { return s.endless || (k > 0 && k < n && st.at(static_cast<int>(k))); };
     if (!st.lengths.empty()) {
       if (s.endless)
         fail(f + ".lengths", "(given on the endless line)", "absent: the endless line's one span repeats, give length");
@@ -377,10 +380,9 @@ void validate_stitched(const Scene& s) {
                  (st.at_supports.empty() ? "supports 1 to " + std::to_string(n - 1) : "at_supports") + ")");
       // Each clamp within its span: the halves of the stitch wires at a span's two supports must
       // not meet, a lone one lies within the span.
-      auto carries_k = [&](std::size_t k) { return k > 0 && k < n && st.at(static_cast<int>(k)); };
       for (std::size_t i = 0; i < n; ++i) {
-        const double a = carries_k(i) ? 0.5 * st.length_at(static_cast<int>(i)) : 0.0;
-        const double b = carries_k(i + 1) ? 0.5 * st.length_at(static_cast<int>(i) + 1) : 0.0;
+        const double a = carries(i) ? 0.5 * st.length_at(static_cast<int>(i)) : 0.0;
+        const double b = carries(i + 1) ? 0.5 * st.length_at(static_cast<int>(i) + 1) : 0.0;
         if (a + b < sec.spans[i]) continue;
         const int support = static_cast<int>(b > 0.0 ? i + 1 : i);
         fail(f + ".lengths[" + std::to_string(st.length_index(support)) + "]", fmt(st.length_at(support)),
@@ -396,7 +398,6 @@ void validate_stitched(const Scene& s) {
     // lies within the span (length < 2 span), so that a stitched line may end on short spans
     // (toward a portal, a joint with a rail). The section's end supports carry none; an endless
     // line's one span repeats, both its supports carrying one.
-    auto carries = [&](std::size_t k) { return s.endless || (k > 0 && k < n && st.at(static_cast<int>(k))); };
     double allowed = 1e300;
     std::size_t limiting = 0;
     for (std::size_t i = 0; i < n; ++i) {
