@@ -134,10 +134,9 @@ TEST(FusedStep, MatchesThePlainStepBitForBitOverAPass) {
 // the other ways a pass runs: the moving window, the endless line, two pantographs, two sections
 // (an overlap: two packs), the coarsest rung and the half-step's finest (h = 0.1 m, the reference
 // preset's rung where the centred step does not go, e.g. beta 0; the centred step has its own
-// tests, test_centred_damping.cpp), a twin contact wire (a pack of one wire beside one of two, both
-// swept in one loop), with and without a window, and a compound line (its auxiliary a pack of its
-// own swept in one loop with the pair's; hangers and droppers as point forces on three wires), with
-// and without a window.
+// tests, test_centred_damping.cpp), a twin contact wire (a pack of one wire beside one of two), with
+// and without a window, and a compound line (its auxiliary a pack of its own; hangers and droppers
+// as point forces on three wires), with and without a window.
 TEST(FusedStep, MatchesTheGenericStepBitForBit) {
   struct Case {
     std::string file;

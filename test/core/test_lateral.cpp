@@ -1544,6 +1544,11 @@ TEST(Lateral, FusedStepIsTheGenericStepBitForBit) {
   while (compound_joint.step() == StepStatus::kOk) {
   }
   EXPECT_EQ(compound_joint.state().lateral.work->joined_steps, compound_joint.state().steps);
+  // And in the moving window, where the lateral step sweeps on its own (a steady wind).
+  windowed_fused = 0;
+  EXPECT_GT(expect_fused_is_generic({"line.span_count=12", "numerics.window=auto", "wind.turbulence=null"}, &windowed_fused, compound),
+            5000);
+  EXPECT_GT(windowed_fused, 5000);
 }
 
 TEST(Lateral, AHeldRegistrationsRowIsItsWholeWiresBandForce) {

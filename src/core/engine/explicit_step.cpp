@@ -44,41 +44,22 @@ bool sweep_packs(const Model& m, State& s, bool windowed) {
   // joint layout (LateralWorkspace::sweep, WirePacks::dof_joint_force).
   const bool join = m.lateral && s.lateral.work->join;
   bool lateral_outside = false;
-  const std::vector<int>& with = m.wire_packs->sweep_with;
-  auto setup = [&](std::size_t pk, PackSweep& a) {
-    if (!setup_pack_sweep(m.wire_packs->packs[pk], m.wires, windowed ? &s.window : nullptr, s.work->sweep_factors.data(),
-                          s.work->sweep.data(), u, v, un, vn, acc, a))
-      return false;
+  for (std::size_t pk = 0; pk < m.wire_packs->packs.size(); ++pk) {
+    PackSweep a, b;
+    if (!setup_pack_sweep(m.wire_packs->packs[pk], m.wires, windowed ? &s.window : nullptr, s.work->sweep_factors.data(), s.work->sweep.data(), u, v,
+                          un, vn, acc, a))
+      continue;
     a.beta = beta;
     a.dt = dt;
     a.limit = limit;
-    return true;
-  };
-  auto joint_record = [&](std::size_t pk) { return s.lateral.work->sweep.data() + 2 * kSweepRecord * m.wire_packs->packs[pk].offset; };
-  // A pack alone, its lateral plane taken along where the join takes it.
-  auto alone = [&](std::size_t pk, const PackSweep& a) {
-    PackSweep b;
     if (join && setup_lateral_sweep(m, s, pk, false, b)) {
       bool b_outside = false;
-      outside |= sweep_pack_pair(a, b, joint_record(pk), &b_outside);
+      double* joint_record = s.lateral.work->sweep.data() + 2 * kSweepRecord * m.wire_packs->packs[pk].offset;
+      outside |= sweep_pack_pair(a, b, joint_record, &b_outside);
       lateral_outside |= b_outside;
     } else {
       outside |= sweep_pack(a);
     }
-  };
-  for (std::size_t pk = 0; pk < m.wire_packs->packs.size(); ++pk) {
-    if (with[pk] == WirePacks::kSweptWithPair) continue;  // (in its pair's turn)
-    PackSweep a, one;
-    const bool has = setup(pk, a);
-    const bool has_one = with[pk] >= 0 && setup(static_cast<std::size_t>(with[pk]), one);
-    // (With both planes the pair's four lanes and the lone wire's two in one loop measured slower
-    // than the two sweeps one after the other: the join takes each pack alone.)
-    if (has && has_one && !join && one.lo == a.lo && one.hi == a.hi) {
-      outside |= sweep_pack_and_one(a, one);
-      continue;
-    }
-    if (has) alone(pk, a);
-    if (has_one) alone(static_cast<std::size_t>(with[pk]), one);  // (a window's ranges apart)
   }
   if (join) {
     s.lateral.work->joined = true;

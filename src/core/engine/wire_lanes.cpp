@@ -443,76 +443,6 @@ __attribute__((always_inline)) inline bool sweep_pair(const PackSweep& a, const 
   return !Lane<L>::ok(s.ok.vertical);
 }
 
-// A pack of two wires and a lone wire on the same nodes (a compound line's contact wire and
-// messenger, and its auxiliary; a twin contact wire's second wire) in one loop, on what A and B
-// read and write (OnePlane): the lone wire shares the pair's loop instead of paying one of its
-// own, and its recurrences (y = r - l y forward, theta = y / d - l theta backward, chains of
-// dependent operations) overlap the pair's (0.94-0.97 of the two loops' time, BENCHMARKS.md).
-// Each lane does its own pack's operations in their order: the bits of the sweeps one after the
-// other.
-template <class X, class Y>
-struct Joined {
-  X a;
-  Y b;
-};
-template <class X, class Y>
-inline Joined<X, Y> operator+(Joined<X, Y> p, Joined<X, Y> q) { return {p.a + q.a, p.b + q.b}; }
-template <class X, class Y>
-inline Joined<X, Y> operator-(Joined<X, Y> p, Joined<X, Y> q) { return {p.a - q.a, p.b - q.b}; }
-template <class X, class Y>
-inline Joined<X, Y> operator*(Joined<X, Y> p, Joined<X, Y> q) { return {p.a * q.a, p.b * q.b}; }
-template <class X, class Y>
-inline Joined<X, Y> operator-(Joined<X, Y> p) { return {-p.a, -p.b}; }
-
-template <class A, class B>
-struct TwoPacks {
-  using T = Joined<typename A::T, typename B::T>;
-  using Mask = Joined<typename A::Mask, typename B::Mask>;
-  A pa;
-  B pb;
-  T beta, dt, ww_lo, wt_lo, ww_hi, wt_hi;
-  int lo, hi;
-
-  TwoPacks(const A& pair, const B& one)
-      : pa(pair), pb(one), beta{pa.beta, pb.beta}, dt{pa.dt, pb.dt}, ww_lo{pa.ww_lo, pb.ww_lo}, wt_lo{pa.wt_lo, pb.wt_lo},
-        ww_hi{pa.ww_hi, pb.ww_hi}, wt_hi{pa.wt_hi, pb.wt_hi}, lo(pair.lo), hi(pair.hi) {}
-
-  __attribute__((always_inline)) T c(int i, int k) const { return {pa.c(i, k), pb.c(i, k)}; }
-  __attribute__((always_inline)) T lower(int i) const { return {pa.lower(i), pb.lower(i)}; }
-  __attribute__((always_inline)) T ip(int i) const { return {pa.ip(i), pb.ip(i)}; }
-  __attribute__((always_inline)) T get(int i, int k) const { return {pa.get(i, k), pb.get(i, k)}; }
-  __attribute__((always_inline)) void set(int i, int k, T x) {
-    pa.set(i, k, x.a);
-    pb.set(i, k, x.b);
-  }
-  __attribute__((always_inline)) T inv_mass(int i) const { return {pa.inv_mass(i), pb.inv_mass(i)}; }
-  __attribute__((always_inline)) T init(int i, T vi) const { return {pa.init(i, vi.a), pb.init(i, vi.b)}; }
-  __attribute__((always_inline)) void state(int i, T& ui, T& vi) const {
-    pa.state(i, ui.a, vi.a);
-    pb.state(i, ui.b, vi.b);
-  }
-  __attribute__((always_inline)) void state2(int i, T& u0, T& u1, T& v0, T& v1) const {
-    pa.state2(i, u0.a, u1.a, v0.a, v1.a);
-    pb.state2(i, u0.b, u1.b, v0.b, v1.b);
-  }
-  __attribute__((always_inline)) void update(int i, T a, Mask& ok) {
-    pa.update(i, a.a, ok.a);
-    pb.update(i, a.b, ok.b);
-  }
-  __attribute__((always_inline)) void update2(int i, T a0, T a1, Mask& ok) {
-    pa.update2(i, a0.a, a1.a, ok.a);
-    pb.update2(i, a0.b, a1.b, ok.b);
-  }
-  static Mask all() { return Mask{A::all(), B::all()}; }
-};
-
-template <class A, class B>
-__attribute__((always_inline)) inline typename TwoPacks<A, B>::Mask sweep_two_packs(const A& pair, const B& one) {
-  Sweeper<TwoPacks<A, B>> s(pair, one);
-  drive(s);
-  return s.ok;
-}
-
 }  // namespace
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
@@ -533,11 +463,6 @@ CATENARY_SIM_CLONES bool sweep_pack_pair(const PackSweep& a, const PackSweep& b,
   if (a.pack->lanes == 2)
     return b.wind[0] ? sweep_pair<2, true>(a, b, joint_record, b_outside) : sweep_pair<2, false>(a, b, joint_record, b_outside);
   return b.wind[0] ? sweep_pair<1, true>(a, b, joint_record, b_outside) : sweep_pair<1, false>(a, b, joint_record, b_outside);
-}
-
-CATENARY_SIM_CLONES bool sweep_pack_and_one(const PackSweep& pair, const PackSweep& one) {
-  const auto ok = sweep_two_packs(OnePlane<2, false, false>(pair), OnePlane<1, false, false>(one));
-  return !(Lane<2>::ok(ok.a) && Lane<1>::ok(ok.b));
 }
 
 bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const std::vector<WireWindow>* windows,

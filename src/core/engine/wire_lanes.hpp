@@ -54,11 +54,6 @@ bool sweep_pack(const PackSweep& sweep);
 // vertical sweep's flag, the lateral's in `lateral_outside`.
 bool sweep_pack_pair(const PackSweep& vertical, const PackSweep& lateral, double* joint_record, bool* lateral_outside);
 
-// The vertical plane's sweeps of a pack of two wires `pair` and a lone wire's `one` over the same
-// nodes in one loop, each to the bit what sweep_pack gives it alone (lane by lane the same
-// operations). Returns true if some new displacement of either is beyond the limit or not a number.
-bool sweep_pack_and_one(const PackSweep& pair, const PackSweep& one);
-
 // Sets up pack p's sweep over `windows` (per wire of `wires`, their factors interleaved in
 // `window_factors`: the vertical plane's State::window or the lateral plane's own; null: the whole
 // wires) on the state arrays x, v, x_next, v_next and accel, indexed by `wires`' w_dof (the

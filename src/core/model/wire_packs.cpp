@@ -65,16 +65,6 @@ std::shared_ptr<WirePacks> build_wire_packs(const Model& m) {
     }
     pk.packs.push_back(std::move(p));
   }
-  pk.sweep_with.assign(pk.packs.size(), -1);
-  for (std::size_t a = 0; a < pk.packs.size(); ++a) {
-    if (pk.packs[a].lanes != 2) continue;
-    for (std::size_t b = 0; b < pk.packs.size(); ++b)
-      if (pk.packs[b].lanes == 1 && pk.sweep_with[b] == -1 && m.wires[pk.packs[b].wire[0]].x == m.wires[pk.packs[a].wire[0]].x) {
-        pk.sweep_with[a] = static_cast<int>(b);
-        pk.sweep_with[b] = WirePacks::kSweptWithPair;
-        break;
-      }
-  }
   for (std::vector<int>* at : {&pk.dof_sweep_force, &pk.dof_sweep_z, &pk.dof_joint_force, &pk.dof_joint_z})
     at->assign(m.n_catenary_dof, 0);
   for (const WireLanes& p : pk.packs)

@@ -39,11 +39,6 @@ enum { kRecTheta, kRecZ, kRecInit, kRecForce, kSweepRecord };
 struct WirePacks {
   std::vector<WireLanes> packs;
   std::vector<int> wire_pack, wire_lane;  // per wire (Model::wires): its pack and lane
-  // Per pack: a lone wire's pack on a pair's stations (a compound line's auxiliary beside its
-  // contact wire and messenger) is swept in one loop with that pair (sweep_pack_and_one): the
-  // pair's entry names the lone pack, the lone pack's is kSweptWithPair; -1 alone.
-  enum { kSweptWithPair = -2 };
-  std::vector<int> sweep_with;
   std::vector<int> centred_fixed_dofs;    // the wires' fixed vertical DOFs (centred damping step)
   double centred_v_ratio = 0.0;           // (2 / dt) / D_i per mass (centred damping step)
   // Per catenary DOF: where the sweep leaves its band force and its z in StepWorkspace::sweep;
