@@ -22,25 +22,26 @@ inline void expect_refused(const std::string& yaml, const std::string& field) {
   }
 }
 
-// The message a scene file with `overrides` (--set style) is refused with, when it is read or
-// built into a simulation; "" when it is accepted.
-inline std::string refusal_of(const std::string& file, const std::vector<std::string>& overrides) {
+// The message a scene that `load` reads is refused with, when it is read or built into a
+// simulation; "" when it is accepted.
+template <class Load>
+std::string refusal(Load&& load) {
   try {
-    catenary_sim::Simulation sim(catenary_sim::load_scene_file(file, overrides));
+    catenary_sim::Simulation sim(load());
   } catch (const catenary_sim::SceneError& e) {
     return e.what();
   }
   return "";
 }
 
+// The same for a scene file with `overrides` (--set style).
+inline std::string refusal_of(const std::string& file, const std::vector<std::string>& overrides) {
+  return refusal([&] { return catenary_sim::load_scene_file(file, overrides); });
+}
+
 // The same for a scene given as YAML text.
 inline std::string refusal_of_yaml(const std::string& yaml, const std::vector<std::string>& overrides = {}) {
-  try {
-    catenary_sim::Simulation sim(catenary_sim::load_scene_string(yaml, overrides));
-  } catch (const catenary_sim::SceneError& e) {
-    return e.what();
-  }
-  return "";
+  return refusal([&] { return catenary_sim::load_scene_string(yaml, overrides); });
 }
 
 }  // namespace test_scenes
