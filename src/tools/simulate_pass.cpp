@@ -288,9 +288,11 @@ void print_pantograph(const PantographStatistics& s) {
   std::cout << std::setprecision(1) << "  " << s.name << ": mean " << s.filtered.mean << " N, std "
             << s.filtered.std_dev << " N, max " << s.filtered.max << " N, min " << s.filtered.min
             << " N, stat max " << s.filtered.stat_max << " N, stat min " << s.filtered.stat_min
-            << " N, contact loss " << std::setprecision(2) << s.contact_loss_percent << " %, max uplift at steady arm "
-            << std::setprecision(1) << s.max_uplift_at_support_m * 1e3 << " mm\n"
-            << "      unfiltered: max " << s.unfiltered.max << " N, min " << s.unfiltered.min << " N, std "
+            << " N, contact loss " << std::setprecision(2) << s.contact_loss_percent << " %, max uplift at steady arm ";
+  if (std::isnan(s.max_uplift_at_support_m)) std::cout << "none (no steady arms)";
+  else std::cout << std::setprecision(1) << s.max_uplift_at_support_m * 1e3 << " mm";
+  std::cout << "\n"
+            << std::setprecision(1) << "      unfiltered: max " << s.unfiltered.max << " N, min " << s.unfiltered.min << " N, std "
             << s.unfiltered.std_dev << " N\n";
   if (s.target_mean) {
     const PantographStatistics::TargetMean& t = *s.target_mean;
@@ -305,8 +307,10 @@ void print_pantograph(const PantographStatistics& s) {
                 << w.contact_percent << " % of the time\n";
   std::cout << std::setprecision(2) << "      contact losses: " << s.loss_events_total << " (" << s.loss_events_per_km
             << " per km), longest " << s.longest_loss_s * 1e3 << " ms\n";
-  std::cout << "      spectrum: span passing " << s.spectrum.span_passing_hz << " Hz, dropper passing "
-            << s.spectrum.dropper_passing_hz << " Hz; peaks";
+  std::cout << "      spectrum: span passing " << s.spectrum.span_passing_hz << " Hz, dropper passing ";
+  if (std::isnan(s.spectrum.dropper_passing_hz)) std::cout << "none (no droppers)";  // a trolley wire, a rail
+  else std::cout << s.spectrum.dropper_passing_hz << " Hz";
+  std::cout << "; peaks";
   for (const SpectralPeak& k : s.spectrum.peaks)
     std::cout << " " << k.frequency << " Hz (" << std::setprecision(1) << k.amplitude << " N)" << std::setprecision(2);
   std::cout << "\n";
