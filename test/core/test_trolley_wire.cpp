@@ -1,0 +1,228 @@
+// A trolley wire (docs/trolley_wire.md): one tensioned contact wire held at each support by its
+// suspension, no messenger or droppers. Its own-weight sag against a tensioned beam, its
+// elasticity against a string on elastic supports, a slow moving force against the statics, the
+// reference scene's pass, and bad input.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "catenary_sim/core/model/build_model.hpp"
+#include "catenary_sim/core/model/contact_geometry.hpp"
+#include "catenary_sim/core/model/model.hpp"
+#include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/scene/scene.hpp"
+#include "catenary_sim/core/simulation.hpp"
+#include "../support/scene_refusal.hpp"
+#include "../support/scenes.hpp"
+
+namespace cs = catenary_sim;
+
+namespace {
+
+constexpr double kMass = 0.951, kTension = 10000.0, kG = 9.81, kSpan = 25.0;
+
+// One section of `spans` equal spans, its wire held at each intermediate support by a spring of
+// `support` N/m; `extra` is appended (pantographs, train, damping, ...).
+std::string trolley_yaml(int spans, double ei, double support, double element, const std::string& extra = "") {
+  std::ostringstream y;
+  y.precision(10);
+  y << "name: trolley\n"
+    << "line:\n  span_length: " << kSpan << "\n  span_count: " << spans << "\n"
+    << "contact_wire:\n  linear_mass: " << kMass << "\n  bending_stiffness: " << ei << "\n  tension: " << kTension
+    << "\n"
+    << "steady_arms:\n  stiffness: " << support << "\n"
+    << "contact:\n  rub_length: 0.0\n"
+    << "numerics:\n  element_length: " << element << "\n"
+    << extra;
+  return y.str();
+}
+
+double height_at(const cs::Wire& w, double x) {
+  const int e = w.element_at(x);
+  const double t = (x - w.x[e]) / (w.x[e + 1] - w.x[e]);
+  return (1 - t) * w.height[e] + t * w.height[e + 1];
+}
+
+// Exact stiffness of a beam of bending stiffness EI under tension T over length l, on its end
+// values (w1, theta1, w2, theta2): its shapes solve EI w'''' - T w'' = 0, w = a + b x +
+// c e^(-k x) + d e^(-k (l - x)) with k = sqrt(T / EI) (decaying exponentials: well conditioned),
+// and the end forces are the variation of (1/2) int EI w''^2 + T w'^2: f_w1 = EI w'''(0) - T w'(0),
+// f_theta1 = -EI w''(0), f_w2 = T w'(l) - EI w'''(l), f_theta2 = EI w''(l).
+Eigen::Matrix4d tensioned_beam_stiffness(double ei, double T, double l) {
+  const double k = std::sqrt(T / ei), e = std::exp(-k * l), k2 = k * k, k3 = k2 * k;
+  // Rows: w(0), w'(0), w(l), w'(l); columns: 1, x, e^(-k x), e^(-k (l - x)).
+  Eigen::Matrix4d A;
+  A << 1, 0, 1, e,  //
+      0, 1, -k, k * e,  //
+      1, l, e, 1,  //
+      0, 1, -k * e, k;
+  // Rows: the end forces above, of the same coefficients.
+  Eigen::Matrix4d F;
+  F << 0, -T, -ei * k3 + T * k, ei * k3 * e - T * k * e,  //
+      0, 0, -ei * k2, -ei * k2 * e,  //
+      0, T, -T * k * e + ei * k3 * e, T * k - ei * k3,  //
+      0, 0, ei * k2 * e, ei * k2;
+  return F * A.inverse();
+}
+
+// Deflections of a tensioned beam over `stations` (m, increasing), held at the first and last (w
+// = 0), by springs k[i] at the others (0: free), under an upward force P at station `at`: exact
+// tensioned-beam pieces between neighbouring stations, two DOFs (w, theta) at each.
+Eigen::VectorXd beam_on_springs(const std::vector<double>& stations, const std::vector<double>& k, double ei, double T,
+                                int at, double P) {
+  const int n = static_cast<int>(stations.size());
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  for (int i = 0; i + 1 < n; ++i)
+    K.block(2 * i, 2 * i, 4, 4) += tensioned_beam_stiffness(ei, T, stations[i + 1] - stations[i]);
+  for (int i = 1; i + 1 < n; ++i) K(2 * i, 2 * i) += k[i];
+  for (int d : {0, 2 * (n - 1)}) {  // the anchors' w held: identity rows and columns
+    K.row(d).setZero();
+    K.col(d).setZero();
+    K(d, d) = 1.0;
+  }
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(2 * n);
+  f[2 * at] = P;
+  const Eigen::VectorXd q = K.partialPivLu().solve(f);
+  Eigen::VectorXd w(n);
+  for (int i = 0; i < n; ++i) w[i] = q[2 * i];
+  return w;
+}
+
+}  // namespace
+
+// Own-weight sag: the design statics hold the wire at the design height at its supports, and it
+// sags between them as a tensioned beam, EI w'''' - T w'' = q. An interior span of equal spans
+// meets its supports level (by symmetry, to exp(-k L) ~ 1e-100 of the ends' effect, k = sqrt(T/EI)),
+// so it is a beam clamped at both ends: mid-span sag q L^2 / (8 T) - (q L / (2 T k))
+// (cosh(k L / 2) - 1) / sinh(k L / 2); the bending term is 4 / (k L) = 1.7 % of the string's sag.
+// Tolerance 0.1 % of the sag: with lumped nodal loads a string's nodal values are exact, and the
+// bending term's boundary layer (1/k = 0.10 m) is resolved by 0.025 m elements to a small part of
+// its 1.7 % (0.05 m elements move the sag by 0.02 %).
+TEST(TrolleyWire, OwnWeightSagMatchesTheTensionedBeam) {
+  const int n = 6;
+  const double ei = 109.0;
+  const cs::Model m = cs::build_model(cs::load_scene_string(trolley_yaml(n, ei, 2e4, 0.025)));
+  ASSERT_EQ(m.contact_wires.size(), 1u);
+  ASSERT_EQ(m.wires.size(), 1u);  // no messenger
+  const cs::Wire& w = m.wires[m.contact_wires[0]];
+  const double q = kMass * kG, L = kSpan, k = std::sqrt(kTension / ei), H = m.scene.contact_wire_height;
+  const double string_sag = q * L * L / (8.0 * kTension);
+  const double sag = string_sag - q * L / (2.0 * kTension * k) * (std::cosh(k * L / 2) - 1.0) / std::sinh(k * L / 2);
+  for (int j = 0; j <= n; ++j) EXPECT_NEAR(height_at(w, j * L), H, 1e-9) << "support " << j;
+  for (int j = 1; j + 1 < n; ++j) EXPECT_NEAR(H - height_at(w, (j + 0.5) * L), sag, 1e-3 * sag) << "span " << j;
+}
+
+// The elasticity at mid-span and at a support against a tensioned beam on spring supports,
+// solved exactly between the stations. The elements are exact for the string's part; only the
+// bending's boundary layers (width 1/k = 0.10 m, k = sqrt(T / EI)) are approximated, and they are
+// 2 / (k L) = 0.8 % of the mid-span elasticity: at 0.125 m elements a tenth of that share bounds
+// the error. Tolerance 0.1 %.
+TEST(TrolleyWire, ElasticityMatchesATensionedBeamOnElasticSupports) {
+  const int n = 6;
+  const double ei = 109.0, support = 2e4, P = 100.0;
+  const cs::ElasticityProbe probe(cs::load_scene_string(trolley_yaml(n, ei, support, 0.125)), P);
+  std::vector<double> xs, ks;
+  for (int i = 0; i <= n; ++i) {
+    xs.push_back(i * kSpan);
+    ks.push_back(support);
+  }
+  for (int j : {1, 2, 3}) {
+    // Stations: the supports and the middle of span j.
+    std::vector<double> x = xs, k = ks;
+    x.insert(x.begin() + j + 1, (j + 0.5) * kSpan);
+    k.insert(k.begin() + j + 1, 0.0);
+    const double mid = beam_on_springs(x, k, ei, kTension, j + 1, P)[j + 1];
+    EXPECT_NEAR(probe.uplift((j + 0.5) * kSpan).at(0), mid, 1e-3 * mid) << "span " << j;
+    const double at_support = beam_on_springs(xs, ks, ei, kTension, j, P)[j];
+    EXPECT_NEAR(probe.uplift(j * kSpan).at(0), at_support, 1e-3 * at_support) << "support " << j;
+    // What the line is: hard at its supports, soft in its spans (a string alone: L / (4 T) at
+    // mid-span on rigid supports against about 1 / (k_s + 2 T / L) at a support).
+    EXPECT_GT(mid, 5.0 * at_support);
+  }
+  // The exact pieces themselves, against a closed form: a span clamped at both ends under a load
+  // at its middle sags P L / (4 T) - P tanh(k L / 4) / (T k) (EI w''' - T w' = -P / 2 on each
+  // half, w' = 0 at the load and the ends). Two pieces, the middle's w and theta free.
+  const double L = kSpan, kb = std::sqrt(kTension / ei);
+  Eigen::Matrix<double, 6, 6> K = Eigen::Matrix<double, 6, 6>::Zero();
+  K.block<4, 4>(0, 0) += tensioned_beam_stiffness(ei, kTension, L / 2);
+  K.block<4, 4>(2, 2) += tensioned_beam_stiffness(ei, kTension, L / 2);
+  const Eigen::Vector2d middle = K.block<2, 2>(2, 2).lu().solve(Eigen::Vector2d(P, 0.0));
+  const double clamped = P * L / (4.0 * kTension) - P * std::tanh(kb * L / 4) / (kTension * kb);
+  EXPECT_NEAR(middle[0], clamped, 1e-9 * clamped);
+  EXPECT_NEAR(middle[1], 0.0, 1e-12);
+}
+
+// A constant force moving slowly reproduces the static elasticity under it. At 1 m/s the span's
+// first mode (w1 = pi c / L = 12.9 rad/s, c = sqrt(T / m) = 103 m/s) sees the load at
+// Omega = pi v / L = 0.13 rad/s: inertia adds (Omega / w1)^2 = 1e-4; Rayleigh alpha = 4 1/s lags
+// the quasi-static response by alpha Omega / w1^2 = 0.3 % and damps the start's transient by
+// exp(-alpha t / 2) < 1e-8 before the load reaches the checked span at t = 30 s. Tolerance 1 %.
+TEST(TrolleyWire, SlowMovingForceReproducesTheStaticDeflection) {
+  const double P = 100.0;
+  const std::string extra =
+      "damping:\n  alpha: 4.0\n"
+      "pantographs:\n  - name: force\n    type: moving_force\n    static_uplift: 100.0\n"
+      "train:\n  speed: 1.0\n  start: 0.0\n  end: 52.0\n";
+  const cs::Scene scene = cs::load_scene_string(trolley_yaml(4, 109.0, 2e4, 0.25, extra));
+  const cs::ElasticityProbe probe(scene, P);
+  cs::Simulation sim(scene);
+  const cs::Model& m = sim.model();
+  const cs::Wire& wire = m.wires[m.contact_wires[0]];
+  std::vector<int> node(m.max_contact_nodes);
+  std::vector<double> weight(m.max_contact_nodes);
+  int checked = 0;
+  double next = 30.0;
+  while (!sim.finished()) {
+    ASSERT_EQ(sim.step(), cs::StepStatus::kOk) << sim.status_message();
+    const cs::State& s = sim.state();
+    if (s.front < next) continue;
+    const int cnt = cs::contact_weights(wire, 0.0, s.front, node.data(), weight.data());
+    double u = 0.0;
+    for (int a = 0; a < cnt; ++a) u += weight[a] * s.wire_uplift(m, 0, node[a]);
+    const double expected = probe.uplift(s.front).at(0);
+    ASSERT_GT(expected, 0.0);
+    EXPECT_NEAR(u, expected, 0.01 * expected) << "x " << s.front;
+    ++checked;
+    next += 2.5;  // from a support (25 m + 5) across the span to the next support (50 m)
+    if (next > 50.0) break;
+  }
+  EXPECT_EQ(checked, 9);
+}
+
+// The reference scene's pass at a street tramway's speed (60 km/h, 0.16 of the wire's wave speed)
+// keeps the pantograph on the wire at every step over the analysis section: the wire's largest
+// static elasticity (0.6 mm/N at mid-span) lets it rise a few centimetres, far from lifting off.
+TEST(TrolleyWire, ReferencePassKeepsContact) {
+  cs::Simulation sim(cs::load_scene_file(test_scenes::kConfigDir + "trolley_wire.yaml"));
+  const cs::Model& m = sim.model();
+  ASSERT_EQ(m.wires.size(), 1u);
+  double x0 = 0.0, x1 = 0.0;
+  cs::analysis_section(m, &x0, &x1);
+  long in_section = 0, in_contact = 0;
+  while (!sim.finished()) {
+    ASSERT_EQ(sim.step(), cs::StepStatus::kOk) << sim.status_message();
+    const cs::State& s = sim.state();
+    if (s.front < x0 || s.front > x1) continue;
+    ++in_section;
+    if (s.pantograph_force_on(m, 0, 0) > 0.0) ++in_contact;
+  }
+  ASSERT_GT(in_section, 1000);
+  EXPECT_EQ(in_contact, in_section);
+}
+
+// Bad input: what hangs from a messenger or an auxiliary has nothing to hang from on a trolley
+// wire, and is refused by name.
+TEST(TrolleyWire, PartsOfACatenaryAreRefusedByName) {
+  const auto refused = test_scenes::expect_refused;
+  const std::string y = trolley_yaml(3, 109.0, 2e4, 0.25);
+  refused(y + "droppers:\n  positions: [5.0]\n  axial_stiffness: 1e5\n", "droppers");
+  refused(y + "messenger_supports:\n  stiffness: 5e5\n", "messenger_supports");
+  refused(y + "stitch_wire:\n  length: 12\n  tension: 2800\n  linear_mass: 0.1\n", "stitch_wire");
+  refused(y + "auxiliary_messenger:\n  linear_mass: 1.0\n  tension: 10000\n  height: 0.15\n", "auxiliary_messenger");
+  refused(y + "hangers:\n  positions: [5.0]\n  axial_stiffness: 1e5\n", "hangers");
+  refused(y + "contact_wire_count: 2\n", "contact_wire_count");
+}
