@@ -24,7 +24,7 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
 SIMULATE_PASS = os.path.join(ROOT, ".ws", "devel", "lib", "catenary_sim", "simulate_pass")
 DEFAULT_SCENES = ["config/reference_55m.yaml", "config/reference_55m_stitched.yaml", "config/reference_55m_hinged_arms.yaml",
-                  "config/rigid_conductor_rail.yaml", "config/compound_catenary.yaml"]
+                  "config/rigid_conductor_rail.yaml", "config/compound_catenary.yaml", "config/trolley_wire.yaml"]
 
 
 def split_entry(entry):
