@@ -1,10 +1,11 @@
 // A trolley wire (docs/trolley_wire.md): one tensioned contact wire held at each support by its
 // suspension, no messenger or droppers. Its own-weight sag against a tensioned beam, its
-// elasticity against a string on elastic supports, a slow moving force against the statics, the
-// reference scene's pass, and bad input.
+// elasticity against a tensioned beam on elastic supports, a slow moving force against the
+// statics, the reference scene's pass, a catenary joined to it, and bad input.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -212,6 +213,33 @@ TEST(TrolleyWire, ReferencePassKeepsContact) {
   }
   ASSERT_GT(in_section, 1000);
   EXPECT_EQ(in_contact, in_section);
+}
+
+// A catenary joined to a trolley wire (config/catenary_to_trolley_wire.yaml): the overlap of one
+// 30 m span, 200-230 m, where each wire rises 10 cm to its anchor support. The head stays on the
+// line at every step; at each end of the overlap only the wire held at the design height there
+// carries it (the other is 10 cm up, against the head's few centimetres of travel); inside it
+// both carry the head for a while: the hand-over is shared, not a jump from one wire to the other.
+TEST(TrolleyWire, ACatenaryJoinedToATrolleyWireHandsThePantographOver) {
+  cs::Simulation sim(cs::load_scene_file(test_scenes::kConfigDir + "catenary_to_trolley_wire.yaml"));
+  const cs::Model& m = sim.model();
+  ASSERT_EQ(m.contact_wires.size(), 2u);  // the catenary's wire, then the trolley wire
+  long steps = 0, in_contact = 0, shared = 0;
+  double near_start_on_trolley = 0.0, near_end_on_catenary = 0.0;
+  while (!sim.finished()) {
+    ASSERT_EQ(sim.step(), cs::StepStatus::kOk) << sim.status_message();
+    const cs::State& s = sim.state();
+    const double x = s.front, f0 = s.pantograph_force_on(m, 0, 0), f1 = s.pantograph_force_on(m, 0, 1);
+    ++steps;
+    if (f0 + f1 > 0.0) ++in_contact;
+    if (x > 200.0 && x < 230.0 && f0 > 0.0 && f1 > 0.0) ++shared;
+    if (x >= 200.0 && x <= 201.0) near_start_on_trolley = std::max(near_start_on_trolley, f1);
+    if (x >= 229.0 && x <= 230.0) near_end_on_catenary = std::max(near_end_on_catenary, f0);
+  }
+  EXPECT_EQ(in_contact, steps);
+  EXPECT_EQ(near_start_on_trolley, 0.0);
+  EXPECT_EQ(near_end_on_catenary, 0.0);
+  EXPECT_GT(shared, 0);
 }
 
 // Bad input: what hangs from a messenger or an auxiliary has nothing to hang from on a trolley
