@@ -13,6 +13,7 @@
 
 #include "catenary_sim/core/model/build_model.hpp"
 #include "catenary_sim/core/model/contact_geometry.hpp"
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/model/statics.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
@@ -240,6 +241,43 @@ TEST(TrolleyWire, ACatenaryJoinedToATrolleyWireHandsThePantographOver) {
   EXPECT_EQ(near_start_on_trolley, 0.0);
   EXPECT_EQ(near_end_on_catenary, 0.0);
   EXPECT_GT(shared, 0);
+}
+
+// On a 3-D line a steady cross wind blows the trolley wire out between its suspensions, which hold
+// it in plan: each interior span of equal spans meets its supports square (by symmetry), so its
+// blow-off is the tensioned beam's under the drag q = 0.5 rho Cd d U^2 clamped at both ends,
+// w(s) = A + B cosh(k s) - q s^2 / (2 T) about mid-span (the sag test's shape across the track):
+// q L^2 / (8 T) = 2.3 cm at mid-span for 20 m/s. Each support takes a span's drag, q L.
+// Tolerance 0.1 % of the mid-span blow-off (the sag test's, with the same 0.025 m elements).
+TEST(TrolleyWire, OnA3dLineASteadyWindBlowsEachSpanOutAsATensionedBeam) {
+  const int n = 6;
+  const double ei = 109.0, speed = 20.0, rho = 1.225, cd = 1.0, d = 0.012;
+  std::ostringstream wind;
+  wind << "wind:\n  speed: " << speed << "\n  contact_wire: {diameter: " << d << ", drag_coefficient: " << cd << "}\n";
+  const cs::Model m = cs::build_model(cs::load_scene_string(trolley_yaml(n, ei, 2e4, 0.025, wind.str())));
+  ASSERT_TRUE(m.lateral && m.lateral->windy);
+  const cs::LateralModel& lat = *m.lateral;
+  ASSERT_EQ(lat.wires.size(), 1u);
+  const cs::Wire& w = lat.wires[0];
+  const double q = 0.5 * rho * cd * d * speed * speed, L = kSpan, k = std::sqrt(kTension / ei);
+  const double B = q * L / (2.0 * kTension * k * std::sinh(k * L / 2)), A = q * L * L / (8.0 * kTension) - B * std::cosh(k * L / 2);
+  const double middle = A + B;
+  int checked = 0;
+  for (int i = 0; i < w.nodes(); ++i) {
+    if (w.x[i] < L - 1e-9 || w.x[i] > (n - 1) * L + 1e-9) continue;  // the interior spans
+    const double s = w.x[i] - (std::floor(w.x[i] / L - 1e-9) + 0.5) * L;
+    const double expected = A + B * std::cosh(k * s) - q * s * s / (2.0 * kTension);
+    EXPECT_NEAR(lat.initial[w.w_dof + i] - lat.calm[w.w_dof + i], expected, 1e-3 * middle) << "x " << w.x[i];
+    ++checked;
+  }
+  EXPECT_EQ(checked, 4 * 1000 + 1);
+  int supports = 0;
+  for (const cs::LateralSupport& sup : lat.supports) {
+    if (sup.x < 2 * L - 1e-9 || sup.x > (n - 2) * L + 1e-9) continue;
+    EXPECT_NEAR(sup.pull_off_wind - sup.pull_off, q * L, 1e-3 * q * L) << "support at " << sup.x;
+    ++supports;
+  }
+  EXPECT_EQ(supports, 3);
 }
 
 // Bad input: what hangs from a messenger or an auxiliary has nothing to hang from on a trolley
