@@ -18,7 +18,6 @@
 #include "catenary_sim/core/engine/lateral_step.hpp"
 #include "catenary_sim/core/engine/step.hpp"
 #include "catenary_sim/core/model/build_model.hpp"
-#include "catenary_sim/core/model/contact_geometry.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/model/statics.hpp"
@@ -26,6 +25,7 @@
 #include "catenary_sim/core/output/pass_recorder.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
+#include "../support/quasi_static.hpp"
 #include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
 #include "engine/lateral_workspace.hpp"  // (the joint solve's count of steps)
@@ -142,35 +142,12 @@ TEST(RigidConductorRail, ElasticSupportUnderPointLoadMatchesBeamOnSpring) {
 // ~ Omega/w1 = 2 % of the deflection) by exp(-alpha t / 2) < 1e-8 before the load reaches the
 // checked span at t = 10 s. Tolerance 1 %.
 TEST(RigidConductorRail, SlowMovingForceReproducesTheStaticDeflection) {
-  const double P = 100.0;
   const std::string extra =
       "damping:\n  alpha: 4.0\n"
       "pantographs:\n  - name: force\n    type: moving_force\n    static_uplift: 100.0\n"
       "train:\n  speed: 1.0\n  start: 0.0\n  end: 20.0\n";
   const cs::Scene scene = cs::load_scene_string(rail_yaml(4, 1e7, 0.5, extra));
-  const cs::ElasticityProbe probe(scene, P);
-  cs::Simulation sim(scene);
-  const cs::Model& m = sim.model();
-  const cs::Wire& wire = m.wires[m.contact_wires[0]];
-  std::vector<int> node(m.max_contact_nodes);
-  std::vector<double> weight(m.max_contact_nodes);
-  int checked = 0;
-  double next = 12.0;
-  while (!sim.finished()) {
-    ASSERT_EQ(sim.step(), cs::StepStatus::kOk) << sim.status_message();
-    const cs::State& s = sim.state();
-    if (s.front < next) continue;
-    const int cnt = cs::contact_weights(wire, 0.0, s.front, node.data(), weight.data());
-    double u = 0.0;
-    for (int a = 0; a < cnt; ++a) u += weight[a] * s.wire_uplift(m, 0, node[a]);
-    const double expected = probe.uplift(s.front).at(0);
-    ASSERT_GT(expected, 0.0);
-    EXPECT_NEAR(u, expected, 0.01 * expected) << "x " << s.front;
-    ++checked;
-    next += 1.0;
-    if (next > 18.0) break;
-  }
-  EXPECT_EQ(checked, 7);
+  EXPECT_EQ(test_scenes::expect_quasi_static(scene, 100.0, 12.0, 1.0, 18.0, 0.01), 7);
 }
 
 // (d) Bad input is refused naming the field.
