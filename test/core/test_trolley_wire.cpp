@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "catenary_sim/core/model/build_model.hpp"
+#include "catenary_sim/core/model/contact_geometry.hpp"
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/model/statics.hpp"
@@ -41,12 +42,6 @@ std::string trolley_yaml(int spans, double ei, double support, double element, c
     << "numerics:\n  element_length: " << element << "\n"
     << extra;
   return y.str();
-}
-
-double height_at(const cs::Wire& w, double x) {
-  const int e = w.element_at(x);
-  const double t = (x - w.x[e]) / (w.x[e + 1] - w.x[e]);
-  return (1 - t) * w.height[e] + t * w.height[e + 1];
 }
 
 // Exact stiffness of a beam of bending stiffness EI under tension T over length l, on its end
@@ -110,12 +105,11 @@ TEST(TrolleyWire, OwnWeightSagMatchesTheTensionedBeam) {
   const cs::Model m = cs::build_model(cs::load_scene_string(trolley_yaml(n, ei, 2e4, 0.025)));
   ASSERT_EQ(m.contact_wires.size(), 1u);
   ASSERT_EQ(m.wires.size(), 1u);  // no messenger
-  const cs::Wire& w = m.wires[m.contact_wires[0]];
   const double q = kMass * kG, L = kSpan, k = std::sqrt(kTension / ei), H = m.scene.contact_wire_height;
   const double string_sag = q * L * L / (8.0 * kTension);
   const double sag = string_sag - q * L / (2.0 * kTension * k) * (std::cosh(k * L / 2) - 1.0) / std::sinh(k * L / 2);
-  for (int j = 0; j <= n; ++j) EXPECT_NEAR(height_at(w, j * L), H, 1e-9) << "support " << j;
-  for (int j = 1; j + 1 < n; ++j) EXPECT_NEAR(H - height_at(w, (j + 0.5) * L), sag, 1e-3 * sag) << "span " << j;
+  for (int j = 0; j <= n; ++j) EXPECT_NEAR(cs::lowest_design_height(m, j * L), H, 1e-9) << "support " << j;
+  for (int j = 1; j + 1 < n; ++j) EXPECT_NEAR(H - cs::lowest_design_height(m, (j + 0.5) * L), sag, 1e-3 * sag) << "span " << j;
 }
 
 // The elasticity at mid-span and at a support against a tensioned beam on spring supports,
