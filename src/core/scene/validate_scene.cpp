@@ -378,12 +378,17 @@ void validate_stitched(const Scene& s) {
         fail(f + ".lengths", std::to_string(st.lengths.size()) + " lengths",
              std::to_string(carrying) + ", one per support that carries a stitch wire (" +
                  (st.at_supports.empty() ? "supports 1 to " + std::to_string(n - 1) : "at_supports") + ")");
-      // Each clamp within its span: the halves of the stitch wires at a span's two supports must
-      // not meet, a lone one lies within the span.
-      for (std::size_t i = 0; i < n; ++i) {
-        const double a = carries(i) ? 0.5 * st.length_at(static_cast<int>(i)) : 0.0;
-        const double b = carries(i + 1) ? 0.5 * st.length_at(static_cast<int>(i) + 1) : 0.0;
-        if (a + b < sec.spans[i]) continue;
+    }
+    // Each span holds the clamps of the stitch wires at its supports that carry one, half a length
+    // from the support: where both do, the halves must not meet, where one does, it lies within the
+    // span (a length below twice the span), so that a stitched line may end on short spans (toward
+    // a portal, a joint with a rail). The section's end supports carry none; an endless line's one
+    // span repeats, both its supports carrying one.
+    auto half = [&](std::size_t k) { return carries(k) ? 0.5 * st.length_at(static_cast<int>(k)) : 0.0; };
+    for (std::size_t i = 0; i < n; ++i) {
+      const double a = half(i), b = half(i + 1);
+      if (a + b < sec.spans[i]) continue;
+      if (!st.lengths.empty()) {
         const int support = static_cast<int>(b > 0.0 ? i + 1 : i);
         fail(f + ".lengths[" + std::to_string(st.length_index(support)) + "]", fmt(st.length_at(support)),
              "a length whose clamps stay within span " + std::to_string(i) + " (" + fmt(sec.spans[i]) + " m): " +
@@ -391,25 +396,17 @@ void validate_stitched(const Scene& s) {
                                            std::to_string(i + 1) + " together (" + fmt(a) + " + " + fmt(b) + " m) below the span"
                                      : "half its length below the span"));
       }
-      continue;
-    }
-    // Each span holds the clamps of the stitch wires at its supports that carry one, length / 2
-    // from the support: where both do, they must not meet (length < span), where one does, it
-    // lies within the span (length < 2 span), so that a stitched line may end on short spans
-    // (toward a portal, a joint with a rail). The section's end supports carry none; an endless
-    // line's one span repeats, both its supports carrying one.
-    double allowed = 1e300;
-    std::size_t limiting = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const int clamps = carries(i) + carries(i + 1);
-      if (clamps == 0) continue;
-      const double room = clamps == 2 ? sec.spans[i] : 2.0 * sec.spans[i];
-      if (room < allowed) {
-        allowed = room;
-        limiting = i;
+      // One length for all: the range every span allows, and the span that sets it.
+      double allowed = 1e300;
+      std::size_t limiting = 0;
+      for (std::size_t j = 0; j < n; ++j) {
+        const int clamps = carries(j) + carries(j + 1);
+        const double room = clamps == 2 ? sec.spans[j] : 2.0 * sec.spans[j];
+        if (clamps > 0 && room < allowed) {
+          allowed = room;
+          limiting = j;
+        }
       }
-    }
-    if (!(st.length < allowed)) {
       const bool both = carries(limiting) && carries(limiting + 1);
       fail(f + ".length", fmt(st.length),
            "(0, " + fmt(allowed) + ") m: each clamp within its span, " + fmt(0.5 * st.length) + " m from its support (span " +
