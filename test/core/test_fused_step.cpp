@@ -136,7 +136,7 @@ TEST(FusedStep, MatchesThePlainStepBitForBitOverAPass) {
 // preset's rung where the centred step does not go, e.g. beta 0; the centred step has its own
 // tests, test_centred_damping.cpp), a twin contact wire (a pack of one wire beside one of two), with
 // and without a window, and a compound line (its auxiliary a pack of its own; hangers and droppers
-// as point forces on three wires), with and without a window.
+// as point forces on three wires), with and without a window, and a trolley wire on bridles.
 TEST(FusedStep, MatchesTheGenericStepBitForBit) {
   struct Case {
     std::string file;
@@ -175,6 +175,8 @@ TEST(FusedStep, MatchesTheGenericStepBitForBit) {
       {"twin", {"numerics.window=auto", "train.speed_kmh=250"}, 3000},
       {"compound_catenary.yaml", {}, 3000},
       {"compound_catenary.yaml", {"numerics.window=auto"}, 3000},
+      // A trolley wire on bridles: packs of one wire (the bridles pair up), clamps below them.
+      {"trolley_wire_bridle.yaml", {"numerics.damping=half_step"}, 3000},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.file + (c.overrides.empty() ? "" : " " + c.overrides.front()));

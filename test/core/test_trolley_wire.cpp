@@ -1,7 +1,9 @@
 // A trolley wire (docs/trolley_wire.md): one tensioned contact wire held at each support by its
 // suspension, no messenger or droppers. Its own-weight sag against a tensioned beam, its
 // elasticity against a tensioned beam on elastic supports, a slow moving force against the
-// statics, the reference scene's pass, a catenary joined to it, and bad input.
+// statics, the reference scene's pass, a catenary joined to it, and bad input; the same wire hung
+// from bridles: their design statics, the elasticity against an exact network of tensioned beams,
+// and their bad input.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -18,6 +20,7 @@
 #include "catenary_sim/core/model/statics.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
 #include "catenary_sim/core/simulation.hpp"
+#include "../support/design_equilibrium.hpp"
 #include "../support/quasi_static.hpp"
 #include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
@@ -87,6 +90,61 @@ Eigen::VectorXd beam_on_springs(const std::vector<double>& stations, const std::
   Eigen::VectorXd w(n);
   for (int i = 0; i < n; ++i) w[i] = q[2 * i];
   return w;
+}
+
+// A bridle at each intermediate support (config/trolley_wire_bridle.yaml's: bronze 35 mm^2).
+constexpr double kBridleLength = 8.0, kBridleTension = 1500.0, kBridleMass = 0.31, kBridleEi = 10.7, kClampMass = 0.38;
+
+std::string bridle_yaml() {
+  std::ostringstream y;
+  y.precision(10);
+  y << "bridle:\n  length: " << kBridleLength << "\n  tension: " << kBridleTension << "\n  linear_mass: " << kBridleMass
+    << "\n  bending_stiffness: " << kBridleEi << "\n  clamp_mass: " << kClampMass << "\n";
+  return y.str();
+}
+
+// The elasticity of a trolley wire on `spans` equal spans hung from a bridle at each intermediate
+// support: exact tensioned-beam pieces (tensioned_beam_stiffness) between the stations of the
+// contact wire (anchors, clamps and the probe's station `at`) and of each bridle (its ends and its
+// middle), the support's spring `support` on the bridle's middle, and each clamp a spring of
+// `clamp` N/m between the bridle's end and the contact wire. Returns the uplift at `at` under P.
+double bridled_uplift(int spans, double ei, double support, double clamp, double at, double P) {
+  const double a = 0.5 * kBridleLength;
+  std::vector<double> x{0.0, spans * kSpan};
+  for (int j = 1; j < spans; ++j) {
+    x.push_back(j * kSpan - a);
+    x.push_back(j * kSpan + a);
+  }
+  x.push_back(at);
+  std::sort(x.begin(), x.end());
+  x.erase(std::unique(x.begin(), x.end(), [](double p, double q) { return std::fabs(p - q) < 1e-9; }), x.end());
+  const int n = static_cast<int>(x.size()), bridles = spans - 1, size = 2 * n + 6 * bridles;
+  auto node = [&](double xs) {
+    return static_cast<int>(std::find_if(x.begin(), x.end(), [&](double p) { return std::fabs(p - xs) < 1e-9; }) - x.begin());
+  };
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(size, size);
+  for (int i = 0; i + 1 < n; ++i) K.block(2 * i, 2 * i, 4, 4) += tensioned_beam_stiffness(ei, kTension, x[i + 1] - x[i]);
+  for (int j = 1; j < spans; ++j) {
+    const int b = 2 * n + 6 * (j - 1);  // (w, theta) at its first end, its middle, its second end
+    K.block(b, b, 4, 4) += tensioned_beam_stiffness(kBridleEi, kBridleTension, a);
+    K.block(b + 2, b + 2, 4, 4) += tensioned_beam_stiffness(kBridleEi, kBridleTension, a);
+    K(b + 2, b + 2) += support;
+    for (const auto& [end, station] : {std::pair<int, double>{b, j * kSpan - a}, {b + 4, j * kSpan + a}}) {
+      const int c = 2 * node(station);
+      K(end, end) += clamp;
+      K(c, c) += clamp;
+      K(end, c) -= clamp;
+      K(c, end) -= clamp;
+    }
+  }
+  for (int d : {0, 2 * (n - 1)}) {  // the anchors' w held
+    K.row(d).setZero();
+    K.col(d).setZero();
+    K(d, d) = 1.0;
+  }
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(size);
+  f[2 * node(at)] = P;
+  return K.partialPivLu().solve(f)[2 * node(at)];
 }
 
 }  // namespace
@@ -272,6 +330,71 @@ TEST(TrolleyWire, OnA3dLineASteadyWindBlowsEachSpanOutAsATensionedBeam) {
   EXPECT_EQ(supports, 3);
 }
 
+// A bridle's design: the contact wire hangs at the working height at every clamp, each bridle's
+// lower end there too; the design state is an equilibrium at every free node (rounding: 1e-9 of a
+// node's weight). The middle support of six equal spans is the line's mirror plane: its bridle's
+// arms are loaded alike, so both its ends are at the working height, and its preload is the weight
+// it carries, one span of contact wire, the bridle and its two clamps and the support's own mass, to
+// rounding (the lumped masses sum to the wires', HRZ). (Elsewhere the anchors' moments reach each
+// support through the held clamps, a millionth of its load two supports in.)
+TEST(TrolleyWire, BridlesHangTheWireAtTheWorkingHeightAndCarryItsWeight) {
+  const int n = 6;
+  const double support_mass = 1.0;
+  const std::string extra = bridle_yaml();
+  std::string y = trolley_yaml(n, 109.0, 2e4, 0.25, extra);
+  const std::string arms = "steady_arms:\n  stiffness: 20000\n";
+  y.replace(y.find(arms), arms.size(), arms + "  mass: 1.0\n");
+  const cs::Model m = cs::build_model(cs::load_scene_string(y));
+  ASSERT_EQ(m.wires.size(), 1u + (n - 1));
+  ASSERT_EQ(m.clamps.size(), 2u * (n - 1));
+  ASSERT_EQ(m.springs.size(), static_cast<std::size_t>(n - 1));
+  test_scenes::expect_design_equilibrium(m);
+  const double H = m.scene.contact_wire_height;
+  const cs::Wire& cw = m.wires[m.contact_wires.front()];
+  for (const cs::WireClamp& c : m.clamps) {
+    EXPECT_NEAR(cw.height[c.stitch_dof - cw.w_dof], H, 1e-9) << "clamp at " << c.x;
+    EXPECT_GT(c.static_force, 0.0) << "clamp at " << c.x;
+  }
+  for (std::size_t b = 1; b < m.wires.size(); ++b) {
+    const cs::Wire& w = m.wires[b];
+    ASSERT_TRUE(w.is_bridle);
+    EXPECT_NEAR(std::min(w.height.front(), w.height.back()), H, 1e-9) << w.name;
+    const int k = static_cast<int>(std::lround(w.x[w.support_nodes.front()] / kSpan));
+    if (2 * k == n) {
+      EXPECT_NEAR(w.height.front(), w.height.back(), 1e-9) << w.name;
+    }
+    EXPECT_GT(w.height[w.support_nodes.front()], H + 0.1) << w.name;  // a V: its middle well above its ends
+  }
+  for (const cs::SupportSpring& sp : m.springs) {
+    const int k = static_cast<int>(std::lround(sp.x / kSpan));
+    if (2 * k != n) continue;
+    const double carried = kG * (kMass * kSpan + kBridleMass * kBridleLength + 2.0 * kClampMass + support_mass);
+    EXPECT_NEAR(sp.static_force, carried, 1e-9 * carried) << "support " << k;
+  }
+}
+
+// The elasticity of the bridled wire against the exact network (bridled_uplift): at a support (the
+// bridle's middle, between its clamps), at a clamp and at mid-span. The network's pieces are exact
+// tensioned beams; the model's elements approximate only the bending's boundary layers, 1/k = 0.10 m
+// on the contact wire and sqrt(EI / T) = 0.08 m on the bridle, at the clamps and the bridle's
+// middle. The difference falls as the fourth power of the element (0.25, 0.1, 0.05 m elements:
+// 4e-4, 2e-5, 1e-6 of the elasticity at these stations). Tolerance 1e-4 at 0.1 m elements.
+TEST(TrolleyWire, BridledElasticityMatchesAnExactNetworkOfTensionedBeams) {
+  const int n = 6;
+  const double ei = 109.0, support = 2e4, P = 100.0;
+  const cs::ElasticityProbe probe(cs::load_scene_string(trolley_yaml(n, ei, support, 0.1, bridle_yaml())), P);
+  for (int j : {2, 3}) {
+    for (double at : {j * kSpan, j * kSpan + 0.5 * kBridleLength, (j + 0.5) * kSpan}) {
+      const double exact = bridled_uplift(n, ei, support, cs::kStitchClampStiffness, at, P);
+      EXPECT_NEAR(probe.uplift(at).at(0), exact, 1e-4 * exact) << "station " << at;
+    }
+  }
+  // What the bridle is for: against the wire held at one point by the same support, the support
+  // is far softer and mid-span hardly moves (the bridle spreads the hold over its length).
+  const cs::ElasticityProbe direct(cs::load_scene_string(trolley_yaml(n, ei, support, 0.1)), P);
+  EXPECT_GT(probe.uplift(3 * kSpan).at(0), 10.0 * direct.uplift(3 * kSpan).at(0));
+}
+
 // Bad input: what hangs from a messenger or an auxiliary has nothing to hang from on a trolley
 // wire, and is refused by name.
 TEST(TrolleyWire, PartsOfACatenaryAreRefusedByName) {
@@ -288,4 +411,27 @@ TEST(TrolleyWire, PartsOfACatenaryAreRefusedByName) {
   twin.replace(twin.find(line), line.size(), "line: {}\nsections:\n  - {span_length: 25.0, span_count: 3, contact_wire_count: 2}\n");
   const std::string message = test_scenes::refusal_of_yaml(twin);
   for (const char* word : {"contact_wire_count", "droppers"}) EXPECT_NE(message.find(word), std::string::npos) << message;
+}
+
+// Bad input on bridles: each refused by the field at fault, with what is allowed.
+TEST(TrolleyWire, BridlesBadInputIsRefusedByName) {
+  const auto refused = test_scenes::expect_refused;
+  const std::string y = trolley_yaml(3, 109.0, 2e4, 0.25, bridle_yaml());
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = y;
+    t.replace(t.find(from), from.size(), to);
+    return t;
+  };
+  refused(with("length: 8", "length: 25"), "bridle.length");  // a middle span's clamps would meet
+  refused(with("length: 8", "length: 0"), "bridle.length");
+  refused(with("tension: 1500", "tension: -1"), "bridle.tension");
+  refused(with("tension: 1500", "tension: 1500\n  foo: 1"), "bridle.foo");
+  refused(with("span_count: 3", "span_count: 1"), "bridle");
+  refused(y + "messenger:\n  linear_mass: 1.07\n  tension: 16000\n  bending_stiffness: 0\n", "bridle");
+  refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\n", "bridle");
+  refused(with("element_length: 0.25\n", "element_length: 0.25\n  window: auto\n"), "numerics.window");
+  refused(with("steady_arms:\n  stiffness: 20000\n", "steady_arms:\n  length: 1.0\n  linear_mass: 1.0\n  pull_off: 200\n"),
+          "steady_arms");
+  const std::string message = test_scenes::refusal_of_yaml(with("length: 8", "length: 25"));
+  for (const char* word : {"(0, 25) m", "span 1"}) EXPECT_NE(message.find(word), std::string::npos) << message;
 }

@@ -45,7 +45,12 @@ std::vector<double> mesh_section(const SectionSpec& sec, double element_length, 
       if (i > 0 && st.at(a)) breaks.push_back(x0 + 0.5 * st.length_at(a));
       if (i + 1 < nspan && st.at(b)) breaks.push_back(x0 + sec.spans[i] - 0.5 * st.length_at(b));
     }
-    if (sec.hangers || sec.stitch_wire) {  // (droppers alone are in order: validate_sections)
+    if (sec.bridle) {  // the clamps of the bridles at the span's intermediate supports
+      const double half = 0.5 * sec.bridle->length;
+      if (i > 0) breaks.push_back(x0 + half);
+      if (i + 1 < nspan) breaks.push_back(x0 + sec.spans[i] - half);
+    }
+    if (sec.hangers || sec.stitch_wire || sec.bridle) {  // (droppers alone are in order: validate_sections)
       std::sort(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end());
       breaks.erase(std::unique(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end(),
                                [](double a, double b) { return b - a < 1e-9; }),
@@ -84,6 +89,7 @@ void add_single_section(Scene& scene) {
   sec.steady_arms = scene.steady_arms;
   sec.messenger_supports = scene.messenger_supports;
   sec.stitch_wire = scene.stitch_wire;
+  sec.bridle = scene.bridle;
   sec.auxiliary_messenger = scene.auxiliary_messenger;
   sec.hangers = scene.hangers;
   if (sec.hangers && sec.hangers->positions.size() == 1 && sec.spans.size() > 1)
@@ -143,6 +149,36 @@ void add_stitch_wires(const StitchWireSpec& st, int section, const std::vector<d
   }
 }
 
+// A trolley wire's bridle at each intermediate support of a section: the section's node stations
+// between its clamps (mesh_section puts nodes there), held at its middle by the support.
+void add_bridles(const BridleSpec& b, int section, const std::vector<double>& supports, const std::vector<double>& x,
+                 bool lumped_rot, const std::string& suffix, Model& m, int& dof, Section& info) {
+  WireSpec spec;
+  spec.linear_mass = b.linear_mass;
+  spec.bending_stiffness = b.bending_stiffness;
+  spec.tension = b.tension;
+  for (std::size_t k = 1; k + 1 < supports.size(); ++k) {
+    const int lo = node_at(x, supports[k] - 0.5 * b.length), hi = node_at(x, supports[k] + 0.5 * b.length);
+    Wire w;
+    w.name = "bridle" + suffix + "_" + std::to_string(k);
+    w.section = section;
+    w.is_stitch_wire = true;  // (a short wire between two clamps: the window and the packs take it as one)
+    w.is_bridle = true;
+    w.spec = spec;
+    w.x.assign(x.begin() + lo, x.begin() + hi + 1);
+    w.support_nodes.push_back(node_at(w.x, supports[k]));
+    w.w_dof = dof;
+    dof += w.nodes();
+    if (lumped_rot) {
+      w.theta_dof = dof;
+      dof += w.nodes();
+    }
+    assemble_band(w, {});
+    info.stitch_wires.push_back(static_cast<int>(m.wires.size()));
+    m.wires.push_back(std::move(w));
+  }
+}
+
 // DOF layout: per wire the vertical displacements, then (lumped rotary inertia only) the
 // rotations; section by section (contact wire(s), messenger, stitch wires or the auxiliary
 // messenger); the pantographs last.
@@ -190,6 +226,7 @@ void mesh_wires(const Scene& scene, const std::vector<double>& rise_first, const
     if (sec.messenger) add_wire("messenger" + suffix, *sec.messenger, false);
     if (sec.auxiliary_messenger) add_wire("auxiliary_messenger" + suffix, *sec.auxiliary_messenger, false, true);
     if (sec.stitch_wire) add_stitch_wires(*sec.stitch_wire, static_cast<int>(si), section_supports[si], x, lumped_rot, suffix, m, dof, info);
+    if (sec.bridle) add_bridles(*sec.bridle, static_cast<int>(si), section_supports[si], x, lumped_rot, suffix, m, dof, info);
     m.sections.push_back(info);
   }
 }
@@ -258,13 +295,14 @@ std::vector<bool> lump_masses(const Scene& scene, Model& m) {
         m.mass[w.theta_dof + e + 1] += beam_rotary_mass(he, w.spec.linear_mass);
       }
     }
-    const bool contact = w.is_contact_wire;
+    const bool contact = w.is_contact_wire || w.is_bridle;  // (a bridle: the contact wire's suspension)
     const std::optional<SupportSpec>& spring = contact ? sec.steady_arms : sec.messenger_supports;
     const int ns = static_cast<int>(w.support_nodes.size());
     for (int k = 0; k < ns; ++k) {
       const int node = w.support_nodes[k];
-      const bool end = k == 0 || k == ns - 1;  // anchors of the tension section
+      const bool end = !w.is_bridle && (k == 0 || k == ns - 1);  // anchors of the tension section
       if (!end && w.is_auxiliary_messenger) continue;  // free through the supports, hung by droppers
+      if (!end && w.is_contact_wire && sec.bridle) continue;  // hung from the bridle's clamps
       if (end || !spring) {
         fixed[w.w_dof + node] = true;
       } else {
@@ -307,6 +345,29 @@ void clamp_stitch_wires(const Scene& scene, Model& m) {
         c.stitch_dof = w.w_dof + end;
         c.stiffness = kStitchClampStiffness;
         m.mass[c.stitch_dof] += sec.stitch_wire->clamp_mass;
+        m.clamps.push_back(c);
+      }
+    }
+  }
+}
+
+// Each bridle's two clamps on the contact wire, the clamp masses on the bridle's ends (as a stitch
+// wire's). Their static forces come from the design statics.
+void clamp_bridles(const Scene& scene, Model& m) {
+  for (std::size_t si = 0; si < scene.sections.size(); ++si) {
+    const SectionSpec& sec = scene.sections[si];
+    const Section& info = m.sections[si];
+    if (!sec.bridle) continue;
+    const Wire& cw = m.wires[info.wires.front()];  // the one contact wire (validate_bridles)
+    for (int wi : info.stitch_wires) {
+      const Wire& w = m.wires[wi];
+      for (int end : {0, w.nodes() - 1}) {
+        WireClamp c;
+        c.x = w.x[end];
+        c.messenger_dof = w.w_dof + end;
+        c.stitch_dof = cw.w_dof + node_at(cw.x, c.x);
+        c.stiffness = kStitchClampStiffness;
+        m.mass[c.messenger_dof] += sec.bridle->clamp_mass;
         m.clamps.push_back(c);
       }
     }
@@ -580,6 +641,7 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
   const std::vector<bool> fixed = lump_masses(scene, m);
   hang_droppers(scene, section_supports, m);
   clamp_stitch_wires(scene, m);
+  clamp_bridles(scene, m);
   design_statics(scene, section_supports, m);
   apply_wear(scene, m);
   set_constant_load(scene, m, fixed);

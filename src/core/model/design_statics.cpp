@@ -17,6 +17,33 @@ bool holds(const Wire& w, int dof) { return dof >= w.w_dof && dof < w.w_dof + w.
 
 const Wire& wire_of(const Model& m, int dof) { return m.wires[wire_holding(m, dof)]; }
 
+// A trolley wire's bridles (BridleSpec) once the contact wire is solved held at its anchors and,
+// from node `held` of `clamp_nodes` on, at the clamps at the working height: each clamp's force is
+// the contact wire's reaction there, and pulls the bridle's end down. The bridle, held at its middle
+// only, hangs from there in a V under those forces and its weight; it is raised until its lower end
+// is at the working height, the other end above by what its arms' loads differ (the clamp then a
+// short link). Its reaction at the middle is the support's preload (design_statics).
+void bridle_statics(const Scene& scene, const Section& info, std::size_t held, const std::vector<int>& clamp_nodes,
+                    Model& m, std::vector<std::vector<double>>& react) {
+  const Wire& cw = m.wires[info.wires.front()];
+  for (std::size_t j = held; j < clamp_nodes.size(); ++j)
+    for (WireClamp& c : m.clamps)
+      if (c.stitch_dof == cw.w_dof + clamp_nodes[j]) c.static_force = react[info.wires.front()][j];
+  for (int wi : info.stitch_wires) {
+    Wire& w = m.wires[wi];
+    const int n = w.nodes();
+    std::vector<double> load(n);
+    for (int i = 0; i < n; ++i) load[i] = -scene.gravity * m.mass[w.w_dof + i];
+    for (const WireClamp& c : m.clamps)
+      if (holds(w, c.messenger_dof)) load[c.messenger_dof - w.w_dof] -= c.static_force;
+    const double H = scene.contact_wire_height;
+    solve_wire_statics(w, load, {w.support_nodes.front()}, {H}, w.height, w.slope, react[wi]);
+    // (A rigid rise: the band has no force from it, the reaction stays.)
+    const double rise = H - std::min(w.height.front(), w.height.back());
+    for (double& y : w.height) y += rise;
+  }
+}
+
 // One section's statics: the contact wire(s) held at the supports and droppers, then the messenger
 // under the dropper tensions, a few fixed-point passes for the droppers' weight.
 void section_statics(const Scene& scene, std::size_t si, const std::vector<std::vector<double>>& section_supports,
@@ -50,9 +77,17 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
       std::vector<double> ph;
       const int ns = static_cast<int>(w.support_nodes.size());
       for (int k = 0; k < ns; ++k) {
+        if (sec.bridle && k > 0 && k < ns - 1) continue;  // hung from the bridle's clamps (below)
         pn.push_back(w.support_nodes[k]);
         ph.push_back(H + (k == 0 ? info.rise_first : 0.0) + (k == ns - 1 ? info.rise_last : 0.0));
       }
+      const std::size_t held = pn.size();  // (a bridle's clamps after the supports)
+      if (sec.bridle)
+        for (const WireClamp& c : m.clamps)
+          if (holds(w, c.stitch_dof)) {
+            pn.push_back(c.stitch_dof - w.w_dof);
+            ph.push_back(H);
+          }
       for (std::size_t k : mine) {
         const Dropper& d = m.droppers[k];
         if (d.contact_dof < w.w_dof || d.contact_dof >= w.w_dof + n) continue;
@@ -63,6 +98,10 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
         ph.push_back(transition(d.span) ? H : H - sec.contact_wire.presag * 4.0 * s * (1.0 - s));
       }
       solve_wire_statics(w, load, pn, ph, w.height, w.slope, react[wi], &solver[wi]);
+      if (sec.bridle) {
+        bridle_statics(scene, info, held, pn, m, react);
+        continue;  // (no droppers)
+      }
       // Dropper tensions: the reactions at the dropper nodes, in the order they were added.
       std::size_t r = static_cast<std::size_t>(ns);
       for (std::size_t k : mine)

@@ -74,7 +74,7 @@ void read_spans(Reader& r, const std::string& path, std::vector<double>& spans) 
 // contact_wire and steady_arms; a messenger, droppers or presag have nothing to act on.
 void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
   for (const char* other : {"contact_wire", "messenger", "droppers", "steady_arms", "messenger_supports", "stitch_wire",
-                            "contact_wire_count", "auxiliary_messenger", "hangers"})
+                            "contact_wire_count", "auxiliary_messenger", "hangers", "bridle"})
     if (r.has(other))
       fail(pre + other, "(given with conductor_rail)",
            "a rigid conductor rail has no tensioned wires, droppers or steady arms: give conductor_rail alone "
@@ -104,6 +104,7 @@ void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
   sec.messenger_supports.reset();
   sec.auxiliary_messenger.reset();
   sec.hangers.reset();
+  sec.bridle.reset();
   sec.contact_wire_count = 1;
 }
 
@@ -144,6 +145,25 @@ void read_stitch_wire(Reader& r, const std::string& pre, SectionSpec& sec) {
   }
   w.finish();
   sec.stitch_wire = st;
+}
+
+// A section's bridles; `bridle: none` in a section leaves out the ones the scene's defaults give.
+void read_bridle(Reader& r, const std::string& pre, SectionSpec& sec) {
+  const YAML::Node node = r.child("bridle");
+  if (node.IsScalar()) {
+    if (node.Scalar() != "none") fail(pre + "bridle", node.Scalar(), "a map of length, tension, linear_mass, ... or none (no bridle)");
+    sec.bridle.reset();
+    return;
+  }
+  Reader w(node, pre + "bridle");
+  BridleSpec b;
+  b.length = w.number("length", 0.0, 100.0, std::nullopt, true);
+  b.tension = w.number("tension", 0.0, 1e5, std::nullopt, true);
+  b.linear_mass = w.number("linear_mass", 0.0, 10.0, std::nullopt, true);
+  b.bending_stiffness = w.number("bending_stiffness", 0.0, 1e4, 0.0);
+  b.clamp_mass = w.number("clamp_mass", 0.0, 10.0, 0.0);
+  w.finish();
+  sec.bridle = b;
 }
 
 // Droppers, or a compound line's hangers (the same parts between the auxiliary messenger and the
@@ -246,6 +266,7 @@ void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, co
     sec.messenger_supports = read_support(a);
   }
   if (r.has("stitch_wire")) read_stitch_wire(r, pre, sec);
+  if (r.has("bridle")) read_bridle(r, pre, sec);
 }
 
 // Section stations from the overlaps, dropper positions per span, and the line's spans (the union
@@ -571,6 +592,7 @@ Scene scene_from_yaml(const YAML::Node& root, const std::string& base_dir) {
   s.steady_arms = first.steady_arms;
   s.messenger_supports = first.messenger_supports;
   s.stitch_wire = first.stitch_wire;
+  s.bridle = first.bridle;
   s.auxiliary_messenger = first.auxiliary_messenger;
   s.hangers = first.hangers;
   resolve_line(s);

@@ -439,12 +439,60 @@ void validate_compound(const Scene& s) {
   }
 }
 
+// Bridles: a trolley wire's (no messenger, one contact wire), each hung from its support, the
+// clamps at its ends within the spans beside it.
+void validate_bridles(const Scene& s) {
+  for (std::size_t si = 0; si < s.sections.size(); ++si) {
+    const SectionSpec& sec = s.sections[si];
+    if (!sec.bridle) continue;
+    const std::string pre = s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "";
+    const std::string f = pre + "bridle";
+    if (sec.messenger)
+      fail(f, "(given with messenger)",
+           "a trolley wire's: a bridle hangs the contact wire from its supports; on a catenary the messenger carries it "
+           "(stitch_wire evens its supports)");
+    if (sec.contact_wire_count != 1)
+      fail(pre + "contact_wire_count", std::to_string(sec.contact_wire_count), "1 with a bridle (its clamps hold one contact wire)");
+    if (sec.steady_arms && sec.steady_arms->hinged_arm)
+      fail(pre + "steady_arms", "(a hinged arm, with a bridle)",
+           "a spring (stiffness, mass) or none: the support holds the bridle's middle, which a registration arm does not");
+    if (s.lateral())
+      fail(f, "(given on a 3-D line)",
+           "a 2-D line (no stagger, alignment, wind or pantograph_head.sway): the bridle's motion across the track is not modelled");
+    if (s.endless) fail(f, "(given on the endless line)", "a finite line: the endless line does not carry bridles");
+    if (s.numerics.windowed())
+      fail("numerics.window", "(given with a bridle)",
+           "none: the moving window cuts the wires at supports, where a contact wire under a bridle hangs free");
+    const std::size_t n = sec.spans.size();
+    if (n < 2)
+      fail(f, "(given on a section of 1 span)", "a section with intermediate supports (2 spans or more): a bridle hangs at one");
+    // Half a length either side of each intermediate support: the halves from a span's two
+    // supports must not meet, and in an end span the one half lies within it. The span whose
+    // room is least sets the range.
+    double allowed = 1e300;
+    std::size_t limiting = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int carrying = (i > 0) + (i + 1 < n);
+      const double room = 2.0 * sec.spans[i] / carrying;
+      if (room < allowed) {
+        allowed = room;
+        limiting = i;
+      }
+    }
+    if (!(sec.bridle->length < allowed))
+      fail(f + ".length", fmt(sec.bridle->length),
+           "(0, " + fmt(allowed) + ") m: its clamps within span " + std::to_string(limiting) + " (" + fmt(sec.spans[limiting]) +
+               " m, " + (limiting > 0 && limiting + 1 < n ? "the clamps of the bridles at both its supports" : "one clamp") + ")");
+  }
+}
+
 void validate(const Scene& s) {
   const double line = s.line_length();
   validate_sections(s);
   validate_rigid(s);
   validate_stitched(s);
   validate_compound(s);
+  validate_bridles(s);
   validate_limits(s);
   validate_acting_fields(s);
   validate_pantographs(s);

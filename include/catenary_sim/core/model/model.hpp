@@ -28,7 +28,9 @@ struct Wire {
   std::string name;
   int section = 0;               // tension section it belongs to
   bool is_contact_wire = false;
-  bool is_stitch_wire = false;   // a stitch wire (StitchWireSpec): no supports, clamped to the messenger
+  bool is_stitch_wire = false;   // a stitch wire (StitchWireSpec): no supports, clamped to the messenger;
+                                 // or a bridle (BridleSpec, is_bridle): held at its middle, clamped to the contact wire
+  bool is_bridle = false;        // a trolley wire's bridle; support_nodes: its middle, where the support holds it
   bool is_auxiliary_messenger = false;  // a compound line's (AuxiliaryMessengerSpec): held at its anchors only
   WireSpec spec;
   std::vector<double> x;         // m, node stations along the line
@@ -64,10 +66,12 @@ struct Dropper {
 
 // A stitch wire's end clamped to the messenger: a bilateral spring, stiff beside the line's own
 // compliance (kStitchClampStiffness), carrying the stitch wire's end reaction in the design state.
+// A clamp joining two wires' nodes: a stitch wire's end hung from the messenger, or a trolley
+// wire hung from a bridle's end (messenger_dof then the bridle's end, stitch_dof the contact wire's node).
 struct WireClamp {
-  int messenger_dof = 0, stitch_dof = 0;
+  int messenger_dof = 0, stitch_dof = 0;  // the upper wire's node, the lower wire's node
   double stiffness = 0.0;     // N/m
-  double static_force = 0.0;  // N: pulls the stitch wire's end up and the messenger down at u = 0
+  double static_force = 0.0;  // N: pulls the lower node up and the upper one down at u = 0
   double x = 0.0;             // m
 };
 // 5e-6 m/N, in series with a stitch wire's ~1e-3 m/N (L / (4 T) for 14-18 m at 3-3.5 kN): rigid to
@@ -128,7 +132,7 @@ struct Section {
   double rise_first = 0.0, rise_last = 0.0;  // m, at its first and last support
   std::vector<int> wires;              // indices into Model::wires: contact wire(s), messenger
   int messenger = -1;                  // index into Model::wires, -1 without a messenger
-  std::vector<int> stitch_wires;       // indices into Model::wires, one per intermediate support
+  std::vector<int> stitch_wires;       // indices into Model::wires, one per intermediate support (or bridles)
   int auxiliary = -1;                  // index into Model::wires of a compound line's auxiliary messenger
 };
 

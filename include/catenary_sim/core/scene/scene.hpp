@@ -94,6 +94,18 @@ struct StitchWireSpec {
   }
 };
 
+// A trolley wire's elastic suspension (docs/trolley_wire.md): at each intermediate support a short
+// wire, the bridle, hung at its middle from the support (`steady_arms`, or rigidly without) and
+// clamped to the contact wire at its two ends, so that the support holds the contact wire through
+// the bridle's two arms instead of at one point. No messenger: on a catenary a stitch wire does this.
+struct BridleSpec {
+  double length = 0.0;             // m between its two clamps on the contact wire
+  double tension = 0.0;            // N
+  double linear_mass = 0.0;        // kg/m
+  double bending_stiffness = 0.0;  // EI, N m^2
+  double clamp_mass = 0.0;         // kg, each clamp on the contact wire (lumped on the bridle's end)
+};
+
 // A steady (registration) arm as built: a bar hinged at the registration tube, its tip clamped to
 // the contact wire, which pulls it along its axis with the horizontal pull-off of the stagger and
 // the curve. The paper's eq. 4 takes k_A from "the linearization of the statics equations"; for
@@ -204,6 +216,7 @@ struct SectionSpec {
   std::optional<SupportSpec> steady_arms;
   std::optional<SupportSpec> messenger_supports;
   std::optional<StitchWireSpec> stitch_wire;  // at every intermediate support of the section
+  std::optional<BridleSpec> bridle;           // a trolley wire's, at every intermediate support
   // Compound catenary: the auxiliary messenger and the hangers from it to the contact wire (the
   // droppers then hang the auxiliary from the messenger).
   std::optional<AuxiliaryMessengerSpec> auxiliary_messenger;
@@ -494,6 +507,7 @@ struct Scene {
   std::optional<SupportSpec> steady_arms;         // intermediate contact-wire supports
   std::optional<SupportSpec> messenger_supports;  // intermediate messenger supports
   std::optional<StitchWireSpec> stitch_wire;      // stitched catenary
+  std::optional<BridleSpec> bridle;               // a trolley wire's elastic suspension
   std::optional<AuxiliaryMessengerSpec> auxiliary_messenger;  // compound catenary
   std::optional<DropperSpec> hangers;                         // compound catenary
   double rayleigh_alpha = 0.0;  // 1/s, eq. 5
