@@ -112,7 +112,9 @@ int list_contact_nodes(const Model& m, State& s, bool windowed) {
 // corrected DOF beyond the divergence limit (also NaN), or -1.
 int springs_at_middle(const Model& m, State& s, bool windowed, const double* u, const double* v, double* un, double* vn,
                       double* acc) {
-  if (m.support_at_middle.empty() && m.dropper_at_middle.empty()) return -1;
+  // (Links: droppers and clamps. A line may have clamps and no droppers: a trolley wire's bridles.)
+  const bool supports = !m.support_at_middle.empty(), links = !m.dropper_at_middle.empty() || !m.clamp_at_middle.empty();
+  if (!supports && !links) return -1;
   const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
   const double* im = m.inv_mass.data();
   const double* lean = leaning(m, s) ? s.lateral.dropper_stretch.data() : nullptr;
@@ -155,7 +157,6 @@ int springs_at_middle(const Model& m, State& s, bool windowed, const double* u, 
     const WireClamp& c = m.clamps[k];
     apply(c.messenger_dof, c.stitch_dof, middle_force(c.messenger_dof, c.stitch_dof, c.stiffness, c.static_force, 0.0));
   };
-  const bool supports = !m.support_at_middle.empty(), links = !m.dropper_at_middle.empty();
   if (windowed) {
     for (int j = 0; supports && j < s.window_spring_count; ++j) support(s.window_springs[j]);
     for (int j = 0; links && j < s.window_dropper_count; ++j) dropper(s.window_droppers[j]);
@@ -278,7 +279,7 @@ StepStatus generic_step(const Model& m, State& s, bool windowed) {
     update(0, n);
   }
   // The springs' corrected nodes moved: the last DOF beyond the limit among the final values.
-  const bool middle = !m.support_at_middle.empty() || !m.dropper_at_middle.empty();
+  const bool middle = !m.support_at_middle.empty() || !m.dropper_at_middle.empty() || !m.clamp_at_middle.empty();
   if (springs_at_middle(m, s, windowed, u, v, u_new, v_new, acc) >= 0 || (bad >= 0 && middle))
     bad = last_beyond(m, s, windowed, u_new);
   if (bad >= 0) return diverged(s, bad, u_new);
