@@ -26,9 +26,11 @@ A study file (YAML; paths relative to it):
                                                     # in DIR/cases/NNNNNN/, linked from results.csv and
                                                     # DIR/index.html
 
-Each case is written atomically to DIR/cases/NNNNNN.json when it finishes; a study started again
-on the same DIR resumes where it stopped (the plan must be the same); a failed case is recorded
-with its message and the others go on. The table DIR/results.csv (pandas.read_csv) has one row per
+The scene with the overrides, each parameter's key and each output are checked before any case
+runs (a key or output the scene lacks would fail every case). Each case is written atomically to
+DIR/cases/NNNNNN.json when it finishes; a study started again on the same DIR resumes where it
+stopped (the plan must be the same); a failed case is recorded with its message (its outputs null)
+and the others go on. The table DIR/results.csv (pandas.read_csv) has one row per
 case: its parameters, the outputs, status and message. Plots: DIR/*.png. With sampling: saltelli,
 DIR/sensitivity.json holds first-order and total Sobol indices with bootstrap intervals.
 A thin skin: the passes are the core's (catenary_sim.run_pass); no physics here.
@@ -337,6 +339,63 @@ def _output(stats, path):
     return float(node)
 
 
+def _output_shape_error(stats, path):
+    """Why `path` cannot be a number of stats.json shaped as `stats` (a pass's before it runs: the
+    scene's pantographs and wires, nulls where numbers come); None when it can. A list still empty
+    (the steady arms, the droppers, the events) or a null is filled by the pass: not judged."""
+    node = stats
+    for part in path.split("."):
+        if isinstance(node, list):
+            if not node:
+                return None
+            if not part.isdigit() or int(part) >= len(node):
+                return f"'{part}' is not an index of its list of {len(node)}"
+            node = node[int(part)]
+        elif isinstance(node, dict):
+            if part not in node:
+                return f"no field '{part}' there (its fields: {', '.join(node)})"
+            node = node[part]
+        elif node is None:
+            return None
+        else:
+            return f"'{part}' lies below a number"
+    if isinstance(node, (dict, list)):
+        return "a group of fields, not a number"
+    if isinstance(node, (str, bool)):
+        return f"not a number ({node!r})"
+    return None
+
+
+def check_study_against_scene(study):
+    """What the scene decides, before any case runs. The scene with the study's overrides must be
+    valid, each parameter a field of it and each output a number of its stats.json: a refused value
+    is one case's failure, but a field that does not exist fails every case. Raises StudyError."""
+    import catenary_sim as cs
+    try:
+        cs.check_scene(study["scene"], overrides=study["overrides"])
+    except SceneError as e:
+        raise StudyError(f"study fields 'scene' and 'overrides': the scene they give is refused: {e}") from None
+    for i, p in enumerate(study["parameters"]):
+        if "values" in p:
+            value = p["values"][0]
+        else:
+            value = float(_ppf(p["distribution"], 0.5))
+            if p["distribution"]["type"] == "integers":
+                value = int(value)
+        try:
+            cs.check_scene(study["scene"], overrides={**study["overrides"], p["key"]: value})
+        except SceneError as e:
+            if e.value == "(unknown field)":
+                raise StudyError(f"study field 'parameters[{i}].key' = '{p['key']}': no such scene field "
+                                 f"({e}); allowed the dotted key of a field, as docs/scene_reference.md lists") from None
+    stats = cs.Simulation(study["scene"], overrides=study["overrides"]).statistics(0.0)
+    for j, o in enumerate(study["outputs"]):
+        why = _output_shape_error(stats, o)
+        if why:
+            raise StudyError(f"study field 'outputs[{j}]' = '{o}': {why}; allowed a number of the pass's stats.json, "
+                             "e.g. pantographs.0.std_force_N")
+
+
 def _pass_report_script():
     here = os.path.dirname(os.path.abspath(__file__))
     # the sources (devel space: the package is loaded from python/catenary_sim), or an install
@@ -418,6 +477,7 @@ def _read_case(out, i, n_outputs, warn=False):
     except (ValueError, OSError) as e:
         ok, why = False, str(e)
     if ok:
+        r["outputs"] = {k: math.nan if v is None else v for k, v in r["outputs"].items()}
         return r
     if warn:
         print(f"catenary_sim_study: case file '{path}' is damaged ({why}); the case runs again", flush=True)
@@ -455,6 +515,7 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
     study = load_study(study_path)
     if not isinstance(workers, int) or not 1 <= workers <= 1024:
         raise StudyError(f"workers = {workers!r}: allowed 1 to 1024")
+    check_study_against_scene(study)
     os.makedirs(os.path.join(out, "cases"), exist_ok=True)
     lock = open(os.path.join(out, ".catenary_sim.lock"), "w")
     try:
@@ -508,7 +569,10 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
                 i = futures[fut]
                 record = fut.result()
                 record["case"] = i
-                _write_atomically(_case_path(out, i), json.dumps(record))
+                # (an output that is not a number, a failed case's, as null: strict JSON)
+                record["outputs"] = {k: None if isinstance(v, float) and math.isnan(v) else v
+                                     for k, v in record["outputs"].items()}
+                _write_atomically(_case_path(out, i), json.dumps(record, allow_nan=False))
                 bar.update(1)
             bar.close()
         finally:

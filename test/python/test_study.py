@@ -1,7 +1,10 @@
 """Studies (catenary_sim.study): the Sobol estimator against the Ishigami function's published
-indices, a study on a 2-worker local Dask cluster killed half-way and resumed, failed cases."""
+indices, a study on a 2-worker local Dask cluster killed half-way and resumed, failed cases, and
+fields the scene lacks refused before any case runs."""
+import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -92,6 +95,30 @@ def test_failed_cases_are_recorded_and_the_others_go_on(tmp_path):
     assert "pantographs[0].static_uplift" in table["message"][1]
     assert math.isnan(table["pantographs.0.std_force_N"][1])
     assert os.path.exists(str(tmp_path / "out" / "pantographs_0_std_force_N.png"))
+    # The failed case's file is strict JSON: its outputs null, not NaN.
+    with open(tmp_path / "out" / "cases" / "000001.json") as f:
+        record = json.loads(f.read(), parse_constant=lambda c: pytest.fail(f"{c} in a case file: not JSON"))
+    assert record["outputs"]["pantographs.0.std_force_N"] is None
+
+
+def test_fields_the_scene_lacks_are_refused_before_any_case_runs(tmp_path):
+    # A misspelt parameter key or output, or overrides the scene refuses, would fail every case:
+    # refused by name before the output directory is made.
+    grid = [{"key": "pantographs.0.static_uplift", "values": [100, 120]}]
+    bad = {"parameters[0].key": dict(parameters=[{"key": "steady_arms.stifness", "values": [1, 2]}]),
+           "outputs[1]": dict(parameters=grid, outputs=["pantographs.0.std_force_N", "pantographs.0.std_forc_N"]),
+           "outputs[0]": dict(parameters=grid, outputs=["pantographs.3.std_force_N"]),
+           "overrides": dict(parameters=grid, overrides={"numerics.dt": -1})}
+    for field, fields in bad.items():
+        out = tmp_path / ("out_" + field.replace("[", "_").replace("]", ""))
+        with pytest.raises(study.StudyError, match=re.escape(field)):
+            study.run_study(write_study(str(tmp_path / "s.yaml"), **fields), str(out), workers=1, progress=False)
+        assert not out.exists(), field
+    # The command says so with status 2.
+    p = run_cli(write_study(str(tmp_path / "s.yaml"), **bad["outputs[1]"]), str(tmp_path / "cli"))
+    assert p.wait(timeout=300) == 2
+    assert "outputs[1]" in p.stdout.read().decode()
+    assert not (tmp_path / "cli").exists()
 
 
 def test_bad_study_files_name_the_field(tmp_path):
