@@ -198,9 +198,10 @@ int build_pass(const Options& o, Scene* scene, std::unique_ptr<Simulation>* sim)
 // The output directory: created, locked against a second run, and checked writable before the
 // pass (a full or read-only target is found now, not after the pass). *bag_target: the bag's path
 // with its links followed. Returns -1 to go on, else the exit code.
-int prepare_outputs(const Options& o, const Model& m, std::unique_ptr<DirectoryLock>* lock, std::string* bag_target) {
+int prepare_outputs(const Options& o, const Model& m, std::unique_ptr<DirectoryLock>* lock, std::string* bag_target,
+                    std::vector<std::string>* made) {
   try {
-    make_directories(o.out_dir);
+    *made = make_directories(o.out_dir);
     *lock = std::make_unique<DirectoryLock>(o.out_dir);
     check_pass_files_writable(o.out_dir, m);
     if (!o.bag_path.empty()) {
@@ -427,7 +428,15 @@ int main(int argc, char** argv) {
   const Model& m = sim->model();
   std::unique_ptr<DirectoryLock> lock;
   std::string bag_target;
-  if (const int rc = prepare_outputs(o, m, &lock, &bag_target); rc >= 0) return rc;
+  std::vector<std::string> made;  // the output directories this run created
+  if (const int rc = prepare_outputs(o, m, &lock, &bag_target, &made); rc >= 0) return rc;
+  // A pass that ends writing nothing (it diverged) takes back the lock file and directories it made.
+  auto written_nothing = [&](int rc) {
+    lock->remove_if_made();
+    lock.reset();
+    remove_made_directories(made);
+    return rc;
+  };
 
   PassRecorder recorder(m, scene.output.sample_rate);
   LateralRecorder lateral(m, scene.output.sample_rate);  // records nothing on a 2-D line
@@ -435,7 +444,7 @@ int main(int argc, char** argv) {
   for (const std::string& w : m.warnings) std::cerr << "simulate_pass: warning: " << w << "\n";
   const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build).count();
   PassRun run;
-  if (const int rc = run_pass(o, *sim, bag_target, recorder, lateral, &run); rc >= 0) return rc;
+  if (const int rc = run_pass(o, *sim, bag_target, recorder, lateral, &run); rc >= 0) return written_nothing(rc);
   const State& st = sim->state();
   const std::vector<PantographStatistics> stats = recorder.statistics(m);
   if (!all_finite(stats)) {
@@ -445,7 +454,7 @@ int main(int argc, char** argv) {
     std::cerr << "simulate_pass: the pass gave no statistics over the analysis section (output.analysis_spans); "
                  "nothing written\n";
     if (!run.bag_tmp.empty()) std::remove(run.bag_tmp.c_str());
-    return kBadInput;
+    return written_nothing(kBadInput);
   }
   try {
     RunInfo info;

@@ -246,6 +246,34 @@ TEST(FuzzBadInput, CorruptedSceneFiles) {
   std::system(("rm -rf '" + dir + "'").c_str());
 }
 
+// A pass the watchdog stops (exit 3) writes nothing: the output directories it made and its lock
+// file are taken back, and a directory that was there keeps what it held and gains nothing.
+// (A trolley wire at 10 N, its wave speed under 4 m/s, let below the train's speed: it diverges
+// within a tenth of a second.)
+TEST(FuzzBadInput, ADivergedPassLeavesNothingBehind) {
+  const std::string dir = temp_dir("catenary_sim_diverged_");
+  const std::vector<std::string> diverging{kSimulatePass, "--scene", test_scenes::kSourceDir + "/config/trolley_wire.yaml",
+                                           "--set", "contact_wire.tension=10", "--set", "numerics.allow_supercritical=true",
+                                           "--quiet", "--no-progress", "--out"};
+  std::vector<std::string> fresh = diverging;
+  fresh.push_back(dir + "/new/pass");
+  const ChildRun a = run(fresh, dir, 60.0);
+  EXPECT_EQ(a.exit_code, 3) << a.out;
+  EXPECT_NE(a.out.find("diverged"), std::string::npos) << a.out;
+  EXPECT_FALSE(exists(dir + "/new")) << "the output directories it made stayed";
+  const std::string kept = dir + "/kept";
+  ASSERT_EQ(::mkdir(kept.c_str(), 0755), 0);
+  std::ofstream(kept + "/notes.txt") << "mine\n";
+  std::vector<std::string> existing = diverging;
+  existing.push_back(kept);
+  const ChildRun b = run(existing, dir, 60.0);
+  EXPECT_EQ(b.exit_code, 3) << b.out;
+  EXPECT_EQ(slurp(kept + "/notes.txt"), "mine\n");
+  EXPECT_FALSE(exists(kept + "/.catenary_sim.lock"));
+  EXPECT_FALSE(exists(kept + "/stats.json"));
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
 TEST(FuzzBadInput, OutputTargetsThatAreNotRegularFiles) {
   // The tools' single-file outputs onto what is not a regular file (output_files.hpp): a FIFO is
   // written through (elasticity_curve) or refused before the pass (--bag: a rosbag seeks), never

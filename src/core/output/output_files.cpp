@@ -212,25 +212,33 @@ void check_writable(const std::string& path) {
   ::unlink(tmp.c_str());
 }
 
-void make_directories(const std::string& dir) {
+std::vector<std::string> make_directories(const std::string& dir) {
   if (dir.empty()) throw OutputError("output directory: empty path");
+  std::vector<std::string> made;
   std::string cur;
   std::stringstream ss(dir);
   if (dir[0] == '/') cur = "/";
   for (std::string part; std::getline(ss, part, '/');) {
     if (part.empty()) continue;
     cur += part + "/";
-    if (::mkdir(cur.c_str(), 0755) != 0 && errno != EEXIST)
-      throw OutputError("cannot create directory '" + cur + "': " + reason());
+    if (::mkdir(cur.c_str(), 0755) == 0) made.push_back(cur);
+    else if (errno != EEXIST) throw OutputError("cannot create directory '" + cur + "': " + reason());
   }
   struct stat st {};
   if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
     throw OutputError("cannot use '" + dir + "' as an output directory: not a directory");
+  return made;
 }
 
-DirectoryLock::DirectoryLock(const std::string& dir) {
-  const std::string name = dir + "/.catenary_sim.lock";
-  fd_ = ::open(name.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+void remove_made_directories(const std::vector<std::string>& made) {
+  for (auto it = made.rbegin(); it != made.rend(); ++it) ::rmdir(it->c_str());  // (fails, harmlessly, if not empty)
+}
+
+DirectoryLock::DirectoryLock(const std::string& dir) : path_(dir + "/.catenary_sim.lock") {
+  const std::string& name = path_;
+  fd_ = ::open(name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  made_ = fd_ >= 0;
+  if (fd_ < 0 && errno == EEXIST) fd_ = ::open(name.c_str(), O_RDWR | O_CLOEXEC);
   if (fd_ < 0) throw OutputError("cannot lock output directory '" + dir + "': " + reason());
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const bool busy = errno == EWOULDBLOCK;
@@ -244,6 +252,11 @@ DirectoryLock::DirectoryLock(const std::string& dir) {
 
 DirectoryLock::~DirectoryLock() {
   if (fd_ >= 0) ::close(fd_);  // releases the lock
+}
+
+void DirectoryLock::remove_if_made() {
+  if (made_ && fd_ >= 0) ::unlink(path_.c_str());
+  made_ = false;
 }
 
 }  // namespace catenary_sim

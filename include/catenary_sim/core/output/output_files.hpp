@@ -18,6 +18,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace catenary_sim {
 
@@ -45,8 +46,9 @@ struct OutputTarget {
 };
 OutputTarget output_target(const std::string& path);
 
-// Creates `dir` and its parents (mkdir -p). Throws OutputError.
-void make_directories(const std::string& dir);
+// Creates `dir` and its parents (mkdir -p); returns the directories it created, outermost first
+// (none when `dir` was there). Throws OutputError.
+std::vector<std::string> make_directories(const std::string& dir);
 
 // A file being written: text goes to DIR/.NAME.tmp.XXXXXX; commit() flushes, fsyncs and renames it
 // to `path` (to what a link at `path` names). Destroyed without commit() (an error, an exception) it
@@ -84,9 +86,18 @@ class DirectoryLock {
   ~DirectoryLock();
   DirectoryLock(const DirectoryLock&) = delete;
   DirectoryLock& operator=(const DirectoryLock&) = delete;
+  // A run that writes nothing after all (it diverged) takes back the lock file it made (one that
+  // was there stays); the lock is held until the object goes.
+  void remove_if_made();
 
  private:
   int fd_ = -1;
+  bool made_ = false;
+  std::string path_;
 };
+
+// Removes the directories make_directories created (`made`, outermost first), innermost first,
+// each only if empty: a run that wrote nothing leaves no directory behind.
+void remove_made_directories(const std::vector<std::string>& made);
 
 }  // namespace catenary_sim
