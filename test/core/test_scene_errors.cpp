@@ -344,6 +344,16 @@ TEST(SceneErrors, FieldsThatCannotActAreRefused) {
   EXPECT_MENTIONS(error_of({"pantographs.0.collectors=[{offset: 0.0, working_width: 1.0}]"}),
                   "pantographs[0].collectors[0].working_width", "only on a 3-D line");
   EXPECT_EQ(error_of_3d({"pantographs.0.collectors=[{offset: 0.0, working_width: 1.0}]"}), "");
+  // An overlap needs two sections; its rise is given or derived from a force, not both; dropper
+  // positions for transition spans need a line that has some.
+  EXPECT_MENTIONS(error_of({"overlap={spans: 1, support_rise: 0.1}"}), "'overlap'", "one section", "two or more");
+  EXPECT_MENTIONS(error_of({"droppers.transition_positions=[5.0]"}), "droppers.transition_positions", "one section");
+  const std::string two = test_scenes::scene_path("reference_55m_two_sections.yaml");
+  EXPECT_MENTIONS(test_scenes::refusal_of(two, {"overlap.support_rise=0.1", "overlap.design_force=100"}),
+                  "overlap.design_force", "100", "support_rise");
+  EXPECT_EQ(test_scenes::refusal_of(two, {"overlap.design_force=100"}), "");
+  // A messenger without droppers would hang apart from the contact wire.
+  EXPECT_MENTIONS(error_of({"droppers=null", "contact_wire.presag=0"}), "'messenger'", "without droppers");
 }
 
 // numerics.supports and numerics.droppers: a value of the two, and implicit only where the explicit
@@ -420,4 +430,16 @@ TEST(SceneErrors, DivergenceNamesItsLikelyCause) {
   const std::string soft = message({"contact.stiffness=0.001"});
   EXPECT_MENTIONS(soft, "contact.stiffness");
   EXPECT_EQ(soft.find("stability estimate"), std::string::npos) << soft;
+}
+
+// A design the statics cannot build names the field of the line's kind that makes it so: a
+// compound line's hangers and auxiliary, a stitched line's stitch wire.
+TEST(SceneErrors, DesignStaticsRefusalsNameTheKindsFields) {
+  const std::string compound = test_scenes::scene_path("compound_catenary.yaml");
+  EXPECT_MENTIONS(test_scenes::refusal_of(compound, {"hangers.positions=[5.0]"}), "hangers.positions", "auxiliary messenger",
+                  "push");
+  EXPECT_MENTIONS(test_scenes::refusal_of(compound, {"auxiliary_messenger.height=1.49"}), "lower auxiliary_messenger.height");
+  const std::string stitched = test_scenes::scene_path("reference_55m_stitched.yaml");
+  EXPECT_MENTIONS(test_scenes::refusal_of(stitched, {"stitch_wire.tension=1"}), "stitch_wire.tension 1 N", "raise it");
+  EXPECT_MENTIONS(test_scenes::refusal_of(stitched, {"stitch_wire.tension=1e5"}), "lower stitch_wire.tension");
 }

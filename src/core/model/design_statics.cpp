@@ -189,11 +189,15 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
     const std::string part = d.hanger ? "hanger" : "dropper";
     if (d.length <= 0.01) {
       const Wire& top = wire_of(m, d.messenger_dof);
-      const std::string low = wire_of(m, d.contact_dof).is_auxiliary_messenger ? "auxiliary messenger" : "contact wire";
+      const bool holds_auxiliary = wire_of(m, d.contact_dof).is_auxiliary_messenger;
+      const std::string low = holds_auxiliary ? "auxiliary messenger" : "contact wire";
       const std::string top_name = top.is_stitch_wire ? "stitch wire" : top.is_auxiliary_messenger ? "auxiliary messenger" : "messenger";
       throw SceneError(part + "s: at x = " + fmt(d.x) + " m the " + top_name + " hangs " + fmt(-d.length) + " m below the " + low +
                        " (" + part + " length " + fmt(d.length) + " m): raise " +
                        (d.hanger ? "auxiliary_messenger.height or its tension" : "line.encumbrance or the " + top_name + "'s tension") +
+                       (holds_auxiliary ? ", lower auxiliary_messenger.height (" + fmt(sec.auxiliary_messenger->height) + " m)" : "") +
+                       // (a stitch wire pulls the messenger down at its clamps by its tension's share)
+                       (sec.stitch_wire ? ", lower stitch_wire.tension (" + fmt(sec.stitch_wire->tension) + " N)" : "") +
                        ", or reduce the presag");
     }
     const int nspan = static_cast<int>(sec.spans.size());
@@ -204,6 +208,17 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
                        fmt(std::max(m.sections[d.section].rise_first, m.sections[d.section].rise_last)) +
                        " m) pulls the wire up past it; lower overlap.support_rise (or overlap.design_force) or hang " + part +
                        "s.transition_positions nearer the section's own support");
+    if (d.static_tension <= 0.0 && sec.auxiliary_messenger && !d.hanger)
+      throw SceneError("droppers: at x = " + fmt(d.x) + " m the dropper would have to push the auxiliary messenger up (static force " +
+                       fmt(d.static_tension) + " N): held auxiliary_messenger.height (" + fmt(sec.auxiliary_messenger->height) +
+                       " m) above the contact wire there, it must bend down more than its hangers' loads bend it; hang the "
+                       "contact wire from hangers nearer each dropper (hangers.positions), or reduce contact_wire.presag (" +
+                       fmt(sec.contact_wire.presag) + " m)");
+    if (d.static_tension <= 0.0 && wire_of(m, d.messenger_dof).is_stitch_wire)
+      throw SceneError("droppers: at x = " + fmt(d.x) + " m the dropper would have to push (static force " +
+                       fmt(d.static_tension) + " N): the stitch wire it hangs from sags too far at stitch_wire.tension " +
+                       fmt(sec.stitch_wire->tension) + " N; raise it, or reduce contact_wire.presag (" +
+                       fmt(sec.contact_wire.presag) + " m)");
     if (d.static_tension <= 0.0)
       throw SceneError(part + "s: at x = " + fmt(d.x) + " m the " + part + " would have to push (static force " +
                        fmt(d.static_tension) + " N): contact_wire.presag " + fmt(sec.contact_wire.presag) +

@@ -303,6 +303,9 @@ void resolve_line(Scene& s) {
       } else {
         const std::vector<double> common = d.positions.empty() ? std::vector<double>{} : d.positions.front();
         d.positions.assign(n, common);
+        if (!d.transition_positions.empty() && s.sections.size() < 2)
+          fail(std::string(key) + ".transition_positions", "(given on a line of one section)",
+               "only where tension sections overlap (two or more): their transition spans take them; remove it here");
         if (!d.transition_positions.empty()) {
           if (sec.last_span_transition) d.positions[n - 1] = d.transition_positions;
           if (sec.first_span_transition) {
@@ -379,8 +382,14 @@ void read_overlap(Reader& top, Scene& s) {
     o.spans = static_cast<int>(k);
     if (r.has("support_rise")) o.support_rise = r.number("support_rise", 0.0, 2.0);
     if (r.has("design_force")) o.design_force = r.number("design_force", 0.0, 2000.0, std::nullopt, true);
+    if (o.support_rise && o.design_force)
+      fail("overlap.design_force", fmt(*o.design_force) + " (given with support_rise)",
+           "one of them: support_rise is the rise, design_force derives it (eq. 6-8) when it is absent");
     o.lateral_separation = r.number("lateral_separation", -1.0, 1.0, 0.0);
     r.finish();
+    if (s.sections.size() < 2)
+      fail("overlap", "(given on a line of one section)",
+           "only where tension sections overlap (sections: two or more); remove it here");
     s.overlap = o;
   } else if (s.sections.size() > 1) {
     s.overlap = OverlapSpec{};

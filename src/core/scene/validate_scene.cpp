@@ -486,6 +486,17 @@ void validate_bridles(const Scene& s) {
   }
 }
 
+// A messenger carries the line through its droppers: without any it would hang apart, loading
+// nothing (what hangs from it on a stitched or compound line is checked with those kinds).
+void validate_messengers(const Scene& s) {
+  for (std::size_t si = 0; si < s.sections.size(); ++si) {
+    const SectionSpec& sec = s.sections[si];
+    if (sec.messenger && !sec.droppers)
+      fail((s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : std::string()) + "messenger", "(given without droppers)",
+           "droppers that hang the contact wire from it; a trolley wire has no messenger: remove it");
+  }
+}
+
 void validate(const Scene& s) {
   const double line = s.line_length();
   validate_sections(s);
@@ -493,6 +504,7 @@ void validate(const Scene& s) {
   validate_stitched(s);
   validate_compound(s);
   validate_bridles(s);
+  validate_messengers(s);
   validate_limits(s);
   validate_acting_fields(s);
   validate_pantographs(s);
