@@ -155,6 +155,11 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
     return s;
   };
   refused(with("bending_stiffness: 280000", "bending_stiffness: -1"), "conductor_rail.bending_stiffness");
+  // Too soft to be a beam: 5 q L^4 / (384 EI) above L / 50 below 250 q L^3 / 384 = 46431 N m^2 here.
+  const std::string soft = test_scenes::refusal_of_yaml(with("bending_stiffness: 280000", "bending_stiffness: 46000"));
+  for (const char* word : {"conductor_rail.bending_stiffness", "46000", "at least 46431", "fiftieth"})
+    EXPECT_NE(soft.find(word), std::string::npos) << soft;
+  EXPECT_EQ(test_scenes::refusal_of_yaml(with("bending_stiffness: 280000", "bending_stiffness: 46500")), "");
   refused(with("linear_mass: 7.27", "linear_mass: 0"), "conductor_rail.linear_mass");
   refused(with("  support_stiffness: 5000000\n", ""), "conductor_rail.support_stiffness");
   refused(y + "messenger:\n  linear_mass: 1.0\n  tension: 10000\n", "messenger");

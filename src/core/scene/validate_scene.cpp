@@ -323,6 +323,30 @@ void validate_rigid(const Scene& s) {
   if (s.imperfections.contact_wire_wear.any())
     fail("imperfections.contact_wire_wear", "(given with conductor_rail)",
          "none: the wear law scales the whole beam, a rail's beam is mostly the aluminium profile");
+  // A beam, not a chain: under its weight the profile must sag less than a fiftieth of its span
+  // (simply supported, 5 q L^4 / (384 EI): the small deflections its beam theory needs; the shipped
+  // profile sags a thousandth). A softer one hangs as no rail does and the static state runs away.
+  auto stiff_enough = [&](const std::string& field, double ei, double span, double linear_mass) {
+    const double q = linear_mass * s.gravity, least = 250.0 * q * span * span * span / 384.0;
+    if (!(ei >= least))
+      fail(field, fmt(ei),
+           "at least " + fmt(least) + " N m^2 here: the profile would sag " + fmt(5.0 * q * std::pow(span, 4) / (384.0 * ei)) +
+               " m under its weight over a " + fmt(span) + " m span (5 q L^4 / (384 EI)), more than a fiftieth of it");
+  };
+  for (std::size_t i = 0; i < s.sections.size(); ++i) {
+    const SectionSpec& sec = s.sections[i];
+    if (!sec.rigid) continue;
+    const std::string f = (s.sections.size() > 1 ? "sections[" + std::to_string(i) + "]." : "") + "conductor_rail";
+    stiff_enough(f + ".bending_stiffness", sec.contact_wire.bending_stiffness, *std::max_element(sec.spans.begin(), sec.spans.end()),
+                 sec.contact_wire.linear_mass);
+    if (sec.rail_transition_piece) {
+      const double end_span = std::max(transition_piece_at_start(s, i) ? sec.spans.front() : 0.0,
+                                       transition_piece_at_end(s, i) ? sec.spans.back() : 0.0);
+      if (end_span > 0.0)
+        stiff_enough(f + ".transition_piece.end_bending_stiffness", sec.rail_transition_piece->end_bending_stiffness, end_span,
+                     sec.contact_wire.linear_mass);
+    }
+  }
   for (std::size_t i = 0; i < s.sections.size(); ++i) {
     const SectionSpec& sec = s.sections[i];
     if (!sec.rail_transition_piece) continue;
