@@ -154,7 +154,7 @@ def load_study(path):
         _fail("scene", scene, "required: the scene file, relative to the study file")
     s["scene"] = scene if os.path.isabs(scene) else os.path.normpath(os.path.join(base, scene))
     if not os.path.isfile(s["scene"]):
-        _fail("scene", scene, f"a scene file; '{s['scene']}' does not exist")
+        _fail("scene", scene, f"a scene file; '{s['scene']}' " + ("is a directory" if os.path.isdir(s["scene"]) else "does not exist"))
     ov = doc.get("overrides", {}) or {}
     if not isinstance(ov, dict):
         _fail("overrides", ov, "a map {dotted.key: value}")
@@ -190,6 +190,9 @@ def load_study(path):
                 _fail(f + ".labels", labels, f"a list of {len(v)} names, one per value")
             if len(set(map(str, labels))) != len(labels):
                 _fail(f + ".labels", labels, "distinct names (give labels for values that print alike)")
+            if not all(_finite(x) for x in v):
+                _fail(f + ".values", v, "finite numbers (NaN and inf cannot be a scene's value), text, true/false, "
+                      "null, lists and maps")
             s["parameters"].append({"key": p["key"], "values": v, "labels": labels})
         elif "labels" in p:
             _fail(f + ".labels", p["labels"], "only with sampling: grid")
@@ -229,6 +232,17 @@ def load_study(path):
         raise StudyError(f"study file '{path}': a value that cannot be written to plan.json ({e}); allowed "
                          "numbers, text, true/false, null, lists and maps") from None
     return s
+
+
+def _finite(x):
+    """False for a NaN or an infinity anywhere in a grid value (lists and maps looked into)."""
+    if isinstance(x, float):
+        return math.isfinite(x)
+    if isinstance(x, list):
+        return all(_finite(y) for y in x)
+    if isinstance(x, dict):
+        return all(_finite(y) for y in x.values())
+    return True
 
 
 def case_count(study):

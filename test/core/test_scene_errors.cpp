@@ -54,6 +54,11 @@ TEST(SceneErrors, OutOfRangeNamesFieldValueAndRange) {
   EXPECT_MENTIONS(error_of({"contact_wire.linear_mass=.nan"}), "contact_wire.linear_mass", "allowed range");
   EXPECT_MENTIONS(error_of({"damping.beta=1"}), "damping.beta", "1", "[0, 0.1]");
   EXPECT_MENTIONS(error_of({"pantographs.0.static_uplift=-1"}), "pantographs[0].static_uplift", "-1", "allowed range");
+  // Stations are finite; a start of -0 (the front at the line's start less no offset) shows as 0.
+  EXPECT_MENTIONS(error_of({"train.end=.inf"}), "train.end", "[-1000000000, 1000000000]");
+  const std::string before = error_of({"train.end=-5"});
+  EXPECT_MENTIONS(before, "train.end", "-5", "train.start (0 m)");
+  EXPECT_EQ(before.find("-0 m"), std::string::npos) << before;
 }
 
 // The report's fields: limits absent by default, each checked like the others.

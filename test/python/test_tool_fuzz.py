@@ -330,7 +330,9 @@ STUDY_CASES = [
                                     parameters=[{"key": f"p{i}", "distribution": {"type": "uniform", "low": 0,
                                                                                    "high": 1}} for i in range(5)]),
      ["'samples'", "7000000 cases"]),
-    ("nan value", study_text().replace("- 250", "- .nan"), ["s.yaml", "plan.json"]),
+    ("nan value", study_text().replace("- 250", "- .nan"), ["'parameters[0].values'", "finite"]),
+    ("inf in a list value", study_text().replace("- 250", "- [1.0, .inf]"), ["'parameters[0].values'", "finite"]),
+    ("scene a directory", study_text(scene=os.path.dirname(REFERENCE)), ["'scene'", "is a directory"]),
     ("a date", study_text().replace("- 250", "- 2024-01-01"), ["s.yaml", "plan.json"]),
     ("deep nesting", "name: " + "[" * 5000 + "]" * 5000 + "\n", ["s.yaml"]),
 ]

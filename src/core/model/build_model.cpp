@@ -523,7 +523,8 @@ void set_train_travel(const Scene& scene, double endless_front, Model& m) {
       throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": allowed at most " + fmt(hi) +
                        " m (the foremost collector, " + fmt(lead) + " m ahead of the front, stays on the line)");
     if (m.train_end < m.train_start)
-      throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": allowed >= train.start (" + fmt(m.train_start) + " m)");
+      throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": allowed >= train.start (" +
+                       fmt(m.train_start + 0.0) + " m)");  // (+ 0.0: a start of -0 shows as 0)
     // Every pantograph passes through some of the analysis section, or its statistics are empty.
     double x0 = 0.0, x1 = 0.0;
       x0 = m.support_x[scene.analysis_first()];

@@ -421,8 +421,9 @@ void read_train(Reader& top, Scene& s) {
     // Any finite speed >= 0 here; validate() applies the limit (train_speed_limit).
     if (r.has("speed_kmh")) s.train_speed = r.number("speed_kmh", 0.0, kInf) / 3.6;
     else s.train_speed = r.number("speed", 0.0, kInf, 0.0);
-    if (r.has("start")) s.train_start = r.number("start", -kInf, kInf);
-    if (r.has("end")) s.train_end = r.number("end", -kInf, kInf);
+    // Stations in m, finite (within a million km: a line's, not a bound anything reaches).
+    if (r.has("start")) s.train_start = r.number("start", -1e9, 1e9);
+    if (r.has("end")) s.train_end = r.number("end", -1e9, 1e9);
     r.finish();
   }
 }
