@@ -118,65 +118,59 @@ void support_rises(const Scene& scene, const BuildOptions& options, std::vector<
   }
 }
 
-// A stitch wire at each intermediate support of a section: the section's node stations between
-// its clamps (mesh_section puts nodes there), no supports of its own.
+// A short wire over the section's stations from `from` to `to` (mesh_section puts nodes at its
+// ends), clamped there to another wire: a stitch wire (no supports of its own), or a trolley wire's
+// bridle (`middle`: the station where its support holds it).
+void add_clamped_wire(const std::string& name, int section, const WireSpec& spec, const std::vector<double>& x, double from,
+                      double to, std::optional<double> middle, bool lumped_rot, Model& m, int& dof, Section& info) {
+  const int lo = node_at(x, from), hi = node_at(x, to);
+  Wire w;
+  w.name = name;
+  w.section = section;
+  w.is_stitch_wire = true;  // (a bridle too: a short wire between two clamps, which the window and the packs take alike)
+  w.is_bridle = middle.has_value();
+  w.spec = spec;
+  w.x.assign(x.begin() + lo, x.begin() + hi + 1);
+  if (middle) w.support_nodes.push_back(node_at(w.x, *middle));
+  w.w_dof = dof;
+  dof += w.nodes();
+  if (lumped_rot) {
+    w.theta_dof = dof;
+    dof += w.nodes();
+  }
+  assemble_band(w, {});
+  info.stitch_wires.push_back(static_cast<int>(m.wires.size()));
+  m.wires.push_back(std::move(w));
+}
+
+WireSpec wire_spec(double linear_mass, double bending_stiffness, double tension) {
+  WireSpec spec;
+  spec.linear_mass = linear_mass;
+  spec.bending_stiffness = bending_stiffness;
+  spec.tension = tension;
+  return spec;
+}
+
+// A stitch wire at each intermediate support of a section that carries one.
 void add_stitch_wires(const StitchWireSpec& st, int section, const std::vector<double>& supports,
                       const std::vector<double>& x, bool lumped_rot, const std::string& suffix, Model& m, int& dof,
                       Section& info) {
-  WireSpec spec;
-  spec.linear_mass = st.linear_mass;
-  spec.bending_stiffness = st.bending_stiffness;
-  spec.tension = st.tension;
+  const WireSpec spec = wire_spec(st.linear_mass, st.bending_stiffness, st.tension);
   for (std::size_t k = 1; k + 1 < supports.size(); ++k) {
     if (!st.at(static_cast<int>(k))) continue;  // held as on a simple line
     const double half = 0.5 * st.length_at(static_cast<int>(k));
-    const int lo = node_at(x, supports[k] - half), hi = node_at(x, supports[k] + half);
-    Wire w;
-    w.name = "stitch_wire" + suffix + "_" + std::to_string(k);
-    w.section = section;
-    w.is_stitch_wire = true;
-    w.spec = spec;
-    w.x.assign(x.begin() + lo, x.begin() + hi + 1);
-    w.w_dof = dof;
-    dof += w.nodes();
-    if (lumped_rot) {
-      w.theta_dof = dof;
-      dof += w.nodes();
-    }
-    assemble_band(w, {});
-    info.stitch_wires.push_back(static_cast<int>(m.wires.size()));
-    m.wires.push_back(std::move(w));
+    add_clamped_wire("stitch_wire" + suffix + "_" + std::to_string(k), section, spec, x, supports[k] - half,
+                     supports[k] + half, std::nullopt, lumped_rot, m, dof, info);
   }
 }
 
-// A trolley wire's bridle at each intermediate support of a section: the section's node stations
-// between its clamps (mesh_section puts nodes there), held at its middle by the support.
+// A trolley wire's bridle at each intermediate support of a section, held at its middle there.
 void add_bridles(const BridleSpec& b, int section, const std::vector<double>& supports, const std::vector<double>& x,
                  bool lumped_rot, const std::string& suffix, Model& m, int& dof, Section& info) {
-  WireSpec spec;
-  spec.linear_mass = b.linear_mass;
-  spec.bending_stiffness = b.bending_stiffness;
-  spec.tension = b.tension;
-  for (std::size_t k = 1; k + 1 < supports.size(); ++k) {
-    const int lo = node_at(x, supports[k] - 0.5 * b.length), hi = node_at(x, supports[k] + 0.5 * b.length);
-    Wire w;
-    w.name = "bridle" + suffix + "_" + std::to_string(k);
-    w.section = section;
-    w.is_stitch_wire = true;  // (a short wire between two clamps: the window and the packs take it as one)
-    w.is_bridle = true;
-    w.spec = spec;
-    w.x.assign(x.begin() + lo, x.begin() + hi + 1);
-    w.support_nodes.push_back(node_at(w.x, supports[k]));
-    w.w_dof = dof;
-    dof += w.nodes();
-    if (lumped_rot) {
-      w.theta_dof = dof;
-      dof += w.nodes();
-    }
-    assemble_band(w, {});
-    info.stitch_wires.push_back(static_cast<int>(m.wires.size()));
-    m.wires.push_back(std::move(w));
-  }
+  const WireSpec spec = wire_spec(b.linear_mass, b.bending_stiffness, b.tension);
+  for (std::size_t k = 1; k + 1 < supports.size(); ++k)
+    add_clamped_wire("bridle" + suffix + "_" + std::to_string(k), section, spec, x, supports[k] - 0.5 * b.length,
+                     supports[k] + 0.5 * b.length, supports[k], lumped_rot, m, dof, info);
 }
 
 // DOF layout: per wire the vertical displacements, then (lumped rotary inertia only) the
