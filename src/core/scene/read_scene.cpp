@@ -382,9 +382,6 @@ void read_overlap(Reader& top, Scene& s) {
     o.spans = static_cast<int>(k);
     if (r.has("support_rise")) o.support_rise = r.number("support_rise", 0.0, 2.0);
     if (r.has("design_force")) o.design_force = r.number("design_force", 0.0, 2000.0, std::nullopt, true);
-    if (o.support_rise && o.design_force)
-      fail("overlap.design_force", fmt(*o.design_force) + " (given with support_rise)",
-           "one of them: support_rise is the rise, design_force derives it (eq. 6-8) when it is absent");
     o.lateral_separation = r.number("lateral_separation", -1.0, 1.0, 0.0);
     r.finish();
     if (s.sections.size() < 2)
