@@ -321,47 +321,27 @@ std::pair<const Wire*, int> dropper_top(const Model& m, const Section& info, dou
   return {&mwire, node_at(mwire.x, xd)};
 }
 
-// Each stitch wire's two clamps on the messenger, the clamp masses on the stitch wire's ends (the
-// clamp is one body; on the lighter node it keeps the clamp's own frequency low). Their static
-// forces come from the design statics.
-void clamp_stitch_wires(const Scene& scene, Model& m) {
+// Each short clamped wire's two clamps, the clamp masses on its ends (the clamp is one body; on the
+// lighter node it keeps the clamp's own frequency low): a stitch wire hangs from the messenger, a
+// bridle holds the contact wire below it. Their static forces come from the design statics.
+void clamp_short_wires(const Scene& scene, Model& m) {
   for (std::size_t si = 0; si < scene.sections.size(); ++si) {
     const SectionSpec& sec = scene.sections[si];
     const Section& info = m.sections[si];
-    if (!sec.stitch_wire) continue;
-    const Wire& mwire = m.wires[info.messenger];
+    if (!sec.stitch_wire && !sec.bridle) continue;
+    const bool bridle = sec.bridle.has_value();  // (never both: a stitch wire needs a messenger, a bridle refuses one)
+    const Wire& other = m.wires[bridle ? info.wires.front() : info.messenger];  // (a bridle's: the one contact wire)
+    const double clamp_mass = bridle ? sec.bridle->clamp_mass : sec.stitch_wire->clamp_mass;
     for (int wi : info.stitch_wires) {
       const Wire& w = m.wires[wi];
       for (int end : {0, w.nodes() - 1}) {
         WireClamp c;
         c.x = w.x[end];
-        c.messenger_dof = mwire.w_dof + node_at(mwire.x, c.x);
-        c.stitch_dof = w.w_dof + end;
+        const int own = w.w_dof + end, held = other.w_dof + node_at(other.x, c.x);
+        c.messenger_dof = bridle ? own : held;  // the upper node
+        c.stitch_dof = bridle ? held : own;     // the lower node
         c.stiffness = kStitchClampStiffness;
-        m.mass[c.stitch_dof] += sec.stitch_wire->clamp_mass;
-        m.clamps.push_back(c);
-      }
-    }
-  }
-}
-
-// Each bridle's two clamps on the contact wire, the clamp masses on the bridle's ends (as a stitch
-// wire's). Their static forces come from the design statics.
-void clamp_bridles(const Scene& scene, Model& m) {
-  for (std::size_t si = 0; si < scene.sections.size(); ++si) {
-    const SectionSpec& sec = scene.sections[si];
-    const Section& info = m.sections[si];
-    if (!sec.bridle) continue;
-    const Wire& cw = m.wires[info.wires.front()];  // the one contact wire (validate_bridles)
-    for (int wi : info.stitch_wires) {
-      const Wire& w = m.wires[wi];
-      for (int end : {0, w.nodes() - 1}) {
-        WireClamp c;
-        c.x = w.x[end];
-        c.messenger_dof = w.w_dof + end;
-        c.stitch_dof = cw.w_dof + node_at(cw.x, c.x);
-        c.stiffness = kStitchClampStiffness;
-        m.mass[c.messenger_dof] += sec.bridle->clamp_mass;
+        m.mass[own] += clamp_mass;
         m.clamps.push_back(c);
       }
     }
@@ -635,8 +615,7 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
   m.n_dof = dof;
   const std::vector<bool> fixed = lump_masses(scene, m);
   hang_droppers(scene, section_supports, m);
-  clamp_stitch_wires(scene, m);
-  clamp_bridles(scene, m);
+  clamp_short_wires(scene, m);
   design_statics(scene, section_supports, m);
   apply_wear(scene, m);
   set_constant_load(scene, m, fixed);

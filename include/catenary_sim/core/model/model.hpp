@@ -64,10 +64,10 @@ struct Dropper {
   double unstretched_length = 0.0;
 };
 
-// A stitch wire's end clamped to the messenger: a bilateral spring, stiff beside the line's own
-// compliance (kStitchClampStiffness), carrying the stitch wire's end reaction in the design state.
-// A clamp joining two wires' nodes: a stitch wire's end hung from the messenger, or a trolley
-// wire hung from a bridle's end (messenger_dof then the bridle's end, stitch_dof the contact wire's node).
+// A clamp joining two wires' nodes: a stitch wire's end hung from the messenger, or a trolley wire
+// hung from a bridle's end (messenger_dof then the bridle's end, stitch_dof the contact wire's
+// node). A bilateral spring, stiff beside the line's own compliance (kStitchClampStiffness),
+// carrying the short wire's end reaction in the design state.
 struct WireClamp {
   int messenger_dof = 0, stitch_dof = 0;  // the upper wire's node, the lower wire's node
   double stiffness = 0.0;     // N/m
