@@ -17,18 +17,13 @@ bool holds(const Wire& w, int dof) { return dof >= w.w_dof && dof < w.w_dof + w.
 
 const Wire& wire_of(const Model& m, int dof) { return m.wires[wire_holding(m, dof)]; }
 
-// A trolley wire's bridles (BridleSpec) once the contact wire is solved held at its anchors and,
-// from node `held` of `clamp_nodes` on, at the clamps at the working height: each clamp's force is
-// the contact wire's reaction there, and pulls the bridle's end down. The bridle, held at its middle
-// only, hangs from there in a V under those forces and its weight; it is raised until its lower end
-// is at the working height, the other end above by what its arms' loads differ (the clamp then a
-// short link). Its reaction at the middle is the support's preload (design_statics).
-void bridle_statics(const Scene& scene, const Section& info, std::size_t held, const std::vector<int>& clamp_nodes,
-                    Model& m, std::vector<std::vector<double>>& react) {
-  const Wire& cw = m.wires[info.wires.front()];
-  for (std::size_t j = held; j < clamp_nodes.size(); ++j)
-    for (WireClamp& c : m.clamps)
-      if (c.stitch_dof == cw.w_dof + clamp_nodes[j]) c.static_force = react[info.wires.front()][j];
+// A trolley wire's bridles (BridleSpec) once the contact wire is solved held at its anchors and at
+// the clamps at the working height (each clamp's static force set to the contact wire's reaction
+// there): the clamp pulls the bridle's end down. The bridle, held at its middle only, hangs from
+// there in a V under those forces and its weight; it is raised until its lower end is at the
+// working height, the other end above by what its arms' loads differ (the clamp then a short
+// link). Its reaction at the middle is the support's preload (design_statics).
+void bridle_statics(const Scene& scene, const Section& info, Model& m, std::vector<std::vector<double>>& react) {
   for (int wi : info.stitch_wires) {
     Wire& w = m.wires[wi];
     const int n = w.nodes();
@@ -81,10 +76,12 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
         pn.push_back(w.support_nodes[k]);
         ph.push_back(H + (k == 0 ? info.rise_first : 0.0) + (k == ns - 1 ? info.rise_last : 0.0));
       }
-      const std::size_t held = pn.size();  // (a bridle's clamps after the supports)
+      std::vector<WireClamp*> clamps;  // a bridle's, held from node first_clamp of pn on, in this order
+      const std::size_t first_clamp = pn.size();
       if (sec.bridle)
-        for (const WireClamp& c : m.clamps)
+        for (WireClamp& c : m.clamps)
           if (holds(w, c.stitch_dof)) {
+            clamps.push_back(&c);
             pn.push_back(c.stitch_dof - w.w_dof);
             ph.push_back(H);
           }
@@ -99,7 +96,8 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
       }
       solve_wire_statics(w, load, pn, ph, w.height, w.slope, react[wi], &solver[wi]);
       if (sec.bridle) {
-        bridle_statics(scene, info, held, pn, m, react);
+        for (std::size_t j = 0; j < clamps.size(); ++j) clamps[j]->static_force = react[wi][first_clamp + j];
+        bridle_statics(scene, info, m, react);
         continue;  // (no droppers)
       }
       // Dropper tensions: the reactions at the dropper nodes, in the order they were added.
