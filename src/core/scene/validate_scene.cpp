@@ -370,6 +370,24 @@ void validate_rigid(const Scene& s) {
          "the end ramp's rise in m, [0, 2]: eq. 6-8 derive it from a tensioned wire's sag, a rigid profile has none");
 }
 
+// The longest a short clamped wire (a stitch wire, a bridle) centred on each support that
+// carries one (`carries(k)`, support k of the section's spans) may be, each clamp within its span:
+// where both of a span's supports carry one, the halves must not meet (below the span); where one
+// does, its half lies within it (below twice the span). *limiting: the span that sets it.
+template <class Carries>
+double least_clamp_room(const std::vector<double>& spans, Carries&& carries, std::size_t* limiting) {
+  double allowed = 1e300;
+  for (std::size_t j = 0; j < spans.size(); ++j) {
+    const int clamps = carries(j) + carries(j + 1);
+    const double room = clamps == 2 ? spans[j] : 2.0 * spans[j];
+    if (clamps > 0 && room < allowed) {
+      allowed = room;
+      *limiting = j;
+    }
+  }
+  return allowed;
+}
+
 // Stitch wires: hung from a messenger around intermediate supports, each within its spans.
 void validate_stitched(const Scene& s) {
   const bool any = std::any_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.stitch_wire.has_value(); });
@@ -421,16 +439,8 @@ void validate_stitched(const Scene& s) {
                                      : "half its length below the span"));
       }
       // One length for all: the range every span allows, and the span that sets it.
-      double allowed = 1e300;
       std::size_t limiting = 0;
-      for (std::size_t j = 0; j < n; ++j) {
-        const int clamps = carries(j) + carries(j + 1);
-        const double room = clamps == 2 ? sec.spans[j] : 2.0 * sec.spans[j];
-        if (clamps > 0 && room < allowed) {
-          allowed = room;
-          limiting = j;
-        }
-      }
+      const double allowed = least_clamp_room(sec.spans, carries, &limiting);
       const bool both = carries(limiting) && carries(limiting + 1);
       fail(f + ".length", fmt(st.length),
            "(0, " + fmt(allowed) + ") m: each clamp within its span, " + fmt(0.5 * st.length) + " m from its support (span " +
@@ -490,19 +500,9 @@ void validate_bridles(const Scene& s) {
     const std::size_t n = sec.spans.size();
     if (n < 2)
       fail(f, "(given on a section of 1 span)", "a section with intermediate supports (2 spans or more): a bridle hangs at one");
-    // Half a length either side of each intermediate support: the halves from a span's two
-    // supports must not meet, and in an end span the one half lies within it. The span whose
-    // room is least sets the range.
-    double allowed = 1e300;
+    // Half a length either side of each intermediate support (the section's ends carry none).
     std::size_t limiting = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const int carrying = (i > 0) + (i + 1 < n);
-      const double room = 2.0 * sec.spans[i] / carrying;
-      if (room < allowed) {
-        allowed = room;
-        limiting = i;
-      }
-    }
+    const double allowed = least_clamp_room(sec.spans, [&](std::size_t k) { return k > 0 && k < n; }, &limiting);
     if (!(sec.bridle->length < allowed))
       fail(f + ".length", fmt(sec.bridle->length),
            "(0, " + fmt(allowed) + ") m: its clamps within span " + std::to_string(limiting) + " (" + fmt(sec.spans[limiting]) +
