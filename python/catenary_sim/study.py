@@ -335,9 +335,15 @@ def _index_of(values, v):
     raise StudyError(f"case value {v!r} is not among the grid's values")
 
 
-def _output(stats, path):
+def _node(stats, path, before_pass=False):
+    """The value at `path` of stats.json; KeyError naming the part that is not there. With
+    before_pass, `stats` is a pass's before it runs (the scene's pantographs and wires, nulls where
+    numbers come): a list still empty (the steady arms, the droppers, the events) or a null is
+    filled by the pass, and the path is not judged below it (None)."""
     node = stats
     for part in path.split("."):
+        if before_pass and (node is None or (isinstance(node, list) and not node)):
+            return None
         if isinstance(node, list):
             if not part.isdigit() or int(part) >= len(node):
                 raise KeyError(f"output '{path}': '{part}' is not an index of a list of {len(node)}")
@@ -346,38 +352,16 @@ def _output(stats, path):
             node = node[part]
         else:
             raise KeyError(f"output '{path}': no field '{part}' in stats.json")
+    return node
+
+
+def _output(stats, path):
+    node = _node(stats, path)
     if node is None:
         return float("nan")
     if isinstance(node, bool) or not isinstance(node, (int, float)):
         raise KeyError(f"output '{path}': not a number ({node!r})")
     return float(node)
-
-
-def _output_shape_error(stats, path):
-    """Why `path` cannot be a number of stats.json shaped as `stats` (a pass's before it runs: the
-    scene's pantographs and wires, nulls where numbers come); None when it can. A list still empty
-    (the steady arms, the droppers, the events) or a null is filled by the pass: not judged."""
-    node = stats
-    for part in path.split("."):
-        if isinstance(node, list):
-            if not node:
-                return None
-            if not part.isdigit() or int(part) >= len(node):
-                return f"'{part}' is not an index of its list of {len(node)}"
-            node = node[int(part)]
-        elif isinstance(node, dict):
-            if part not in node:
-                return f"no field '{part}' there (its fields: {', '.join(node)})"
-            node = node[part]
-        elif node is None:
-            return None
-        else:
-            return f"'{part}' lies below a number"
-    if isinstance(node, (dict, list)):
-        return "a group of fields, not a number"
-    if isinstance(node, (str, bool)):
-        return f"not a number ({node!r})"
-    return None
 
 
 def check_study_against_scene(study):
@@ -404,7 +388,12 @@ def check_study_against_scene(study):
                                  f"({e}); allowed the dotted key of a field, as docs/scene_reference.md lists") from None
     stats = cs.Simulation(study["scene"], overrides=study["overrides"]).statistics(0.0)
     for j, o in enumerate(study["outputs"]):
-        why = _output_shape_error(stats, o)
+        try:
+            node = _node(stats, o, before_pass=True)
+            why = "" if node is None or (isinstance(node, (int, float)) and not isinstance(node, bool)) else \
+                f"not a number ({'a group of fields' if isinstance(node, (dict, list)) else repr(node)})"
+        except KeyError as e:
+            why = str(e).strip("'\"")
         if why:
             raise StudyError(f"study field 'outputs[{j}]' = '{o}': {why}; allowed a number of the pass's stats.json, "
                              "e.g. pantographs.0.std_force_N")
