@@ -179,10 +179,10 @@ void add_wires(visualization_msgs::MarkerArray& out, const Drawing& d) {
     const Wire& w = m.wires[wi];
     const bool profile = m.scene.sections[w.section].rigid;  // the aluminium profile with its wire
     Marker mk = marker(d.h, "wires", static_cast<int>(wi), Marker::LINE_STRIP);
-    mk.scale.x = profile ? 0.11 : w.is_contact_wire ? 0.04 : w.is_stitch_wire ? 0.025 : 0.03;  // a profile about 110 mm high
+    mk.scale.x = profile ? 0.11 : w.is_contact_wire ? 0.04 : w.is_clamped_wire ? 0.025 : 0.03;  // a profile about 110 mm high
     mk.color = profile              ? color(0.78f, 0.8f, 0.84f)
                : w.is_contact_wire ? color(0.85f, 0.55f, 0.2f)
-               : w.is_stitch_wire  ? color(0.65f, 0.5f, 0.3f)  // bronze
+               : w.is_clamped_wire ? color(0.65f, 0.5f, 0.3f)  // bronze
                : w.is_auxiliary_messenger ? color(0.75f, 0.45f, 0.25f)  // hard-drawn copper
                                    : color(0.6f, 0.6f, 0.65f);
     for (int i : sample_nodes(w, d.o.shape_resolution))

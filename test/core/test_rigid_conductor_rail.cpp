@@ -353,7 +353,7 @@ TEST(RigidConductorRail, AStitchedLineHasItsStitchWiresWhereTheSceneSaysAndNoneA
   auto stitch_wires_and_the_portals_dropper = [](const cs::Model& m, std::vector<double>* middles) {
     int top = -1;
     for (const cs::Wire& w : m.wires) {
-      if (!w.is_stitch_wire) continue;
+      if (!w.is_clamped_wire) continue;
       middles->push_back(0.5 * (w.x.front() + w.x.back()));
       EXPECT_NEAR(w.x.back() - w.x.front(), 16.0, 1e-9);
     }
@@ -370,13 +370,13 @@ TEST(RigidConductorRail, AStitchedLineHasItsStitchWiresWhereTheSceneSaysAndNoneA
   const int top = stitch_wires_and_the_portals_dropper(shipped, &middles);
   EXPECT_EQ(middles, (std::vector<double>{55.0, 110.0, 165.0, 220.0}));
   ASSERT_GE(top, 0);
-  EXPECT_FALSE(shipped.wires[top].is_stitch_wire);
+  EXPECT_FALSE(shipped.wires[top].is_clamped_wire);
   middles.clear();
   const cs::Model every = cs::build_model(cs::load_scene_file(path, {"sections[0].stitch_wire.at_supports=null"}));
   const int every_top = stitch_wires_and_the_portals_dropper(every, &middles);
   EXPECT_EQ(middles, (std::vector<double>{55.0, 110.0, 165.0, 220.0, 250.0}));
   ASSERT_GE(every_top, 0);
-  EXPECT_TRUE(every.wires[every_top].is_stitch_wire);
+  EXPECT_TRUE(every.wires[every_top].is_clamped_wire);
 }
 
 // An expansion joint of three spans holds both profiles at two shared supports: each of the two

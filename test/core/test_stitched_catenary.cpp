@@ -102,7 +102,7 @@ double network_uplift(const cs::Model& m, double probe, double F, int spans = 2,
     for (double xd : droppers)
       if (stitch_of(xd) == static_cast<int>(j)) sx.push_back(xd);
     chain("s" + std::to_string(j) + "_", sx, {}, kTs);
-    for (double x : {a, b}) links.push_back({node("m" + std::to_string(x)), node("s" + std::to_string(j) + "_" + std::to_string(x)), cs::kStitchClampStiffness});
+    for (double x : {a, b}) links.push_back({node("m" + std::to_string(x)), node("s" + std::to_string(j) + "_" + std::to_string(x)), cs::kWireClampStiffness});
   }
   chain("m", mx, supports, kTm);
   for (const cs::Dropper& d : m.droppers) {
@@ -252,11 +252,11 @@ TEST(StitchedCatenary, TheDesignStateIsAnEquilibrium) {
   test_scenes::expect_design_equilibrium(m);
   // Each stitch wire hangs by its clamps: their forces carry its weight and its droppers'.
   for (const cs::Section& sec : m.sections)
-    for (int wi : sec.stitch_wires) {
+    for (int wi : sec.clamped_wires) {
       const cs::Wire& w = m.wires[wi];
       double clamps = 0.0, carried = 0.0;
       for (const cs::WireClamp& c : m.clamps)
-        if (c.stitch_dof >= w.w_dof && c.stitch_dof < w.w_dof + w.nodes()) clamps += c.static_force;
+        if (c.lower_dof >= w.w_dof && c.lower_dof < w.w_dof + w.nodes()) clamps += c.static_force;
       for (int i = 0; i < w.nodes(); ++i) carried += 9.81 * m.mass[w.w_dof + i];
       for (const cs::Dropper& d : m.droppers)
         if (d.messenger_dof >= w.w_dof && d.messenger_dof < w.w_dof + w.nodes()) carried += d.static_tension;
@@ -380,8 +380,8 @@ TEST(StitchedCatenary, ASectionCanLeaveTheStitchWireOut) {
   ASSERT_TRUE(scene.sections[0].stitch_wire.has_value());
   EXPECT_FALSE(scene.sections[1].stitch_wire.has_value());
   const cs::Model m = cs::build_model(scene);
-  EXPECT_EQ(m.sections[0].stitch_wires.size(), 9u);  // at the section's 9 intermediate supports
-  EXPECT_TRUE(m.sections[1].stitch_wires.empty());
+  EXPECT_EQ(m.sections[0].clamped_wires.size(), 9u);  // at the section's 9 intermediate supports
+  EXPECT_TRUE(m.sections[1].clamped_wires.empty());
 }
 
 // A stitch wire too slack for its droppers hangs below the contact wire: refused, naming it.
@@ -423,7 +423,7 @@ TEST(StitchedCatenary, TheEndlessBlockMovesTheStitchWiresExactly) {
   cs::Simulation a(test_scenes::endless_scene(test_scenes::kReferenceStitched, pass));
   cs::Simulation b(cs::load_scene_file(test_scenes::kReferenceStitched, finite));
   ASSERT_TRUE(a.model().endless);
-  ASSERT_FALSE(a.model().sections[0].stitch_wires.empty());
+  ASSERT_FALSE(a.model().sections[0].clamped_wires.empty());
   double worst = 0.0, offset_seen = 0.0;
   while (true) {
     const cs::StepStatus sa = a.step(), sb = b.step();
@@ -458,7 +458,7 @@ std::string windy_network_yaml(double element) {
 // positions taken from the statics (they are the string's boundary values, not what is checked).
 std::pair<double, double> stitch_sag_and_string(const cs::Model& m) {
   const cs::LateralModel& lat = *m.lateral;
-  const int wi = m.sections[0].stitch_wires.at(0);
+  const int wi = m.sections[0].clamped_wires.at(0);
   const cs::Wire& w = lat.wires[wi];
   const Eigen::VectorXd& y = lat.initial;
   const double x0 = w.x.front(), L = w.x.back() - x0;
@@ -540,7 +540,7 @@ namespace {
 double stitch_wire_under_pantograph(const cs::Simulation& sim) {
   const cs::Model& m = sim.model();
   const double xp = sim.state().front - m.pantographs[0].position;
-  for (int wi : m.sections[0].stitch_wires) {
+  for (int wi : m.sections[0].clamped_wires) {
     const cs::Wire& w = m.lateral->wires[wi];
     if (xp < w.x.front() || xp > w.x.back()) continue;
     const int i = static_cast<int>(std::lower_bound(w.x.begin(), w.x.end(), xp) - w.x.begin());
@@ -702,5 +702,5 @@ TEST(StitchedCatenary, LineEnergyIsThePotentialOfTheStepsForces) {
     return (up - line_energy(m, p)) / (2.0 * h);
   };
   for (const WireClamp& c : m.clamps)
-    for (int i : {c.stitch_dof, c.messenger_dof}) EXPECT_NEAR(slope(i), -f[i], 1e-3) << "DOF " << i;
+    for (int i : {c.lower_dof, c.upper_dof}) EXPECT_NEAR(slope(i), -f[i], 1e-3) << "DOF " << i;
 }

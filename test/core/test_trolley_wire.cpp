@@ -352,7 +352,7 @@ TEST(TrolleyWire, BridlesHangTheWireAtTheWorkingHeightAndCarryItsWeight) {
   const double H = m.scene.contact_wire_height;
   const cs::Wire& cw = m.wires[m.contact_wires.front()];
   for (const cs::WireClamp& c : m.clamps) {
-    EXPECT_NEAR(cw.height[c.stitch_dof - cw.w_dof], H, 1e-9) << "clamp at " << c.x;
+    EXPECT_NEAR(cw.height[c.lower_dof - cw.w_dof], H, 1e-9) << "clamp at " << c.x;
     EXPECT_GT(c.static_force, 0.0) << "clamp at " << c.x;
   }
   for (std::size_t b = 1; b < m.wires.size(); ++b) {
@@ -385,7 +385,7 @@ TEST(TrolleyWire, BridledElasticityMatchesAnExactNetworkOfTensionedBeams) {
   const cs::ElasticityProbe probe(cs::load_scene_string(trolley_yaml(n, ei, support, 0.1, bridle_yaml())), P);
   for (int j : {2, 3}) {
     for (double at : {j * kSpan, j * kSpan + 0.5 * kBridleLength, (j + 0.5) * kSpan}) {
-      const double exact = bridled_uplift(n, ei, support, cs::kStitchClampStiffness, at, P);
+      const double exact = bridled_uplift(n, ei, support, cs::kWireClampStiffness, at, P);
       EXPECT_NEAR(probe.uplift(at).at(0), exact, 1e-4 * exact) << "station " << at;
     }
   }

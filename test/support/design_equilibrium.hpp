@@ -20,8 +20,8 @@ inline void expect_design_equilibrium(const catenary_sim::Model& m) {
     f[d.messenger_dof] -= d.static_tension;
   }
   for (const catenary_sim::WireClamp& c : m.clamps) {
-    f[c.stitch_dof] += c.static_force;
-    f[c.messenger_dof] -= c.static_force;
+    f[c.lower_dof] += c.static_force;
+    f[c.upper_dof] -= c.static_force;
   }
   for (const catenary_sim::Wire& w : m.wires)
     for (int i = 0; i < w.nodes(); ++i) {

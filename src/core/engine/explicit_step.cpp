@@ -158,7 +158,7 @@ int springs_at_middle(const Model& m, State& s, bool windowed, const double* u, 
   auto clamp = [&](int k) {
     if (!m.clamp_at_middle[k]) return;
     const WireClamp& c = m.clamps[k];
-    apply(c.messenger_dof, c.stitch_dof, middle_force(c.messenger_dof, c.stitch_dof, c.stiffness, c.static_force, 0.0));
+    apply(c.upper_dof, c.lower_dof, middle_force(c.upper_dof, c.lower_dof, c.stiffness, c.static_force, 0.0));
   };
   if (windowed) {
     for (int j = 0; supports && j < s.window_spring_count; ++j) support(s.window_springs[j]);

@@ -81,9 +81,9 @@ void add_wire_point_forces(const Model& m, State& s, const double* u, const doub
   auto clamp = [&](std::size_t k) {
     if (clamp_middle && clamp_middle[k]) return;
     const WireClamp& c = m.clamps[k];
-    const double t = c.static_force + c.stiffness * (z(c.messenger_dof) - z(c.stitch_dof));
-    f(c.stitch_dof) += t;
-    f(c.messenger_dof) -= t;
+    const double t = c.static_force + c.stiffness * (z(c.upper_dof) - z(c.lower_dof));
+    f(c.lower_dof) += t;
+    f(c.upper_dof) -= t;
   };
   if (m.scene.numerics.windowed()) {
     for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {

@@ -91,7 +91,7 @@ double line_energy(const Model& m, const State& s) {
   // The stitch wires' clamps: the force static_force + k e on the stitch wire's end, e its stretch
   // from the messenger (forces.hpp), is -dV/du_s of V(e) = static_force e + k e^2 / 2.
   for (const WireClamp& c : m.clamps) {
-    const double stretch = u[c.messenger_dof] - u[c.stitch_dof];
+    const double stretch = u[c.upper_dof] - u[c.lower_dof];
     e += c.static_force * stretch + 0.5 * c.stiffness * stretch * stretch;
   }
   if (m.lateral) e += lateral_energy(m, s);

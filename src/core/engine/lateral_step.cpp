@@ -714,7 +714,7 @@ void shift_lateral_block(const Model& m, State& s) {
   LateralState& ls = s.lateral;
   LateralWorkspace& lw = *ls.work;
   const bool windowed = lat.windowed;  // (an endless line always is)
-  // A stitched line's stitch wires (hand_over_stitch_wires): the window's state handed over (the
+  // A stitched line's stitch wires (hand_over_clamped_wires): the window's state handed over (the
   // stagger repeats with the move, so their static states are alike); the nodes it leaves, and the
   // last wires', to the static state under the mean wind at rest.
   auto to_rest = [&](int wire, const WireWindow& ww) {
@@ -724,7 +724,7 @@ void shift_lateral_block(const Model& m, State& s) {
       ls.v[o + i] = 0.0;
     }
   };
-  hand_over_stitch_wires(
+  hand_over_clamped_wires(
       m, ls.window,
       [&](int to, int from, const WireWindow& fw) {
         to_rest(to, ls.window[to]);
@@ -738,7 +738,7 @@ void shift_lateral_block(const Model& m, State& s) {
       to_rest);
   for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
     const Wire& w = lat.wires[wi];
-    if (w.is_stitch_wire) continue;
+    if (w.is_clamped_wire) continue;
     const int ns = m.endless_shift_spans * m.span_nodes[wi], o = w.w_dof, nn = w.nodes();
     // The nodes stepped: the window (outside it they are in the static state), as the vertical
     // plane moves its window (shift_endless_block).

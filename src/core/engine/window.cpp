@@ -23,7 +23,7 @@ void shift_endless_block(const Model& m, State& s) {
   double* v = s.v.data();
   double* a = s.accel.data();
   // A stitched line's stitch wires: the whole wire handed over, or back to u = 0 at rest.
-  hand_over_stitch_wires(
+  hand_over_clamped_wires(
       m, s.window,
       [&](int to, int from, const WireWindow&) {
         const int w0 = m.wires[to].w_dof, src = m.wires[from].w_dof;
@@ -39,7 +39,7 @@ void shift_endless_block(const Model& m, State& s) {
       });
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     WireWindow& ww = s.window[wi];
-    if (ww.hi < ww.lo || m.wires[wi].is_stitch_wire) continue;
+    if (ww.hi < ww.lo || m.wires[wi].is_clamped_wire) continue;
     const int ns = spans * m.span_nodes[wi], w0 = m.wires[wi].w_dof;
     for (int i = ww.lo; i <= ww.hi; ++i) {  // upward: the destination is always below the source
       u[w0 + i - ns] = u[w0 + i];
@@ -195,7 +195,7 @@ void update_window(const Model& m, State& s) {
       m.spring_order, m.spring_order_x, a, b, [&](int k) { return inside(m.springs[k].dof); }, s.window_springs.data());
   s.window_clamp_count = select_between(
       m.clamp_order, m.clamp_order_x, a, b,
-      [&](int k) { return inside(m.clamps[k].stitch_dof) && inside(m.clamps[k].messenger_dof); }, s.window_clamps.data());
+      [&](int k) { return inside(m.clamps[k].lower_dof) && inside(m.clamps[k].upper_dof); }, s.window_clamps.data());
 }
 
 bool in_windows(const std::vector<Wire>& wires, const std::vector<WireWindow>& windows, int dof) {

@@ -62,8 +62,8 @@ void shift_endless_block(const Model& model, State& state);
 // before `to`'s window changes); the last ones return to the static state (rest(wire, its window))
 // with their window empty until the window is placed again.
 template <class Take, class Rest>
-void hand_over_stitch_wires(const Model& m, std::vector<WireWindow>& windows, Take&& take, Rest&& rest) {
-  const std::vector<int>& stitch = m.sections.front().stitch_wires;
+void hand_over_clamped_wires(const Model& m, std::vector<WireWindow>& windows, Take&& take, Rest&& rest) {
+  const std::vector<int>& stitch = m.sections.front().clamped_wires;
   const std::size_t spans = static_cast<std::size_t>(m.endless_shift_spans);
   for (std::size_t j = 0; j < stitch.size(); ++j) {
     WireWindow& ww = windows[stitch[j]];
@@ -99,8 +99,8 @@ void for_each_point(const Model& m, const State& s, bool windowed, Fn&& fn) {
     }
     for (int j = 0; j < s.window_clamp_count; ++j) {
       const WireClamp& c = m.clamps[s.window_clamps[j]];
-      fn(c.stitch_dof);
-      fn(c.messenger_dof);
+      fn(c.lower_dof);
+      fn(c.upper_dof);
     }
   } else {
     for (const SupportSpring& sp : m.springs) fn(sp.dof);
@@ -109,8 +109,8 @@ void for_each_point(const Model& m, const State& s, bool windowed, Fn&& fn) {
       fn(d.messenger_dof);
     }
     for (const WireClamp& c : m.clamps) {
-      fn(c.stitch_dof);
-      fn(c.messenger_dof);
+      fn(c.lower_dof);
+      fn(c.upper_dof);
     }
   }
 }

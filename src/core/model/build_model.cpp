@@ -127,7 +127,7 @@ void add_clamped_wire(const std::string& name, int section, const WireSpec& spec
   Wire w;
   w.name = name;
   w.section = section;
-  w.is_stitch_wire = true;  // (a bridle too: a short wire between two clamps, which the window and the packs take alike)
+  w.is_clamped_wire = true;  // (a bridle too: a short wire between two clamps, which the window and the packs take alike)
   w.is_bridle = middle.has_value();
   w.spec = spec;
   w.x.assign(x.begin() + lo, x.begin() + hi + 1);
@@ -139,7 +139,7 @@ void add_clamped_wire(const std::string& name, int section, const WireSpec& spec
     dof += w.nodes();
   }
   assemble_band(w, {});
-  info.stitch_wires.push_back(static_cast<int>(m.wires.size()));
+  info.clamped_wires.push_back(static_cast<int>(m.wires.size()));
   m.wires.push_back(std::move(w));
 }
 
@@ -313,7 +313,7 @@ std::vector<bool> lump_masses(const Scene& scene, Model& m) {
 // The wire a dropper at station xd hangs from: the stitch wire whose clamps it lies strictly
 // between, else the messenger; and its node there.
 std::pair<const Wire*, int> dropper_top(const Model& m, const Section& info, double xd) {
-  for (int wi : info.stitch_wires) {
+  for (int wi : info.clamped_wires) {
     const Wire& w = m.wires[wi];
     if (xd > w.x.front() + 1e-9 && xd < w.x.back() - 1e-9) return {&w, node_at(w.x, xd)};
   }
@@ -332,15 +332,15 @@ void clamp_short_wires(const Scene& scene, Model& m) {
     const bool bridle = sec.bridle.has_value();  // (never both: a stitch wire needs a messenger, a bridle refuses one)
     const Wire& other = m.wires[bridle ? info.wires.front() : info.messenger];  // (a bridle's: the one contact wire)
     const double clamp_mass = bridle ? sec.bridle->clamp_mass : sec.stitch_wire->clamp_mass;
-    for (int wi : info.stitch_wires) {
+    for (int wi : info.clamped_wires) {
       const Wire& w = m.wires[wi];
       for (int end : {0, w.nodes() - 1}) {
         WireClamp c;
         c.x = w.x[end];
         const int own = w.w_dof + end, held = other.w_dof + node_at(other.x, c.x);
-        c.messenger_dof = bridle ? own : held;  // the upper node
-        c.stitch_dof = bridle ? held : own;     // the lower node
-        c.stiffness = kStitchClampStiffness;
+        c.upper_dof = bridle ? own : held;  // the upper node
+        c.lower_dof = bridle ? held : own;     // the lower node
+        c.stiffness = kWireClampStiffness;
         m.mass[own] += clamp_mass;
         m.clamps.push_back(c);
       }
@@ -542,7 +542,7 @@ void mark_springs_at_middle(const NumericsSpec& num, Model& m) {
   m.dropper_at_middle.assign(m.droppers.size(), 0);
   for (std::size_t k = 0; k < m.droppers.size(); ++k) m.dropper_at_middle[k] = take(m.droppers[k].messenger_dof, m.droppers[k].contact_dof);
   m.clamp_at_middle.assign(m.clamps.size(), 0);
-  for (std::size_t k = 0; k < m.clamps.size(); ++k) m.clamp_at_middle[k] = take(m.clamps[k].messenger_dof, m.clamps[k].stitch_dof);
+  for (std::size_t k = 0; k < m.clamps.size(); ++k) m.clamp_at_middle[k] = take(m.clamps[k].upper_dof, m.clamps[k].lower_dof);
 }
 
 // The explicit stability limit (validation.md section 5) and the step, or the implicit matrix.

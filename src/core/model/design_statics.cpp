@@ -24,13 +24,13 @@ const Wire& wire_of(const Model& m, int dof) { return m.wires[wire_holding(m, do
 // working height, the other end above by what its arms' loads differ (the clamp then a short
 // link). Its reaction at the middle is the support's preload (design_statics).
 void bridle_statics(const Scene& scene, const Section& info, Model& m, std::vector<std::vector<double>>& react) {
-  for (int wi : info.stitch_wires) {
+  for (int wi : info.clamped_wires) {
     Wire& w = m.wires[wi];
     const int n = w.nodes();
     std::vector<double> load(n);
     for (int i = 0; i < n; ++i) load[i] = -scene.gravity * m.mass[w.w_dof + i];
     for (const WireClamp& c : m.clamps)
-      if (holds(w, c.messenger_dof)) load[c.messenger_dof - w.w_dof] -= c.static_force;
+      if (holds(w, c.upper_dof)) load[c.upper_dof - w.w_dof] -= c.static_force;
     const double H = scene.contact_wire_height;
     solve_wire_statics(w, load, {w.support_nodes.front()}, {H}, w.height, w.slope, react[wi]);
     // (A rigid rise: the band has no force from it, the reaction stays.)
@@ -59,7 +59,7 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
     if (m.droppers[k].section == static_cast<int>(si)) mine.push_back(k);
   // (A stitch wire's clamps take the messenger's heights of the pass before: two more passes.)
   // (as do a compound line's auxiliary messenger's dropper heights)
-  const int passes = mine.empty() ? 1 : info.stitch_wires.empty() && info.auxiliary < 0 ? 4 : 6;
+  const int passes = mine.empty() ? 1 : info.clamped_wires.empty() && info.auxiliary < 0 ? 4 : 6;
   std::vector<SpdSolver> solver(m.wires.size());  // per wire: its pattern is the same every pass
   for (int pass = 0; pass < passes; ++pass) {
     for (int wi : info.wires) {
@@ -80,9 +80,9 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
       const std::size_t first_clamp = pn.size();
       if (sec.bridle)
         for (WireClamp& c : m.clamps)
-          if (holds(w, c.stitch_dof)) {
+          if (holds(w, c.lower_dof)) {
             clamps.push_back(&c);
-            pn.push_back(c.stitch_dof - w.w_dof);
+            pn.push_back(c.lower_dof - w.w_dof);
             ph.push_back(H);
           }
       for (std::size_t k : mine) {
@@ -136,7 +136,7 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
     }
     // The stitch wires: each under its weight and its droppers' tensions, held at its clamps at
     // the messenger's heights there (the last pass's; level at the encumbrance on the first).
-    for (int wi : info.stitch_wires) {
+    for (int wi : info.clamped_wires) {
       Wire& w = m.wires[wi];
       const int n = w.nodes();
       std::vector<double> load(n);
@@ -147,10 +147,10 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
       const std::vector<int> pn{0, n - 1};
       std::vector<double> ph(2, H + scene.encumbrance);
       for (const WireClamp& c : m.clamps)
-        if (holds(w, c.stitch_dof) && !mwm.height.empty()) ph[c.stitch_dof == w.w_dof ? 0 : 1] = mwm.height[c.messenger_dof - mwm.w_dof];
+        if (holds(w, c.lower_dof) && !mwm.height.empty()) ph[c.lower_dof == w.w_dof ? 0 : 1] = mwm.height[c.upper_dof - mwm.w_dof];
       solve_wire_statics(w, load, pn, ph, w.height, w.slope, react[wi], &solver[wi]);
       for (WireClamp& c : m.clamps)
-        if (holds(w, c.stitch_dof)) c.static_force = react[wi][c.stitch_dof == w.w_dof ? 0 : 1];
+        if (holds(w, c.lower_dof)) c.static_force = react[wi][c.lower_dof == w.w_dof ? 0 : 1];
     }
     const int n = mwm.nodes();
     std::vector<double> mload(n);
@@ -160,7 +160,7 @@ void section_statics(const Scene& scene, std::size_t si, const std::vector<std::
       if (holds(mwm, d.messenger_dof)) mload[d.messenger_dof - mwm.w_dof] -= d.static_tension + 0.5 * g * mu_of(k) * weight_len[k];
     }
     for (const WireClamp& c : m.clamps)
-      if (holds(mwm, c.messenger_dof)) mload[c.messenger_dof - mwm.w_dof] -= c.static_force;
+      if (holds(mwm, c.upper_dof)) mload[c.upper_dof - mwm.w_dof] -= c.static_force;
     std::vector<int> mpn(mwm.support_nodes.begin(), mwm.support_nodes.end());
     std::vector<double> mph(mpn.size(), H + scene.encumbrance);
     solve_wire_statics(mwm, mload, mpn, mph, mwm.height, mwm.slope, react[info.messenger], &solver[info.messenger]);
@@ -189,7 +189,7 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
       const Wire& top = wire_of(m, d.messenger_dof);
       const bool holds_auxiliary = wire_of(m, d.contact_dof).is_auxiliary_messenger;
       const std::string low = holds_auxiliary ? "auxiliary messenger" : "contact wire";
-      const std::string top_name = top.is_stitch_wire ? "stitch wire" : top.is_auxiliary_messenger ? "auxiliary messenger" : "messenger";
+      const std::string top_name = top.is_clamped_wire ? "stitch wire" : top.is_auxiliary_messenger ? "auxiliary messenger" : "messenger";
       throw SceneError(part + "s: at x = " + fmt(d.x) + " m the " + top_name + " hangs " + fmt(-d.length) + " m below the " + low +
                        " (" + part + " length " + fmt(d.length) + " m): raise " +
                        (d.hanger ? "auxiliary_messenger.height or its tension" : "line.encumbrance or the " + top_name + "'s tension") +
@@ -212,7 +212,7 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
                        " m) above the contact wire there, it must bend down more than its hangers' loads bend it; hang the "
                        "contact wire from hangers nearer each dropper (hangers.positions), or reduce contact_wire.presag (" +
                        fmt(sec.contact_wire.presag) + " m)");
-    if (d.static_tension <= 0.0 && wire_of(m, d.messenger_dof).is_stitch_wire)
+    if (d.static_tension <= 0.0 && wire_of(m, d.messenger_dof).is_clamped_wire)
       throw SceneError("droppers: at x = " + fmt(d.x) + " m the dropper would have to push (static force " +
                        fmt(d.static_tension) + " N): the stitch wire it hangs from sags too far at stitch_wire.tension " +
                        fmt(sec.stitch_wire->tension) + " N; raise it, or reduce contact_wire.presag (" +

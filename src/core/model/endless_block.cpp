@@ -111,7 +111,7 @@ void check_endless_block(Model& m) {
   const int margin = endless_margin(m.scene);
   const Wire* last_stitch = nullptr;
   for (const Wire& w : m.wires) {
-    if (w.is_stitch_wire) {
+    if (w.is_clamped_wire) {
       // One at every intermediate support of the block: the move hands each one's state to the
       // one a span behind (shift_endless_block), so each must be the one before it a span on.
       const Wire* prev = last_stitch;

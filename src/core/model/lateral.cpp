@@ -356,7 +356,7 @@ void add_pendulums(const Model& m, LateralModel* lat) {
 void add_clamps(const Model& m, LateralModel* lat) {
   for (const WireClamp& c : m.clamps)
     lat->clamps.push_back(
-        LateralClamp{lateral_dof_of(m, *lat, c.messenger_dof), lateral_dof_of(m, *lat, c.stitch_dof), c.stiffness});
+        LateralClamp{lateral_dof_of(m, *lat, c.upper_dof), lateral_dof_of(m, *lat, c.lower_dof), c.stiffness});
 }
 
 // Wind: the normal component of the mean wind on each node's wire, following the track's heading,
@@ -374,7 +374,7 @@ void add_wind(const Model& m, const WindSpec& ws, LateralModel* lat) {
     const Wire& w = m.wires[wi];
     const WireDragSpec& d = sc.sections[w.section].rigid ? ws.conductor_rail
                             : w.is_contact_wire          ? ws.contact_wire
-                            : w.is_stitch_wire           ? ws.stitch_wire
+                            : w.is_clamped_wire          ? ws.stitch_wire
                             : w.is_auxiliary_messenger   ? ws.auxiliary_messenger
                                                          : ws.messenger;
     const int nn = w.nodes();

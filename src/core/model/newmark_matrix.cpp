@@ -20,7 +20,7 @@ std::shared_ptr<const ImplicitMatrix> newmark_matrix(const Model& m, double dt) 
   for (const Wire& w : m.wires) add_wire_band(k, w, w.w_dof, w.theta_dof);
   for (const SupportSpring& sp : m.springs) k.emplace_back(sp.dof, sp.dof, sp.stiffness);
   for (const Dropper& d : m.droppers) add_spring(k, unused, d.messenger_dof, d.contact_dof, d.stiffness, 0.0);
-  for (const WireClamp& cl : m.clamps) add_spring(k, unused, cl.messenger_dof, cl.stitch_dof, cl.stiffness, 0.0);
+  for (const WireClamp& cl : m.clamps) add_spring(k, unused, cl.upper_dof, cl.lower_dof, cl.stiffness, 0.0);
   // Rayleigh damping of the catenary (eq. 5) is beta K0 + alpha M.
   for (const auto& e : k) c.emplace_back(e.row(), e.col(), m.beta * e.value());
   for (int i = 0; i < m.n_catenary_dof; ++i) c.emplace_back(i, i, m.alpha * m.mass[i]);

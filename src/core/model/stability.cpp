@@ -67,7 +67,7 @@ void compute_stability_limit(Model& m) {
       for (int dof : {d.contact_dof, d.messenger_dof})
         if (m.mass[dof] > 0.0) limit_by(d.stiffness, m.beta * d.stiffness, m.mass[dof]);
     for (const WireClamp& c : m.clamps)
-      for (int dof : {c.stitch_dof, c.messenger_dof})
+      for (int dof : {c.lower_dof, c.upper_dof})
         if (m.mass[dof] > 0.0) limit_by(c.stiffness, m.beta * c.stiffness, m.mass[dof]);
   }
   for (const Pantograph& p : m.pantographs) {

@@ -97,7 +97,7 @@ void add_line(const Model& m, const StaticUnknowns& q, const ActiveSet& active, 
     const Dropper& d = m.droppers[k];
     if (active.dropper_on[k]) add_spring(sys.t, sys.r, d.messenger_dof, d.contact_dof, d.stiffness, -d.static_tension);
   }
-  for (const WireClamp& c : m.clamps) add_spring(sys.t, sys.r, c.messenger_dof, c.stitch_dof, c.stiffness, -c.static_force);
+  for (const WireClamp& c : m.clamps) add_spring(sys.t, sys.r, c.upper_dof, c.lower_dof, c.stiffness, -c.static_force);
 }
 
 // A lumped pantograph's frame (eq. 9 at rest): the springs between its masses with their

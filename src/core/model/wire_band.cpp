@@ -166,9 +166,9 @@ void apply_stiffness(const Model& m, double front, const double* x, double* y, d
   for (std::size_t k = 0; k < m.clamps.size(); ++k) {
     if (skip_clamps && m.clamp_at_middle[k]) continue;
     const WireClamp& c = m.clamps[k];
-    const double t = c.stiffness * (x[c.messenger_dof] - x[c.stitch_dof]);
-    y[c.stitch_dof] += t;
-    y[c.messenger_dof] -= t;
+    const double t = c.stiffness * (x[c.upper_dof] - x[c.lower_dof]);
+    y[c.lower_dof] += t;
+    y[c.upper_dof] -= t;
   }
   std::vector<int> node(m.max_contact_nodes);
   std::vector<double> weight(m.max_contact_nodes);

@@ -30,7 +30,7 @@ std::shared_ptr<WirePacks> build_wire_packs(const Model& m) {
     // sweeps read no station), so the short wires around the supports do not run a lane idle.
     auto partners = [&](const Wire& wa, const Wire& wb) {
       if (wb.x == wa.x) return true;
-      return !m.scene.numerics.windowed() && wa.is_stitch_wire && wb.is_stitch_wire && wa.nodes() == wb.nodes();
+      return !m.scene.numerics.windowed() && wa.is_clamped_wire && wb.is_clamped_wire && wa.nodes() == wb.nodes();
     };
     for (std::size_t b = a + 1; b < m.wires.size() && p.lanes == 1; ++b)
       if (pk.wire_pack[b] < 0 && partners(m.wires[a], m.wires[b])) {

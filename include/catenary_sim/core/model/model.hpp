@@ -28,8 +28,9 @@ struct Wire {
   std::string name;
   int section = 0;               // tension section it belongs to
   bool is_contact_wire = false;
-  bool is_stitch_wire = false;   // a stitch wire (StitchWireSpec): no supports, clamped to the messenger;
-                                 // or a bridle (BridleSpec, is_bridle): held at its middle, clamped to the contact wire
+  bool is_clamped_wire = false;  // a short wire between two clamps: a stitch wire (StitchWireSpec), no supports,
+                                 // clamped to the messenger; or a bridle (BridleSpec, is_bridle), held at its
+                                 // middle, clamped to the contact wire
   bool is_bridle = false;        // a trolley wire's bridle; support_nodes: its middle, where the support holds it
   bool is_auxiliary_messenger = false;  // a compound line's (AuxiliaryMessengerSpec): held at its anchors only
   WireSpec spec;
@@ -65,11 +66,11 @@ struct Dropper {
 };
 
 // A clamp joining two wires' nodes: a stitch wire's end hung from the messenger, or a trolley wire
-// hung from a bridle's end (messenger_dof then the bridle's end, stitch_dof the contact wire's
-// node). A bilateral spring, stiff beside the line's own compliance (kStitchClampStiffness),
-// carrying the short wire's end reaction in the design state.
+// hung from a bridle's end (upper_dof then the bridle's end, lower_dof the contact wire's node).
+// A bilateral spring, stiff beside the line's own compliance (kWireClampStiffness), carrying the
+// short wire's end reaction in the design state.
 struct WireClamp {
-  int messenger_dof = 0, stitch_dof = 0;  // the upper wire's node, the lower wire's node
+  int upper_dof = 0, lower_dof = 0;  // the upper wire's node, the lower wire's node
   double stiffness = 0.0;     // N/m
   double static_force = 0.0;  // N: pulls the lower node up and the upper one down at u = 0
   double x = 0.0;             // m
@@ -78,7 +79,7 @@ struct WireClamp {
 // the line (the reference stitched line's elasticity is within 0.03 % of 1e8 N/m clamps'). Its
 // frequency on the clamp's node masses stays below the wires' highest, so the line keeps its dt
 // (1e6 N/m would set a smaller one through the half-step's beta K).
-constexpr double kStitchClampStiffness = 2e5;
+constexpr double kWireClampStiffness = 2e5;
 
 // An elastic support: steady arm on the contact wire (eq. 4) or messenger support spring.
 // m, a hinged arm's end's travel out, away from its hinge, with the end raised by u: a (cos(theta)
@@ -132,7 +133,7 @@ struct Section {
   double rise_first = 0.0, rise_last = 0.0;  // m, at its first and last support
   std::vector<int> wires;              // indices into Model::wires: contact wire(s), messenger
   int messenger = -1;                  // index into Model::wires, -1 without a messenger
-  std::vector<int> stitch_wires;       // indices into Model::wires, one per intermediate support (or bridles)
+  std::vector<int> clamped_wires;      // its stitch wires or bridles (Wire::is_clamped_wire), one per intermediate support
   int auxiliary = -1;                  // index into Model::wires of a compound line's auxiliary messenger
 };
 
