@@ -29,8 +29,8 @@ using test_stepping::run_to_end;
 // The same model with every dropper and clamp at q_n (the supports as they were).
 Model links_at_qn(const Model& m) {
   Model e = m;
-  e.dropper_at_middle.clear();
-  e.clamp_at_middle.clear();
+  e.dropper_at_middle.assign(e.droppers.size(), 0);
+  e.clamp_at_middle.assign(e.clamps.size(), 0);
   return e;
 }
 
@@ -245,7 +245,7 @@ TEST(DroppersAtMiddle, TheStitchWiresClampsGoToTheMiddleToo) {
   ASSERT_FALSE(mid.clamps.empty());
   EXPECT_EQ(std::count(mid.clamp_at_middle.begin(), mid.clamp_at_middle.end(), 1), static_cast<long>(mid.clamps.size()));
   Model clamps_at_qn = mid;
-  clamps_at_qn.clamp_at_middle.clear();
+  clamps_at_qn.clamp_at_middle.assign(mid.clamps.size(), 0);
   const double limit = critical_time_step(highest_eigenfrequency(clamps_at_qn, 3000, true), mid.alpha, mid.beta);
   EXPECT_GT(mid.dt, 1.5 * limit) << "dt " << mid.dt << " s; the clamps at q_n allow " << limit << " s";
   EXPECT_EQ(run_from_static(mid, 100000), StepStatus::kFinished);

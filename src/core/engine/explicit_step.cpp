@@ -110,13 +110,9 @@ int list_contact_nodes(const Model& m, State& s, bool windowed) {
 // No node carries two such corrections (mark_springs_at_middle), so each is closed and the order
 // does not matter. Writes the droppers' tensions to State::dropper_tension; returns the highest
 // corrected DOF beyond the divergence limit (also NaN), or -1.
-// Whether the step takes links at its middle: droppers or clamps (a line may have clamps and no
-// droppers, a trolley wire's bridles).
-bool links_at_middle(const Model& m) { return !m.dropper_at_middle.empty() || !m.clamp_at_middle.empty(); }
-
 int springs_at_middle(const Model& m, State& s, bool windowed, const double* u, const double* v, double* un, double* vn,
                       double* acc) {
-  const bool supports = !m.support_at_middle.empty(), links = links_at_middle(m);
+  const bool supports = m.takes_supports_at_middle, links = m.takes_links_at_middle;
   if (!supports && !links) return -1;
   const double dt = m.dt, beta = m.beta, limit = m.scene.numerics.divergence_limit;
   const double* im = m.inv_mass.data();
@@ -282,7 +278,7 @@ StepStatus generic_step(const Model& m, State& s, bool windowed) {
     update(0, n);
   }
   // The springs' corrected nodes moved: the last DOF beyond the limit among the final values.
-  const bool middle = !m.support_at_middle.empty() || links_at_middle(m);
+  const bool middle = m.takes_supports_at_middle || m.takes_links_at_middle;
   if (springs_at_middle(m, s, windowed, u, v, u_new, v_new, acc) >= 0 || (bad >= 0 && middle))
     bad = last_beyond(m, s, windowed, u_new);
   if (bad >= 0) return diverged(s, bad, u_new);

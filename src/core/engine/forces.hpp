@@ -49,7 +49,7 @@ void add_wire_point_forces(const Model& m, State& s, const double* u, const doub
                            bool given_slack) {
   const double* lean = kLean ? s.lateral.dropper_stretch.data() : nullptr;
   // Droppers at the step's middle (numerics.droppers implicit) act after the update (explicit_step.cpp).
-  const std::uint8_t* at_middle = m.dropper_at_middle.empty() ? nullptr : m.dropper_at_middle.data();
+  const std::uint8_t* at_middle = m.takes_links_at_middle ? m.dropper_at_middle.data() : nullptr;
   auto dropper = [&](std::size_t k) {
     if (at_middle && at_middle[k]) return;
     // Droppers work only in tension; the switch is decided on the elastic stretch.
@@ -77,7 +77,7 @@ void add_wire_point_forces(const Model& m, State& s, const double* u, const doub
     f(d.messenger_dof) -= t;
   };
   // Stitch wires' clamps: bilateral, never slack (at the step's middle, explicit_step.cpp).
-  const std::uint8_t* clamp_middle = m.clamp_at_middle.empty() ? nullptr : m.clamp_at_middle.data();
+  const std::uint8_t* clamp_middle = m.takes_links_at_middle ? m.clamp_at_middle.data() : nullptr;
   auto clamp = [&](std::size_t k) {
     if (clamp_middle && clamp_middle[k]) return;
     const WireClamp& c = m.clamps[k];

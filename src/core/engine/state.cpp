@@ -75,7 +75,7 @@ State make_state(const Model& m) {
   s.contact_force.assign(m.collectors.size() * m.contact_wires.size(), 0.0);
   s.collector_height.assign(m.collectors.size() * m.contact_wires.size(), 0.0);
   s.dropper_slack.assign(m.droppers.size(), 0);
-  if (!m.dropper_at_middle.empty()) s.dropper_tension.assign(m.droppers.size(), std::nan(""));
+  if (m.takes_links_at_middle) s.dropper_tension.assign(m.droppers.size(), std::nan(""));
   s.window.resize(m.wires.size());
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     s.window[wi].tt_lower.assign(m.wires[wi].nodes(), 0.0);

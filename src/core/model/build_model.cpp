@@ -524,13 +524,15 @@ void set_train_travel(const Scene& scene, double endless_front, Model& m) {
 // q_n and the stability limit keeps them.
 void mark_springs_at_middle(const NumericsSpec& num, Model& m) {
   std::vector<int> count(m.n_dof, 0);
-  if (num.supports == SpringStep::kImplicit) {
+  m.takes_supports_at_middle = num.supports == SpringStep::kImplicit;
+  m.takes_links_at_middle = num.droppers == SpringStep::kImplicit;
+  if (m.takes_supports_at_middle) {
     for (const SupportSpring& sp : m.springs) ++count[sp.dof];
     m.support_at_middle.assign(m.springs.size(), 0);
     for (std::size_t k = 0; k < m.springs.size(); ++k)
       m.support_at_middle[k] = m.inv_mass[m.springs[k].dof] > 0.0 && count[m.springs[k].dof] == 1;
   }
-  if (num.droppers != SpringStep::kImplicit) return;  // (refused on a 3-D line: validate_scene.cpp)
+  if (!m.takes_links_at_middle) return;  // (refused on a 3-D line: validate_scene.cpp)
   std::vector<std::uint8_t> held(m.n_dof, 0);  // a node whose update another middle correction redoes
   for (std::size_t k = 0; k < m.support_at_middle.size(); ++k)
     if (m.support_at_middle[k]) held[m.springs[k].dof] = 1;

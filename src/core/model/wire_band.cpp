@@ -149,8 +149,8 @@ void wire_elastic_force(const Wire& wire, const double* z, double* f, double* th
 void apply_stiffness(const Model& m, double front, const double* x, double* y, double* scratch, bool explicit_part) {
   std::fill(y, y + m.n_dof, 0.0);
   for (const Wire& w : m.wires) wire_elastic_force(w, x, y, scratch);  // y = -K x so far
-  const bool skip_supports = explicit_part && !m.support_at_middle.empty();
-  const bool skip_droppers = explicit_part && !m.dropper_at_middle.empty();
+  const bool skip_supports = explicit_part && m.takes_supports_at_middle;
+  const bool skip_droppers = explicit_part && m.takes_links_at_middle;
   for (std::size_t k = 0; k < m.springs.size(); ++k) {
     const SupportSpring& s = m.springs[k];
     if (!(skip_supports && m.support_at_middle[k])) y[s.dof] -= s.stiffness * x[s.dof];
@@ -162,7 +162,7 @@ void apply_stiffness(const Model& m, double front, const double* x, double* y, d
     y[d.contact_dof] += t;
     y[d.messenger_dof] -= t;
   }
-  const bool skip_clamps = explicit_part && !m.clamp_at_middle.empty();
+  const bool skip_clamps = explicit_part && m.takes_links_at_middle;
   for (std::size_t k = 0; k < m.clamps.size(); ++k) {
     if (skip_clamps && m.clamp_at_middle[k]) continue;
     const WireClamp& c = m.clamps[k];

@@ -198,9 +198,11 @@ struct Model {
   double omega_max = 0.0;       // rad/s, highest eigenfrequency of the assembled system
   double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction (inf: implicit)
   double dt = 0.0;              // s, the step in use
-  // numerics.supports / numerics.droppers implicit: 1 for each support spring (springs), dropper
-  // (droppers) and stitch wire's clamp (clamps) the explicit step takes at its middle
-  // (explicit_step.cpp), 0 for those it takes at q_n; empty when all are at q_n.
+  // numerics.supports implicit: the explicit step takes support springs at its middle, and
+  // numerics.droppers implicit: links (droppers and clamps), each where its nodes allow
+  // (explicit_step.cpp). Then 1 for each support spring (springs), dropper (droppers) and clamp
+  // (clamps) it takes there, 0 for those it takes at q_n; otherwise the lists are empty.
+  bool takes_supports_at_middle = false, takes_links_at_middle = false;
   std::vector<std::uint8_t> support_at_middle, dropper_at_middle, clamp_at_middle;
   std::shared_ptr<const ImplicitMatrix> implicit;  // set when the integrator is implicit
   // Explicit with condensed rotations: the wires packed side by side for the fused step, their
