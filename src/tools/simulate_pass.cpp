@@ -364,10 +364,10 @@ void print_lateral(const Scene& scene, const Model& m, const LateralStatistics& 
   if (scene.wind && scene.wind->blow_off_limit)
     std::cout << "; " << exceeded << " of " << ls.spans.size() << " spans above the limit of " << *scene.wind->blow_off_limit << " m";
   // The registrations' pull-off: the still line's, and under the mean wind where there is one.
-  // (steady arms on a catenary, the suspension clamps on a rail)
+  // (steady arms on a catenary, the suspension clamps on a rail, a bridle's middle on a trolley wire)
   double pull = 0.0, pull_wind = 0.0;
   for (const LateralSupport& s : m.lateral->supports)
-    if (!s.anchor && m.wires[s.wire].is_contact_wire) {
+    if (!s.anchor && (m.wires[s.wire].is_contact_wire || m.wires[s.wire].is_bridle)) {
       pull = std::max(pull, std::fabs(s.pull_off));
       pull_wind = std::max(pull_wind, std::fabs(s.pull_off_wind));
     }

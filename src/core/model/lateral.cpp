@@ -2,6 +2,7 @@
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/stability.hpp"
 
+#include <Eigen/LU>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -265,6 +266,8 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
     }
     const int ns = static_cast<int>(w.support_nodes.size());
     for (int k = 0; k < ns; ++k) {
+      // Under bridles the contact wire passes its intermediate supports free: their clamps hold it.
+      if (w.is_contact_wire && sc.sections[w.section].bridle && k > 0 && k < ns - 1) continue;
       LateralSupport s;
       s.wire = static_cast<int>(wi);
       s.node = w.support_nodes[k];
@@ -275,16 +278,18 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
       // free, hung by its droppers), so that the hangers hang plumb and the droppers above take
       // any lean toward the messenger.
       const double apart = overlap.offset(s.line_support, w.section);
-      s.stagger = stagger_at(sc, w.is_contact_wire || w.is_auxiliary_messenger, s.line_support + support_offset) +
-                  (w.is_contact_wire ? stagger_error[s.line_support] : 0.0) +  // (no errors on an endless line)
+      // A bridle's middle starts at the contact wire's stagger there (register_bridles moves it).
+      const bool contact_side = w.is_contact_wire || w.is_bridle;
+      s.stagger = stagger_at(sc, contact_side || w.is_auxiliary_messenger, s.line_support + support_offset) +
+                  (contact_side ? stagger_error[s.line_support] : 0.0) +  // (no errors on an endless line)
                   apart;
       if (w.is_contact_wire && apart != 0.0 && !(std::fabs(s.stagger) < half_width))
         throw SceneError("scene field 'overlap.lateral_separation' = " + fmt(sc.overlap->lateral_separation) +
                          " m puts the contact wire of section " + std::to_string(w.section) + " at " + fmt(s.stagger) +
                          " m at the support at station " + fmt(s.x) + " m: keep it inside the pantograph head's working width, |y| < " +
                          fmt(half_width) + " m (pantograph_head.working_width / 2)");
-      s.anchor = k == 0 || k == ns - 1;
-      const std::optional<double>& spring = w.is_contact_wire ? arm_k : msup_k;
+      s.anchor = !w.is_bridle && (k == 0 || k == ns - 1);  // (a bridle's one support: its middle)
+      const std::optional<double>& spring = contact_side ? arm_k : msup_k;
       s.rigid = s.anchor || !spring;
       const int a = l.w_dof + s.node;
       if (s.rigid) {
@@ -374,6 +379,7 @@ void add_wind(const Model& m, const WindSpec& ws, LateralModel* lat) {
     const Wire& w = m.wires[wi];
     const WireDragSpec& d = sc.sections[w.section].rigid ? ws.conductor_rail
                             : w.is_contact_wire          ? ws.contact_wire
+                            : w.is_bridle                ? ws.bridle
                             : w.is_clamped_wire          ? ws.stitch_wire
                             : w.is_auxiliary_messenger   ? ws.auxiliary_messenger
                                                          : ws.messenger;
@@ -561,12 +567,117 @@ void add_stiffness(const Model& m, const LateralModel& lat, Add&& add) {
   }
 }
 
+// The lateral statics of one or more load cases at once, one factorisation: loads F (2n rows, the
+// rotations' 0) and the rigid nodes' values `fixed_value` (n rows; `fixed` per lateral DOF), a
+// column per case. The full system has the rotations as unknowns: y_i at i, theta_i at n + i. Rigid
+// nodes are eliminated (their rows become y_i = their value); `full` (optional) receives the
+// unconstrained matrix, which gives the reactions.
+Eigen::MatrixXd solve_lateral_cases(const Model& m, const LateralModel& lat, const std::vector<bool>& fixed,
+                                    const Eigen::MatrixXd& F, const Eigen::MatrixXd& fixed_value,
+                                    Eigen::SparseMatrix<double>* full_matrix) {
+  const int n = lat.n, N = 2 * n, cases = static_cast<int>(F.cols());
+  std::vector<Eigen::Triplet<double>> full, reduced;
+  Eigen::MatrixXd Fr = F;
+  auto add = [&](int i, int j, double v) {
+    full.emplace_back(i, j, v);
+    const bool fi = i < n && fixed[i], fj = j < n && fixed[j];
+    if (fi) return;
+    if (fj)
+      for (int c = 0; c < cases; ++c) Fr(i, c) -= v * fixed_value(j, c);
+    else
+      reduced.emplace_back(i, j, v);
+  };
+  add_stiffness(m, lat, add);
+  for (int i = 0; i < n; ++i)
+    if (fixed[i]) {
+      reduced.emplace_back(i, i, 1.0);
+      Fr.row(i) = fixed_value.row(i);
+    }
+  Eigen::SparseMatrix<double> K(N, N);
+  K.setFromTriplets(reduced.begin(), reduced.end());
+  if (full_matrix) {
+    full_matrix->resize(N, N);
+    full_matrix->setFromTriplets(full.begin(), full.end());
+  }
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(K);
+  if (solver.info() != Eigen::Success)
+    throw SceneError("scene: the lateral statics has no solution: a wire is free to move sideways (check stagger.steady_arm_stiffness and stagger.messenger_support_stiffness)");
+  Eigen::MatrixXd x = solver.solve(Fr);
+  if (solver.info() != Eigen::Success || !x.allFinite())
+    throw SceneError("scene: the lateral statics has no solution (a wire free to move sideways)");
+  return x;
+}
+
+// Bridles in plan: the stagger is where the contact wire passes each support, where only the
+// bridle's clamps hold it, so the bridle's middle is registered beyond it, far enough that its
+// arms carry the wire's pull-off (T_b (b - y_c) / a at a clamp, a the arm, y_c the clamp's
+// position). The design in plan is linear in the registrations b: solved with them at 0, and for
+// each at 1 alone, in one factorisation, b is the one that puts the contact wire at its stagger at
+// every support.
+void register_bridles(const Model& m, LateralModel* lat) {
+  std::vector<int> held, at;  // per bridle: its support's index, the contact wire's lateral DOF there
+  std::vector<double> target;
+  for (std::size_t k = 0; k < lat->supports.size(); ++k) {
+    const LateralSupport& s = lat->supports[k];
+    const Wire& bridle = m.wires[s.wire];
+    if (!bridle.is_bridle) continue;
+    const int contact = m.sections[bridle.section].wires.front();  // (a bridle holds one contact wire)
+    const Wire& cw = m.wires[contact];
+    held.push_back(static_cast<int>(k));
+    const auto node = std::lower_bound(cw.x.begin(), cw.x.end(), s.x - 1e-9) - cw.x.begin();  // (a node: mesh_section)
+    at.push_back(lat->wires[contact].w_dof + static_cast<int>(node));
+    target.push_back(s.stagger);
+  }
+  const int nb = static_cast<int>(held.size());
+  if (nb == 0) return;
+  // Registers bridle j at b: its held node, or its spring's anchor (and the load it pulls with).
+  auto place = [&](int j, double b) {
+    LateralSupport& s = lat->supports[held[j]];
+    const int dof = lat->wires[s.wire].w_dof + s.node;
+    if (!s.rigid)
+      for (LateralSpring& sp : lat->springs)
+        if (sp.dof == dof) {
+          lat->load[dof] += sp.stiffness * (b - sp.anchor);
+          sp.anchor = b;
+        }
+    s.stagger = b;
+  };
+  for (int j = 0; j < nb; ++j) place(j, 0.0);
+  // Case 0: the line with every b at 0; case 1 + j: b_j = 1 alone, nothing else loaded or held off 0.
+  const int n = lat->n;
+  std::vector<bool> fixed(n, false);
+  Eigen::MatrixXd F = Eigen::MatrixXd::Zero(2 * n, nb + 1), value = Eigen::MatrixXd::Zero(n, nb + 1);
+  F.col(0).head(n) = lat->load;
+  for (const LateralSupport& s : lat->supports)
+    if (s.rigid) {
+      fixed[lat->wires[s.wire].w_dof + s.node] = true;
+      value(lat->wires[s.wire].w_dof + s.node, 0) = s.stagger;
+    }
+  for (int j = 0; j < nb; ++j) {
+    const LateralSupport& s = lat->supports[held[j]];
+    const int dof = lat->wires[s.wire].w_dof + s.node;
+    if (s.rigid) value(dof, 1 + j) = 1.0;
+    for (const LateralSpring& sp : lat->springs)
+      if (!s.rigid && sp.dof == dof) F(dof, 1 + j) = sp.stiffness;
+  }
+  const Eigen::MatrixXd y = solve_lateral_cases(m, *lat, fixed, F, value, nullptr);
+  Eigen::MatrixXd A(nb, nb);
+  Eigen::VectorXd r(nb);
+  for (int i = 0; i < nb; ++i) {
+    for (int j = 0; j < nb; ++j) A(i, j) = y(at[i], 1 + j);
+    r[i] = target[i] - y(at[i], 0);
+  }
+  const Eigen::VectorXd b = A.partialPivLu().solve(r);
+  if (!b.allFinite())
+    throw SceneError("bridle: no registration of the bridles' middles puts the contact wire at its stagger (the wire "
+                     "is not held across the track through their clamps); report this with the scene");
+  for (int j = 0; j < nb; ++j) place(j, b[j]);
+}
+
 }  // namespace
 
 void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wind, Eigen::VectorXd* y_out,
                            std::vector<double>* force_on_support, const std::vector<double>* registration_travel) {
-  // Full system with the rotations as unknowns: y_i at i, theta_i at n + i. Rigid nodes are
-  // eliminated (their rows become y_i = stagger); the unconstrained matrix gives the reactions.
   const int n = lat.n, N = 2 * n;
   Eigen::VectorXd F = Eigen::VectorXd::Zero(N), fixed_value = Eigen::VectorXd::Zero(n);
   std::vector<bool> fixed(n, false);
@@ -589,30 +700,8 @@ void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wi
       if (r.spring >= 0) F[r.dof] += lat.springs[r.spring].stiffness * travel;  // its anchor moved
       else fixed_value[r.dof] += travel;
     }
-  std::vector<Eigen::Triplet<double>> full, reduced;
-  Eigen::VectorXd Fr = F;
-  auto add = [&](int i, int j, double v) {
-    full.emplace_back(i, j, v);
-    const bool fi = i < n && fixed[i], fj = j < n && fixed[j];
-    if (fi) return;
-    if (fj) Fr[i] -= v * fixed_value[j];
-    else reduced.emplace_back(i, j, v);
-  };
-  add_stiffness(m, lat, add);
-  for (int i = 0; i < n; ++i)
-    if (fixed[i]) {
-      reduced.emplace_back(i, i, 1.0);
-      Fr[i] = fixed_value[i];
-    }
-  Eigen::SparseMatrix<double> K(N, N), Kf(N, N);
-  K.setFromTriplets(reduced.begin(), reduced.end());
-  Kf.setFromTriplets(full.begin(), full.end());
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(K);
-  if (solver.info() != Eigen::Success)
-    throw SceneError("scene: the lateral statics has no solution: a wire is free to move sideways (check stagger.steady_arm_stiffness and stagger.messenger_support_stiffness)");
-  const Eigen::VectorXd x = solver.solve(Fr);
-  if (solver.info() != Eigen::Success || !x.allFinite())
-    throw SceneError("scene: the lateral statics has no solution (a wire free to move sideways)");
+  Eigen::SparseMatrix<double> Kf;
+  const Eigen::VectorXd x = solve_lateral_cases(m, lat, fixed, F, fixed_value, force_on_support ? &Kf : nullptr).col(0);
   *y_out = x.head(n);
   if (force_on_support) support_forces(lat, F, Kf, x, force_on_support);
 }
@@ -723,6 +812,7 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   add_wires_and_supports(m, lat.get());
   add_pendulums(m, lat.get());
   add_clamps(m, lat.get());
+  register_bridles(m, lat.get());
   add_registrations(m, lat.get());
   if (sc.wind) add_wind(m, *sc.wind, lat.get());
   lat->windowed = sc.numerics.windowed() && (m.endless || lat->field.empty() || sc.numerics.gust_lead.has_value());

@@ -94,6 +94,7 @@ void read_wind(Reader& top, Scene& s) {
   drag("messenger", w.messenger);
   drag("stitch_wire", w.stitch_wire);
   drag("auxiliary_messenger", w.auxiliary_messenger);
+  drag("bridle", w.bridle);
   drag("conductor_rail", w.conductor_rail, "height", 0.5);
   if (r.has("turbulence")) {
     Reader q(r.child("turbulence"), "wind.turbulence");

@@ -140,6 +140,7 @@ void validate_acting_fields(const Scene& s) {
         if (kind == "contact_wire") return !sec.rigid;
         if (kind == "messenger") return sec.messenger.has_value();
         if (kind == "stitch_wire") return sec.stitch_wire.has_value();
+        if (kind == "bridle") return sec.bridle.has_value();
         return sec.auxiliary_messenger.has_value();
       });
     };
@@ -490,9 +491,6 @@ void validate_bridles(const Scene& s) {
     if (sec.steady_arms && sec.steady_arms->hinged_arm)
       fail(pre + "steady_arms", "(a hinged arm, with a bridle)",
            "a spring (stiffness, mass) or none: the support holds the bridle's middle, which a registration arm does not");
-    if (s.lateral())
-      fail(f, "(given on a 3-D line)",
-           "a 2-D line (no stagger, alignment, wind or pantograph_head.sway): the bridle's motion across the track is not modelled");
     // The contact wire is free at its supports, which hardly reflect its waves: they run the
     // section's length and back, and a window that holds only what is near the pantograph misses
     // them (measured in docs/trolley_wire.md, "What is not modelled").

@@ -460,6 +460,8 @@ struct WindSpec {
   // A compound line's auxiliary messenger (AuxiliaryMessengerSpec): 150 mm^2 stranded, 19 strands
   // of 3.17 mm, five strands across: 15.9 mm.
   WireDragSpec auxiliary_messenger{0.0159, 1.0};
+  // A trolley wire's bridle (BridleSpec): the stitch wire's Bz II 35 mm^2, 7.5 mm.
+  WireDragSpec bridle{0.0075, 1.0};
   // A rigid conductor rail's profile, the wind meeting its height (scene key `height`): the
   // 110 mm of the DSS and Sicat SR profiles (rigid_conductor_rail.yaml); Cd assumed, no measured
   // profile found: EN 1991-1-4 7.6 gives a sharp-cornered rectangle 2.0 for depth / height up to
