@@ -475,6 +475,14 @@ TEST(TrolleyWire, BridlesOnA3dLineRegisterTheWireAtItsStagger) {
     ++checked;
   }
   EXPECT_EQ(checked, n - 1);
+  // A lateral spring on the middles (stagger.steady_arm_stiffness) pulls each toward the same
+  // registration, as a steady arm's pulls the wire toward its stagger (then the wire gives way by
+  // its pull-off over the spring's stiffness): the registrations are the rigid design's.
+  const cs::Model sprung =
+      cs::build_model(cs::load_scene_string(trolley_yaml(n, ei, 2e4, 0.1, bridle_yaml() + stagger + "  steady_arm_stiffness: 5.0e4\n")));
+  ASSERT_EQ(sprung.lateral->supports.size(), lat.supports.size());
+  for (std::size_t k = 0; k < lat.supports.size(); ++k)
+    EXPECT_NEAR(sprung.lateral->supports[k].stagger, lat.supports[k].stagger, 1e-9) << "support " << k;
 }
 
 // Across the track the bridled wire is the same network as up and down: a lateral force on the
@@ -538,6 +546,11 @@ TEST(TrolleyWire, BridlesBadInputIsRefusedByName) {
   refused(y + "messenger:\n  linear_mass: 1.07\n  tension: 16000\n  bending_stiffness: 0\n", "bridle");
   refused(trolley_yaml(3, 109.0, 2e4, 0.25, "stagger:\n  contact_wire: [0.2, -0.2]\nwind:\n  speed: 10\n  bridle: {diameter: 0.0075}\n"),
           "wind.bridle");  // a drag block for a wire the line does not have
+  // A bridle too slack to carry the pull-off without its arms running far across the track.
+  // (found in the design in plan, when the model is built)
+  const std::string slack = test_scenes::refusal(
+      [&] { return cs::load_scene_string(with("tension: 1500", "tension: 300") + "stagger:\n  contact_wire: [0.2, -0.2]\n"); });
+  for (const char* word : {"bridle.tension", "at most 0.25"}) EXPECT_NE(slack.find(word), std::string::npos) << slack;
   refused(with("element_length: 0.25\n", "element_length: 0.25\n  window: auto\n"), "numerics.window");
   refused(with("steady_arms:\n  stiffness: 20000\n", "steady_arms:\n  length: 1.0\n  linear_mass: 1.0\n  pull_off: 200\n"),
           "steady_arms");

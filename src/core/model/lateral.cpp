@@ -611,9 +611,11 @@ Eigen::MatrixXd solve_lateral_cases(const Model& m, const LateralModel& lat, con
 // Bridles in plan: the stagger is where the contact wire passes each support, where only the
 // bridle's clamps hold it, so the bridle's middle is registered beyond it, far enough that its
 // arms carry the wire's pull-off (T_b (b - y_c) / a at a clamp, a the arm, y_c the clamp's
-// position). The design in plan is linear in the registrations b: solved with them at 0, and for
-// each at 1 alone, in one factorisation, b is the one that puts the contact wire at its stagger at
-// every support.
+// position). The design in plan holds the middles there rigidly, and is linear in the
+// registrations b: solved with them at 0, and for each at 1 alone, in one factorisation, b is the
+// one that puts the contact wire at its stagger at every support. A lateral spring
+// (stagger.steady_arm_stiffness) pulls the middle toward its registration, as a steady arm's pulls
+// the wire toward its stagger.
 void register_bridles(const Model& m, LateralModel* lat) {
   std::vector<int> held, at;  // per bridle: its support's index, the contact wire's lateral DOF there
   std::vector<double> target;
@@ -630,20 +632,8 @@ void register_bridles(const Model& m, LateralModel* lat) {
   }
   const int nb = static_cast<int>(held.size());
   if (nb == 0) return;
-  // Registers bridle j at b: its held node, or its spring's anchor (and the load it pulls with).
-  auto place = [&](int j, double b) {
-    LateralSupport& s = lat->supports[held[j]];
-    const int dof = lat->wires[s.wire].w_dof + s.node;
-    if (!s.rigid)
-      for (LateralSpring& sp : lat->springs)
-        if (sp.dof == dof) {
-          lat->load[dof] += sp.stiffness * (b - sp.anchor);
-          sp.anchor = b;
-        }
-    s.stagger = b;
-  };
-  for (int j = 0; j < nb; ++j) place(j, 0.0);
-  // Case 0: the line with every b at 0; case 1 + j: b_j = 1 alone, nothing else loaded or held off 0.
+  // Case 0: the line with every middle held at 0; case 1 + j: middle j at 1 alone, nothing else
+  // loaded or held off 0.
   const int n = lat->n;
   std::vector<bool> fixed(n, false);
   Eigen::MatrixXd F = Eigen::MatrixXd::Zero(2 * n, nb + 1), value = Eigen::MatrixXd::Zero(n, nb + 1);
@@ -653,12 +643,13 @@ void register_bridles(const Model& m, LateralModel* lat) {
       fixed[lat->wires[s.wire].w_dof + s.node] = true;
       value(lat->wires[s.wire].w_dof + s.node, 0) = s.stagger;
     }
+  std::vector<int> middle(nb);
   for (int j = 0; j < nb; ++j) {
     const LateralSupport& s = lat->supports[held[j]];
-    const int dof = lat->wires[s.wire].w_dof + s.node;
-    if (s.rigid) value(dof, 1 + j) = 1.0;
-    for (const LateralSpring& sp : lat->springs)
-      if (!s.rigid && sp.dof == dof) F(dof, 1 + j) = sp.stiffness;
+    middle[j] = lat->wires[s.wire].w_dof + s.node;
+    fixed[middle[j]] = true;
+    value(middle[j], 0) = 0.0;
+    value(middle[j], 1 + j) = 1.0;
   }
   const Eigen::MatrixXd y = solve_lateral_cases(m, *lat, fixed, F, value, nullptr);
   Eigen::MatrixXd A(nb, nb);
@@ -671,7 +662,34 @@ void register_bridles(const Model& m, LateralModel* lat) {
   if (!b.allFinite())
     throw SceneError("bridle: no registration of the bridles' middles puts the contact wire at its stagger (the wire "
                      "is not held across the track through their clamps); report this with the scene");
-  for (int j = 0; j < nb; ++j) place(j, b[j]);
+  // The lateral model takes small angles: an arm running across the track at more than 1 in 4
+  // would pull more than 3 % off its tension's true share (tan against sin).
+  const Eigen::VectorXd plan = y.col(0) + y.rightCols(nb) * b;
+  for (int j = 0; j < nb; ++j) {
+    const LateralSupport& s = lat->supports[held[j]];
+    const Wire& w = lat->wires[s.wire];
+    double slope = 0.0;
+    for (int end : {0, w.nodes() - 1})
+      slope = std::max(slope, std::fabs(plan[w.w_dof + end] - b[j]) / std::fabs(w.x[end] - s.x));
+    if (!(slope <= 0.25)) {
+      const int sec = m.wires[s.wire].section;
+      const std::string field = (m.scene.sections.size() > 1 ? "sections[" + std::to_string(sec) + "]." : std::string()) + "bridle";
+      throw SceneError("scene field '" + field + ".tension' = " + fmt(m.scene.sections[sec].bridle->tension) +
+                       " N: to carry the contact wire's pull-off at the support at station " + fmt(s.x) +
+                       " m the bridle's arms would run across the track at a slope of " + fmt(slope) + " (its middle " +
+                       fmt(std::fabs(b[j] - target[j])) + " m beyond the stagger); at most 0.25, the lateral model's small "
+                       "angles: raise " + field + ".tension, or lessen the stagger or the curve the wire turns by there");
+    }
+  }
+  for (int j = 0; j < nb; ++j) {
+    LateralSupport& s = lat->supports[held[j]];
+    for (LateralSpring& sp : lat->springs)
+      if (sp.dof == middle[j]) {
+        lat->load[middle[j]] += sp.stiffness * (b[j] - sp.anchor);
+        sp.anchor = b[j];
+      }
+    s.stagger = b[j];
+  }
 }
 
 }  // namespace
