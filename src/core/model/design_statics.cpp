@@ -36,6 +36,20 @@ void bridle_statics(const Scene& scene, const Section& info, Model& m, std::vect
     // (A rigid rise: the band has no force from it, the reaction stays.)
     const double rise = H - std::min(w.height.front(), w.height.back());
     for (double& y : w.height) y += rise;
+    // The wires are beams in small deflections: an arm whose V is steeper than 1 in 4 would pull
+    // more than 3 % off its tension's true share (tan against sin), as in plan (lateral.cpp).
+    const int mid = w.support_nodes.front();
+    for (int end : {0, n - 1}) {
+      const double slope = std::fabs(w.height[mid] - w.height[end]) / std::fabs(w.x[end] - w.x[mid]);
+      if (!(slope <= 0.25)) {
+        const std::string field =
+            (scene.sections.size() > 1 ? "sections[" + std::to_string(w.section) + "]." : std::string()) + "bridle";
+        throw SceneError("scene field '" + field + ".tension' = " + fmt(scene.sections[w.section].bridle->tension) +
+                         " N: the bridle at station " + fmt(w.x[mid]) + " m would hang in a V of slope " + fmt(slope) +
+                         " (its middle " + fmt(w.height[mid] - H) + " m above the wire) to carry the contact wire; at most "
+                         "0.25, the model's small deflections: raise " + field + ".tension");
+      }
+    }
   }
 }
 
