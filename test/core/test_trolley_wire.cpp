@@ -547,6 +547,21 @@ TEST(TrolleyWire, BridlesBadInputIsRefusedByName) {
   refused(trolley_yaml(3, 109.0, 2e4, 0.25, "stagger:\n  contact_wire: [0.2, -0.2]\nwind:\n  speed: 10\n  bridle: {diameter: 0.0075}\n"),
           "wind.bridle");  // a drag block for a wire the line does not have
   // A bridle too slack to carry the pull-off without its arms running far across the track.
+  // Two bridled sections whose overlap holds each wire s/2 beside the stagger: where a bridle
+  // hangs, the wire passing its support beyond the working width (0.45 + 0.2 > 0.6 m) is refused
+  // as a held wire is (found when the model is built).
+  const std::string two = with("line:\n  span_length: 25\n  span_count: 3\n", "line:\n  contact_wire_height: 5.5\n"
+                               "sections:\n  - spans: [25, 25, 25, 25, 25, 25]\n  - spans: [25, 25, 25, 25, 25, 25]\n"
+                               "overlap: {spans: 2, support_rise: 0.1, lateral_separation: 0.4}\n") +
+                          "stagger:\n  per_support: true\n  contact_wire: [0.0, 0.2, -0.2, 0.2, 0.0, 0.45, 0.0, 0.2, -0.2, 0.2, 0.0]\n";
+  const std::string wide = test_scenes::refusal([&] { return cs::load_scene_string(two); });
+  EXPECT_NE(wide.find("overlap.lateral_separation"), std::string::npos) << wide;
+  const std::string narrow = test_scenes::refusal([&] {
+    std::string t = two;
+    t.replace(t.find("0.45"), 4, "0.3");
+    return cs::load_scene_string(t);
+  });
+  EXPECT_EQ(narrow, "");  // (0.3 + 0.2 inside: the refusal above is the width's)
   // A bridle too slack to carry the wire without a steep V: found in the design statics.
   const std::string steep = test_scenes::refusal([&] { return cs::load_scene_string(with("tension: 1500", "tension: 300")); });
   for (const char* word : {"bridle.tension", "at most 0.25"}) EXPECT_NE(steep.find(word), std::string::npos) << steep;

@@ -283,7 +283,7 @@ void add_wires_and_supports(const Model& m, LateralModel* lat) {
       s.stagger = stagger_at(sc, contact_side || w.is_auxiliary_messenger, s.line_support + support_offset) +
                   (contact_side ? stagger_error[s.line_support] : 0.0) +  // (no errors on an endless line)
                   apart;
-      if (w.is_contact_wire && apart != 0.0 && !(std::fabs(s.stagger) < half_width))
+      if (contact_side && apart != 0.0 && !(std::fabs(s.stagger) < half_width))  // (a bridle's: where the wire passes)
         throw SceneError("scene field 'overlap.lateral_separation' = " + fmt(sc.overlap->lateral_separation) +
                          " m puts the contact wire of section " + std::to_string(w.section) + " at " + fmt(s.stagger) +
                          " m at the support at station " + fmt(s.x) + " m: keep it inside the pantograph head's working width, |y| < " +
@@ -567,46 +567,58 @@ void add_stiffness(const Model& m, const LateralModel& lat, Add&& add) {
   }
 }
 
-// The lateral statics of one or more load cases at once, one factorisation: loads F (2n rows, the
-// rotations' 0) and the rigid nodes' values `fixed_value` (n rows; `fixed` per lateral DOF), a
-// column per case. The full system has the rotations as unknowns: y_i at i, theta_i at n + i. Rigid
-// nodes are eliminated (their rows become y_i = their value); `full` (optional) receives the
-// unconstrained matrix, which gives the reactions.
-Eigen::MatrixXd solve_lateral_cases(const Model& m, const LateralModel& lat, const std::vector<bool>& fixed,
-                                    const Eigen::MatrixXd& F, const Eigen::MatrixXd& fixed_value,
-                                    Eigen::SparseMatrix<double>* full_matrix) {
-  const int n = lat.n, N = 2 * n, cases = static_cast<int>(F.cols());
-  std::vector<Eigen::Triplet<double>> full, reduced;
-  Eigen::MatrixXd Fr = F;
-  auto add = [&](int i, int j, double v) {
-    full.emplace_back(i, j, v);
-    const bool fi = i < n && fixed[i], fj = j < n && fixed[j];
-    if (fi) return;
-    if (fj)
-      for (int c = 0; c < cases; ++c) Fr(i, c) -= v * fixed_value(j, c);
-    else
-      reduced.emplace_back(i, j, v);
-  };
-  add_stiffness(m, lat, add);
-  for (int i = 0; i < n; ++i)
-    if (fixed[i]) {
-      reduced.emplace_back(i, i, 1.0);
-      Fr.row(i) = fixed_value.row(i);
+// The lateral statics' system, factorised once for any number of load cases. The full system
+// has the rotations as unknowns: y_i at i, theta_i at n + i. Rigid nodes (`fixed` per lateral DOF)
+// are eliminated: their rows become y_i = their value, and their columns move to the loads; the
+// unconstrained matrix (full(), kept on request) gives the reactions.
+class LateralSystem {
+ public:
+  LateralSystem(const Model& m, const LateralModel& lat, const std::vector<bool>& fixed, bool keep_full)
+      : n_(lat.n), fixed_(fixed) {
+    const int N = 2 * n_;
+    std::vector<Eigen::Triplet<double>> full, reduced;
+    add_stiffness(m, lat, [&](int i, int j, double v) {
+      if (keep_full) full.emplace_back(i, j, v);
+      const bool fi = i < n_ && fixed_[i], fj = j < n_ && fixed_[j];
+      if (fi) return;
+      if (fj) moved_.emplace_back(i, j, v);  // (in this order: the loads take them as assembled)
+      else reduced.emplace_back(i, j, v);
+    });
+    for (int i = 0; i < n_; ++i)
+      if (fixed_[i]) reduced.emplace_back(i, i, 1.0);
+    Eigen::SparseMatrix<double> K(N, N);
+    K.setFromTriplets(reduced.begin(), reduced.end());
+    if (keep_full) {
+      full_.resize(N, N);
+      full_.setFromTriplets(full.begin(), full.end());
     }
-  Eigen::SparseMatrix<double> K(N, N);
-  K.setFromTriplets(reduced.begin(), reduced.end());
-  if (full_matrix) {
-    full_matrix->resize(N, N);
-    full_matrix->setFromTriplets(full.begin(), full.end());
+    solver_.compute(K);
+    if (solver_.info() != Eigen::Success)
+      throw SceneError("scene: the lateral statics has no solution: a wire is free to move sideways (check stagger.steady_arm_stiffness and stagger.messenger_support_stiffness)");
   }
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(K);
-  if (solver.info() != Eigen::Success)
-    throw SceneError("scene: the lateral statics has no solution: a wire is free to move sideways (check stagger.steady_arm_stiffness and stagger.messenger_support_stiffness)");
-  Eigen::MatrixXd x = solver.solve(Fr);
-  if (solver.info() != Eigen::Success || !x.allFinite())
-    throw SceneError("scene: the lateral statics has no solution (a wire free to move sideways)");
-  return x;
-}
+  // The displacements (2n rows) under loads F (2n rows, the rotations' 0) with the rigid nodes at
+  // `fixed_value` (n rows), a column per case.
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& F, const Eigen::MatrixXd& fixed_value) const {
+    Eigen::MatrixXd Fr = F;
+    const int cases = static_cast<int>(F.cols());
+    for (const Eigen::Triplet<double>& t : moved_)
+      for (int c = 0; c < cases; ++c) Fr(t.row(), c) -= t.value() * fixed_value(t.col(), c);
+    for (int i = 0; i < n_; ++i)
+      if (fixed_[i]) Fr.row(i) = fixed_value.row(i);
+    Eigen::MatrixXd x = solver_.solve(Fr);
+    if (solver_.info() != Eigen::Success || !x.allFinite())
+      throw SceneError("scene: the lateral statics has no solution (a wire free to move sideways)");
+    return x;
+  }
+  const Eigen::SparseMatrix<double>& full() const { return full_; }
+
+ private:
+  int n_;
+  std::vector<bool> fixed_;
+  std::vector<Eigen::Triplet<double>> moved_;  // the entries in the rigid nodes' columns
+  Eigen::SparseMatrix<double> full_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver_;
+};
 
 // Bridles in plan: the stagger is where the contact wire passes each support, where only the
 // bridle's clamps hold it, so the bridle's middle is registered beyond it, far enough that its
@@ -632,54 +644,83 @@ void register_bridles(const Model& m, LateralModel* lat) {
   }
   const int nb = static_cast<int>(held.size());
   if (nb == 0) return;
-  // Case 0: the line with every middle held at 0; case 1 + j: middle j at 1 alone, nothing else
-  // loaded or held off 0.
   const int n = lat->n;
   std::vector<bool> fixed(n, false);
-  Eigen::MatrixXd F = Eigen::MatrixXd::Zero(2 * n, nb + 1), value = Eigen::MatrixXd::Zero(n, nb + 1);
-  F.col(0).head(n) = lat->load;
+  Eigen::VectorXd base_value = Eigen::VectorXd::Zero(n);
   for (const LateralSupport& s : lat->supports)
     if (s.rigid) {
       fixed[lat->wires[s.wire].w_dof + s.node] = true;
-      value(lat->wires[s.wire].w_dof + s.node, 0) = s.stagger;
+      base_value[lat->wires[s.wire].w_dof + s.node] = s.stagger;
     }
-  std::vector<int> middle(nb);
+  // The rows wanted: the contact wire at each support (0..nb), each bridle's ends (nb + 2 j, + 1).
+  std::vector<int> middle(nb), rows(at);
   for (int j = 0; j < nb; ++j) {
     const LateralSupport& s = lat->supports[held[j]];
     middle[j] = lat->wires[s.wire].w_dof + s.node;
     fixed[middle[j]] = true;
-    value(middle[j], 0) = 0.0;
-    value(middle[j], 1 + j) = 1.0;
+    base_value[middle[j]] = 0.0;
+    rows.push_back(lat->wires[s.wire].w_dof);
+    rows.push_back(lat->wires[s.wire].w_dof + lat->wires[s.wire].nodes() - 1);
   }
-  const Eigen::MatrixXd y = solve_lateral_cases(m, *lat, fixed, F, value, nullptr);
-  Eigen::MatrixXd A(nb, nb);
-  Eigen::VectorXd r(nb);
-  for (int i = 0; i < nb; ++i) {
-    for (int j = 0; j < nb; ++j) A(i, j) = y(at[i], 1 + j);
-    r[i] = target[i] - y(at[i], 0);
+  const LateralSystem system(m, *lat, fixed, false);
+  // Case 0: every middle at 0; case 1 + j: middle j at 1 alone, nothing else loaded or held off 0.
+  // Solved a block of cases at a time, keeping the wanted rows: memory in the line's length.
+  const int cases = nb + 1, block = 32;
+  Eigen::MatrixXd kept(rows.size(), cases);
+  for (int c0 = 0; c0 < cases; c0 += block) {
+    const int nc = std::min(block, cases - c0);
+    Eigen::MatrixXd F = Eigen::MatrixXd::Zero(2 * n, nc), value = Eigen::MatrixXd::Zero(n, nc);
+    for (int c = 0; c < nc; ++c) {
+      if (c0 + c == 0) {
+        F.col(c).head(n) = lat->load;
+        value.col(c) = base_value;
+      } else {
+        value(middle[c0 + c - 1], c) = 1.0;
+      }
+    }
+    const Eigen::MatrixXd y = system.solve(F, value);
+    for (std::size_t r = 0; r < rows.size(); ++r) kept.row(r).segment(c0, nc) = y.row(rows[r]);
   }
-  const Eigen::VectorXd b = A.partialPivLu().solve(r);
+  const Eigen::MatrixXd A = kept.topRightCorner(nb, nb);
+  const Eigen::VectorXd b = A.partialPivLu().solve(Eigen::Map<const Eigen::VectorXd>(target.data(), nb) - kept.col(0).head(nb));
   if (!b.allFinite())
     throw SceneError("bridle: no registration of the bridles' middles puts the contact wire at its stagger (the wire "
                      "is not held across the track through their clamps); report this with the scene");
-  // The lateral model takes small angles: an arm running across the track at more than 1 in 4
-  // would pull more than 3 % off its tension's true share (tan against sin).
-  const Eigen::VectorXd plan = y.col(0) + y.rightCols(nb) * b;
+  // The model takes small angles: an arm running at more than 1 in 4, up and across the track
+  // together (its V in the design statics), would pull more than 3 % off its tension's true share
+  // (tan against sin). Its slope in plan is what the wire's turn needs.
+  const Eigen::VectorXd ends = kept.col(0).tail(2 * nb) + kept.bottomRightCorner(2 * nb, nb) * b;
+  double worst = 0.0, worst_plan = 0.0;
+  int at_worst = -1;
   for (int j = 0; j < nb; ++j) {
     const LateralSupport& s = lat->supports[held[j]];
-    const Wire& w = lat->wires[s.wire];
-    double slope = 0.0;
-    for (int end : {0, w.nodes() - 1})
-      slope = std::max(slope, std::fabs(plan[w.w_dof + end] - b[j]) / std::fabs(w.x[end] - s.x));
-    if (!(slope <= 0.25)) {
-      const int sec = m.wires[s.wire].section;
-      const std::string field = (m.scene.sections.size() > 1 ? "sections[" + std::to_string(sec) + "]." : std::string()) + "bridle";
-      throw SceneError("scene field '" + field + ".tension' = " + fmt(m.scene.sections[sec].bridle->tension) +
-                       " N: to carry the contact wire's pull-off at the support at station " + fmt(s.x) +
-                       " m the bridle's arms would run across the track at a slope of " + fmt(slope) + " (its middle " +
-                       fmt(std::fabs(b[j] - target[j])) + " m beyond the stagger); at most 0.25, the lateral model's small "
-                       "angles: raise " + field + ".tension, or lessen the stagger or the curve the wire turns by there");
+    const Wire& w = m.wires[s.wire];
+    const int mid = w.support_nodes.front();
+    for (int e : {0, 1}) {
+      const int end = e == 0 ? 0 : w.nodes() - 1;
+      const double arm = std::fabs(w.x[end] - w.x[mid]);
+      const double plan = std::fabs(ends[2 * j + e] - b[j]) / arm, up = std::fabs(w.height[mid] - w.height[end]) / arm;
+      if (std::hypot(plan, up) > worst) {
+        worst = std::hypot(plan, up);
+        worst_plan = plan;
+        at_worst = j;
+      }
     }
+  }
+  if (!(worst <= 0.25)) {
+    const LateralSupport& s = lat->supports[held[at_worst]];
+    const int sec = m.wires[s.wire].section;
+    const SectionSpec& spec = m.scene.sections[sec];
+    const std::string field = (m.scene.sections.size() > 1 ? "sections[" + std::to_string(sec) + "]." : std::string()) + "bridle";
+    // Both slopes fall as 1 / T_b (the string's arms); the turn is taken between two bridles' clamps.
+    const double least = spec.bridle->tension * worst / 0.25;
+    throw SceneError("scene field '" + field + ".tension' = " + fmt(spec.bridle->tension) +
+                     " N: to carry the contact wire's pull-off at the support at station " + fmt(s.x) +
+                     " m the bridle's arms would run at a slope of " + fmt(worst) + " (" + fmt(worst_plan) +
+                     " across the track, its middle " + fmt(std::fabs(b[at_worst] - target[at_worst])) +
+                     " m beyond the stagger); at most 0.25, the model's small angles: raise " + field +
+                     ".tension (about " + fmt(least) + " N; the slopes fall as 1 / tension, at most 1e5), shorten " + field +
+                     ".length (the wire turns between two bridles' clamps), or lessen the stagger or the curve there");
   }
   for (int j = 0; j < nb; ++j) {
     LateralSupport& s = lat->supports[held[j]];
@@ -718,10 +759,10 @@ void solve_lateral_statics(const Model& m, const LateralModel& lat, bool with_wi
       if (r.spring >= 0) F[r.dof] += lat.springs[r.spring].stiffness * travel;  // its anchor moved
       else fixed_value[r.dof] += travel;
     }
-  Eigen::SparseMatrix<double> Kf;
-  const Eigen::VectorXd x = solve_lateral_cases(m, lat, fixed, F, fixed_value, force_on_support ? &Kf : nullptr).col(0);
+  const LateralSystem system(m, lat, fixed, force_on_support != nullptr);
+  const Eigen::VectorXd x = system.solve(F, fixed_value).col(0);
   *y_out = x.head(n);
-  if (force_on_support) support_forces(lat, F, Kf, x, force_on_support);
+  if (force_on_support) support_forces(lat, F, system.full(), x, force_on_support);
 }
 
 std::vector<RegistrationLateral> registration_lateral(const Model& m, const std::vector<int>& dofs) {
