@@ -576,3 +576,26 @@ TEST(TrolleyWire, BridlesBadInputIsRefusedByName) {
   const std::string message = test_scenes::refusal_of_yaml(with("length: 8", "length: 25"));
   for (const char* word : {"(0, 25) m", "span 1"}) EXPECT_NE(message.find(word), std::string::npos) << message;
 }
+
+// The centred damping step takes the wires' band at the step's middle, but a lateral support
+// spring acts as a point force on y + beta v: its beta k is explicit damping, which a stiff
+// registration (1e9 N/m, stagger.steady_arm_stiffness's top) makes far faster than the band's
+// limit (2 m / (beta k) = 20 us on a 1 kg bracket). The lateral plane must take substeps for it
+// and hold: in a 20 m/s cross wind on the direct suspension and on bridles, the pass's first
+// 0.5 s stays within a metre of the static state (it diverged within 3 ms without them).
+TEST(TrolleyWire, StiffLateralSupportsHoldUnderTheCentredStep) {
+  for (const char* file : {"trolley_wire.yaml", "trolley_wire_bridle_3d.yaml"}) {
+    SCOPED_TRACE(file);
+    const std::vector<std::string> o = {"numerics.damping=centred", "stagger.contact_wire=[0.2,-0.2]",
+                                        "stagger.steady_arm_stiffness=1e9", "wind.speed=20"};
+    cs::Simulation sim(cs::load_scene_file(test_scenes::scene_path(file), o));
+    const cs::LateralModel& lat = *sim.model().lateral;
+    EXPECT_GT(lat.substeps, 1);
+    double worst = 0.0;
+    for (int k = 0; k < 500; ++k) {
+      ASSERT_EQ(sim.step(), cs::StepStatus::kOk) << "step " << k << ": " << sim.status_message();
+      for (int i = 0; i < lat.n; ++i) worst = std::max(worst, std::fabs(sim.state().lateral.y[i] - lat.initial[i]));
+    }
+    EXPECT_LT(worst, 1.0);
+  }
+}

@@ -29,9 +29,9 @@ double lateral_wire_energy(const Model& m, const State& s) {
   for (const Wire& w : lat.wires) wire_elastic_force(w, y, f.data(), theta.data());  // f = -K y
   for (const LateralSpring& sp : lat.springs) f[sp.dof] -= sp.stiffness * y[sp.dof];
   for (const LateralClamp& c : lat.clamps) {  // (a stitch wire's clamps: k (y_m - y_s)^2 / 2)
-    const double d = c.stiffness * (y[c.messenger] - y[c.stitch]);
-    f[c.stitch] += d;
-    f[c.messenger] -= d;
+    const double d = c.stiffness * (y[c.upper] - y[c.lower]);
+    f[c.lower] += d;
+    f[c.upper] -= d;
   }
   double e = 0.0;
   for (int i = 0; i < n; ++i)

@@ -328,9 +328,9 @@ void add_springs_and_pendulums(const Model& m, State& s, bool windowed, const do
   const int n_clamps = windowed ? lw.window_clamp_count : static_cast<int>(lat.clamps.size());
   for (int j = 0; j < n_clamps; ++j) {
     const LateralClamp& c = lat.clamps[windowed ? lw.window_clamps[j] : j];
-    const double df = c.stiffness * (z_at(c.messenger) - z_at(c.stitch));
-    f[c.stitch] += df;
-    f[c.messenger] -= df;
+    const double df = c.stiffness * (z_at(c.upper) - z_at(c.lower));
+    f[c.lower] += df;
+    f[c.upper] -= df;
   }
 }
 

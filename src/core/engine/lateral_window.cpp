@@ -92,7 +92,7 @@ void list_window_points(const Model& m, State& s, int first, double xa, double x
         lw.window_droppers.data());
     lw.window_clamp_count = select_between(
         m.clamp_order, m.clamp_order_x, xa, xb,
-        [&](int k) { return inside(lat.clamps[k].stitch) && inside(lat.clamps[k].messenger); }, lw.window_clamps.data());
+        [&](int k) { return inside(lat.clamps[k].lower) && inside(lat.clamps[k].upper); }, lw.window_clamps.data());
   }
   // The fused step's nodes with point forces: the cut layers, springs, pendulums, clamps, held
   // registrations' rows.
@@ -106,8 +106,8 @@ void list_window_points(const Model& m, State& s, int first, double xa, double x
   }
   for (int j = 0; j < lw.window_clamp_count; ++j) {
     const LateralClamp& c = lat.clamps[lw.window_clamps[j]];
-    lw.window_points[q++] = c.stitch;
-    lw.window_points[q++] = c.messenger;
+    lw.window_points[q++] = c.lower;
+    lw.window_points[q++] = c.upper;
   }
   for (const LateralRegistration& r : lat.registrations) {
     if (r.spring >= 0) continue;

@@ -77,9 +77,9 @@ void elastic_force(const Model& m, const LateralModel& lat, const double* tensio
     f[p.messenger] -= d;
   }
   for (const LateralClamp& c : lat.clamps) {
-    const double d = c.stiffness * (z[c.messenger] - z[c.stitch]);
-    f[c.stitch] += d;
-    f[c.messenger] -= d;
+    const double d = c.stiffness * (z[c.upper] - z[c.lower]);
+    f[c.lower] += d;
+    f[c.upper] -= d;
   }
 }
 
@@ -151,8 +151,8 @@ void build_lateral_packs(const Model& m, LateralModel& lat) {
     add(p.messenger);
   }
   for (const LateralClamp& c : lat.clamps) {
-    add(c.stitch);
-    add(c.messenger);
+    add(c.lower);
+    add(c.upper);
   }
   // A held registration and its row's nodes: the sweep may see it where the last step put it,
   // the point forces then add its move's share (add_springs_and_pendulums, lateral_step.cpp).
@@ -456,8 +456,23 @@ void set_substeps(const Model& m, LateralModel* lat) {
   // The centred step takes the wires' Rayleigh damping implicitly: its limit is the undamped one.
   const bool centred = m.scene.numerics.damping == DampingStep::kCentred;
   const double xi = centred ? 0.0 : 0.5 * (m.alpha / std::max(lat->omega_max, 1e-9) + m.beta * lat->omega_max);
-  const double dt_crit = lat->omega_max > 0.0 ? 2.0 / lat->omega_max * (std::sqrt(1.0 + xi * xi) - xi)
-                                               : std::numeric_limits<double>::infinity();
+  double dt_crit = lat->omega_max > 0.0 ? 2.0 / lat->omega_max * (std::sqrt(1.0 + xi * xi) - xi)
+                                         : std::numeric_limits<double>::infinity();
+  if (centred) {
+    // The centred step takes the wires' band at the step's middle, but the support springs and
+    // clamps act as point forces on y + beta v: their beta k is explicit damping on their nodes
+    // (as in the vertical plane: compute_stability_limit). Each as one DOF, w^2 = k / m, damping
+    // beta k / m; a stiff lateral spring (5e7 N/m on a 1 kg bracket: 2 / (beta k / m) = 0.4 ms)
+    // binds here, not in the band.
+    auto limit_by = [&](double k, int dof) {
+      const double mass = lat->mass[dof];
+      if (!(lat->inv_mass[dof] > 0.0) || !(m.beta * k > 0.0)) return;
+      dt_crit = std::min(dt_crit, critical_time_step(std::sqrt(k / mass), m.beta * k / mass, 0.0));
+    };
+    for (const LateralSpring& sp : lat->springs) limit_by(sp.stiffness, sp.dof);
+    for (const LateralClamp& c : lat->clamps)
+      for (int dof : {c.upper, c.lower}) limit_by(c.stiffness, dof);
+  }
   lat->substeps = std::max(1, static_cast<int>(std::ceil(m.dt / (0.9 * dt_crit))));
   if (lat->substeps > 1000)
     throw SceneError("scene field 'stagger.steady_arm_stiffness': the lateral plane's stability limit (" + fmt(dt_crit) +
@@ -560,10 +575,10 @@ void add_stiffness(const Model& m, const LateralModel& lat, Add&& add) {
     add(p.messenger, p.contact, -k);
   }
   for (const LateralClamp& c : lat.clamps) {
-    add(c.stitch, c.stitch, c.stiffness);
-    add(c.messenger, c.messenger, c.stiffness);
-    add(c.stitch, c.messenger, -c.stiffness);
-    add(c.messenger, c.stitch, -c.stiffness);
+    add(c.lower, c.lower, c.stiffness);
+    add(c.upper, c.upper, c.stiffness);
+    add(c.lower, c.upper, -c.stiffness);
+    add(c.upper, c.lower, -c.stiffness);
   }
 }
 

@@ -53,7 +53,7 @@ struct LateralPendulum {
 // stiff bilateral spring as in the vertical plane, between the two lateral nodes. The stitch wire
 // has no support of its own: sideways it hangs from its two clamps (and its droppers' pendulums).
 struct LateralClamp {
-  int messenger = 0, stitch = 0;  // lateral indices
+  int upper = 0, lower = 0;  // lateral indices: the upper wire's node, the lower wire's (WireClamp)
   double stiffness = 0.0;         // N/m
 };
 
