@@ -562,6 +562,9 @@ TEST(TrolleyWire, BridlesBadInputIsRefusedByName) {
     return cs::load_scene_string(t);
   });
   EXPECT_EQ(narrow, "");  // (0.3 + 0.2 inside: the refusal above is the width's)
+  // A messenger's stagger or support on a line without a messenger.
+  refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\n  messenger: [0.0]\n", "stagger.messenger");
+  refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\n  messenger_support_stiffness: 1.0e5\n", "stagger.messenger_support_stiffness");
   // A bridle too slack to carry the wire without a steep V: found in the design statics.
   const std::string steep = test_scenes::refusal([&] { return cs::load_scene_string(with("tension: 1500", "tension: 300")); });
   for (const char* word : {"bridle.tension", "at most 0.25"}) EXPECT_NE(steep.find(word), std::string::npos) << steep;

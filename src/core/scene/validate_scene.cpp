@@ -132,6 +132,13 @@ void validate_acting_fields(const Scene& s) {
              fmt(*s.sections[i].rail_lateral_bending_stiffness),
              "only on a 3-D line (stagger, alignment or pantograph_head.sway): a 2-D line does not bend the "
              "profile across the track");
+  if (s.stagger && std::none_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.messenger.has_value(); })) {
+    // A messenger's stagger or support on a line without one would hold nothing.
+    const std::string allowed = "absent: no section has a messenger (a trolley wire or a rail); remove it";
+    if (!s.stagger->messenger.empty()) fail("stagger.messenger", "(given)", allowed);
+    if (s.stagger->messenger_support_stiffness)
+      fail("stagger.messenger_support_stiffness", fmt(*s.stagger->messenger_support_stiffness), allowed);
+  }
   if (s.wind) {
     // A drag block for a wire the line does not have would load nothing.
     auto has = [&](const std::string& kind) {
