@@ -18,7 +18,7 @@ void validate_sections(const Scene& s) {
   if (s.sections.empty()) fail("line", "(no tension section)", "at least one section of spans");
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
-    const std::string pre = s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "";
+    const std::string pre = s.section_field(si, "");
     if (sec.rigid) {
       // The rail's beam carries no tension: anything hung from a messenger, a presag set by
       // droppers or a support-less profile has no meaning here.
@@ -127,8 +127,7 @@ void validate_acting_fields(const Scene& s) {
   if (!s.lateral())
     for (std::size_t i = 0; i < s.sections.size(); ++i)
       if (s.sections[i].rail_lateral_bending_stiffness)
-        fail((s.sections.size() > 1 ? "sections[" + std::to_string(i) + "]." : std::string()) +
-                 "conductor_rail.lateral_bending_stiffness",
+        fail(s.section_field(i, "conductor_rail.lateral_bending_stiffness"),
              fmt(*s.sections[i].rail_lateral_bending_stiffness),
              "only on a 3-D line (stagger, alignment or pantograph_head.sway): a 2-D line does not bend the "
              "profile across the track");
@@ -344,7 +343,7 @@ void validate_rigid(const Scene& s) {
   for (std::size_t i = 0; i < s.sections.size(); ++i) {
     const SectionSpec& sec = s.sections[i];
     if (!sec.rigid) continue;
-    const std::string f = (s.sections.size() > 1 ? "sections[" + std::to_string(i) + "]." : "") + "conductor_rail";
+    const std::string f = s.section_field(i, "conductor_rail");
     stiff_enough(f + ".bending_stiffness", sec.contact_wire.bending_stiffness, *std::max_element(sec.spans.begin(), sec.spans.end()),
                  sec.contact_wire.linear_mass);
     if (sec.rail_transition_piece) {
@@ -358,7 +357,7 @@ void validate_rigid(const Scene& s) {
   for (std::size_t i = 0; i < s.sections.size(); ++i) {
     const SectionSpec& sec = s.sections[i];
     if (!sec.rail_transition_piece) continue;
-    const std::string f = (s.sections.size() > 1 ? "sections[" + std::to_string(i) + "]." : "") + "conductor_rail.transition_piece";
+    const std::string f = s.section_field(i, "conductor_rail.transition_piece");
     const SectionSpec::TransitionPiece& piece = *sec.rail_transition_piece;
     if (piece.end_bending_stiffness > sec.contact_wire.bending_stiffness)
       fail(f + ".end_bending_stiffness", fmt(piece.end_bending_stiffness),
@@ -403,7 +402,7 @@ void validate_stitched(const Scene& s) {
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     if (!sec.stitch_wire) continue;
-    const std::string f = (s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "") + "stitch_wire";
+    const std::string f = s.section_field(si, "stitch_wire");
     if (!sec.messenger || !sec.droppers)
       fail(f, "(given)", "a stitch wire hangs from a messenger and carries droppers: add messenger and droppers or remove it");
     if (sec.spans.size() < 2 && !s.endless)  // (an endless line's one span repeats: supports on both sides)
@@ -463,7 +462,7 @@ void validate_compound(const Scene& s) {
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     if (!sec.auxiliary_messenger && !sec.hangers) continue;
-    const std::string pre = s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "";
+    const std::string pre = s.section_field(si, "");
     if (!sec.auxiliary_messenger)
       fail(pre + "hangers", "(given)", "hangers hang the contact wire from an auxiliary messenger: add auxiliary_messenger or remove hangers");
     const std::string f = pre + "auxiliary_messenger";
@@ -487,7 +486,7 @@ void validate_bridles(const Scene& s) {
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     if (!sec.bridle) continue;
-    const std::string pre = s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : "";
+    const std::string pre = s.section_field(si, "");
     const std::string f = pre + "bridle";
     if (sec.messenger)
       fail(f, "(given with messenger)",
@@ -527,7 +526,7 @@ void validate_messengers(const Scene& s) {
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     if (sec.messenger && !sec.droppers)
-      fail((s.sections.size() > 1 ? "sections[" + std::to_string(si) + "]." : std::string()) + "messenger", "(given without droppers)",
+      fail(s.section_field(si, "messenger"), "(given without droppers)",
            "droppers that hang the contact wire from it; a trolley wire has no messenger: remove it");
   }
 }

@@ -532,6 +532,10 @@ struct Scene {
   }
 
   double line_length() const;
+  // A field of section i as messages name it: "sections[i].name", or "name" on a line of one section.
+  std::string section_field(std::size_t i, const std::string& name) const {
+    return (sections.size() > 1 ? "sections[" + std::to_string(i) + "]." : std::string()) + name;
+  }
   // Span index [first, last) of the statistics section, resolved against the defaults.
   int analysis_first() const;
   int analysis_last() const;
