@@ -36,22 +36,31 @@ void bridle_statics(const Scene& scene, const Section& info, Model& m, std::vect
     // (A rigid rise: the band has no force from it, the reaction stays.)
     const double rise = H - std::min(w.height.front(), w.height.back());
     for (double& y : w.height) y += rise;
-    // The wires are beams in small deflections: an arm whose V is steeper than 1 in 4 would pull
-    // more than 3 % off its tension's true share (tan against sin), as in plan (lateral.cpp).
-    const int mid = w.support_nodes.front();
-    for (int end : {0, n - 1}) {
-      const double slope = std::fabs(w.height[mid] - w.height[end]) / std::fabs(w.x[end] - w.x[mid]);
-      if (!(slope <= 0.25)) {
-        const std::string field =
-            (scene.sections.size() > 1 ? "sections[" + std::to_string(w.section) + "]." : std::string()) + "bridle";
-        throw SceneError("scene field '" + field + ".tension' = " + fmt(scene.sections[w.section].bridle->tension) +
-                         " N: the bridle at station " + fmt(w.x[mid]) + " m would hang in a V of slope " + fmt(slope) +
-                         " (its middle " + fmt(w.height[mid] - H) + " m above the wire) to carry the contact wire; at most "
-                         "0.25, the model's small deflections: raise " + field + ".tension");
-      }
-    }
+    // Its V in the small angles (a 3-D line checks each arm up and across together: lateral.cpp).
+    const double slope = std::max(bridle_arm_rise(w, 0), bridle_arm_rise(w, n - 1));
+    if (!(slope <= kSteepestBridleArm))
+      refuse_slack_bridle(scene, w, slope,
+                          "in its V, its middle " + fmt(w.height[w.support_nodes.front()] - H) + " m above the wire");
   }
 }
+
+}  // namespace
+
+double bridle_arm_rise(const Wire& w, int end) {
+  const int mid = w.support_nodes.front();
+  return std::fabs(w.height[mid] - w.height[end]) / std::fabs(w.x[end] - w.x[mid]);
+}
+
+void refuse_slack_bridle(const Scene& scene, const Wire& w, double slope, const std::string& how, const std::string& advice) {
+  const std::string field = scene.section_field(w.section, "bridle");
+  const double tension = scene.sections[w.section].bridle->tension;
+  throw SceneError("scene field '" + field + ".tension' = " + fmt(tension) + " N: to carry the contact wire, the bridle at station " +
+                   fmt(w.x[w.support_nodes.front()]) + " m would run its arms at a slope of " + fmt(slope) + " (" + how +
+                   "); at most " + fmt(kSteepestBridleArm) + ", the model's small angles: raise " + field + ".tension (about " +
+                   fmt(tension * slope / kSteepestBridleArm) + " N; the slopes fall as 1 / tension, at most 1e5)" + advice);
+}
+
+namespace {
 
 // One section's statics: the contact wire(s) held at the supports and droppers, then the messenger
 // under the dropper tensions, a few fixed-point passes for the droppers' weight.
@@ -332,7 +341,7 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
   for (std::size_t q = 0; q < hinged.size(); ++q) {
     SupportSpring& sp = m.springs[hinged[q]];
     const int section = wire_of(m, sp.dof).section;
-    const std::string pre = scene.sections.size() > 1 ? "sections[" + std::to_string(section) + "]." : "";
+    const std::string pre = scene.section_field(section, "");
     const HingedArmSpec& arm = *scene.sections[section].steady_arms->hinged_arm;
     // (The arms a 3-D line's lateral plane moves: pulled to one side, LateralModel::registrations.)
     const bool in_plan = scene.lateral() && wire[q].side != 0.0;

@@ -11,4 +11,14 @@ namespace catenary_sim {
 // section_supports: per section, the station of each of its supports.
 void design_statics(const Scene& scene, const std::vector<std::vector<double>>& section_supports, Model& m);
 
+// A bridle's arm in the model's small angles: at a slope of 1 in 4 an arm's pull is 3 % off its
+// tension's true share (tan against sin). Its rise in the V from the middle to its end `end`.
+constexpr double kSteepestBridleArm = 0.25;
+double bridle_arm_rise(const Wire& bridle, int end);
+// Refuses (SceneError, by the section's bridle.tension) the bridle whose steepest arm, `slope`
+// (above kSteepestBridleArm), is told of by `how`; `advice` is added to raising the tension,
+// which the slopes fall with as 1 / tension.
+[[noreturn]] void refuse_slack_bridle(const Scene& scene, const Wire& bridle, double slope, const std::string& how,
+                                      const std::string& advice = "");
+
 }  // namespace catenary_sim

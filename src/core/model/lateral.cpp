@@ -15,6 +15,7 @@
 #include "catenary_sim/core/model/beam.hpp"
 #include "catenary_sim/core/model/wire_band.hpp"
 #include "model/centred_factors.hpp"
+#include "model/design_statics.hpp"
 #include "model/normal_errors.hpp"
 #include "model/wire_packs.hpp"
 
@@ -455,9 +456,9 @@ void set_substeps(const Model& m, LateralModel* lat) {
   lat->omega_max = lateral_omega_max(m, *lat);
   // The centred step takes the wires' Rayleigh damping implicitly: its limit is the undamped one.
   const bool centred = m.scene.numerics.damping == DampingStep::kCentred;
-  const double xi = centred ? 0.0 : 0.5 * (m.alpha / std::max(lat->omega_max, 1e-9) + m.beta * lat->omega_max);
-  double dt_crit = lat->omega_max > 0.0 ? 2.0 / lat->omega_max * (std::sqrt(1.0 + xi * xi) - xi)
-                                         : std::numeric_limits<double>::infinity();
+  double dt_crit = !(lat->omega_max > 0.0) ? std::numeric_limits<double>::infinity()
+                   : centred                 ? critical_time_step(lat->omega_max, 0.0, 0.0)
+                                             : critical_time_step(lat->omega_max, m.alpha, m.beta);
   if (centred) {
     // The centred step takes the wires' band at the step's middle, but the support springs and
     // clamps act as point forces on y + beta v: their beta k is explicit damping on their nodes
@@ -701,41 +702,31 @@ void register_bridles(const Model& m, LateralModel* lat) {
   if (!b.allFinite())
     throw SceneError("bridle: no registration of the bridles' middles puts the contact wire at its stagger (the wire "
                      "is not held across the track through their clamps); report this with the scene");
-  // The model takes small angles: an arm running at more than 1 in 4, up and across the track
-  // together (its V in the design statics), would pull more than 3 % off its tension's true share
-  // (tan against sin). Its slope in plan is what the wire's turn needs.
+  // The arms in the model's small angles, up and across the track together (their V alone is
+  // checked in the design statics). Their slope in plan is what the wire's turn needs.
   const Eigen::VectorXd ends = kept.col(0).tail(2 * nb) + kept.bottomRightCorner(2 * nb, nb) * b;
   double worst = 0.0, worst_plan = 0.0;
   int at_worst = -1;
   for (int j = 0; j < nb; ++j) {
-    const LateralSupport& s = lat->supports[held[j]];
-    const Wire& w = m.wires[s.wire];
-    const int mid = w.support_nodes.front();
+    const Wire& w = m.wires[lat->supports[held[j]].wire];
     for (int e : {0, 1}) {
       const int end = e == 0 ? 0 : w.nodes() - 1;
-      const double arm = std::fabs(w.x[end] - w.x[mid]);
-      const double plan = std::fabs(ends[2 * j + e] - b[j]) / arm, up = std::fabs(w.height[mid] - w.height[end]) / arm;
-      if (std::hypot(plan, up) > worst) {
-        worst = std::hypot(plan, up);
+      const double plan = std::fabs(ends[2 * j + e] - b[j]) / std::fabs(w.x[end] - w.x[w.support_nodes.front()]);
+      const double slope = std::hypot(plan, bridle_arm_rise(w, end));
+      if (slope > worst) {
+        worst = slope;
         worst_plan = plan;
         at_worst = j;
       }
     }
   }
-  if (!(worst <= 0.25)) {
-    const LateralSupport& s = lat->supports[held[at_worst]];
-    const int sec = m.wires[s.wire].section;
-    const SectionSpec& spec = m.scene.sections[sec];
-    const std::string field = (m.scene.sections.size() > 1 ? "sections[" + std::to_string(sec) + "]." : std::string()) + "bridle";
-    // Both slopes fall as 1 / T_b (the string's arms); the turn is taken between two bridles' clamps.
-    const double least = spec.bridle->tension * worst / 0.25;
-    throw SceneError("scene field '" + field + ".tension' = " + fmt(spec.bridle->tension) +
-                     " N: to carry the contact wire's pull-off at the support at station " + fmt(s.x) +
-                     " m the bridle's arms would run at a slope of " + fmt(worst) + " (" + fmt(worst_plan) +
-                     " across the track, its middle " + fmt(std::fabs(b[at_worst] - target[at_worst])) +
-                     " m beyond the stagger); at most 0.25, the model's small angles: raise " + field +
-                     ".tension (about " + fmt(least) + " N; the slopes fall as 1 / tension, at most 1e5), shorten " + field +
-                     ".length (the wire turns between two bridles' clamps), or lessen the stagger or the curve there");
+  if (!(worst <= kSteepestBridleArm)) {
+    const Wire& w = m.wires[lat->supports[held[at_worst]].wire];
+    refuse_slack_bridle(m.scene, w, worst,
+                        fmt(worst_plan) + " across the track, its middle " + fmt(std::fabs(b[at_worst] - target[at_worst])) +
+                            " m beyond the stagger",
+                        ", shorten " + m.scene.section_field(w.section, "bridle.length") +
+                            " (the wire turns between two bridles' clamps), or lessen the stagger or the curve there");
   }
   for (int j = 0; j < nb; ++j) {
     LateralSupport& s = lat->supports[held[j]];
