@@ -339,7 +339,7 @@ void clamp_short_wires(const Scene& scene, Model& m) {
         c.x = w.x[end];
         const int own = w.w_dof + end, held = other.w_dof + node_at(other.x, c.x);
         c.upper_dof = bridle ? own : held;  // the upper node
-        c.lower_dof = bridle ? held : own;     // the lower node
+        c.lower_dof = bridle ? held : own;  // the lower node
         c.stiffness = kWireClampStiffness;
         m.mass[own] += clamp_mass;
         m.clamps.push_back(c);

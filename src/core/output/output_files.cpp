@@ -235,10 +235,9 @@ void remove_made_directories(const std::vector<std::string>& made) {
 }
 
 DirectoryLock::DirectoryLock(const std::string& dir) : path_(dir + "/.catenary_sim.lock") {
-  const std::string& name = path_;
-  fd_ = ::open(name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   made_ = fd_ >= 0;
-  if (fd_ < 0 && errno == EEXIST) fd_ = ::open(name.c_str(), O_RDWR | O_CLOEXEC);
+  if (fd_ < 0 && errno == EEXIST) fd_ = ::open(path_.c_str(), O_RDWR | O_CLOEXEC);
   if (fd_ < 0) throw OutputError("cannot lock output directory '" + dir + "': " + reason());
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const bool busy = errno == EWOULDBLOCK;
