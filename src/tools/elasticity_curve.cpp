@@ -4,7 +4,8 @@
 // droppers tension-only, contact only where it pushes) and the static uplift of each contact
 // wire under it is written as CSV: x_m, then uplift_<wire>_mm per contact wire (empty where the
 // probe does not touch that wire). --spans FILE.csv adds the elasticity's range and uniformity
-// (EN 50119's (max - min) / (max + min)) over each span of each contact wire.
+// (EN 50119's (max - min) / (max + min)) over each span of each contact wire. A 3-D scene's plan
+// is designed too, and refused where simulate_pass would refuse it.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/output/elasticity_uniformity.hpp"
 #include "catenary_sim/core/output/output_files.hpp"
@@ -57,6 +59,10 @@ int main(int argc, char** argv) {
     const std::vector<double> rises = transition_support_rises(scene);
     const ElasticityProbe probe(scene, force, rises);
     const Model& m = probe.model();
+    // A 3-D line's plan is part of its design (the bridles' registrations, the wires inside the
+    // working width): what simulate_pass refuses there is refused here, though the elasticity is
+    // the vertical plane's alone.
+    if (scene.lateral()) check_lateral_design(m);
     const double x0 = m.support_x.front(), x1 = m.support_x.back();
     const double stations = std::floor((x1 - x0) / step + 1e-9) + 1.0;
     if (stations > kMaxStations) {

@@ -177,6 +177,11 @@ TEST(FuzzBadInput, OverridePathsAndValues) {
   expect_rejected(kElasticity, {"elasticity: bad --set", {"--scene", kReference, "--set", "name.foo=1"}, {"name"}}, dir, &count);
   expect_rejected(kElasticity, {"elasticity: --step 0", {"--scene", kReference, "--step", "0"}, {"--step"}}, dir, &count);
   expect_rejected(kElasticity, {"elasticity: unknown flag", {"--scene", kReference, "--stepp", "1"}, {"--stepp"}}, dir, &count);
+  // A 3-D line whose plan cannot be designed (a bridle too slack to turn the staggered wire
+  // without arms steeper than 1 in 4 across the track) is refused as simulate_pass refuses it.
+  expect_rejected(kElasticity, {"elasticity: a 3-D line's plan", {"--scene", test_scenes::scene_path("trolley_wire_bridle_3d.yaml"),
+                                                                   "--set", "bridle.tension=900"}, {"bridle.tension"}},
+                  dir, &count);
   // The lower bound as written (5), not std::to_string's 5.000000.
   expect_rejected(kFrf, {"frf: --fmax below --fmin", {kReference, "--pantograph", "pantograph", "--out", "@OUT", "--fmin",
                                                        "5", "--fmax", "1"}, {"--fmax: must be >= --fmin (5)"}},

@@ -871,22 +871,34 @@ void set_lead_step(const Model& m, LateralModel& lat, int every) {
   }
 }
 
-std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
-  const Scene& sc = m.scene;
+namespace {
+
+// The line in plan as designed: its wires, supports, registrations and wind, and its static
+// states (calm and under the mean wind). No numerics: nothing here reads dt or the damping step.
+std::shared_ptr<LateralModel> design_lateral(const Model& m) {
   auto lat = std::make_shared<LateralModel>();
   add_wires_and_supports(m, lat.get());
   add_pendulums(m, lat.get());
   add_clamps(m, lat.get());
   register_bridles(m, lat.get());
   add_registrations(m, lat.get());
-  if (sc.wind) add_wind(m, *sc.wind, lat.get());
+  if (m.scene.wind) add_wind(m, *m.scene.wind, lat.get());
+  set_static_states(m, lat.get());
+  return lat;
+}
+
+}  // namespace
+
+void check_lateral_design(const Model& m) { design_lateral(m); }
+
+std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
+  const Scene& sc = m.scene;
+  std::shared_ptr<LateralModel> lat = design_lateral(m);
   lat->windowed = sc.numerics.windowed() && (m.endless || lat->field.empty() || sc.numerics.gust_lead.has_value());
   lat->gust_lead = lat->windowed ? gust_lead_time(sc) : 0.0;
   const PantographHeadSpec& head = sc.pantograph_head;
   lat->half_working_width = 0.5 * head.working_width;
   lat->half_horn_width = 0.5 * head.horn_width;
-
-  set_static_states(m, lat.get());
   set_substeps(m, lat.get());
   build_lateral_packs(m, *lat);
   if (sc.numerics.damping == DampingStep::kCentred) factor_lateral_centred(m, *lat);

@@ -249,6 +249,10 @@ std::vector<RegistrationLateral> registration_lateral(const Model& model, const 
 
 // Builds the lateral plane of a model whose scene asks for one (Scene::lateral()); throws SceneError.
 std::shared_ptr<const LateralModel> build_lateral(const Model& model);
+// Designs the line in plan alone (the bridles' registrations, the wires inside the working
+// width, the static states) and throws SceneError for what build_lateral would refuse there. For
+// a model built without its numerics (BuildOptions::stability false), e.g. the elasticity's probe.
+void check_lateral_design(const Model& model);
 
 // Lateral static state of the wires (y: n entries) under the constant loads, the droppers at their
 // static tension, with (mean wind) or without wind; `force_on_support` (optional, per
