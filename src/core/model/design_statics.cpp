@@ -24,6 +24,8 @@ const Wire& wire_of(const Model& m, int dof) { return m.wires[wire_holding(m, do
 // working height, the other end above by what its arms' loads differ (the clamp then a short
 // link). Its reaction at the middle is the support's preload (design_statics).
 void bridle_statics(const Scene& scene, const Section& info, Model& m, std::vector<std::vector<double>>& react) {
+  const Wire* steepest = nullptr;  // refused by the worst, as the plan's check is (lateral.cpp)
+  double worst = 0.0;
   for (int wi : info.clamped_wires) {
     Wire& w = m.wires[wi];
     const int n = w.nodes();
@@ -38,10 +40,15 @@ void bridle_statics(const Scene& scene, const Section& info, Model& m, std::vect
     for (double& y : w.height) y += rise;
     // Its V in the small angles (a 3-D line checks each arm up and across together: lateral.cpp).
     const double slope = std::max(bridle_arm_rise(w, 0), bridle_arm_rise(w, n - 1));
-    if (!(slope <= kSteepestBridleArm))
-      refuse_slack_bridle(scene, w, slope,
-                          "in its V, its middle " + fmt(w.height[w.support_nodes.front()] - H) + " m above the wire");
+    if (!(slope <= worst) && !std::isnan(worst)) {  // (a NaN slope is the worst)
+      worst = slope;
+      steepest = &w;
+    }
   }
+  if (steepest && !(worst <= kSteepestBridleArm))
+    refuse_slack_bridle(scene, *steepest, worst,
+                        "in its V, its middle " + fmt(steepest->height[steepest->support_nodes.front()] - scene.contact_wire_height) +
+                            " m above the wire");
 }
 
 }  // namespace
