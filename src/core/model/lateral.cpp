@@ -728,14 +728,15 @@ void register_bridles(const Model& m, LateralModel* lat) {
                         ", shorten " + m.scene.section_field(w.section, "bridle.length") +
                             " (the wire turns between two bridles' clamps), or lessen the stagger or the curve there");
   }
+  std::vector<int> spring_on(n, -1);  // a lateral DOF's support spring (one at most: add_wires_and_supports)
+  for (std::size_t k = 0; k < lat->springs.size(); ++k) spring_on[lat->springs[k].dof] = static_cast<int>(k);
   for (int j = 0; j < nb; ++j) {
-    LateralSupport& s = lat->supports[held[j]];
-    for (LateralSpring& sp : lat->springs)
-      if (sp.dof == middle[j]) {
-        lat->load[middle[j]] += sp.stiffness * (b[j] - sp.anchor);
-        sp.anchor = b[j];
-      }
-    s.stagger = b[j];
+    if (spring_on[middle[j]] >= 0) {
+      LateralSpring& sp = lat->springs[spring_on[middle[j]]];
+      lat->load[middle[j]] += sp.stiffness * (b[j] - sp.anchor);
+      sp.anchor = b[j];
+    }
+    lat->supports[held[j]].stagger = b[j];
   }
 }
 
