@@ -83,10 +83,13 @@ class PySimulation {
     const State& st = sim_.state();
     const double left = st.speed > 0.0 ? (sim_.model().train_end - st.front - st.line_offset) / st.speed / sim_.model().dt
                                        : std::numeric_limits<double>::infinity();
-    if (!(left <= max_steps))
+    if (!(left <= max_steps)) {
+      const std::string note = short_element_note(sim_.model());
       throw py::value_error("run(): max_steps = " + fmt(max_steps) + " rejected: the rest of the pass would take " +
                             fmt(std::ceil(left)) + " steps at " + fmt(st.speed) +
-                            " m/s; allowed max_steps at least that (set a speed, or step(n) yourself)");
+                            " m/s; allowed max_steps at least that (set a speed, or step(n) yourself)" +
+                            (note.empty() ? "" : "; " + note));
+    }
     return step_locked(std::numeric_limits<long long>::max());
   }
 

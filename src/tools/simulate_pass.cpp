@@ -189,6 +189,8 @@ int build_pass(const Options& o, Scene* scene, std::unique_ptr<Simulation>* sim)
       << " m at " << scene->train_speed * 3.6 << " km/h with dt " << m.dt << " s), more than --max-steps "
       << o.max_steps << "; raise --max-steps if that is meant, or check train.speed_kmh, the line length and "
       << "the masses that set dt";
+    const std::string note = short_element_note(m);
+    if (!note.empty()) s << "; " << note;
     std::cerr << s.str() << "\n";
     return kBadInput;
   }

@@ -167,6 +167,12 @@ TEST(FuzzBadInput, OverridePathsAndValues) {
     c.args = args;
     expect_rejected(kSimulatePass, c, dir, &count);
   }
+  // A stitch wire of 5 cm puts its clamps 2.5 cm from the support: elements a tenth of the
+  // mesh's, dt 160 times shorter. The pass's refusal for its length names that element.
+  expect_rejected(kSimulatePass, {"a stitch wire of 5 cm", {"--scene", test_scenes::scene_path("reference_55m_stitched.yaml"), "--out", "@OUT",
+                                                            "--set", "stitch_wire.length=0.05", "--max-steps", "1e5"},
+                                  {"shortest element is 0.025 m"}},
+                  dir, &count);
   // Outputs that cannot be written, found before the pass.
   expect_rejected(kSimulatePass, {"--out is a file", {"--scene", kReference, "--out", kReference}, {kReference}}, dir, &count);
   expect_rejected(kSimulatePass, {"--out under /proc", {"--scene", kReference, "--out", "/proc/catenary_sim_out"}, {"/proc/catenary_sim_out"}},

@@ -688,6 +688,26 @@ void analysis_section(const Model& m, double* x0, double* x1) {
   }
 }
 
+std::string short_element_note(const Model& m) {
+  const double asked = m.scene.numerics.element_length;
+  double shortest = asked;
+  const Wire* on = nullptr;
+  double at = 0.0;
+  for (const Wire& w : m.wires)
+    for (std::size_t i = 0; i + 1 < w.x.size(); ++i)
+      if (w.x[i + 1] - w.x[i] < shortest) {
+        shortest = w.x[i + 1] - w.x[i];
+        on = &w;
+        at = w.x[i];
+      }
+  if (!on || !(shortest < 0.5 * asked)) return "";
+  std::ostringstream s;
+  s.precision(3);
+  s << "the mesh's shortest element is " << shortest << " m (of numerics.element_length " << asked << " m), on "
+    << on->name << " at station " << at << " m, where two of its stations nearly meet (a clamp, a dropper, a support)";
+  return s.str();
+}
+
 std::string speed_warning(const Model& m, double speed) {
   if (!(speed > 0.7 * m.wave_speed)) return "";
   std::ostringstream s;

@@ -30,4 +30,11 @@ void analysis_section(const Model& model, double* x0, double* x1);
 // A warning (empty if none) for a train speed above 0.7 of the contact wire's wave speed.
 std::string speed_warning(const Model& model, double speed_mps);
 
+// Where the mesh is finer than numerics.element_length asks, and so dt shorter than it need be
+// (a wire's element falls with its length: a stitch wire's or bridle's clamps a few centimetres
+// from their support, a dropper next to another): "" when every element is at least half the
+// asked length, else the shortest element, its wire and station, e.g. for a refusal of a pass
+// too long to run.
+std::string short_element_note(const Model& model);
+
 }  // namespace catenary_sim
