@@ -777,32 +777,20 @@ std::vector<RegistrationLateral> registration_lateral(const Model& m, const std:
   add_wires_and_supports(m, &lat);
   add_pendulums(m, &lat);
   add_clamps(m, &lat);
-  const int n = lat.n, N = 2 * n;
+  const int n = lat.n;
   auto lateral_dof = [&](int vertical) { return lateral_dof_of(m, lat, vertical); };
   // Every support held (rows y_i = 0), then each asked node let go in turn: its stiffness is the
   // Schur complement K_ii - K_ir K_rr^-1 K_ri over the rest r of the plane.
   std::vector<bool> fixed(n, false);
   for (const LateralSupport& sup : lat.supports) fixed[lat.wires[sup.wire].w_dof + sup.node] = true;
-  std::vector<Eigen::Triplet<double>> held, full;
-  add_stiffness(m, lat, [&](int i, int j, double v) {
-    full.emplace_back(i, j, v);
-    if (!(i < n && fixed[i]) && !(j < n && fixed[j])) held.emplace_back(i, j, v);
-  });
-  for (int i = 0; i < n; ++i)
-    if (fixed[i]) held.emplace_back(i, i, 1.0);
-  Eigen::SparseMatrix<double> K(N, N), Kf(N, N);
-  K.setFromTriplets(held.begin(), held.end());
-  Kf.setFromTriplets(full.begin(), full.end());
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(K);
-  if (solver.info() != Eigen::Success)
-    throw SceneError("scene: the lateral stiffness at the steady arms has no solution (a wire free to move sideways)");
+  const LateralSystem held(m, lat, fixed, true);
+  const Eigen::SparseMatrix<double>& Kf = held.full();
+  const Eigen::VectorXd at_rest = Eigen::VectorXd::Zero(n);
   std::vector<RegistrationLateral> out(dofs.size());
   for (std::size_t q = 0; q < dofs.size(); ++q) {
     const int i = lateral_dof(dofs[q]);
-    Eigen::VectorXd c = Kf.col(i);
-    for (int j = 0; j < n; ++j)
-      if (fixed[j]) c[j] = 0.0;
-    const Eigen::VectorXd x = solver.solve(c);
+    const Eigen::VectorXd c = Kf.col(i);
+    const Eigen::VectorXd x = held.solve(c, at_rest);  // K_rr^-1 K_ri, 0 on the held rows
     // (Without the support's own lateral spring: that is the arm itself, stiff along its length.)
     double own = 0.0;
     for (const LateralSpring& sp : lat.springs)
