@@ -16,14 +16,25 @@ constexpr const char* kEndedMessage = "the pass has ended; reset to run again";
 }  // namespace
 
 void SimulationNode::on_reconfigure(NodeConfig& c, uint32_t) {
-  // The ranges of the .cfg are those of the parameters; dynamic_reconfigure clamps to them.
-  if (c.real_time_factor != params_.real_time_factor) reanchor();
-  params_.real_time_factor = c.real_time_factor;
-  params_.vertical_scale = c.vertical_scale;
-  params_.lateral_scale = c.lateral_scale;
-  params_.publish_rate = c.publish_rate;
-  params_.shape_rate = c.shape_rate;
-  params_.marker_rate = c.marker_rate;
+  // The ranges of the .cfg are those of the parameters; dynamic_reconfigure clamps to them, but
+  // NaN passes its clamp (it compares false): refused here, the value in effect kept and
+  // published back.
+  const NodeConfig lo = NodeConfig::__getMin__(), hi = NodeConfig::__getMax__();
+  auto take = [](const char* name, double& asked, double min, double max, double& kept) {
+    if (std::isfinite(asked)) {
+      kept = asked;
+      return;
+    }
+    ROS_ERROR("catenary_sim: %s = %g rejected: allowed %g to %g; kept %g", name, asked, min, max, kept);
+    asked = kept;
+  };
+  if (std::isfinite(c.real_time_factor) && c.real_time_factor != params_.real_time_factor) reanchor();
+  take("real_time_factor", c.real_time_factor, lo.real_time_factor, hi.real_time_factor, params_.real_time_factor);
+  take("vertical_scale", c.vertical_scale, lo.vertical_scale, hi.vertical_scale, params_.vertical_scale);
+  take("lateral_scale", c.lateral_scale, lo.lateral_scale, hi.lateral_scale, params_.lateral_scale);
+  take("publish_rate", c.publish_rate, lo.publish_rate, hi.publish_rate, params_.publish_rate);
+  take("shape_rate", c.shape_rate, lo.shape_rate, hi.shape_rate, params_.shape_rate);
+  take("marker_rate", c.marker_rate, lo.marker_rate, hi.marker_rate, params_.marker_rate);
   std::string err;
   if (sim_->set_max_acceleration(c.max_acceleration, &err)) {
     params_.max_acceleration = c.max_acceleration;

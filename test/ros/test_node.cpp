@@ -369,4 +369,35 @@ TEST(Node, DynamicReconfigureChangesTheRealTimeFactorLive) {
   ASSERT_TRUE(reconfigure("max_acceleration", 5.0));
 }
 
+// dynamic_reconfigure clamps a value to the .cfg's range, but NaN passes its clamp (it compares
+// false either way). Each field must refuse it and answer with the value in effect, and the pass
+// must go on: a NaN publish_rate stopped the node ("Duration is out of dual 32-bit range"), a NaN
+// real_time_factor froze the pass, a NaN scale drew NaN markers.
+TEST(Node, DynamicReconfigureRefusesNaN) {
+  dynamic_reconfigure::Reconfigure now;
+  ASSERT_TRUE(ros::service::call("/catenary_sim/set_parameters", now));  // (an empty request: the config in effect)
+  for (const dynamic_reconfigure::DoubleParameter& before : now.response.config.doubles) {
+    SCOPED_TRACE(before.name);
+    ASSERT_TRUE(std::isfinite(before.value));
+    dynamic_reconfigure::Reconfigure r;
+    dynamic_reconfigure::DoubleParameter p;
+    p.name = before.name;
+    p.value = std::nan("");
+    r.request.config.doubles.push_back(p);
+    ASSERT_TRUE(ros::service::call("/catenary_sim/set_parameters", r));
+    bool answered = false;
+    for (const auto& d : r.response.config.doubles)
+      if (d.name == before.name) {
+        EXPECT_EQ(d.value, before.value) << "not the value in effect";
+        answered = true;
+      }
+    EXPECT_TRUE(answered);
+  }
+  Recorder<PantographStateArray> state("pantograph_state");
+  const PantographStateArray a = latest_state(state);
+  ros::WallDuration(0.5).sleep();
+  const PantographStateArray b = latest_state(state);
+  EXPECT_NE(b.sim_time, a.sim_time) << "the pass stopped";  // (at_end loop: it may have started again)
+}
+
 int main(int argc, char** argv) { return ros_test::ros_test_main(argc, argv, "test_catenary_sim_node"); }
