@@ -131,13 +131,10 @@ Scene load_hil_scene(const HilParams& p) {
   Scene scene;
   try {
     scene = load_scene_file(p.scene);
-    if (p.speed_kmh) {
-      scene.train_speed = *p.speed_kmh / 3.6;
-      validate(scene);
-    }
   } catch (const SceneError& e) {
     throw ParamError("parameter ~scene = '" + p.scene + "': " + e.what());
   }
+  apply_speed_kmh(p.speed_kmh, scene);
   bool external = false;
   for (const PantographSpec& ps : scene.pantographs) external = external || ps.external;
   if (!external)

@@ -327,18 +327,28 @@ std::string resolve_scene_path(const std::string& scene) {
   return path;
 }
 
+void apply_speed_kmh(const std::optional<double>& speed_kmh, Scene& scene) {
+  if (!speed_kmh) return;
+  if (const TrainSpeedLimit limit = train_speed_limit(scene); !limit.allows(*speed_kmh / 3.6))
+    throw ParamError("parameter ~speed_kmh = " + fmt(*speed_kmh) + " km/h: allowed " + limit.text());
+  scene.train_speed = *speed_kmh / 3.6;
+  try {
+    validate(scene);
+  } catch (const SceneError& e) {
+    throw ParamError("parameter ~speed_kmh = " + fmt(*speed_kmh) + " km/h: " + e.what());
+  }
+}
+
 Scene load_scene(const NodeParams& p) {
   const std::string path = resolve_scene_path(p.scene);
+  Scene scene;
   try {
-    Scene scene = load_scene_file(path);
-    if (p.speed_kmh) {
-      scene.train_speed = *p.speed_kmh / 3.6;
-      validate(scene);
-    }
-    return scene;
+    scene = load_scene_file(path);
   } catch (const SceneError& e) {
     throw ParamError("parameter ~scene = '" + p.scene + "': " + e.what());
   }
+  apply_speed_kmh(p.speed_kmh, scene);
+  return scene;
 }
 
 }  // namespace ros_layer

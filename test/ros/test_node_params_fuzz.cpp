@@ -260,6 +260,15 @@ TEST_F(NodeParamsFuzz, KnownCasesSayValueAndWhatIsAllowed) {
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.out.find(c.says), std::string::npos);
   }
+  // A speed within ~speed_kmh's range but beyond the scene's contact-wire wave speed (438 km/h on
+  // reference_55m, 460 km/h on its HIL twin) is the parameter's fault, named as simulate_pass
+  // names --speed.
+  for (const auto& [node, scene] : {std::pair{kNode, kScene}, std::pair{kHilNode, kHilScene}}) {
+    const ChildRun r = run(node, {"_scene:=" + scene, "_speed_kmh:=500"});
+    SCOPED_TRACE(node + "\n  output: " + r.out);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.out.find("parameter ~speed_kmh = 500 km/h: allowed"), std::string::npos);
+  }
 }
 
 // replay_markers says a bad value as it was written and its range in the same words as the

@@ -83,6 +83,9 @@ class ParamReader {
 // (an empty launch argument, speed_kmh:="") for "not given". Returns whether it was given.
 bool read_speed_kmh(ParamReader& r, const ros::NodeHandle& private_nh, std::optional<double>& out,
                     const std::string& expected);
+// ~speed_kmh, when given, as the scene's train speed, within the scene's own limit (below the
+// contact wire's wave speed); throws ParamError naming ~speed_kmh, as simulate_pass names --speed.
+void apply_speed_kmh(const std::optional<double>& speed_kmh, Scene& scene);
 
 // The lower bounds of the rates (Hz). The period 1/rate becomes a ros::WallDuration, whose
 // seconds are an int32: anything below 1/2^31 Hz (e.g. 1e-10, 1e-300) threw out of the
