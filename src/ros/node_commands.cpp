@@ -150,7 +150,9 @@ bool SimulationNode::on_step(Step::Request& req, Step::Response& res) {
   res.sim_time = sim_->state().time;
   res.success = res.steps_advanced == req.steps;
   res.message = res.success ? "ok" : "stopped early: " + sim_->status_message();
-  handle_end();
+  // With at_end exit the main loop ends the pass once this reply has gone: shutting down inside
+  // the callback would leave the caller without one.
+  if (params_.at_end != AtEnd::kExit) handle_end();
   publish(true);
   return true;
 }

@@ -338,6 +338,25 @@ TEST_F(NodeParamsFuzz, StatsFileThatFailsAtTheEndFailsTheExitCode) {
   EXPECT_FALSE(exists(out));
 }
 
+// A Step that reaches the end of the pass with at_end exit gets its answer (success false, stopped
+// early at the end, the steps it took) before the node exits 0: the node shut down inside the
+// service's callback, and the caller got a transport error instead.
+TEST_F(NodeParamsFuzz, AStepToTheEndWithAtEndExitIsAnswered) {
+  Child node({kNode, "__name:=stepping", "_scene:=" + kScene, "_speed_kmh:=250", "_real_time_factor:=0", "_paused:=true",
+              "_at_end:=exit", "_publish_clock:=false"},
+             dir_ + "/stepping.log", env_);
+  // (reference_55m at 250 km/h: about 9100 steps, within one call's 100000)
+  const ChildRun call = Child({"/usr/bin/rosservice", "call", "--wait", "/stepping/step", "steps: 100000"},
+                              dir_ + "/stepping_call.log", env_)
+                            .wait(120.0);
+  EXPECT_EQ(call.exit_code, 0) << call.out;
+  EXPECT_NE(call.out.find("success: False"), std::string::npos) << call.out;
+  EXPECT_NE(call.out.find("stopped early"), std::string::npos) << call.out;
+  const ChildRun r = node.wait(60.0);
+  ASSERT_FALSE(r.hung) << r.out;
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+}
+
 // ~report_file: at the end of the pass the node writes the pass's files beside the page and draws
 // the same report as simulate_pass --report (same sections, pictures embedded), then exits 0.
 // A short pass (six spans, 0.5 m elements) at full speed; the page's checks are test_pass_report's.
