@@ -200,7 +200,7 @@ void Simulation::reset(bool keep_time) {
 bool Simulation::set_target_speed(double v, std::string* error) {
   const TrainSpeedLimit limit = train_speed_limit(model_.scene);
   if (!limit.allows(v)) {
-    if (error) *error = "train speed " + fmt(v) + " m/s rejected: allowed " + limit.text();
+    if (error) *error = "train speed " + fmt_given(v) + " m/s rejected: allowed " + limit.text();
     return false;
   }
   state_.target_speed = v;
@@ -209,7 +209,7 @@ bool Simulation::set_target_speed(double v, std::string* error) {
 
 bool Simulation::set_max_acceleration(double a, std::string* error) {
   if (!std::isfinite(a) || a < 0.0 || a > 20.0) {
-    if (error) *error = "max acceleration " + fmt(a) + " m/s^2 rejected: allowed 0 (no limit) to 20 m/s^2";
+    if (error) *error = "max acceleration " + fmt_given(a) + " m/s^2 rejected: allowed 0 (no limit) to 20 m/s^2";
     return false;
   }
   state_.max_acceleration = a;
@@ -223,7 +223,7 @@ bool Simulation::set_uplift(int p, double f, std::string* error) {
     return false;
   }
   if (!std::isfinite(f) || f < 0.0 || f > kMaxUplift) {
-    if (error) *error = "uplift force " + fmt(f) + " N rejected: allowed 0 to " + fmt(kMaxUplift) + " N";
+    if (error) *error = "uplift force " + fmt_given(f) + " N rejected: allowed 0 to " + fmt(kMaxUplift) + " N";
     return false;
   }
   if (p < 0) {
@@ -242,7 +242,7 @@ bool Simulation::set_external_force(int p, double f, std::string* error) {
   }
   if (!std::isfinite(f) || f < kMinExternalForce || f > kMaxExternalForce) {
     std::ostringstream s;
-    s << "external contact force " << f << " N rejected: allowed " << kMinExternalForce << " to " << kMaxExternalForce
+    s << "external contact force " << fmt_given(f) << " N rejected: allowed " << kMinExternalForce << " to " << kMaxExternalForce
       << " N (negative readings are taken as 0)";
     if (error) *error = s.str();
     return false;

@@ -273,7 +273,7 @@ void HilNode::on_wrench(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
                                                    {"torque.z", w.torque.z}};
   for (const auto& o : others)
     if (!std::isfinite(o.second)) {
-      loop_->reject(std::string("hil/contact_wrench.wrench.") + o.first + " = " + format_number(o.second) +
+      loop_->reject(std::string("hil/contact_wrench.wrench.") + o.first + " = " + format_given(o.second) +
                     " rejected: allowed a finite value (only force.z is used; the other components must be finite)");
       return;
     }

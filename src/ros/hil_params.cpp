@@ -20,7 +20,7 @@ void validate_hil_params(const HilParams& p) {
   if (const std::string e = hil::loop_rate_error(p.rate, "parameter ~hil/rate"); !e.empty()) throw ParamError(e);
   const double period = 1.0 / p.rate;
   if (!std::isfinite(p.timeout) || p.timeout < 2.0 * period || p.timeout > 10.0)
-    throw ParamError("parameter ~hil/timeout = " + format_number(p.timeout) + " s rejected: allowed [" + format_number(2.0 * period) +
+    throw ParamError("parameter ~hil/timeout = " + format_given(p.timeout) + " s rejected: allowed [" + format_number(2.0 * period) +
                      ", 10] s (at least two loop periods of ~hil/rate = " + format_number(p.rate) + " Hz)");
   check_range("hil/hold_ramp", p.hold_ramp, 0.0, 60.0, false, "s (0: at once)");
   check_range("hil/hold_deceleration", p.hold_deceleration, 0.0, 50.0, false, "m/s^2 (0: at once)");
@@ -31,7 +31,7 @@ void validate_hil_params(const HilParams& p) {
   check_range("shape_rate", p.shape_rate, kMinShapeRate, 100.0, false, "Hz");
   check_range("shape_resolution", p.shape_resolution, 0.0, 100.0, false, "m (0: every node)");
   if (!std::isfinite(p.spin_wait) || p.spin_wait < 0.0 || p.spin_wait > 0.5 * period)
-    throw ParamError("parameter ~hil/spin_wait = " + format_number(p.spin_wait) + " s rejected: allowed [0, " +
+    throw ParamError("parameter ~hil/spin_wait = " + format_given(p.spin_wait) + " s rejected: allowed [0, " +
                      format_number(0.5 * period) + "] s (at most half a loop period of ~hil/rate = " +
                      format_number(p.rate) + " Hz; 0: no spinning)");
   if (p.realtime_priority < 0 || p.realtime_priority > 99)

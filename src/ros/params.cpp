@@ -22,6 +22,7 @@ namespace ros_layer {
 
 
 std::string format_number(double v) { return fmt(v); }
+std::string format_given(double v) { return fmt_given(v); }
 
 std::string range_text(double lo, double hi, bool lo_open, const char* unit) {
   std::string s = (lo_open ? "(" : "[") + format_number(lo) + ", " + format_number(hi) + "]";
@@ -32,7 +33,7 @@ std::string range_text(double lo, double hi, bool lo_open, const char* unit) {
 void check_range(const char* name, double v, double lo, double hi, bool lo_open, const char* unit) {
   const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi;
   if (!ok)
-    throw ParamError(std::string("parameter ~") + name + " = " + format_number(v) + " rejected: allowed " +
+    throw ParamError(std::string("parameter ~") + name + " = " + format_given(v) + " rejected: allowed " +
                      range_text(lo, hi, lo_open, unit));
 }
 
@@ -51,7 +52,7 @@ std::string describe_value(const XmlRpc::XmlRpcValue& v) {
   switch (v.getType()) {
     case XmlRpcValue::TypeBoolean: return std::string(static_cast<const bool&>(v) ? "true" : "false") + " (a boolean)";
     case XmlRpcValue::TypeInt: return std::to_string(static_cast<const int&>(v)) + " (an integer)";
-    case XmlRpcValue::TypeDouble: return format_number(static_cast<const double&>(v)) + " (a number)";
+    case XmlRpcValue::TypeDouble: return format_given(static_cast<const double&>(v)) + " (a number)";
     case XmlRpcValue::TypeString: return "'" + static_cast<const std::string&>(v) + "' (a string)";
     case XmlRpcValue::TypeArray: return "a list";
     case XmlRpcValue::TypeStruct: return "a map";
@@ -330,12 +331,12 @@ std::string resolve_scene_path(const std::string& scene) {
 void apply_speed_kmh(const std::optional<double>& speed_kmh, Scene& scene) {
   if (!speed_kmh) return;
   if (const TrainSpeedLimit limit = train_speed_limit(scene); !limit.allows(*speed_kmh / 3.6))
-    throw ParamError("parameter ~speed_kmh = " + fmt(*speed_kmh) + " km/h: allowed " + limit.text());
+    throw ParamError("parameter ~speed_kmh = " + fmt_given(*speed_kmh) + " km/h: allowed " + limit.text());
   scene.train_speed = *speed_kmh / 3.6;
   try {
     validate(scene);
   } catch (const SceneError& e) {
-    throw ParamError("parameter ~speed_kmh = " + fmt(*speed_kmh) + " km/h: " + e.what());
+    throw ParamError("parameter ~speed_kmh = " + fmt_given(*speed_kmh) + " km/h: " + e.what());
   }
 }
 

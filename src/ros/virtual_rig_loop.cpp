@@ -38,7 +38,7 @@ VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   r.number("rate", rate_, "a number in [0, 20000] Hz (0: the node's loop rate)");
   // (a rate below 1 Hz would leave the loop asleep for seconds between measurements: no rig runs so)
   if (!std::isfinite(rate_) || !(rate_ == 0.0 || (rate_ >= 1.0 && rate_ <= 20000.0)))
-    throw ParamError("parameter ~rate = " + format_number(rate_) +
+    throw ParamError("parameter ~rate = " + format_given(rate_) +
                      " rejected: allowed 0 (the node's loop rate) or [1, 20000] Hz");
   r.boolean("extrapolate", extrapolate_);
   stepper_ = RigStepper(extrapolate_);

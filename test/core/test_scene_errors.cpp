@@ -183,6 +183,22 @@ TEST(Commands, RejectedCommandsLeaveTheStateAsItWas) {
   EXPECT_EQ(sim.state().uplift[0], 120.0);
 }
 
+// A refused command's value is printed whole: one just past a limit must not read as the limit
+// ("1000 N rejected: allowed 0 to 1000 N"). The number in the message reads back as the value.
+TEST(Commands, AValueJustPastALimitIsPrintedWhole) {
+  Simulation sim(load_scene_file(kReference));
+  std::string err;
+  auto value_in = [&](const std::string& before) { return std::stod(err.substr(err.find(before) + before.size())); };
+  const double uplift = std::nextafter(Simulation::kMaxUplift, 2.0 * Simulation::kMaxUplift);
+  EXPECT_FALSE(sim.set_uplift(-1, uplift, &err));
+  EXPECT_EQ(value_in("uplift force "), uplift) << err;
+  EXPECT_FALSE(sim.set_max_acceleration(20.0000001, &err));
+  EXPECT_EQ(value_in("max acceleration "), 20.0000001) << err;
+  const double speed = std::nextafter(150.0, 200.0);  // above the 540 km/h bound of every scene
+  EXPECT_FALSE(sim.set_target_speed(speed, &err));
+  EXPECT_EQ(value_in("train speed "), speed) << err;
+}
+
 namespace {
 
 using test_scenes::kReference3d;

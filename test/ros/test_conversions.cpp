@@ -501,6 +501,8 @@ TEST(Commands, SpeedCommandErrorNamesTopicValueAndRange) {
   EXPECT_NE(speed_command_error(scene, c).find("wave speed"), std::string::npos);
   EXPECT_NE(speed_command_error(scene, -0.5).find("= -0.5 m/s rejected"), std::string::npos);
   EXPECT_NE(speed_command_error(scene, std::nan("")).find("= nan m/s rejected"), std::string::npos);
+  // Just past the bound, printed whole (not as the bound it passes).
+  EXPECT_NE(speed_command_error(scene, 150.0000001).find("= 150.0000001 m/s rejected"), std::string::npos);
   EXPECT_NE(speed_command_error(scene, std::numeric_limits<double>::infinity()), "");
   // Whatever it accepts the core accepts, and the other way round.
   for (double v : {-1e-9, 0.0, 75.0, 0.99 * c, c, 150.0, 150.0000001, std::nan("")})

@@ -25,8 +25,10 @@ class ParamError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// A number as a user would write it (no trailing zeros).
+// A number as a user would write it (no trailing zeros), six significant digits: a limit.
 std::string format_number(double v);
+// A value as it was given, every digit it has: one just past a limit does not print as the limit.
+std::string format_given(double v);
 // Throws ParamError naming the parameter ~name, the value and the allowed range unless v is
 // finite and in [lo, hi] (or (lo, hi] when lo_open).
 void check_range(const char* name, double v, double lo, double hi, bool lo_open, const char* unit);
