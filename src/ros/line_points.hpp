@@ -12,15 +12,20 @@
 namespace catenary_sim {
 namespace ros_layer {
 
-// Node indices of a wire sampled at about `resolution` m, first and last node always included.
+// Node indices of a wire sampled at about `resolution` m; its first and last nodes (a clamp, an
+// anchor) and its support nodes (where a steady arm, a bracket or a bridle's middle holds it)
+// always included, so that what holds the wire is drawn on it at any resolution.
 inline std::vector<int> sample_nodes(const Wire& w, double resolution) {
   std::vector<int> idx;
   const int n = w.nodes();
   if (n == 0) return idx;
   idx.push_back(0);
   double last = w.x[0];
+  std::size_t next_support = 0;  // (support_nodes ascending)
   for (int i = 1; i + 1 < n; ++i) {
-    if (w.x[i] - last + 1e-9 >= resolution) {
+    while (next_support < w.support_nodes.size() && w.support_nodes[next_support] < i) ++next_support;
+    const bool support = next_support < w.support_nodes.size() && w.support_nodes[next_support] == i;
+    if (support || w.x[i] - last + 1e-9 >= resolution) {
       idx.push_back(i);
       last = w.x[i];
     }
