@@ -85,6 +85,12 @@ std::string train_from_messages(const Model& m, const PantographStateArray& stat
   if (force.pantographs.size() != m.pantographs.size())
     return "contact_force has " + num(force.pantographs.size()) + " pantographs, the scene " +
            num(m.pantographs.size()) + kOtherScene;
+  // Every number drawn or read again must be finite: a NaN in a recording is refused by name, as
+  // the wires' samples are, never drawn.
+  for (const auto& [name, v] : {std::pair<const char*, double>{"sim_time", state.sim_time}, {"train_front", state.train_front},
+                                {"speed", state.speed}, {"target_speed", state.target_speed},
+                                {"max_acceleration", state.max_acceleration}})
+    if (!std::isfinite(v)) return std::string("pantograph_state.") + name + " = " + num(v) + ": expected a finite value";
   s->time = state.sim_time;
   s->steps = state.step;
   s->front = state.train_front - offset;
@@ -105,9 +111,13 @@ std::string train_from_messages(const Model& m, const PantographStateArray& stat
       return field + ": " + num(ps.displacement.size()) + " displacements and " + num(ps.velocity.size()) +
              " velocities: expected " + num(masses) + " of each (the masses of '" + pg.name + "')" + kOtherScene;
     for (std::size_t i = 0; i < masses; ++i) {
+      if (!std::isfinite(ps.displacement[i]) || !std::isfinite(ps.velocity[i]))
+        return field + ".displacement/velocity[" + num(i) + "] = " + num(ps.displacement[i]) + " / " + num(ps.velocity[i]) +
+               ": expected finite values";
       s->pantograph_displacement(m, static_cast<int>(p), static_cast<int>(i)) = ps.displacement[i];
       s->pantograph_velocity(m, static_cast<int>(p), static_cast<int>(i)) = ps.velocity[i];
     }
+    if (!std::isfinite(ps.uplift)) return field + ".uplift = " + num(ps.uplift) + ": expected a finite value, N";
     s->uplift[p] = ps.uplift;
     if (c.contact_wires.size() != nw)
       return "contact_force.pantographs[" + num(p) + "].contact_wires has " + num(c.contact_wires.size()) +
@@ -120,8 +130,13 @@ std::string train_from_messages(const Model& m, const PantographStateArray& stat
       return "contact_force.pantographs[" + num(p) + "].wire_forces has " + num(c.wire_forces.size()) +
              " values: expected " + num(pg.collectors.size() * nw) + " (collectors x contact wires)" + kOtherScene;
     for (std::size_t j = 0; j < pg.collectors.size(); ++j)
-      for (std::size_t k = 0; k < nw; ++k)
-        s->contact_force_on(m, pg.collectors[j], static_cast<int>(k)) = c.wire_forces[j * nw + k];  // message: collectors x wires
+      for (std::size_t k = 0; k < nw; ++k) {
+        const double f = c.wire_forces[j * nw + k];  // message: collectors x wires
+        if (!std::isfinite(f))
+          return "contact_force.pantographs[" + num(p) + "].wire_forces[" + num(j * nw + k) + "] = " + num(f) +
+                 ": expected a finite value, N";
+        s->contact_force_on(m, pg.collectors[j], static_cast<int>(k)) = f;
+      }
   }
   return "";
 }

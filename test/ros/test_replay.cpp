@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
 #include "catenary_sim/ros/conversions.hpp"
@@ -178,6 +181,44 @@ TEST(Replay, RecordingOfAnotherSceneIsRefusedWithTheField) {
   const std::string e2 = state_from_messages(m2, to_wire_shape(m2, pair.state(), 1.0, stamp, "line"), ps,
                                              to_contact_force(m2, pair.state(), stamp, "line"), &out2);
   EXPECT_NE(e2.find("pantograph_state has 1 pantographs, the scene 2"), std::string::npos) << e2;
+}
+
+// A NaN anywhere in a recording is refused by the field that holds it, never drawn (the wires'
+// samples were checked; the train's, the pantographs' and the contact forces' were drawn as NaN).
+TEST(Replay, ANaNInTheRecordingIsRefusedByItsField) {
+  Simulation sim(load_scene_file(scene_path("reference_55m.yaml")));
+  for (int k = 0; k < 500; ++k) ASSERT_EQ(sim.step(), StepStatus::kOk);
+  const Model& m = sim.model();
+  const ros::Time stamp(1.0 + sim.state().time);
+  const WireShapeArray shape = to_wire_shape(m, sim.state(), 1.0, stamp, "line");
+  const PantographStateArray state = to_pantograph_state(m, sim.state(), stamp, "line");
+  const ContactForceArray force = to_contact_force(m, sim.state(), stamp, "line");
+  const double nan = std::nan("");
+  auto refusal = [&](auto&& spoil) {
+    PantographStateArray ps = state;
+    ContactForceArray cf = force;
+    spoil(ps, cf);
+    State out = make_state(m);
+    return state_from_messages(m, shape, ps, cf, &out);
+  };
+  State out = make_state(m);
+  ASSERT_EQ(state_from_messages(m, shape, state, force, &out), "");
+  const std::vector<std::pair<std::string, std::function<void(PantographStateArray&, ContactForceArray&)>>> cases = {
+      {"pantograph_state.train_front", [&](PantographStateArray& p, ContactForceArray&) { p.train_front = nan; }},
+      {"pantograph_state.sim_time", [&](PantographStateArray& p, ContactForceArray&) { p.sim_time = nan; }},
+      {"pantograph_state.speed", [&](PantographStateArray& p, ContactForceArray&) { p.speed = nan; }},
+      {"pantograph_state.pantographs[0].displacement/velocity[1]",
+       [&](PantographStateArray& p, ContactForceArray&) { p.pantographs[0].displacement[1] = nan; }},
+      {"pantograph_state.pantographs[0].displacement/velocity[0]",
+       [&](PantographStateArray& p, ContactForceArray&) { p.pantographs[0].velocity[0] = nan; }},
+      {"pantograph_state.pantographs[0].uplift", [&](PantographStateArray& p, ContactForceArray&) { p.pantographs[0].uplift = nan; }},
+      {"contact_force.pantographs[0].wire_forces[0]", [&](PantographStateArray&, ContactForceArray& c) { c.pantographs[0].wire_forces[0] = nan; }},
+  };
+  for (const auto& [field, spoil] : cases) {
+    const std::string e = refusal(spoil);
+    EXPECT_EQ(e.rfind(field, 0), 0u) << field << ": " << e;
+    EXPECT_NE(e.find("finite"), std::string::npos) << e;
+  }
 }
 
 // The scene a recording carries (the node's ~scene_yaml, simulate_pass's bag): the same model as
