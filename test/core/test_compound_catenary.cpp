@@ -257,7 +257,8 @@ TEST(CompoundCatenary, BadInputIsRefusedByName) {
   refused(no_aux, "hangers");
 }
 
-// An auxiliary too slack for its hangers hangs below the contact wire: refused, naming it.
+// An auxiliary too slack for its hangers hangs below the contact wire: refused by its tension
+// (the field, as scene fields are named: Python's SceneError.field reads it).
 TEST(CompoundCatenary, AnAuxiliaryBelowTheContactWireIsRefused) {
   std::string y = strings_yaml(0.25);
   y.replace(y.find("tension: 14700, height"), 22, "tension: 50, height");
@@ -265,7 +266,9 @@ TEST(CompoundCatenary, AnAuxiliaryBelowTheContactWireIsRefused) {
     cs::build_model(cs::load_scene_string(y));
     ADD_FAILURE() << "an auxiliary of 50 N was accepted";
   } catch (const cs::SceneError& e) {
-    EXPECT_NE(std::string(e.what()).find("auxiliary messenger"), std::string::npos) << e.what();
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("scene field 'auxiliary_messenger.tension' = 50 N: ", 0), 0u) << what;
+    EXPECT_NE(what.find("auxiliary messenger hangs"), std::string::npos) << what;
   }
 }
 

@@ -384,7 +384,9 @@ TEST(StitchedCatenary, ASectionCanLeaveTheStitchWireOut) {
   EXPECT_TRUE(m.sections[1].clamped_wires.empty());
 }
 
-// A stitch wire too slack for its droppers hangs below the contact wire: refused, naming it.
+// A stitch wire too slack for its droppers hangs below the contact wire: refused by its tension
+// (the field, as scene fields are named: Python's SceneError.field reads it), with its length as
+// the other remedy.
 TEST(StitchedCatenary, AStitchWireBelowTheContactWireIsRefused) {
   std::string y = network_yaml(0.25);
   y.replace(y.find("tension: 3500"), 13, "tension: 100");
@@ -392,7 +394,10 @@ TEST(StitchedCatenary, AStitchWireBelowTheContactWireIsRefused) {
     cs::build_model(cs::load_scene_string(y));
     ADD_FAILURE() << "a stitch wire of 100 N was accepted";
   } catch (const cs::SceneError& e) {
-    EXPECT_NE(std::string(e.what()).find("stitch wire"), std::string::npos) << e.what();
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("scene field 'stitch_wire.tension' = 100 N: ", 0), 0u) << what;
+    EXPECT_NE(what.find("stitch wire hangs"), std::string::npos) << what;
+    EXPECT_NE(what.find("shorten stitch_wire.length"), std::string::npos) << what;
   }
 }
 

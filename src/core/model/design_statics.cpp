@@ -216,16 +216,32 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
     const DropperSpec& spec = d.hanger ? *sec.hangers : *sec.droppers;
     const std::string part = d.hanger ? "hanger" : "dropper";
     if (d.length <= 0.01) {
+      // Named by the field that most directly lifts the wire above: a stitch wire's own tension
+      // (it sags as L^2 / T between its clamps), the auxiliary's tension (it sags between its
+      // droppers under the hangers), else the system height.
       const Wire& top = wire_of(m, d.messenger_dof);
       const bool holds_auxiliary = wire_of(m, d.contact_dof).is_auxiliary_messenger;
       const std::string low = holds_auxiliary ? "auxiliary messenger" : "contact wire";
       const std::string top_name = top.is_clamped_wire ? "stitch wire" : top.is_auxiliary_messenger ? "auxiliary messenger" : "messenger";
-      throw SceneError(part + "s: at x = " + fmt(d.x) + " m the " + top_name + " hangs " + fmt(-d.length) + " m below the " + low +
-                       " (" + part + " length " + fmt(d.length) + " m): raise " +
-                       (d.hanger ? "auxiliary_messenger.height or its tension" : "line.encumbrance or the " + top_name + "'s tension") +
-                       (holds_auxiliary ? ", lower auxiliary_messenger.height (" + fmt(sec.auxiliary_messenger->height) + " m)" : "") +
-                       // (a stitch wire pulls the messenger down at its clamps by its tension's share)
-                       (sec.stitch_wire ? ", lower stitch_wire.tension (" + fmt(sec.stitch_wire->tension) + " N)" : "") +
+      std::string field, value, advice;
+      if (top.is_clamped_wire) {
+        field = scene.section_field(d.section, "stitch_wire.tension");
+        value = fmt(sec.stitch_wire->tension) + " N";
+        advice = "raise it, or shorten " + scene.section_field(d.section, "stitch_wire.length") + " (its sag grows as its length squared over its tension)";
+      } else if (d.hanger) {
+        field = scene.section_field(d.section, "auxiliary_messenger.tension");
+        value = fmt(sec.auxiliary_messenger->tension) + " N";
+        advice = "raise it, or raise auxiliary_messenger.height (" + fmt(sec.auxiliary_messenger->height) + " m)";
+      } else {
+        field = "line.encumbrance";
+        value = fmt(scene.encumbrance) + " m";
+        advice = "raise it or the " + top_name + "'s tension" +
+                 (holds_auxiliary ? ", or lower auxiliary_messenger.height (" + fmt(sec.auxiliary_messenger->height) + " m)" : "") +
+                 // (a stitch wire pulls the messenger down at its clamps by its tension's share)
+                 (sec.stitch_wire ? ", or lower stitch_wire.tension (" + fmt(sec.stitch_wire->tension) + " N)" : "");
+      }
+      throw SceneError("scene field '" + field + "' = " + value + ": at x = " + fmt(d.x) + " m the " + top_name + " hangs " +
+                       fmt(-d.length) + " m below the " + low + " (" + part + " length " + fmt(d.length) + " m); " + advice +
                        ", or reduce the presag");
     }
     const int nspan = static_cast<int>(sec.spans.size());
