@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "catenary_sim/core/model/lateral.hpp"
 #include "catenary_sim/core/model/statics.hpp"
+#include "catenary_sim/core/model/wire_band.hpp"
 #include "model/spd_solver.hpp"
 #include "util/format.hpp"
 
@@ -24,31 +26,45 @@ const Wire& wire_of(const Model& m, int dof) { return m.wires[wire_holding(m, do
 // working height, the other end above by what its arms' loads differ (the clamp then a short
 // link). Its reaction at the middle is the support's preload (design_statics).
 void bridle_statics(const Scene& scene, const Section& info, Model& m, std::vector<std::vector<double>>& react) {
-  const Wire* steepest = nullptr;  // refused by the worst, as the plan's check is (lateral.cpp)
-  double worst = 0.0;
-  for (int wi : info.clamped_wires) {
-    Wire& w = m.wires[wi];
+  const double H = scene.contact_wire_height;
+  // Hangs bridle w; returns the steeper arm's slope, its V in the small angles (a 3-D line checks
+  // each arm up and across together: lateral.cpp).
+  auto hang = [&](Wire& w, std::vector<double>& reaction) {
     const int n = w.nodes();
     std::vector<double> load(n);
     for (int i = 0; i < n; ++i) load[i] = -scene.gravity * m.mass[w.w_dof + i];
     for (const WireClamp& c : m.clamps)
       if (holds(w, c.upper_dof)) load[c.upper_dof - w.w_dof] -= c.static_force;
-    const double H = scene.contact_wire_height;
-    solve_wire_statics(w, load, {w.support_nodes.front()}, {H}, w.height, w.slope, react[wi]);
+    solve_wire_statics(w, load, {w.support_nodes.front()}, {H}, w.height, w.slope, reaction);
     // (A rigid rise: the band has no force from it, the reaction stays.)
     const double rise = H - std::min(w.height.front(), w.height.back());
     for (double& y : w.height) y += rise;
-    // Its V in the small angles (a 3-D line checks each arm up and across together: lateral.cpp).
-    const double slope = std::max(bridle_arm_rise(w, 0), bridle_arm_rise(w, n - 1));
+    return std::max(bridle_arm_rise(w, 0), bridle_arm_rise(w, n - 1));
+  };
+  const Wire* steepest = nullptr;  // refused by the worst, as the plan's check is (lateral.cpp)
+  double worst = 0.0;
+  for (int wi : info.clamped_wires) {
+    const double slope = hang(m.wires[wi], react[wi]);
     if (!(slope <= worst) && !std::isnan(worst)) {  // (a NaN slope is the worst)
       worst = slope;
-      steepest = &w;
+      steepest = &m.wires[wi];
     }
   }
-  if (steepest && !(worst <= kSteepestBridleArm))
-    refuse_slack_bridle(scene, *steepest, worst,
-                        "in its V, its middle " + fmt(steepest->height[steepest->support_nodes.front()] - scene.contact_wire_height) +
-                            " m above the wire");
+  if (!steepest || worst <= kSteepestBridleArm) return;
+  // The tension that would do: the string's share of a slope falls as 1 / tension, the bridle's
+  // bending's does not, so the steepest is hung again at the string's estimate and the slope
+  // taken as a / T + b through the two.
+  const double t1 = steepest->spec.tension, t2 = t1 * worst / kSteepestBridleArm;
+  Wire again = *steepest;
+  again.spec.tension = t2;
+  assemble_band(again, {});
+  std::vector<double> reaction;
+  const double s2 = hang(again, reaction);
+  const double a = (worst - s2) / (1.0 / t1 - 1.0 / t2), b = worst - a / t1;
+  const double needed = a > 0.0 && b < kSteepestBridleArm ? a / (kSteepestBridleArm - b) : t2;
+  refuse_slack_bridle(scene, *steepest, worst,
+                      "in its V, its middle " + fmt(steepest->height[steepest->support_nodes.front()] - H) + " m above the wire",
+                      "", needed);
 }
 
 }  // namespace
@@ -58,13 +74,16 @@ double bridle_arm_rise(const Wire& w, int end) {
   return std::fabs(w.height[mid] - w.height[end]) / std::fabs(w.x[end] - w.x[mid]);
 }
 
-void refuse_slack_bridle(const Scene& scene, const Wire& w, double slope, const std::string& how, const std::string& advice) {
+void refuse_slack_bridle(const Scene& scene, const Wire& w, double slope, const std::string& how, const std::string& advice,
+                         std::optional<double> needed) {
   const std::string field = scene.section_field(w.section, "bridle");
   const double tension = scene.sections[w.section].bridle->tension;
   throw SceneError("scene field '" + field + ".tension' = " + fmt(tension) + " N: to carry the contact wire, the bridle at station " +
                    fmt(w.x[w.support_nodes.front()]) + " m would run its arms at a slope of " + fmt(slope) + " (" + how +
                    "); at most " + fmt(kSteepestBridleArm) + ", the model's small angles: raise " + field + ".tension (about " +
-                   fmt(tension * slope / kSteepestBridleArm) + " N; the slopes fall as 1 / tension, at most 1e5)" + advice);
+                   (needed ? fmt(*needed) + " N, the bridle hung again at two tensions" :
+                             fmt(tension * slope / kSteepestBridleArm) + " N; the slopes fall nearly as 1 / tension") +
+                   ", at most 1e5)" + advice);
 }
 
 namespace {

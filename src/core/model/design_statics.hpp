@@ -2,6 +2,8 @@
 // that hold the contact wire at its design shape, and the support preloads.
 #pragma once
 
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "catenary_sim/core/model/model.hpp"
@@ -16,9 +18,9 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
 constexpr double kSteepestBridleArm = 0.25;
 double bridle_arm_rise(const Wire& bridle, int end);
 // Refuses (SceneError, by the section's bridle.tension) the bridle whose steepest arm, `slope`
-// (above kSteepestBridleArm), is told of by `how`; `advice` is added to raising the tension,
-// which the slopes fall with as 1 / tension.
+// (above kSteepestBridleArm), is told of by `how`; `advice` is added to raising the tension: to
+// `needed` where known, else the tension at which the slope would fall as 1 / tension.
 [[noreturn]] void refuse_slack_bridle(const Scene& scene, const Wire& bridle, double slope, const std::string& how,
-                                      const std::string& advice = "");
+                                      const std::string& advice = "", std::optional<double> needed = std::nullopt);
 
 }  // namespace catenary_sim
