@@ -84,6 +84,11 @@ TEST(SceneErrors, OutputLimitsAndMeasurementFields) {
 TEST(SceneErrors, NotANumber) {
   EXPECT_MENTIONS(error_of({"contact_wire.linear_mass=heavy"}), "contact_wire.linear_mass", "'heavy'", "a number");
   EXPECT_MENTIONS(error_of({"droppers.positions=7"}), "droppers.positions", "a list of numbers");
+  // Text that spells a number is still text: quoted, in an override or a file, and in a list.
+  EXPECT_MENTIONS(error_of({"contact_wire.tension=\"20000\""}), "contact_wire.tension", "'20000' (in quotes, so text)");
+  EXPECT_MENTIONS(error_of({"contact_wire.tension='2e4 '"}), "contact_wire.tension", "'2e4 '", "without quotes");
+  EXPECT_MENTIONS(error_of({"droppers.positions=[4.5, '10.25']"}), "droppers.positions[1]", "in quotes");
+  EXPECT_EQ(error_of({"contact_wire.tension=20000"}), "");
 }
 
 TEST(SceneErrors, MissingRequiredField) {

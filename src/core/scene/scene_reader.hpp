@@ -110,6 +110,8 @@ class Reader {
   static double parse_number(const YAML::Node& n, const std::string& field, double lo, double hi, bool lo_open) {
     if (!n.IsScalar()) fail(field, "(not a scalar)", "a number in " + range(lo, hi, lo_open));
     const std::string raw = n.as<std::string>();
+    // A quoted scalar is text ("1500", '1.5e3 '), whatever it spells: a number is written plain.
+    if (n.Tag() == "!") fail(field, "'" + raw + "' (in quotes, so text)", "a number in " + range(lo, hi, lo_open) + ", written without quotes");
     double v = 0.0;
     try {
       v = n.as<double>();
