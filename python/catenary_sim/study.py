@@ -158,6 +158,12 @@ def load_study(path):
     ov = doc.get("overrides", {}) or {}
     if not isinstance(ov, dict):
         _fail("overrides", ov, "a map {dotted.key: value}")
+    for key, value in ov.items():  # named here, not by the whole file's check below
+        try:
+            json.dumps(value, allow_nan=False)
+        except (TypeError, ValueError):
+            _fail(f"overrides.{key}", value, "a finite number, text, true/false, null, a list or a map (each case's "
+                  "overrides are written to plan.json, which holds no NaN, infinity or other types)")
     s["overrides"] = ov
     s["sampling"] = doc.get("sampling", "grid")
     if s["sampling"] not in SAMPLINGS:

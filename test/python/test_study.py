@@ -132,6 +132,11 @@ def test_bad_study_files_name_the_field(tmp_path):
                                      parameters=[{"key": "a", "distribution": {"type": "uniform", "low": 0, "high": 1}}]))
     with pytest.raises(study.StudyError, match="spam"):
         study.load_study(write_study(str(tmp_path / "d.yaml"), spam=1, parameters=[{"key": "a", "values": [1]}]))
+    # NaN or infinity in the overrides (plan.json holds neither) is refused by its key and value.
+    for bad in (float("nan"), float("inf"), [1.0, float("nan")]):
+        with pytest.raises(study.StudyError, match=r"study field 'overrides\.bridle\.length' = .*(nan|inf)"):
+            study.load_study(write_study(str(tmp_path / "e.yaml"), overrides={"bridle.length": bad},
+                                         parameters=[{"key": "a", "values": [1]}]))
 
 
 def test_grid_values_may_be_lists_and_null_with_labels(tmp_path):
