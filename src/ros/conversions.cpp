@@ -154,6 +154,9 @@ geometry_msgs::TransformStamped to_view_transform(const State& s, const ros::Tim
 namespace {
 constexpr const char* kScenePathLine = "# catenary_sim scene: ";
 constexpr const char* kSceneSetLine = "# catenary_sim set: ";
+// An override's further lines (a value written over several lines): each a comment of its own, so
+// that the scene's YAML below stays one document.
+constexpr const char* kSceneSetMoreLine = "# catenary_sim set+ ";
 }  // namespace
 
 std::string scene_yaml_message(const std::string& path, const std::vector<std::string>& overrides) {
@@ -163,7 +166,13 @@ std::string scene_yaml_message(const std::string& path, const std::vector<std::s
   char* real = ::realpath(path.c_str(), nullptr);
   text << kScenePathLine << (real ? real : path) << "\n";
   std::free(real);
-  for (const std::string& o : overrides) text << kSceneSetLine << o << "\n";
+  for (const std::string& o : overrides) {
+    std::istringstream lines(o);
+    std::string line;
+    std::getline(lines, line);
+    text << kSceneSetLine << line << "\n";
+    while (std::getline(lines, line)) text << kSceneSetMoreLine << line << "\n";
+  }
   text << in.rdbuf();
   return text.str();
 }
@@ -172,7 +181,7 @@ Scene scene_from_message(const std::string& text) {
   std::string base_dir;
   std::vector<std::string> overrides;
   std::istringstream lines(text);
-  const std::string head(kScenePathLine), set(kSceneSetLine);
+  const std::string head(kScenePathLine), set(kSceneSetLine), more(kSceneSetMoreLine);
   for (std::string line; std::getline(lines, line) && line.rfind("# catenary_sim ", 0) == 0;) {
     if (line.compare(0, head.size(), head) == 0) {
       const std::string path = line.substr(head.size());
@@ -180,6 +189,8 @@ Scene scene_from_message(const std::string& text) {
       if (slash != std::string::npos) base_dir = slash == 0 ? "/" : path.substr(0, slash);
     } else if (line.compare(0, set.size(), set) == 0) {
       overrides.push_back(line.substr(set.size()));
+    } else if (line.compare(0, more.size(), more) == 0 && !overrides.empty()) {
+      overrides.back() += "\n" + line.substr(more.size());
     }
   }
   return load_scene_string(text, overrides, base_dir);

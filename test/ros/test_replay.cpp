@@ -235,4 +235,12 @@ TEST(Replay, SceneMessageGivesTheSceneOfTheRecording) {
   EXPECT_EQ(carried.support_x.size(), 7u);  // 6 spans
   // A file that cannot be read is the scene's error, not an empty message.
   EXPECT_THROW(scene_yaml_message("/nonexistent_catenary_sim_dir/s.yaml"), SceneError);
+  // A value written over several lines (a shell's $'[2,\n 4]') stays within the comments: the
+  // message is one YAML document and carries the value whole.
+  const std::string stitched = scene_path("reference_55m_stitched.yaml");
+  const std::vector<std::string> lines{"stitch_wire.at_supports=[2,\n 4]", "line.span_count=6"};
+  const Model two_lines = build_model(scene_from_message(scene_yaml_message(stitched, lines)));
+  const Model given = build_model(load_scene_file(stitched, lines));
+  EXPECT_EQ(two_lines.n_dof, given.n_dof);
+  EXPECT_EQ(two_lines.scene.sections.at(0).stitch_wire->at_supports, (std::vector<int>{2, 4}));
 }

@@ -44,7 +44,8 @@ WireShapeArray to_wire_shape(const Model& m, const State& s, double resolution, 
 // The scene of a pass as the node publishes it (latched ~scene_yaml, std_msgs/String, recorded
 // with the pass): a first line "# catenary_sim scene: PATH" (the file's absolute path, for the
 // files a scene names relative to itself), a line "# catenary_sim set: KEY=VALUE" per override
-// (simulate_pass --set), then the file's text. Throws SceneError if the file cannot be read.
+// (simulate_pass --set; a value's further lines each on a line "# catenary_sim set+ ..."), then
+// the file's text. Throws SceneError if the file cannot be read.
 std::string scene_yaml_message(const std::string& path, const std::vector<std::string>& overrides = {});
 // The scene of such a message (its relative files looked up beside PATH, its overrides applied);
 // throws SceneError.
