@@ -304,7 +304,9 @@ def test_external_force_indexes_are_checked_and_a_refusal_changes_nothing():
 
 def test_numbers_in_messages_are_written_as_numbers():
     sim = cs.Simulation(REFERENCE, overrides=SHORT)
-    for call, shown in ((lambda: sim.set_speed(300.0), "300 m/s"), (lambda: sim.set_speed(1000 / 3), "333.333 m/s"),
+    # A given value whole (its shortest round trip: one just past a limit must not read as the
+    # limit), without trailing zeros.
+    for call, shown in ((lambda: sim.set_speed(300.0), "300 m/s"), (lambda: sim.set_speed(1000 / 3), "333.3333333333333 m/s"),
                         (lambda: sim.set_uplift(1500.0), "1500 N"), (lambda: sim.set_max_acceleration(25.0), "25 m/s^2")):
         with pytest.raises(cs.SceneError) as e:
             call()
