@@ -110,13 +110,28 @@ class ReplayMarkers {
     drawn_any_ = false;
   }
 
+  // A new recording's scene: what the last one drew goes (markers have no lifetime, and parts of
+  // a kind the new line lacks, its stitch wires or auxiliary, would stay drawn).
+  void clear_drawing() {
+    if (!pub_ || !drawn_any_) return;
+    visualization_msgs::MarkerArray clear;
+    clear.markers.emplace_back();
+    clear.markers.back().action = visualization_msgs::Marker::DELETEALL;
+    pub_.publish(clear);
+  }
+
   void on_scene(const std_msgs::String::ConstPtr& m) {
     if (m->data == scene_text_) return;
+    clear_drawing();
+    scene_text_ = m->data;
     try {
       use_scene(scene_from_message(m->data));
-      scene_text_ = m->data;
+      scene_error_.clear();
       ROS_INFO("replay_markers: scene %s from the recording", model_->scene.name.c_str());
     } catch (const std::exception& e) {
+      model_.reset();  // (never drawn with the scene of an earlier recording)
+      drawn_any_ = false;
+      scene_error_ = e.what();
       ROS_ERROR("replay_markers: the recording's scene cannot be used: %s", e.what());
     }
   }
@@ -154,9 +169,13 @@ class ReplayMarkers {
     // The newest shape not drawn yet, with the state and force of its stamp.
     if (shapes_.empty()) return;
     if (!model_) {
-      ROS_WARN_THROTTLE(10.0, "replay_markers: no scene to draw with: the recording has no %s (recorded before the "
-                        "node published it, or another recorder's topic list); give the scene of the recording: "
-                        "replay.launch scene:=FILE", subs_.empty() ? "scene" : subs_[0].getTopic().c_str());
+      if (!scene_error_.empty())
+        ROS_WARN_THROTTLE(10.0, "replay_markers: no scene to draw with: the recording's scene was refused (%s); give "
+                          "a scene for it: replay.launch scene:=FILE", scene_error_.c_str());
+      else
+        ROS_WARN_THROTTLE(10.0, "replay_markers: no scene to draw with: the recording has no %s (recorded before the "
+                          "node published it, or another recorder's topic list); give the scene of the recording: "
+                          "replay.launch scene:=FILE", subs_.empty() ? "scene" : subs_[0].getTopic().c_str());
       return;
     }
     const WireShapeArray& shape = shapes_.back();
@@ -179,7 +198,8 @@ class ReplayMarkers {
   }
 
   std::unique_ptr<Model> model_;   // null until the scene is known
-  std::string scene_text_;         // the recording's scene message in use
+  std::string scene_text_;         // the recording's scene message last received
+  std::string scene_error_;        // why it was refused ("" when in use)
   State state_;
   MarkerOptions options_;
   bool view_ = true;

@@ -171,6 +171,34 @@ TEST(Replay, RecordedPassIsDrawnAndPlotted) {
     ASSERT_TRUE(plotted.count(key)) << "the plot has no steady arm at " << key << " mm";
     EXPECT_EQ(plotted[key], up) << "steady arm at " << key << " mm";
   }
+
+  // A second recording, of another kind of line (stitched: stitch wires the first lacks), played
+  // into the same replay_markers: what the first drew is deleted before the second is drawn
+  // (markers have no lifetime; the first line's parts stayed), and the second is drawn whole.
+  const std::string bag2 = dir + "/stitched.bag";
+  ASSERT_EQ(std::system((test_scenes::program("simulate_pass") + " --scene " + test_scenes::kReferenceStitched +
+                         " --set line.span_count=4 --quiet --out " + dir + "/offline2 --bag " + bag2 + " > " + dir +
+                         "/simulate_pass2.log 2>&1").c_str()),
+            0)
+      << "see " << dir << "/simulate_pass2.log";
+  {
+    std::lock_guard<std::mutex> l(mu);
+    received.clear();
+  }
+  ASSERT_EQ(std::system(sh("rosbag play -q --clock -r 2 -d 1 " + bag2 + " > " + dir + "/play2.log 2>&1").c_str()), 0)
+      << "see " << dir << "/play2.log";
+  ros::WallDuration(2.0).sleep();
+  {
+    std::lock_guard<std::mutex> l(mu);
+    got = received;
+  }
+  ASSERT_GE(got.size(), 2u);
+  ASSERT_FALSE(got.front().markers.empty());
+  EXPECT_EQ(got.front().markers.front().action, visualization_msgs::Marker::DELETEALL) << "the first line's drawing stayed";
+  std::size_t stitch_points = 0;
+  for (const auto& mk : got.back().markers)
+    if (mk.ns == "wires") stitch_points += mk.points.size();
+  EXPECT_GT(stitch_points, 0u);
   if (!HasFailure()) (void)!std::system(("rm -rf " + dir).c_str());  // kept for a look when it failed
 }
 
