@@ -5,7 +5,8 @@
 // steady arms, droppers) comes from the scene the recording carries (the node's latched
 // /catenary_sim/scene_yaml, recorded with the pass), or from ~scene when given.
 //
-// Parameters: ~scene (optional: a scene YAML file, which then must be the scene of the recording),
+// Parameters: ~scene (optional: a scene YAML file, which then must be the scene of the recording:
+// checked against the one the recording carries, scene_difference),
 // ~scene_topic (/catenary_sim/scene_yaml), ~vertical_scale (10, as the live default),
 // ~shape_resolution (1 m between line-strip points, 0: every node), ~publish_view_frame (true:
 // send line -> train_view with each marker message, as the live node does, unless the bag has it
@@ -70,9 +71,11 @@ class ReplayMarkers {
       } catch (const SceneError& e) {
         throw std::runtime_error("parameter ~scene = '" + scene + "': " + e.what());
       }
-    } else {
-      subs_.push_back(nh.subscribe(scene_topic, 1, &ReplayMarkers::on_scene, this));
+      given_ = true;
     }
+    // With ~scene, the recording's scene checks it: a line that differs only where the messages
+    // do not show it would be drawn wrongly without a word.
+    subs_.push_back(nh.subscribe(scene_topic, 1, &ReplayMarkers::on_scene, this));
     options_.vertical_scale = number_param(pnh, "vertical_scale", 10.0, 1e-9, 10000.0, "");
     options_.shape_resolution = number_param(pnh, "shape_resolution", 1.0, 0.0, 100.0, "m (0: every node)");
     pnh.param("publish_view_frame", view_, true);
@@ -124,6 +127,20 @@ class ReplayMarkers {
     if (m->data == scene_text_) return;
     clear_drawing();
     scene_text_ = m->data;
+    if (given_) {
+      try {
+        mismatch_ = scene_difference(*model_, build_model(scene_from_message(m->data)));
+      } catch (const std::exception& e) {
+        mismatch_.clear();
+        ROS_WARN("replay_markers: the recording's scene cannot be read (%s): drawing with ~scene unchecked", e.what());
+        return;
+      }
+      if (!mismatch_.empty())
+        ROS_ERROR("replay_markers: ~scene is not the scene of the recording: %s; leave ~scene empty to draw with the "
+                  "recording's own", mismatch_.c_str());
+      drawn_any_ = false;
+      return;
+    }
     try {
       use_scene(scene_from_message(m->data));
       scene_error_.clear();
@@ -178,6 +195,7 @@ class ReplayMarkers {
                           "replay.launch scene:=FILE", subs_.empty() ? "scene" : subs_[0].getTopic().c_str());
       return;
     }
+    if (!mismatch_.empty()) return;  // (said once, when the recording's scene came)
     const WireShapeArray& shape = shapes_.back();
     const ros::Time t = shape.header.stamp;
     if (t == last_drawn_ && drawn_any_) return;
@@ -200,6 +218,8 @@ class ReplayMarkers {
   std::unique_ptr<Model> model_;   // null until the scene is known
   std::string scene_text_;         // the recording's scene message last received
   std::string scene_error_;        // why it was refused ("" when in use)
+  bool given_ = false;             // drawing with ~scene, checked against the recording's
+  std::string mismatch_;           // how ~scene differs from the recording's scene ("" if it does not)
   State state_;
   MarkerOptions options_;
   bool view_ = true;

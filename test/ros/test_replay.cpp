@@ -221,6 +221,33 @@ TEST(Replay, ANaNInTheRecordingIsRefusedByItsField) {
   }
 }
 
+// A replay's ~scene that differs from the recording's only where the messages do not show it
+// (wire names, node counts and spans the same) is found by its design: a bridle's tension (its V
+// hangs higher), a compound line's auxiliary height, the same scene is no difference.
+TEST(Replay, AGivenSceneThatIsNotTheRecordingsIsNamed) {
+  auto model = [](const char* file, const std::vector<std::string>& o) {
+    return build_model(load_scene_file(scene_path(file), o));
+  };
+  EXPECT_EQ(scene_difference(model("trolley_wire_bridle.yaml", {}), model("trolley_wire_bridle.yaml", {})), "");
+  // A recording at another rung (the fast rung's mesh, the replay's finer one) is the same line,
+  // on every shipped line of one kind or another.
+  for (const char* file : {"reference_55m.yaml", "reference_55m_3d_hinged_arms.yaml", "reference_55m_stitched.yaml",
+                           "compound_catenary.yaml", "rigid_conductor_rail.yaml", "trolley_wire.yaml",
+                           "trolley_wire_bridle.yaml", "catenary_to_rigid_rail.yaml", "catenary_to_trolley_wire.yaml",
+                           "stitched_catenary_to_rigid_rail.yaml", "calpe_example.yaml"})
+    EXPECT_EQ(scene_difference(model(file, {}), model(file, {"numerics.preset=fast"})), "") << file;
+  const std::string bridle = scene_difference(model("trolley_wire_bridle.yaml", {"bridle.tension=3000"}),
+                                              model("trolley_wire_bridle.yaml", {}));
+  EXPECT_NE(bridle.find("wire 'bridle"), std::string::npos) << bridle;
+  EXPECT_NE(bridle.find("in the recording's scene at"), std::string::npos) << bridle;
+  const std::string compound = scene_difference(model("compound_catenary.yaml", {"auxiliary_messenger.height=0.3"}),
+                                                model("compound_catenary.yaml", {}));
+  EXPECT_NE(compound.find("designed at"), std::string::npos) << compound;
+  const std::string spacing = scene_difference(model("trolley_wire.yaml", {"line.span_length=20", "line.span_count=15"}),
+                                               model("trolley_wire.yaml", {}));
+  EXPECT_NE(spacing.find("support"), std::string::npos) << spacing;
+}
+
 // The scene a recording carries (the node's ~scene_yaml, simulate_pass's bag): the same model as
 // the file with its overrides, so that the replay draws without a scene argument. Here with a
 // --set that changes the geometry (6 spans instead of 10): the message must carry it.
