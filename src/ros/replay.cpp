@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 namespace catenary_sim {
 namespace ros_layer {
@@ -56,6 +57,18 @@ std::string wires_from_shape(const Model& m, const WireShapeArray& shape, State*
     else if (std::fabs(o - offset) > 1e-6)
       return field + ".stations[0] = " + num(ws.stations.front()) + ": expected " + num(w.x.front() + offset) +
              " (the line offset of the first wire)" + kOtherScene;
+    // A pass stops where a displacement passes numerics.divergence_limit: a recorded height
+    // further from the design is not a pass's (1 cm over it: the design read between nodes).
+    const double limit = m.scene.numerics.divergence_limit + 0.01;
+    std::vector<double> station(w.x.size());
+    for (std::size_t i = 0; i < w.x.size(); ++i) station[i] = w.x[i] + o;
+    for (std::size_t k = 0; k < ws.stations.size(); ++k) {
+      const double design = interpolate(station, w.height, ws.stations[k]);
+      if (!(std::fabs(ws.heights[k] - design) <= limit))
+        return field + ".heights[" + num(k) + "] = " + num(ws.heights[k]) + " m at station " + num(ws.stations[k]) +
+               " m: expected within numerics.divergence_limit (" + num(m.scene.numerics.divergence_limit) +
+               " m) of the design height " + num(design) + " m";
+    }
     for (int i = 0; i < w.nodes(); ++i)
       s->wire_uplift(m, static_cast<int>(wi), i) = interpolate(ws.stations, ws.heights, w.x[i] + o) - w.height[i];
     // A 3-D line's lateral positions (an empty list on a 2-D line).

@@ -219,6 +219,14 @@ TEST(Replay, ANaNInTheRecordingIsRefusedByItsField) {
     EXPECT_EQ(e.rfind(field, 0), 0u) << field << ": " << e;
     EXPECT_NE(e.find("finite"), std::string::npos) << e;
   }
+  // A finite height no pass can have written (a pass stops at numerics.divergence_limit, 5 m).
+  WireShapeArray far = shape;
+  far.wires[1].heights[3] = 1e300;
+  const std::string e = state_from_messages(m, far, state, force, &out);
+  EXPECT_EQ(e.rfind("wire_shape.wires[1].heights[3] = 1e+300 m", 0), 0u) << e;
+  EXPECT_NE(e.find("divergence_limit"), std::string::npos) << e;
+  far.wires[1].heights[3] = shape.wires[1].heights[3] + 4.9;  // within it: drawn
+  EXPECT_EQ(state_from_messages(m, far, state, force, &out), "");
 }
 
 // A replay's ~scene that differs from the recording's only where the messages do not show it
