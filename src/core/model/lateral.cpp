@@ -466,9 +466,7 @@ void set_substeps(const Model& m, LateralModel* lat) {
     // beta k / m; a stiff lateral spring (5e7 N/m on a 1 kg bracket: 2 / (beta k / m) = 0.4 ms)
     // binds here, not in the band.
     auto limit_by = [&](double k, int dof) {
-      const double mass = lat->mass[dof];
-      if (!(lat->inv_mass[dof] > 0.0) || !(m.beta * k > 0.0)) return;
-      dt_crit = std::min(dt_crit, critical_time_step(std::sqrt(k / mass), m.beta * k / mass, 0.0));
+      if (lat->inv_mass[dof] > 0.0) dt_crit = std::min(dt_crit, point_time_step(k, m.beta * k, lat->mass[dof]));
     };
     for (const LateralSpring& sp : lat->springs) limit_by(sp.stiffness, sp.dof);
     for (const LateralClamp& c : lat->clamps)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace catenary_sim {
@@ -21,6 +22,12 @@ double critical_time_step(double w, double alpha, double beta) {
   if (w <= 0.0) return 1.0;
   const double xi = alpha / (2.0 * w) + 0.5 * beta * w;
   return (2.0 / w) * (std::sqrt(1.0 + xi * xi) - xi);
+}
+
+double point_time_step(double k, double c, double mass) {
+  if (!(c > 0.0)) return std::numeric_limits<double>::infinity();
+  const double w = std::sqrt(k / mass);
+  return w > 0.0 ? critical_time_step(w, c / mass, 0.0) : 2.0 * mass / c;
 }
 
 void compute_stability_limit(Model& m) {
@@ -54,12 +61,7 @@ void compute_stability_limit(Model& m) {
   // Each mass with its own springs and dampers as one DOF (w^2 = k/m, mass-proportional damping
   // c/m in the formula of validation.md section 5): far from binding on real pantographs (the
   // reference's lower frame: 33 ms), binding on absurdly light ones, which then get a dt that holds.
-  auto limit_by = [&](double k, double c, double mass) {
-    if (!(c > 0.0)) return;
-    const double w = std::sqrt(k / mass);
-    const double dt = w > 0.0 ? critical_time_step(w, c / mass, 0.0) : 2.0 * mass / c;
-    m.dt_critical = std::min(m.dt_critical, dt);
-  };
+  auto limit_by = [&](double k, double c, double mass) { m.dt_critical = std::min(m.dt_critical, point_time_step(k, c, mass)); };
   if (centred) {
     for (const SupportSpring& sp : m.springs)
       if (m.mass[sp.dof] > 0.0) limit_by(sp.stiffness, m.beta * sp.stiffness, m.mass[sp.dof]);
