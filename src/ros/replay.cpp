@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-#include <vector>
 
 namespace catenary_sim {
 namespace ros_layer {
@@ -60,10 +59,8 @@ std::string wires_from_shape(const Model& m, const WireShapeArray& shape, State*
     // A pass stops where a displacement passes numerics.divergence_limit: a recorded height
     // further from the design is not a pass's (1 cm over it: the design read between nodes).
     const double limit = m.scene.numerics.divergence_limit + 0.01;
-    std::vector<double> station(w.x.size());
-    for (std::size_t i = 0; i < w.x.size(); ++i) station[i] = w.x[i] + o;
     for (std::size_t k = 0; k < ws.stations.size(); ++k) {
-      const double design = interpolate(station, w.height, ws.stations[k]);
+      const double design = interpolate(w.x, w.height, ws.stations[k] - o);
       if (!(std::fabs(ws.heights[k] - design) <= limit))
         return field + ".heights[" + num(k) + "] = " + num(ws.heights[k]) + " m at station " + num(ws.stations[k]) +
                " m: expected within numerics.divergence_limit (" + num(m.scene.numerics.divergence_limit) +

@@ -27,10 +27,9 @@ std::string state_from_messages(const Model& m, const WireShapeArray& shape, con
 
 // "" when `given` (a replay's ~scene) is the line of `recorded` (the scene the recording carries)
 // as drawn: the same supports, wires, droppers and design heights (meshes may differ); else the
-// first difference,
-// naming the wire or support and both values. A scene that differs in what the recorded messages
-// do not show (a bridle's tension, the auxiliary's height, the supports' spacing) would be drawn
-// wrongly without a word.
+// first difference, naming the wire or support and both values. A scene that differs in what the
+// recorded messages do not show (a bridle's tension, the auxiliary's height, the supports'
+// spacing) would be drawn wrongly without a word.
 std::string scene_difference(const Model& given, const Model& recorded);
 
 }  // namespace ros_layer
