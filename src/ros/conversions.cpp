@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "catenary_sim/core/simulation.hpp"
-#include "../core/util/format.hpp"  // the core's numbers in messages: one way for all
+#include "catenary_sim/ros/params.hpp"  // format_given: numbers in messages as the nodes write them
 #include "line_points.hpp"
 
 namespace catenary_sim {
@@ -18,7 +18,7 @@ namespace ros_layer {
 std::string speed_command_error(const Scene& scene, double v) {
   const TrainSpeedLimit limit = train_speed_limit(scene);
   if (limit.allows(v)) return "";
-  return "cmd/train_speed = " + fmt_given(v) + " m/s rejected: allowed " + limit.text();
+  return "cmd/train_speed = " + format_given(v) + " m/s rejected: allowed " + limit.text();
 }
 
 ros::Time sim_stamp(double sim_time, double offset) { return ros::Time(sim_time + offset); }

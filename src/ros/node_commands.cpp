@@ -7,8 +7,6 @@
 #include <sstream>
 #include <string>
 
-#include "../core/util/format.hpp"  // the core's numbers in messages: one way for all
-
 namespace catenary_sim {
 namespace ros_layer {
 
@@ -27,7 +25,7 @@ void SimulationNode::on_reconfigure(NodeConfig& c, uint32_t) {
       kept = asked;
       return;
     }
-    ROS_ERROR("catenary_sim: %s = %s rejected: allowed %g to %g; kept %g", name, fmt_given(asked).c_str(), min, max, kept);
+    ROS_ERROR("catenary_sim: %s = %s rejected: allowed %g to %g; kept %g", name, format_given(asked).c_str(), min, max, kept);
     asked = kept;
   };
   if (std::isfinite(c.real_time_factor) && c.real_time_factor != params_.real_time_factor) reanchor();
@@ -41,7 +39,7 @@ void SimulationNode::on_reconfigure(NodeConfig& c, uint32_t) {
   if (sim_->set_max_acceleration(c.max_acceleration, &err)) {
     params_.max_acceleration = c.max_acceleration;
   } else {
-    ROS_ERROR("catenary_sim: max_acceleration = %s rejected: %s", fmt_given(c.max_acceleration).c_str(), err.c_str());
+    ROS_ERROR("catenary_sim: max_acceleration = %s rejected: %s", format_given(c.max_acceleration).c_str(), err.c_str());
     c.max_acceleration = params_.max_acceleration;  // the server publishes the value in effect
   }
 }
@@ -82,7 +80,7 @@ void SimulationNode::on_uplift(const std_msgs::Float64MultiArray::ConstPtr& msg)
     const double f = msg->data[i];
     if (!std::isfinite(f) || f < 0.0 || f > Simulation::kMaxUplift) {
       ROS_ERROR_THROTTLE(1.0, "catenary_sim: cmd/uplift_force[%zu] = %s N rejected: allowed 0 to %g N; command ignored",
-                         i, fmt_given(f).c_str(), Simulation::kMaxUplift);
+                         i, format_given(f).c_str(), Simulation::kMaxUplift);
       return;
     }
   }
