@@ -79,13 +79,13 @@ class PySimulation {
     std::lock_guard<std::mutex> lock(mutex_);
     // An infinite bound would let a pass at speed 0 run for ever.
     if (!std::isfinite(max_steps))
-      throw py::value_error("run(): max_steps = " + fmt(max_steps) + " rejected: allowed a finite number");
+      throw py::value_error("run(): max_steps = " + fmt_given(max_steps) + " rejected: allowed a finite number");
     const State& st = sim_.state();
     const double left = st.speed > 0.0 ? (sim_.model().train_end - st.front - st.line_offset) / st.speed / sim_.model().dt
                                        : std::numeric_limits<double>::infinity();
     if (!(left <= max_steps)) {
       const std::string note = short_element_note(sim_.model());
-      throw py::value_error("run(): max_steps = " + fmt(max_steps) + " rejected: the rest of the pass would take " +
+      throw py::value_error("run(): max_steps = " + fmt_given(max_steps) + " rejected: the rest of the pass would take " +
                             fmt(std::ceil(left)) + " steps at " + fmt(st.speed) +
                             " m/s; allowed max_steps at least that (set a speed, or step(n) yourself)" +
                             (note.empty() ? "" : "; " + note));
@@ -159,7 +159,7 @@ class Locked {
 
 void check_sample_rate(double sample_rate) {
   if (!std::isfinite(sample_rate) || (sample_rate < 0.0 && sample_rate != -1.0))
-    throw py::value_error("sample_rate = " + fmt(sample_rate) + " rejected: allowed >= 0 Hz (0: every step)");
+    throw py::value_error("sample_rate = " + fmt_given(sample_rate) + " rejected: allowed >= 0 Hz (0: every step)");
 }
 
 using PyClass = py::class_<PySimulation>;
@@ -184,12 +184,12 @@ void bind_scene_checks(py::module& m) {
       "_lowpass_zero_phase",
       [](const std::vector<double>& x, double fs, double fc) {
         if (!(std::isfinite(fs) && fs > 0.0))
-          throw py::value_error("sample rate fs = " + fmt(fs) + " Hz rejected: allowed a finite rate > 0 Hz");
+          throw py::value_error("sample rate fs = " + fmt_given(fs) + " Hz rejected: allowed a finite rate > 0 Hz");
         if (!(std::isfinite(fc) && fc > 0.0))
-          throw py::value_error("cutoff fc = " + fmt(fc) + " Hz rejected: allowed a finite frequency > 0 Hz");
+          throw py::value_error("cutoff fc = " + fmt_given(fc) + " Hz rejected: allowed a finite frequency > 0 Hz");
         for (std::size_t i = 0; i < x.size(); ++i)
           if (!std::isfinite(x[i]))
-            throw py::value_error("sample " + std::to_string(i) + " = " + fmt(x[i]) + " rejected: allowed finite values");
+            throw py::value_error("sample " + std::to_string(i) + " = " + fmt_given(x[i]) + " rejected: allowed finite values");
         return lowpass_zero_phase(x, fs, fc);
       },
       py::arg("x"), py::arg("fs"), py::arg("fc"));
