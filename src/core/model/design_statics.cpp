@@ -19,6 +19,24 @@ bool holds(const Wire& w, int dof) { return dof >= w.w_dof && dof < w.w_dof + w.
 
 const Wire& wire_of(const Model& m, int dof) { return m.wires[wire_holding(m, dof)]; }
 
+}  // namespace
+
+double hang_bridle(const Scene& scene, const Model& m, Wire& w, std::vector<double>& reaction) {
+  const double H = scene.contact_wire_height;
+  const int n = w.nodes();
+  std::vector<double> load(n);
+  for (int i = 0; i < n; ++i) load[i] = -scene.gravity * m.mass[w.w_dof + i];
+  for (const WireClamp& c : m.clamps)
+    if (holds(w, c.upper_dof)) load[c.upper_dof - w.w_dof] -= c.static_force;
+  solve_wire_statics(w, load, {w.support_nodes.front()}, {H}, w.height, w.slope, reaction);
+  // (A rigid rise: the band has no force from it, the reaction stays.)
+  const double rise = H - std::min(w.height.front(), w.height.back());
+  for (double& y : w.height) y += rise;
+  return std::max(bridle_arm_rise(w, 0), bridle_arm_rise(w, n - 1));
+}
+
+namespace {
+
 // A trolley wire's bridles (BridleSpec) once the contact wire is solved held at its anchors and at
 // the clamps at the working height (each clamp's static force set to the contact wire's reaction
 // there): the clamp pulls the bridle's end down. The bridle, held at its middle only, hangs from
@@ -26,25 +44,10 @@ const Wire& wire_of(const Model& m, int dof) { return m.wires[wire_holding(m, do
 // working height, the other end above by what its arms' loads differ (the clamp then a short
 // link). Its reaction at the middle is the support's preload (design_statics).
 void bridle_statics(const Scene& scene, const Section& info, Model& m, std::vector<std::vector<double>>& react) {
-  const double H = scene.contact_wire_height;
-  // Hangs bridle w; returns the steeper arm's slope, its V in the small angles (a 3-D line checks
-  // each arm up and across together: lateral.cpp).
-  auto hang = [&](Wire& w, std::vector<double>& reaction) {
-    const int n = w.nodes();
-    std::vector<double> load(n);
-    for (int i = 0; i < n; ++i) load[i] = -scene.gravity * m.mass[w.w_dof + i];
-    for (const WireClamp& c : m.clamps)
-      if (holds(w, c.upper_dof)) load[c.upper_dof - w.w_dof] -= c.static_force;
-    solve_wire_statics(w, load, {w.support_nodes.front()}, {H}, w.height, w.slope, reaction);
-    // (A rigid rise: the band has no force from it, the reaction stays.)
-    const double rise = H - std::min(w.height.front(), w.height.back());
-    for (double& y : w.height) y += rise;
-    return std::max(bridle_arm_rise(w, 0), bridle_arm_rise(w, n - 1));
-  };
   const Wire* steepest = nullptr;  // refused by the worst, as the plan's check is (lateral.cpp)
   double worst = 0.0;
   for (int wi : info.clamped_wires) {
-    const double slope = hang(m.wires[wi], react[wi]);
+    const double slope = hang_bridle(scene, m, m.wires[wi], react[wi]);
     if (!(slope <= worst) && !std::isnan(worst)) {  // (a NaN slope is the worst)
       worst = slope;
       steepest = &m.wires[wi];
@@ -59,11 +62,12 @@ void bridle_statics(const Scene& scene, const Section& info, Model& m, std::vect
   again.spec.tension = t2;
   assemble_band(again, {});
   std::vector<double> reaction;
-  const double s2 = hang(again, reaction);
+  const double s2 = hang_bridle(scene, m, again, reaction);
   const double a = (worst - s2) / (1.0 / t1 - 1.0 / t2), b = worst - a / t1;
   const double needed = a > 0.0 && b < kSteepestBridleArm ? a / (kSteepestBridleArm - b) : t2;
   refuse_slack_bridle(scene, *steepest, worst,
-                      "in its V, its middle " + fmt(steepest->height[steepest->support_nodes.front()] - H) + " m above the wire",
+                      "in its V, its middle " +
+                          fmt(steepest->height[steepest->support_nodes.front()] - scene.contact_wire_height) + " m above the wire",
                       "", needed);
 }
 
@@ -81,7 +85,7 @@ void refuse_slack_bridle(const Scene& scene, const Wire& w, double slope, const 
   throw SceneError("scene field '" + field + ".tension' = " + fmt(tension) + " N: to carry the contact wire, the bridle at station " +
                    fmt(w.x[w.support_nodes.front()]) + " m would run its arms at a slope of " + fmt(slope) + " (" + how +
                    "); at most " + fmt(kSteepestBridleArm) + ", the model's small angles: raise " + field + ".tension (about " +
-                   (needed ? fmt(*needed) + " N, the bridle hung again at two tensions" :
+                   (needed ? fmt(*needed) + " N, from the bridles' statics at a second tension" :
                              fmt(tension * slope / kSteepestBridleArm) + " N; the slopes fall nearly as 1 / tension") +
                    ", at most 1e5)" + advice);
 }

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
 #include "catenary_sim/core/model/beam.hpp"
@@ -642,41 +643,60 @@ class LateralSystem {
 // one that puts the contact wire at its stagger at every support. A lateral spring
 // (stagger.steady_arm_stiffness) pulls the middle toward its registration, as a steady arm's pulls
 // the wire toward its stagger.
-void register_bridles(const Model& m, LateralModel* lat) {
-  std::vector<int> held, at;  // per bridle: its support's index, the contact wire's lateral DOF there
-  std::vector<double> target;
-  for (std::size_t k = 0; k < lat->supports.size(); ++k) {
-    const LateralSupport& s = lat->supports[k];
+struct BridlePlan {
+  std::vector<int> held;            // per bridle: its support's index in lat.supports
+  std::vector<int> middle;          // its middle's lateral DOF
+  std::vector<double> target;       // the contact wire's stagger at its support
+  Eigen::VectorXd registration;     // b: where its middle is held
+  Eigen::VectorXd ends;             // its first and last node in plan, [2 j], [2 j + 1]
+  // Bridle j's arm e (0: toward its first node) in plan and up its V, as slopes from the middle.
+  double across(const Model& m, const LateralModel& lat, int j, int e) const {
+    const Wire& w = m.wires[lat.supports[held[j]].wire];
+    const int end = e == 0 ? 0 : w.nodes() - 1;
+    return std::fabs(ends[2 * j + e] - registration[j]) / std::fabs(w.x[end] - w.x[w.support_nodes.front()]);
+  }
+  double up(const Model& m, const LateralModel& lat, int j, int e) const {
+    const Wire& w = m.wires[lat.supports[held[j]].wire];
+    return bridle_arm_rise(w, e == 0 ? 0 : w.nodes() - 1);
+  }
+};
+
+BridlePlan plan_bridles(const Model& m, const LateralModel& lat) {
+  BridlePlan p;
+  std::vector<int> at;  // per bridle: the contact wire's lateral DOF at its support
+  for (std::size_t k = 0; k < lat.supports.size(); ++k) {
+    const LateralSupport& s = lat.supports[k];
     const Wire& bridle = m.wires[s.wire];
     if (!bridle.is_bridle) continue;
     const int contact = m.sections[bridle.section].wires.front();  // (a bridle holds one contact wire)
     const Wire& cw = m.wires[contact];
-    held.push_back(static_cast<int>(k));
+    p.held.push_back(static_cast<int>(k));
     const auto node = std::lower_bound(cw.x.begin(), cw.x.end(), s.x - 1e-9) - cw.x.begin();  // (a node: mesh_section)
-    at.push_back(lat->wires[contact].w_dof + static_cast<int>(node));
-    target.push_back(s.stagger);
+    at.push_back(lat.wires[contact].w_dof + static_cast<int>(node));
+    p.target.push_back(s.stagger);
   }
-  const int nb = static_cast<int>(held.size());
-  if (nb == 0) return;
-  const int n = lat->n;
+  const int nb = static_cast<int>(p.held.size());
+  if (nb == 0) return p;
+  const int n = lat.n;
   std::vector<bool> fixed(n, false);
   Eigen::VectorXd base_value = Eigen::VectorXd::Zero(n);
-  for (const LateralSupport& s : lat->supports)
+  for (const LateralSupport& s : lat.supports)
     if (s.rigid) {
-      fixed[lat->wires[s.wire].w_dof + s.node] = true;
-      base_value[lat->wires[s.wire].w_dof + s.node] = s.stagger;
+      fixed[lat.wires[s.wire].w_dof + s.node] = true;
+      base_value[lat.wires[s.wire].w_dof + s.node] = s.stagger;
     }
   // The rows wanted: the contact wire at each support (0..nb), each bridle's ends (nb + 2 j, + 1).
-  std::vector<int> middle(nb), rows(at);
+  std::vector<int> rows(at);
+  p.middle.resize(nb);
   for (int j = 0; j < nb; ++j) {
-    const LateralSupport& s = lat->supports[held[j]];
-    middle[j] = lat->wires[s.wire].w_dof + s.node;
-    fixed[middle[j]] = true;
-    base_value[middle[j]] = 0.0;
-    rows.push_back(lat->wires[s.wire].w_dof);
-    rows.push_back(lat->wires[s.wire].w_dof + lat->wires[s.wire].nodes() - 1);
+    const LateralSupport& s = lat.supports[p.held[j]];
+    p.middle[j] = lat.wires[s.wire].w_dof + s.node;
+    fixed[p.middle[j]] = true;
+    base_value[p.middle[j]] = 0.0;
+    rows.push_back(lat.wires[s.wire].w_dof);
+    rows.push_back(lat.wires[s.wire].w_dof + lat.wires[s.wire].nodes() - 1);
   }
-  const LateralSystem system(m, *lat, fixed, false);
+  const LateralSystem system(m, lat, fixed, false);
   // Case 0: every middle at 0; case 1 + j: middle j at 1 alone, nothing else loaded or held off 0.
   // Solved a block of cases at a time, keeping the wanted rows: memory in the line's length.
   const int cases = nb + 1, block = 32;
@@ -686,55 +706,109 @@ void register_bridles(const Model& m, LateralModel* lat) {
     Eigen::MatrixXd F = Eigen::MatrixXd::Zero(2 * n, nc), value = Eigen::MatrixXd::Zero(n, nc);
     for (int c = 0; c < nc; ++c) {
       if (c0 + c == 0) {
-        F.col(c).head(n) = lat->load;
+        F.col(c).head(n) = lat.load;
         value.col(c) = base_value;
       } else {
-        value(middle[c0 + c - 1], c) = 1.0;
+        value(p.middle[c0 + c - 1], c) = 1.0;
       }
     }
     const Eigen::MatrixXd y = system.solve(F, value);
     for (std::size_t r = 0; r < rows.size(); ++r) kept.row(r).segment(c0, nc) = y.row(rows[r]);
   }
   const Eigen::MatrixXd A = kept.topRightCorner(nb, nb);
-  const Eigen::VectorXd b = A.partialPivLu().solve(Eigen::Map<const Eigen::VectorXd>(target.data(), nb) - kept.col(0).head(nb));
-  if (!b.allFinite())
+  p.registration =
+      A.partialPivLu().solve(Eigen::Map<const Eigen::VectorXd>(p.target.data(), nb) - kept.col(0).head(nb));
+  if (!p.registration.allFinite())
     throw SceneError("bridle: no registration of the bridles' middles puts the contact wire at its stagger (the wire "
                      "is not held across the track through their clamps); report this with the scene");
+  p.ends = kept.col(0).tail(2 * nb) + kept.bottomRightCorner(2 * nb, nb) * p.registration;
+  return p;
+}
+
+// The tension of `section`'s bridles that brings their steepest arm to kSteepestBridleArm, up and
+// across the track together: the section's bridles hung and registered again at t2, each arm's
+// two parts taken as a / T + b through t1 and t2 (a string's share falls as 1 / T, the bridle's
+// bending's does not), and the tension at which the steepest meets the limit. None where the fit
+// says no tension would do, or the second design fails.
+std::optional<double> bridle_tension_needed(const Model& m, const LateralModel& lat, const BridlePlan& p, int section,
+                                            double t1, double t2) {
+  Model again = m;
+  again.scene.sections[section].bridle->tension = t2;
+  LateralModel lat2;
+  BridlePlan p2;
+  try {
+    for (Wire& w : again.wires)
+      if (w.is_bridle && w.section == section) {
+        w.spec.tension = t2;
+        assemble_band(w, {});
+        std::vector<double> reaction;
+        hang_bridle(again.scene, again, w, reaction);
+      }
+    add_wires_and_supports(again, &lat2);
+    add_pendulums(again, &lat2);
+    add_clamps(again, &lat2);
+    p2 = plan_bridles(again, lat2);
+  } catch (const SceneError&) {
+    return std::nullopt;
+  }
+  if (p2.held.size() != p.held.size()) return std::nullopt;
+  const double k = kSteepestBridleArm, s1 = 1.0 / t1, s2 = 1.0 / t2;
+  double needed = t1;
+  for (std::size_t j = 0; j < p.held.size(); ++j) {
+    if (m.wires[lat.supports[p.held[j]].wire].section != section) continue;
+    for (int e : {0, 1}) {
+      const double c1 = p.across(m, lat, j, e), r1 = p.up(m, lat, j, e);
+      if (!(std::hypot(c1, r1) > k)) continue;
+      const double c2 = p2.across(again, lat2, j, e), r2 = p2.up(again, lat2, j, e);
+      const double ac = (c1 - c2) / (s1 - s2), bc = c1 - ac * s1, ar = (r1 - r2) / (s1 - s2), br = r1 - ar * s1;
+      // (ac s + bc)^2 + (ar s + br)^2 = k^2 in s = 1 / T: one positive root where the share
+      // that does not fall with T is below the limit (C < 0).
+      const double A = ac * ac + ar * ar, B = 2.0 * (ac * bc + ar * br), C = bc * bc + br * br - k * k;
+      if (!(C < 0.0) || !(A > 0.0)) return std::nullopt;
+      const double s = (-B + std::sqrt(B * B - 4.0 * A * C)) / (2.0 * A);
+      if (!(s > 0.0)) return std::nullopt;
+      needed = std::max(needed, 1.0 / s);
+    }
+  }
+  return needed;
+}
+
+void register_bridles(const Model& m, LateralModel* lat) {
+  const BridlePlan p = plan_bridles(m, *lat);
+  const int nb = static_cast<int>(p.held.size());
+  if (nb == 0) return;
   // The arms in the model's small angles, up and across the track together (their V alone is
   // checked in the design statics). Their slope in plan is what the wire's turn needs.
-  const Eigen::VectorXd ends = kept.col(0).tail(2 * nb) + kept.bottomRightCorner(2 * nb, nb) * b;
   double worst = 0.0, worst_plan = 0.0;
   int at_worst = -1;
-  for (int j = 0; j < nb; ++j) {
-    const Wire& w = m.wires[lat->supports[held[j]].wire];
+  for (int j = 0; j < nb; ++j)
     for (int e : {0, 1}) {
-      const int end = e == 0 ? 0 : w.nodes() - 1;
-      const double plan = std::fabs(ends[2 * j + e] - b[j]) / std::fabs(w.x[end] - w.x[w.support_nodes.front()]);
-      const double slope = std::hypot(plan, bridle_arm_rise(w, end));
-      if (slope > worst) {
+      const double plan = p.across(m, *lat, j, e), slope = std::hypot(plan, p.up(m, *lat, j, e));
+      if (!(slope <= worst) && !std::isnan(worst)) {  // (a NaN slope is the worst)
         worst = slope;
         worst_plan = plan;
         at_worst = j;
       }
     }
-  }
   if (!(worst <= kSteepestBridleArm)) {
-    const Wire& w = m.wires[lat->supports[held[at_worst]].wire];
+    const Wire& w = m.wires[lat->supports[p.held[at_worst]].wire];
+    const double t1 = m.scene.sections[w.section].bridle->tension;
     refuse_slack_bridle(m.scene, w, worst,
-                        fmt(worst_plan) + " across the track, its middle " + fmt(std::fabs(b[at_worst] - target[at_worst])) +
-                            " m beyond the stagger",
+                        fmt(worst_plan) + " across the track, its middle " +
+                            fmt(std::fabs(p.registration[at_worst] - p.target[at_worst])) + " m beyond the stagger",
                         ", shorten " + m.scene.section_field(w.section, "bridle.length") +
-                            " (the wire turns between two bridles' clamps), or lessen the stagger or the curve there");
+                            " (the wire turns between two bridles' clamps), or lessen the stagger or the curve there",
+                        bridle_tension_needed(m, *lat, p, w.section, t1, t1 * worst / kSteepestBridleArm));
   }
-  std::vector<int> spring_on(n, -1);  // a lateral DOF's support spring (one at most: add_wires_and_supports)
+  std::vector<int> spring_on(lat->n, -1);  // a lateral DOF's support spring (one at most: add_wires_and_supports)
   for (std::size_t k = 0; k < lat->springs.size(); ++k) spring_on[lat->springs[k].dof] = static_cast<int>(k);
   for (int j = 0; j < nb; ++j) {
-    if (spring_on[middle[j]] >= 0) {
-      LateralSpring& sp = lat->springs[spring_on[middle[j]]];
-      lat->load[middle[j]] += sp.stiffness * (b[j] - sp.anchor);
-      sp.anchor = b[j];
+    if (spring_on[p.middle[j]] >= 0) {
+      LateralSpring& sp = lat->springs[spring_on[p.middle[j]]];
+      lat->load[p.middle[j]] += sp.stiffness * (p.registration[j] - sp.anchor);
+      sp.anchor = p.registration[j];
     }
-    lat->supports[held[j]].stagger = b[j];
+    lat->supports[p.held[j]].stagger = p.registration[j];
   }
 }
 
