@@ -310,8 +310,12 @@ void print_pantograph(const PantographStatistics& s) {
                 << w.contact_percent << " % of the time\n";
   std::cout << std::setprecision(2) << "      contact losses: " << s.loss_events_total << " (" << s.loss_events_per_km
             << " per km), longest " << s.longest_loss_s * 1e3 << " ms\n";
-  std::cout << "      spectrum: span passing " << s.spectrum.span_passing_hz << " Hz, dropper passing ";
-  if (std::isnan(s.spectrum.dropper_passing_hz)) std::cout << "none (no droppers)";  // a trolley wire, a rail
+  // (No speed through the section where the pantograph is sampled there fewer than twice.)
+  if (std::isnan(s.spectrum.span_passing_hz)) std::cout << "      spectrum: span passing unknown (too few samples in the analysis section)";
+  else std::cout << "      spectrum: span passing " << s.spectrum.span_passing_hz << " Hz";
+  std::cout << ", dropper passing ";
+  if (std::isnan(s.spectrum.span_passing_hz)) std::cout << "unknown";
+  else if (std::isnan(s.spectrum.dropper_passing_hz)) std::cout << "none (no droppers)";  // a trolley wire, a rail
   else std::cout << s.spectrum.dropper_passing_hz << " Hz";
   std::cout << "; peaks";
   for (const SpectralPeak& k : s.spectrum.peaks)

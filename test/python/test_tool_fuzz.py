@@ -387,3 +387,22 @@ def test_pass_report_says_how_the_spectrum_was_averaged_and_counts_spans_from_on
     first_span_bars = sorted(p.get_x() + p.get_width() / 2 for p in blow.patches)[:2]
     assert first_span_bars == pytest.approx([0.8, 1.2])
     assert "first span is 1" in blow.get_xlabel()
+
+
+def test_a_pass_sampling_too_little_of_the_analysis_section(tmp_path):
+    # A train ending exactly where the analysis section starts runs none of it: refused by
+    # train.end. A millimetre further, the pantograph is sampled there once: no speed through the
+    # section, so no spectrum and no passing frequencies; the summary and the report say so
+    # instead of printing NaN or refusing the pass's own files.
+    sim = os.path.join(DEVEL, "simulate_pass")
+    common = ["--scene", REFERENCE, "--set", "line.span_count=6", "--set", "numerics.preset=fast", "--no-progress"]
+    first = 2 * 55.0  # output.analysis_spans of the reference scene start at its third support
+    r = subprocess.run([sim, *common, "--out", str(tmp_path / "a"), "--set", "train.end=%g" % first],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode > 0 and "train.end" in r.stderr and "allowed >" in r.stderr, r.stderr
+    assert not os.path.exists(tmp_path / "a" / "stats.json")
+    r = subprocess.run([sim, *common, "--out", str(tmp_path / "b"), "--set", "train.end=%g" % (first + 0.001), "--report"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "span passing unknown" in r.stdout and "nan" not in r.stdout.lower(), r.stdout
+    assert os.path.exists(tmp_path / "b" / "report_psd.png")

@@ -504,14 +504,15 @@ void set_train_travel(const Scene& scene, double endless_front, Model& m) {
       x0 = m.support_x[scene.analysis_first()];
     x1 = m.support_x[scene.analysis_last()];
     for (const PantographSpec& p : scene.pantographs) {
-      if (m.train_end - p.position < x0)
-        throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": pantograph '" + p.name +
-                         "' would stop before the analysis section " + fmt(x0) + "-" + fmt(x1) +
-                         " m (output.analysis_spans); allowed >= " + fmt(x0 + p.position) + " m");
-      if (m.train_start - p.position > x1)
-        throw SceneError("scene field 'train.start' = " + fmt(m.train_start) + ": pantograph '" + p.name +
+      // (At its start or end exactly, it would pass none of it: one sample, no statistics.)
+      if (m.train_end - p.position <= x0)
+        throw SceneError("scene field 'train.end' = " + fmt_given(m.train_end) + ": pantograph '" + p.name +
+                         "' would stop before running through the analysis section " + fmt(x0) + "-" + fmt(x1) +
+                         " m (output.analysis_spans); allowed > " + fmt(x0 + p.position) + " m");
+      if (m.train_start - p.position >= x1)
+        throw SceneError("scene field 'train.start' = " + fmt_given(m.train_start) + ": pantograph '" + p.name +
                          "' would start after the analysis section " + fmt(x0) + "-" + fmt(x1) +
-                         " m (output.analysis_spans); allowed <= " + fmt(x1 + p.position) + " m");
+                         " m (output.analysis_spans); allowed < " + fmt(x1 + p.position) + " m");
     }
   }
 }
