@@ -194,6 +194,23 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
       "sections:\n  - {span_length: 10.0, span_count: 4}\n  - {span_length: 10.0, span_count: 4}\n"
       "overlap: {spans: 2}\n";
   refused(two, "overlap.support_rise");
+  // A section that takes the top level's conductor_rail is a rail section: a catenary's part given
+  // there alone is refused by its name (it replaced the profile's support spring, or hung the profile
+  // from bridles); its own contact_wire makes it a catenary section.
+  auto second = [](const std::string& part) {
+    return "name: two\nline: {}\nconductor_rail: {linear_mass: 7.27, bending_stiffness: 2.8e5, support_stiffness: 5e6}\n"
+           "sections:\n  - {span_length: 10.0, span_count: 4}\n  - {span_length: 10.0, span_count: 4" +
+           (part.empty() ? "" : ", " + part) + "}\noverlap: {spans: 2, support_rise: 0.0}\n";
+  };
+  EXPECT_EQ(test_scenes::refusal_of_yaml(second("")), "");
+  refused(second("steady_arms: {stiffness: 100}"), "sections[1].steady_arms");
+  refused(second("steady_arms: {length: 1.15, linear_mass: 0.78, pull_off: 480}"), "sections[1].steady_arms");
+  refused(second("bridle: {length: 8, tension: 5000, linear_mass: 0.31}"), "sections[1].bridle");
+  refused(second("droppers: {positions: [5.0], axial_stiffness: 1e5}"), "sections[1].droppers");
+  // A part the sections take from the top level is named there, not as the first section's.
+  const std::string soft_top = test_scenes::refusal_of_yaml(second(""),
+                                                            {"conductor_rail.bending_stiffness=1000"});
+  EXPECT_NE(soft_top.find("'conductor_rail.bending_stiffness' = 1000"), std::string::npos) << soft_top;
   // A catenary section joined to a rigid one: the same end ramp is needed, and what the rail does
   // not model is refused for the whole line.
   const std::string mixed =
@@ -536,7 +553,7 @@ void plucked_profile_swings_at_its_span_frequency(double lateral_ei) {
   const std::string extra =
       "stagger:\n  contact_wire: [0.2, -0.2]\n"
       "pantographs:\n  - name: force\n    type: moving_force\n    static_uplift: 100.0\n"
-      "train:\n  speed: 1.0\n  start: 0.0\n  end: 20.0\n";
+      "train:\n  speed: 1.0\n  start: 0.0\n  end: 25.0\n";
   cs::Simulation sim(cs::load_scene_string(rail_yaml(6, 5e6, 0.25, extra, lateral_ei)));
   const cs::Model& m = sim.model();
   ASSERT_TRUE(m.lateral && !m.lateral->windy && m.lateral->pendulums.empty() && m.lateral->registrations.empty());
@@ -822,9 +839,10 @@ TEST(RigidConductorRail, ATransitionPieceSoftensTheProfilesEndAsABeamOfVaryingSt
   const auto refused = test_scenes::expect_refused;
   // (read where it is given, the top level; checked against the section it went to)
   const std::string f = "conductor_rail.transition_piece";
-  refused(rail_then_catenary("{length: 5.0, end_bending_stiffness: 3e5}"), "sections[0]." + f + ".end_bending_stiffness");
+  // (The piece is the top level's conductor_rail's: named there, not as the first section's.)
+  refused(rail_then_catenary("{length: 5.0, end_bending_stiffness: 3e5}"), "'" + f + ".end_bending_stiffness'");
   refused(rail_then_catenary("{length: 0, end_bending_stiffness: 7e4}"), f + ".length");
-  refused(rail_then_catenary("{length: 12, end_bending_stiffness: 7e4}"), "sections[0]." + f + ".length");
+  refused(rail_then_catenary("{length: 12, end_bending_stiffness: 7e4}"), "'" + f + ".length'");
   refused(rail_then_catenary("{length: 5.0}"), f + ".end_bending_stiffness");
   refused(rail_then_catenary("{length: 5.0, end_bending_stiffness: 7e4, shape: linear}"), f + ".shape");
   // A rail no catenary joins has no end for a piece.

@@ -105,6 +105,7 @@ void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
   sec.auxiliary_messenger.reset();
   sec.hangers.reset();
   sec.bridle.reset();
+  sec.stitch_wire.reset();
   sec.contact_wire_count = 1;
 }
 
@@ -233,6 +234,15 @@ void read_section_parts(Reader& r, const std::string& path, SectionSpec& sec, co
     read_conductor_rail(r, pre, sec);
     return;
   }
+  // A rail section by the top level's conductor_rail takes none of a catenary's parts; its own
+  // contact_wire makes it a catenary section.
+  if (sec.rigid && !r.has("contact_wire"))
+    for (const char* other : {"messenger", "droppers", "steady_arms", "messenger_supports", "stitch_wire",
+                              "contact_wire_count", "auxiliary_messenger", "hangers", "bridle"})
+      if (r.has(other))
+        fail(pre + other, "(given in a section of the top level's conductor_rail)",
+             "a rigid conductor rail has no tensioned wires, droppers or steady arms (its support_stiffness and "
+             "support_mass hold the profile); give the section a contact_wire to make it a catenary section");
   if (r.has("contact_wire") && sec.rigid) {  // a catenary section among rigid defaults: none of the rail's parts
     SectionSpec fresh;
     fresh.spans = sec.spans;
@@ -359,6 +369,8 @@ void read_line(Reader& top, Scene& s) {
       const std::string path = "sections[" + std::to_string(i) + "]";
       Reader sr(secs[i], path);
       SectionSpec sec = defaults;
+      if (secs[i].IsMap())
+        for (const auto& kv : secs[i]) sec.given.push_back(kv.first.Scalar());
       read_spans(sr, path, sec.spans);
       read_section_parts(sr, path, sec, &defaults);
       const double count = sr.number("contact_wire_count", 1.0, 2.0, 1.0);

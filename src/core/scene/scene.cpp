@@ -63,6 +63,14 @@ double Scene::line_length() const {
   return s;
 }
 
+std::string Scene::section_field(std::size_t i, const std::string& name) const {
+  if (sections.size() < 2) return name;
+  const std::vector<std::string>& given = sections[i].given;
+  const std::string part = name.substr(0, name.find('.'));
+  if (!given.empty() && std::find(given.begin(), given.end(), part) == given.end()) return name;
+  return "sections[" + std::to_string(i) + "]." + name;
+}
+
 int Scene::analysis_first() const {
   const int n = static_cast<int>(spans.size());
   return output.analysis_first_span ? *output.analysis_first_span : (n > 4 ? 2 : 0);

@@ -240,6 +240,9 @@ struct SectionSpec {
   std::optional<TransitionPiece> rail_transition_piece;
   bool first_span_transition = false;  // default: true where a previous section overlaps it
   bool last_span_transition = false;   // default: true where a next section overlaps it
+  // The keys the section's own entry in `sections` gives; a part it does not give is the top
+  // level's, and is named there (Scene::section_field). Empty: all its own (a scene built in code).
+  std::vector<std::string> given;
   double length() const;
   double end() const { return start + length(); }
 };
@@ -532,10 +535,9 @@ struct Scene {
   }
 
   double line_length() const;
-  // A field of section i as messages name it: "sections[i].name", or "name" on a line of one section.
-  std::string section_field(std::size_t i, const std::string& name) const {
-    return (sections.size() > 1 ? "sections[" + std::to_string(i) + "]." : std::string()) + name;
-  }
+  // A field of section i as messages name it: "sections[i].name", or "name" on a line of one section
+  // and where the section takes that part from the top level.
+  std::string section_field(std::size_t i, const std::string& name) const;
   // Span index [first, last) of the statistics section, resolved against the defaults.
   int analysis_first() const;
   int analysis_last() const;
