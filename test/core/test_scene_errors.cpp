@@ -466,3 +466,38 @@ TEST(SceneErrors, DesignStaticsRefusalsNameTheKindsFields) {
   EXPECT_MENTIONS(test_scenes::refusal_of(stitched, {"stitch_wire.tension=1"}), "stitch_wire.tension 1 N", "raise it");
   EXPECT_MENTIONS(test_scenes::refusal_of(stitched, {"stitch_wire.tension=1e5"}), "lower stitch_wire.tension");
 }
+
+// Two stations of a wire (supports, droppers, hangers, the clamps of stitch wires and bridles)
+// closer than a dropper's or a clamp's fitting, 1 cm, are refused by the field that put the one
+// beside the support or the other station there. A stitch wire or bridle of 10 um aborted the
+// pass (a contact patch sized for its 5 um elements overflowed the statics' reservation), and a
+// hanger 1 mm from its support was blamed on the auxiliary's tension. At 2 cm (clamps 1 cm from
+// the support) the line is built; at the same station the two are one node.
+TEST(SceneErrors, StationsCloserThanAFittingAreRefusedByTheirField) {
+  using test_scenes::refusal_of;
+  using test_scenes::scene_path;
+  struct Case {
+    const char* file;
+    std::vector<std::string> o;
+    const char* field;
+  };
+  const std::vector<Case> refused = {
+      {"reference_55m_stitched.yaml", {"stitch_wire.length=1e-5"}, "'stitch_wire.length' = 1e-05"},
+      {"reference_55m_stitched.yaml", {"stitch_wire.length=null", "stitch_wire.lengths=[16,16,1e-5,16,16,16,16,16,16]"},
+       "'stitch_wire.lengths' = 1e-05"},
+      {"trolley_wire_bridle.yaml", {"bridle.length=1e-5", "bridle.tension=1e5"}, "'bridle.length' = 1e-05"},
+      {"compound_catenary.yaml", {"hangers.positions=[0.001,7.5,12.5,17.5,22.5,27.5,32.5,37.5,42.5,47.5]"},
+       "'hangers.positions' = 0.001"},
+      {"compound_catenary.yaml", {"hangers.positions=[2.5,4.995,12.5,17.5,22.5,27.5,32.5,37.5,42.5,47.5]"},
+       "hangers.positions"},  // (beside a dropper: either may be named, with the other)
+  };
+  for (const Case& c : refused) {
+    SCOPED_TRACE(std::string(c.file) + " " + c.o.back());
+    const std::string message = refusal_of(scene_path(c.file), c.o);
+    EXPECT_NE(message.find(c.field), std::string::npos) << message;
+    EXPECT_NE(message.find("at least 0.01 m apart"), std::string::npos) << message;
+  }
+  EXPECT_EQ(refusal_of(scene_path("reference_55m_stitched.yaml"), {"stitch_wire.length=0.02"}), "");
+  EXPECT_EQ(refusal_of(scene_path("compound_catenary.yaml"), {"hangers.positions=[2.5,5.0,12.5,17.5,22.5,27.5,32.5,37.5,42.5,47.5]"}),
+            "");  // (a hanger at a dropper's station: one node)
+}

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -25,46 +26,73 @@
 namespace catenary_sim {
 namespace {
 
+// Two stations of a wire closer than this are refused: a dropper's or a clamp's fitting is a few
+// centimetres long, so closer ones cannot both be built, and the element between them would cut
+// dt by the square of its share of numerics.element_length and load the statics with stiffnesses
+// of its cube (at 5 um, garbage). Stations closer than 1e-9 m are one node.
+constexpr double kClosestStations = 0.01;  // m
+
 // Node stations of one tension section: every support and dropper is a node; the segments
 // between them are split into equal elements no longer than the requested length.
-std::vector<double> mesh_section(const SectionSpec& sec, double element_length, std::vector<double>& support_x) {
-  std::vector<double> breaks;
+std::vector<double> mesh_section(const Scene& scene, std::size_t si, std::vector<double>& support_x) {
+  const SectionSpec& sec = scene.sections[si];
+  const double element_length = scene.numerics.element_length;
+  struct Station {
+    double x;
+    const char* what;  // the scene field that put it there
+    double given;      // its value there (a position in the span, a length)
+  };
+  std::vector<Station> breaks;
   double x0 = sec.start;
   support_x.assign(1, x0);
   const std::size_t nspan = sec.spans.size();
   for (std::size_t i = 0; i < nspan; ++i) {
     const std::size_t first = breaks.size();
-    breaks.push_back(x0);
+    breaks.push_back({x0, "spans", sec.spans[i]});
     if (sec.droppers)
-      for (double p : sec.droppers->positions[i]) breaks.push_back(x0 + p);
+      for (double p : sec.droppers->positions[i]) breaks.push_back({x0 + p, "droppers.positions", p});
     if (sec.hangers)  // a compound line's
-      for (double p : sec.hangers->positions[i]) breaks.push_back(x0 + p);
+      for (double p : sec.hangers->positions[i]) breaks.push_back({x0 + p, "hangers.positions", p});
     if (sec.stitch_wire) {  // the clamps of the stitch wires at the span's intermediate supports
       const StitchWireSpec& st = *sec.stitch_wire;
+      const char* what = st.lengths.empty() ? "stitch_wire.length" : "stitch_wire.lengths";
       const int a = static_cast<int>(i), b = a + 1;
-      if (i > 0 && st.at(a)) breaks.push_back(x0 + 0.5 * st.length_at(a));
-      if (i + 1 < nspan && st.at(b)) breaks.push_back(x0 + sec.spans[i] - 0.5 * st.length_at(b));
+      if (i > 0 && st.at(a)) breaks.push_back({x0 + 0.5 * st.length_at(a), what, st.length_at(a)});
+      if (i + 1 < nspan && st.at(b)) breaks.push_back({x0 + sec.spans[i] - 0.5 * st.length_at(b), what, st.length_at(b)});
     }
     if (sec.bridle) {  // the clamps of the bridles at the span's intermediate supports
       const double half = 0.5 * sec.bridle->length;
-      if (i > 0) breaks.push_back(x0 + half);
-      if (i + 1 < nspan) breaks.push_back(x0 + sec.spans[i] - half);
+      if (i > 0) breaks.push_back({x0 + half, "bridle.length", sec.bridle->length});
+      if (i + 1 < nspan) breaks.push_back({x0 + sec.spans[i] - half, "bridle.length", sec.bridle->length});
     }
     if (sec.hangers || sec.stitch_wire || sec.bridle) {  // (droppers alone are in order: validate_sections)
-      std::sort(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end());
-      breaks.erase(std::unique(breaks.begin() + static_cast<std::ptrdiff_t>(first), breaks.end(),
-                               [](double a, double b) { return b - a < 1e-9; }),
+      const auto from = breaks.begin() + static_cast<std::ptrdiff_t>(first);
+      std::stable_sort(from, breaks.end(), [](const Station& a, const Station& b) { return a.x < b.x; });
+      breaks.erase(std::unique(from, breaks.end(), [](const Station& a, const Station& b) { return b.x - a.x < 1e-9; }),
                    breaks.end());
     }
     x0 += sec.spans[i];
     support_x.push_back(x0);
   }
-  breaks.push_back(x0);
+  breaks.push_back({x0, "spans", 0.0});
+  for (std::size_t i = 0; i + 1 < breaks.size(); ++i) {
+    const Station &a = breaks[i], &b = breaks[i + 1];
+    if (b.x - a.x > kClosestStations - 1e-9) continue;  // (1 cm as given, less the stations' rounding)
+    // (A support stays: what came near it is what to move.)
+    const bool b_support = std::strcmp(b.what, "spans") == 0;
+    const Station &moved = b_support ? a : b, &other = b_support ? b : a;
+    const std::string near =
+        std::strcmp(other.what, "spans") == 0 ? "the support" : "a station of '" + scene.section_field(si, other.what) + "'";
+    throw SceneError("scene field '" + scene.section_field(si, moved.what) + "' = " + fmt_given(moved.given) +
+                     " m puts a station at " + fmt_given(moved.x) + " m, " + fmt(b.x - a.x) + " m from " + near + " at " +
+                     fmt_given(other.x) + " m: stations at least " + fmt(kClosestStations) +
+                     " m apart (a dropper's or a clamp's fitting), or at the same station");
+  }
   std::vector<double> x;
   for (std::size_t i = 0; i + 1 < breaks.size(); ++i) {
-    const double len = breaks[i + 1] - breaks[i];
+    const double len = breaks[i + 1].x - breaks[i].x;
     const int n = std::max(1, static_cast<int>(std::ceil(len / element_length - 1e-9)));
-    for (int k = 0; k < n; ++k) x.push_back(breaks[i] + len * k / n);
+    for (int k = 0; k < n; ++k) x.push_back(breaks[i].x + len * k / n);
   }
   x.push_back(x0);
   return x;
@@ -181,7 +209,7 @@ void mesh_wires(const Scene& scene, const std::vector<double>& rise_first, const
   const bool lumped_rot = scene.numerics.rotary_inertia == RotaryInertia::kLumped;
   for (std::size_t si = 0; si < scene.sections.size(); ++si) {
     const SectionSpec& sec = scene.sections[si];
-    const std::vector<double> x = mesh_section(sec, scene.numerics.element_length, section_supports[si]);
+    const std::vector<double> x = mesh_section(scene, si, section_supports[si]);
     Section info;
     info.start = sec.start;
     info.end = sec.end();
@@ -425,11 +453,17 @@ void set_constant_load(const Scene& scene, Model& m, const std::vector<bool>& fi
 
 void set_pantograph_masses(Model& m) {
   // Pantographs: unit-less references are set by the initial statics in the Simulation.
+  // The most nodes a contact patch (rub_length wide) can cover on a wire the collectors touch: the
+  // most stations within rub_length of one another, and one more on each side.
   int max_nodes = 2;
-  double hmin = 1e9;
-  for (const Wire& w : m.wires)
-    for (int e = 0; e + 1 < w.nodes(); ++e) hmin = std::min(hmin, w.x[e + 1] - w.x[e]);
-  if (m.rub_length > 0.0) max_nodes = static_cast<int>(std::ceil(m.rub_length / hmin)) + 3;
+  if (m.rub_length > 0.0)
+    for (int wi : m.contact_wires) {
+      const std::vector<double>& x = m.wires[wi].x;
+      for (std::size_t lo = 0, hi = 0; hi < x.size(); ++hi) {
+        while (x[hi] - x[lo] > m.rub_length) ++lo;
+        max_nodes = std::max(max_nodes, static_cast<int>(hi - lo + 1) + 3);
+      }
+    }
   m.max_contact_nodes = max_nodes;
   for (Pantograph& p : m.pantographs)
     if (!p.moving_force) {  // a moving force set in code may keep masses it does not use (no DOFs)

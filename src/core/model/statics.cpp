@@ -268,8 +268,8 @@ Eigen::VectorXd solve_static_equilibrium(const Model& m, const PantographLoads& 
   // 8 an element, a spring's 4, the contact springs' (nodes + 2)^2 per collector and wire.
   std::size_t room = 4 * (m.springs.size() + m.droppers.size()) + 64 * m.pantographs.size();
   for (const Wire& w : m.wires) room += 12 * static_cast<std::size_t>(w.nodes());
-  room += static_cast<std::size_t>((m.max_contact_nodes + 2) * (m.max_contact_nodes + 2)) * m.collectors.size() *
-          m.contact_wires.size();
+  const std::size_t patch = static_cast<std::size_t>(m.max_contact_nodes) + 2;
+  room += patch * patch * m.collectors.size() * m.contact_wires.size();
   sys.t.reserve(room);
   sys.node.resize(m.max_contact_nodes);
   sys.weight.resize(m.max_contact_nodes);
