@@ -43,7 +43,9 @@ SupportSpec read_steady_arms(Reader& r, const std::string& path) {
            "either a spring (stiffness, mass) or a hinged arm (length, linear_mass, clamp_mass, pull_off), not both: "
            "a hinged arm's stiffness and mass follow from its geometry and pull-off");
   HingedArmSpec a;
-  a.length = r.number("length", 0.0, 5.0, std::nullopt, true);
+  // At least 0.1 m: registration arms are 0.3-1.5 m; a shorter one's k_A = pull_off / length
+  // (eq. 4) runs to infinity, and its inclination flips under the uplift.
+  a.length = r.number("length", 0.1, 5.0, std::nullopt);
   a.linear_mass = r.number("linear_mass", 0.0, 20.0, std::nullopt);
   a.clamp_mass = r.number("clamp_mass", 0.0, 20.0, 0.0);
   if (r.has("pull_off")) a.pull_off = r.number("pull_off", 0.0, 1e5, std::nullopt, true);
