@@ -2,6 +2,7 @@
 // what the fields allow together, each refusal naming a field, its value and what is allowed.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <set>
 #include <string>
@@ -333,25 +334,42 @@ void validate_rigid(const Scene& s) {
   // A beam, not a chain: under its weight the profile must sag less than a fiftieth of its span
   // (simply supported, 5 q L^4 / (384 EI): the small deflections its beam theory needs; the shipped
   // profile sags a thousandth). A softer one hangs as no rail does and the static state runs away.
-  auto stiff_enough = [&](const std::string& field, double ei, double span, double linear_mass) {
-    const double q = linear_mass * s.gravity, least = 250.0 * q * span * span * span / 384.0;
+  // The same across the track under the mean wind's drag on the profile (the lateral plane's small
+  // deflections; a profile of EI 1 N m^2 blew out kilometres and went NaN).
+  const double wind_q = s.wind && s.lateral()
+                            ? 0.5 * s.wind->air_density * s.wind->conductor_rail.drag_coefficient *
+                                  s.wind->conductor_rail.diameter * s.wind->speed * s.wind->speed
+                            : 0.0;
+  auto stiff_enough = [&](std::size_t i, const std::string& field, double ei, double span, double q, const char* under,
+                          const char* way, const std::string& note = "") {
+    const double least = 250.0 * q * span * span * span / 384.0;
+    // (A span no profile of the allowed EI could take is the span's to shorten.)
+    if (least > 1e8 && std::strcmp(under, "its weight") == 0)
+      fail(s.sections.size() > 1 ? "sections[" + std::to_string(i) + "].spans" : "line.spans", fmt(span) + " m",
+           "a rigid rail's span short enough for a profile of at most 1e8 N m^2 (this one needs " + fmt(least) +
+               " N m^2 so as to sag less than a fiftieth of it under its weight); supports every 8-12 m in service");
     if (!(ei >= least))
-      fail(field, fmt(ei),
-           "at least " + fmt(least) + " N m^2 here: the profile would sag " + fmt(5.0 * q * std::pow(span, 4) / (384.0 * ei)) +
-               " m under its weight over a " + fmt(span) + " m span (5 q L^4 / (384 EI)), more than a fiftieth of it");
+      fail(field, fmt(ei) + note,
+           "at least " + fmt(least) + " N m^2 here: the profile would " + way + " " + fmt(5.0 * q * std::pow(span, 4) / (384.0 * ei)) +
+               " m under " + under + " over a " + fmt(span) + " m span (5 q L^4 / (384 EI)), more than a fiftieth of it");
   };
   for (std::size_t i = 0; i < s.sections.size(); ++i) {
     const SectionSpec& sec = s.sections[i];
     if (!sec.rigid) continue;
     const std::string f = s.section_field(i, "conductor_rail");
-    stiff_enough(f + ".bending_stiffness", sec.contact_wire.bending_stiffness, *std::max_element(sec.spans.begin(), sec.spans.end()),
-                 sec.contact_wire.linear_mass);
+    const double longest = *std::max_element(sec.spans.begin(), sec.spans.end());
+    stiff_enough(i, f + ".bending_stiffness", sec.contact_wire.bending_stiffness, longest,
+                 sec.contact_wire.linear_mass * s.gravity, "its weight", "sag");
+    if (wind_q > 0.0)
+      stiff_enough(i, f + ".lateral_bending_stiffness", sec.rail_lateral_bending_stiffness.value_or(sec.contact_wire.bending_stiffness),
+                   longest, wind_q, "the mean wind (wind.speed)", "blow out",
+                   sec.rail_lateral_bending_stiffness ? "" : " (absent: the bending_stiffness)");
     if (sec.rail_transition_piece) {
       const double end_span = std::max(transition_piece_at_start(s, i) ? sec.spans.front() : 0.0,
                                        transition_piece_at_end(s, i) ? sec.spans.back() : 0.0);
       if (end_span > 0.0)
-        stiff_enough(f + ".transition_piece.end_bending_stiffness", sec.rail_transition_piece->end_bending_stiffness, end_span,
-                     sec.contact_wire.linear_mass);
+        stiff_enough(i, f + ".transition_piece.end_bending_stiffness", sec.rail_transition_piece->end_bending_stiffness, end_span,
+                     sec.contact_wire.linear_mass * s.gravity, "its weight", "sag");
     }
   }
   for (std::size_t i = 0; i < s.sections.size(); ++i) {
