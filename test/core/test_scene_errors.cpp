@@ -465,6 +465,16 @@ TEST(SceneErrors, DesignStaticsRefusalsNameTheKindsFields) {
   const std::string stitched = test_scenes::scene_path("reference_55m_stitched.yaml");
   EXPECT_MENTIONS(test_scenes::refusal_of(stitched, {"stitch_wire.tension=1"}), "stitch_wire.tension 1 N", "raise it");
   EXPECT_MENTIONS(test_scenes::refusal_of(stitched, {"stitch_wire.tension=1e5"}), "lower stitch_wire.tension");
+  // A dropper of 5 mm is refused as too short for its fittings (it read as hanging below), and a
+  // drawn dropper error too long for a hanger names the spread that drew it (it named a list of
+  // errors that was not given, and called the hanger a dropper).
+  EXPECT_MENTIONS(test_scenes::refusal_of(compound, {"auxiliary_messenger.height=1.3"}), "'line.encumbrance'", "hangs only",
+                  "shorter than 0.01 m");
+  EXPECT_MENTIONS(test_scenes::refusal_of(compound, {"imperfections.dropper_length_std=0.05"}),
+                  "'imperfections.dropper_length_std' = 0.05", "the hanger at");
+  // A one-section line's per-span list is its top-level field's, not under line.
+  EXPECT_MENTIONS(test_scenes::refusal_of(compound, {"hangers.positions=null", "hangers.positions_per_span=[[2.5],[2.5]]"}),
+                  "'hangers.positions_per_span'");
 }
 
 // Two stations of a wire (supports, droppers, hangers, the clamps of stitch wires and bridles)

@@ -263,9 +263,11 @@ void set_dropper_lengths(const Scene& scene, const std::vector<double>& weight_l
                  // (a stitch wire pulls the messenger down at its clamps by its tension's share)
                  (sec.stitch_wire ? ", or lower stitch_wire.tension (" + fmt(sec.stitch_wire->tension) + " N)" : "");
       }
-      throw SceneError("scene field '" + field + "' = " + value + ": at x = " + fmt(d.x) + " m the " + top_name + " hangs " +
-                       fmt(-d.length) + " m below the " + low + " (" + part + " length " + fmt(d.length) + " m); " + advice +
-                       ", or reduce the presag");
+      // (At least 1 cm: a dropper's fittings; a shorter or negative one cannot be built.)
+      const std::string where = d.length > 0.0 ? " only " + fmt(d.length) + " m above the " + low + ", a " + part + " shorter than 0.01 m"
+                                               : " " + fmt(-d.length) + " m below the " + low + ", a " + part + " of negative length";
+      throw SceneError("scene field '" + field + "' = " + value + ": at x = " + fmt(d.x) + " m the " + top_name + " hangs" + where +
+                       " (at least 0.01 m: its fittings); " + advice + ", or reduce the presag");
     }
     const int nspan = static_cast<int>(sec.spans.size());
     const bool in_transition = (d.span == 0 && sec.first_span_transition) || (d.span == nspan - 1 && sec.last_span_transition);

@@ -76,9 +76,16 @@ void apply_imperfections(const Scene& scene, Model& m, const std::vector<bool>& 
                      : im.dropper_length_std > 0.0     ? dropper_normal.next(im.dropper_length_std)
                                                        : 0.0;
     Dropper& d = m.droppers[order[j]];
-    if (e >= d.unstretched_length)
-      throw SceneError("scene field 'imperfections.dropper_length_errors' (dropper at " + fmt(d.x) + " m) = " + fmt(e) +
-                       ": allowed below the dropper's length " + fmt(d.unstretched_length) + " m");
+    if (e >= d.unstretched_length) {
+      // Named as given: a listed error, or the draw of dropper_length_std (a compound line's hangers draw too).
+      const char* part = d.hanger ? "hanger" : "dropper";
+      if (!im.dropper_length_errors.empty())
+        throw SceneError("scene field 'imperfections.dropper_length_errors' (the " + std::string(part) + " at " + fmt(d.x) +
+                         " m) = " + fmt_given(e) + ": allowed below its length " + fmt(d.unstretched_length) + " m");
+      throw SceneError("scene field 'imperfections.dropper_length_std' = " + fmt_given(im.dropper_length_std) + " m draws " +
+                       fmt(e) + " m for the " + part + " at " + fmt(d.x) + " m, not below its length " +
+                       fmt(d.unstretched_length) + " m: a smaller spread, or another dropper_length_seed");
+    }
     d.static_tension -= d.stiffness * e;  // may go negative: a dropper too long hangs slack
   }
   std::vector<int> arms;

@@ -310,7 +310,7 @@ void resolve_line(Scene& s) {
       const std::size_t n = sec.spans.size();
       if (d.per_span) {
         if (d.positions.size() != n)
-          fail(path + "." + key + ".positions_per_span", "(" + std::to_string(d.positions.size()) + " entries)",
+          fail(s.section_field(i, std::string(key) + ".positions_per_span"), "(" + std::to_string(d.positions.size()) + " entries)",
                "one list per span (" + std::to_string(n) + ")");
       } else {
         const std::vector<double> common = d.positions.empty() ? std::vector<double>{} : d.positions.front();
