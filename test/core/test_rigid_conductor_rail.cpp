@@ -854,6 +854,9 @@ TEST(RigidConductorRail, ATransitionPieceSoftensTheProfilesEndAsABeamOfVaryingSt
   refused(rail_then_catenary("{length: 5.0, end_bending_stiffness: 3e5}"), "'" + f + ".end_bending_stiffness'");
   refused(rail_then_catenary("{length: 0, end_bending_stiffness: 7e4}"), f + ".length");
   refused(rail_then_catenary("{length: 12, end_bending_stiffness: 7e4}"), "'" + f + ".length'");
+  // (Bounded by the end span alone, as the scene reference says: no cap of its own below it.)
+  const std::string long_piece = test_scenes::refusal_of_yaml(rail_then_catenary("{length: 60, end_bending_stiffness: 7e4}"));
+  EXPECT_NE(long_piece.find("within the end span"), std::string::npos) << long_piece;
   refused(rail_then_catenary("{length: 5.0}"), f + ".end_bending_stiffness");
   refused(rail_then_catenary("{length: 5.0, end_bending_stiffness: 7e4, shape: linear}"), f + ".shape");
   // A rail no catenary joins has no end for a piece.

@@ -89,6 +89,12 @@ TEST(SceneErrors, NotANumber) {
   EXPECT_MENTIONS(error_of({"contact_wire.tension='2e4 '"}), "contact_wire.tension", "'2e4 '", "without quotes");
   EXPECT_MENTIONS(error_of({"droppers.positions=[4.5, '10.25']"}), "droppers.positions[1]", "in quotes");
   EXPECT_EQ(error_of({"contact_wire.tension=20000"}), "");
+  // A tag says what a scalar is: !!str makes text of it (it was read as the number), YAML's
+  // number tags leave it a number.
+  EXPECT_MENTIONS(error_of({"contact_wire.tension=!!str 20000"}), "contact_wire.tension", "tagged", "written plain");
+  EXPECT_MENTIONS(error_of({"contact_wire.tension=!tension 20000"}), "contact_wire.tension", "tagged");
+  EXPECT_EQ(error_of({"contact_wire.tension=!!float 20000"}), "");
+  EXPECT_EQ(error_of({"contact_wire.tension=!!int 20000"}), "");
 }
 
 TEST(SceneErrors, MissingRequiredField) {

@@ -91,7 +91,7 @@ void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
   if (c.has("transition_piece")) {
     Reader t(c.child("transition_piece"), pre + "conductor_rail.transition_piece");
     SectionSpec::TransitionPiece piece;
-    piece.length = t.number("length", 0.0, 50.0, std::nullopt, true);
+    piece.length = t.number("length", 0.0, 500.0, std::nullopt, true);  // (within the end span: validate_rigid)
     piece.end_bending_stiffness = t.number("end_bending_stiffness", 0.0, 1e8, std::nullopt, true);
     t.finish();
     sec.rail_transition_piece = piece;

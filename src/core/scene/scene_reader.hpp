@@ -112,6 +112,9 @@ class Reader {
     const std::string raw = n.as<std::string>();
     // A quoted scalar is text ("1500", '1.5e3 '), whatever it spells: a number is written plain.
     if (n.Tag() == "!") fail(field, "'" + raw + "' (in quotes, so text)", "a number in " + range(lo, hi, lo_open) + ", written without quotes");
+    // A tag other than YAML's own for numbers makes it something else (!!str 8.0 is text).
+    if (n.Tag() != "?" && n.Tag() != "tag:yaml.org,2002:float" && n.Tag() != "tag:yaml.org,2002:int")
+      fail(field, "'" + raw + "' (tagged " + n.Tag() + ")", "a number in " + range(lo, hi, lo_open) + ", written plain");
     double v = 0.0;
     try {
       v = n.as<double>();
