@@ -52,11 +52,21 @@ HilLoop::HilLoop(Scene scene, const LoopOptions& o, const std::string& rate_name
   double auto_dt = 0.0;
   if (!scene.numerics.dt) auto_dt = build_model(scene).dt;
   timing_ = hil_timing(opt_.rate, scene.numerics.dt, auto_dt, rate_name, scene_name);
+  auto name = [this](const char* parameter, const char* option) {
+    return opt_.command_line ? std::string(option) : "parameter ~hil/" + std::string(parameter);
+  };
   if (!std::isfinite(opt_.delay_compensation) || opt_.delay_compensation < 0.0 || opt_.delay_compensation > 0.1)
-    throw HilError("delay compensation = " + fmt(opt_.delay_compensation) + " s rejected: allowed [0, 0.1] s");
+    throw HilError(name("delay_compensation", "--delay-compensation") + " = " + fmt_given(opt_.delay_compensation) +
+                   " s rejected: allowed [0, 0.1] s");
   if (!std::isfinite(opt_.timeout) || opt_.timeout < 2.0 * timing_.period || opt_.timeout > 10.0)
-    throw HilError("timeout = " + fmt(opt_.timeout) + " s rejected: allowed [2 loop periods = " +
+    throw HilError(name("timeout", "--timeout") + " = " + fmt_given(opt_.timeout) + " s rejected: allowed [2 loop periods = " +
                    fmt(2.0 * timing_.period) + ", 10] s");
+  // (checked before the scene is built: a refused option costs no static solve)
+  if (!std::isfinite(opt_.hold_deceleration) || opt_.hold_deceleration < 0.0 ||
+      opt_.hold_deceleration > Simulation::kMaxAcceleration)
+    throw HilError(name("hold_deceleration", "--hold-deceleration") + " = " + fmt_given(opt_.hold_deceleration) +
+                   " m/s^2 rejected: allowed [0, " + fmt(Simulation::kMaxAcceleration) +
+                   "] m/s^2 (0: at once; the core's limit on the train's acceleration)");
   scene.numerics.dt = timing_.dt;
   sim_ = std::make_unique<Simulation>(scene);
   const Model& m = sim_->model();
@@ -65,7 +75,7 @@ HilLoop::HilLoop(Scene scene, const LoopOptions& o, const std::string& rate_name
     throw HilError(scene_name + ": the scene has no `type: external` pantograph (one the rig's measurement drives)");
   commanded_speed_ = scene.train_speed;
   std::string err;
-  if (!sim_->set_max_acceleration(opt_.hold_deceleration, &err)) throw HilError("hold_deceleration: " + err);
+  sim_->set_max_acceleration(opt_.hold_deceleration, &err);  // (in range: checked above)
   hold_ = MeasurementHold(external_.size());
   accept_buf_.assign(external_.size(), 0.0);
   hold_from_.assign(m.pantographs.size(), 0.0);

@@ -62,6 +62,7 @@ int parse_options(int argc, char** argv, UdpOptions* o) {
   hil::LoopOptions& lo = o->lo;
   lo.who = "catenary_sim_hil_udp";
   lo.input = "UDP measurement";
+  lo.command_line = true;
   app.add_option("--scene", o->scene_file, "scene YAML with at least one `type: external` pantograph")->required()->type_name("FILE");
   app.add_option("--speed-kmh", o->speed_kmh, "train speed, km/h (default: the scene's)")->check(kFinite & CLI::Range(0.0, 3.6 * kMaxTrainSpeed));
   app.add_option("--rate", lo.rate, "loop rate, Hz")->check(kFinite & kLoopRate)->capture_default_str();
@@ -71,7 +72,7 @@ int parse_options(int argc, char** argv, UdpOptions* o) {
   app.add_option("--hold-ramp", lo.hold_ramp, "s, force ramp to the static force in the safe hold")
       ->check(kFinite & CLI::Range(0.0, 60.0))->capture_default_str();
   app.add_option("--hold-deceleration", lo.hold_deceleration, "m/s^2, the train stops at this rate in the safe hold (0: at once)")
-      ->check(kFinite & CLI::Range(0.0, 50.0))->capture_default_str();
+      ->check(kFinite & CLI::Range(0.0, Simulation::kMaxAcceleration))->capture_default_str();
   app.add_option("--start-delay", lo.start_delay, "s in which measurements are ignored")->check(kFinite & CLI::Range(0.0, 60.0));
   app.add_option("--delay-compensation", lo.delay_compensation,
                  "s: send the contact point predicted this far ahead (the known loop delay)")

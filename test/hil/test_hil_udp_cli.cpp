@@ -60,6 +60,8 @@ TEST(HilUdpCli, BadOptionsAreRefusedNamingTheOption) {
   expect_refused(with({"--rate", "20000"}), {"--rate = 20000 rejected: allowed [1000, 10000] Hz"});
   expect_refused(with({"--timeout", "0.0015", "--rate", "1000"}), {"timeout", "0.0015", "allowed"});
   expect_refused(with({"--delay-compensation", "0.5"}), {"--delay-compensation"});
+  // (beyond the core's limit on the train's acceleration: refused by the option, not by the loop)
+  expect_refused(with({"--hold-deceleration", "30"}), {"--hold-deceleration", "30"});
   expect_refused(with({"--rig", "localhost"}), {"--rig", "HOST:PORT"});
   expect_refused(with({"--rig", "127.0.0.1:0"}), {"--rig", "1 to 65535"});
   expect_refused(with({"--rig", "example.org:47801"}), {"--rig", "IPv4"});

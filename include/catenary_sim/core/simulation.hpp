@@ -45,6 +45,7 @@ class Simulation {
   static constexpr double kMaxExternalForce = 2000.0; // N
   static constexpr double kMaxSpeed = kMaxTrainSpeed;  // m/s, the ceiling; below it train_speed_limit (scene.hpp)
   static constexpr double kMaxUplift = 1000.0;  // N
+  static constexpr double kMaxAcceleration = 20.0;  // m/s^2, set_max_acceleration's ceiling (about 2 g)
 
   // A dt above this share of the stability estimate is what a divergence message blames first.
   static constexpr double kStepNearEstimate = 0.95;

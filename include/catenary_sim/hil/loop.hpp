@@ -59,6 +59,9 @@ struct LoopOptions {
   // answer to the state at the time it is applied. 0: the state as it is.
   double delay_compensation = 0.0;
   std::string who = "catenary_sim_hil";    // prefix of the log lines
+  // Errors name the options as the command line spells them (--hold-deceleration) instead of as
+  // the ROS parameters (~hil/hold_deceleration).
+  bool command_line = false;
   std::string input = "hil/contact_force"; // how the measurement input is named in messages
 };
 
