@@ -148,7 +148,8 @@ bool HilLoop::execute(Request r, std::string& msg) {
   const std::string now = stopping_ ? "stopping (~stop)" : mode_ == Mode::kPaused
       ? std::string(paused_from_ == Mode::kHold ? "paused (in the safe hold)" : "paused")
       : mode_ == Mode::kWaiting ? (armed_ ? "waiting for the first measurement" : "waiting for ~arm")
-      : mode_ == Mode::kEnded ? (diverged_ ? "ended (diverged)" : "ended") : mode_name(mode_);
+      : mode_ == Mode::kEnded ? (diverged_ ? "ended (diverged)" : dewired_ ? "ended (dewirement)" : "ended")
+      : mode_name(mode_);
   auto refuse = [&](const std::string& why) {
     msg = "refused: the pass is " + now + "; " + why;
     return false;
@@ -248,7 +249,7 @@ void HilLoop::new_pass() {
     hold_start_time_ = sim_->state().time;
     for (int p : external_) hold_from_[p] = sim_->state().uplift[p];
   }
-  diverged_ = false;
+  diverged_ = dewired_ = false;
   recovering_ = false;
 }
 
@@ -568,14 +569,21 @@ void HilLoop::handle_end() {
   const State& s = sim_->state();
   if (mode_ == Mode::kEnded) return;
   const bool diverged = s.status == StepStatus::kDiverged;
+  // (Simulation::finished() is true for a dewirement too: it is not the end of the line)
+  const bool dewired = s.status == StepStatus::kDewired;
   const bool stopped = stopping_ && stop_settled();
-  if (!diverged && !stopped && !sim_->finished()) return;
+  if (!diverged && !dewired && !stopped && !sim_->finished()) return;
   // The pass is over: its statistics are the skin's (filtering takes milliseconds).
   skin_->pass_ended(std::move(recorder_), s);
   recorder_ = std::make_unique<PassRecorder>(sim_->model(), kRecorderRowRate);
   if (diverged) {
     diverged_ = true;
     log(LogLevel::kError, sim_->status_message());
+  } else if (dewired) {
+    // The scene asks the pass to stop there (pantograph_head.on_dewirement: stop), as
+    // simulate_pass does; the line is held and ~arm starts a new pass.
+    dewired_ = true;
+    log(LogLevel::kError, "pass " + std::to_string(pass_count_) + " " + sim_->status_message() + ": ended");
   } else if (stopping_) {
     log(LogLevel::kInfo, printf_text("pass %u stopped (~stop) at t = %.4f s (train front at %.2f m), the line settled: ended; "
                              "%lld periods, %lld overruns", pass_count_, s.time, s.front + s.line_offset,
@@ -585,7 +593,7 @@ void HilLoop::handle_end() {
                              pass_count_, s.time, s.front + s.line_offset, static_cast<long long>(c_.batches),
                              static_cast<long long>(c_.overruns)));
   }
-  if (!diverged && !stopping_ && opt_.at_end == EndAction::kLoop) {
+  if (!diverged && !dewired && !stopping_ && opt_.at_end == EndAction::kLoop) {
     // A new pass from the initial static state with the static force (no new static solve), the
     // clock running on; pass_count tells the rig to re-initialise.
     for (int p : external_) sim_->set_external_force(p, sim_->state().uplift[p], nullptr);

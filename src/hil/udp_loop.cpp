@@ -322,10 +322,13 @@ void UdpLoopSkin::send_end(std::uint32_t reason, const PointFrame* f) {
                            udp::end_reason_name(reason));
 }
 
+std::uint32_t UdpLoopSkin::end_reason() const {
+  return loop_.diverged() ? CSIM_UDP_END_DIVERGED : loop_.dewired() ? CSIM_UDP_END_DEWIRED : CSIM_UDP_END_FINISHED;
+}
+
 void UdpLoopSkin::finish() {
   if (end_sent_ && end_sent_pass_ == loop_.pass_count()) return;
-  const bool ended = loop_.mode() == Mode::kEnded;
-  send_end(!ended ? CSIM_UDP_END_SHUTDOWN : loop_.diverged() ? CSIM_UDP_END_DIVERGED : CSIM_UDP_END_FINISHED, nullptr);
+  send_end(loop_.mode() == Mode::kEnded ? end_reason() : CSIM_UDP_END_SHUTDOWN, nullptr);
 }
 
 void UdpLoopSkin::send(const PointFrame& f) {
@@ -354,7 +357,7 @@ void UdpLoopSkin::send(const PointFrame& f) {
     else ++send_errors_;
   }
   if (f.mode == Mode::kEnded && !(end_sent_ && end_sent_pass_ == f.pass_count))
-    send_end(loop_.diverged() ? CSIM_UDP_END_DIVERGED : CSIM_UDP_END_FINISHED, &f);
+    send_end(end_reason(), &f);
   if (monitor_) {
     MonitorSample s;
     s.wall = steady_now();

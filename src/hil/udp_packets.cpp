@@ -151,6 +151,7 @@ const char* end_reason_name(std::uint32_t reason) {
     case CSIM_UDP_END_FINISHED: return "the pass ended";
     case CSIM_UDP_END_DIVERGED: return "the simulation diverged";
     case CSIM_UDP_END_SHUTDOWN: return "the simulator stopped";
+    case CSIM_UDP_END_DEWIRED: return "the pass stopped at a dewirement";
     default: return "unknown";
   }
 }
@@ -159,9 +160,9 @@ bool decode_end(const void* data, std::size_t size, csim_udp_end& out, Reject& w
   csim_udp_header h;
   if (!check_header(data, size, CSIM_UDP_KIND_END, CSIM_UDP_END_SIZE, "end", h, why, reason)) return false;
   std::memcpy(&out, data, sizeof out);
-  if (out.reason < CSIM_UDP_END_FINISHED || out.reason > CSIM_UDP_END_SHUTDOWN)
+  if (out.reason < CSIM_UDP_END_FINISHED || out.reason > CSIM_UDP_END_DEWIRED)
     return fail(Reject::kFlags, why, reason,
-                "end.reason = " + std::to_string(out.reason) + " rejected: allowed 1 to 3 (CSIM_UDP_END_*)");
+                "end.reason = " + std::to_string(out.reason) + " rejected: allowed 1 to 4 (CSIM_UDP_END_*)");
   return finite_field(out.simulation_time, "end.simulation_time", why, reason);
 }
 

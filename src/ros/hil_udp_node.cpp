@@ -191,10 +191,15 @@ int HilUdpNode::run() {
   State end_state;
   if (std::unique_ptr<PassRecorder> rec = skin_->take_finished(&end_state)) {
     const std::vector<PantographStatistics> st = rec->statistics(loop_->model());
-    if (!params_.stats_file.empty()) {
+    std::string why;
+    const std::string text =
+        hil::pass_stats_json(loop_->model(), end_state, st, RunInfo{-1.0, -1.0, loop_->counters().overruns}, &why);
+    if (text.empty()) {
+      std::fprintf(stderr, "[ERROR] catenary_sim_hil_udp: %s\n", why.c_str());
+      if (!params_.stats_file.empty() && rc == 0) rc = 1;
+    } else if (!params_.stats_file.empty()) {
       try {
-        write_file_atomically(params_.stats_file,
-                              statistics_json(loop_->model(), end_state, st, RunInfo{-1.0, -1.0, loop_->counters().overruns}));
+        write_file_atomically(params_.stats_file, text);
       } catch (const OutputError& e) {
         std::fprintf(stderr, "[ERROR] catenary_sim_hil_udp: ~stats_file: %s\n", e.what());
         if (rc == 0) rc = 1;

@@ -24,6 +24,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <mutex>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -61,10 +62,13 @@ std::string summary_text(const char* what, const ForceStatistics& s) {
 // The UDP loop of config/reference_55m_hil.yaml on a loopback port of its own, running in a thread
 // until stop() (or the end of the test), and a rig socket to talk to it.
 struct RunningUdpLoop {
-  explicit RunningUdpLoop(const LoopOptions& lo)
-      : loop(scene_with_dt("reference_55m_hil.yaml", 0.0), lo), skin(loop, loopback()) {
+  explicit RunningUdpLoop(const LoopOptions& lo, const Scene& scene = scene_with_dt("reference_55m_hil.yaml", 0.0))
+      : loop(scene, lo), skin(loop, loopback()) {
     skin.set_running([this] { return !done.load(); });
-    skin.set_log([](LogLevel, const std::string&) {});
+    skin.set_log([this](LogLevel, const std::string& t) {
+      std::lock_guard<std::mutex> l(log_mu);
+      log += t + "\n";
+    });
     to = udp_address("127.0.0.1", skin.port(), "simulator");
     runner = std::thread([this] { loop.run(); });
   }
@@ -85,6 +89,8 @@ struct RunningUdpLoop {
   UdpSocket rig{"127.0.0.1", 0, "rig"};
   sockaddr_in to{};
   std::thread runner;
+  std::mutex log_mu;
+  std::string log;
 };
 
 // A measurement packet of one pantograph (a negative force: none, the rig's hello).
@@ -310,4 +316,67 @@ TEST(UdpLoop, ARigThatFallsSilentPutsTheLineIntoTheSafeHold) {
   EXPECT_EQ(not_hold_after, 0u);
   EXPECT_EQ(loop.counters().holds, 1);
   EXPECT_EQ(loop.mode(), Mode::kHold);
+}
+
+TEST(UdpLoop, APassStoppedByADewirementIsReportedAsSuchAndNotRestarted) {
+  // config/reference_55m_hil.yaml made 3-D: the contact wire staggered +-0.3 m, the head 1.2 m
+  // wide swaying 0.5 m at 2 Hz, so the contact point leaves the working width in the first span,
+  // long before the analysis section; the scene asks the pass to stop there. With at_end loop the
+  // pass must not start again as if it had reached its end: it ends, the log says the dewirement,
+  // the end packet gives its reason, and there are no statistics to write (as simulate_pass).
+  const Scene scene = test_scenes::edited_scene("reference_55m_hil.yaml", [](YAML::Node& root) {
+    root["stagger"]["contact_wire"] = std::vector<double>{0.3, -0.3};
+    root["stagger"]["messenger"] = std::vector<double>{0.0};
+    root["stagger"]["steady_arm_stiffness"] = 2.0e5;
+    root["pantograph_head"]["working_width"] = 1.2;
+    root["pantograph_head"]["on_dewirement"] = "stop";
+    root["pantograph_head"]["sway"]["amplitude"] = 0.5;
+    root["pantograph_head"]["sway"]["frequency"] = 2.0;
+  });
+  LoopOptions lo;
+  lo.rate = 1000.0;
+  lo.timeout = 5.0;
+  lo.at_end = EndAction::kLoop;
+  lo.who = "test_udp_loop";
+  RunningUdpLoop run(lo, scene);
+  HilLoop& loop = run.loop;
+  // The rig: 100 N every millisecond, reading what comes back, until an end packet (at most 60 s
+  // of wall clock: the dewirement comes within 0.2 s of simulation, however far the loop falls behind).
+  std::vector<std::uint32_t> reasons;
+  alignas(8) std::uint8_t buf[2048];
+  const double deadline = steady_now() + 60.0;
+  for (std::uint32_t seq = 1; reasons.empty() && steady_now() < deadline; ++seq) {
+    const csim_udp_measurement m = measurement(seq, 100.0);
+    ASSERT_TRUE(run.rig.send(&m, sizeof m, run.to));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    sockaddr_in from{};
+    long n;
+    while ((n = run.rig.receive(buf, sizeof buf, &from)) >= 0) {
+      csim_udp_end e;
+      udp::Reject why;
+      std::string reason;
+      if (udp::kind_of(buf, static_cast<std::size_t>(n)) == CSIM_UDP_KIND_END &&
+          udp::decode_end(buf, static_cast<std::size_t>(n), e, why, reason))
+        reasons.push_back(e.reason);
+    }
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // (the loop goes on: a restart would show)
+  run.stop();
+  ASSERT_FALSE(reasons.empty()) << "no end packet within 60 s\n" << run.log;
+  EXPECT_EQ(reasons.front(), CSIM_UDP_END_DEWIRED);
+  EXPECT_STREQ(udp::end_reason_name(CSIM_UDP_END_DEWIRED), "the pass stopped at a dewirement");
+  EXPECT_TRUE(loop.dewired());
+  EXPECT_FALSE(loop.diverged());
+  EXPECT_EQ(loop.mode(), Mode::kEnded);
+  EXPECT_EQ(loop.pass_count(), 0u) << "the pass started again";
+  EXPECT_NE(run.log.find("dewirement of pantograph leading at"), std::string::npos) << run.log;
+  EXPECT_EQ(run.log.find("finished"), std::string::npos) << run.log;
+  State end_state;
+  const std::unique_ptr<PassRecorder> rec = run.skin.take_finished(&end_state);
+  ASSERT_TRUE(rec);
+  EXPECT_EQ(end_state.status, StepStatus::kDewired);
+  std::string why;
+  const std::string text = pass_stats_json(loop.model(), end_state, rec->statistics(loop.model()), RunInfo{}, &why);
+  EXPECT_TRUE(text.empty()) << text;
+  EXPECT_NE(why.find("dewirement before it crossed the analysis section"), std::string::npos) << why;
 }

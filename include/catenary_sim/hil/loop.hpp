@@ -157,6 +157,8 @@ class HilLoop {
   bool stopping() const { return stopping_; }
   bool recovering() const { return recovering_; }
   bool diverged() const { return diverged_; }
+  // The pass stopped at a dewirement (the scene's pantograph_head.on_dewirement: stop).
+  bool dewired() const { return dewired_; }
   std::uint32_t pass_count() const { return pass_count_; }
   double commanded_speed() const { return commanded_speed_; }
   double age(double now) const { return hold_.has_value() ? hold_.age(now) : -1.0; }
@@ -223,7 +225,7 @@ class HilLoop {
   std::uint64_t step_in_effect_ = 0;
   double hold_start_time_ = 0.0;
   std::vector<double> hold_from_;
-  bool diverged_ = false, exit_requested_ = false;
+  bool diverged_ = false, dewired_ = false, exit_requested_ = false;
   int exit_code_ = 0;
   std::uint32_t pass_count_ = 0;
   double started_ = 0.0;

@@ -159,6 +159,8 @@ class UdpLoopSkin : public LoopSkin {
   void hand_to_loop(const csim_udp_measurement& m, double arrival);
   bool allowed(const sockaddr_in& from) const;
   void send_end(std::uint32_t reason, const PointFrame* f);
+  // Why the pass that ended did (CSIM_UDP_END_FINISHED, _DIVERGED or _DEWIRED).
+  std::uint32_t end_reason() const;
   // At most once per second per `slot`: true when the line may be logged now.
   bool throttle(int slot);
   void say(LogLevel level, const std::string& text) { log(level, loop_.options().who + ": " + text); }

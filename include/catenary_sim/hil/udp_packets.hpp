@@ -45,7 +45,8 @@ bool decode_contact_point(const void* data, std::size_t size, csim_udp_contact_p
 bool decode_end(const void* data, std::size_t size, csim_udp_end& out, Reject& why, std::string& reason);
 // The kind of a datagram that carries a header (0: too short for one).
 std::uint16_t kind_of(const void* data, std::size_t size);
-// "the pass ended", "the simulation diverged", "the simulator stopped" for CSIM_UDP_END_*.
+// "the pass ended", "the simulation diverged", "the simulator stopped", "the pass stopped at a
+// dewirement" for CSIM_UDP_END_*.
 const char* end_reason_name(std::uint32_t reason);
 
 // The contact point packet of a loop frame. Fails (false, `reason`) when the frame does not fit
