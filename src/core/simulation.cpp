@@ -244,15 +244,20 @@ bool Simulation::set_external_force(int p, double f, std::string* error) {
     if (error) *error = "pantograph index " + std::to_string(p) + " rejected: not an external (hardware-in-the-loop) pantograph";
     return false;
   }
-  if (!std::isfinite(f) || f < kMinExternalForce || f > kMaxExternalForce) {
-    std::ostringstream s;
-    s << "external contact force " << fmt_given(f) << " N rejected: allowed " << kMinExternalForce << " to " << kMaxExternalForce
-      << " N (negative readings are taken as 0)";
-    if (error) *error = s.str();
+  if (std::string e = external_force_error(f); !e.empty()) {
+    if (error) *error = std::move(e);
     return false;
   }
   state_.external_force[p] = std::max(0.0, f);
   return true;
+}
+
+std::string Simulation::external_force_error(double f) {
+  if (std::isfinite(f) && f >= kMinExternalForce && f <= kMaxExternalForce) return std::string();
+  std::ostringstream s;
+  s << "external contact force " << fmt_given(f) << " N rejected: allowed " << kMinExternalForce << " to " << kMaxExternalForce
+    << " N (negative readings are taken as 0)";
+  return s.str();
 }
 
 }  // namespace catenary_sim

@@ -262,24 +262,28 @@ void HilLoop::reject(const std::string& what) {
                               std::to_string(c_.rejected) + " rejected so far)");
 }
 
+std::string HilLoop::measurement_error(const double* force, std::size_t n_given, const char* field, bool indexed) const {
+  const std::size_t n = external_.size();
+  if (n_given != n)
+    return std::string(field) + " with " + std::to_string(n_given) + " values rejected: the scene has " +
+           std::to_string(n) + " external pantograph(s), send one total force (N) each in scene order";
+  // The core's check of each value (NaN, inf, range).
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::string e = Simulation::external_force_error(force[i]); !e.empty())
+      return std::string(field) + (indexed ? "[" + std::to_string(i) + "]" : std::string()) + ": " + e;
+  return std::string();
+}
+
 bool HilLoop::accept(const double* force, std::size_t n_given, double arrival, double measured, std::uint64_t step,
                      const char* field, bool indexed) {
   const std::size_t n = external_.size();
-  if (n_given != n) {
-    reject(std::string(field) + " with " + std::to_string(n_given) + " values rejected: the scene has " +
-           std::to_string(n) + " external pantograph(s), send one total force (N) each in scene order");
+  // A rejected measurement changes nothing.
+  if (std::string e = measurement_error(force, n_given, field, indexed); !e.empty()) {
+    reject(e);
     return false;
   }
-  // The core checks each value (NaN, inf, range); a rejected measurement changes nothing.
   std::string err;
-  for (std::size_t i = 0; i < n; ++i) accept_buf_[i] = sim_->state().external_force[external_[i]];
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!sim_->set_external_force(external_[i], force[i], &err)) {
-      for (std::size_t j = 0; j < i; ++j) sim_->set_external_force(external_[j], accept_buf_[j], nullptr);
-      reject(std::string(field) + (indexed ? "[" + std::to_string(i) + "]" : std::string()) + ": " + err);
-      return false;
-    }
-  }
+  for (std::size_t i = 0; i < n; ++i) sim_->set_external_force(external_[i], force[i], &err);  // (checked above)
   for (std::size_t i = 0; i < n; ++i) accept_buf_[i] = sim_->state().external_force[external_[i]];
   if (unused_) ++c_.superseded;
   hold_.accept(accept_buf_, arrival, measured, step);

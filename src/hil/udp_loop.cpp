@@ -225,8 +225,25 @@ void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_i
       return;
     }
     ++rejected_[static_cast<int>(why)];
+    tracker_.rejected();
     loop_.reject("UDP " + reason);
     return;
+  }
+  // Values the loop would refuse are refused before the packet names the rig or its number is
+  // taken: a refused packet leaves both as they were (a number taken from it would drop every
+  // later valid measurement numbered below it).
+  if (m.pantographs > 0) {
+    for (std::uint32_t i = 0; i < m.pantographs; ++i) force_[i] = m.force[i];  // (out of the packed struct)
+    if (std::string e = loop_.measurement_error(force_.data(), m.pantographs, "UDP measurement.force", true);
+        !e.empty()) {
+      if (have_peer_ && !from_peer) {
+        ignore_foreign(from, "the loop follows the rig at " + address_text(peer_));
+        return;
+      }
+      tracker_.rejected();
+      loop_.reject(e);
+      return;
+    }
   }
   if (!follow_rig(from, from_peer, m)) return;
   if (!in_sequence(from, m)) return;

@@ -3,6 +3,7 @@
 #include "../core/util/format.hpp"  // the core's numbers in messages: one way for all
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 
 namespace catenary_sim {
@@ -230,6 +231,7 @@ SequenceTracker::Verdict SequenceTracker::observe(std::uint32_t seq) {
   ++received_;
   if (!any_) {
     any_ = true;
+    rejected_since_ = 0;
     newest_ = seq;
     seen_ = 1;
     return Verdict::kFirst;
@@ -238,13 +240,16 @@ SequenceTracker::Verdict SequenceTracker::observe(std::uint32_t seq) {
   const std::int64_t d = static_cast<std::int32_t>(seq - newest_);
   if (d > kRestartJump || d < -kRestartJump) {
     ++restarts_;
+    rejected_since_ = 0;
     newest_ = seq;
     seen_ = 1;
     return Verdict::kRestart;
   }
   if (d > 0) {
     run_ = 0;
-    lost_ += static_cast<std::uint64_t>(d - 1);
+    const std::uint64_t gap = static_cast<std::uint64_t>(d - 1);
+    lost_ += gap - std::min(gap, rejected_since_);
+    rejected_since_ = 0;
     seen_ = d >= 64 ? 1 : ((seen_ << d) | 1);
     newest_ = seq;
     return d == 1 ? Verdict::kInOrder : Verdict::kGap;

@@ -234,9 +234,10 @@ TEST(UdpLoop, ClosedOverLoopbackAt1kHzIsItsOwnReplayAndWithoutDelayTheInternalPa
 
 TEST(UdpLoop, BadLostReorderedAndDuplicatedPacketsAreCountedAndChangeNothing) {
   // A rig that misbehaves, packet by packet, against the running loop: a hello, measurement 1,
-  // then a duplicate of 1, measurement 3, a late 2 (reordered), a NaN force, a short packet and a
-  // force out of range. Only 1 and 3 may reach the loop; every other one is counted, and none
-  // changes the force in effect.
+  // then a duplicate of 1, measurement 3, a late 2 (reordered), a NaN force, a short packet, a
+  // force out of range and one out of range numbered far ahead, then a good one. Only 1, 3 and
+  // the last may reach the loop; every other one is counted, and none changes the force in effect
+  // or the sequence tracking (a number taken from a refused packet would drop the last one).
   LoopOptions lo;
   lo.rate = 1000.0;
   lo.timeout = 5.0;
@@ -256,21 +257,23 @@ TEST(UdpLoop, BadLostReorderedAndDuplicatedPacketsAreCountedAndChangeNothing) {
   send(measurement(5, std::nan("")));
   send(measurement(6, 150.0), 40);  // short
   send(measurement(7, 5000.0));     // out of range (the loop's check, shared with ROS)
+  send(measurement(60, 5000.0));    // out of range, numbered far ahead
+  send(measurement(8, 140.0));      // good: taken
   run.stop();
   const auto& seq = skin.sequence();
+  EXPECT_EQ(seq.newest(), 8u);
   EXPECT_EQ(seq.duplicates(), 1u);
   EXPECT_EQ(seq.reordered(), 1u);
-  // 3 came, late; 5 and 6 were rejected before their sequence number was taken (a packet that
-  // fails validation has no number to trust), so they count as lost as well as rejected.
-  EXPECT_EQ(seq.lost(), 2u);
+  // 3 came, late; 5, 6 and 7 came and were rejected (counted so), so none is lost.
+  EXPECT_EQ(seq.lost(), 0u);
   EXPECT_EQ(skin.unusable(), 2u);
   EXPECT_EQ(skin.rejected()[static_cast<int>(udp::Reject::kNonFinite)], 1u);
   EXPECT_EQ(skin.rejected()[static_cast<int>(udp::Reject::kSize)], 1u);
-  EXPECT_EQ(loop.counters().accepted, 2);
-  EXPECT_EQ(loop.counters().rejected, 3);  // NaN, short, out of range
+  EXPECT_EQ(loop.counters().accepted, 3);
+  EXPECT_EQ(loop.counters().rejected, 4);  // NaN, short, two out of range
   EXPECT_EQ(loop.mode(), Mode::kRunning);
-  // The force in effect is the last good measurement's (130 N), not a rejected or stale one.
-  EXPECT_DOUBLE_EQ(loop.state().external_force[loop.external()[0]], 130.0);
+  // The force in effect is the last good measurement's, not a rejected or stale one.
+  EXPECT_DOUBLE_EQ(loop.state().external_force[loop.external()[0]], 140.0);
 }
 
 TEST(UdpLoop, ARigThatFallsSilentPutsTheLineIntoTheSafeHold) {

@@ -40,6 +40,8 @@ class Simulation {
   // collector cannot pull); NaN, inf and values outside [kMinExternalForce, kMaxExternalForce] are
   // rejected and leave the state unchanged.
   bool set_external_force(int pantograph, double force_n, std::string* error);
+  // set_external_force's check of a value alone: empty when allowed, else its error.
+  static std::string external_force_error(double force_n);
 
   static constexpr double kMinExternalForce = -50.0;  // N
   static constexpr double kMaxExternalForce = 2000.0; // N

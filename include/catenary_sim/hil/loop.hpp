@@ -134,6 +134,9 @@ class HilLoop {
   // rejected one changes nothing and is counted. False when rejected.
   bool accept(const double* force, std::size_t n, double arrival, double measured, std::uint64_t step,
               const char* field, bool indexed);
+  // Why accept() would reject these forces (empty: it would not); changes nothing. A transport
+  // that must know before it takes a packet's sequence number asks this first.
+  std::string measurement_error(const double* force, std::size_t n, const char* field, bool indexed) const;
   // A measurement the transport already refused (bad packet or message): counted and logged.
   void reject(const std::string& what);
   // A fresh measurement may start the period.

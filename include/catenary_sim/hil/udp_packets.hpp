@@ -78,6 +78,10 @@ class SequenceTracker {
     return any_ && static_cast<std::int32_t>(sequence - newest_) <= 0;
   }
   static bool usable(Verdict v) { return v != Verdict::kReordered && v != Verdict::kDuplicate; }
+  // A packet of the sender that was rejected (it did not decode, or its values were refused): its
+  // number is not taken (it may be garbage), but the next gap is not counted lost for it (it came,
+  // and is counted as rejected).
+  void rejected() { ++rejected_since_; }
   std::uint64_t received() const { return received_; }
   std::uint64_t lost() const { return lost_; }          // skipped and not arrived since (within 64)
   std::uint64_t reordered() const { return reordered_; }  // arrived after a newer one
@@ -92,6 +96,7 @@ class SequenceTracker {
   std::uint64_t seen_ = 0;  // bit i: newest_ - i arrived
   int run_ = 0;               // consecutive numbers older than newest_, ending at run_next_ - 1
   std::uint32_t run_next_ = 0;
+  std::uint64_t rejected_since_ = 0;  // rejected packets since the newest taken
   std::uint64_t received_ = 0, lost_ = 0, reordered_ = 0, duplicates_ = 0, restarts_ = 0;
 };
 
