@@ -26,6 +26,10 @@ HilUdpNode::HilUdpNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   hil::UdpLoopOptions u;
   u.bind_address = params_.udp_bind;
   u.port = params_.udp_port;
+  u.bind_name = "~hil/udp_bind/~hil/udp_port";
+  u.rig_name = "~hil/udp_rig";
+  u.allow_name = "~hil/udp_allow";
+  u.scene_name = "~scene = '" + params_.scene + "'";
   try {
     if (!params_.udp_rig.empty()) std::tie(u.rig_address, u.rig_port) = hil::parse_host_port(params_.udp_rig, "~hil/udp_rig");
     u.allow = hil::parse_allow_list(params_.udp_allow, "~hil/udp_allow");
@@ -34,11 +38,15 @@ HilUdpNode::HilUdpNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   }
   try {
     loop_ = std::make_unique<hil::HilLoop>(scene, o);
-    skin_ = std::make_unique<hil::UdpLoopSkin>(*loop_, u, &ring_);
   } catch (const SceneError& e) {
     throw ParamError("parameter ~scene = '" + params_.scene + "': " + e.what());
   } catch (const hil::HilError& e) {
-    throw ParamError(std::string("parameter ~hil/udp_*: ") + e.what());
+    throw ParamError(e.what());  // (the loop's errors name their parameter, as catenary_sim_hil_node's)
+  }
+  try {
+    skin_ = std::make_unique<hil::UdpLoopSkin>(*loop_, u, &ring_);
+  } catch (const hil::HilError& e) {
+    throw ParamError(std::string("parameter ") + e.what());  // (named by UdpLoopOptions' names)
   }
   skin_->set_running([] { return ros::ok() && !ros::isShuttingDown(); });
   skin_->set_log([](hil::LogLevel level, const std::string& t) {

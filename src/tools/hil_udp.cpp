@@ -158,7 +158,9 @@ int run_loop(const UdpOptions& o) {
   Scene scene = load_scene_file(o.scene_file);
   if (o.speed_kmh) scene.train_speed = *o.speed_kmh / 3.6;
   hil::HilLoop loop(scene, o.lo, "--rate", "--scene " + o.scene_file);
-  hil::UdpLoopSkin skin(loop, o.uo);
+  hil::UdpLoopOptions uo = o.uo;
+  uo.scene_name = "--scene " + o.scene_file;
+  hil::UdpLoopSkin skin(loop, uo);
   const double start = hil::steady_now();
   const double duration = o.duration;
   if (duration > 0.0) skin.set_running([start, duration] { return hil::steady_now() - start < duration; });

@@ -41,6 +41,7 @@ namespace {
 const std::string kNode = test_scenes::program("catenary_sim_node");
 const std::string kHilNode = test_scenes::program("catenary_sim_hil_node");
 const std::string kRig = test_scenes::program("virtual_rig");
+const std::string kHilUdpNode = test_scenes::program("catenary_sim_hil_udp_node");
 const std::string& kScene = test_scenes::kReference;
 const std::string& kHilScene = test_scenes::kReferenceHil;
 
@@ -467,4 +468,36 @@ TEST_F(NodeParamsFuzz, HilReportFileThatFailsAtExitFailsTheExitCode) {
   EXPECT_EQ(r.signal, 0);
   EXPECT_EQ(r.exit_code, 1) << r.out;
   EXPECT_NE(r.out.find("~hil/report_file: cannot write '" + out + "/report.json'"), std::string::npos) << r.out;
+}
+
+// catenary_sim_hil_udp_node names its own parameters in every error at start-up: the socket's
+// (~hil/udp_bind), the rig's (~hil/udp_rig, ~hil/udp_allow), the scene's (~scene), never the
+// command-line options of catenary_sim_hil_udp.
+TEST_F(NodeParamsFuzz, HilUdpNodeErrorsNameItsOwnParameters) {
+  auto expect_names = [](const ChildRun& r, const std::string& what, const std::string& name) {
+    SCOPED_TRACE(what + "\n  output: " + r.out);
+    EXPECT_FALSE(r.hung);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.out.find(name), std::string::npos) << "does not name " << name;
+    EXPECT_EQ(r.out.find(" --"), std::string::npos) << "names a command-line option";
+    EXPECT_EQ(r.out.find("~hil/udp_*"), std::string::npos);
+  };
+  expect_names(run(kHilUdpNode, {"_scene:=" + kHilScene, "_hil/udp_bind:=300.1.1.1"}), "bind", "~hil/udp_bind");
+  expect_names(run(kHilUdpNode, {"_scene:=" + kHilScene, "_hil/udp_rig:=10.0.0.3:47801", "_hil/udp_allow:=10.0.0.2"}),
+               "rig off the allow-list", "~hil/udp_allow");
+  // A scene whose frames do not fit a packet: five external pantographs (a packet carries four).
+  YAML::Node root = YAML::LoadFile(kHilScene);
+  YAML::Node first = YAML::Clone(root["pantographs"][0]);
+  root["pantographs"] = YAML::Node(YAML::NodeType::Sequence);
+  for (int i = 0; i < 5; ++i) {
+    YAML::Node p = YAML::Clone(first);
+    p["name"] = "p" + std::to_string(i);
+    p["position"] = 20.0 * i;
+    root["pantographs"].push_back(p);
+  }
+  const std::string five = dir_ + "/five_external.yaml";
+  std::ofstream(five) << YAML::Dump(root) << "\n";
+  const ChildRun r = run(kHilUdpNode, {"_scene:=" + five});
+  expect_names(r, "five external pantographs", "~scene = '" + five + "'");
+  EXPECT_NE(r.out.find("at most 4"), std::string::npos) << r.out;
 }

@@ -101,11 +101,13 @@ struct UdpLoopOptions {
   int rig_port = 0;
   std::vector<AllowedSender> allow;  // empty: any sender may become the rig
   bool same_clock = false;  // the rig's send_time_ns is on this machine's CLOCK_MONOTONIC: transport measured
+  // How errors name the options: the command line's by default (a ROS node gives its parameters).
+  std::string bind_name = "--bind/--port", rig_name = "--rig", allow_name = "--allow", scene_name = "--scene";
 };
 
 class UdpLoopSkin : public LoopSkin {
  public:
-  // Opens the socket (HilError naming --port/--bind/--rig on failure) and checks that the scene's
+  // Opens the socket (HilError naming the option of UdpLoopOptions on failure) and checks that the scene's
   // frames fit the packets. `running`: an extra condition (e.g. ros::ok); `log_sink` receives
   // the loop's lines (stderr by default).
   UdpLoopSkin(HilLoop& loop, const UdpLoopOptions& o, MonitorRing* monitor = nullptr);
@@ -209,6 +211,9 @@ struct UdpRigOptions {
   double contact_timeout = 2.0;
   // s to wait for the first contact point (hellos every 50 ms meanwhile); 0: for ever.
   double connect_timeout = 30.0;
+  // How errors name the options: the command line's by default (a ROS node gives its parameters).
+  std::string bind_name = "--bind/--port", simulator_name = "--simulator", scene_name = "--pantograph-scene",
+              rate_name = "--rate";
 };
 
 // How UdpVirtualRig::run ended.
