@@ -501,3 +501,48 @@ TEST_F(NodeParamsFuzz, HilUdpNodeErrorsNameItsOwnParameters) {
   expect_names(r, "five external pantographs", "~scene = '" + five + "'");
   EXPECT_NE(r.out.find("at most 4"), std::string::npos) << r.out;
 }
+
+// virtual_rig refuses at start-up a ~pantograph_scene without a lumped pantograph it can step
+// (over the topics it took it and died at the first contact point, the node waiting for ever),
+// and over UDP names its parameters, not udp_rig_client's options.
+TEST_F(NodeParamsFuzz, VirtualRigRefusesAPantographSceneWithoutLumpedPantographsAtStartUp) {
+  for (const std::string transport : {"topics", "udp"}) {
+    const ChildRun r = run(kRig, {"_pantograph_scene:=" + kHilScene, "_transport:=" + transport}, 10.0);
+    SCOPED_TRACE(transport + "\n  output: " + r.out);
+    EXPECT_FALSE(r.hung) << "accepted at start-up";
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.out.find("~pantograph_scene = '" + kHilScene + "': no lumped pantograph"), std::string::npos);
+    EXPECT_EQ(r.out.find("--"), std::string::npos) << "names a command-line option";
+  }
+  const ChildRun r = run(kRig, {"_pantograph_scene:=" + kScene, "_transport:=udp", "_simulator:=abc:47800"}, 10.0);
+  SCOPED_TRACE("output: " + r.out);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("~simulator"), std::string::npos);
+  EXPECT_EQ(r.out.find("--"), std::string::npos) << "names a command-line option";
+}
+
+// virtual_rig over UDP writes ~report_file at exit as over the topics (here stopped by SIGINT
+// before any simulator answered: no measurement sent).
+TEST_F(NodeParamsFuzz, VirtualRigOverUdpWritesItsReportFile) {
+  const std::string out = dir_ + "/rig_udp";
+  mkdir(out.c_str(), 0755);
+  const std::string report = out + "/report.json", log = dir_ + "/rig_udp.log";
+  Child c({kRig, "__name:=rig_udp", "_pantograph_scene:=" + kScene, "_transport:=udp",
+           "_simulator:=127.0.0.1:" + std::to_string(free_port()), "_report_file:=" + report},
+          log, env_);
+  ASSERT_TRUE(c.started());
+  bool up = false;
+  for (int i = 0; i < 600 && !up; ++i) {
+    up = slurp(log).find("over UDP to") != std::string::npos;
+    if (!up) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_TRUE(up) << slurp(log);
+  kill(c.pid(), SIGINT);
+  const ChildRun r = c.wait(30.0);
+  EXPECT_FALSE(r.hung);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  ASSERT_TRUE(exists(report)) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(j.at("measurements").get<int>(), 0);
+  EXPECT_TRUE(j.contains("round_trip"));
+}
