@@ -326,7 +326,8 @@ void UdpLoopSkin::send_end(std::uint32_t reason, const PointFrame* f) {
   if (!have_rig_) return;
   csim_udp_end e;
   std::memset(&e, 0, sizeof e);
-  e.step = f ? f->step : 0;
+  // (the step at the end: the frame's, or the state's when the loop has returned without one)
+  e.step = f ? f->step : static_cast<std::uint64_t>(loop_.state().steps);
   e.pass_count = loop_.pass_count();
   e.reason = reason;
   e.simulation_time = loop_.state().time;

@@ -321,13 +321,11 @@ TEST(UdpLoop, ARigThatFallsSilentPutsTheLineIntoTheSafeHold) {
   EXPECT_EQ(loop.mode(), Mode::kHold);
 }
 
-TEST(UdpLoop, APassStoppedByADewirementIsReportedAsSuchAndNotRestarted) {
-  // config/reference_55m_hil.yaml made 3-D: the contact wire staggered +-0.3 m, the head 1.2 m
-  // wide swaying 0.5 m at 2 Hz, so the contact point leaves the working width in the first span,
-  // long before the analysis section; the scene asks the pass to stop there. With at_end loop the
-  // pass must not start again as if it had reached its end: it ends, the log says the dewirement,
-  // the end packet gives its reason, and there are no statistics to write (as simulate_pass).
-  const Scene scene = test_scenes::edited_scene("reference_55m_hil.yaml", [](YAML::Node& root) {
+// config/reference_55m_hil.yaml made 3-D: the contact wire staggered +-0.3 m, the head 1.2 m wide
+// swaying 0.5 m at 2 Hz, so the contact point leaves the working width in the first span, long
+// before the analysis section; the scene asks the pass to stop there.
+Scene dewiring_scene() {
+  return test_scenes::edited_scene("reference_55m_hil.yaml", [](YAML::Node& root) {
     root["stagger"]["contact_wire"] = std::vector<double>{0.3, -0.3};
     root["stagger"]["messenger"] = std::vector<double>{0.0};
     root["stagger"]["steady_arm_stiffness"] = 2.0e5;
@@ -336,6 +334,13 @@ TEST(UdpLoop, APassStoppedByADewirementIsReportedAsSuchAndNotRestarted) {
     root["pantograph_head"]["sway"]["amplitude"] = 0.5;
     root["pantograph_head"]["sway"]["frequency"] = 2.0;
   });
+}
+
+TEST(UdpLoop, APassStoppedByADewirementIsReportedAsSuchAndNotRestarted) {
+  // dewiring_scene() with at_end loop: the pass must not start again as if it had reached its
+  // end: it ends, the log says the dewirement, the end packet gives its reason, and there are no
+  // statistics to write (as simulate_pass).
+  const Scene scene = dewiring_scene();
   LoopOptions lo;
   lo.rate = 1000.0;
   lo.timeout = 5.0;
@@ -382,4 +387,52 @@ TEST(UdpLoop, APassStoppedByADewirementIsReportedAsSuchAndNotRestarted) {
   const std::string text = pass_stats_json(loop.model(), end_state, rec->statistics(loop.model()), RunInfo{}, &why);
   EXPECT_TRUE(text.empty()) << text;
   EXPECT_NE(why.find("dewirement before it crossed the analysis section"), std::string::npos) << why;
+}
+
+TEST(UdpLoop, TheEndPacketAfterTheLoopReturnedCarriesTheStepAtTheEnd) {
+  // With at_end exit (catenary_sim_hil_udp's default) the loop returns at the end of the pass and
+  // the end packet is sent after it (finish()): its step is the last contact point's, as the
+  // packet's description says, not 0.
+  LoopOptions lo;
+  lo.rate = 1000.0;
+  lo.timeout = 5.0;
+  lo.at_end = EndAction::kExit;
+  lo.who = "test_udp_loop";
+  RunningUdpLoop run(lo, dewiring_scene());
+  std::uint64_t last_step = 0;
+  alignas(8) std::uint8_t buf[2048];
+  auto drain = [&](std::vector<csim_udp_end>& ends) {
+    sockaddr_in from{};
+    long n;
+    while ((n = run.rig.receive(buf, sizeof buf, &from)) >= 0) {
+      const std::size_t size = static_cast<std::size_t>(n);
+      udp::Reject why;
+      std::string reason;
+      csim_udp_contact_point p;
+      csim_udp_end e;
+      if (udp::kind_of(buf, size) == CSIM_UDP_KIND_END && udp::decode_end(buf, size, e, why, reason)) ends.push_back(e);
+      else if (udp::decode_contact_point(buf, size, p, why, reason)) last_step = p.step;
+    }
+  };
+  std::vector<csim_udp_end> ends;
+  const double deadline = steady_now() + 60.0;  // (as above: the end comes within 0.2 s of simulation)
+  for (std::uint32_t seq = 1; run.loop.mode() != Mode::kEnded && steady_now() < deadline; ++seq) {
+    const csim_udp_measurement m = measurement(seq, 100.0);
+    ASSERT_TRUE(run.rig.send(&m, sizeof m, run.to));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    drain(ends);
+  }
+  run.stop();  // (the loop has returned: exit)
+  ASSERT_EQ(run.loop.mode(), Mode::kEnded);
+  drain(ends);
+  EXPECT_TRUE(ends.empty()) << "an end packet before the loop returned";
+  run.skin.finish();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  drain(ends);
+  ASSERT_EQ(ends.size(), 3u);  // (three copies)
+  ASSERT_GT(last_step, 0u);
+  for (const csim_udp_end& e : ends) {
+    EXPECT_EQ(e.step, last_step);
+    EXPECT_EQ(e.reason, CSIM_UDP_END_DEWIRED);
+  }
 }
