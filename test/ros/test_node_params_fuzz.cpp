@@ -546,3 +546,35 @@ TEST_F(NodeParamsFuzz, VirtualRigOverUdpWritesItsReportFile) {
   EXPECT_EQ(j.at("measurements").get<int>(), 0);
   EXPECT_TRUE(j.contains("round_trip"));
 }
+
+// catenary_sim_hil_udp_node writes ~stats_file at the end of each pass and logs its statistics,
+// as catenary_sim_hil_node does (with at_end loop the file is there while the node runs on).
+TEST_F(NodeParamsFuzz, HilUdpNodeWritesTheStatisticsAtTheEndOfEachPass) {
+  const std::string out = dir_ + "/udp_stats";
+  mkdir(out.c_str(), 0755);
+  const std::string stats = out + "/stats.json", log = dir_ + "/udp_stats.log";
+  const std::string port = std::to_string(free_port());
+  Child node({kHilUdpNode, "__name:=udp_stats", "_scene:=" + kHilScene, "_at_end:=loop", "_stats_file:=" + stats,
+              "_hil/timeout:=1.0", "_hil/udp_bind:=127.0.0.1", "_hil/udp_port:=" + port},
+             log, env_);
+  Child rig({kRig, "__name:=udp_stats_rig", "_pantograph_scene:=" + kScene, "_transport:=udp",
+             "_simulator:=127.0.0.1:" + port},
+            dir_ + "/udp_stats_rig.log", env_);
+  ASSERT_TRUE(node.started());
+  ASSERT_TRUE(rig.started());
+  // The reference pass is 6.6 s of simulation; 120 s of wall clock covers a loaded machine.
+  bool written = false;
+  for (int i = 0; i < 1200 && !written; ++i) {
+    written = exists(stats);
+    if (!written) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const std::string text = slurp(log);
+  kill(rig.pid(), SIGINT);
+  kill(node.pid(), SIGINT);
+  rig.wait(30.0);
+  const ChildRun r = node.wait(30.0);
+  ASSERT_TRUE(written) << "no ~stats_file while the node runs\n" << r.out;
+  EXPECT_NE(text.find("catenary_sim_hil_udp: leading: mean"), std::string::npos) << text;
+  const nlohmann::json j = nlohmann::json::parse(slurp(stats));
+  EXPECT_TRUE(j.at("pantographs").at(0).at("mean_force_N").is_number()) << j.dump();
+}

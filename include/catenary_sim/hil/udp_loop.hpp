@@ -123,7 +123,16 @@ class UdpLoopSkin : public LoopSkin {
   void receive(double until) override;
   void send(const PointFrame& frame) override;
   void log(LogLevel level, const std::string& text) override;
+  // A pass has ended (loop thread): to `on_pass_ended` when set (it must not block the loop for
+  // long), else kept for take_finished().
+  void set_on_pass_ended(std::function<void(std::unique_ptr<PassRecorder>, const State&)> f) {
+    on_pass_ended_ = std::move(f);
+  }
   void pass_ended(std::unique_ptr<PassRecorder> recorder, const State& state) override {
+    if (on_pass_ended_) {
+      on_pass_ended_(std::move(recorder), state);
+      return;
+    }
     finished_ = std::move(recorder);
     finished_state_ = state;
   }
@@ -183,6 +192,7 @@ class UdpLoopSkin : public LoopSkin {
   std::atomic<bool> stop_{false};
   std::function<bool()> running_fn_;
   std::function<void(LogLevel, const std::string&)> log_sink_;
+  std::function<void(std::unique_ptr<PassRecorder>, const State&)> on_pass_ended_;
   udp::SequenceTracker tracker_;
   std::array<std::uint64_t, static_cast<int>(udp::Reject::kNumReasons)> rejected_{};
   std::uint64_t sent_ = 0, send_errors_ = 0, unusable_ = 0;
