@@ -208,8 +208,12 @@ bool Simulation::set_target_speed(double v, std::string* error) {
 }
 
 bool Simulation::set_max_acceleration(double a, std::string* error) {
-  if (!std::isfinite(a) || a < 0.0 || a > 20.0) {
-    if (error) *error = "max acceleration " + fmt_given(a) + " m/s^2 rejected: allowed 0 (no limit) to 20 m/s^2";
+  // The ceiling is about 2 g: several times what any train does (service braking about 1 m/s^2,
+  // emergency braking 1.5 to 3 m/s^2), so every real ramp fits, while a value in the tens or
+  // hundreds (a unit slip, km/h per s) is refused rather than taken as a jump.
+  if (!std::isfinite(a) || a < 0.0 || a > kMaxAcceleration) {
+    if (error) *error = "max acceleration " + fmt_given(a) + " m/s^2 rejected: allowed 0 (no limit) to " +
+                        fmt(kMaxAcceleration) + " m/s^2";
     return false;
   }
   state_.max_acceleration = a;
@@ -240,15 +244,20 @@ bool Simulation::set_external_force(int p, double f, std::string* error) {
     if (error) *error = "pantograph index " + std::to_string(p) + " rejected: not an external (hardware-in-the-loop) pantograph";
     return false;
   }
-  if (!std::isfinite(f) || f < kMinExternalForce || f > kMaxExternalForce) {
-    std::ostringstream s;
-    s << "external contact force " << fmt_given(f) << " N rejected: allowed " << kMinExternalForce << " to " << kMaxExternalForce
-      << " N (negative readings are taken as 0)";
-    if (error) *error = s.str();
+  if (std::string e = external_force_error(f); !e.empty()) {
+    if (error) *error = std::move(e);
     return false;
   }
   state_.external_force[p] = std::max(0.0, f);
   return true;
+}
+
+std::string Simulation::external_force_error(double f) {
+  if (std::isfinite(f) && f >= kMinExternalForce && f <= kMaxExternalForce) return std::string();
+  std::ostringstream s;
+  s << "external contact force " << fmt_given(f) << " N rejected: allowed " << kMinExternalForce << " to " << kMaxExternalForce
+    << " N (negative readings are taken as 0)";
+  return s.str();
 }
 
 }  // namespace catenary_sim

@@ -52,11 +52,21 @@ HilLoop::HilLoop(Scene scene, const LoopOptions& o, const std::string& rate_name
   double auto_dt = 0.0;
   if (!scene.numerics.dt) auto_dt = build_model(scene).dt;
   timing_ = hil_timing(opt_.rate, scene.numerics.dt, auto_dt, rate_name, scene_name);
+  auto name = [this](const char* parameter, const char* option) {
+    return opt_.command_line ? std::string(option) : "parameter ~hil/" + std::string(parameter);
+  };
   if (!std::isfinite(opt_.delay_compensation) || opt_.delay_compensation < 0.0 || opt_.delay_compensation > 0.1)
-    throw HilError("delay compensation = " + fmt(opt_.delay_compensation) + " s rejected: allowed [0, 0.1] s");
+    throw HilError(name("delay_compensation", "--delay-compensation") + " = " + fmt_given(opt_.delay_compensation) +
+                   " s rejected: allowed [0, 0.1] s");
   if (!std::isfinite(opt_.timeout) || opt_.timeout < 2.0 * timing_.period || opt_.timeout > 10.0)
-    throw HilError("timeout = " + fmt(opt_.timeout) + " s rejected: allowed [2 loop periods = " +
+    throw HilError(name("timeout", "--timeout") + " = " + fmt_given(opt_.timeout) + " s rejected: allowed [2 loop periods = " +
                    fmt(2.0 * timing_.period) + ", 10] s");
+  // (checked before the scene is built: a refused option costs no static solve)
+  if (!std::isfinite(opt_.hold_deceleration) || opt_.hold_deceleration < 0.0 ||
+      opt_.hold_deceleration > Simulation::kMaxAcceleration)
+    throw HilError(name("hold_deceleration", "--hold-deceleration") + " = " + fmt_given(opt_.hold_deceleration) +
+                   " m/s^2 rejected: allowed [0, " + fmt(Simulation::kMaxAcceleration) +
+                   "] m/s^2 (0: at once; the core's limit on the train's acceleration)");
   scene.numerics.dt = timing_.dt;
   sim_ = std::make_unique<Simulation>(scene);
   const Model& m = sim_->model();
@@ -65,7 +75,7 @@ HilLoop::HilLoop(Scene scene, const LoopOptions& o, const std::string& rate_name
     throw HilError(scene_name + ": the scene has no `type: external` pantograph (one the rig's measurement drives)");
   commanded_speed_ = scene.train_speed;
   std::string err;
-  if (!sim_->set_max_acceleration(opt_.hold_deceleration, &err)) throw HilError("hold_deceleration: " + err);
+  sim_->set_max_acceleration(opt_.hold_deceleration, &err);  // (in range: checked above)
   hold_ = MeasurementHold(external_.size());
   accept_buf_.assign(external_.size(), 0.0);
   hold_from_.assign(m.pantographs.size(), 0.0);
@@ -138,7 +148,8 @@ bool HilLoop::execute(Request r, std::string& msg) {
   const std::string now = stopping_ ? "stopping (~stop)" : mode_ == Mode::kPaused
       ? std::string(paused_from_ == Mode::kHold ? "paused (in the safe hold)" : "paused")
       : mode_ == Mode::kWaiting ? (armed_ ? "waiting for the first measurement" : "waiting for ~arm")
-      : mode_ == Mode::kEnded ? (diverged_ ? "ended (diverged)" : "ended") : mode_name(mode_);
+      : mode_ == Mode::kEnded ? (diverged_ ? "ended (diverged)" : dewired_ ? "ended (dewirement)" : "ended")
+      : mode_name(mode_);
   auto refuse = [&](const std::string& why) {
     msg = "refused: the pass is " + now + "; " + why;
     return false;
@@ -238,7 +249,7 @@ void HilLoop::new_pass() {
     hold_start_time_ = sim_->state().time;
     for (int p : external_) hold_from_[p] = sim_->state().uplift[p];
   }
-  diverged_ = false;
+  diverged_ = dewired_ = false;
   recovering_ = false;
 }
 
@@ -251,24 +262,28 @@ void HilLoop::reject(const std::string& what) {
                               std::to_string(c_.rejected) + " rejected so far)");
 }
 
+std::string HilLoop::measurement_error(const double* force, std::size_t n_given, const char* field, bool indexed) const {
+  const std::size_t n = external_.size();
+  if (n_given != n)
+    return std::string(field) + " with " + std::to_string(n_given) + " values rejected: the scene has " +
+           std::to_string(n) + " external pantograph(s), send one total force (N) each in scene order";
+  // The core's check of each value (NaN, inf, range).
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::string e = Simulation::external_force_error(force[i]); !e.empty())
+      return std::string(field) + (indexed ? "[" + std::to_string(i) + "]" : std::string()) + ": " + e;
+  return std::string();
+}
+
 bool HilLoop::accept(const double* force, std::size_t n_given, double arrival, double measured, std::uint64_t step,
                      const char* field, bool indexed) {
   const std::size_t n = external_.size();
-  if (n_given != n) {
-    reject(std::string(field) + " with " + std::to_string(n_given) + " values rejected: the scene has " +
-           std::to_string(n) + " external pantograph(s), send one total force (N) each in scene order");
+  // A rejected measurement changes nothing.
+  if (std::string e = measurement_error(force, n_given, field, indexed); !e.empty()) {
+    reject(e);
     return false;
   }
-  // The core checks each value (NaN, inf, range); a rejected measurement changes nothing.
   std::string err;
-  for (std::size_t i = 0; i < n; ++i) accept_buf_[i] = sim_->state().external_force[external_[i]];
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!sim_->set_external_force(external_[i], force[i], &err)) {
-      for (std::size_t j = 0; j < i; ++j) sim_->set_external_force(external_[j], accept_buf_[j], nullptr);
-      reject(std::string(field) + (indexed ? "[" + std::to_string(i) + "]" : std::string()) + ": " + err);
-      return false;
-    }
-  }
+  for (std::size_t i = 0; i < n; ++i) sim_->set_external_force(external_[i], force[i], &err);  // (checked above)
   for (std::size_t i = 0; i < n; ++i) accept_buf_[i] = sim_->state().external_force[external_[i]];
   if (unused_) ++c_.superseded;
   hold_.accept(accept_buf_, arrival, measured, step);
@@ -558,14 +573,21 @@ void HilLoop::handle_end() {
   const State& s = sim_->state();
   if (mode_ == Mode::kEnded) return;
   const bool diverged = s.status == StepStatus::kDiverged;
+  // (Simulation::finished() is true for a dewirement too: it is not the end of the line)
+  const bool dewired = s.status == StepStatus::kDewired;
   const bool stopped = stopping_ && stop_settled();
-  if (!diverged && !stopped && !sim_->finished()) return;
+  if (!diverged && !dewired && !stopped && !sim_->finished()) return;
   // The pass is over: its statistics are the skin's (filtering takes milliseconds).
   skin_->pass_ended(std::move(recorder_), s);
   recorder_ = std::make_unique<PassRecorder>(sim_->model(), kRecorderRowRate);
   if (diverged) {
     diverged_ = true;
     log(LogLevel::kError, sim_->status_message());
+  } else if (dewired) {
+    // The scene asks the pass to stop there (pantograph_head.on_dewirement: stop), as
+    // simulate_pass does; the line is held and ~arm starts a new pass.
+    dewired_ = true;
+    log(LogLevel::kError, "pass " + std::to_string(pass_count_) + " " + sim_->status_message() + ": ended");
   } else if (stopping_) {
     log(LogLevel::kInfo, printf_text("pass %u stopped (~stop) at t = %.4f s (train front at %.2f m), the line settled: ended; "
                              "%lld periods, %lld overruns", pass_count_, s.time, s.front + s.line_offset,
@@ -575,7 +597,7 @@ void HilLoop::handle_end() {
                              pass_count_, s.time, s.front + s.line_offset, static_cast<long long>(c_.batches),
                              static_cast<long long>(c_.overruns)));
   }
-  if (!diverged && !stopping_ && opt_.at_end == EndAction::kLoop) {
+  if (!diverged && !dewired && !stopping_ && opt_.at_end == EndAction::kLoop) {
     // A new pass from the initial static state with the static force (no new static solve), the
     // clock running on; pass_count tells the rig to re-initialise.
     for (int p : external_) sim_->set_external_force(p, sim_->state().uplift[p], nullptr);

@@ -1,5 +1,6 @@
 #include "catenary_sim/hil/report.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 namespace catenary_sim {
@@ -81,6 +82,26 @@ std::string loop_summary(const HilLoop& L) {
                 L.latency().max() * 1e6, static_cast<unsigned long long>(L.latency().count()),
                 L.jitter().quantile(0.99) * 1e6, L.jitter().max() * 1e6);
   return buf;
+}
+
+std::string pass_stats_json(const Model& m, const State& state, const std::vector<PantographStatistics>& stats,
+                            const RunInfo& run, std::string* why) {
+  const bool dewired = state.status == StepStatus::kDewired;
+  if (dewired) {
+    for (const PantographStatistics& s : stats)
+      for (double v : {s.filtered.mean, s.filtered.std_dev, s.filtered.max, s.filtered.min, s.unfiltered.mean})
+        if (!std::isfinite(v)) {
+          if (why) *why = "the pass stopped at the dewirement before it crossed the analysis section; nothing written";
+          return std::string();
+        }
+  }
+  std::string text = statistics_json(m, state, stats, run);
+  if (m.lateral) {
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(text);
+    j["stopped_by_dewirement"] = dewired;
+    text = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  }
+  return text;
 }
 
 }  // namespace hil

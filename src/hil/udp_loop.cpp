@@ -145,15 +145,16 @@ bool UdpSocket::send(const void* data, std::size_t n, const sockaddr_in& to) con
 // ---- The simulator's side ----
 
 UdpLoopSkin::UdpLoopSkin(HilLoop& loop, const UdpLoopOptions& o, MonitorRing* monitor)
-    : loop_(loop), opt_(o), socket_(o.bind_address, o.port, "--bind/--port"), monitor_(monitor) {
-  if (const std::string e = udp::check_fits(loop.model()); !e.empty()) throw HilError("~scene: " + e);
+    : loop_(loop), opt_(o), socket_(o.bind_address, o.port, o.bind_name), monitor_(monitor) {
+  if (const std::string e = udp::check_fits(loop.model()); !e.empty()) throw HilError(o.scene_name + ": " + e);
   if (!o.rig_address.empty()) {
     if (o.rig_port <= 0 || o.rig_port > 65535)
-      throw HilError("--rig port = " + std::to_string(o.rig_port) + " rejected: allowed 1 to 65535");
-    rig_ = udp_address(o.rig_address, o.rig_port, "--rig");
+      throw HilError(o.rig_name + " port = " + std::to_string(o.rig_port) + " rejected: allowed 1 to 65535");
+    rig_ = udp_address(o.rig_address, o.rig_port, o.rig_name);
     fixed_rig_ = have_rig_ = true;
     if (!allowed(rig_))
-      throw HilError("--rig = " + address_text(rig_) + " is not on the allow-list (--allow): it could never be the rig");
+      throw HilError(o.rig_name + " = " + address_text(rig_) + " is not on the allow-list (" + o.allow_name +
+                     "): it could never be the rig");
   }
   loop_.attach(this);
 }
@@ -225,8 +226,25 @@ void UdpLoopSkin::take(const std::uint8_t* data, std::size_t n, const sockaddr_i
       return;
     }
     ++rejected_[static_cast<int>(why)];
+    tracker_.rejected();
     loop_.reject("UDP " + reason);
     return;
+  }
+  // Values the loop would refuse are refused before the packet names the rig or its number is
+  // taken: a refused packet leaves both as they were (a number taken from it would drop every
+  // later valid measurement numbered below it).
+  if (m.pantographs > 0) {
+    for (std::uint32_t i = 0; i < m.pantographs; ++i) force_[i] = m.force[i];  // (out of the packed struct)
+    if (std::string e = loop_.measurement_error(force_.data(), m.pantographs, "UDP measurement.force", true);
+        !e.empty()) {
+      if (have_peer_ && !from_peer) {
+        ignore_foreign(from, "the loop follows the rig at " + address_text(peer_));
+        return;
+      }
+      tracker_.rejected();
+      loop_.reject(e);
+      return;
+    }
   }
   if (!follow_rig(from, from_peer, m)) return;
   if (!in_sequence(from, m)) return;
@@ -308,7 +326,8 @@ void UdpLoopSkin::send_end(std::uint32_t reason, const PointFrame* f) {
   if (!have_rig_) return;
   csim_udp_end e;
   std::memset(&e, 0, sizeof e);
-  e.step = f ? f->step : 0;
+  // (the step at the end: the frame's, or the state's when the loop has returned without one)
+  e.step = f ? f->step : static_cast<std::uint64_t>(loop_.state().steps);
   e.pass_count = loop_.pass_count();
   e.reason = reason;
   e.simulation_time = loop_.state().time;
@@ -322,10 +341,13 @@ void UdpLoopSkin::send_end(std::uint32_t reason, const PointFrame* f) {
                            udp::end_reason_name(reason));
 }
 
+std::uint32_t UdpLoopSkin::end_reason() const {
+  return loop_.diverged() ? CSIM_UDP_END_DIVERGED : loop_.dewired() ? CSIM_UDP_END_DEWIRED : CSIM_UDP_END_FINISHED;
+}
+
 void UdpLoopSkin::finish() {
   if (end_sent_ && end_sent_pass_ == loop_.pass_count()) return;
-  const bool ended = loop_.mode() == Mode::kEnded;
-  send_end(!ended ? CSIM_UDP_END_SHUTDOWN : loop_.diverged() ? CSIM_UDP_END_DIVERGED : CSIM_UDP_END_FINISHED, nullptr);
+  send_end(loop_.mode() == Mode::kEnded ? end_reason() : CSIM_UDP_END_SHUTDOWN, nullptr);
 }
 
 void UdpLoopSkin::send(const PointFrame& f) {
@@ -354,7 +376,7 @@ void UdpLoopSkin::send(const PointFrame& f) {
     else ++send_errors_;
   }
   if (f.mode == Mode::kEnded && !(end_sent_ && end_sent_pass_ == f.pass_count))
-    send_end(loop_.diverged() ? CSIM_UDP_END_DIVERGED : CSIM_UDP_END_FINISHED, &f);
+    send_end(end_reason(), &f);
   if (monitor_) {
     MonitorSample s;
     s.wall = steady_now();
@@ -420,10 +442,10 @@ void UdpLoopSkin::add_report(nlohmann::ordered_json& j) const {
 // ---- The simulated rig ----
 
 UdpVirtualRig::UdpVirtualRig(const Scene& scene, const UdpRigOptions& o)
-    : scene_(scene), opt_(o), socket_(o.bind_address, o.port, "--bind/--port"), stepper_(o.extrapolate) {
-  simulator_ = udp_address(o.simulator_address, o.simulator_port, "--simulator");
+    : scene_(scene), opt_(o), socket_(o.bind_address, o.port, o.bind_name), stepper_(o.extrapolate) {
+  simulator_ = udp_address(o.simulator_address, o.simulator_port, o.simulator_name);
   if (!std::isfinite(o.rate) || !(o.rate == 0.0 || (o.rate >= 1.0 && o.rate <= 20000.0)))
-    throw HilError("--rate = " + fmt(o.rate) + " rejected: allowed 0 (the simulator's loop rate) or [1, 20000] Hz");
+    throw HilError(o.rate_name + " = " + fmt(o.rate) + " rejected: allowed 0 (the simulator's loop rate) or [1, 20000] Hz");
   if (!std::isfinite(o.contact_timeout) || o.contact_timeout < 0.0 || o.contact_timeout > 3600.0)
     throw HilError("--timeout = " + fmt(o.contact_timeout) + " rejected: allowed 0 (never) or up to 3600 s");
   if (!std::isfinite(o.connect_timeout) || o.connect_timeout < 0.0 || o.connect_timeout > 3600.0)
@@ -434,10 +456,10 @@ UdpVirtualRig::UdpVirtualRig(const Scene& scene, const UdpRigOptions& o)
     try {
       rigs_.emplace_back(ps, scene_.contact.stiffness);
     } catch (const std::invalid_argument& e) {
-      throw HilError(std::string("--pantograph-scene: ") + e.what());
+      throw HilError(o.scene_name + ": " + e.what());
     }
   }
-  if (rigs_.empty()) throw HilError("--pantograph-scene: no lumped pantograph (type lumped) in the scene");
+  if (rigs_.empty()) throw HilError(o.scene_name + ": no lumped pantograph (type lumped) in the scene");
   if (rigs_.size() > CSIM_UDP_MAX_PANTOGRAPHS)  // (a packet carries no more)
     rigs_.erase(rigs_.begin() + CSIM_UDP_MAX_PANTOGRAPHS, rigs_.end());
 }
@@ -447,8 +469,8 @@ void UdpVirtualRig::on_point(const csim_udp_contact_point& msg) {
   if (msg.pantographs > rigs_.size()) {
     ++rejected_;
     if (!cannot_serve_)
-      message_ = "the simulator has " + std::to_string(msg.pantographs) + " external pantographs; --pantograph-scene "
-                 "has " + std::to_string(rigs_.size()) + " lumped one(s): allowed a scene with at least one lumped "
+      message_ = "the simulator has " + std::to_string(msg.pantographs) + " external pantographs; " + opt_.scene_name +
+                 " has " + std::to_string(rigs_.size()) + " lumped one(s): allowed a scene with at least one lumped "
                  "pantograph per external one, in scene order";
     cannot_serve_ = true;
     return;

@@ -3,6 +3,7 @@
 #include "../core/util/format.hpp"  // the core's numbers in messages: one way for all
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 
 namespace catenary_sim {
@@ -151,6 +152,7 @@ const char* end_reason_name(std::uint32_t reason) {
     case CSIM_UDP_END_FINISHED: return "the pass ended";
     case CSIM_UDP_END_DIVERGED: return "the simulation diverged";
     case CSIM_UDP_END_SHUTDOWN: return "the simulator stopped";
+    case CSIM_UDP_END_DEWIRED: return "the pass stopped at a dewirement";
     default: return "unknown";
   }
 }
@@ -159,9 +161,9 @@ bool decode_end(const void* data, std::size_t size, csim_udp_end& out, Reject& w
   csim_udp_header h;
   if (!check_header(data, size, CSIM_UDP_KIND_END, CSIM_UDP_END_SIZE, "end", h, why, reason)) return false;
   std::memcpy(&out, data, sizeof out);
-  if (out.reason < CSIM_UDP_END_FINISHED || out.reason > CSIM_UDP_END_SHUTDOWN)
+  if (out.reason < CSIM_UDP_END_FINISHED || out.reason > CSIM_UDP_END_DEWIRED)
     return fail(Reject::kFlags, why, reason,
-                "end.reason = " + std::to_string(out.reason) + " rejected: allowed 1 to 3 (CSIM_UDP_END_*)");
+                "end.reason = " + std::to_string(out.reason) + " rejected: allowed 1 to 4 (CSIM_UDP_END_*)");
   return finite_field(out.simulation_time, "end.simulation_time", why, reason);
 }
 
@@ -229,6 +231,7 @@ SequenceTracker::Verdict SequenceTracker::observe(std::uint32_t seq) {
   ++received_;
   if (!any_) {
     any_ = true;
+    rejected_since_ = 0;
     newest_ = seq;
     seen_ = 1;
     return Verdict::kFirst;
@@ -237,13 +240,16 @@ SequenceTracker::Verdict SequenceTracker::observe(std::uint32_t seq) {
   const std::int64_t d = static_cast<std::int32_t>(seq - newest_);
   if (d > kRestartJump || d < -kRestartJump) {
     ++restarts_;
+    rejected_since_ = 0;
     newest_ = seq;
     seen_ = 1;
     return Verdict::kRestart;
   }
   if (d > 0) {
     run_ = 0;
-    lost_ += static_cast<std::uint64_t>(d - 1);
+    const std::uint64_t gap = static_cast<std::uint64_t>(d - 1);
+    lost_ += gap - std::min(gap, rejected_since_);
+    rejected_since_ = 0;
     seen_ = d >= 64 ? 1 : ((seen_ << d) | 1);
     newest_ = seq;
     return d == 1 ? Verdict::kInOrder : Verdict::kGap;

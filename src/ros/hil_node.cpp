@@ -319,6 +319,7 @@ void HilNode::snapshot(double t) {
   std::copy(L.latency_quantiles(), L.latency_quantiles() + 3, snap_.latency);
   snap_.jitter = L.jitter_summary();
   snap_.diverged = L.diverged();
+  snap_.dewired = L.dewired();
   snap_.pass_count = L.pass_count();
   snap_.armed = L.armed();
   snap_.stopping = L.stopping();
@@ -409,6 +410,15 @@ void HilNode::publish_snapshot(const Model& m) {
 
 void HilNode::report_pass(const Model& m, const PassRecorder& finished, const State& finished_state) {
   const std::vector<PantographStatistics> stats = finished.statistics(m);
+  std::string why;
+  const std::string text =
+      hil::pass_stats_json(m, finished_state, stats, RunInfo{-1.0, -1.0, wsnap_.counters.overruns}, &why);
+  if (text.empty()) {
+    // (a pass with no statistics: the file asked for is missing, which the exit code says)
+    end_error("catenary_sim_hil: " + why);
+    if (!params_.stats_file.empty()) stats_failed_ = true;
+    return;
+  }
   for (const PantographStatistics& st : stats) {
     ROS_INFO("catenary_sim_hil: %s: mean %.1f N, std %.1f N, max %.1f N, min %.1f N, contact loss %.2f %% "
              "(%zu samples, filtered %.0f Hz)", st.name.c_str(), st.filtered.mean, st.filtered.std_dev,
@@ -417,8 +427,7 @@ void HilNode::report_pass(const Model& m, const PassRecorder& finished, const St
   if (!params_.stats_file.empty()) {
     // Whole or not at all (checked writable at start-up; a full disk is still possible).
     try {
-      write_file_atomically(params_.stats_file,
-                            statistics_json(m, finished_state, stats, RunInfo{-1.0, -1.0, wsnap_.counters.overruns}));
+      write_file_atomically(params_.stats_file, text);
     } catch (const OutputError& e) {
       end_error(std::string("catenary_sim_hil: ~stats_file: ") + e.what());
       stats_failed_ = true;
@@ -483,6 +492,7 @@ void HilNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
       break;
     case Mode::kEnded:
       if (s.diverged) stat.summary(DiagnosticStatus::ERROR, "diverged: the loop is stopped");
+      else if (s.dewired) stat.summary(DiagnosticStatus::ERROR, "stopped at a dewirement (pantograph_head.on_dewirement: stop)");
       else stat.summary(DiagnosticStatus::OK, "pass finished");
       break;
   }

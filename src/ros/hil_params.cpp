@@ -23,7 +23,8 @@ void validate_hil_params(const HilParams& p) {
     throw ParamError("parameter ~hil/timeout = " + format_given(p.timeout) + " s rejected: allowed [" + format_number(2.0 * period) +
                      ", 10] s (at least two loop periods of ~hil/rate = " + format_number(p.rate) + " Hz)");
   check_range("hil/hold_ramp", p.hold_ramp, 0.0, 60.0, false, "s (0: at once)");
-  check_range("hil/hold_deceleration", p.hold_deceleration, 0.0, 50.0, false, "m/s^2 (0: at once)");
+  // (the core's limit on the train's acceleration: Simulation::set_max_acceleration)
+  check_range("hil/hold_deceleration", p.hold_deceleration, 0.0, Simulation::kMaxAcceleration, false, "m/s^2 (0: at once)");
   // (lower bounds as catenary_sim_node's: params.hpp)
   check_range("publish_rate", p.publish_rate, kMinPublishRate, 1000.0, false, "Hz");
   check_range("marker_rate", p.marker_rate, kMinMarkerRate, 100.0, false, "Hz");
@@ -94,7 +95,8 @@ HilParams load_hil_params(const ros::NodeHandle& nh) {
   r.number("hil/rate", p.rate, "a number in " + range_text(hil::kMinLoopRate, hil::kMaxLoopRate, false, "Hz"));
   r.number("hil/timeout", p.timeout, "a number of seconds in [2 loop periods, 10]");
   r.number("hil/hold_ramp", p.hold_ramp, "a number in [0, 60] s");
-  r.number("hil/hold_deceleration", p.hold_deceleration, "a number in [0, 50] m/s^2");
+  r.number("hil/hold_deceleration", p.hold_deceleration,
+           "a number in " + range_text(0.0, Simulation::kMaxAcceleration, false, "m/s^2"));
   r.number("publish_rate", p.publish_rate, "a number in " + range_text(kMinPublishRate, 1000.0, false, "Hz"));
   r.number("marker_rate", p.marker_rate, "a number in " + range_text(kMinMarkerRate, 100.0, false, "Hz"));
   r.number("start_delay", p.start_delay, "a number in [0, 60] s");

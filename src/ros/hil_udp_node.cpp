@@ -26,6 +26,10 @@ HilUdpNode::HilUdpNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   hil::UdpLoopOptions u;
   u.bind_address = params_.udp_bind;
   u.port = params_.udp_port;
+  u.bind_name = "~hil/udp_bind/~hil/udp_port";
+  u.rig_name = "~hil/udp_rig";
+  u.allow_name = "~hil/udp_allow";
+  u.scene_name = "~scene = '" + params_.scene + "'";
   try {
     if (!params_.udp_rig.empty()) std::tie(u.rig_address, u.rig_port) = hil::parse_host_port(params_.udp_rig, "~hil/udp_rig");
     u.allow = hil::parse_allow_list(params_.udp_allow, "~hil/udp_allow");
@@ -34,13 +38,23 @@ HilUdpNode::HilUdpNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   }
   try {
     loop_ = std::make_unique<hil::HilLoop>(scene, o);
-    skin_ = std::make_unique<hil::UdpLoopSkin>(*loop_, u, &ring_);
   } catch (const SceneError& e) {
     throw ParamError("parameter ~scene = '" + params_.scene + "': " + e.what());
   } catch (const hil::HilError& e) {
-    throw ParamError(std::string("parameter ~hil/udp_*: ") + e.what());
+    throw ParamError(e.what());  // (the loop's errors name their parameter, as catenary_sim_hil_node's)
+  }
+  try {
+    skin_ = std::make_unique<hil::UdpLoopSkin>(*loop_, u, &ring_);
+  } catch (const hil::HilError& e) {
+    throw ParamError(std::string("parameter ") + e.what());  // (named by UdpLoopOptions' names)
   }
   skin_->set_running([] { return ros::ok() && !ros::isShuttingDown(); });
+  skin_->set_on_pass_ended([this](std::unique_ptr<PassRecorder> recorder, const State& state) {
+    std::lock_guard<std::mutex> l(pass_mu_);  // (the publisher holds it only to take the recorder)
+    pass_recorder_ = std::move(recorder);
+    pass_state_ = state;
+    pass_overruns_ = loop_->counters().overruns;
+  });
   skin_->set_log([](hil::LogLevel level, const std::string& t) {
     if (level == hil::LogLevel::kInfo) ROS_INFO("%s", t.c_str());
     else if (level == hil::LogLevel::kWarn) ROS_WARN("%s", t.c_str());
@@ -139,6 +153,7 @@ void HilUdpNode::publisher() {
       }
       point_pub_.publish(m);
     }
+    report_finished_pass();
     const double now = hil::steady_now();
     if (now >= next_diag) {
       next_diag = now + 0.1;
@@ -177,6 +192,44 @@ void HilUdpNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("sim time [s]", s.simulation_time);
 }
 
+void HilUdpNode::report_finished_pass() {
+  std::unique_ptr<PassRecorder> rec;
+  State state;
+  std::int64_t overruns = 0;
+  {
+    std::lock_guard<std::mutex> l(pass_mu_);
+    if (!pass_recorder_) return;
+    rec = std::move(pass_recorder_);
+    state = pass_state_;
+    overruns = pass_overruns_;
+  }
+  // An error after a shutdown on stderr (rosconsole no longer prints then).
+  auto error = [](const std::string& what) {
+    if (ros::ok() && !ros::isShuttingDown()) ROS_ERROR("%s", what.c_str());
+    else std::fprintf(stderr, "[ERROR] %s\n", what.c_str());
+  };
+  const Model& m = loop_->model();
+  const std::vector<PantographStatistics> st = rec->statistics(m);
+  std::string why;
+  const std::string text = hil::pass_stats_json(m, state, st, RunInfo{-1.0, -1.0, overruns}, &why);
+  if (text.empty()) {
+    error("catenary_sim_hil_udp: " + why);
+    if (!params_.stats_file.empty()) stats_failed_ = true;
+    return;
+  }
+  for (const PantographStatistics& p : st)
+    ROS_INFO("catenary_sim_hil_udp: %s: mean %.1f N, std %.1f N, max %.1f N, min %.1f N, contact loss %.2f %% "
+             "(%zu samples, filtered %.0f Hz)", p.name.c_str(), p.filtered.mean, p.filtered.std_dev, p.filtered.max,
+             p.filtered.min, p.contact_loss_percent, p.samples, m.scene.output.filter_cutoff);
+  if (params_.stats_file.empty()) return;
+  try {
+    write_file_atomically(params_.stats_file, text);  // (whole or not at all)
+  } catch (const OutputError& e) {
+    error(std::string("catenary_sim_hil_udp: ~stats_file: ") + e.what());
+    stats_failed_ = true;
+  }
+}
+
 int HilUdpNode::run() {
   if (const std::string e = hil::apply_realtime(realtime_options(params_)); !e.empty()) {
     ROS_FATAL("catenary_sim_hil_udp: parameter %s", e.c_str());
@@ -188,19 +241,8 @@ int HilUdpNode::run() {
   if (publisher_.joinable()) publisher_.join();
   std::printf("catenary_sim_hil_udp: %s\n", hil::loop_summary(*loop_).c_str());
   std::fflush(stdout);
-  State end_state;
-  if (std::unique_ptr<PassRecorder> rec = skin_->take_finished(&end_state)) {
-    const std::vector<PantographStatistics> st = rec->statistics(loop_->model());
-    if (!params_.stats_file.empty()) {
-      try {
-        write_file_atomically(params_.stats_file,
-                              statistics_json(loop_->model(), end_state, st, RunInfo{-1.0, -1.0, loop_->counters().overruns}));
-      } catch (const OutputError& e) {
-        std::fprintf(stderr, "[ERROR] catenary_sim_hil_udp: ~stats_file: %s\n", e.what());
-        if (rc == 0) rc = 1;
-      }
-    }
-  }
+  report_finished_pass();  // (a pass that ended in the last period)
+  if (stats_failed_ && rc == 0) rc = 1;
   if (!params_.report_file.empty()) {
     nlohmann::ordered_json j = hil::loop_report(*loop_);
     skin_->add_report(j);

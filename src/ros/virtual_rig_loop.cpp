@@ -20,6 +20,9 @@ namespace ros_layer {
 
 namespace {
 
+// A pantograph the rig can stand in for (RigPantograph takes it).
+bool is_lumped(const PantographSpec& ps) { return !ps.moving_force && !ps.external && !ps.masses.empty(); }
+
 double mono_now() {
   timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -53,6 +56,22 @@ VirtualRig::VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   } catch (const SceneError& e) {
     throw ParamError("parameter ~pantograph_scene = '" + scene_file + "': " + e.what());
   }
+  // The rig stands in for lumped pantographs: a scene without one it can step is refused now,
+  // not at the first contact point (the simulator would wait for it for ever).
+  scene_name_ = "parameter ~pantograph_scene = '" + scene_file + "'";
+  std::size_t lumped = 0;
+  for (const PantographSpec& ps : scene_.pantographs) {
+    if (!is_lumped(ps)) continue;
+    try {
+      RigPantograph(ps, scene_.contact.stiffness);
+    } catch (const std::invalid_argument& e) {
+      throw ParamError(scene_name_ + ": " + e.what());
+    }
+    ++lumped;
+  }
+  if (lumped == 0)
+    throw ParamError(scene_name_ + ": no lumped pantograph (type lumped) in the scene; allowed a scene whose lumped "
+                     "pantographs have the names of the simulator's external ones (e.g. config/reference_55m.yaml)");
   if (transport_ == "udp") return;  // (run_udp: no topics)
   // Every contact point, even after a stall of the loop thread (up to 1 s at 10 kHz): the
   // pantograph is stepped through each one (a lost one: two periods against an extrapolated wire).
@@ -80,6 +99,10 @@ int VirtualRig::run_udp() {
               simulator_.c_str());
     return 2;
   }
+  o.simulator_name = "parameter ~simulator";
+  o.scene_name = scene_name_;
+  o.rate_name = "parameter ~rate";
+  o.bind_name = "virtual_rig's local UDP socket (any port)";
   o.simulator_address = simulator_.substr(0, colon);
   o.simulator_port = port;
   o.rate = rate_;
@@ -91,7 +114,10 @@ int VirtualRig::run_udp() {
   try {
     hil::UdpVirtualRig rig(scene_, o);
     ROS_INFO("virtual_rig: over UDP to %s (local port %d)", simulator_.c_str(), rig.port());
-    rig.run([this] { return running(); });
+    const double start = mono_now();
+    const hil::RigEnd end = rig.run([this] { return running(); });
+    const double wall = mono_now() - start;
+    if (end == hil::RigEnd::kCannotServe) ROS_ERROR("virtual_rig: %s", rig.message().c_str());
     const auto& q = rig.sequence();
     std::printf("virtual_rig: %llu measurements sent over UDP, %llu missed ticks; contact points %llu received, %llu "
                 "lost; round trip p50 %.1f us, p99 %.1f us, max %.1f us\n",
@@ -99,11 +125,33 @@ int VirtualRig::run_udp() {
                 static_cast<unsigned long long>(q.received()), static_cast<unsigned long long>(q.lost()),
                 rig.round_trip().quantile(0.5) * 1e6, rig.round_trip().quantile(0.99) * 1e6, rig.round_trip().max() * 1e6);
     std::fflush(stdout);
+    if (!write_report(rig.sent(), rig.missed_ticks(), wall, rig.round_trip())) return 1;
+    if (end == hil::RigEnd::kCannotServe) return 2;
   } catch (const hil::HilError& e) {
     ROS_FATAL("virtual_rig: %s", e.what());
     return 2;
   }
   return 0;
+}
+
+bool VirtualRig::write_report(std::uint64_t sent, std::uint64_t missed, double wall, const LatencyHistogram& round_trip) {
+  if (report_file_.empty()) return true;
+  nlohmann::ordered_json j;  // (a non-finite number is written as null)
+  j["measurements"] = sent;
+  j["missed_ticks"] = missed;
+  j["wall_s"] = wall;
+  j["round_trip"] = {{"count", round_trip.count()},
+                     {"p50_s", round_trip.quantile(0.5)},
+                     {"p99_s", round_trip.quantile(0.99)},
+                     {"max_s", round_trip.max()}};
+  try {
+    write_file_atomically(report_file_, j.dump() + "\n");
+  } catch (const OutputError& e) {
+    // (after a shutdown rosconsole no longer prints)
+    std::fprintf(stderr, "[ERROR] virtual_rig: ~report_file: %s\n", e.what());
+    return false;
+  }
+  return true;
 }
 
 int VirtualRig::run() {
@@ -132,24 +180,8 @@ int VirtualRig::run() {
               round_trip_.quantile(0.5) * 1e6, round_trip_.quantile(0.99) * 1e6, round_trip_.max() * 1e6,
               static_cast<unsigned long long>(round_trip_.count()));
   std::fflush(stdout);
-  if (!report_file_.empty()) {
-    nlohmann::ordered_json j;  // (a non-finite number is written as null)
-    j["measurements"] = sent_;
-    j["missed_ticks"] = missed_;
-    j["wall_s"] = wall;
-    j["round_trip"] = {{"count", round_trip_.count()},
-                       {"p50_s", round_trip_.quantile(0.5)},
-                       {"p99_s", round_trip_.quantile(0.99)},
-                       {"max_s", round_trip_.max()}};
-    try {
-      write_file_atomically(report_file_, j.dump() + "\n");
-    } catch (const OutputError& e) {
-      // (after a shutdown rosconsole no longer prints)
-      std::fprintf(stderr, "[ERROR] virtual_rig: ~report_file: %s\n", e.what());
-      return 1;
-    }
-  }
-  return 0;
+  if (!write_report(sent_, missed_, wall, round_trip_)) return 1;
+  return failed_ ? 2 : 0;
 }
 
 void VirtualRig::on_point(const ContactPointArray::ConstPtr& msg) {
@@ -161,11 +193,17 @@ void VirtualRig::on_point(const ContactPointArray::ConstPtr& msg) {
     for (const ContactPoint& c : msg->pantographs) {
       const PantographSpec* spec = nullptr;
       for (const PantographSpec& ps : scene_.pantographs)
-        if (ps.name == c.name) spec = &ps;
+        if (ps.name == c.name && is_lumped(ps)) spec = &ps;
       if (!spec) {
-        ROS_ERROR_THROTTLE(5.0, "virtual_rig: no pantograph named '%s' in ~pantograph_scene", c.name.c_str());
+        // The rig cannot answer: it stops (and the launch with it) rather than leave the simulator
+        // waiting for ever.
+        ROS_FATAL("virtual_rig: %s: no lumped pantograph named '%s' (the simulator's external pantograph); allowed "
+                  "a scene whose lumped pantographs have the names of the external ones", scene_name_.c_str(),
+                  c.name.c_str());
         have_ = false;
         stepper_.clear();
+        failed_ = true;
+        stop_ = true;
         return;
       }
       rigs.emplace_back(*spec, scene_.contact.stiffness);

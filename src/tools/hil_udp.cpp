@@ -62,6 +62,7 @@ int parse_options(int argc, char** argv, UdpOptions* o) {
   hil::LoopOptions& lo = o->lo;
   lo.who = "catenary_sim_hil_udp";
   lo.input = "UDP measurement";
+  lo.command_line = true;
   app.add_option("--scene", o->scene_file, "scene YAML with at least one `type: external` pantograph")->required()->type_name("FILE");
   app.add_option("--speed-kmh", o->speed_kmh, "train speed, km/h (default: the scene's)")->check(kFinite & CLI::Range(0.0, 3.6 * kMaxTrainSpeed));
   app.add_option("--rate", lo.rate, "loop rate, Hz")->check(kFinite & kLoopRate)->capture_default_str();
@@ -71,7 +72,7 @@ int parse_options(int argc, char** argv, UdpOptions* o) {
   app.add_option("--hold-ramp", lo.hold_ramp, "s, force ramp to the static force in the safe hold")
       ->check(kFinite & CLI::Range(0.0, 60.0))->capture_default_str();
   app.add_option("--hold-deceleration", lo.hold_deceleration, "m/s^2, the train stops at this rate in the safe hold (0: at once)")
-      ->check(kFinite & CLI::Range(0.0, 50.0))->capture_default_str();
+      ->check(kFinite & CLI::Range(0.0, Simulation::kMaxAcceleration))->capture_default_str();
   app.add_option("--start-delay", lo.start_delay, "s in which measurements are ignored")->check(kFinite & CLI::Range(0.0, 60.0));
   app.add_option("--delay-compensation", lo.delay_compensation,
                  "s: send the contact point predicted this far ahead (the known loop delay)")
@@ -107,8 +108,10 @@ int parse_options(int argc, char** argv, UdpOptions* o) {
   return -1;
 }
 
-// What the loop did, on stdout; the statistics (--stats) and the report (--report) written.
-void finish(const UdpOptions& o, hil::HilLoop& loop, hil::UdpLoopSkin& skin, double start) {
+// What the loop did, on stdout; the statistics (--stats) and the report (--report) written. False
+// when --stats was asked for a pass that gave none (stopped at a dewirement before the analysis
+// section): the file is missing.
+bool finish(const UdpOptions& o, hil::HilLoop& loop, hil::UdpLoopSkin& skin, double start) {
   std::printf("catenary_sim_hil_udp: %s\n", hil::loop_summary(loop).c_str());
   const auto& seq = skin.sequence();
   std::printf("catenary_sim_hil_udp: packets: %llu received, %llu lost, %llu reordered, %llu duplicated, %llu from "
@@ -122,21 +125,29 @@ void finish(const UdpOptions& o, hil::HilLoop& loop, hil::UdpLoopSkin& skin, dou
               "the loop delay (%lld of %lld periods with the answered contact point known)\n",
               en.interface_j, en.delay_j, static_cast<long long>(en.known), static_cast<long long>(en.periods));
   State end_state;
+  bool stats_missing = false;
   if (std::unique_ptr<PassRecorder> rec = skin.take_finished(&end_state)) {
     const std::vector<PantographStatistics> st = rec->statistics(loop.model());
-    for (const PantographStatistics& s : st)
-      std::printf("catenary_sim_hil_udp: %s: mean %.1f N, std %.1f N, max %.1f N, min %.1f N, contact loss %.2f %%\n",
-                  s.name.c_str(), s.filtered.mean, s.filtered.std_dev, s.filtered.max, s.filtered.min,
-                  s.contact_loss_percent);
-    if (!o.stats_file.empty())
-      write_file_atomically(o.stats_file, statistics_json(loop.model(), end_state, st,
-                                                          RunInfo{hil::steady_now() - start, -1.0, loop.counters().overruns}));
+    std::string why;
+    const std::string text = hil::pass_stats_json(loop.model(), end_state, st,
+                                                  RunInfo{hil::steady_now() - start, -1.0, loop.counters().overruns}, &why);
+    if (text.empty()) {
+      std::fprintf(stderr, "catenary_sim_hil_udp: %s\n", why.c_str());
+      stats_missing = !o.stats_file.empty();
+    } else {
+      for (const PantographStatistics& s : st)
+        std::printf("catenary_sim_hil_udp: %s: mean %.1f N, std %.1f N, max %.1f N, min %.1f N, contact loss %.2f %%\n",
+                    s.name.c_str(), s.filtered.mean, s.filtered.std_dev, s.filtered.max, s.filtered.min,
+                    s.contact_loss_percent);
+      if (!o.stats_file.empty()) write_file_atomically(o.stats_file, text);
+    }
   }
   if (!o.report_file.empty()) {
     nlohmann::ordered_json j = hil::loop_report(loop);
     skin.add_report(j);
     write_file_atomically(o.report_file, j.dump(2) + "\n");
   }
+  return !stats_missing;
 }
 
 // The loop run to its end; returns its exit code. Throws HilError, SceneError, OutputError.
@@ -147,7 +158,9 @@ int run_loop(const UdpOptions& o) {
   Scene scene = load_scene_file(o.scene_file);
   if (o.speed_kmh) scene.train_speed = *o.speed_kmh / 3.6;
   hil::HilLoop loop(scene, o.lo, "--rate", "--scene " + o.scene_file);
-  hil::UdpLoopSkin skin(loop, o.uo);
+  hil::UdpLoopOptions uo = o.uo;
+  uo.scene_name = "--scene " + o.scene_file;
+  hil::UdpLoopSkin skin(loop, uo);
   const double start = hil::steady_now();
   const double duration = o.duration;
   if (duration > 0.0) skin.set_running([start, duration] { return hil::steady_now() - start < duration; });
@@ -161,8 +174,8 @@ int run_loop(const UdpOptions& o) {
   const int rc = loop.run();
   g_skin = nullptr;
   skin.finish();  // the rig is told that the pass ended (or that the simulator stops)
-  finish(o, loop, skin, start);
-  return rc;
+  const bool stats_ok = finish(o, loop, skin, start);
+  return rc == 0 && !stats_ok ? 1 : rc;
 }
 
 }  // namespace

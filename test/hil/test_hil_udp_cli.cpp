@@ -6,7 +6,10 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <yaml-cpp/yaml.h>
+
 #include <chrono>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -60,6 +63,8 @@ TEST(HilUdpCli, BadOptionsAreRefusedNamingTheOption) {
   expect_refused(with({"--rate", "20000"}), {"--rate = 20000 rejected: allowed [1000, 10000] Hz"});
   expect_refused(with({"--timeout", "0.0015", "--rate", "1000"}), {"timeout", "0.0015", "allowed"});
   expect_refused(with({"--delay-compensation", "0.5"}), {"--delay-compensation"});
+  // (beyond the core's limit on the train's acceleration: refused by the option, not by the loop)
+  expect_refused(with({"--hold-deceleration", "30"}), {"--hold-deceleration", "30"});
   expect_refused(with({"--rig", "localhost"}), {"--rig", "HOST:PORT"});
   expect_refused(with({"--rig", "127.0.0.1:0"}), {"--rig", "1 to 65535"});
   expect_refused(with({"--rig", "example.org:47801"}), {"--rig", "IPv4"});
@@ -72,6 +77,25 @@ TEST(HilUdpCli, BadOptionsAreRefusedNamingTheOption) {
   expect_refused(with({"--cpus", ""}), {"--cpus"});
   expect_refused({kSim, "--scene", kLumped, "--port", "0", "--duration", "1"}, {"external"});
   expect_refused({kSim, "--scene", "/nonexistent.yaml"}, {"--scene", "/nonexistent.yaml"});
+  {
+    // A scene whose frames do not fit a packet (five external pantographs) is --scene's fault.
+    YAML::Node root = YAML::LoadFile(kHil);
+    YAML::Node first = YAML::Clone(root["pantographs"][0]);
+    root["pantographs"] = YAML::Node(YAML::NodeType::Sequence);
+    for (int i = 0; i < 5; ++i) {
+      YAML::Node p = YAML::Clone(first);
+      p["name"] = "p" + std::to_string(i);
+      p["position"] = 20.0 * i;
+      root["pantographs"].push_back(p);
+    }
+    char dir[] = "/tmp/catenary_sim_udp_cli_XXXXXX";
+    const std::string five = std::string(mkdtemp(dir)) + "/five.yaml";
+    std::ofstream(five) << YAML::Dump(root) << "\n";
+    const ChildRun r = run({kSim, "--scene", five, "--port", "0", "--duration", "1"});
+    EXPECT_EQ(r.exit_code, 2) << r.out;
+    EXPECT_NE(r.out.find("--scene " + five + ": the scene has 5 external pantographs"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("~scene"), std::string::npos) << r.out;
+  }
   expect_refused({kRig, "--pantograph-scene", kLumped, "--simulator", "127.0.0.1"}, {"--simulator", "HOST:PORT"});
   expect_refused({kRig, "--pantograph-scene", kHil, "--simulator", "127.0.0.1:47800"}, {"lumped"});
   expect_refused({kRig, "--pantograph-scene", kLumped, "--rate", "-1"}, {"--rate"});

@@ -24,6 +24,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <mutex>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -61,10 +62,13 @@ std::string summary_text(const char* what, const ForceStatistics& s) {
 // The UDP loop of config/reference_55m_hil.yaml on a loopback port of its own, running in a thread
 // until stop() (or the end of the test), and a rig socket to talk to it.
 struct RunningUdpLoop {
-  explicit RunningUdpLoop(const LoopOptions& lo)
-      : loop(scene_with_dt("reference_55m_hil.yaml", 0.0), lo), skin(loop, loopback()) {
+  explicit RunningUdpLoop(const LoopOptions& lo, const Scene& scene = scene_with_dt("reference_55m_hil.yaml", 0.0))
+      : loop(scene, lo), skin(loop, loopback()) {
     skin.set_running([this] { return !done.load(); });
-    skin.set_log([](LogLevel, const std::string&) {});
+    skin.set_log([this](LogLevel, const std::string& t) {
+      std::lock_guard<std::mutex> l(log_mu);
+      log += t + "\n";
+    });
     to = udp_address("127.0.0.1", skin.port(), "simulator");
     runner = std::thread([this] { loop.run(); });
   }
@@ -85,6 +89,8 @@ struct RunningUdpLoop {
   UdpSocket rig{"127.0.0.1", 0, "rig"};
   sockaddr_in to{};
   std::thread runner;
+  std::mutex log_mu;
+  std::string log;
 };
 
 // A measurement packet of one pantograph (a negative force: none, the rig's hello).
@@ -228,9 +234,10 @@ TEST(UdpLoop, ClosedOverLoopbackAt1kHzIsItsOwnReplayAndWithoutDelayTheInternalPa
 
 TEST(UdpLoop, BadLostReorderedAndDuplicatedPacketsAreCountedAndChangeNothing) {
   // A rig that misbehaves, packet by packet, against the running loop: a hello, measurement 1,
-  // then a duplicate of 1, measurement 3, a late 2 (reordered), a NaN force, a short packet and a
-  // force out of range. Only 1 and 3 may reach the loop; every other one is counted, and none
-  // changes the force in effect.
+  // then a duplicate of 1, measurement 3, a late 2 (reordered), a NaN force, a short packet, a
+  // force out of range and one out of range numbered far ahead, then a good one. Only 1, 3 and
+  // the last may reach the loop; every other one is counted, and none changes the force in effect
+  // or the sequence tracking (a number taken from a refused packet would drop the last one).
   LoopOptions lo;
   lo.rate = 1000.0;
   lo.timeout = 5.0;
@@ -250,21 +257,23 @@ TEST(UdpLoop, BadLostReorderedAndDuplicatedPacketsAreCountedAndChangeNothing) {
   send(measurement(5, std::nan("")));
   send(measurement(6, 150.0), 40);  // short
   send(measurement(7, 5000.0));     // out of range (the loop's check, shared with ROS)
+  send(measurement(60, 5000.0));    // out of range, numbered far ahead
+  send(measurement(8, 140.0));      // good: taken
   run.stop();
   const auto& seq = skin.sequence();
+  EXPECT_EQ(seq.newest(), 8u);
   EXPECT_EQ(seq.duplicates(), 1u);
   EXPECT_EQ(seq.reordered(), 1u);
-  // 3 came, late; 5 and 6 were rejected before their sequence number was taken (a packet that
-  // fails validation has no number to trust), so they count as lost as well as rejected.
-  EXPECT_EQ(seq.lost(), 2u);
+  // 3 came, late; 5, 6 and 7 came and were rejected (counted so), so none is lost.
+  EXPECT_EQ(seq.lost(), 0u);
   EXPECT_EQ(skin.unusable(), 2u);
   EXPECT_EQ(skin.rejected()[static_cast<int>(udp::Reject::kNonFinite)], 1u);
   EXPECT_EQ(skin.rejected()[static_cast<int>(udp::Reject::kSize)], 1u);
-  EXPECT_EQ(loop.counters().accepted, 2);
-  EXPECT_EQ(loop.counters().rejected, 3);  // NaN, short, out of range
+  EXPECT_EQ(loop.counters().accepted, 3);
+  EXPECT_EQ(loop.counters().rejected, 4);  // NaN, short, two out of range
   EXPECT_EQ(loop.mode(), Mode::kRunning);
-  // The force in effect is the last good measurement's (130 N), not a rejected or stale one.
-  EXPECT_DOUBLE_EQ(loop.state().external_force[loop.external()[0]], 130.0);
+  // The force in effect is the last good measurement's, not a rejected or stale one.
+  EXPECT_DOUBLE_EQ(loop.state().external_force[loop.external()[0]], 140.0);
 }
 
 TEST(UdpLoop, ARigThatFallsSilentPutsTheLineIntoTheSafeHold) {
@@ -310,4 +319,120 @@ TEST(UdpLoop, ARigThatFallsSilentPutsTheLineIntoTheSafeHold) {
   EXPECT_EQ(not_hold_after, 0u);
   EXPECT_EQ(loop.counters().holds, 1);
   EXPECT_EQ(loop.mode(), Mode::kHold);
+}
+
+// config/reference_55m_hil.yaml made 3-D: the contact wire staggered +-0.3 m, the head 1.2 m wide
+// swaying 0.5 m at 2 Hz, so the contact point leaves the working width in the first span, long
+// before the analysis section; the scene asks the pass to stop there.
+Scene dewiring_scene() {
+  return test_scenes::edited_scene("reference_55m_hil.yaml", [](YAML::Node& root) {
+    root["stagger"]["contact_wire"] = std::vector<double>{0.3, -0.3};
+    root["stagger"]["messenger"] = std::vector<double>{0.0};
+    root["stagger"]["steady_arm_stiffness"] = 2.0e5;
+    root["pantograph_head"]["working_width"] = 1.2;
+    root["pantograph_head"]["on_dewirement"] = "stop";
+    root["pantograph_head"]["sway"]["amplitude"] = 0.5;
+    root["pantograph_head"]["sway"]["frequency"] = 2.0;
+  });
+}
+
+TEST(UdpLoop, APassStoppedByADewirementIsReportedAsSuchAndNotRestarted) {
+  // dewiring_scene() with at_end loop: the pass must not start again as if it had reached its
+  // end: it ends, the log says the dewirement, the end packet gives its reason, and there are no
+  // statistics to write (as simulate_pass).
+  const Scene scene = dewiring_scene();
+  LoopOptions lo;
+  lo.rate = 1000.0;
+  lo.timeout = 5.0;
+  lo.at_end = EndAction::kLoop;
+  lo.who = "test_udp_loop";
+  RunningUdpLoop run(lo, scene);
+  HilLoop& loop = run.loop;
+  // The rig: 100 N every millisecond, reading what comes back, until an end packet (at most 60 s
+  // of wall clock: the dewirement comes within 0.2 s of simulation, however far the loop falls behind).
+  std::vector<std::uint32_t> reasons;
+  alignas(8) std::uint8_t buf[2048];
+  const double deadline = steady_now() + 60.0;
+  for (std::uint32_t seq = 1; reasons.empty() && steady_now() < deadline; ++seq) {
+    const csim_udp_measurement m = measurement(seq, 100.0);
+    ASSERT_TRUE(run.rig.send(&m, sizeof m, run.to));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    sockaddr_in from{};
+    long n;
+    while ((n = run.rig.receive(buf, sizeof buf, &from)) >= 0) {
+      csim_udp_end e;
+      udp::Reject why;
+      std::string reason;
+      if (udp::kind_of(buf, static_cast<std::size_t>(n)) == CSIM_UDP_KIND_END &&
+          udp::decode_end(buf, static_cast<std::size_t>(n), e, why, reason))
+        reasons.push_back(e.reason);
+    }
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // (the loop goes on: a restart would show)
+  run.stop();
+  ASSERT_FALSE(reasons.empty()) << "no end packet within 60 s\n" << run.log;
+  EXPECT_EQ(reasons.front(), CSIM_UDP_END_DEWIRED);
+  EXPECT_STREQ(udp::end_reason_name(CSIM_UDP_END_DEWIRED), "the pass stopped at a dewirement");
+  EXPECT_TRUE(loop.dewired());
+  EXPECT_FALSE(loop.diverged());
+  EXPECT_EQ(loop.mode(), Mode::kEnded);
+  EXPECT_EQ(loop.pass_count(), 0u) << "the pass started again";
+  EXPECT_NE(run.log.find("dewirement of pantograph leading at"), std::string::npos) << run.log;
+  EXPECT_EQ(run.log.find("finished"), std::string::npos) << run.log;
+  State end_state;
+  const std::unique_ptr<PassRecorder> rec = run.skin.take_finished(&end_state);
+  ASSERT_TRUE(rec);
+  EXPECT_EQ(end_state.status, StepStatus::kDewired);
+  std::string why;
+  const std::string text = pass_stats_json(loop.model(), end_state, rec->statistics(loop.model()), RunInfo{}, &why);
+  EXPECT_TRUE(text.empty()) << text;
+  EXPECT_NE(why.find("dewirement before it crossed the analysis section"), std::string::npos) << why;
+}
+
+TEST(UdpLoop, TheEndPacketAfterTheLoopReturnedCarriesTheStepAtTheEnd) {
+  // With at_end exit (catenary_sim_hil_udp's default) the loop returns at the end of the pass and
+  // the end packet is sent after it (finish()): its step is the last contact point's, as the
+  // packet's description says, not 0.
+  LoopOptions lo;
+  lo.rate = 1000.0;
+  lo.timeout = 5.0;
+  lo.at_end = EndAction::kExit;
+  lo.who = "test_udp_loop";
+  RunningUdpLoop run(lo, dewiring_scene());
+  std::uint64_t last_step = 0;
+  alignas(8) std::uint8_t buf[2048];
+  auto drain = [&](std::vector<csim_udp_end>& ends) {
+    sockaddr_in from{};
+    long n;
+    while ((n = run.rig.receive(buf, sizeof buf, &from)) >= 0) {
+      const std::size_t size = static_cast<std::size_t>(n);
+      udp::Reject why;
+      std::string reason;
+      csim_udp_contact_point p;
+      csim_udp_end e;
+      if (udp::kind_of(buf, size) == CSIM_UDP_KIND_END && udp::decode_end(buf, size, e, why, reason)) ends.push_back(e);
+      else if (udp::decode_contact_point(buf, size, p, why, reason)) last_step = p.step;
+    }
+  };
+  std::vector<csim_udp_end> ends;
+  const double deadline = steady_now() + 60.0;  // (as above: the end comes within 0.2 s of simulation)
+  for (std::uint32_t seq = 1; run.loop.mode() != Mode::kEnded && steady_now() < deadline; ++seq) {
+    const csim_udp_measurement m = measurement(seq, 100.0);
+    ASSERT_TRUE(run.rig.send(&m, sizeof m, run.to));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    drain(ends);
+  }
+  run.stop();  // (the loop has returned: exit)
+  ASSERT_EQ(run.loop.mode(), Mode::kEnded);
+  drain(ends);
+  EXPECT_TRUE(ends.empty()) << "an end packet before the loop returned";
+  run.skin.finish();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  drain(ends);
+  ASSERT_EQ(ends.size(), 3u);  // (three copies)
+  ASSERT_GT(last_step, 0u);
+  for (const csim_udp_end& e : ends) {
+    EXPECT_EQ(e.step, last_step);
+    EXPECT_EQ(e.reason, CSIM_UDP_END_DEWIRED);
+  }
 }

@@ -193,6 +193,36 @@ TEST(HilParams, SpinWaitPriorityAndShapeParametersAreChecked) {
   EXPECT_NE(message(q).find("~shape_resolution = -1 rejected"), std::string::npos) << message(q);
 }
 
+// ~hil/hold_deceleration: every value the parameter check lets through, the loop takes, and every
+// value the loop would refuse is refused at start-up naming the parameter (the two ranges are one).
+TEST(HilParams, HoldDecelerationIsCheckedToTheRangeTheLoopTakes) {
+  HilParams p;
+  p.scene = "x.yaml";
+  const Scene scene = load_scene_file(test_scenes::kReferenceHil);
+  for (double a : {0.0, 2.5, 20.0, 20.5, 30.0, 50.0, -1.0}) {
+    HilParams q = p;
+    q.hold_deceleration = a;
+    bool params_take = true;
+    try {
+      validate_hil_params(q);
+    } catch (const ParamError& e) {
+      params_take = false;
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("~hil/hold_deceleration = " + format_given(a)), std::string::npos) << msg;
+      EXPECT_NE(msg.find("allowed [0, 20] m/s^2"), std::string::npos) << msg;
+    }
+    bool loop_takes = true;
+    hil::LoopOptions o = loop_options(q);
+    try {
+      hil::HilLoop loop(scene, o);
+    } catch (const hil::HilError& e) {
+      loop_takes = false;
+      EXPECT_NE(std::string(e.what()).find("~hil/hold_deceleration"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(params_take, loop_takes) << "hold_deceleration " << a << " m/s^2";
+  }
+}
+
 TEST(HilScene, ReferenceHilIsTheReferenceSceneWithAnExternalPantograph) {
   YAML::Node hil = YAML::LoadFile(test_scenes::kReferenceHil);
   YAML::Node ref = YAML::LoadFile(test_scenes::kReference);

@@ -41,6 +41,7 @@ namespace {
 const std::string kNode = test_scenes::program("catenary_sim_node");
 const std::string kHilNode = test_scenes::program("catenary_sim_hil_node");
 const std::string kRig = test_scenes::program("virtual_rig");
+const std::string kHilUdpNode = test_scenes::program("catenary_sim_hil_udp_node");
 const std::string& kScene = test_scenes::kReference;
 const std::string& kHilScene = test_scenes::kReferenceHil;
 
@@ -467,4 +468,113 @@ TEST_F(NodeParamsFuzz, HilReportFileThatFailsAtExitFailsTheExitCode) {
   EXPECT_EQ(r.signal, 0);
   EXPECT_EQ(r.exit_code, 1) << r.out;
   EXPECT_NE(r.out.find("~hil/report_file: cannot write '" + out + "/report.json'"), std::string::npos) << r.out;
+}
+
+// catenary_sim_hil_udp_node names its own parameters in every error at start-up: the socket's
+// (~hil/udp_bind), the rig's (~hil/udp_rig, ~hil/udp_allow), the scene's (~scene), never the
+// command-line options of catenary_sim_hil_udp.
+TEST_F(NodeParamsFuzz, HilUdpNodeErrorsNameItsOwnParameters) {
+  auto expect_names = [](const ChildRun& r, const std::string& what, const std::string& name) {
+    SCOPED_TRACE(what + "\n  output: " + r.out);
+    EXPECT_FALSE(r.hung);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.out.find(name), std::string::npos) << "does not name " << name;
+    EXPECT_EQ(r.out.find(" --"), std::string::npos) << "names a command-line option";
+    EXPECT_EQ(r.out.find("~hil/udp_*"), std::string::npos);
+  };
+  expect_names(run(kHilUdpNode, {"_scene:=" + kHilScene, "_hil/udp_bind:=300.1.1.1"}), "bind", "~hil/udp_bind");
+  expect_names(run(kHilUdpNode, {"_scene:=" + kHilScene, "_hil/udp_rig:=10.0.0.3:47801", "_hil/udp_allow:=10.0.0.2"}),
+               "rig off the allow-list", "~hil/udp_allow");
+  // A scene whose frames do not fit a packet: five external pantographs (a packet carries four).
+  YAML::Node root = YAML::LoadFile(kHilScene);
+  YAML::Node first = YAML::Clone(root["pantographs"][0]);
+  root["pantographs"] = YAML::Node(YAML::NodeType::Sequence);
+  for (int i = 0; i < 5; ++i) {
+    YAML::Node p = YAML::Clone(first);
+    p["name"] = "p" + std::to_string(i);
+    p["position"] = 20.0 * i;
+    root["pantographs"].push_back(p);
+  }
+  const std::string five = dir_ + "/five_external.yaml";
+  std::ofstream(five) << YAML::Dump(root) << "\n";
+  const ChildRun r = run(kHilUdpNode, {"_scene:=" + five});
+  expect_names(r, "five external pantographs", "~scene = '" + five + "'");
+  EXPECT_NE(r.out.find("at most 4"), std::string::npos) << r.out;
+}
+
+// virtual_rig refuses at start-up a ~pantograph_scene without a lumped pantograph it can step
+// (over the topics it took it and died at the first contact point, the node waiting for ever),
+// and over UDP names its parameters, not udp_rig_client's options.
+TEST_F(NodeParamsFuzz, VirtualRigRefusesAPantographSceneWithoutLumpedPantographsAtStartUp) {
+  for (const std::string transport : {"topics", "udp"}) {
+    const ChildRun r = run(kRig, {"_pantograph_scene:=" + kHilScene, "_transport:=" + transport}, 10.0);
+    SCOPED_TRACE(transport + "\n  output: " + r.out);
+    EXPECT_FALSE(r.hung) << "accepted at start-up";
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.out.find("~pantograph_scene = '" + kHilScene + "': no lumped pantograph"), std::string::npos);
+    EXPECT_EQ(r.out.find("--"), std::string::npos) << "names a command-line option";
+  }
+  const ChildRun r = run(kRig, {"_pantograph_scene:=" + kScene, "_transport:=udp", "_simulator:=abc:47800"}, 10.0);
+  SCOPED_TRACE("output: " + r.out);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("~simulator"), std::string::npos);
+  EXPECT_EQ(r.out.find("--"), std::string::npos) << "names a command-line option";
+}
+
+// virtual_rig over UDP writes ~report_file at exit as over the topics (here stopped by SIGINT
+// before any simulator answered: no measurement sent).
+TEST_F(NodeParamsFuzz, VirtualRigOverUdpWritesItsReportFile) {
+  const std::string out = dir_ + "/rig_udp";
+  mkdir(out.c_str(), 0755);
+  const std::string report = out + "/report.json", log = dir_ + "/rig_udp.log";
+  Child c({kRig, "__name:=rig_udp", "_pantograph_scene:=" + kScene, "_transport:=udp",
+           "_simulator:=127.0.0.1:" + std::to_string(free_port()), "_report_file:=" + report},
+          log, env_);
+  ASSERT_TRUE(c.started());
+  bool up = false;
+  for (int i = 0; i < 600 && !up; ++i) {
+    up = slurp(log).find("over UDP to") != std::string::npos;
+    if (!up) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_TRUE(up) << slurp(log);
+  kill(c.pid(), SIGINT);
+  const ChildRun r = c.wait(30.0);
+  EXPECT_FALSE(r.hung);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  ASSERT_TRUE(exists(report)) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(j.at("measurements").get<int>(), 0);
+  EXPECT_TRUE(j.contains("round_trip"));
+}
+
+// catenary_sim_hil_udp_node writes ~stats_file at the end of each pass and logs its statistics,
+// as catenary_sim_hil_node does (with at_end loop the file is there while the node runs on).
+TEST_F(NodeParamsFuzz, HilUdpNodeWritesTheStatisticsAtTheEndOfEachPass) {
+  const std::string out = dir_ + "/udp_stats";
+  mkdir(out.c_str(), 0755);
+  const std::string stats = out + "/stats.json", log = dir_ + "/udp_stats.log";
+  const std::string port = std::to_string(free_port());
+  Child node({kHilUdpNode, "__name:=udp_stats", "_scene:=" + kHilScene, "_at_end:=loop", "_stats_file:=" + stats,
+              "_hil/timeout:=1.0", "_hil/udp_bind:=127.0.0.1", "_hil/udp_port:=" + port},
+             log, env_);
+  Child rig({kRig, "__name:=udp_stats_rig", "_pantograph_scene:=" + kScene, "_transport:=udp",
+             "_simulator:=127.0.0.1:" + port},
+            dir_ + "/udp_stats_rig.log", env_);
+  ASSERT_TRUE(node.started());
+  ASSERT_TRUE(rig.started());
+  // The reference pass is 6.6 s of simulation; 120 s of wall clock covers a loaded machine.
+  bool written = false;
+  for (int i = 0; i < 1200 && !written; ++i) {
+    written = exists(stats);
+    if (!written) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const std::string text = slurp(log);
+  kill(rig.pid(), SIGINT);
+  kill(node.pid(), SIGINT);
+  rig.wait(30.0);
+  const ChildRun r = node.wait(30.0);
+  ASSERT_TRUE(written) << "no ~stats_file while the node runs\n" << r.out;
+  EXPECT_NE(text.find("catenary_sim_hil_udp: leading: mean"), std::string::npos) << text;
+  const nlohmann::json j = nlohmann::json::parse(slurp(stats));
+  EXPECT_TRUE(j.at("pantographs").at(0).at("mean_force_N").is_number()) << j.dump();
 }

@@ -40,11 +40,14 @@ class Simulation {
   // collector cannot pull); NaN, inf and values outside [kMinExternalForce, kMaxExternalForce] are
   // rejected and leave the state unchanged.
   bool set_external_force(int pantograph, double force_n, std::string* error);
+  // set_external_force's check of a value alone: empty when allowed, else its error.
+  static std::string external_force_error(double force_n);
 
   static constexpr double kMinExternalForce = -50.0;  // N
   static constexpr double kMaxExternalForce = 2000.0; // N
   static constexpr double kMaxSpeed = kMaxTrainSpeed;  // m/s, the ceiling; below it train_speed_limit (scene.hpp)
   static constexpr double kMaxUplift = 1000.0;  // N
+  static constexpr double kMaxAcceleration = 20.0;  // m/s^2, set_max_acceleration's ceiling (about 2 g)
 
   // A dt above this share of the stability estimate is what a divergence message blames first.
   static constexpr double kStepNearEstimate = 0.95;

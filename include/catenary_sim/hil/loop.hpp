@@ -59,6 +59,9 @@ struct LoopOptions {
   // answer to the state at the time it is applied. 0: the state as it is.
   double delay_compensation = 0.0;
   std::string who = "catenary_sim_hil";    // prefix of the log lines
+  // Errors name the options as the command line spells them (--hold-deceleration) instead of as
+  // the ROS parameters (~hil/hold_deceleration).
+  bool command_line = false;
   std::string input = "hil/contact_force"; // how the measurement input is named in messages
 };
 
@@ -131,6 +134,9 @@ class HilLoop {
   // rejected one changes nothing and is counted. False when rejected.
   bool accept(const double* force, std::size_t n, double arrival, double measured, std::uint64_t step,
               const char* field, bool indexed);
+  // Why accept() would reject these forces (empty: it would not); changes nothing. A transport
+  // that must know before it takes a packet's sequence number asks this first.
+  std::string measurement_error(const double* force, std::size_t n, const char* field, bool indexed) const;
   // A measurement the transport already refused (bad packet or message): counted and logged.
   void reject(const std::string& what);
   // A fresh measurement may start the period.
@@ -154,6 +160,8 @@ class HilLoop {
   bool stopping() const { return stopping_; }
   bool recovering() const { return recovering_; }
   bool diverged() const { return diverged_; }
+  // The pass stopped at a dewirement (the scene's pantograph_head.on_dewirement: stop).
+  bool dewired() const { return dewired_; }
   std::uint32_t pass_count() const { return pass_count_; }
   double commanded_speed() const { return commanded_speed_; }
   double age(double now) const { return hold_.has_value() ? hold_.age(now) : -1.0; }
@@ -220,7 +228,7 @@ class HilLoop {
   std::uint64_t step_in_effect_ = 0;
   double hold_start_time_ = 0.0;
   std::vector<double> hold_from_;
-  bool diverged_ = false, exit_requested_ = false;
+  bool diverged_ = false, dewired_ = false, exit_requested_ = false;
   int exit_code_ = 0;
   std::uint32_t pass_count_ = 0;
   double started_ = 0.0;

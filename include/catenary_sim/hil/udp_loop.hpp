@@ -101,11 +101,13 @@ struct UdpLoopOptions {
   int rig_port = 0;
   std::vector<AllowedSender> allow;  // empty: any sender may become the rig
   bool same_clock = false;  // the rig's send_time_ns is on this machine's CLOCK_MONOTONIC: transport measured
+  // How errors name the options: the command line's by default (a ROS node gives its parameters).
+  std::string bind_name = "--bind/--port", rig_name = "--rig", allow_name = "--allow", scene_name = "--scene";
 };
 
 class UdpLoopSkin : public LoopSkin {
  public:
-  // Opens the socket (HilError naming --port/--bind/--rig on failure) and checks that the scene's
+  // Opens the socket (HilError naming the option of UdpLoopOptions on failure) and checks that the scene's
   // frames fit the packets. `running`: an extra condition (e.g. ros::ok); `log_sink` receives
   // the loop's lines (stderr by default).
   UdpLoopSkin(HilLoop& loop, const UdpLoopOptions& o, MonitorRing* monitor = nullptr);
@@ -121,7 +123,16 @@ class UdpLoopSkin : public LoopSkin {
   void receive(double until) override;
   void send(const PointFrame& frame) override;
   void log(LogLevel level, const std::string& text) override;
+  // A pass has ended (loop thread): to `on_pass_ended` when set (it must not block the loop for
+  // long), else kept for take_finished().
+  void set_on_pass_ended(std::function<void(std::unique_ptr<PassRecorder>, const State&)> f) {
+    on_pass_ended_ = std::move(f);
+  }
   void pass_ended(std::unique_ptr<PassRecorder> recorder, const State& state) override {
+    if (on_pass_ended_) {
+      on_pass_ended_(std::move(recorder), state);
+      return;
+    }
     finished_ = std::move(recorder);
     finished_state_ = state;
   }
@@ -159,6 +170,8 @@ class UdpLoopSkin : public LoopSkin {
   void hand_to_loop(const csim_udp_measurement& m, double arrival);
   bool allowed(const sockaddr_in& from) const;
   void send_end(std::uint32_t reason, const PointFrame* f);
+  // Why the pass that ended did (CSIM_UDP_END_FINISHED, _DIVERGED or _DEWIRED).
+  std::uint32_t end_reason() const;
   // At most once per second per `slot`: true when the line may be logged now.
   bool throttle(int slot);
   void say(LogLevel level, const std::string& text) { log(level, loop_.options().who + ": " + text); }
@@ -179,6 +192,7 @@ class UdpLoopSkin : public LoopSkin {
   std::atomic<bool> stop_{false};
   std::function<bool()> running_fn_;
   std::function<void(LogLevel, const std::string&)> log_sink_;
+  std::function<void(std::unique_ptr<PassRecorder>, const State&)> on_pass_ended_;
   udp::SequenceTracker tracker_;
   std::array<std::uint64_t, static_cast<int>(udp::Reject::kNumReasons)> rejected_{};
   std::uint64_t sent_ = 0, send_errors_ = 0, unusable_ = 0;
@@ -207,6 +221,9 @@ struct UdpRigOptions {
   double contact_timeout = 2.0;
   // s to wait for the first contact point (hellos every 50 ms meanwhile); 0: for ever.
   double connect_timeout = 30.0;
+  // How errors name the options: the command line's by default (a ROS node gives its parameters).
+  std::string bind_name = "--bind/--port", simulator_name = "--simulator", scene_name = "--pantograph-scene",
+              rate_name = "--rate";
 };
 
 // How UdpVirtualRig::run ended.

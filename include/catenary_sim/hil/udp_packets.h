@@ -62,7 +62,7 @@
 #define CSIM_UDP_MODE_WAITING 0u   /* no measurement yet: the line holds its initial static state */
 #define CSIM_UDP_MODE_RUNNING 1u   /* stepping with the rig's measurements */
 #define CSIM_UDP_MODE_SAFE_HOLD 2u /* no valid measurement for the timeout: train stops, force ramps */
-#define CSIM_UDP_MODE_ENDED 3u     /* the pass ended (or diverged): the last state, held */
+#define CSIM_UDP_MODE_ENDED 3u     /* the pass ended (or diverged, or stopped at a dewirement): the last state, held */
 #define CSIM_UDP_MODE_PAUSED 4u    /* held: no steps; velocities 0 */
 #define CSIM_UDP_FLAG_HELD 0x100u       /* this period ran without a fresh measurement (held/extrapolated) */
 #define CSIM_UDP_FLAG_OVERRUN 0x200u    /* the loop has fallen behind since the last packet (periods dropped) */
@@ -72,6 +72,7 @@
 #define CSIM_UDP_END_FINISHED 1u /* the pass ended (the end of the line, or ~stop once the line settled) */
 #define CSIM_UDP_END_DIVERGED 2u /* the simulation diverged: the pass ended */
 #define CSIM_UDP_END_SHUTDOWN 3u /* the simulator stops before the pass ended (a signal, --duration) */
+#define CSIM_UDP_END_DEWIRED 4u  /* the pass stopped at a dewirement (the scene's pantograph_head.on_dewirement: stop) */
 
 #pragma pack(push, 1)
 

@@ -45,7 +45,8 @@ bool decode_contact_point(const void* data, std::size_t size, csim_udp_contact_p
 bool decode_end(const void* data, std::size_t size, csim_udp_end& out, Reject& why, std::string& reason);
 // The kind of a datagram that carries a header (0: too short for one).
 std::uint16_t kind_of(const void* data, std::size_t size);
-// "the pass ended", "the simulation diverged", "the simulator stopped" for CSIM_UDP_END_*.
+// "the pass ended", "the simulation diverged", "the simulator stopped", "the pass stopped at a
+// dewirement" for CSIM_UDP_END_*.
 const char* end_reason_name(std::uint32_t reason);
 
 // The contact point packet of a loop frame. Fails (false, `reason`) when the frame does not fit
@@ -77,6 +78,10 @@ class SequenceTracker {
     return any_ && static_cast<std::int32_t>(sequence - newest_) <= 0;
   }
   static bool usable(Verdict v) { return v != Verdict::kReordered && v != Verdict::kDuplicate; }
+  // A packet of the sender that was rejected (it did not decode, or its values were refused): its
+  // number is not taken (it may be garbage), but the next gap is not counted lost for it (it came,
+  // and is counted as rejected).
+  void rejected() { ++rejected_since_; }
   std::uint64_t received() const { return received_; }
   std::uint64_t lost() const { return lost_; }          // skipped and not arrived since (within 64)
   std::uint64_t reordered() const { return reordered_; }  // arrived after a newer one
@@ -91,6 +96,7 @@ class SequenceTracker {
   std::uint64_t seen_ = 0;  // bit i: newest_ - i arrived
   int run_ = 0;               // consecutive numbers older than newest_, ending at run_next_ - 1
   std::uint32_t run_next_ = 0;
+  std::uint64_t rejected_since_ = 0;  // rejected packets since the newest taken
   std::uint64_t received_ = 0, lost_ = 0, reordered_ = 0, duplicates_ = 0, restarts_ = 0;
 };
 

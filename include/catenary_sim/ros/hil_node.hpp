@@ -149,7 +149,7 @@ class HilNode : public hil::LoopSkin {
     double age = -1.0, age_in_effect = -1.0;
     double latency[3] = {0, 0, 0};
     hil::JitterSummary jitter;
-    bool diverged = false, armed = true, stopping = false, recovering = false;
+    bool diverged = false, dewired = false, armed = true, stopping = false, recovering = false;
     std::uint32_t pass_count = 0;
     double commanded_speed = 0.0;
   };

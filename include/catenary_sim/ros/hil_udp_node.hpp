@@ -4,7 +4,9 @@
 // lock-free single-producer/single-consumer ring (hil::MonitorRing) that a publisher thread
 // drains into hil/contact_point and /diagnostics, so that publishing never blocks the loop (a
 // full ring drops and counts: `monitor dropped` in the diagnostics and the report). Services
-// ~arm, ~set_paused, ~reset, ~stop and cmd/train_speed as the TCPROS node's. Parameters: those of
+// ~arm, ~set_paused, ~reset, ~stop and cmd/train_speed as the TCPROS node's; each pass's
+// statistics logged and written to ~stats_file at its end by the publisher thread, as the TCPROS
+// node's worker does. Parameters: those of
 // catenary_sim_hil_node plus ~hil/udp_bind, ~hil/udp_port, ~hil/udp_rig (docs/hil.md, "UDP").
 #pragma once
 
@@ -17,6 +19,7 @@
 
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <thread>
 
 #include "catenary_sim/hil/loop.hpp"
@@ -35,6 +38,9 @@ class HilUdpNode {
 
  private:
   void publisher();
+  // The statistics of a pass that ended: logged and written to ~stats_file (publisher thread,
+  // then at exit for the last one), as catenary_sim_hil_node's worker does.
+  void report_finished_pass();
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   std::pair<bool, std::string> ask(hil::Request r, const char* service);
 
@@ -50,6 +56,12 @@ class HilUdpNode {
   ros::Publisher point_pub_;
   diagnostic_updater::Updater updater_;
   hil::MonitorSample last_{};
+  // A pass that ended, handed over by the loop thread.
+  std::mutex pass_mu_;
+  std::unique_ptr<PassRecorder> pass_recorder_;
+  State pass_state_;
+  std::int64_t pass_overruns_ = 0;
+  std::atomic<bool> stats_failed_{false};
   std::uint64_t published_ = 0;
   // Control.
   ros::CallbackQueue ctrl_queue_;

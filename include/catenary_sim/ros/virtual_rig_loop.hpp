@@ -38,8 +38,9 @@ class VirtualRig {
  public:
   // Reads the parameters and loads the scene; throws ParamError naming the parameter.
   VirtualRig(ros::NodeHandle nh, ros::NodeHandle pnh);
-  // Runs the rig's loop until shutdown or stop(); prints (and writes) the report. Returns 0, or 1
-  // when ~report_file could not be written.
+  // Runs the rig's loop until shutdown or stop(); prints (and writes) the report. Returns 0, 1
+  // when ~report_file could not be written, or 2 when ~pantograph_scene cannot serve the
+  // simulator's pantographs.
   int run();
   void stop() { stop_ = true; }
 
@@ -59,6 +60,10 @@ class VirtualRig {
   std::string transport_ = "topics";
   std::string simulator_ = "127.0.0.1:47800";
   int run_udp();
+  // ~report_file (none: true); false when it could not be written.
+  bool write_report(std::uint64_t sent, std::uint64_t missed, double wall, const LatencyHistogram& round_trip);
+  std::string scene_name_;  // "parameter ~pantograph_scene = '<file>'" in messages
+  bool failed_ = false;     // stopped because it cannot serve the simulator's pantographs
   std::string frame_;  // frame_id of the last contact point, sent back with the measurements
   hil::RigStepper stepper_;  // the pantographs and their stepping (shared with the UDP rig)
   bool have_ = false;
