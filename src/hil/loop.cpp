@@ -30,7 +30,7 @@ constexpr double kSettledMotion = 2e-3;  // m/s
 constexpr double kSettleMax = 5.0;       // s (simulation)
 
 // Throttle slots of the log lines.
-enum Slot { kSlotOverrun, kSlotCompute, kSlotReject, kSlotNonFinite };
+enum Slot { kSlotOverrun, kSlotCompute, kSlotReject, kSlotNonFinite, kSlotStamps };
 
 std::string printf_text(const char* f, ...) __attribute__((format(printf, 1, 2)));
 std::string printf_text(const char* f, ...) {
@@ -287,6 +287,10 @@ bool HilLoop::accept(const double* force, std::size_t n_given, double arrival, d
   for (std::size_t i = 0; i < n; ++i) accept_buf_[i] = sim_->state().external_force[external_[i]];
   if (unused_) ++c_.superseded;
   hold_.accept(accept_buf_, arrival, measured, step);
+  if (opt_.extrapolate && hold_.stamps_implausible() && throttle(kSlotStamps, 10.0))
+    log(LogLevel::kWarn, "the measurements' own stamps do not advance with their arrivals (less than half or more than "
+                         "twice as fast): the extrapolation holds the newest measurement instead; check the rig's "
+                         "clock and its unit (nanoseconds)");
   unused_ = true;
   ++c_.accepted;
   // Which period it starts. An answer to the last contact point sent starts the next period (a

@@ -261,6 +261,32 @@ TEST(MeasurementHold, HoldsTheNewestAndExtrapolatesOnlyWhenAskedAndWithinTheHori
   EXPECT_DOUBLE_EQ(h.value(0, 10.003, true, 1.0), 120.0);  // stamped after unstamped: two clocks, held
   h.accept({130.0}, 10.0030, 50.004, 13);                   // 5 N per ms by the stamps
   EXPECT_NEAR(h.value(0, 10.0040, true, 1.0), 135.0, 1e-6);
+  EXPECT_FALSE(h.stamps_implausible());
+}
+
+// A rig whose stamps run a thousandfold slow (microseconds sent as nanoseconds) made the slope a
+// thousandfold steep: +-1 N of noise swung the applied force between 0 and 2000 N. Over a
+// baseline of arrivals long enough to average their jitter, stamps that do not run with them are
+// held, not extrapolated; stamps that do (a rig at 1 kHz with 0.3 ms of jitter) extrapolate.
+TEST(MeasurementHold, HoldsWhereTheStampsDoNotRunWithTheArrivals) {
+  for (const double stamp_scale : {1.0, 1e-3, 1e3}) {
+    SCOPED_TRACE(stamp_scale);
+    MeasurementHold h(1);
+    double force = 100.0, arrival = 0.0;
+    for (int k = 0; k < 30; ++k) {
+      arrival = 1.0 + 1e-3 * k + (k % 2 ? 3e-4 : 0.0);  // 1 kHz, alternate packets late
+      force = k % 2 ? 101.0 : 99.0;                     // +-1 N of noise
+      h.accept({force}, arrival, 5.0 + stamp_scale * 1e-3 * k, static_cast<std::uint64_t>(k));
+    }
+    const double held = h.value(0, arrival + 1e-3, true, 1e-3);
+    if (stamp_scale == 1.0) {
+      EXPECT_FALSE(h.stamps_implausible());
+      EXPECT_NEAR(held, force + 2.0, 1e-6);  // the true slope, 2 N per ms, for the 1 ms ahead
+    } else {
+      EXPECT_TRUE(h.stamps_implausible());
+      EXPECT_DOUBLE_EQ(held, force);
+    }
+  }
 }
 
 TEST(HoldRamp, LinearFromTheLastForceToTheStaticOne) {

@@ -27,12 +27,19 @@ class MeasurementHold {
   // Force (N) for pantograph i at time t: the newest value, or with `extrapolate` the line through
   // the last two measurements continued to t, at most `horizon` s past the newest arrival (the
   // newest value when there is no earlier one or their times do not increase).
+  // Stamps whose clock does not run with the arrivals' (a unit slip: microseconds given as
+  // nanoseconds) give slopes a thousandfold off: held instead (stamps_implausible()).
   double value(std::size_t i, double t, bool extrapolate, double horizon) const;
+  // The stamped measurements' stamps advanced less than half or more than twice as fast as their
+  // arrivals over at least kStampBaseline s since the first (or since the stamps went back).
+  bool stamps_implausible() const { return implausible_; }
+  static constexpr double kStampBaseline = 0.01;  // s: long enough to average the transport's jitter
 
  private:
   std::vector<double> force_, previous_;
   double arrival_ = 0.0, time_ = 0.0, previous_time_ = 0.0;
-  bool stamped_ = false, previous_stamped_ = false;
+  double base_time_ = 0.0, base_arrival_ = 0.0;  // the stamped run's first measurement
+  bool stamped_ = false, previous_stamped_ = false, implausible_ = false;
   std::uint64_t count_ = 0, step_ = 0;
 };
 
