@@ -455,7 +455,7 @@ TEST(HingedSteadyArms, BadInputIsRefusedByName) {
   test_scenes::expect_refused(base + "steady_arms: {" + arm + ", pull_off: 0}\n", "steady_arms.pull_off");
   test_scenes::expect_refused(base + "steady_arms: {" + arm + ", pull_off: -480}\n", "steady_arms.pull_off");
   test_scenes::expect_refused(base + "steady_arms: {length: 0, linear_mass: 0.78, pull_off: 480}\n", "steady_arms.length");
-  // (An arm of 1e-310 m made k_A infinite and the pass NaN, blamed on dt.)
+  // (An arm of 1e-310 m would make k_A infinite and the pass NaN.)
   for (const char* tiny : {"1e-310", "0.099"})
     test_scenes::expect_refused(base + "steady_arms: {length: " + tiny + ", linear_mass: 0, pull_off: 1e5}\n", "steady_arms.length");
   EXPECT_EQ(test_scenes::refusal_of_yaml(base + "steady_arms: {length: 0.1, linear_mass: 0.78, pull_off: 480}\n"), "");

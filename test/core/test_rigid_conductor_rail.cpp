@@ -188,14 +188,14 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
   negative.replace(negative.find("lateral_bending_stiffness: 100000"), 33, "lateral_bending_stiffness: -1");
   refused(negative, "conductor_rail.lateral_bending_stiffness");
   refused(rail_yaml(3, 5e6, 0.25, "", 1e5), "conductor_rail.lateral_bending_stiffness");  // a 2-D line
-  // Across the track the same bound under the mean wind's drag q = 0.5 rho Cd h V^2 (it went NaN):
+  // Across the track the same bound under the mean wind's drag q = 0.5 rho Cd h V^2 (a softer profile goes NaN):
   // at 10 m/s on the 0.11 m profile (Cd 2) q = 13.5 N/m, so at least 250 q L^3 / 384 = 8773 N m^2.
   const std::string windy = rail_yaml(3, 5e6, 0.25, stagger + "wind: {speed: 10}\n", 1.0);
   const std::string blown = test_scenes::refusal_of_yaml(windy);
   for (const char* word : {"conductor_rail.lateral_bending_stiffness", "at least 8772", "mean wind"})
     EXPECT_NE(blown.find(word), std::string::npos) << blown;
   EXPECT_EQ(test_scenes::refusal_of_yaml(rail_yaml(3, 5e6, 0.25, stagger + "wind: {speed: 10}\n", 8800.0)), "");
-  // A span no allowed profile can take is the span's to shorten (it asked for EI above the limit).
+  // A span no allowed profile can take is the span's to shorten (the EI it would need is beyond the field's limit).
   std::string long_span = rail_yaml(3, 5e6, 0.25);
   long_span.replace(long_span.find("span_length: 10\n"), 16, "span_length: 500\n");
   refused(long_span, "line.spans");

@@ -89,7 +89,7 @@ TEST(SceneErrors, NotANumber) {
   EXPECT_MENTIONS(error_of({"contact_wire.tension='2e4 '"}), "contact_wire.tension", "'2e4 '", "without quotes");
   EXPECT_MENTIONS(error_of({"droppers.positions=[4.5, '10.25']"}), "droppers.positions[1]", "in quotes");
   EXPECT_EQ(error_of({"contact_wire.tension=20000"}), "");
-  // A tag says what a scalar is: !!str makes text of it (it was read as the number), YAML's
+  // A tag says what a scalar is: !!str makes text of it (not the number it spells), YAML's
   // number tags leave it a number.
   EXPECT_MENTIONS(error_of({"contact_wire.tension=!!str 20000"}), "contact_wire.tension", "tagged", "written plain");
   EXPECT_MENTIONS(error_of({"contact_wire.tension=!tension 20000"}), "contact_wire.tension", "tagged");
@@ -471,9 +471,9 @@ TEST(SceneErrors, DesignStaticsRefusalsNameTheKindsFields) {
   const std::string stitched = test_scenes::scene_path("reference_55m_stitched.yaml");
   EXPECT_MENTIONS(test_scenes::refusal_of(stitched, {"stitch_wire.tension=1"}), "stitch_wire.tension 1 N", "raise it");
   EXPECT_MENTIONS(test_scenes::refusal_of(stitched, {"stitch_wire.tension=1e5"}), "lower stitch_wire.tension");
-  // A dropper of 5 mm is refused as too short for its fittings (it read as hanging below), and a
-  // drawn dropper error too long for a hanger names the spread that drew it (it named a list of
-  // errors that was not given, and called the hanger a dropper).
+  // A dropper of 5 mm is refused as too short for its fittings (not as hanging below), and a
+  // drawn dropper error too long for a hanger names the spread that drew it and the hanger (not a
+  // list of errors the scene does not give).
   EXPECT_MENTIONS(test_scenes::refusal_of(compound, {"auxiliary_messenger.height=1.3"}), "'line.encumbrance'", "hangs only",
                   "shorter than 0.01 m");
   EXPECT_MENTIONS(test_scenes::refusal_of(compound, {"imperfections.dropper_length_std=0.05"}),
@@ -485,9 +485,9 @@ TEST(SceneErrors, DesignStaticsRefusalsNameTheKindsFields) {
 
 // Two stations of a wire (supports, droppers, hangers, the clamps of stitch wires and bridles)
 // closer than a dropper's or a clamp's fitting, 1 cm, are refused by the field that put the one
-// beside the support or the other station there. A stitch wire or bridle of 10 um aborted the
-// pass (a contact patch sized for its 5 um elements overflowed the statics' reservation), and a
-// hanger 1 mm from its support was blamed on the auxiliary's tension. At 2 cm (clamps 1 cm from
+// beside the support or the other station there. A stitch wire or bridle of 10 um would put 5 um
+// elements in the mesh (a contact patch sized for them overflows the statics' reservation), and a
+// hanger 1 mm from its support is no fault of the auxiliary's tension. At 2 cm (clamps 1 cm from
 // the support) the line is built; at the same station the two are one node.
 TEST(SceneErrors, StationsCloserThanAFittingAreRefusedByTheirField) {
   using test_scenes::refusal_of;

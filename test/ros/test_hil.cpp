@@ -264,8 +264,8 @@ TEST(MeasurementHold, HoldsTheNewestAndExtrapolatesOnlyWhenAskedAndWithinTheHori
   EXPECT_FALSE(h.stamps_implausible());
 }
 
-// A rig whose stamps run a thousandfold slow (microseconds sent as nanoseconds) made the slope a
-// thousandfold steep: +-1 N of noise swung the applied force between 0 and 2000 N. Over a
+// A rig whose stamps run a thousandfold slow (microseconds sent as nanoseconds) makes the slope a
+// thousandfold steep: +-1 N of noise would swing the applied force between 0 and 2000 N. Over a
 // baseline of arrivals long enough to average their jitter, stamps that do not run with them are
 // held, not extrapolated; stamps that do (a rig at 1 kHz with 0.3 ms of jitter) extrapolate.
 TEST(MeasurementHold, HoldsWhereTheStampsDoNotRunWithTheArrivals) {

@@ -335,7 +335,7 @@ void validate_rigid(const Scene& s) {
   // (simply supported, 5 q L^4 / (384 EI): the small deflections its beam theory needs; the shipped
   // profile sags a thousandth). A softer one hangs as no rail does and the static state runs away.
   // The same across the track under the mean wind's drag on the profile (the lateral plane's small
-  // deflections; a profile of EI 1 N m^2 blew out kilometres and went NaN).
+  // deflections; a profile of EI 1 N m^2 would blow out kilometres and go NaN).
   const double wind_q = s.wind && s.lateral()
                             ? 0.5 * s.wind->air_density * s.wind->conductor_rail.drag_coefficient *
                                   s.wind->conductor_rail.diameter * s.wind->speed * s.wind->speed
