@@ -22,8 +22,9 @@ A calibration file (YAML; paths relative to it):
 
 Every evaluation is catenary_sim.measurement.compare with the parameters as overrides, run on a
 Dask cluster (a local one of --workers processes by default) and written atomically to
-DIR/evaluations/ keyed by its parameter values, so that a calibration started again on the same DIR
-replays them and goes on where it stopped. Writes DIR/calibrated.yaml (the scene snippet),
+DIR/evaluations/ keyed by its parameter values and a digest of everything else that decides it
+(scene and record text, overrides, speed profile, cutoff, objective), so that the same calibration
+started again on the same DIR replays them and goes on where it stopped, and another one never does. Writes DIR/calibrated.yaml (the scene snippet),
 DIR/calibration.json (values, uncertainties, identifiability, residuals before and after) and
 DIR/before/ and DIR/after/ (compare_measurement's report at the initial and calibrated values).
 """
@@ -84,6 +85,7 @@ def load_calibration(path):
             _fail(k, doc[k], "not a field; allowed " + ", ".join(sorted(FIELDS)))
     base = os.path.dirname(os.path.abspath(path))
     out = dict(doc)
+    out["path"] = os.path.abspath(path)
     for k in ("scene", "record"):
         if not isinstance(doc.get(k), str):
             _fail(k, doc.get(k), "a file path (relative to the calibration file)")
@@ -210,8 +212,33 @@ def evaluate(cal, keys, values):
             "band_hz": min(c.settings["cutoff_hz"], c.record.bandwidth_hz)}
 
 
-def _key(values):
-    return hashlib.sha1(json.dumps([float("%.12g" % v) for v in values]).encode()).hexdigest()[:16]
+def _file_digest(path):
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def fingerprint(cal):
+    """A digest of everything besides the parameter values that decides an evaluation's residuals:
+    the scene's and the record's text (with the record's side metadata), the overrides, speed
+    profile, cutoff, objective and which scene fields the parameters are. Evaluations kept under
+    one fingerprint are never replayed for a calibration with another."""
+    side = cal["meta"]
+    if side is None:
+        stem = os.path.splitext(cal["record"])[0]
+        side = next((stem + e for e in (".yaml", ".yml") if os.path.isfile(stem + e)), None)
+    try:
+        files = {"scene": _file_digest(cal["scene"]), "record": _file_digest(cal["record"]),
+                 "meta": _file_digest(side) if side else None}
+    except OSError as e:
+        raise CalibrationError(f"calibration file {cal['path']!r}: {e}") from None
+    doc = {"files": files, "overrides": cal["overrides"], "speed_profile": cal["speed_profile"],
+           "cutoff": cal["cutoff"], "objective": cal["objective"],
+           "parameters": [p["key"] for p in cal["parameters"]]}
+    return hashlib.sha256(json.dumps(doc, sort_keys=True, default=repr).encode()).hexdigest()[:16]
+
+
+def _key(context, values):
+    return hashlib.sha1(json.dumps([context, [float("%.12g" % v) for v in values]]).encode()).hexdigest()[:16]
 
 
 def _write_atomically(path, text):
@@ -233,6 +260,7 @@ class _Evaluator:
         self.cal, self.client = cal, client
         self.keys = [p["key"] for p in cal["parameters"]]
         self.dir = os.path.join(out, "evaluations")
+        self.context = fingerprint(cal)
         os.makedirs(self.dir, exist_ok=True)
         self.count = self.replayed = 0
 
@@ -240,10 +268,12 @@ class _Evaluator:
         values = [to_values(self.cal["parameters"], u) for u in us]
         results, todo = [None] * len(values), []
         for i, v in enumerate(values):
-            path = os.path.join(self.dir, _key(v) + ".json")
+            path = os.path.join(self.dir, _key(self.context, v) + ".json")
+            done = None
             if os.path.isfile(path):
                 with open(path, encoding="utf-8") as f:
                     done = json.load(f)
+            if done is not None and done.get("context") == self.context:
                 results[i] = np.array(done["residuals"])
                 self.band_hz = done["band_hz"]
                 self.replayed += 1
@@ -252,8 +282,8 @@ class _Evaluator:
         futures = [self.client.submit(evaluate, self.cal, self.keys, values[i], pure=False) for i in todo]
         for i, fut in zip(todo, futures):
             r = fut.result()
-            _write_atomically(os.path.join(self.dir, _key(values[i]) + ".json"),
-                              json.dumps({"values": dict(zip(self.keys, values[i])), **r}))
+            _write_atomically(os.path.join(self.dir, _key(self.context, values[i]) + ".json"),
+                              json.dumps({"context": self.context, "values": dict(zip(self.keys, values[i])), **r}))
             results[i] = np.array(r["residuals"])
             self.band_hz = r["band_hz"]
         self.count += len(values)

@@ -93,3 +93,32 @@ def test_a_bad_calibration_file_is_refused_by_field(tmp_path, edit, words):
     with pytest.raises(calibration.CalibrationError) as e:
         calibration.load_calibration(str(path))
     assert f"'{words}'" in str(e.value)
+
+
+# A short, fast pass: a calibration of it takes seconds.
+FAST = {"numerics.preset": "fast", "line.span_count": 6}
+
+
+def _fast_calibration(tmp_path, name, beta, **fields):
+    """A calibration file of damping.beta against a record synthesised with `beta`."""
+    cm.synthesise_record(REFERENCE, str(tmp_path / f"{name}.csv"), overrides=dict(FAST, **{"damping.beta": beta}),
+                         speed_profile=270.0, noise_std_N=2.0, seed=1)
+    spec = {"scene": REFERENCE, "record": f"{name}.csv", "overrides": FAST,
+            "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3, "scale": "log", "initial": 1e-4}],
+            "optimiser": {"method": "least_squares", "max_evaluations": 6}}
+    spec.update(fields)
+    path = tmp_path / f"cal_{name}.yaml"  # not {name}.yaml: that is the record's metadata
+    path.write_text(yaml.safe_dump(spec))
+    return str(path)
+
+
+def test_a_directory_of_another_calibration_replays_none_of_its_evaluations(tmp_path):
+    a = _fast_calibration(tmp_path, "a", 3e-4)
+    b = _fast_calibration(tmp_path, "b", 6e-4)
+    calibration.calibrate(a, str(tmp_path / "shared"), workers=1, report=False)
+    # b run where a kept its evaluations gives exactly what b gives on its own: the passes are
+    # deterministic, so any replay of a's residuals would show as a difference.
+    shared = calibration.calibrate(b, str(tmp_path / "shared"), workers=1, report=False)
+    alone = calibration.calibrate(b, str(tmp_path / "alone"), workers=1, report=False)
+    assert [p["value"] for p in shared["parameters"]] == [p["value"] for p in alone["parameters"]]
+    assert shared["cost_before"] == alone["cost_before"]
