@@ -71,6 +71,24 @@ def _number(v, field, allowed, positive=False):
     return float(v)
 
 
+def _weight(w, field):
+    # A weight is a number as YAML reads it: text ("1e0", quoted or without a dot) is refused.
+    if isinstance(w, bool) or not isinstance(w, (int, float)) or not math.isfinite(w) or w < 0:
+        _fail(field, w, "a weight: a finite number >= 0, not text (YAML 1.1 reads 1e0 as text: write 1.0)")
+    return float(w)
+
+
+def measurable(cal, record):
+    """Refuses an objective that asks for a statistic the record cannot give: its residual would
+    never be formed (the head's without a head column, the steady arms' uplift without supports)."""
+    needs = {n: ("a head_PANTOGRAPH column", bool(record.head_m)) for n in cm.HEAD}
+    needs.update({n: ("supports with uplift_SUPPORT columns", bool(record.uplift_m)) for n in cm.UPLIFT})
+    for k, w in cal["objective"]["statistics"].items():
+        if w and k in needs and not needs[k][1]:
+            _fail(f"objective.statistics.{k}", w, f"a statistic the record has: it needs {needs[k][0]}, "
+                  f"which {cal['record']} has not")
+
+
 def load_calibration(path):
     """Reads and checks a calibration file; returns a dict with absolute paths."""
     try:
@@ -133,16 +151,16 @@ def load_calibration(path):
     stats = obj.get("statistics") or {}
     if not isinstance(stats, dict):
         _fail("objective.statistics", stats, "a map NAME: weight")
+    weights = {}
     for k, w in stats.items():
         if k not in cm.TOLERANCE_NAMES or k in cm.DIFFERENCES:
             _fail(f"objective.statistics.{k}", w, "a statistic: " + ", ".join(
                 n for n in cm.TOLERANCE_NAMES if n not in cm.DIFFERENCES))
-        _number(w, f"objective.statistics.{k}", "a weight >= 0")
-    for k in ("time_history", "spectrum"):
-        _number(obj.get(k, 0.0), f"objective.{k}", "a weight >= 0")
-    out["objective"] = {"statistics": stats, "time_history": float(obj.get("time_history", 0.0)),
-                        "spectrum": float(obj.get("spectrum", 0.0))}
-    if not stats and not out["objective"]["time_history"] and not out["objective"]["spectrum"]:
+        weights[k] = _weight(w, f"objective.statistics.{k}")
+    out["objective"] = {"statistics": weights,
+                        "time_history": _weight(obj.get("time_history", 0.0), "objective.time_history"),
+                        "spectrum": _weight(obj.get("spectrum", 0.0), "objective.spectrum")}
+    if not any(weights.values()) and not out["objective"]["time_history"] and not out["objective"]["spectrum"]:
         _fail("objective", obj, "at least one weight above 0")
     opt = doc.get("optimiser") or {}
     method = opt.get("method", "least_squares")
@@ -282,6 +300,11 @@ class _Evaluator:
         futures = [self.client.submit(evaluate, self.cal, self.keys, values[i], pure=False) for i in todo]
         for i, fut in zip(todo, futures):
             r = fut.result()
+            if not r["residuals"] or not np.all(np.isfinite(r["residuals"])):
+                raise CalibrationError(
+                    f"calibration {self.cal['path']}: objective = {self.cal['objective']!r} gives "
+                    f"{'no residuals' if not r['residuals'] else 'non-finite residuals'} at "
+                    f"{dict(zip(self.keys, values[i]))}; allowed an objective the record and the pass can measure")
             _write_atomically(os.path.join(self.dir, _key(self.context, values[i]) + ".json"),
                               json.dumps({"context": self.context, "values": dict(zip(self.keys, values[i])), **r}))
             results[i] = np.array(r["residuals"])
@@ -349,6 +372,7 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     params = cal["parameters"]
     # Checked here, before any cluster starts: the record, the scene, each parameter at its initial value.
     rec = cm.read_record(cal["record"], cal["meta"])
+    measurable(cal, rec)
     # The initial values (the range's middle unless given), just inside the bounds as the
     # trust-region method needs.
     u0 = np.array([to_unit([p], [p["initial"]])[0] if "initial" in p else 0.5 for p in params])
@@ -408,7 +432,7 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
                       "# calibrated against %s (rms residual %.4g, was %.4g)\n" % (
                           cal["record"], result["rms_residual_after"], result["rms_residual_before"])
                       + yaml.safe_dump(snippet, sort_keys=False))
-    _write_atomically(os.path.join(out, "calibration.json"), json.dumps(result, indent=2) + "\n")
+    _write_atomically(os.path.join(out, "calibration.json"), json.dumps(result, indent=2, allow_nan=False) + "\n")
     if report:
         for name, values in (("before", to_values(params, u0)), ("after", [p["value"] for p in table])):
             ov = dict(cal["overrides"])

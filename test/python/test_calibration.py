@@ -83,7 +83,11 @@ def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path)
     (lambda d: d.update(objective={"statistics": {"spread": 1}}), "objective.statistics.spread"),
     (lambda d: d.update(optimiser={"method": "simplex"}), "optimiser.method"),
     (lambda d: d.update(colour="red"), "colour"),
-], ids=["no parameters", "bounds reversed", "unknown scale", "unknown statistic", "unknown method", "unknown field"])
+    (lambda d: d.update(objective={"statistics": {"std_force_N": "1e0"}}), "objective.statistics.std_force_N"),
+    (lambda d: d.update(objective={"time_history": -1}), "objective.time_history"),
+    (lambda d: d.update(objective={"statistics": {"std_force_N": 0}, "time_history": 0}), "objective"),
+], ids=["no parameters", "bounds reversed", "unknown scale", "unknown statistic", "unknown method", "unknown field",
+        "weight as text", "negative weight", "all weights 0"])
 def test_a_bad_calibration_file_is_refused_by_field(tmp_path, edit, words):
     spec = {"scene": REFERENCE, "record": "rec.csv",
             "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3}]}
@@ -122,3 +126,17 @@ def test_a_directory_of_another_calibration_replays_none_of_its_evaluations(tmp_
     alone = calibration.calibrate(b, str(tmp_path / "alone"), workers=1, report=False)
     assert [p["value"] for p in shared["parameters"]] == [p["value"] for p in alone["parameters"]]
     assert shared["cost_before"] == alone["cost_before"]
+
+
+def test_an_objective_the_record_cannot_measure_is_refused_before_anything_runs(tmp_path):
+    cm.synthesise_record(REFERENCE, str(tmp_path / "bare.csv"), overrides=FAST, speed_profile=270.0, supports=None)
+    spec = {"scene": REFERENCE, "record": "bare.csv", "overrides": FAST,
+            "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3, "scale": "log"}],
+            "objective": {"statistics": {"max_uplift_m": 1}, "time_history": 0},
+            "optimiser": {"max_evaluations": 2}}
+    path = tmp_path / "cal.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    with pytest.raises(calibration.CalibrationError) as e:
+        calibration.calibrate(str(path), str(tmp_path / "out"), workers=1, report=False)
+    assert "'objective.statistics.max_uplift_m'" in str(e.value) and "uplift_SUPPORT" in str(e.value)
+    assert not (tmp_path / "out").exists()
