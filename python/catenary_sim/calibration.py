@@ -50,6 +50,11 @@ DIFF_STEP = 0.01
 # A direction of the parameters whose singular value is below this share of the largest changes the
 # residuals a thousand times less than the best-determined one: the record does not fix it.
 IDENTIFIABLE_SV = 1e-3
+# The residuals one difference step on the other side of the optimum may depart from the Jacobian's
+# straight line by this share of the step's change: a smooth objective departs by the curvature
+# over 1 % of the range (a few per cent); a rough one (a coarse preset, where the last bit of a
+# parameter moves the objective by tens of per cent) by about the whole change or more.
+LINEAR_RATIO = 0.5
 
 
 class CalibrationError(ValueError):
@@ -407,9 +412,24 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
                                     bounds=[(0.0, 1.0)] * len(u0), options={"maxfev": budget})
             u = np.clip(res.x, 0.0, 1.0)
         r, jac = ev.jacobian(u)
+        # The linear model checked on the other side of the optimum, one difference step away.
+        steps = [-DIFF_STEP if u[i] - DIFF_STEP >= 0.0 else 2 * DIFF_STEP for i in range(len(u))]
+        others = ev.many([u + np.eye(len(u))[i] * steps[i] for i in range(len(u))])
+        ratio = 0.0
+        for i, ri in enumerate(others):
+            change = np.linalg.norm(jac[:, i] * steps[i])
+            miss = np.linalg.norm(ri - (r + jac[:, i] * steps[i]))
+            ratio = max(ratio, miss / change if change > 0 else (0.0 if miss == 0 else math.inf))
         correlated = max(1.0, rec.sample_rate_hz / (2.0 * ev.band_hz)) if cal["objective"]["time_history"] else 1.0
         table, info = uncertainty(params, u, r, jac, correlated)
         info["residuals_per_independent_one"] = correlated
+        info["linearity_ratio"] = ratio if math.isfinite(ratio) else None
+        info["uncertainty_available"] = bool(ratio <= LINEAR_RATIO)
+        if not info["uncertainty_available"]:
+            for p in table:
+                p.update(std=None, identifiable=None,
+                         why_not="uncertainty not available: the objective is rough at the difference step "
+                                 "(a finer numerics.preset makes it smooth)")
         result = {"calibration": os.path.abspath(path), "method": cal["optimiser"]["method"],
                   "converged": bool(res.success), "message": str(res.message),
                   "evaluations": ev.count, "replayed": ev.replayed,
@@ -429,8 +449,9 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
             node = node.setdefault(part, {})
         node[parts[-1]] = float("%.6g" % p["value"])
     _write_atomically(os.path.join(out, "calibrated.yaml"),
-                      "# calibrated against %s (rms residual %.4g, was %.4g)\n" % (
-                          cal["record"], result["rms_residual_after"], result["rms_residual_before"])
+                      "# calibrated against %s (rms residual %.4g, was %.4g)%s\n" % (
+                          cal["record"], result["rms_residual_after"], result["rms_residual_before"],
+                          "" if result["converged"] else "; NOT CONVERGED: " + result["message"])
                       + yaml.safe_dump(snippet, sort_keys=False))
     _write_atomically(os.path.join(out, "calibration.json"), json.dumps(result, indent=2, allow_nan=False) + "\n")
     if report:
@@ -459,9 +480,18 @@ def main():
     except (CalibrationError, SceneError) as e:
         sys.stderr.write(f"calibrate: {e}\n")
         return 2
+    if not result["converged"]:
+        print("NOT CONVERGED: %s (the values below are where the optimiser stopped)" % result["message"])
+    if not result["uncertainty_available"]:
+        print("UNCERTAINTY NOT AVAILABLE: the objective is rough at the difference step (the other side of "
+              "the optimum departs from the linear model by %s of the change); use a finer numerics.preset" % (
+                  "%.2g" % result["linearity_ratio"] if result["linearity_ratio"] is not None else "all"))
     for p in result["parameters"]:
-        print("%-32s %.6g +- %.2g%s" % (p["key"], p["value"], p["std"],
-                                       "" if p["identifiable"] else "  NOT IDENTIFIABLE: " + p["why_not"]))
+        if p["std"] is None:
+            print("%-32s %.6g" % (p["key"], p["value"]))
+        else:
+            print("%-32s %.6g +- %.2g%s" % (p["key"], p["value"], p["std"],
+                                           "" if p["identifiable"] else "  NOT IDENTIFIABLE: " + p["why_not"]))
     print("rms residual %.4g (was %.4g), %d evaluations (%d replayed); wrote %s" % (
         result["rms_residual_after"], result["rms_residual_before"], result["evaluations"], result["replayed"],
         a.out))

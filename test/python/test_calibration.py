@@ -140,3 +140,17 @@ def test_an_objective_the_record_cannot_measure_is_refused_before_anything_runs(
         calibration.calibrate(str(path), str(tmp_path / "out"), workers=1, report=False)
     assert "'objective.statistics.max_uplift_m'" in str(e.value) and "uplift_SUPPORT" in str(e.value)
     assert not (tmp_path / "out").exists()
+
+
+def test_non_convergence_and_a_rough_objective_are_said_plainly(tmp_path):
+    # Two evaluations cannot converge; the fast preset's objective is rough at the difference step
+    # (the last bit of a parameter moves it by tens of per cent), so no uncertainty can be given.
+    path = _fast_calibration(tmp_path, "a", 3e-4, optimiser={"method": "least_squares", "max_evaluations": 2})
+    r = subprocess.run([sys.executable, CLI, path, "--out", str(tmp_path / "out"), "--workers", "1", "--no-report"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert r.returncode == 0, r.stdout[-3000:]
+    result = json.loads((tmp_path / "out" / "calibration.json").read_text())
+    assert not result["converged"] and "NOT CONVERGED" in r.stdout
+    assert not result["uncertainty_available"] and "UNCERTAINTY NOT AVAILABLE" in r.stdout
+    assert all(p["std"] is None for p in result["parameters"]) and "+-" not in r.stdout
+    assert "NOT CONVERGED" in (tmp_path / "out" / "calibrated.yaml").read_text()
