@@ -113,15 +113,21 @@ def load_calibration(path):
         if not isinstance(doc.get(k), str):
             _fail(k, doc.get(k), "a file path (relative to the calibration file)")
         out[k] = os.path.join(base, doc[k])
+    if doc.get("meta") is not None and not isinstance(doc["meta"], str):
+        _fail("meta", doc["meta"], "null (beside the record or in its '#' lines) or a YAML file path")
     out["meta"] = os.path.join(base, doc["meta"]) if isinstance(doc.get("meta"), str) else None
     ov = doc.get("overrides") or {}
     if not isinstance(ov, dict):
         _fail("overrides", ov, "a map {dotted.key: value}")
     out["overrides"] = ov
-    out["speed_profile"] = doc.get("speed_profile")
-    if out["speed_profile"] is not None:
-        _number(out["speed_profile"], "speed_profile", "null (the record's) or a speed in km/h > 0", True)
-    out["cutoff"] = doc.get("cutoff", "scene")
+    v = out["speed_profile"] = doc.get("speed_profile")
+    # Numbers as YAML reads them: text ("300") is refused rather than read as one.
+    if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v <= 540):
+        _fail("speed_profile", v, "null (the record's) or a speed in km/h, 0 < v <= 540 (not text)")
+    c = out["cutoff"] = doc.get("cutoff", "scene")
+    if c not in ("scene", "bandwidth") and (isinstance(c, bool) or not isinstance(c, (int, float))
+                                             or not math.isfinite(c) or c <= 0):
+        _fail("cutoff", c, "scene, bandwidth or a frequency in Hz > 0 (not text)")
     params = doc.get("parameters")
     if not isinstance(params, list) or not params:
         _fail("parameters", params, "a list of {key, low, high, scale}")
@@ -168,6 +174,11 @@ def load_calibration(path):
     if not any(weights.values()) and not out["objective"]["time_history"] and not out["objective"]["spectrum"]:
         _fail("objective", obj, "at least one weight above 0")
     opt = doc.get("optimiser") or {}
+    if not isinstance(opt, dict):
+        _fail("optimiser", opt, "a map {method, max_evaluations}")
+    for k in opt:
+        if k not in ("method", "max_evaluations"):
+            _fail(f"optimiser.{k}", opt[k], "not a field; allowed method, max_evaluations")
     method = opt.get("method", "least_squares")
     if method not in METHODS:
         _fail("optimiser.method", method, "one of " + ", ".join(METHODS))

@@ -86,8 +86,17 @@ def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path)
     (lambda d: d.update(objective={"statistics": {"std_force_N": "1e0"}}), "objective.statistics.std_force_N"),
     (lambda d: d.update(objective={"time_history": -1}), "objective.time_history"),
     (lambda d: d.update(objective={"statistics": {"std_force_N": 0}, "time_history": 0}), "objective"),
+    (lambda d: d.update(cutoff="abc"), "cutoff"),
+    (lambda d: d.update(cutoff=-5), "cutoff"),
+    (lambda d: d.update(cutoff="20"), "cutoff"),
+    (lambda d: d.update(speed_profile="300"), "speed_profile"),
+    (lambda d: d.update(speed_profile=1000), "speed_profile"),
+    (lambda d: d.update(optimiser=[1]), "optimiser"),
+    (lambda d: d.update(optimiser={"method": "least_squares", "tol": 1}), "optimiser.tol"),
+    (lambda d: d.update(meta=5), "meta"),
 ], ids=["no parameters", "bounds reversed", "unknown scale", "unknown statistic", "unknown method", "unknown field",
-        "weight as text", "negative weight", "all weights 0"])
+        "weight as text", "negative weight", "all weights 0", "cutoff word", "cutoff negative", "cutoff as text",
+        "speed as text", "speed beyond 540 km/h", "optimiser a list", "unknown optimiser key", "meta a number"])
 def test_a_bad_calibration_file_is_refused_by_field(tmp_path, edit, words):
     spec = {"scene": REFERENCE, "record": "rec.csv",
             "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3}]}
