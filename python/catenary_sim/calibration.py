@@ -381,6 +381,13 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     from dask.distributed import Client, LocalCluster
     import dask
 
+    for name, v in (("path", path), ("out", out)):
+        if not isinstance(v, (str, os.PathLike)):
+            raise CalibrationError(f"{name} = {v!r}: allowed a file path (str or os.PathLike)")
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:
+        raise CalibrationError(f"workers = {workers!r}: allowed an integer from 1 to 1024")
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise CalibrationError(f"scheduler = {scheduler!r}: allowed None or an address such as tcp://host:8786")
     cal = load_calibration(path)
     out = os.path.abspath(out)
     if os.path.lexists(out) and not os.path.isdir(out):
@@ -400,15 +407,19 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
         check_scene(cal["scene"], ov)
     except SceneError as e:
         raise CalibrationError(f"calibration {path}: {e}") from None
-    os.makedirs(out, exist_ok=True)
     own = None
     if scheduler:
-        client = Client(scheduler, timeout=10)
+        try:
+            client = Client(scheduler, timeout=10)
+        except (OSError, ValueError, TypeError) as e:
+            raise CalibrationError(f"scheduler = {scheduler!r}: cannot be reached ({e}); allowed the address "
+                                   "of a running dask-scheduler, e.g. tcp://host:8786") from None
     else:
         with dask.config.set({"distributed.worker.profile.enabled": False}):
             own = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(own)
     try:
+        os.makedirs(out, exist_ok=True)
         ev = _Evaluator(cal, out, client)
         budget = cal["optimiser"]["max_evaluations"]
         r0 = ev.many([u0])[0]

@@ -163,3 +163,21 @@ def test_non_convergence_and_a_rough_objective_are_said_plainly(tmp_path):
     assert not result["uncertainty_available"] and "UNCERTAINTY NOT AVAILABLE" in r.stdout
     assert all(p["std"] is None for p in result["parameters"]) and "+-" not in r.stdout
     assert "NOT CONVERGED" in (tmp_path / "out" / "calibrated.yaml").read_text()
+
+
+@pytest.mark.parametrize("kw,words", [
+    ({"workers": 0}, "workers = 0"), ({"workers": -1}, "workers = -1"), ({"workers": "two"}, "workers = 'two'"),
+    ({"workers": 2.5}, "workers = 2.5"), ({"path": None}, "path = None"), ({"path": 5}, "path = 5"),
+    ({"out": None}, "out = None"), ({"scheduler": 5}, "scheduler = 5"),
+    # port 1 is reserved (tcpmux) and not served here: nothing answers
+    ({"scheduler": "tcp://127.0.0.1:1"}, "scheduler = 'tcp://127.0.0.1:1'"),
+], ids=["workers 0", "workers -1", "workers text", "workers fraction", "path None", "path a number", "out None",
+        "scheduler a number", "scheduler unreachable"])
+def test_bad_arguments_of_calibrate_are_refused_by_name(tmp_path, kw, words):
+    args = {"path": _fast_calibration(tmp_path, "a", 3e-4), "out": str(tmp_path / "out"), "workers": 1,
+            "report": False}
+    args.update(kw)
+    with pytest.raises(calibration.CalibrationError) as e:
+        calibration.calibrate(**args)
+    assert words in str(e.value)
+    assert not (tmp_path / "out").exists()
