@@ -22,8 +22,9 @@ A calibration file (YAML; paths relative to it):
 
 Every evaluation is catenary_sim.measurement.compare with the parameters as overrides, run on a
 Dask cluster (a local one of --workers processes by default) and written atomically to
-DIR/evaluations/ keyed by its parameter values, so that a calibration started again on the same DIR
-replays them and goes on where it stopped. Writes DIR/calibrated.yaml (the scene snippet),
+DIR/evaluations/ keyed by its parameter values and a digest of everything else that decides it
+(scene and record text, overrides, speed profile, cutoff, objective), so that the same calibration
+started again on the same DIR replays them and goes on where it stopped, and another one never does. Writes DIR/calibrated.yaml (the scene snippet),
 DIR/calibration.json (values, uncertainties, identifiability, residuals before and after) and
 DIR/before/ and DIR/after/ (compare_measurement's report at the initial and calibrated values).
 """
@@ -49,6 +50,11 @@ DIFF_STEP = 0.01
 # A direction of the parameters whose singular value is below this share of the largest changes the
 # residuals a thousand times less than the best-determined one: the record does not fix it.
 IDENTIFIABLE_SV = 1e-3
+# The residuals one difference step on the other side of the optimum may depart from the Jacobian's
+# straight line by this share of the step's change: a smooth objective departs by the curvature
+# over 1 % of the range (a few per cent); a rough one (a coarse preset, where the last bit of a
+# parameter moves the objective by tens of per cent) by about the whole change or more.
+LINEAR_RATIO = 0.5
 
 
 class CalibrationError(ValueError):
@@ -70,6 +76,24 @@ def _number(v, field, allowed, positive=False):
     return float(v)
 
 
+def _weight(w, field):
+    # A weight is a number as YAML reads it: text ("1e0", quoted or without a dot) is refused.
+    if isinstance(w, bool) or not isinstance(w, (int, float)) or not math.isfinite(w) or w < 0:
+        _fail(field, w, "a weight: a finite number >= 0, not text (YAML 1.1 reads 1e0 as text: write 1.0)")
+    return float(w)
+
+
+def measurable(cal, record):
+    """Refuses an objective that asks for a statistic the record cannot give: its residual would
+    never be formed (the head's without a head column, the steady arms' uplift without supports)."""
+    needs = {n: ("a head_PANTOGRAPH column", bool(record.head_m)) for n in cm.HEAD}
+    needs.update({n: ("supports with uplift_SUPPORT columns", bool(record.uplift_m)) for n in cm.UPLIFT})
+    for k, w in cal["objective"]["statistics"].items():
+        if w and k in needs and not needs[k][1]:
+            _fail(f"objective.statistics.{k}", w, f"a statistic the record has: it needs {needs[k][0]}, "
+                  f"which {cal['record']} has not")
+
+
 def load_calibration(path):
     """Reads and checks a calibration file; returns a dict with absolute paths."""
     try:
@@ -84,19 +108,26 @@ def load_calibration(path):
             _fail(k, doc[k], "not a field; allowed " + ", ".join(sorted(FIELDS)))
     base = os.path.dirname(os.path.abspath(path))
     out = dict(doc)
+    out["path"] = os.path.abspath(path)
     for k in ("scene", "record"):
         if not isinstance(doc.get(k), str):
             _fail(k, doc.get(k), "a file path (relative to the calibration file)")
         out[k] = os.path.join(base, doc[k])
+    if doc.get("meta") is not None and not isinstance(doc["meta"], str):
+        _fail("meta", doc["meta"], "null (beside the record or in its '#' lines) or a YAML file path")
     out["meta"] = os.path.join(base, doc["meta"]) if isinstance(doc.get("meta"), str) else None
     ov = doc.get("overrides") or {}
     if not isinstance(ov, dict):
         _fail("overrides", ov, "a map {dotted.key: value}")
     out["overrides"] = ov
-    out["speed_profile"] = doc.get("speed_profile")
-    if out["speed_profile"] is not None:
-        _number(out["speed_profile"], "speed_profile", "null (the record's) or a speed in km/h > 0", True)
-    out["cutoff"] = doc.get("cutoff", "scene")
+    v = out["speed_profile"] = doc.get("speed_profile")
+    # Numbers as YAML reads them: text ("300") is refused rather than read as one.
+    if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v <= 540):
+        _fail("speed_profile", v, "null (the record's) or a speed in km/h, 0 < v <= 540 (not text)")
+    c = out["cutoff"] = doc.get("cutoff", "scene")
+    if c not in ("scene", "bandwidth") and (isinstance(c, bool) or not isinstance(c, (int, float))
+                                             or not math.isfinite(c) or c <= 0):
+        _fail("cutoff", c, "scene, bandwidth or a frequency in Hz > 0 (not text)")
     params = doc.get("parameters")
     if not isinstance(params, list) or not params:
         _fail("parameters", params, "a list of {key, low, high, scale}")
@@ -131,18 +162,23 @@ def load_calibration(path):
     stats = obj.get("statistics") or {}
     if not isinstance(stats, dict):
         _fail("objective.statistics", stats, "a map NAME: weight")
+    weights = {}
     for k, w in stats.items():
         if k not in cm.TOLERANCE_NAMES or k in cm.DIFFERENCES:
             _fail(f"objective.statistics.{k}", w, "a statistic: " + ", ".join(
                 n for n in cm.TOLERANCE_NAMES if n not in cm.DIFFERENCES))
-        _number(w, f"objective.statistics.{k}", "a weight >= 0")
-    for k in ("time_history", "spectrum"):
-        _number(obj.get(k, 0.0), f"objective.{k}", "a weight >= 0")
-    out["objective"] = {"statistics": stats, "time_history": float(obj.get("time_history", 0.0)),
-                        "spectrum": float(obj.get("spectrum", 0.0))}
-    if not stats and not out["objective"]["time_history"] and not out["objective"]["spectrum"]:
+        weights[k] = _weight(w, f"objective.statistics.{k}")
+    out["objective"] = {"statistics": weights,
+                        "time_history": _weight(obj.get("time_history", 0.0), "objective.time_history"),
+                        "spectrum": _weight(obj.get("spectrum", 0.0), "objective.spectrum")}
+    if not any(weights.values()) and not out["objective"]["time_history"] and not out["objective"]["spectrum"]:
         _fail("objective", obj, "at least one weight above 0")
     opt = doc.get("optimiser") or {}
+    if not isinstance(opt, dict):
+        _fail("optimiser", opt, "a map {method, max_evaluations}")
+    for k in opt:
+        if k not in ("method", "max_evaluations"):
+            _fail(f"optimiser.{k}", opt[k], "not a field; allowed method, max_evaluations")
     method = opt.get("method", "least_squares")
     if method not in METHODS:
         _fail("optimiser.method", method, "one of " + ", ".join(METHODS))
@@ -210,8 +246,33 @@ def evaluate(cal, keys, values):
             "band_hz": min(c.settings["cutoff_hz"], c.record.bandwidth_hz)}
 
 
-def _key(values):
-    return hashlib.sha1(json.dumps([float("%.12g" % v) for v in values]).encode()).hexdigest()[:16]
+def _file_digest(path):
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def fingerprint(cal):
+    """A digest of everything besides the parameter values that decides an evaluation's residuals:
+    the scene's and the record's text (with the record's side metadata), the overrides, speed
+    profile, cutoff, objective and which scene fields the parameters are. Evaluations kept under
+    one fingerprint are never replayed for a calibration with another."""
+    side = cal["meta"]
+    if side is None:
+        stem = os.path.splitext(cal["record"])[0]
+        side = next((stem + e for e in (".yaml", ".yml") if os.path.isfile(stem + e)), None)
+    try:
+        files = {"scene": _file_digest(cal["scene"]), "record": _file_digest(cal["record"]),
+                 "meta": _file_digest(side) if side else None}
+    except OSError as e:
+        raise CalibrationError(f"calibration file {cal['path']!r}: {e}") from None
+    doc = {"files": files, "overrides": cal["overrides"], "speed_profile": cal["speed_profile"],
+           "cutoff": cal["cutoff"], "objective": cal["objective"],
+           "parameters": [p["key"] for p in cal["parameters"]]}
+    return hashlib.sha256(json.dumps(doc, sort_keys=True, default=repr).encode()).hexdigest()[:16]
+
+
+def _key(context, values):
+    return hashlib.sha1(json.dumps([context, [float("%.12g" % v) for v in values]]).encode()).hexdigest()[:16]
 
 
 def _write_atomically(path, text):
@@ -233,6 +294,7 @@ class _Evaluator:
         self.cal, self.client = cal, client
         self.keys = [p["key"] for p in cal["parameters"]]
         self.dir = os.path.join(out, "evaluations")
+        self.context = fingerprint(cal)
         os.makedirs(self.dir, exist_ok=True)
         self.count = self.replayed = 0
 
@@ -240,10 +302,12 @@ class _Evaluator:
         values = [to_values(self.cal["parameters"], u) for u in us]
         results, todo = [None] * len(values), []
         for i, v in enumerate(values):
-            path = os.path.join(self.dir, _key(v) + ".json")
+            path = os.path.join(self.dir, _key(self.context, v) + ".json")
+            done = None
             if os.path.isfile(path):
                 with open(path, encoding="utf-8") as f:
                     done = json.load(f)
+            if done is not None and done.get("context") == self.context:
                 results[i] = np.array(done["residuals"])
                 self.band_hz = done["band_hz"]
                 self.replayed += 1
@@ -252,8 +316,13 @@ class _Evaluator:
         futures = [self.client.submit(evaluate, self.cal, self.keys, values[i], pure=False) for i in todo]
         for i, fut in zip(todo, futures):
             r = fut.result()
-            _write_atomically(os.path.join(self.dir, _key(values[i]) + ".json"),
-                              json.dumps({"values": dict(zip(self.keys, values[i])), **r}))
+            if not r["residuals"] or not np.all(np.isfinite(r["residuals"])):
+                raise CalibrationError(
+                    f"calibration {self.cal['path']}: objective = {self.cal['objective']!r} gives "
+                    f"{'no residuals' if not r['residuals'] else 'non-finite residuals'} at "
+                    f"{dict(zip(self.keys, values[i]))}; allowed an objective the record and the pass can measure")
+            _write_atomically(os.path.join(self.dir, _key(self.context, values[i]) + ".json"),
+                              json.dumps({"context": self.context, "values": dict(zip(self.keys, values[i])), **r}))
             results[i] = np.array(r["residuals"])
             self.band_hz = r["band_hz"]
         self.count += len(values)
@@ -312,6 +381,13 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     from dask.distributed import Client, LocalCluster
     import dask
 
+    for name, v in (("path", path), ("out", out)):
+        if not isinstance(v, (str, os.PathLike)):
+            raise CalibrationError(f"{name} = {v!r}: allowed a file path (str or os.PathLike)")
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:
+        raise CalibrationError(f"workers = {workers!r}: allowed an integer from 1 to 1024")
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise CalibrationError(f"scheduler = {scheduler!r}: allowed None or an address such as tcp://host:8786")
     cal = load_calibration(path)
     out = os.path.abspath(out)
     if os.path.lexists(out) and not os.path.isdir(out):
@@ -319,6 +395,7 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     params = cal["parameters"]
     # Checked here, before any cluster starts: the record, the scene, each parameter at its initial value.
     rec = cm.read_record(cal["record"], cal["meta"])
+    measurable(cal, rec)
     # The initial values (the range's middle unless given), just inside the bounds as the
     # trust-region method needs.
     u0 = np.array([to_unit([p], [p["initial"]])[0] if "initial" in p else 0.5 for p in params])
@@ -330,15 +407,19 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
         check_scene(cal["scene"], ov)
     except SceneError as e:
         raise CalibrationError(f"calibration {path}: {e}") from None
-    os.makedirs(out, exist_ok=True)
     own = None
     if scheduler:
-        client = Client(scheduler, timeout=10)
+        try:
+            client = Client(scheduler, timeout=10)
+        except (OSError, ValueError, TypeError) as e:
+            raise CalibrationError(f"scheduler = {scheduler!r}: cannot be reached ({e}); allowed the address "
+                                   "of a running dask-scheduler, e.g. tcp://host:8786") from None
     else:
         with dask.config.set({"distributed.worker.profile.enabled": False}):
             own = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(own)
     try:
+        os.makedirs(out, exist_ok=True)
         ev = _Evaluator(cal, out, client)
         budget = cal["optimiser"]["max_evaluations"]
         r0 = ev.many([u0])[0]
@@ -353,9 +434,24 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
                                     bounds=[(0.0, 1.0)] * len(u0), options={"maxfev": budget})
             u = np.clip(res.x, 0.0, 1.0)
         r, jac = ev.jacobian(u)
+        # The linear model checked on the other side of the optimum, one difference step away.
+        steps = [-DIFF_STEP if u[i] - DIFF_STEP >= 0.0 else 2 * DIFF_STEP for i in range(len(u))]
+        others = ev.many([u + np.eye(len(u))[i] * steps[i] for i in range(len(u))])
+        ratio = 0.0
+        for i, ri in enumerate(others):
+            change = np.linalg.norm(jac[:, i] * steps[i])
+            miss = np.linalg.norm(ri - (r + jac[:, i] * steps[i]))
+            ratio = max(ratio, miss / change if change > 0 else (0.0 if miss == 0 else math.inf))
         correlated = max(1.0, rec.sample_rate_hz / (2.0 * ev.band_hz)) if cal["objective"]["time_history"] else 1.0
         table, info = uncertainty(params, u, r, jac, correlated)
         info["residuals_per_independent_one"] = correlated
+        info["linearity_ratio"] = ratio if math.isfinite(ratio) else None
+        info["uncertainty_available"] = bool(ratio <= LINEAR_RATIO)
+        if not info["uncertainty_available"]:
+            for p in table:
+                p.update(std=None, identifiable=None,
+                         why_not="uncertainty not available: the objective is rough at the difference step "
+                                 "(a finer numerics.preset makes it smooth)")
         result = {"calibration": os.path.abspath(path), "method": cal["optimiser"]["method"],
                   "converged": bool(res.success), "message": str(res.message),
                   "evaluations": ev.count, "replayed": ev.replayed,
@@ -375,10 +471,11 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
             node = node.setdefault(part, {})
         node[parts[-1]] = float("%.6g" % p["value"])
     _write_atomically(os.path.join(out, "calibrated.yaml"),
-                      "# calibrated against %s (rms residual %.4g, was %.4g)\n" % (
-                          cal["record"], result["rms_residual_after"], result["rms_residual_before"])
+                      "# calibrated against %s (rms residual %.4g, was %.4g)%s\n" % (
+                          cal["record"], result["rms_residual_after"], result["rms_residual_before"],
+                          "" if result["converged"] else "; NOT CONVERGED: " + result["message"])
                       + yaml.safe_dump(snippet, sort_keys=False))
-    _write_atomically(os.path.join(out, "calibration.json"), json.dumps(result, indent=2) + "\n")
+    _write_atomically(os.path.join(out, "calibration.json"), json.dumps(result, indent=2, allow_nan=False) + "\n")
     if report:
         for name, values in (("before", to_values(params, u0)), ("after", [p["value"] for p in table])):
             ov = dict(cal["overrides"])
@@ -405,9 +502,18 @@ def main():
     except (CalibrationError, SceneError) as e:
         sys.stderr.write(f"calibrate: {e}\n")
         return 2
+    if not result["converged"]:
+        print("NOT CONVERGED: %s (the values below are where the optimiser stopped)" % result["message"])
+    if not result["uncertainty_available"]:
+        print("UNCERTAINTY NOT AVAILABLE: the objective is rough at the difference step (the other side of "
+              "the optimum departs from the linear model by %s of the change); use a finer numerics.preset" % (
+                  "%.2g" % result["linearity_ratio"] if result["linearity_ratio"] is not None else "all"))
     for p in result["parameters"]:
-        print("%-32s %.6g +- %.2g%s" % (p["key"], p["value"], p["std"],
-                                       "" if p["identifiable"] else "  NOT IDENTIFIABLE: " + p["why_not"]))
+        if p["std"] is None:
+            print("%-32s %.6g" % (p["key"], p["value"]))
+        else:
+            print("%-32s %.6g +- %.2g%s" % (p["key"], p["value"], p["std"],
+                                           "" if p["identifiable"] else "  NOT IDENTIFIABLE: " + p["why_not"]))
     print("rms residual %.4g (was %.4g), %d evaluations (%d replayed); wrote %s" % (
         result["rms_residual_after"], result["rms_residual_before"], result["evaluations"], result["replayed"],
         a.out))

@@ -83,7 +83,20 @@ def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path)
     (lambda d: d.update(objective={"statistics": {"spread": 1}}), "objective.statistics.spread"),
     (lambda d: d.update(optimiser={"method": "simplex"}), "optimiser.method"),
     (lambda d: d.update(colour="red"), "colour"),
-], ids=["no parameters", "bounds reversed", "unknown scale", "unknown statistic", "unknown method", "unknown field"])
+    (lambda d: d.update(objective={"statistics": {"std_force_N": "1e0"}}), "objective.statistics.std_force_N"),
+    (lambda d: d.update(objective={"time_history": -1}), "objective.time_history"),
+    (lambda d: d.update(objective={"statistics": {"std_force_N": 0}, "time_history": 0}), "objective"),
+    (lambda d: d.update(cutoff="abc"), "cutoff"),
+    (lambda d: d.update(cutoff=-5), "cutoff"),
+    (lambda d: d.update(cutoff="20"), "cutoff"),
+    (lambda d: d.update(speed_profile="300"), "speed_profile"),
+    (lambda d: d.update(speed_profile=1000), "speed_profile"),
+    (lambda d: d.update(optimiser=[1]), "optimiser"),
+    (lambda d: d.update(optimiser={"method": "least_squares", "tol": 1}), "optimiser.tol"),
+    (lambda d: d.update(meta=5), "meta"),
+], ids=["no parameters", "bounds reversed", "unknown scale", "unknown statistic", "unknown method", "unknown field",
+        "weight as text", "negative weight", "all weights 0", "cutoff word", "cutoff negative", "cutoff as text",
+        "speed as text", "speed beyond 540 km/h", "optimiser a list", "unknown optimiser key", "meta a number"])
 def test_a_bad_calibration_file_is_refused_by_field(tmp_path, edit, words):
     spec = {"scene": REFERENCE, "record": "rec.csv",
             "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3}]}
@@ -93,3 +106,78 @@ def test_a_bad_calibration_file_is_refused_by_field(tmp_path, edit, words):
     with pytest.raises(calibration.CalibrationError) as e:
         calibration.load_calibration(str(path))
     assert f"'{words}'" in str(e.value)
+
+
+# A short, fast pass: a calibration of it takes seconds.
+FAST = {"numerics.preset": "fast", "line.span_count": 6}
+
+
+def _fast_calibration(tmp_path, name, beta, **fields):
+    """A calibration file of damping.beta against a record synthesised with `beta`."""
+    cm.synthesise_record(REFERENCE, str(tmp_path / f"{name}.csv"), overrides=dict(FAST, **{"damping.beta": beta}),
+                         speed_profile=270.0, noise_std_N=2.0, seed=1)
+    spec = {"scene": REFERENCE, "record": f"{name}.csv", "overrides": FAST,
+            "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3, "scale": "log", "initial": 1e-4}],
+            "optimiser": {"method": "least_squares", "max_evaluations": 6}}
+    spec.update(fields)
+    path = tmp_path / f"cal_{name}.yaml"  # not {name}.yaml: that is the record's metadata
+    path.write_text(yaml.safe_dump(spec))
+    return str(path)
+
+
+def test_a_directory_of_another_calibration_replays_none_of_its_evaluations(tmp_path):
+    a = _fast_calibration(tmp_path, "a", 3e-4)
+    b = _fast_calibration(tmp_path, "b", 6e-4)
+    calibration.calibrate(a, str(tmp_path / "shared"), workers=1, report=False)
+    # b run where a kept its evaluations gives exactly what b gives on its own: the passes are
+    # deterministic, so any replay of a's residuals would show as a difference.
+    shared = calibration.calibrate(b, str(tmp_path / "shared"), workers=1, report=False)
+    alone = calibration.calibrate(b, str(tmp_path / "alone"), workers=1, report=False)
+    assert [p["value"] for p in shared["parameters"]] == [p["value"] for p in alone["parameters"]]
+    assert shared["cost_before"] == alone["cost_before"]
+
+
+def test_an_objective_the_record_cannot_measure_is_refused_before_anything_runs(tmp_path):
+    cm.synthesise_record(REFERENCE, str(tmp_path / "bare.csv"), overrides=FAST, speed_profile=270.0, supports=None)
+    spec = {"scene": REFERENCE, "record": "bare.csv", "overrides": FAST,
+            "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3, "scale": "log"}],
+            "objective": {"statistics": {"max_uplift_m": 1}, "time_history": 0},
+            "optimiser": {"max_evaluations": 2}}
+    path = tmp_path / "cal.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    with pytest.raises(calibration.CalibrationError) as e:
+        calibration.calibrate(str(path), str(tmp_path / "out"), workers=1, report=False)
+    assert "'objective.statistics.max_uplift_m'" in str(e.value) and "uplift_SUPPORT" in str(e.value)
+    assert not (tmp_path / "out").exists()
+
+
+def test_non_convergence_and_a_rough_objective_are_said_plainly(tmp_path):
+    # Two evaluations cannot converge; the fast preset's objective is rough at the difference step
+    # (the last bit of a parameter moves it by tens of per cent), so no uncertainty can be given.
+    path = _fast_calibration(tmp_path, "a", 3e-4, optimiser={"method": "least_squares", "max_evaluations": 2})
+    r = subprocess.run([sys.executable, CLI, path, "--out", str(tmp_path / "out"), "--workers", "1", "--no-report"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert r.returncode == 0, r.stdout[-3000:]
+    result = json.loads((tmp_path / "out" / "calibration.json").read_text())
+    assert not result["converged"] and "NOT CONVERGED" in r.stdout
+    assert not result["uncertainty_available"] and "UNCERTAINTY NOT AVAILABLE" in r.stdout
+    assert all(p["std"] is None for p in result["parameters"]) and "+-" not in r.stdout
+    assert "NOT CONVERGED" in (tmp_path / "out" / "calibrated.yaml").read_text()
+
+
+@pytest.mark.parametrize("kw,words", [
+    ({"workers": 0}, "workers = 0"), ({"workers": -1}, "workers = -1"), ({"workers": "two"}, "workers = 'two'"),
+    ({"workers": 2.5}, "workers = 2.5"), ({"path": None}, "path = None"), ({"path": 5}, "path = 5"),
+    ({"out": None}, "out = None"), ({"scheduler": 5}, "scheduler = 5"),
+    # port 1 is reserved (tcpmux) and not served here: nothing answers
+    ({"scheduler": "tcp://127.0.0.1:1"}, "scheduler = 'tcp://127.0.0.1:1'"),
+], ids=["workers 0", "workers -1", "workers text", "workers fraction", "path None", "path a number", "out None",
+        "scheduler a number", "scheduler unreachable"])
+def test_bad_arguments_of_calibrate_are_refused_by_name(tmp_path, kw, words):
+    args = {"path": _fast_calibration(tmp_path, "a", 3e-4), "out": str(tmp_path / "out"), "workers": 1,
+            "report": False}
+    args.update(kw)
+    with pytest.raises(calibration.CalibrationError) as e:
+        calibration.calibrate(**args)
+    assert words in str(e.value)
+    assert not (tmp_path / "out").exists()
