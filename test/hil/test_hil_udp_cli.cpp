@@ -79,18 +79,8 @@ TEST(HilUdpCli, BadOptionsAreRefusedNamingTheOption) {
   expect_refused({kSim, "--scene", "/nonexistent.yaml"}, {"--scene", "/nonexistent.yaml"});
   {
     // A scene whose frames do not fit a packet (five external pantographs) is --scene's fault.
-    YAML::Node root = YAML::LoadFile(kHil);
-    YAML::Node first = YAML::Clone(root["pantographs"][0]);
-    root["pantographs"] = YAML::Node(YAML::NodeType::Sequence);
-    for (int i = 0; i < 5; ++i) {
-      YAML::Node p = YAML::Clone(first);
-      p["name"] = "p" + std::to_string(i);
-      p["position"] = 20.0 * i;
-      root["pantographs"].push_back(p);
-    }
     char dir[] = "/tmp/catenary_sim_udp_cli_XXXXXX";
-    const std::string five = std::string(mkdtemp(dir)) + "/five.yaml";
-    std::ofstream(five) << YAML::Dump(root) << "\n";
+    const std::string five = test_scenes::with_pantograph_copies(kHil, 5, std::string(mkdtemp(dir)) + "/five.yaml");
     const ChildRun r = run({kSim, "--scene", five, "--port", "0", "--duration", "1"});
     EXPECT_EQ(r.exit_code, 2) << r.out;
     EXPECT_NE(r.out.find("--scene " + five + ": the scene has 5 external pantographs"), std::string::npos) << r.out;

@@ -486,17 +486,7 @@ TEST_F(NodeParamsFuzz, HilUdpNodeErrorsNameItsOwnParameters) {
   expect_names(run(kHilUdpNode, {"_scene:=" + kHilScene, "_hil/udp_rig:=10.0.0.3:47801", "_hil/udp_allow:=10.0.0.2"}),
                "rig off the allow-list", "~hil/udp_allow");
   // A scene whose frames do not fit a packet: five external pantographs (a packet carries four).
-  YAML::Node root = YAML::LoadFile(kHilScene);
-  YAML::Node first = YAML::Clone(root["pantographs"][0]);
-  root["pantographs"] = YAML::Node(YAML::NodeType::Sequence);
-  for (int i = 0; i < 5; ++i) {
-    YAML::Node p = YAML::Clone(first);
-    p["name"] = "p" + std::to_string(i);
-    p["position"] = 20.0 * i;
-    root["pantographs"].push_back(p);
-  }
-  const std::string five = dir_ + "/five_external.yaml";
-  std::ofstream(five) << YAML::Dump(root) << "\n";
+  const std::string five = test_scenes::with_pantograph_copies(kHilScene, 5, dir_ + "/five_external.yaml");
   const ChildRun r = run(kHilUdpNode, {"_scene:=" + five});
   expect_names(r, "five external pantographs", "~scene = '" + five + "'");
   EXPECT_NE(r.out.find("at most 4"), std::string::npos) << r.out;

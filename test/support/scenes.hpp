@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <fstream>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -119,6 +120,22 @@ inline catenary_sim::WindSpec gusty_wind(std::uint64_t seed, double spacing = 5.
   t.seed = seed;
   w.turbulence = t;
   return w;
+}
+
+// `file` with its first pantograph repeated `count` times, 20 m apart (names p0, p1, ...), written
+// to `path` (e.g. five external pantographs, more than a HIL packet carries); returns `path`.
+inline std::string with_pantograph_copies(const std::string& file, int count, const std::string& path) {
+  YAML::Node root = YAML::LoadFile(file);
+  const YAML::Node first = YAML::Clone(root["pantographs"][0]);
+  root["pantographs"] = YAML::Node(YAML::NodeType::Sequence);
+  for (int i = 0; i < count; ++i) {
+    YAML::Node p = YAML::Clone(first);
+    p["name"] = "p" + std::to_string(i);
+    p["position"] = 20.0 * i;
+    root["pantographs"].push_back(p);
+  }
+  std::ofstream(path) << YAML::Dump(root) << "\n";
+  return path;
 }
 
 }  // namespace test_scenes
