@@ -340,14 +340,9 @@ void validate_rigid(const Scene& s) {
                             ? 0.5 * s.wind->air_density * s.wind->conductor_rail.drag_coefficient *
                                   s.wind->conductor_rail.diameter * s.wind->speed * s.wind->speed
                             : 0.0;
-  auto stiff_enough = [&](std::size_t i, const std::string& field, double ei, double span, double q, const char* under,
+  auto stiff_enough = [&](const std::string& field, double ei, double span, double q, const char* under,
                           const char* way, const std::string& note = "") {
     const double least = 250.0 * q * span * span * span / 384.0;
-    // (A span no profile of the allowed EI could take is the span's to shorten.)
-    if (least > 1e8 && std::strcmp(under, "its weight") == 0)
-      fail(s.sections.size() > 1 ? "sections[" + std::to_string(i) + "].spans" : "line.spans", fmt(span) + " m",
-           "a rigid rail's span short enough for a profile of at most 1e8 N m^2 (this one needs " + fmt(least) +
-               " N m^2 so as to sag less than a fiftieth of it under its weight); supports every 8-12 m in service");
     if (!(ei >= least))
       fail(field, fmt(ei) + note,
            "at least " + fmt(least) + " N m^2 here: the profile would " + way + " " + fmt(5.0 * q * std::pow(span, 4) / (384.0 * ei)) +
@@ -358,17 +353,22 @@ void validate_rigid(const Scene& s) {
     if (!sec.rigid) continue;
     const std::string f = s.section_field(i, "conductor_rail");
     const double longest = *std::max_element(sec.spans.begin(), sec.spans.end());
-    stiff_enough(i, f + ".bending_stiffness", sec.contact_wire.bending_stiffness, longest,
-                 sec.contact_wire.linear_mass * s.gravity, "its weight", "sag");
+    // A span no profile of the allowed EI (1e8 N m^2) could take under its weight is the span's to shorten.
+    const double q_weight = sec.contact_wire.linear_mass * s.gravity, least = 250.0 * q_weight * std::pow(longest, 3) / 384.0;
+    if (least > 1e8)
+      fail(s.sections.size() > 1 ? "sections[" + std::to_string(i) + "].spans" : "line.spans", fmt(longest) + " m",
+           "a rigid rail's span short enough for a profile of at most 1e8 N m^2 (this one needs " + fmt(least) +
+               " N m^2 so as to sag less than a fiftieth of it under its weight); supports every 8-12 m in service");
+    stiff_enough(f + ".bending_stiffness", sec.contact_wire.bending_stiffness, longest, q_weight, "its weight", "sag");
     if (wind_q > 0.0)
-      stiff_enough(i, f + ".lateral_bending_stiffness", sec.rail_lateral_bending_stiffness.value_or(sec.contact_wire.bending_stiffness),
+      stiff_enough(f + ".lateral_bending_stiffness", sec.rail_lateral_bending_stiffness.value_or(sec.contact_wire.bending_stiffness),
                    longest, wind_q, "the mean wind (wind.speed)", "blow out",
                    sec.rail_lateral_bending_stiffness ? "" : " (absent: the bending_stiffness)");
     if (sec.rail_transition_piece) {
       const double end_span = std::max(transition_piece_at_start(s, i) ? sec.spans.front() : 0.0,
                                        transition_piece_at_end(s, i) ? sec.spans.back() : 0.0);
       if (end_span > 0.0)
-        stiff_enough(i, f + ".transition_piece.end_bending_stiffness", sec.rail_transition_piece->end_bending_stiffness, end_span,
+        stiff_enough(f + ".transition_piece.end_bending_stiffness", sec.rail_transition_piece->end_bending_stiffness, end_span,
                      sec.contact_wire.linear_mass * s.gravity, "its weight", "sag");
     }
   }
