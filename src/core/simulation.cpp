@@ -211,13 +211,17 @@ bool Simulation::set_max_acceleration(double a, std::string* error) {
   // The ceiling is about 2 g: several times what any train does (service braking about 1 m/s^2,
   // emergency braking 1.5 to 3 m/s^2), so every real ramp fits, while a value in the tens or
   // hundreds (a unit slip, km/h per s) is refused rather than taken as a jump.
-  if (!std::isfinite(a) || a < 0.0 || a > kMaxAcceleration) {
-    if (error) *error = "max acceleration " + fmt_given(a) + " m/s^2 rejected: allowed 0 (no limit) to " +
-                        fmt(kMaxAcceleration) + " m/s^2";
+  if (std::string e = max_acceleration_error(a); !e.empty()) {
+    if (error) *error = std::move(e);
     return false;
   }
   state_.max_acceleration = a;
   return true;
+}
+
+std::string Simulation::max_acceleration_error(double a) {
+  if (std::isfinite(a) && a >= 0.0 && a <= kMaxAcceleration) return std::string();
+  return "max acceleration " + fmt_given(a) + " m/s^2 rejected: allowed 0 (no limit) to " + fmt(kMaxAcceleration) + " m/s^2";
 }
 
 bool Simulation::set_uplift(int p, double f, std::string* error) {

@@ -62,8 +62,7 @@ HilLoop::HilLoop(Scene scene, const LoopOptions& o, const std::string& rate_name
     throw HilError(name("timeout", "--timeout") + " = " + fmt_given(opt_.timeout) + " s rejected: allowed [2 loop periods = " +
                    fmt(2.0 * timing_.period) + ", 10] s");
   // (checked before the scene is built: a refused option costs no static solve)
-  if (!std::isfinite(opt_.hold_deceleration) || opt_.hold_deceleration < 0.0 ||
-      opt_.hold_deceleration > Simulation::kMaxAcceleration)
+  if (!Simulation::max_acceleration_error(opt_.hold_deceleration).empty())
     throw HilError(name("hold_deceleration", "--hold-deceleration") + " = " + fmt_given(opt_.hold_deceleration) +
                    " m/s^2 rejected: allowed [0, " + fmt(Simulation::kMaxAcceleration) +
                    "] m/s^2 (0: at once; the core's limit on the train's acceleration)");

@@ -32,6 +32,8 @@ class Simulation {
   // and leave the state untouched.
   bool set_target_speed(double speed_mps, std::string* error);
   bool set_max_acceleration(double accel_mps2, std::string* error);
+  // set_max_acceleration's check of a value alone: empty when allowed, else its error.
+  static std::string max_acceleration_error(double accel_mps2);
   // pantograph < 0: all pantographs.
   bool set_uplift(int pantograph, double force_n, std::string* error);
 
