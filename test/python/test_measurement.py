@@ -365,3 +365,24 @@ def test_the_statistics_filter_is_a_zero_phase_fourth_order_butterworth():
 def test_the_filter_refuses_bad_input_by_name(x, fs, fc, named):
     with pytest.raises(ValueError, match=re.escape(named)):
         cm.lowpass(x, fs, fc)
+
+
+def test_the_worked_example_writes_only_into_its_scratch_directory():
+    # The page's commands run from the repository's root: every file they make (the synthesised
+    # record, --out directories, the calibration file's record) lies in work/, which git ignores.
+    with open(os.path.join(ROOT, "docs", "measured_records.md"), encoding="utf-8") as f:
+        page = f.read()
+    example = page[page.index("## A worked example"):page.index("## Tests")]
+    written = re.findall(r"synthesise_record\([^,]+,\s*\"([^\"]+)\"", example)
+    written += [d for d in re.findall(r"--out (\S+)", example) if d != "DIR"]  # DIR: the usage line
+    read = re.findall(r"cm\.compare\([^,]+,\s*\"([^\"]+)\"", example)
+    assert len(written) == 3 and len(read) == 1, (written, read)
+    for p in written + read:
+        assert p.startswith("work/"), p
+    with open(os.path.join(ROOT, "docs", "measured_records_calibration.yaml"), encoding="utf-8") as f:
+        cal = yaml.safe_load(f)
+    record = os.path.normpath(os.path.join(ROOT, "docs", cal["record"]))
+    assert record == os.path.join(ROOT, "work", "measured_run.csv")
+    for p in written + [os.path.relpath(record, ROOT)]:
+        r = subprocess.run(["git", "check-ignore", "-q", "--no-index", p], cwd=ROOT, timeout=60)
+        assert r.returncode == 0, f"{p} is not ignored by git"
