@@ -806,16 +806,31 @@ def synthesise_record(scene, path, overrides=None, speed_profile=300.0, sample_r
     noise of noise_std_N per sample passed through the same measuring filter (zero-phase
     Butterworth, as the core's sensor model), the speed, the head displacement and the uplift of
     the steady arms ("section": those in the scene's analysis section, named A1, A2, ...; None:
-    none). Writes PATH (CSV) and its side YAML (PATH with .yaml), each whole. Returns the Record."""
-    path = os.fspath(_path("path", path, "a CSV file path"))
-    fs = _real("sample_rate_hz", sample_rate_hz, "a sample rate in Hz > 0", 1e-3, 1e7)
+    none). Writes PATH (CSV) and its side YAML (PATH with .yaml) once every argument and the
+    record read back are checked, each whole; a refusal leaves neither. Returns the Record."""
+    path, side = _record_paths(path)
+    fs = _real("sample_rate_hz", sample_rate_hz, f"a sample rate in Hz, {MIN_RECORD_RATE_HZ:g} to "
+               f"{MAX_RECORD_RATE_HZ:g} (the time column's {10.0 ** -DECIMALS['time_s']:g} s resolution)",
+               MIN_RECORD_RATE_HZ, MAX_RECORD_RATE_HZ)
     bw = _real("bandwidth_hz", bandwidth_hz, "a bandwidth in Hz > 0", 1e-3, 1e7)
     sigma = _real("noise_std_N", noise_std_N, "a noise std in N >= 0", 0.0, 1e4)
     seed = _integer("seed", seed, "an integer >= 0", 0, 2 ** 63 - 1)
     origin = _real("station_origin_m", station_origin_m, "a station in m", -1e7, 1e7)
+    if not (supports is None or (isinstance(supports, str) and supports == "section")):
+        raise SceneError(f"supports = {_shown(supports)} rejected: allowed 'section' (the steady arms of the "
+                         "analysis section) or None (no uplift columns)", field="supports", value=_shown(supports),
+                         allowed="'section' or None")
+    if not isinstance(head, (bool, np.bool_)):
+        raise SceneError(f"head = {_shown(head)} rejected: allowed True or False (head displacement columns or "
+                         "none)", field="head", value=_shown(head), allowed="True or False")
     run = simulate_run(scene, None, overrides, speed_profile, sensor_bandwidth_hz=bw)
     ref = run.reference
     t = np.arange(run.time_s[0], run.time_s[-1], 1.0 / fs)
+    if len(t) < 3:
+        duration = float(run.time_s[-1] - run.time_s[0])
+        raise SceneError(f"sample_rate_hz = {fs:g} rejected: the pass of {duration:.4g} s gives {len(t)} "
+                         f"row(s); allowed at least {3.0 / duration:.4g} Hz (3 rows)", field="sample_rate_hz",
+                         value=f"{fs:g}", allowed=f"at least {3.0 / duration:.4g} Hz")
     station = np.interp(t, run.time_s, run.position_m[ref])
     cols = {"station_m": np.round(station + origin, DECIMALS["station_m"]),
             "time_s": np.round(t - t[0], DECIMALS["time_s"]),
@@ -841,21 +856,71 @@ def synthesise_record(scene, path, overrides=None, speed_profile=300.0, sample_r
             cols[f"uplift_{name}_mm"] = np.round(1e3 * np.interp(t, run.time_s, u), DECIMALS["uplift_mm"])
             meta["supports"][name] = float(x + origin)
     table = pd.DataFrame(cols)
-    text = table.to_csv(index=False, float_format="%.6f")
-    _write_atomically(path, text)
-    _write_atomically(os.path.splitext(path)[0] + ".yaml", yaml.safe_dump(meta, sort_keys=False))
-    return read_record(path)
+    # Both files are written beside their places and read back as a record before either is
+    # moved into place: a record that would be refused, or a write that fails, leaves nothing.
+    staged = []
+    try:
+        for target, text in ((path, table.to_csv(index=False, float_format="%.6f")),
+                             (side, yaml.safe_dump(meta, sort_keys=False))):
+            staged.append((_stage(target, text), target))
+        record = read_record(staged[0][0], meta=staged[1][0])
+        new_side = not os.path.lexists(side)
+        os.replace(staged[1][0], side)
+        try:
+            os.replace(staged[0][0], path)
+        except OSError:
+            if new_side:
+                os.remove(side)
+            raise
+    except OSError as e:
+        raise SceneError(f"path = {path!r} rejected: cannot be written ({e.strerror or e}); allowed a CSV path in a "
+                         "writable directory", field="path", value=repr(path),
+                         allowed="a CSV path in a writable directory") from None
+    finally:
+        for tmp, _target in staged:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+    record.path = path
+    return record
 
 
-def _write_atomically(path, text):
-    d = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=d)
+# The synthesised record's sample rate: at 1e5 Hz a row's interval is 10 us, which the time
+# column's rounding to 1 us moves by at most 10 %, the reader's agreement with the declared rate.
+MIN_RECORD_RATE_HZ, MAX_RECORD_RATE_HZ = 1e-3, 1e5
+
+
+def _record_paths(path):
+    """A synthesised record's CSV path and its side YAML's, refused unless PATH ends in .csv and
+    both can be made in an existing, writable directory."""
+    path = os.fspath(_path("path", path, "a CSV file path ending in .csv"))
+
+    def refuse(why, allowed="a path ending in .csv in an existing, writable directory"):
+        raise SceneError(f"path = {path!r} rejected: {why}; allowed {allowed}", field="path", value=repr(path),
+                         allowed=allowed)
+
+    stem, ext = os.path.splitext(path)
+    if ext.lower() != ".csv" or not os.path.basename(stem):
+        refuse("not a .csv file name (the metadata goes beside it as NAME.yaml)")
+    side = stem + ".yaml"
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        refuse(f"its directory {directory} does not exist")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        refuse(f"its directory {directory} is not writable")
+    for p in (path, side):
+        if os.path.isdir(p):
+            refuse(f"{p} is a directory")
+    return path, side
+
+
+def _stage(path, text):
+    """TEXT in a new file beside PATH (made with the umask's mode); returns its path."""
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=os.path.dirname(os.path.abspath(path)))
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             f.write(text)
         os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
     except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+        os.remove(tmp)
         raise
+    return tmp

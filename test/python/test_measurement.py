@@ -386,3 +386,39 @@ def test_the_worked_example_writes_only_into_its_scratch_directory():
     for p in written + [os.path.relpath(record, ROOT)]:
         r = subprocess.run(["git", "check-ignore", "-q", "--no-index", p], cwd=ROOT, timeout=60)
         assert r.returncode == 0, f"{p} is not ignored by git"
+
+
+@pytest.mark.parametrize("kw, field", [
+    ({"sample_rate_hz": 5e6}, "sample_rate_hz"),          # finer than the time column's 1 us
+    ({"sample_rate_hz": 0.01}, "sample_rate_hz"),         # fewer than 3 rows over the pass
+    ({"supports": "all"}, "supports"),
+    ({"supports": 5}, "supports"),
+    ({"head": "no"}, "head"),
+    ({"path": "y.yaml"}, "path"),                         # the CSV where its side YAML belongs
+    ({"path": "run.txt"}, "path"),
+    ({"path": "missing/run.csv"}, "path"),
+    ({"path": "."}, "path"),
+])
+def test_synthesise_record_refuses_bad_arguments_before_writing(tmp_path, kw, field):
+    kw = dict(kw)
+    path = str(tmp_path / kw.pop("path", "run.csv"))
+    with pytest.raises(cs.SceneError) as e:
+        cm.synthesise_record(REFERENCE, path, overrides=SHORT, **kw)
+    assert e.value.field == field, str(e.value)
+    assert f"{field} = " in str(e.value) and "allowed" in str(e.value)
+    assert os.listdir(tmp_path) == []
+
+
+def test_synthesise_record_leaves_nothing_when_a_file_cannot_be_placed(tmp_path, monkeypatch):
+    # The CSV cannot be moved into place after its side YAML was: neither is left, nor a staged file.
+    real = os.replace
+
+    def replace(src, dst):
+        if dst.endswith(".csv"):
+            raise PermissionError(13, "Permission denied")
+        return real(src, dst)
+    monkeypatch.setattr(os, "replace", replace)
+    with pytest.raises(cs.SceneError) as e:
+        cm.synthesise_record(REFERENCE, str(tmp_path / "run.csv"), overrides=SHORT)
+    assert e.value.field == "path" and "Permission denied" in str(e.value)
+    assert os.listdir(tmp_path) == []
