@@ -396,6 +396,10 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     # Checked here, before any cluster starts: the record, the scene, each parameter at its initial value.
     rec = cm.read_record(cal["record"], cal["meta"])
     measurable(cal, rec)
+    try:
+        cm._cutoff(cal["cutoff"], rec)
+    except SceneError as e:
+        _fail("cutoff", cal["cutoff"], e.allowed)
     # The initial values (the range's middle unless given), just inside the bounds as the
     # trust-region method needs.
     u0 = np.array([to_unit([p], [p["initial"]])[0] if "initial" in p else 0.5 for p in params])

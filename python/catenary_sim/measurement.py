@@ -312,6 +312,11 @@ def read_record(path, meta=None):
         raise RecordError("gap", path, col, frame[col].iloc[k + 1] if col else f"{dt[k]:.4g} s",
                           f"at most {max_gap:g} sample intervals between rows (metadata max_gap_samples)",
                           f"{dt[k] * sample_rate:.3g} sample intervals after the row before", row=row0 + k + 1)
+    least = least_band_hz(len(frame), sample_rate)
+    if bandwidth < least:
+        raise RecordError("metadata", path, "bandwidth_hz", _shown(doc["bandwidth_hz"]),
+                          f"at least {least:.4g} Hz for this record ({len(frame)} rows at {sample_rate:g} Hz, "
+                          f"{1.0 / least:.4g} s)", "its period exceeds the record's duration")
     supports = doc.get("supports", {}) or {}
     if not isinstance(supports, dict):
         raise RecordError("metadata", path, "supports", _shown(supports), "a map SUPPORT: station (m)", "not a map")
@@ -459,7 +464,17 @@ def simulate_run(scene, record=None, overrides=None, speed_profile=None, sensor_
     if bw is not None:
         bw = _real("sensor_bandwidth_hz", bw, "a bandwidth in Hz > 0", 1e-6)
         ov = ov + [f"output.sensor_bandwidth={bw!r}"]
-    probe = Simulation(scene, ov, sample_rate=0)
+    try:
+        probe = Simulation(scene, ov, sample_rate=0)
+    except SceneError as e:
+        if bw is None or e.field != "output.sensor_bandwidth":
+            raise
+        allowed = f"the measuring pantograph's bandwidth, output.sensor_bandwidth's {e.allowed}"
+        if sensor_bandwidth_hz is None:
+            raise RecordError("metadata", record.path, "bandwidth_hz", f"{bw:g}", allowed,
+                              "beyond what the simulated measuring pantograph takes") from None
+        raise SceneError(f"sensor_bandwidth_hz = {bw:g} rejected: allowed {allowed}", field="sensor_bandwidth_hz",
+                         value=f"{bw:g}", allowed=allowed) from None
     names = list(probe.pantograph_names)
     if record is not None:
         for name in record.force_N:
@@ -641,12 +656,35 @@ def _umask():
     return m
 
 
-def _cutoff(cutoff_hz, record, stats):
-    if cutoff_hz is None or cutoff_hz == "scene":
-        return float(stats["filter_cutoff_hz"]), "the scene's output.filter_cutoff"
-    if cutoff_hz == "bandwidth":
-        return record.bandwidth_hz, "the record's bandwidth"
-    return _real("cutoff_hz", cutoff_hz, "a cutoff in Hz > 0, 'scene' or 'bandwidth'", 1e-6), "given"
+def least_band_hz(rows, sample_rate_hz):
+    """The lowest cutoff or bandwidth a record of `rows` samples at sample_rate_hz is filtered with:
+    one period within its duration (rows / sample_rate_hz). A filter whose period is longer has no
+    whole period of the record to act on; its edge padding, not the record, makes the result."""
+    return sample_rate_hz / rows
+
+
+def _cutoff(cutoff_hz, record, stats=None):
+    """The analysis low-pass in Hz and where it comes from; refused by name below the record's
+    least band. Without stats (before the pass) the scene's cutoff is not yet known: None."""
+    least = least_band_hz(len(record.station_m), record.sample_rate_hz)
+    duration = f"at least {least:.4g} Hz for this record ({len(record.station_m)} rows at " \
+               f"{record.sample_rate_hz:g} Hz, {1.0 / least:.4g} s)"
+    if isinstance(cutoff_hz, str) and cutoff_hz == "bandwidth":
+        return record.bandwidth_hz, "the record's bandwidth"  # read_record checks it against the duration
+    if cutoff_hz is None or (isinstance(cutoff_hz, str) and cutoff_hz == "scene"):
+        if stats is None:
+            return None, "the scene's output.filter_cutoff"
+        fc = float(stats["filter_cutoff_hz"])
+        if fc < least:
+            raise SceneError(f"cutoff_hz = 'scene' rejected: the scene's output.filter_cutoff, {fc:g} Hz, has a "
+                             f"period longer than the record; allowed {duration}, or 'bandwidth'",
+                             field="cutoff_hz", value="'scene'", allowed=duration)
+        return fc, "the scene's output.filter_cutoff"
+    fc = _real("cutoff_hz", cutoff_hz, "a cutoff in Hz > 0, 'scene' or 'bandwidth'", 1e-6)
+    if fc < least:
+        raise SceneError(f"cutoff_hz = {fc:g} rejected: its period exceeds the record's duration; allowed {duration}",
+                         field="cutoff_hz", value=f"{fc:g}", allowed=duration)
+    return fc, "given"
 
 
 def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, tolerances=None, meta=None):
@@ -660,6 +698,7 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
         record = read_record(record, meta)
     owners = list(record.force_N) + list(record.uplift_m)
     tol = _check_tolerances(tolerances, owners)
+    _cutoff(cutoff_hz, record)
     run = simulate_run(scene, record, overrides, speed_profile)
     stats = run.stats
     fc, fc_source = _cutoff(cutoff_hz, record, stats)
@@ -823,7 +862,13 @@ def synthesise_record(scene, path, overrides=None, speed_profile=300.0, sample_r
     if not isinstance(head, (bool, np.bool_)):
         raise SceneError(f"head = {_shown(head)} rejected: allowed True or False (head displacement columns or "
                          "none)", field="head", value=_shown(head), allowed="True or False")
-    run = simulate_run(scene, None, overrides, speed_profile, sensor_bandwidth_hz=bw)
+    try:
+        run = simulate_run(scene, None, overrides, speed_profile, sensor_bandwidth_hz=bw)
+    except SceneError as e:
+        if e.field != "sensor_bandwidth_hz":
+            raise
+        raise SceneError(str(e).replace("sensor_bandwidth_hz", "bandwidth_hz", 1), field="bandwidth_hz",
+                         value=e.value, allowed=e.allowed) from None
     ref = run.reference
     t = np.arange(run.time_s[0], run.time_s[-1], 1.0 / fs)
     if len(t) < 3:
@@ -831,6 +876,11 @@ def synthesise_record(scene, path, overrides=None, speed_profile=300.0, sample_r
         raise SceneError(f"sample_rate_hz = {fs:g} rejected: the pass of {duration:.4g} s gives {len(t)} "
                          f"row(s); allowed at least {3.0 / duration:.4g} Hz (3 rows)", field="sample_rate_hz",
                          value=f"{fs:g}", allowed=f"at least {3.0 / duration:.4g} Hz")
+    least = least_band_hz(len(t), fs)
+    if bw < least:
+        raise SceneError(f"bandwidth_hz = {bw:g} rejected: its period exceeds the record's duration; allowed at "
+                         f"least {least:.4g} Hz for {len(t)} rows at {fs:g} Hz", field="bandwidth_hz",
+                         value=f"{bw:g}", allowed=f"at least {least:.4g} Hz")
     station = np.interp(t, run.time_s, run.position_m[ref])
     cols = {"station_m": np.round(station + origin, DECIMALS["station_m"]),
             "time_s": np.round(t - t[0], DECIMALS["time_s"]),

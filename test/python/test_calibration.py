@@ -165,6 +165,15 @@ def test_non_convergence_and_a_rough_objective_are_said_plainly(tmp_path):
     assert "NOT CONVERGED" in (tmp_path / "out" / "calibrated.yaml").read_text()
 
 
+def test_a_cutoff_longer_than_the_record_is_refused_before_anything_runs(tmp_path):
+    # The fast pass's record lasts a few seconds: 0.01 Hz has a period of 100 s.
+    path = _fast_calibration(tmp_path, "a", 3e-4, cutoff=0.01)
+    with pytest.raises(calibration.CalibrationError) as e:
+        calibration.calibrate(path, str(tmp_path / "out"), workers=1, report=False)
+    assert "'cutoff'" in str(e.value) and "at least" in str(e.value)
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.mark.parametrize("kw,words", [
     ({"workers": 0}, "workers = 0"), ({"workers": -1}, "workers = -1"), ({"workers": "two"}, "workers = 'two'"),
     ({"workers": 2.5}, "workers = 2.5"), ({"path": None}, "path = None"), ({"path": 5}, "path = 5"),

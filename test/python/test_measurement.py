@@ -422,3 +422,43 @@ def test_synthesise_record_leaves_nothing_when_a_file_cannot_be_placed(tmp_path,
         cm.synthesise_record(REFERENCE, str(tmp_path / "run.csv"), overrides=SHORT)
     assert e.value.field == "path" and "Permission denied" in str(e.value)
     assert os.listdir(tmp_path) == []
+
+
+# --------------------------------------------------------------------------------------------
+# Filters no longer than the record
+# --------------------------------------------------------------------------------------------
+def test_a_band_whose_period_exceeds_the_record_is_refused_by_its_name(tmp_path, clean):
+    # The record spans rows / sample rate seconds; a low-pass whose period is longer has no whole
+    # period of it to act on: refused, naming the least cutoff for this record.
+    duration = len(clean.station_m) / clean.sample_rate_hz
+    least = 1.0 / duration
+    err = refused(write(tmp_path, clean, meta=lambda d: d.update(bandwidth_hz=0.5 * least)), "metadata",
+                  "bandwidth_hz")
+    assert f"at least {least:.4g} Hz" in str(err)
+    with pytest.raises(cs.SceneError) as e:
+        cm.compare(REFERENCE, clean, overrides=SHORT, cutoff_hz=0.5 * least)
+    assert e.value.field == "cutoff_hz" and f"at least {least:.4g} Hz" in str(e.value)
+    with pytest.raises(cs.SceneError) as e:  # the scene's own cutoff, as low
+        cm.compare(REFERENCE, clean, overrides=SHORT + [f"output.filter_cutoff={0.5 * least!r}"])
+    assert e.value.field == "cutoff_hz" and "output.filter_cutoff" in str(e.value)
+    cm.compare(REFERENCE, clean, overrides=SHORT, cutoff_hz=1.01 * least)  # one period within: accepted
+    out = tmp_path / "never"
+    r = cli(REFERENCE, clean.path, "--out", out, "--set", SHORT[0], "--set", SHORT[1], "--cutoff", 0.5 * least)
+    assert r.returncode == 2 and "--cutoff = " in r.stderr and f"at least {least:.4g} Hz" in r.stderr, r.stderr
+    assert not out.exists()
+    with pytest.raises(cs.SceneError) as e:
+        cm.synthesise_record(REFERENCE, str(tmp_path / "s.csv"), overrides=SHORT, bandwidth_hz=1e-3)
+    assert e.value.field == "bandwidth_hz" and "exceeds the record's duration" in str(e.value)
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_a_bandwidth_beyond_the_measuring_pantographs_is_named_as_the_records(tmp_path, clean):
+    # The record's bandwidth becomes the simulated measuring pantograph's output.sensor_bandwidth:
+    # one beyond that field's range is the record's field, not a scene field the user never wrote.
+    err = refused(write(tmp_path, clean, meta=lambda d: d.update(bandwidth_hz=1e6)), "metadata", "bandwidth_hz",
+                  scene=True)
+    assert "output.sensor_bandwidth" in err.allowed
+    with pytest.raises(cs.SceneError) as e:
+        cm.synthesise_record(REFERENCE, str(tmp_path / "s.csv"), overrides=SHORT, bandwidth_hz=1e6)
+    assert e.value.field == "bandwidth_hz", str(e.value)
+    assert not (tmp_path / "s.csv").exists()
