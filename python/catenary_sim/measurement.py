@@ -14,6 +14,7 @@ through set_speed); the measuring pantograph's view of it is the core's (force_p
 output.sensor_bandwidth set to the record's bandwidth). Here only filtering, sampling and the
 statistics that are applied identically to both sides.
 """
+import csv
 import json
 import math
 import os
@@ -102,7 +103,8 @@ class Record:
 # Reading and checking a record
 # --------------------------------------------------------------------------------------------
 def _shown(v):
-    text = repr(v) if not isinstance(v, str) else v
+    """A value as it was read: text quoted (a quoted '200' is not the number 200)."""
+    text = repr(v)
     return text if len(text) <= 60 else text[:57] + "..."
 
 
@@ -121,7 +123,7 @@ def _read_metadata(path, meta, comment_lines):
                           "given both in the CSV's '#' header and in a side YAML")
     try:
         if side is not None:
-            with open(side, encoding="utf-8") as f:
+            with open(side, encoding="utf-8-sig") as f:  # a byte order mark is no part of the YAML
                 doc = yaml.safe_load(f)
         else:
             doc = yaml.safe_load(header) if header else None
@@ -145,8 +147,11 @@ def _meta_real(doc, path, key, low, high, allowed, default=None, required=True):
             raise RecordError("metadata", path, key, "absent", allowed, "required")
         return default
     v = doc[key]
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not low <= v <= high:
-        raise RecordError("metadata", path, key, _shown(v), allowed, "out of range or not a number")
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise RecordError("metadata", path, key, _shown(v), allowed + " (a number, not quoted)",
+                          f"not a number (read as {type(v).__name__})")
+    if not math.isfinite(v) or not low <= v <= high:
+        raise RecordError("metadata", path, key, _shown(v), allowed, "out of range")
     return float(v)
 
 
@@ -167,6 +172,24 @@ def _parse_columns(path, names):
     return out
 
 
+def _check_fields(path, lines, skip):
+    """Refuses a row with more fields than the header (pandas would drop them); returns whether
+    the header ends in an empty field (a trailing comma) with every row as long or one shorter."""
+    rows = list(csv.reader(lines[skip:]))
+    if not rows or not rows[0]:
+        return False
+    head = rows[0]
+    trailing = len(head) > 1 and head[-1].strip() == ""
+    names = len(head) - trailing
+    for k, row in enumerate(rows[1:]):
+        extra = row[names:]
+        if extra and not (len(extra) == 1 and extra[0].strip() == ""):
+            raise RecordError("format", path, "row", f"of {len(row)} fields",
+                              f"at most the header's {names} fields (and a trailing comma)",
+                              "more fields than the header", row=skip + k + 2)
+    return trailing
+
+
 def read_record(path, meta=None):
     """Reads and checks a record (CSV; metadata from `meta`, a side YAML of the same stem, or '#'
     lines atop the CSV). Returns a Record in SI units; raises RecordError naming the class of fault,
@@ -176,7 +199,7 @@ def read_record(path, meta=None):
     if meta is not None:
         meta = _path("meta", meta, "a YAML file path (str or os.PathLike)")
     try:
-        with open(path, encoding="utf-8", newline="") as f:
+        with open(path, encoding="utf-8-sig", newline="") as f:  # a byte order mark is no part of the text
             lines = f.read().splitlines()
     except (OSError, UnicodeDecodeError) as e:
         raise RecordError("format", path, "file", path, "a UTF-8 CSV file", f"cannot be read ({e})") from None
@@ -185,12 +208,17 @@ def read_record(path, meta=None):
         comments.append(lines[len(comments)])
     doc = _read_metadata(path, meta, comments)
     header_line = len(comments) + 1
+    trailing = _check_fields(path, lines, len(comments))
     try:
+        # index_col=False: a trailing comma on every row is an empty last field, not a shift of the
+        # columns by one (the first taken as the index); _check_fields refuses longer rows.
         frame = pd.read_csv(path, skiprows=len(comments), dtype=str, keep_default_na=False, skip_blank_lines=False,
-                            comment=None)
+                            comment=None, encoding="utf-8-sig", index_col=False)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError) as e:
         raise RecordError("format", path, "file", path, "a CSV with a header line and one row per sample",
                           str(e).strip().splitlines()[0]) from None
+    if trailing:
+        frame = frame.iloc[:, :-1]
     if len(frame) < 3:
         raise RecordError("format", path, "rows", len(frame), "at least 3 rows under the header",
                           "too few samples")
@@ -243,11 +271,12 @@ def read_record(path, meta=None):
                               f"a mean of at least {MIN_MEAN_FORCE_N:g} N", "too small for a contact force: "
                               "kN written as N?")
     listed = doc.get("pantographs", list(forces))
-    if not isinstance(listed, list) or set(listed) != set(forces):
+    if (not isinstance(listed, list) or not all(isinstance(n, str) for n in listed)
+            or sorted(listed) != sorted(forces)):
         raise RecordError("metadata", path, "pantographs", _shown(listed), "the names of the force columns: "
                           + ", ".join(forces), "does not match the force columns")
     station_of = doc.get("station_of", listed[0])
-    if station_of not in forces:
+    if not isinstance(station_of, str) or station_of not in forces:
         raise RecordError("metadata", path, "station_of", _shown(station_of), "one of " + ", ".join(forces),
                           "not a measured pantograph")
     for (q, name) in data:

@@ -462,3 +462,46 @@ def test_a_bandwidth_beyond_the_measuring_pantographs_is_named_as_the_records(tm
         cm.synthesise_record(REFERENCE, str(tmp_path / "s.csv"), overrides=SHORT, bandwidth_hz=1e6)
     assert e.value.field == "bandwidth_hz", str(e.value)
     assert not (tmp_path / "s.csv").exists()
+
+
+# --------------------------------------------------------------------------------------------
+# Files as spreadsheets and editors write them
+# --------------------------------------------------------------------------------------------
+def test_a_byte_order_mark_and_trailing_commas_read_as_the_plain_record(tmp_path, clean):
+    with open(clean.path) as f:
+        lines = f.read().splitlines()
+    with open(os.path.splitext(clean.path)[0] + ".yaml") as f:
+        doc = yaml.safe_load(f)
+    header = ["# " + ln for ln in yaml.safe_dump(doc).splitlines()]
+    variants = {
+        # a UTF-8 byte order mark before the '#' metadata lines
+        "bom": ("\ufeff" + "\n".join(header + lines) + "\n", None),
+        # ... and before a side YAML
+        "bom_side": ("\n".join(lines) + "\n", "\ufeff" + yaml.safe_dump(doc)),
+        # a trailing comma on every data row, on the header and the rows, on the header alone
+        "rows": ("\n".join(lines[:1] + [ln + "," for ln in lines[1:]]) + "\n", yaml.safe_dump(doc)),
+        "both": ("\n".join(ln + "," for ln in lines) + "\n", yaml.safe_dump(doc)),
+        "head": ("\n".join([lines[0] + ","] + lines[1:]) + "\n", yaml.safe_dump(doc)),
+    }
+    for name, (csv_text, side) in variants.items():
+        (tmp_path / f"{name}.csv").write_text(csv_text, encoding="utf-8")
+        if side is not None:
+            (tmp_path / f"{name}.yaml").write_text(side, encoding="utf-8")
+        r = cm.read_record(str(tmp_path / f"{name}.csv"))
+        assert list(r.columns.values()) == list(clean.columns.values()), name
+        assert np.array_equal(r.station_m, clean.station_m), name
+        assert np.array_equal(r.force_N["leading"], clean.force_N["leading"]), name
+        assert r.support_station_m == clean.support_station_m, name
+    # A row with a field more than the header (not an empty trailing one) is refused by its line.
+    refused(write(tmp_path, clean, {20: lambda r, h: r + ["7"]}), "format", "row", 22)
+
+
+def test_metadata_of_the_wrong_shape_is_refused_saying_what_was_read(tmp_path, clean):
+    refused(write(tmp_path, clean, meta=lambda d: d.update(station_of=["leading"])), "metadata", "station_of")
+    refused(write(tmp_path, clean, meta=lambda d: d.update(station_of={"a": 1})), "metadata", "station_of")
+    refused(write(tmp_path, clean, meta=lambda d: d.update(pantographs=[{"a": 1}])), "metadata", "pantographs")
+    refused(write(tmp_path, clean, meta=lambda d: d.update(pantographs=[["leading"]])), "metadata", "pantographs")
+    # A quoted number is text: shown quoted, as read, not as the number it looks like.
+    err = refused(write(tmp_path, clean, meta=lambda d: d.update(sample_rate_hz="200")), "metadata",
+                  "sample_rate_hz")
+    assert "'sample_rate_hz' = '200'" in str(err) and "not a number" in str(err)
