@@ -62,6 +62,8 @@ STATISTICS = ("mean_force_N", "std_force_N", "stat_max_force_N", "stat_min_force
               "contact_loss_percent")
 DIFFERENCES = ("force_rms_difference_N", "force_max_abs_difference_N", "spectrum_rms_difference_dB")
 HEAD = ("head_std_m", "head_range_m")
+# The fewest rows an analysis section holds: a mean, a spread and a spectrum need three samples.
+MIN_SECTION_ROWS = 3
 UPLIFT = ("max_uplift_m",)
 TOLERANCE_NAMES = STATISTICS + DIFFERENCES + HEAD + UPLIFT
 
@@ -73,14 +75,15 @@ class RecordError(SceneError):
 
     KINDS = ("format", "metadata", "missing_column", "unknown_column", "unknown_unit", "wrong_unit", "nan",
              "non_monotonic", "gap", "unknown_pantograph", "unknown_support", "section_outside_line",
-             "speed_profile")
+             "speed_profile", "short_section")
 
     def __init__(self, kind, path, field, value, allowed, why, row=None):
         where = f"line {row}, " if row is not None else ""
         if kind == "format":
             what = f"{field} {value}"
         else:
-            what = f"{'field' if kind in ('metadata', 'section_outside_line') else 'column'} '{field}' = {value}"
+            what = f"{'field' if kind in ('metadata', 'section_outside_line', 'short_section') else 'column'} " \
+               f"'{field}' = {value}"
         message = f"record {path}: {kind}: {where}{what}: {why}; allowed {allowed}"
         super().__init__(message, field=field, value=value, allowed=allowed)
         self.kind, self.row, self.path = kind, row, path
@@ -406,7 +409,7 @@ def welch_spectrum(force, fs, segment_s):
     segments of segment_s (the whole series when shorter), mean removed per segment, one-sided
     density, zero-padded to a power of two."""
     x = np.asarray(force, dtype=float)
-    nper = int(max(8, min(len(x), round(segment_s * fs))))
+    nper = int(min(len(x), max(8, round(segment_s * fs))))
     nfft = 1 << (nper - 1).bit_length()
     return signal.welch(x, fs=fs, window="hann", nperseg=nper, noverlap=nper // 2, nfft=nfft,
                         detrend="constant", scaling="density")
@@ -716,6 +719,20 @@ def _cutoff(cutoff_hz, record, stats=None):
     return fc, "given"
 
 
+def _span(supports, section):
+    """The span length of the scene's line at the section (m): the mean of the spans within it,
+    else (a section inside one span) the span of the line around the section's middle; None for a
+    line of fewer than two supports."""
+    within = np.diff([x for x in supports if section[0] - 1e-6 <= x <= section[1] + 1e-6])
+    if len(within):
+        return float(np.mean(within))
+    if len(supports) < 2:
+        return None
+    k = int(np.searchsorted(supports, 0.5 * (section[0] + section[1])))
+    k = min(max(k, 1), len(supports) - 1)  # beyond the line's ends: its end span
+    return float(supports[k] - supports[k - 1])
+
+
 def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, tolerances=None, meta=None):
     """Simulates the record's run on the scene and compares the two (docs/measured_records.md).
 
@@ -773,6 +790,14 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
     rec_f = {p: lowpass(v, fs, fc) for p, v in rec_view.items()}
     sim_f = {p: lowpass(v, fs, fc) for p, v in sim_view.items()}
     inside = (station >= section[0]) & (station <= section[1])
+    if inside.sum() < MIN_SECTION_ROWS:
+        step = float(np.median(np.diff(record.station_m)))
+        raise RecordError("short_section", record.path, "section_m",
+                          f"[{section[0] + record.station_origin_m:g}, {section[1] + record.station_origin_m:g}]",
+                          f"a section holding at least {MIN_SECTION_ROWS} rows (at least "
+                          f"{(MIN_SECTION_ROWS - 1) * step:.3g} m at the record's {step:.3g} m between rows)", f"it holds {int(inside.sum())} of the record's "
+                          "rows" + ("" if record.section_m is not None else
+                                    " (the scene's analysis section where the record reaches: declare section_m)"))
     columns = {"station_m": station + record.station_origin_m, "simulated_time_s": t_at,
                "simulated_speed_kmh": 3.6 * np.interp(t_at, run.time_s, run.speed_mps),
                "profile_speed_kmh": 3.6 * np.interp(station, *run.profile), "in_section": inside.astype(int)}
@@ -781,10 +806,10 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
     rows, peaks = [], {}
     spectra = []
     supports = sorted(x for x in stats.get("support_stations_m", []))
-    spans = np.diff([x for x in supports if section[0] - 1e-6 <= x <= section[1] + 1e-6])
-    mean_span = float(np.mean(spans)) if len(spans) else float(section[1] - section[0])
+    mean_span = _span(supports, section)
     v_mean = float(np.mean(np.interp(t_at[inside], run.time_s, run.speed_mps)))
-    segment_s = 8.0 * mean_span / v_mean
+    # Without a span (a line of fewer than two supports) one segment: the whole section.
+    segment_s = 8.0 * mean_span / v_mean if mean_span else float(inside.sum()) / fs
     for p in record.force_N:
         a = section_statistics(rec_f[p], inside)
         b = section_statistics(sim_f[p], inside)
@@ -838,7 +863,7 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
                                                           section[1] + record.station_origin_m],
                 "station_origin_m": record.station_origin_m, "station_of": ref,
                 "speed_profile": run.profile_source, "welch_segment_s": segment_s,
-                "span_passing_hz": v_mean / mean_span, "mean_speed_kmh": 3.6 * v_mean,
+                "span_passing_hz": v_mean / mean_span if mean_span else None, "mean_speed_kmh": 3.6 * v_mean,
                 "rows_compared": int(keep.sum()), "rows_in_section": int(inside.sum()),
                 "tolerances": {k: (f"{v[0]:g}%" if v[1] else v[0]) for k, v in tol.items()},
                 "overrides": run.overrides}

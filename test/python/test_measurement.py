@@ -505,3 +505,31 @@ def test_metadata_of_the_wrong_shape_is_refused_saying_what_was_read(tmp_path, c
     err = refused(write(tmp_path, clean, meta=lambda d: d.update(sample_rate_hz="200")), "metadata",
                   "sample_rate_hz")
     assert "'sample_rate_hz' = '200'" in str(err) and "not a number" in str(err)
+
+
+def test_a_section_of_fewer_than_three_rows_is_refused_with_the_rows_it_holds(tmp_path, clean):
+    x = clean.station_m
+    k = int(np.searchsorted(x, 160.0))  # inside the analysis section, within one span (110-165 m)
+    two = [float(x[k]), float(x[k + 1])]  # bounds included: two rows
+    err = refused(write(tmp_path, clean, meta=lambda d: d.update(section_m=two), name="two.csv"), "short_section",
+                  "section_m", scene=True)
+    assert "holds 2 of the record's rows" in str(err) and "at least 3 rows" in str(err)
+    # Three rows are enough for every statistic and the spectrum, without a warning.
+    three = write(tmp_path, clean, meta=lambda d: d.update(section_m=[float(x[k]), float(x[k + 2])]), name="3.csv")
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        c = cm.compare(REFERENCE, three, overrides=SHORT)
+    assert c.settings["rows_in_section"] == 3
+
+
+def test_the_span_passing_frequency_is_the_lines_span_at_the_mean_speed(tmp_path, clean):
+    # A section inside one span holds no two supports: the span is still the line's (55 m here),
+    # not the section's length. Both sides of the check are the same division: 1e-12 relative.
+    with open(REFERENCE) as f:
+        span = yaml.safe_load(f)["line"]["span_length"]
+    for section in ([150.0, 160.0], [100.0, 250.0]):
+        rec = write(tmp_path, clean, meta=lambda d: d.update(section_m=section), name="sec.csv")
+        c = cm.compare(REFERENCE, rec, overrides=SHORT)
+        v = c.settings["mean_speed_kmh"] / 3.6
+        assert c.settings["span_passing_hz"] == pytest.approx(v / span, rel=1e-12), section
