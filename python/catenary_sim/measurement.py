@@ -572,21 +572,33 @@ def _tolerance(tolerances, name, owner):
     return None
 
 
-def _check_tolerances(tolerances, owners):
+def _check_tolerances(tolerances, record):
+    """{key: (number, percent)} of the user's tolerances, each refused by name unless it names a
+    quantity the comparison has a row of, for an owner (pantograph or support) the record has."""
     if tolerances is None:
         return {}
     if not isinstance(tolerances, dict):
         raise SceneError(f"tolerances = {_shown(tolerances)} rejected: allowed a map NAME: tolerance",
                          field="tolerances", value=_shown(tolerances), allowed="a map NAME: tolerance")
+    # The rows the comparison forms: per pantograph its statistics and differences (the head's
+    # with a head column), per support the uplift.
+    rows = {p: STATISTICS + DIFFERENCES + (HEAD if p in record.head_m else ()) for p in record.force_N}
+    rows.update({name: UPLIFT for name in record.uplift_m})
+    present = "; ".join(f"{o}: {', '.join(q)}" for o, q in rows.items())
     out = {}
     for key, v in tolerances.items():
         name = str(key).split(".")[-1]
         owner = str(key)[:-len(name) - 1] if "." in str(key) else None
         allowed = ("NAME or OWNER.NAME with NAME one of " + ", ".join(TOLERANCE_NAMES) + " and OWNER a pantograph or "
-                   "support of the record (" + ", ".join(owners) + ")")
-        if name not in TOLERANCE_NAMES or (owner is not None and owner not in owners):
+                   "support of the record (" + ", ".join(rows) + ")")
+        if name not in TOLERANCE_NAMES or (owner is not None and owner not in rows):
             raise SceneError(f"tolerances key {key!r} rejected: allowed {allowed}", field="tolerances",
                              value=repr(key), allowed=allowed)
+        if not any(name in q for o, q in rows.items() if owner is None or o == owner):
+            needs = {**{n: " (it needs a head column)" for n in HEAD}, **{n: " (it needs supports)" for n in UPLIFT}}
+            raise SceneError(f"tolerances key {key!r} rejected: {owner or 'the record'} has no {name} to compare"
+                             f"{needs.get(name, '')}; allowed a quantity the comparison has: {present}",
+                             field="tolerances", value=repr(key), allowed=present)
         text = str(v).strip()
         m = re.fullmatch(r"([0-9.eE+-]+)\s*(%?)", text)
         try:
@@ -597,6 +609,11 @@ def _check_tolerances(tolerances, owners):
             raise SceneError(f"tolerances['{key}'] = {v!r} rejected: allowed a number >= 0 in the quantity's unit, "
                              "or 'P%' of the record's value", field=f"tolerances.{key}", value=repr(v),
                              allowed="a number >= 0, or 'P%'")
+        if m.group(2) and name in DIFFERENCES:
+            unit = name.rsplit("_", 1)[1]
+            raise SceneError(f"tolerances['{key}'] = {v!r} rejected: {name} is itself a difference of the two sides, "
+                             f"with no record's value to take a share of; allowed a number >= 0 in {unit}",
+                             field=f"tolerances.{key}", value=repr(v), allowed=f"a number >= 0 in {unit}")
         out[str(key)] = (num, bool(m.group(2)))
     return out
 
@@ -742,8 +759,7 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
     'bandwidth' (the record's) or Hz; tolerances: {NAME or OWNER.NAME: number or 'P%'}."""
     if not isinstance(record, Record):
         record = read_record(record, meta)
-    owners = list(record.force_N) + list(record.uplift_m)
-    tol = _check_tolerances(tolerances, owners)
+    tol = _check_tolerances(tolerances, record)
     _cutoff(cutoff_hz, record)
     run = simulate_run(scene, record, overrides, speed_profile)
     stats = run.stats

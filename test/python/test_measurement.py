@@ -533,3 +533,30 @@ def test_the_span_passing_frequency_is_the_lines_span_at_the_mean_speed(tmp_path
         c = cm.compare(REFERENCE, rec, overrides=SHORT)
         v = c.settings["mean_speed_kmh"] / 3.6
         assert c.settings["span_passing_hz"] == pytest.approx(v / span, rel=1e-12), section
+
+
+@pytest.mark.parametrize("tolerances, words", [
+    # a difference of the two sides has no record's value to take a percentage of
+    ({"force_rms_difference_N": "10%"}, "is itself a difference"),
+    ({"leading.spectrum_rms_difference_dB": "5 %"}, "is itself a difference"),
+    # an owner without such a row, a quantity no owner has
+    ({"A2.mean_force_N": 1}, "A2 has no mean_force_N"),
+    ({"leading.max_uplift_m": 0.01}, "leading has no max_uplift_m"),
+    ({"trailing.mean_force_N": 1}, "'trailing.mean_force_N'"),
+])
+def test_a_tolerance_the_comparison_cannot_apply_is_refused(clean, tolerances, words):
+    with pytest.raises(cs.SceneError) as e:
+        cm.compare(REFERENCE, clean, overrides=SHORT, tolerances=tolerances)
+    assert words in str(e.value) and "allowed" in str(e.value), str(e.value)
+
+
+def test_a_tolerance_of_the_head_needs_a_head_column(tmp_path, clean):
+    with open(clean.path) as f:
+        rows = [ln.split(",") for ln in f.read().splitlines()]
+    k = rows[0].index("head_leading_mm")
+    (tmp_path / "bare.csv").write_text("\n".join(",".join(r[:k] + r[k + 1:]) for r in rows) + "\n")
+    with open(os.path.splitext(clean.path)[0] + ".yaml") as f:
+        (tmp_path / "bare.yaml").write_text(f.read())
+    with pytest.raises(cs.SceneError) as e:
+        cm.compare(REFERENCE, str(tmp_path / "bare.csv"), overrides=SHORT, tolerances={"head_std_m": 1e-3})
+    assert "the record has no head_std_m" in str(e.value) and "head column" in str(e.value)
