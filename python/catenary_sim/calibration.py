@@ -186,7 +186,42 @@ def load_calibration(path):
     if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 100000:
         _fail("optimiser.max_evaluations", n, "an integer from 1 to 100000")
     out["optimiser"] = {"method": method, "max_evaluations": n}
+    check_bounds(out)
     return out
+
+
+def check_bounds(cal):
+    """Refuses a parameter's low or high the scene refuses (beyond the field's range, or a scene
+    it makes invalid), naming the calibration field: the scene is checked with the overrides and
+    each bound in turn, then with every parameter at its initial value, before any pass."""
+    from . import check_scene
+    params = cal["parameters"]
+    try:
+        check_scene(cal["scene"], cal["overrides"])
+    except SceneError as e:
+        raise CalibrationError(f"calibration {cal['path']}: {e}") from None
+
+    def refers_to(e, value):  # the scene's error is about this value of the field
+        try:
+            return math.isclose(float(e.value), value, rel_tol=1e-9, abs_tol=0.0)
+        except (TypeError, ValueError):
+            return False
+
+    for i, p in enumerate(params):
+        for bound in ("low", "high"):
+            try:
+                check_scene(cal["scene"], dict(cal["overrides"], **{p["key"]: p[bound]}))
+            except SceneError as e:
+                if e.field == p["key"] and refers_to(e, p[bound]):
+                    _fail(f"parameters[{i}].{bound}", p[bound], f"the scene field {p['key']}'s {e.allowed}")
+                if e.field == p["key"]:
+                    _fail(f"parameters[{i}].key", p["key"], f"a number field of the scene ({e})")
+                _fail(f"parameters[{i}].{bound}", p[bound], f"a bound the scene takes ({e})")
+    start = {p["key"]: p.get("initial", to_values([p], [0.5])[0]) for p in params}
+    try:
+        check_scene(cal["scene"], dict(cal["overrides"], **start))
+    except SceneError as e:
+        raise CalibrationError(f"calibration {cal['path']}: parameters at their initial values {start}: {e}") from None
 
 
 # --------------------------------------------------------------------------------------------
