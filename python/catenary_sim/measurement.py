@@ -17,11 +17,13 @@ statistics that are applied identically to both sides.
 import csv
 import json
 import math
+import numbers
 import os
 import re
 import shutil
 import tempfile
 import textwrap
+from collections.abc import Iterable
 
 import numpy as np
 import pandas as pd
@@ -386,16 +388,47 @@ def read_record(path, meta=None):
 def lowpass(x, fs, fc):
     """The core's zero-phase low-pass (output/zero_phase_filter.cpp), the filter of stats.json: a
     4th-order Butterworth run forward and backward with odd reflection at both ends; a cutoff at or
-    above Nyquist passes the series through."""
-    return np.asarray(_core._lowpass_zero_phase(np.asarray(x, dtype=float), float(fs), float(fc)))
+    above Nyquist passes the series through. x: a 1-D sequence of numbers; fs, fc: numbers (the
+    core refuses values out of range by name)."""
+    x = _series("x", x, finite=False)  # the core names a sample that is not finite
+    for name, v in (("sample rate fs", fs), ("cutoff fc", fc)):
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+            raise SceneError(f"{name} = {_shown(v)} rejected: allowed a finite frequency > 0 Hz (a number)",
+                             field=name.split()[-1], value=_shown(v), allowed="a finite frequency > 0 Hz")
+    return np.asarray(_core._lowpass_zero_phase(x, float(fs), float(fc)))
+
+
+def _series(name, x, length=None, finite=True):
+    """x as a 1-D float array, refused by name unless it is one of (finite) numbers (of `length`)."""
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        a = None
+    if a is None or a.ndim != 1 or (length is not None and len(a) != length):
+        allowed = "a 1-D sequence of numbers" + (f" of length {length}" if length is not None else "")
+        raise SceneError(f"{name} = {_shown(x)} rejected: allowed {allowed}", field=name, value=_shown(x),
+                         allowed=allowed)
+    bad = ~np.isfinite(a) if finite else np.zeros(a.shape, dtype=bool)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise SceneError(f"{name}[{k}] = {a[k]!r} rejected: allowed finite numbers", field=name, value=repr(a[k]),
+                         allowed="finite numbers")
+    return a
 
 
 def section_statistics(force, inside, loss_force=None):
     """The statistics of stats.json on one force series over the samples `inside` (a boolean mask):
     mean, population std, mean +- 3 std, the actual max and min, and the share of samples with
     loss_force (default: force) <= 0, in percent."""
-    f = np.asarray(force, dtype=float)[inside]
-    lf = (np.asarray(loss_force, dtype=float) if loss_force is not None else np.asarray(force, dtype=float))[inside]
+    force = _series("force", force)
+    mask = np.asarray(inside)
+    if mask.dtype != bool or mask.shape != force.shape:
+        allowed = f"a boolean mask of the force's length ({len(force)})"
+        raise SceneError(f"inside = {_shown(inside)} rejected: allowed {allowed}", field="inside",
+                         value=_shown(inside), allowed=allowed)
+    loss = _series("loss_force", loss_force, len(force)) if loss_force is not None else force
+    f = force[mask]
+    lf = loss[mask]
     if f.size == 0:
         return {k: None for k in STATISTICS}
     mean, std = float(np.mean(f)), float(np.std(f))
@@ -490,6 +523,10 @@ def simulate_run(scene, record=None, overrides=None, speed_profile=None, sensor_
     `pantograph` (default: the record's station_of, else the first), linear between the profile's
     stations and held beyond its ends. The measuring pantograph's bandwidth is the record's (or
     sensor_bandwidth_hz). Refuses a record's pantograph or support the scene lacks."""
+    if record is not None and not isinstance(record, Record):
+        raise SceneError(f"record = {_shown(record)} rejected: allowed None or a Record (read_record's)",
+                         field="record", value=_shown(record), allowed="None or a Record")
+    max_steps = _real("max_steps", max_steps, "a number of steps >= 1", 1.0)
     ov = _override_list(overrides)
     px, pv, source = _profile(record, speed_profile)
     bw = sensor_bandwidth_hz if sensor_bandwidth_hz is not None else (record.bandwidth_hz if record else None)
@@ -535,7 +572,8 @@ def simulate_run(scene, record=None, overrides=None, speed_profile=None, sensor_
         speeds.append(sim.speed)
         steps += 1
         if steps > max_steps:
-            raise SceneError(f"max_steps = {max_steps:g} rejected: the pass takes longer", field="max_steps",
+            raise SceneError(f"max_steps = {max_steps:g} rejected: the pass takes longer; allowed more steps, or a "
+                             "faster profile", field="max_steps",
                              value=repr(max_steps), allowed="more steps, or a faster profile")
     series = sim.series()
     with tempfile.TemporaryDirectory(prefix="catenary_sim_measure_") as d:
@@ -899,6 +937,13 @@ DECIMALS = {"station_m": 6, "time_s": 6, "speed_kmh": 6, "force": 4, "uplift_mm"
 def noise_after_filters(noise_std, fs, cutoffs, n=1 << 16):
     """The std of white noise of noise_std at fs after the zero-phase low-passes at `cutoffs`:
     sqrt of sigma^2 x the mean of prod |H_k(f)|^4 over [0, fs/2] (filtfilt squares |H|)."""
+    noise_std = _real("noise_std", noise_std, "a noise std >= 0", 0.0)
+    fs = _real("fs", fs, "a sample rate in Hz > 0", 1e-300)
+    if isinstance(cutoffs, (str, bytes)) or not isinstance(cutoffs, Iterable):
+        raise SceneError(f"cutoffs = {_shown(cutoffs)} rejected: allowed a sequence of cutoffs in Hz > 0",
+                         field="cutoffs", value=_shown(cutoffs), allowed="a sequence of cutoffs in Hz > 0")
+    cutoffs = [_real(f"cutoffs[{k}]", c, "a cutoff in Hz > 0", 1e-300) for k, c in enumerate(cutoffs)]
+    n = _integer("n", n, "an integer number of frequencies >= 2", 2, 1 << 26)
     f = np.linspace(0.0, 0.5 * fs, n)
     gain = np.ones_like(f)
     for fc in cutoffs:

@@ -560,3 +560,27 @@ def test_a_tolerance_of_the_head_needs_a_head_column(tmp_path, clean):
     with pytest.raises(cs.SceneError) as e:
         cm.compare(REFERENCE, str(tmp_path / "bare.csv"), overrides=SHORT, tolerances={"head_std_m": 1e-3})
     assert "the record has no head_std_m" in str(e.value) and "head column" in str(e.value)
+
+
+@pytest.mark.parametrize("call, named", [
+    (lambda: cm.lowpass([1.0, 2.0, 3.0, 4.0], 100.0, "a"), "cutoff fc = 'a'"),
+    (lambda: cm.lowpass([1.0, 2.0, 3.0, 4.0], None, 20.0), "sample rate fs = None"),
+    (lambda: cm.lowpass([[1.0, 2.0], [3.0, 4.0]], 100.0, 20.0), "x = [[1.0, 2.0], [3.0, 4.0]]"),
+    (lambda: cm.lowpass(["a", "b"], 100.0, 20.0), "x = ['a', 'b']"),
+    (lambda: cm.section_statistics([1.0, 2.0, 3.0], [0, 1, 1]), "inside = [0, 1, 1]"),  # not an index
+    (lambda: cm.section_statistics([1.0, 2.0, 3.0], np.array([True, True])), "inside = "),
+    (lambda: cm.section_statistics([1.0, float("nan"), 3.0], np.ones(3, bool)), "force[1] = nan"),
+    (lambda: cm.section_statistics([1.0, 2.0, 3.0], np.ones(3, bool), [1.0, 2.0]), "loss_force = [1.0, 2.0]"),
+    (lambda: cm.noise_after_filters(-3.0, 200.0, [20.0]), "noise_std = -3.0"),
+    (lambda: cm.noise_after_filters(3.0, float("nan"), [20.0]), "fs = nan"),
+    (lambda: cm.noise_after_filters(3.0, 200.0, [0.0]), "cutoffs[0] = 0.0"),
+    (lambda: cm.noise_after_filters(3.0, 200.0, 20.0), "cutoffs = 20.0"),
+    (lambda: cm.noise_after_filters(3.0, 200.0, [20.0], n=0), "n = 0"),
+    (lambda: cm.simulate_run(REFERENCE, None, SHORT, 280.0, max_steps=float("nan")), "max_steps = nan"),
+    (lambda: cm.simulate_run(REFERENCE, None, SHORT, 280.0, max_steps="many"), "max_steps = 'many'"),
+    (lambda: cm.simulate_run(REFERENCE, 5, SHORT), "record = 5"),
+])
+def test_the_functions_refuse_bad_arguments_by_name(call, named):
+    with pytest.raises(ValueError) as e:
+        call()
+    assert named in str(e.value) and "allowed" in str(e.value), str(e.value)
