@@ -19,6 +19,7 @@ A calibration file (YAML; paths relative to it):
       time_history: 1                   # (simulated - record) / std(record), rms over the section
       spectrum: 0                       # dB differences up to the cutoff, rms
     optimiser: {method: least_squares, max_evaluations: 60}   # or minimize:Nelder-Mead, minimize:Powell
+                                        # max_evaluations: the passes run, Jacobians' and uncertainty's too
 
 Every evaluation is catenary_sim.measurement.compare with the parameters as overrides, run on a
 Dask cluster (a local one of --workers processes by default) and written atomically to
@@ -183,11 +184,24 @@ def load_calibration(path):
     if method not in METHODS:
         _fail("optimiser.method", method, "one of " + ", ".join(METHODS))
     n = opt.get("max_evaluations", 100)
-    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 100000:
-        _fail("optimiser.max_evaluations", n, "an integer from 1 to 100000")
+    least = 2 + reserved_passes(len(params))
+    if isinstance(n, bool) or not isinstance(n, int) or not least <= n <= 100000:
+        _fail("optimiser.max_evaluations", n, f"an integer from {least} to 100000: the passes the calibration runs, "
+              f"at least the optimiser's first two and the {reserved_passes(len(params))} of the uncertainty at its "
+              f"end for {len(params)} parameter(s)")
     out["optimiser"] = {"method": method, "max_evaluations": n}
     check_bounds(out)
     return out
+
+
+def reserved_passes(n):
+    """The passes kept for the uncertainty at the optimum of n parameters: the Jacobian's n + 1 and
+    the n one difference step on the other side (its point may be one already run)."""
+    return 2 * n + 1
+
+
+class _OutOfPasses(Exception):
+    """The optimiser asked for more passes than optimiser.max_evaluations leaves it."""
 
 
 def check_bounds(cal):
@@ -332,9 +346,18 @@ class _Evaluator:
         self.context = fingerprint(cal)
         os.makedirs(self.dir, exist_ok=True)
         self.count = self.replayed = 0
+        # The parameter points this calibration has evaluated: each a pass, run now or by an
+        # earlier start on the same DIR (read back), counted against `limit` once.
+        self.points = set()
+        self.limit = None
+        self.best = (math.inf, None)
 
     def many(self, us):
         values = [to_values(self.cal["parameters"], u) for u in us]
+        new = {_key(self.context, v) for v in values} - self.points
+        if self.limit is not None and len(self.points) + len(new) > self.limit:
+            raise _OutOfPasses()
+        self.points |= new
         results, todo = [None] * len(values), []
         for i, v in enumerate(values):
             path = os.path.join(self.dir, _key(self.context, v) + ".json")
@@ -361,6 +384,10 @@ class _Evaluator:
             results[i] = np.array(r["residuals"])
             self.band_hz = r["band_hz"]
         self.count += len(values)
+        for u, r in zip(us, results):
+            cost = 0.5 * float(np.sum(r ** 2))
+            if cost < self.best[0]:
+                self.best = (cost, np.array(u, dtype=float))
         return results
 
     def jacobian(self, u):
@@ -461,17 +488,28 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
         os.makedirs(out, exist_ok=True)
         ev = _Evaluator(cal, out, client)
         budget = cal["optimiser"]["max_evaluations"]
+        # Every pass counts against the budget, the Jacobian's too; the optimiser may use all but
+        # those the uncertainty at its end needs, and stops cleanly at its share.
+        ev.limit = budget - reserved_passes(len(params))
         r0 = ev.many([u0])[0]
-        if cal["optimiser"]["method"] == "least_squares":
-            res = optimize.least_squares(lambda u: ev.many([u])[0], u0, jac=lambda u: ev.jacobian(u)[1],
-                                         bounds=(np.zeros(len(u0)), np.ones(len(u0))), method="trf",
-                                         max_nfev=budget, x_scale=1.0)
-            u = res.x
-        else:
-            method = cal["optimiser"]["method"].split(":", 1)[1]
-            res = optimize.minimize(lambda u: 0.5 * float(np.sum(ev.many([u])[0] ** 2)), u0, method=method,
-                                    bounds=[(0.0, 1.0)] * len(u0), options={"maxfev": budget})
-            u = np.clip(res.x, 0.0, 1.0)
+        try:
+            if cal["optimiser"]["method"] == "least_squares":
+                res = optimize.least_squares(lambda u: ev.many([u])[0], u0, jac=lambda u: ev.jacobian(u)[1],
+                                             bounds=(np.zeros(len(u0)), np.ones(len(u0))), method="trf",
+                                             max_nfev=budget, x_scale=1.0)
+                u = res.x
+            else:
+                method = cal["optimiser"]["method"].split(":", 1)[1]
+                res = optimize.minimize(lambda u: 0.5 * float(np.sum(ev.many([u])[0] ** 2)), u0, method=method,
+                                        bounds=[(0.0, 1.0)] * len(u0), options={"maxfev": budget})
+                u = np.clip(res.x, 0.0, 1.0)
+            converged, message = bool(res.success), str(res.message)
+        except _OutOfPasses:
+            # The best point evaluated so far.
+            u, converged = ev.best[1], False
+            message = (f"stopped at optimiser.max_evaluations = {budget} passes ({len(ev.points)} run by the "
+                       f"optimiser, {reserved_passes(len(params))} kept for the uncertainty at its end)")
+        ev.limit = budget
         r, jac = ev.jacobian(u)
         # The linear model checked on the other side of the optimum, one difference step away.
         steps = [-DIFF_STEP if u[i] - DIFF_STEP >= 0.0 else 2 * DIFF_STEP for i in range(len(u))]
@@ -492,8 +530,8 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
                          why_not="uncertainty not available: the objective is rough at the difference step "
                                  "(a finer numerics.preset makes it smooth)")
         result = {"calibration": os.path.abspath(path), "method": cal["optimiser"]["method"],
-                  "converged": bool(res.success), "message": str(res.message),
-                  "evaluations": ev.count, "replayed": ev.replayed,
+                  "converged": converged, "message": message, "max_evaluations": budget,
+                  "passes": len(ev.points), "evaluations": ev.count, "replayed": ev.replayed,
                   "cost_before": 0.5 * float(np.sum(r0 ** 2)), "cost_after": 0.5 * float(np.sum(r ** 2)),
                   "rms_residual_before": float(np.sqrt(np.mean(r0 ** 2))),
                   "rms_residual_after": float(np.sqrt(np.mean(r ** 2))),
@@ -553,7 +591,7 @@ def main():
         else:
             print("%-32s %.6g +- %.2g%s" % (p["key"], p["value"], p["std"],
                                            "" if p["identifiable"] else "  NOT IDENTIFIABLE: " + p["why_not"]))
-    print("rms residual %.4g (was %.4g), %d evaluations (%d replayed); wrote %s" % (
-        result["rms_residual_after"], result["rms_residual_before"], result["evaluations"], result["replayed"],
-        a.out))
+    print("rms residual %.4g (was %.4g), %d passes of at most %d (max_evaluations), %d evaluations (%d read "
+          "back); wrote %s" % (result["rms_residual_after"], result["rms_residual_before"], result["passes"],
+                               result["max_evaluations"], result["evaluations"], result["replayed"], a.out))
     return 0

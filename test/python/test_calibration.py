@@ -147,7 +147,7 @@ def test_an_objective_the_record_cannot_measure_is_refused_before_anything_runs(
     spec = {"scene": REFERENCE, "record": "bare.csv", "overrides": FAST,
             "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3, "scale": "log"}],
             "objective": {"statistics": {"max_uplift_m": 1}, "time_history": 0},
-            "optimiser": {"max_evaluations": 2}}
+            "optimiser": {"max_evaluations": 5}}
     path = tmp_path / "cal.yaml"
     path.write_text(yaml.safe_dump(spec))
     with pytest.raises(calibration.CalibrationError) as e:
@@ -157,9 +157,10 @@ def test_an_objective_the_record_cannot_measure_is_refused_before_anything_runs(
 
 
 def test_non_convergence_and_a_rough_objective_are_said_plainly(tmp_path):
-    # Two evaluations cannot converge; the fast preset's objective is rough at the difference step
-    # (the last bit of a parameter moves it by tens of per cent), so no uncertainty can be given.
-    path = _fast_calibration(tmp_path, "a", 3e-4, optimiser={"method": "least_squares", "max_evaluations": 2})
+    # Five passes (the least for one parameter: two for the optimiser, three for the uncertainty)
+    # cannot converge; the fast preset's objective is rough at the difference step (the last bit
+    # of a parameter moves it by tens of per cent), so no uncertainty can be given.
+    path = _fast_calibration(tmp_path, "a", 3e-4, optimiser={"method": "least_squares", "max_evaluations": 5})
     r = subprocess.run([sys.executable, CLI, path, "--out", str(tmp_path / "out"), "--workers", "1", "--no-report"],
                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
     assert r.returncode == 0, r.stdout[-3000:]
@@ -168,6 +169,22 @@ def test_non_convergence_and_a_rough_objective_are_said_plainly(tmp_path):
     assert not result["uncertainty_available"] and "UNCERTAINTY NOT AVAILABLE" in r.stdout
     assert all(p["std"] is None for p in result["parameters"]) and "+-" not in r.stdout
     assert "NOT CONVERGED" in (tmp_path / "out" / "calibrated.yaml").read_text()
+
+
+def test_max_evaluations_bounds_every_pass_the_calibration_runs(tmp_path):
+    # Each distinct parameter point is one pass and one file in evaluations/: the optimiser's
+    # function and Jacobian passes and the uncertainty's at the end together stay within the
+    # bound, and a calibration stopped by it says so.
+    path = _fast_calibration(tmp_path, "a", 3e-4, optimiser={"method": "least_squares", "max_evaluations": 7})
+    r = subprocess.run([sys.executable, CLI, path, "--out", str(tmp_path / "out"), "--workers", "1", "--no-report"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert r.returncode == 0, r.stdout[-3000:]
+    result = json.loads((tmp_path / "out" / "calibration.json").read_text())
+    kept = _kept(tmp_path / "out" / "evaluations")
+    assert len(kept) <= 7, (len(kept), result)
+    assert result["passes"] == len(kept)
+    assert not result["converged"] and "max_evaluations = 7" in result["message"]
+    assert "NOT CONVERGED" in r.stdout and "max_evaluations" in r.stdout
 
 
 def test_a_cutoff_longer_than_the_record_is_refused_before_anything_runs(tmp_path):
