@@ -374,13 +374,7 @@ class _Evaluator:
         futures = [self.client.submit(evaluate, self.cal, self.keys, values[i], pure=False) for i in todo]
         for i, fut in zip(todo, futures):
             r = fut.result()
-            if not r["residuals"] or not np.all(np.isfinite(r["residuals"])):
-                raise CalibrationError(
-                    f"calibration {self.cal['path']}: objective = {self.cal['objective']!r} gives "
-                    f"{'no residuals' if not r['residuals'] else 'non-finite residuals'} at "
-                    f"{dict(zip(self.keys, values[i]))}; allowed an objective the record and the pass can measure")
-            _write_atomically(os.path.join(self.dir, _key(self.context, values[i]) + ".json"),
-                              json.dumps({"context": self.context, "values": dict(zip(self.keys, values[i])), **r}))
+            self.keep(values[i], r)
             results[i] = np.array(r["residuals"])
             self.band_hz = r["band_hz"]
         self.count += len(values)
@@ -389,6 +383,16 @@ class _Evaluator:
             if cost < self.best[0]:
                 self.best = (cost, np.array(u, dtype=float))
         return results
+
+    def keep(self, values, r):
+        """Checks an evaluation's residuals and keeps it in DIR/evaluations/."""
+        if not r["residuals"] or not np.all(np.isfinite(r["residuals"])):
+            raise CalibrationError(
+                f"calibration {self.cal['path']}: objective = {self.cal['objective']!r} gives "
+                f"{'no residuals' if not r['residuals'] else 'non-finite residuals'} at "
+                f"{dict(zip(self.keys, values))}; allowed an objective the record and the pass can measure")
+        _write_atomically(os.path.join(self.dir, _key(self.context, values) + ".json"),
+                          json.dumps({"context": self.context, "values": dict(zip(self.keys, values)), **r}))
 
     def jacobian(self, u):
         """Forward differences in the unit scale, stepping inwards at an upper bound; all n + 1
@@ -473,6 +477,19 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
         check_scene(cal["scene"], ov)
     except SceneError as e:
         raise CalibrationError(f"calibration {path}: {e}") from None
+    # The first evaluation here, before a cluster starts or DIR is made (unless DIR keeps it):
+    # what only the comparison refuses (the record's section, supports or bandwidth against the
+    # scene) is refused with nothing written; the cluster then reads it back.
+    v0 = to_values(params, u0)
+    kept = os.path.join(out, "evaluations", _key(fingerprint(cal), v0) + ".json")
+    first = None
+    if not os.path.isfile(kept):
+        try:
+            first = evaluate(cal, [p["key"] for p in params], v0)
+        except SceneError as e:
+            raise CalibrationError(f"calibration {path}: {e}") from None
+        if not first["residuals"] or not np.all(np.isfinite(first["residuals"])):
+            first = None  # refused by the evaluator with its message, as any evaluation
     own = None
     if scheduler:
         try:
@@ -487,6 +504,8 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     try:
         os.makedirs(out, exist_ok=True)
         ev = _Evaluator(cal, out, client)
+        if first is not None:
+            ev.keep(v0, first)
         budget = cal["optimiser"]["max_evaluations"]
         # Every pass counts against the budget, the Jacobian's too; the optimiser may use all but
         # those the uncertainty at its end needs, and stops cleanly at its share.

@@ -89,6 +89,11 @@ class RecordError(SceneError):
         message = f"record {path}: {kind}: {where}{what}: {why}; allowed {allowed}"
         super().__init__(message, field=field, value=value, allowed=allowed)
         self.kind, self.row, self.path = kind, row, path
+        self._args = (kind, path, field, value, allowed, why, row)
+
+    def __reduce__(self):
+        # Rebuilt from its own arguments when it crosses processes (a calibration's Dask worker).
+        return (self.__class__, self._args)
 
 
 class Record:

@@ -187,6 +187,19 @@ def test_max_evaluations_bounds_every_pass_the_calibration_runs(tmp_path):
     assert "NOT CONVERGED" in r.stdout and "max_evaluations" in r.stdout
 
 
+def test_what_only_the_comparison_refuses_leaves_no_directory(tmp_path):
+    # A record bandwidth beyond the measuring pantograph's range is found by the first pass: it is
+    # run before the cluster starts and the output directory is made, and named as the record's.
+    path = _fast_calibration(tmp_path, "a", 3e-4)
+    meta = yaml.safe_load((tmp_path / "a.yaml").read_text())
+    meta["bandwidth_hz"] = 1e6
+    (tmp_path / "a.yaml").write_text(yaml.safe_dump(meta))
+    with pytest.raises(calibration.CalibrationError) as e:
+        calibration.calibrate(path, str(tmp_path / "out"), workers=1, report=False)
+    assert "'bandwidth_hz'" in str(e.value) and "output.sensor_bandwidth" in str(e.value)
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_cutoff_longer_than_the_record_is_refused_before_anything_runs(tmp_path):
     # The fast pass's record lasts a few seconds: 0.01 Hz has a period of 100 s.
     path = _fast_calibration(tmp_path, "a", 3e-4, cutoff=0.01)

@@ -584,3 +584,12 @@ def test_the_functions_refuse_bad_arguments_by_name(call, named):
     with pytest.raises(ValueError) as e:
         call()
     assert named in str(e.value) and "allowed" in str(e.value), str(e.value)
+
+
+def test_a_record_error_crosses_processes_whole():
+    # A calibration's Dask worker sends its errors back pickled: the kind, field and line survive.
+    import pickle
+    err = cm.RecordError("nan", "run.csv", "force_leading_N", "'x'", "a finite number", "not a number", row=12)
+    back = pickle.loads(pickle.dumps(err))
+    assert type(back) is cm.RecordError and str(back) == str(err)
+    assert (back.kind, back.field, back.row, back.path) == ("nan", "force_leading_N", 12, "run.csv")
