@@ -19,6 +19,7 @@ A calibration file (YAML; paths relative to it):
       time_history: 1                   # (simulated - record) / std(record), rms over the section
       spectrum: 0                       # dB differences up to the cutoff, rms
     optimiser: {method: least_squares, max_evaluations: 60}   # or minimize:Nelder-Mead, minimize:Powell
+                                        # max_evaluations: the passes run, Jacobians' and uncertainty's too
 
 Every evaluation is catenary_sim.measurement.compare with the parameters as overrides, run on a
 Dask cluster (a local one of --workers processes by default) and written atomically to
@@ -183,10 +184,58 @@ def load_calibration(path):
     if method not in METHODS:
         _fail("optimiser.method", method, "one of " + ", ".join(METHODS))
     n = opt.get("max_evaluations", 100)
-    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 100000:
-        _fail("optimiser.max_evaluations", n, "an integer from 1 to 100000")
+    least = 2 + reserved_passes(len(params))
+    if isinstance(n, bool) or not isinstance(n, int) or not least <= n <= 100000:
+        _fail("optimiser.max_evaluations", n, f"an integer from {least} to 100000: the passes the calibration runs, "
+              f"at least the optimiser's first two and the {reserved_passes(len(params))} of the uncertainty at its "
+              f"end for {len(params)} parameter(s)")
     out["optimiser"] = {"method": method, "max_evaluations": n}
+    check_bounds(out)
     return out
+
+
+def reserved_passes(n):
+    """The passes kept for the uncertainty at the optimum of n parameters: the Jacobian's n + 1 and
+    the n one difference step on the other side (its point may be one already run)."""
+    return 2 * n + 1
+
+
+class _OutOfPasses(Exception):
+    """The optimiser asked for more passes than optimiser.max_evaluations leaves it."""
+
+
+def check_bounds(cal):
+    """Refuses a parameter's low or high the scene refuses (beyond the field's range, or a scene
+    it makes invalid), naming the calibration field: the scene is checked with the overrides and
+    each bound in turn, then with every parameter at its initial value, before any pass."""
+    from . import check_scene
+    params = cal["parameters"]
+    try:
+        check_scene(cal["scene"], cal["overrides"])
+    except SceneError as e:
+        raise CalibrationError(f"calibration {cal['path']}: {e}") from None
+
+    def refers_to(e, value):  # the scene's error is about this value of the field
+        try:
+            return math.isclose(float(e.value), value, rel_tol=1e-9, abs_tol=0.0)
+        except (TypeError, ValueError):
+            return False
+
+    for i, p in enumerate(params):
+        for bound in ("low", "high"):
+            try:
+                check_scene(cal["scene"], dict(cal["overrides"], **{p["key"]: p[bound]}))
+            except SceneError as e:
+                if e.field == p["key"] and refers_to(e, p[bound]):
+                    _fail(f"parameters[{i}].{bound}", p[bound], f"the scene field {p['key']}'s {e.allowed}")
+                if e.field == p["key"]:
+                    _fail(f"parameters[{i}].key", p["key"], f"a number field of the scene ({e})")
+                _fail(f"parameters[{i}].{bound}", p[bound], f"a bound the scene takes ({e})")
+    start = {p["key"]: p.get("initial", to_values([p], [0.5])[0]) for p in params}
+    try:
+        check_scene(cal["scene"], dict(cal["overrides"], **start))
+    except SceneError as e:
+        raise CalibrationError(f"calibration {cal['path']}: parameters at their initial values {start}: {e}") from None
 
 
 # --------------------------------------------------------------------------------------------
@@ -297,9 +346,18 @@ class _Evaluator:
         self.context = fingerprint(cal)
         os.makedirs(self.dir, exist_ok=True)
         self.count = self.replayed = 0
+        # The parameter points this calibration has evaluated: each a pass, run now or by an
+        # earlier start on the same DIR (read back), counted against `limit` once.
+        self.points = set()
+        self.limit = None
+        self.best = (math.inf, None)
 
     def many(self, us):
         values = [to_values(self.cal["parameters"], u) for u in us]
+        new = {_key(self.context, v) for v in values} - self.points
+        if self.limit is not None and len(self.points) + len(new) > self.limit:
+            raise _OutOfPasses()
+        self.points |= new
         results, todo = [None] * len(values), []
         for i, v in enumerate(values):
             path = os.path.join(self.dir, _key(self.context, v) + ".json")
@@ -316,17 +374,25 @@ class _Evaluator:
         futures = [self.client.submit(evaluate, self.cal, self.keys, values[i], pure=False) for i in todo]
         for i, fut in zip(todo, futures):
             r = fut.result()
-            if not r["residuals"] or not np.all(np.isfinite(r["residuals"])):
-                raise CalibrationError(
-                    f"calibration {self.cal['path']}: objective = {self.cal['objective']!r} gives "
-                    f"{'no residuals' if not r['residuals'] else 'non-finite residuals'} at "
-                    f"{dict(zip(self.keys, values[i]))}; allowed an objective the record and the pass can measure")
-            _write_atomically(os.path.join(self.dir, _key(self.context, values[i]) + ".json"),
-                              json.dumps({"context": self.context, "values": dict(zip(self.keys, values[i])), **r}))
+            self.keep(values[i], r)
             results[i] = np.array(r["residuals"])
             self.band_hz = r["band_hz"]
         self.count += len(values)
+        for u, r in zip(us, results):
+            cost = 0.5 * float(np.sum(r ** 2))
+            if cost < self.best[0]:
+                self.best = (cost, np.array(u, dtype=float))
         return results
+
+    def keep(self, values, r):
+        """Checks an evaluation's residuals and keeps it in DIR/evaluations/."""
+        if not r["residuals"] or not np.all(np.isfinite(r["residuals"])):
+            raise CalibrationError(
+                f"calibration {self.cal['path']}: objective = {self.cal['objective']!r} gives "
+                f"{'no residuals' if not r['residuals'] else 'non-finite residuals'} at "
+                f"{dict(zip(self.keys, values))}; allowed an objective the record and the pass can measure")
+        _write_atomically(os.path.join(self.dir, _key(self.context, values) + ".json"),
+                          json.dumps({"context": self.context, "values": dict(zip(self.keys, values)), **r}))
 
     def jacobian(self, u):
         """Forward differences in the unit scale, stepping inwards at an upper bound; all n + 1
@@ -396,6 +462,10 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     # Checked here, before any cluster starts: the record, the scene, each parameter at its initial value.
     rec = cm.read_record(cal["record"], cal["meta"])
     measurable(cal, rec)
+    try:
+        cm._cutoff(cal["cutoff"], rec)
+    except SceneError as e:
+        _fail("cutoff", cal["cutoff"], e.allowed)
     # The initial values (the range's middle unless given), just inside the bounds as the
     # trust-region method needs.
     u0 = np.array([to_unit([p], [p["initial"]])[0] if "initial" in p else 0.5 for p in params])
@@ -407,6 +477,19 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
         check_scene(cal["scene"], ov)
     except SceneError as e:
         raise CalibrationError(f"calibration {path}: {e}") from None
+    # The first evaluation here, before a cluster starts or DIR is made (unless DIR keeps it):
+    # what only the comparison refuses (the record's section, supports or bandwidth against the
+    # scene) is refused with nothing written; the cluster then reads it back.
+    v0 = to_values(params, u0)
+    kept = os.path.join(out, "evaluations", _key(fingerprint(cal), v0) + ".json")
+    first = None
+    if not os.path.isfile(kept):
+        try:
+            first = evaluate(cal, [p["key"] for p in params], v0)
+        except SceneError as e:
+            raise CalibrationError(f"calibration {path}: {e}") from None
+        if not first["residuals"] or not np.all(np.isfinite(first["residuals"])):
+            first = None  # refused by the evaluator with its message, as any evaluation
     own = None
     if scheduler:
         try:
@@ -421,18 +504,31 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     try:
         os.makedirs(out, exist_ok=True)
         ev = _Evaluator(cal, out, client)
+        if first is not None:
+            ev.keep(v0, first)
         budget = cal["optimiser"]["max_evaluations"]
+        # Every pass counts against the budget, the Jacobian's too; the optimiser may use all but
+        # those the uncertainty at its end needs, and stops cleanly at its share.
+        ev.limit = budget - reserved_passes(len(params))
         r0 = ev.many([u0])[0]
-        if cal["optimiser"]["method"] == "least_squares":
-            res = optimize.least_squares(lambda u: ev.many([u])[0], u0, jac=lambda u: ev.jacobian(u)[1],
-                                         bounds=(np.zeros(len(u0)), np.ones(len(u0))), method="trf",
-                                         max_nfev=budget, x_scale=1.0)
-            u = res.x
-        else:
-            method = cal["optimiser"]["method"].split(":", 1)[1]
-            res = optimize.minimize(lambda u: 0.5 * float(np.sum(ev.many([u])[0] ** 2)), u0, method=method,
-                                    bounds=[(0.0, 1.0)] * len(u0), options={"maxfev": budget})
-            u = np.clip(res.x, 0.0, 1.0)
+        try:
+            if cal["optimiser"]["method"] == "least_squares":
+                res = optimize.least_squares(lambda u: ev.many([u])[0], u0, jac=lambda u: ev.jacobian(u)[1],
+                                             bounds=(np.zeros(len(u0)), np.ones(len(u0))), method="trf",
+                                             max_nfev=budget, x_scale=1.0)
+                u = res.x
+            else:
+                method = cal["optimiser"]["method"].split(":", 1)[1]
+                res = optimize.minimize(lambda u: 0.5 * float(np.sum(ev.many([u])[0] ** 2)), u0, method=method,
+                                        bounds=[(0.0, 1.0)] * len(u0), options={"maxfev": budget})
+                u = np.clip(res.x, 0.0, 1.0)
+            converged, message = bool(res.success), str(res.message)
+        except _OutOfPasses:
+            # The best point evaluated so far.
+            u, converged = ev.best[1], False
+            message = (f"stopped at optimiser.max_evaluations = {budget} passes ({len(ev.points)} run by the "
+                       f"optimiser, {reserved_passes(len(params))} kept for the uncertainty at its end)")
+        ev.limit = budget
         r, jac = ev.jacobian(u)
         # The linear model checked on the other side of the optimum, one difference step away.
         steps = [-DIFF_STEP if u[i] - DIFF_STEP >= 0.0 else 2 * DIFF_STEP for i in range(len(u))]
@@ -453,8 +549,8 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
                          why_not="uncertainty not available: the objective is rough at the difference step "
                                  "(a finer numerics.preset makes it smooth)")
         result = {"calibration": os.path.abspath(path), "method": cal["optimiser"]["method"],
-                  "converged": bool(res.success), "message": str(res.message),
-                  "evaluations": ev.count, "replayed": ev.replayed,
+                  "converged": converged, "message": message, "max_evaluations": budget,
+                  "passes": len(ev.points), "evaluations": ev.count, "replayed": ev.replayed,
                   "cost_before": 0.5 * float(np.sum(r0 ** 2)), "cost_after": 0.5 * float(np.sum(r ** 2)),
                   "rms_residual_before": float(np.sqrt(np.mean(r0 ** 2))),
                   "rms_residual_after": float(np.sqrt(np.mean(r ** 2))),
@@ -514,7 +610,7 @@ def main():
         else:
             print("%-32s %.6g +- %.2g%s" % (p["key"], p["value"], p["std"],
                                            "" if p["identifiable"] else "  NOT IDENTIFIABLE: " + p["why_not"]))
-    print("rms residual %.4g (was %.4g), %d evaluations (%d replayed); wrote %s" % (
-        result["rms_residual_after"], result["rms_residual_before"], result["evaluations"], result["replayed"],
-        a.out))
+    print("rms residual %.4g (was %.4g), %d passes of at most %d (max_evaluations), %d evaluations (%d read "
+          "back); wrote %s" % (result["rms_residual_after"], result["rms_residual_before"], result["passes"],
+                               result["max_evaluations"], result["evaluations"], result["replayed"], a.out))
     return 0

@@ -14,13 +14,16 @@ through set_speed); the measuring pantograph's view of it is the core's (force_p
 output.sensor_bandwidth set to the record's bandwidth). Here only filtering, sampling and the
 statistics that are applied identically to both sides.
 """
+import csv
 import json
 import math
+import numbers
 import os
 import re
 import shutil
 import tempfile
 import textwrap
+from collections.abc import Iterable
 
 import numpy as np
 import pandas as pd
@@ -61,6 +64,8 @@ STATISTICS = ("mean_force_N", "std_force_N", "stat_max_force_N", "stat_min_force
               "contact_loss_percent")
 DIFFERENCES = ("force_rms_difference_N", "force_max_abs_difference_N", "spectrum_rms_difference_dB")
 HEAD = ("head_std_m", "head_range_m")
+# The fewest rows an analysis section holds: a mean, a spread and a spectrum need three samples.
+MIN_SECTION_ROWS = 3
 UPLIFT = ("max_uplift_m",)
 TOLERANCE_NAMES = STATISTICS + DIFFERENCES + HEAD + UPLIFT
 
@@ -72,17 +77,23 @@ class RecordError(SceneError):
 
     KINDS = ("format", "metadata", "missing_column", "unknown_column", "unknown_unit", "wrong_unit", "nan",
              "non_monotonic", "gap", "unknown_pantograph", "unknown_support", "section_outside_line",
-             "speed_profile")
+             "speed_profile", "short_section")
 
     def __init__(self, kind, path, field, value, allowed, why, row=None):
         where = f"line {row}, " if row is not None else ""
         if kind == "format":
             what = f"{field} {value}"
         else:
-            what = f"{'field' if kind in ('metadata', 'section_outside_line') else 'column'} '{field}' = {value}"
+            what = f"{'field' if kind in ('metadata', 'section_outside_line', 'short_section') else 'column'} " \
+               f"'{field}' = {value}"
         message = f"record {path}: {kind}: {where}{what}: {why}; allowed {allowed}"
         super().__init__(message, field=field, value=value, allowed=allowed)
         self.kind, self.row, self.path = kind, row, path
+        self._args = (kind, path, field, value, allowed, why, row)
+
+    def __reduce__(self):
+        # Rebuilt from its own arguments when it crosses processes (a calibration's Dask worker).
+        return (self.__class__, self._args)
 
 
 class Record:
@@ -102,7 +113,8 @@ class Record:
 # Reading and checking a record
 # --------------------------------------------------------------------------------------------
 def _shown(v):
-    text = repr(v) if not isinstance(v, str) else v
+    """A value as it was read: text quoted (a quoted '200' is not the number 200)."""
+    text = repr(v)
     return text if len(text) <= 60 else text[:57] + "..."
 
 
@@ -121,7 +133,7 @@ def _read_metadata(path, meta, comment_lines):
                           "given both in the CSV's '#' header and in a side YAML")
     try:
         if side is not None:
-            with open(side, encoding="utf-8") as f:
+            with open(side, encoding="utf-8-sig") as f:  # a byte order mark is no part of the YAML
                 doc = yaml.safe_load(f)
         else:
             doc = yaml.safe_load(header) if header else None
@@ -145,8 +157,11 @@ def _meta_real(doc, path, key, low, high, allowed, default=None, required=True):
             raise RecordError("metadata", path, key, "absent", allowed, "required")
         return default
     v = doc[key]
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not low <= v <= high:
-        raise RecordError("metadata", path, key, _shown(v), allowed, "out of range or not a number")
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise RecordError("metadata", path, key, _shown(v), allowed + " (a number, not quoted)",
+                          f"not a number (read as {type(v).__name__})")
+    if not math.isfinite(v) or not low <= v <= high:
+        raise RecordError("metadata", path, key, _shown(v), allowed, "out of range")
     return float(v)
 
 
@@ -167,6 +182,24 @@ def _parse_columns(path, names):
     return out
 
 
+def _check_fields(path, lines, skip):
+    """Refuses a row with more fields than the header (pandas would drop them); returns whether
+    the header ends in an empty field (a trailing comma) with every row as long or one shorter."""
+    rows = list(csv.reader(lines[skip:]))
+    if not rows or not rows[0]:
+        return False
+    head = rows[0]
+    trailing = len(head) > 1 and head[-1].strip() == ""
+    names = len(head) - trailing
+    for k, row in enumerate(rows[1:]):
+        extra = row[names:]
+        if extra and not (len(extra) == 1 and extra[0].strip() == ""):
+            raise RecordError("format", path, "row", f"of {len(row)} fields",
+                              f"at most the header's {names} fields (and a trailing comma)",
+                              "more fields than the header", row=skip + k + 2)
+    return trailing
+
+
 def read_record(path, meta=None):
     """Reads and checks a record (CSV; metadata from `meta`, a side YAML of the same stem, or '#'
     lines atop the CSV). Returns a Record in SI units; raises RecordError naming the class of fault,
@@ -176,7 +209,7 @@ def read_record(path, meta=None):
     if meta is not None:
         meta = _path("meta", meta, "a YAML file path (str or os.PathLike)")
     try:
-        with open(path, encoding="utf-8", newline="") as f:
+        with open(path, encoding="utf-8-sig", newline="") as f:  # a byte order mark is no part of the text
             lines = f.read().splitlines()
     except (OSError, UnicodeDecodeError) as e:
         raise RecordError("format", path, "file", path, "a UTF-8 CSV file", f"cannot be read ({e})") from None
@@ -185,12 +218,17 @@ def read_record(path, meta=None):
         comments.append(lines[len(comments)])
     doc = _read_metadata(path, meta, comments)
     header_line = len(comments) + 1
+    trailing = _check_fields(path, lines, len(comments))
     try:
+        # index_col=False: a trailing comma on every row is an empty last field, not a shift of the
+        # columns by one (the first taken as the index); _check_fields refuses longer rows.
         frame = pd.read_csv(path, skiprows=len(comments), dtype=str, keep_default_na=False, skip_blank_lines=False,
-                            comment=None)
+                            comment=None, encoding="utf-8-sig", index_col=False)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError) as e:
         raise RecordError("format", path, "file", path, "a CSV with a header line and one row per sample",
                           str(e).strip().splitlines()[0]) from None
+    if trailing:
+        frame = frame.iloc[:, :-1]
     if len(frame) < 3:
         raise RecordError("format", path, "rows", len(frame), "at least 3 rows under the header",
                           "too few samples")
@@ -243,11 +281,12 @@ def read_record(path, meta=None):
                               f"a mean of at least {MIN_MEAN_FORCE_N:g} N", "too small for a contact force: "
                               "kN written as N?")
     listed = doc.get("pantographs", list(forces))
-    if not isinstance(listed, list) or set(listed) != set(forces):
+    if (not isinstance(listed, list) or not all(isinstance(n, str) for n in listed)
+            or sorted(listed) != sorted(forces)):
         raise RecordError("metadata", path, "pantographs", _shown(listed), "the names of the force columns: "
                           + ", ".join(forces), "does not match the force columns")
     station_of = doc.get("station_of", listed[0])
-    if station_of not in forces:
+    if not isinstance(station_of, str) or station_of not in forces:
         raise RecordError("metadata", path, "station_of", _shown(station_of), "one of " + ", ".join(forces),
                           "not a measured pantograph")
     for (q, name) in data:
@@ -312,6 +351,11 @@ def read_record(path, meta=None):
         raise RecordError("gap", path, col, frame[col].iloc[k + 1] if col else f"{dt[k]:.4g} s",
                           f"at most {max_gap:g} sample intervals between rows (metadata max_gap_samples)",
                           f"{dt[k] * sample_rate:.3g} sample intervals after the row before", row=row0 + k + 1)
+    least = least_band_hz(len(frame), sample_rate)
+    if bandwidth < least:
+        raise RecordError("metadata", path, "bandwidth_hz", _shown(doc["bandwidth_hz"]),
+                          f"at least {least:.4g} Hz for this record ({len(frame)} rows at {sample_rate:g} Hz, "
+                          f"{1.0 / least:.4g} s)", "its period exceeds the record's duration")
     supports = doc.get("supports", {}) or {}
     if not isinstance(supports, dict):
         raise RecordError("metadata", path, "supports", _shown(supports), "a map SUPPORT: station (m)", "not a map")
@@ -349,16 +393,47 @@ def read_record(path, meta=None):
 def lowpass(x, fs, fc):
     """The core's zero-phase low-pass (output/zero_phase_filter.cpp), the filter of stats.json: a
     4th-order Butterworth run forward and backward with odd reflection at both ends; a cutoff at or
-    above Nyquist passes the series through."""
-    return np.asarray(_core._lowpass_zero_phase(np.asarray(x, dtype=float), float(fs), float(fc)))
+    above Nyquist passes the series through. x: a 1-D sequence of numbers; fs, fc: numbers (the
+    core refuses values out of range by name)."""
+    x = _series("x", x, finite=False)  # the core names a sample that is not finite
+    for name, v in (("sample rate fs", fs), ("cutoff fc", fc)):
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+            raise SceneError(f"{name} = {_shown(v)} rejected: allowed a finite frequency > 0 Hz (a number)",
+                             field=name.split()[-1], value=_shown(v), allowed="a finite frequency > 0 Hz")
+    return np.asarray(_core._lowpass_zero_phase(x, float(fs), float(fc)))
+
+
+def _series(name, x, length=None, finite=True):
+    """x as a 1-D float array, refused by name unless it is one of (finite) numbers (of `length`)."""
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        a = None
+    if a is None or a.ndim != 1 or (length is not None and len(a) != length):
+        allowed = "a 1-D sequence of numbers" + (f" of length {length}" if length is not None else "")
+        raise SceneError(f"{name} = {_shown(x)} rejected: allowed {allowed}", field=name, value=_shown(x),
+                         allowed=allowed)
+    bad = ~np.isfinite(a) if finite else np.zeros(a.shape, dtype=bool)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise SceneError(f"{name}[{k}] = {a[k]!r} rejected: allowed finite numbers", field=name, value=repr(a[k]),
+                         allowed="finite numbers")
+    return a
 
 
 def section_statistics(force, inside, loss_force=None):
     """The statistics of stats.json on one force series over the samples `inside` (a boolean mask):
     mean, population std, mean +- 3 std, the actual max and min, and the share of samples with
     loss_force (default: force) <= 0, in percent."""
-    f = np.asarray(force, dtype=float)[inside]
-    lf = (np.asarray(loss_force, dtype=float) if loss_force is not None else np.asarray(force, dtype=float))[inside]
+    force = _series("force", force)
+    mask = np.asarray(inside)
+    if mask.dtype != bool or mask.shape != force.shape:
+        allowed = f"a boolean mask of the force's length ({len(force)})"
+        raise SceneError(f"inside = {_shown(inside)} rejected: allowed {allowed}", field="inside",
+                         value=_shown(inside), allowed=allowed)
+    loss = _series("loss_force", loss_force, len(force)) if loss_force is not None else force
+    f = force[mask]
+    lf = loss[mask]
     if f.size == 0:
         return {k: None for k in STATISTICS}
     mean, std = float(np.mean(f)), float(np.std(f))
@@ -372,7 +447,7 @@ def welch_spectrum(force, fs, segment_s):
     segments of segment_s (the whole series when shorter), mean removed per segment, one-sided
     density, zero-padded to a power of two."""
     x = np.asarray(force, dtype=float)
-    nper = int(max(8, min(len(x), round(segment_s * fs))))
+    nper = int(min(len(x), max(8, round(segment_s * fs))))
     nfft = 1 << (nper - 1).bit_length()
     return signal.welch(x, fs=fs, window="hann", nperseg=nper, noverlap=nper // 2, nfft=nfft,
                         detrend="constant", scaling="density")
@@ -453,13 +528,27 @@ def simulate_run(scene, record=None, overrides=None, speed_profile=None, sensor_
     `pantograph` (default: the record's station_of, else the first), linear between the profile's
     stations and held beyond its ends. The measuring pantograph's bandwidth is the record's (or
     sensor_bandwidth_hz). Refuses a record's pantograph or support the scene lacks."""
+    if record is not None and not isinstance(record, Record):
+        raise SceneError(f"record = {_shown(record)} rejected: allowed None or a Record (read_record's)",
+                         field="record", value=_shown(record), allowed="None or a Record")
+    max_steps = _real("max_steps", max_steps, "a number of steps >= 1", 1.0)
     ov = _override_list(overrides)
     px, pv, source = _profile(record, speed_profile)
     bw = sensor_bandwidth_hz if sensor_bandwidth_hz is not None else (record.bandwidth_hz if record else None)
     if bw is not None:
         bw = _real("sensor_bandwidth_hz", bw, "a bandwidth in Hz > 0", 1e-6)
         ov = ov + [f"output.sensor_bandwidth={bw!r}"]
-    probe = Simulation(scene, ov, sample_rate=0)
+    try:
+        probe = Simulation(scene, ov, sample_rate=0)
+    except SceneError as e:
+        if bw is None or e.field != "output.sensor_bandwidth":
+            raise
+        allowed = f"the measuring pantograph's bandwidth, output.sensor_bandwidth's {e.allowed}"
+        if sensor_bandwidth_hz is None:
+            raise RecordError("metadata", record.path, "bandwidth_hz", f"{bw:g}", allowed,
+                              "beyond what the simulated measuring pantograph takes") from None
+        raise SceneError(f"sensor_bandwidth_hz = {bw:g} rejected: allowed {allowed}", field="sensor_bandwidth_hz",
+                         value=f"{bw:g}", allowed=allowed) from None
     names = list(probe.pantograph_names)
     if record is not None:
         for name in record.force_N:
@@ -488,7 +577,8 @@ def simulate_run(scene, record=None, overrides=None, speed_profile=None, sensor_
         speeds.append(sim.speed)
         steps += 1
         if steps > max_steps:
-            raise SceneError(f"max_steps = {max_steps:g} rejected: the pass takes longer", field="max_steps",
+            raise SceneError(f"max_steps = {max_steps:g} rejected: the pass takes longer; allowed more steps, or a "
+                             "faster profile", field="max_steps",
                              value=repr(max_steps), allowed="more steps, or a faster profile")
     series = sim.series()
     with tempfile.TemporaryDirectory(prefix="catenary_sim_measure_") as d:
@@ -525,21 +615,33 @@ def _tolerance(tolerances, name, owner):
     return None
 
 
-def _check_tolerances(tolerances, owners):
+def _check_tolerances(tolerances, record):
+    """{key: (number, percent)} of the user's tolerances, each refused by name unless it names a
+    quantity the comparison has a row of, for an owner (pantograph or support) the record has."""
     if tolerances is None:
         return {}
     if not isinstance(tolerances, dict):
         raise SceneError(f"tolerances = {_shown(tolerances)} rejected: allowed a map NAME: tolerance",
                          field="tolerances", value=_shown(tolerances), allowed="a map NAME: tolerance")
+    # The rows the comparison forms: per pantograph its statistics and differences (the head's
+    # with a head column), per support the uplift.
+    rows = {p: STATISTICS + DIFFERENCES + (HEAD if p in record.head_m else ()) for p in record.force_N}
+    rows.update({name: UPLIFT for name in record.uplift_m})
+    present = "; ".join(f"{o}: {', '.join(q)}" for o, q in rows.items())
     out = {}
     for key, v in tolerances.items():
         name = str(key).split(".")[-1]
         owner = str(key)[:-len(name) - 1] if "." in str(key) else None
         allowed = ("NAME or OWNER.NAME with NAME one of " + ", ".join(TOLERANCE_NAMES) + " and OWNER a pantograph or "
-                   "support of the record (" + ", ".join(owners) + ")")
-        if name not in TOLERANCE_NAMES or (owner is not None and owner not in owners):
+                   "support of the record (" + ", ".join(rows) + ")")
+        if name not in TOLERANCE_NAMES or (owner is not None and owner not in rows):
             raise SceneError(f"tolerances key {key!r} rejected: allowed {allowed}", field="tolerances",
                              value=repr(key), allowed=allowed)
+        if not any(name in q for o, q in rows.items() if owner is None or o == owner):
+            needs = {**{n: " (it needs a head column)" for n in HEAD}, **{n: " (it needs supports)" for n in UPLIFT}}
+            raise SceneError(f"tolerances key {key!r} rejected: {owner or 'the record'} has no {name} to compare"
+                             f"{needs.get(name, '')}; allowed a quantity the comparison has: {present}",
+                             field="tolerances", value=repr(key), allowed=present)
         text = str(v).strip()
         m = re.fullmatch(r"([0-9.eE+-]+)\s*(%?)", text)
         try:
@@ -550,6 +652,11 @@ def _check_tolerances(tolerances, owners):
             raise SceneError(f"tolerances['{key}'] = {v!r} rejected: allowed a number >= 0 in the quantity's unit, "
                              "or 'P%' of the record's value", field=f"tolerances.{key}", value=repr(v),
                              allowed="a number >= 0, or 'P%'")
+        if m.group(2) and name in DIFFERENCES:
+            unit = name.rsplit("_", 1)[1]
+            raise SceneError(f"tolerances['{key}'] = {v!r} rejected: {name} is itself a difference of the two sides, "
+                             f"with no record's value to take a share of; allowed a number >= 0 in {unit}",
+                             field=f"tolerances.{key}", value=repr(v), allowed=f"a number >= 0 in {unit}")
         out[str(key)] = (num, bool(m.group(2)))
     return out
 
@@ -641,12 +748,49 @@ def _umask():
     return m
 
 
-def _cutoff(cutoff_hz, record, stats):
-    if cutoff_hz is None or cutoff_hz == "scene":
-        return float(stats["filter_cutoff_hz"]), "the scene's output.filter_cutoff"
-    if cutoff_hz == "bandwidth":
-        return record.bandwidth_hz, "the record's bandwidth"
-    return _real("cutoff_hz", cutoff_hz, "a cutoff in Hz > 0, 'scene' or 'bandwidth'", 1e-6), "given"
+def least_band_hz(rows, sample_rate_hz):
+    """The lowest cutoff or bandwidth a record of `rows` samples at sample_rate_hz is filtered with:
+    one period within its duration (rows / sample_rate_hz). A filter whose period is longer has no
+    whole period of the record to act on; its edge padding, not the record, makes the result."""
+    return sample_rate_hz / rows
+
+
+def _cutoff(cutoff_hz, record, stats=None):
+    """The analysis low-pass in Hz and where it comes from; refused by name below the record's
+    least band. Without stats (before the pass) the scene's cutoff is not yet known: None."""
+    least = least_band_hz(len(record.station_m), record.sample_rate_hz)
+    duration = f"at least {least:.4g} Hz for this record ({len(record.station_m)} rows at " \
+               f"{record.sample_rate_hz:g} Hz, {1.0 / least:.4g} s)"
+    if isinstance(cutoff_hz, str) and cutoff_hz == "bandwidth":
+        return record.bandwidth_hz, "the record's bandwidth"  # read_record checks it against the duration
+    if cutoff_hz is None or (isinstance(cutoff_hz, str) and cutoff_hz == "scene"):
+        if stats is None:
+            return None, "the scene's output.filter_cutoff"
+        fc = float(stats["filter_cutoff_hz"])
+        if fc < least:
+            raise SceneError(f"cutoff_hz = 'scene' rejected: the scene's output.filter_cutoff, {fc:g} Hz, has a "
+                             f"period longer than the record; allowed {duration}, or 'bandwidth'",
+                             field="cutoff_hz", value="'scene'", allowed=duration)
+        return fc, "the scene's output.filter_cutoff"
+    fc = _real("cutoff_hz", cutoff_hz, "a cutoff in Hz > 0, 'scene' or 'bandwidth'", 1e-6)
+    if fc < least:
+        raise SceneError(f"cutoff_hz = {fc:g} rejected: its period exceeds the record's duration; allowed {duration}",
+                         field="cutoff_hz", value=f"{fc:g}", allowed=duration)
+    return fc, "given"
+
+
+def _span(supports, section):
+    """The span length of the scene's line at the section (m): the mean of the spans within it,
+    else (a section inside one span) the span of the line around the section's middle; None for a
+    line of fewer than two supports."""
+    within = np.diff([x for x in supports if section[0] - 1e-6 <= x <= section[1] + 1e-6])
+    if len(within):
+        return float(np.mean(within))
+    if len(supports) < 2:
+        return None
+    k = int(np.searchsorted(supports, 0.5 * (section[0] + section[1])))
+    k = min(max(k, 1), len(supports) - 1)  # beyond the line's ends: its end span
+    return float(supports[k] - supports[k - 1])
 
 
 def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, tolerances=None, meta=None):
@@ -658,8 +802,8 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
     'bandwidth' (the record's) or Hz; tolerances: {NAME or OWNER.NAME: number or 'P%'}."""
     if not isinstance(record, Record):
         record = read_record(record, meta)
-    owners = list(record.force_N) + list(record.uplift_m)
-    tol = _check_tolerances(tolerances, owners)
+    tol = _check_tolerances(tolerances, record)
+    _cutoff(cutoff_hz, record)
     run = simulate_run(scene, record, overrides, speed_profile)
     stats = run.stats
     fc, fc_source = _cutoff(cutoff_hz, record, stats)
@@ -705,6 +849,14 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
     rec_f = {p: lowpass(v, fs, fc) for p, v in rec_view.items()}
     sim_f = {p: lowpass(v, fs, fc) for p, v in sim_view.items()}
     inside = (station >= section[0]) & (station <= section[1])
+    if inside.sum() < MIN_SECTION_ROWS:
+        step = float(np.median(np.diff(record.station_m)))
+        raise RecordError("short_section", record.path, "section_m",
+                          f"[{section[0] + record.station_origin_m:g}, {section[1] + record.station_origin_m:g}]",
+                          f"a section holding at least {MIN_SECTION_ROWS} rows (at least "
+                          f"{(MIN_SECTION_ROWS - 1) * step:.3g} m at the record's {step:.3g} m between rows)", f"it holds {int(inside.sum())} of the record's "
+                          "rows" + ("" if record.section_m is not None else
+                                    " (the scene's analysis section where the record reaches: declare section_m)"))
     columns = {"station_m": station + record.station_origin_m, "simulated_time_s": t_at,
                "simulated_speed_kmh": 3.6 * np.interp(t_at, run.time_s, run.speed_mps),
                "profile_speed_kmh": 3.6 * np.interp(station, *run.profile), "in_section": inside.astype(int)}
@@ -713,10 +865,10 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
     rows, peaks = [], {}
     spectra = []
     supports = sorted(x for x in stats.get("support_stations_m", []))
-    spans = np.diff([x for x in supports if section[0] - 1e-6 <= x <= section[1] + 1e-6])
-    mean_span = float(np.mean(spans)) if len(spans) else float(section[1] - section[0])
+    mean_span = _span(supports, section)
     v_mean = float(np.mean(np.interp(t_at[inside], run.time_s, run.speed_mps)))
-    segment_s = 8.0 * mean_span / v_mean
+    # Without a span (a line of fewer than two supports) one segment: the whole section.
+    segment_s = 8.0 * mean_span / v_mean if mean_span else float(inside.sum()) / fs
     for p in record.force_N:
         a = section_statistics(rec_f[p], inside)
         b = section_statistics(sim_f[p], inside)
@@ -770,7 +922,7 @@ def compare(scene, record, overrides=None, speed_profile=None, cutoff_hz=None, t
                                                           section[1] + record.station_origin_m],
                 "station_origin_m": record.station_origin_m, "station_of": ref,
                 "speed_profile": run.profile_source, "welch_segment_s": segment_s,
-                "span_passing_hz": v_mean / mean_span, "mean_speed_kmh": 3.6 * v_mean,
+                "span_passing_hz": v_mean / mean_span if mean_span else None, "mean_speed_kmh": 3.6 * v_mean,
                 "rows_compared": int(keep.sum()), "rows_in_section": int(inside.sum()),
                 "tolerances": {k: (f"{v[0]:g}%" if v[1] else v[0]) for k, v in tol.items()},
                 "overrides": run.overrides}
@@ -790,6 +942,13 @@ DECIMALS = {"station_m": 6, "time_s": 6, "speed_kmh": 6, "force": 4, "uplift_mm"
 def noise_after_filters(noise_std, fs, cutoffs, n=1 << 16):
     """The std of white noise of noise_std at fs after the zero-phase low-passes at `cutoffs`:
     sqrt of sigma^2 x the mean of prod |H_k(f)|^4 over [0, fs/2] (filtfilt squares |H|)."""
+    noise_std = _real("noise_std", noise_std, "a noise std >= 0", 0.0)
+    fs = _real("fs", fs, "a sample rate in Hz > 0", 1e-300)
+    if isinstance(cutoffs, (str, bytes)) or not isinstance(cutoffs, Iterable):
+        raise SceneError(f"cutoffs = {_shown(cutoffs)} rejected: allowed a sequence of cutoffs in Hz > 0",
+                         field="cutoffs", value=_shown(cutoffs), allowed="a sequence of cutoffs in Hz > 0")
+    cutoffs = [_real(f"cutoffs[{k}]", c, "a cutoff in Hz > 0", 1e-300) for k, c in enumerate(cutoffs)]
+    n = _integer("n", n, "an integer number of frequencies >= 2", 2, 1 << 26)
     f = np.linspace(0.0, 0.5 * fs, n)
     gain = np.ones_like(f)
     for fc in cutoffs:
@@ -806,16 +965,42 @@ def synthesise_record(scene, path, overrides=None, speed_profile=300.0, sample_r
     noise of noise_std_N per sample passed through the same measuring filter (zero-phase
     Butterworth, as the core's sensor model), the speed, the head displacement and the uplift of
     the steady arms ("section": those in the scene's analysis section, named A1, A2, ...; None:
-    none). Writes PATH (CSV) and its side YAML (PATH with .yaml), each whole. Returns the Record."""
-    path = os.fspath(_path("path", path, "a CSV file path"))
-    fs = _real("sample_rate_hz", sample_rate_hz, "a sample rate in Hz > 0", 1e-3, 1e7)
+    none). Writes PATH (CSV) and its side YAML (PATH with .yaml) once every argument and the
+    record read back are checked, each whole; a refusal leaves neither. Returns the Record."""
+    path, side = _record_paths(path)
+    fs = _real("sample_rate_hz", sample_rate_hz, f"a sample rate in Hz, {MIN_RECORD_RATE_HZ:g} to "
+               f"{MAX_RECORD_RATE_HZ:g} (the time column's {10.0 ** -DECIMALS['time_s']:g} s resolution)",
+               MIN_RECORD_RATE_HZ, MAX_RECORD_RATE_HZ)
     bw = _real("bandwidth_hz", bandwidth_hz, "a bandwidth in Hz > 0", 1e-3, 1e7)
     sigma = _real("noise_std_N", noise_std_N, "a noise std in N >= 0", 0.0, 1e4)
     seed = _integer("seed", seed, "an integer >= 0", 0, 2 ** 63 - 1)
     origin = _real("station_origin_m", station_origin_m, "a station in m", -1e7, 1e7)
-    run = simulate_run(scene, None, overrides, speed_profile, sensor_bandwidth_hz=bw)
+    if not (supports is None or (isinstance(supports, str) and supports == "section")):
+        raise SceneError(f"supports = {_shown(supports)} rejected: allowed 'section' (the steady arms of the "
+                         "analysis section) or None (no uplift columns)", field="supports", value=_shown(supports),
+                         allowed="'section' or None")
+    if not isinstance(head, (bool, np.bool_)):
+        raise SceneError(f"head = {_shown(head)} rejected: allowed True or False (head displacement columns or "
+                         "none)", field="head", value=_shown(head), allowed="True or False")
+    try:
+        run = simulate_run(scene, None, overrides, speed_profile, sensor_bandwidth_hz=bw)
+    except SceneError as e:
+        if e.field != "sensor_bandwidth_hz":
+            raise
+        raise SceneError(str(e).replace("sensor_bandwidth_hz", "bandwidth_hz", 1), field="bandwidth_hz",
+                         value=e.value, allowed=e.allowed) from None
     ref = run.reference
     t = np.arange(run.time_s[0], run.time_s[-1], 1.0 / fs)
+    if len(t) < 3:
+        duration = float(run.time_s[-1] - run.time_s[0])
+        raise SceneError(f"sample_rate_hz = {fs:g} rejected: the pass of {duration:.4g} s gives {len(t)} "
+                         f"row(s); allowed at least {3.0 / duration:.4g} Hz (3 rows)", field="sample_rate_hz",
+                         value=f"{fs:g}", allowed=f"at least {3.0 / duration:.4g} Hz")
+    least = least_band_hz(len(t), fs)
+    if bw < least:
+        raise SceneError(f"bandwidth_hz = {bw:g} rejected: its period exceeds the record's duration; allowed at "
+                         f"least {least:.4g} Hz for {len(t)} rows at {fs:g} Hz", field="bandwidth_hz",
+                         value=f"{bw:g}", allowed=f"at least {least:.4g} Hz")
     station = np.interp(t, run.time_s, run.position_m[ref])
     cols = {"station_m": np.round(station + origin, DECIMALS["station_m"]),
             "time_s": np.round(t - t[0], DECIMALS["time_s"]),
@@ -841,21 +1026,71 @@ def synthesise_record(scene, path, overrides=None, speed_profile=300.0, sample_r
             cols[f"uplift_{name}_mm"] = np.round(1e3 * np.interp(t, run.time_s, u), DECIMALS["uplift_mm"])
             meta["supports"][name] = float(x + origin)
     table = pd.DataFrame(cols)
-    text = table.to_csv(index=False, float_format="%.6f")
-    _write_atomically(path, text)
-    _write_atomically(os.path.splitext(path)[0] + ".yaml", yaml.safe_dump(meta, sort_keys=False))
-    return read_record(path)
+    # Both files are written beside their places and read back as a record before either is
+    # moved into place: a record that would be refused, or a write that fails, leaves nothing.
+    staged = []
+    try:
+        for target, text in ((path, table.to_csv(index=False, float_format="%.6f")),
+                             (side, yaml.safe_dump(meta, sort_keys=False))):
+            staged.append((_stage(target, text), target))
+        record = read_record(staged[0][0], meta=staged[1][0])
+        new_side = not os.path.lexists(side)
+        os.replace(staged[1][0], side)
+        try:
+            os.replace(staged[0][0], path)
+        except OSError:
+            if new_side:
+                os.remove(side)
+            raise
+    except OSError as e:
+        raise SceneError(f"path = {path!r} rejected: cannot be written ({e.strerror or e}); allowed a CSV path in a "
+                         "writable directory", field="path", value=repr(path),
+                         allowed="a CSV path in a writable directory") from None
+    finally:
+        for tmp, _target in staged:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+    record.path = path
+    return record
 
 
-def _write_atomically(path, text):
-    d = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=d)
+# The synthesised record's sample rate: at 1e5 Hz a row's interval is 10 us, which the time
+# column's rounding to 1 us moves by at most 10 %, the reader's agreement with the declared rate.
+MIN_RECORD_RATE_HZ, MAX_RECORD_RATE_HZ = 1e-3, 1e5
+
+
+def _record_paths(path):
+    """A synthesised record's CSV path and its side YAML's, refused unless PATH ends in .csv and
+    both can be made in an existing, writable directory."""
+    path = os.fspath(_path("path", path, "a CSV file path ending in .csv"))
+
+    def refuse(why, allowed="a path ending in .csv in an existing, writable directory"):
+        raise SceneError(f"path = {path!r} rejected: {why}; allowed {allowed}", field="path", value=repr(path),
+                         allowed=allowed)
+
+    stem, ext = os.path.splitext(path)
+    if ext.lower() != ".csv" or not os.path.basename(stem):
+        refuse("not a .csv file name (the metadata goes beside it as NAME.yaml)")
+    side = stem + ".yaml"
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        refuse(f"its directory {directory} does not exist")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        refuse(f"its directory {directory} is not writable")
+    for p in (path, side):
+        if os.path.isdir(p):
+            refuse(f"{p} is a directory")
+    return path, side
+
+
+def _stage(path, text):
+    """TEXT in a new file beside PATH (made with the umask's mode); returns its path."""
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=os.path.dirname(os.path.abspath(path)))
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             f.write(text)
         os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
     except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+        os.remove(tmp)
         raise
+    return tmp

@@ -98,7 +98,7 @@ def pictures(c):
             ax.semilogy(f[ok], v[ok], color=color, lw=1.0, ls="-" if lab == "record" else "--",
                         alpha=1.0 if i == 0 else 0.6, label="%s %s" % (p, lab))
     sp = c.settings["span_passing_hz"]
-    for h in range(1, 200):
+    for h in range(1, 200 if sp else 1):
         if h * sp > 1.5 * fmax:
             break
         ax.axvline(h * sp, color="tab:green", lw=1.2 if h == 1 else 0.5, ls="-" if h == 1 else ":",

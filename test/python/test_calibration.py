@@ -94,9 +94,14 @@ def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path)
     (lambda d: d.update(optimiser=[1]), "optimiser"),
     (lambda d: d.update(optimiser={"method": "least_squares", "tol": 1}), "optimiser.tol"),
     (lambda d: d.update(meta=5), "meta"),
+    # bounds beyond the scene field's own range (damping.beta: [0, 0.1]), found before any pass
+    (lambda d: d["parameters"][0].update(high=0.5), "parameters[0].high"),
+    (lambda d: d["parameters"][0].update(low=-1e-3), "parameters[0].low"),
+    (lambda d: d["parameters"][0].update(key="damping.gamma"), "parameters[0].key"),
 ], ids=["no parameters", "bounds reversed", "unknown scale", "unknown statistic", "unknown method", "unknown field",
         "weight as text", "negative weight", "all weights 0", "cutoff word", "cutoff negative", "cutoff as text",
-        "speed as text", "speed beyond 540 km/h", "optimiser a list", "unknown optimiser key", "meta a number"])
+        "speed as text", "speed beyond 540 km/h", "optimiser a list", "unknown optimiser key", "meta a number",
+        "high beyond the scene's range", "low beyond the scene's range", "key not a scene field"])
 def test_a_bad_calibration_file_is_refused_by_field(tmp_path, edit, words):
     spec = {"scene": REFERENCE, "record": "rec.csv",
             "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3}]}
@@ -142,7 +147,7 @@ def test_an_objective_the_record_cannot_measure_is_refused_before_anything_runs(
     spec = {"scene": REFERENCE, "record": "bare.csv", "overrides": FAST,
             "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3, "scale": "log"}],
             "objective": {"statistics": {"max_uplift_m": 1}, "time_history": 0},
-            "optimiser": {"max_evaluations": 2}}
+            "optimiser": {"max_evaluations": 5}}
     path = tmp_path / "cal.yaml"
     path.write_text(yaml.safe_dump(spec))
     with pytest.raises(calibration.CalibrationError) as e:
@@ -152,9 +157,10 @@ def test_an_objective_the_record_cannot_measure_is_refused_before_anything_runs(
 
 
 def test_non_convergence_and_a_rough_objective_are_said_plainly(tmp_path):
-    # Two evaluations cannot converge; the fast preset's objective is rough at the difference step
-    # (the last bit of a parameter moves it by tens of per cent), so no uncertainty can be given.
-    path = _fast_calibration(tmp_path, "a", 3e-4, optimiser={"method": "least_squares", "max_evaluations": 2})
+    # Five passes (the least for one parameter: two for the optimiser, three for the uncertainty)
+    # cannot converge; the fast preset's objective is rough at the difference step (the last bit
+    # of a parameter moves it by tens of per cent), so no uncertainty can be given.
+    path = _fast_calibration(tmp_path, "a", 3e-4, optimiser={"method": "least_squares", "max_evaluations": 5})
     r = subprocess.run([sys.executable, CLI, path, "--out", str(tmp_path / "out"), "--workers", "1", "--no-report"],
                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
     assert r.returncode == 0, r.stdout[-3000:]
@@ -163,6 +169,44 @@ def test_non_convergence_and_a_rough_objective_are_said_plainly(tmp_path):
     assert not result["uncertainty_available"] and "UNCERTAINTY NOT AVAILABLE" in r.stdout
     assert all(p["std"] is None for p in result["parameters"]) and "+-" not in r.stdout
     assert "NOT CONVERGED" in (tmp_path / "out" / "calibrated.yaml").read_text()
+
+
+def test_max_evaluations_bounds_every_pass_the_calibration_runs(tmp_path):
+    # Each distinct parameter point is one pass and one file in evaluations/: the optimiser's
+    # function and Jacobian passes and the uncertainty's at the end together stay within the
+    # bound, and a calibration stopped by it says so.
+    path = _fast_calibration(tmp_path, "a", 3e-4, optimiser={"method": "least_squares", "max_evaluations": 7})
+    r = subprocess.run([sys.executable, CLI, path, "--out", str(tmp_path / "out"), "--workers", "1", "--no-report"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert r.returncode == 0, r.stdout[-3000:]
+    result = json.loads((tmp_path / "out" / "calibration.json").read_text())
+    kept = _kept(tmp_path / "out" / "evaluations")
+    assert len(kept) <= 7, (len(kept), result)
+    assert result["passes"] == len(kept)
+    assert not result["converged"] and "max_evaluations = 7" in result["message"]
+    assert "NOT CONVERGED" in r.stdout and "max_evaluations" in r.stdout
+
+
+def test_what_only_the_comparison_refuses_leaves_no_directory(tmp_path):
+    # A record bandwidth beyond the measuring pantograph's range is found by the first pass: it is
+    # run before the cluster starts and the output directory is made, and named as the record's.
+    path = _fast_calibration(tmp_path, "a", 3e-4)
+    meta = yaml.safe_load((tmp_path / "a.yaml").read_text())
+    meta["bandwidth_hz"] = 1e6
+    (tmp_path / "a.yaml").write_text(yaml.safe_dump(meta))
+    with pytest.raises(calibration.CalibrationError) as e:
+        calibration.calibrate(path, str(tmp_path / "out"), workers=1, report=False)
+    assert "'bandwidth_hz'" in str(e.value) and "output.sensor_bandwidth" in str(e.value)
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_cutoff_longer_than_the_record_is_refused_before_anything_runs(tmp_path):
+    # The fast pass's record lasts a few seconds: 0.01 Hz has a period of 100 s.
+    path = _fast_calibration(tmp_path, "a", 3e-4, cutoff=0.01)
+    with pytest.raises(calibration.CalibrationError) as e:
+        calibration.calibrate(path, str(tmp_path / "out"), workers=1, report=False)
+    assert "'cutoff'" in str(e.value) and "at least" in str(e.value)
+    assert not (tmp_path / "out").exists()
 
 
 @pytest.mark.parametrize("kw,words", [

@@ -365,3 +365,231 @@ def test_the_statistics_filter_is_a_zero_phase_fourth_order_butterworth():
 def test_the_filter_refuses_bad_input_by_name(x, fs, fc, named):
     with pytest.raises(ValueError, match=re.escape(named)):
         cm.lowpass(x, fs, fc)
+
+
+def test_the_worked_example_writes_only_into_its_scratch_directory():
+    # The page's commands run from the repository's root: every file they make (the synthesised
+    # record, --out directories, the calibration file's record) lies in work/, which git ignores.
+    with open(os.path.join(ROOT, "docs", "measured_records.md"), encoding="utf-8") as f:
+        page = f.read()
+    example = page[page.index("## A worked example"):page.index("## Tests")]
+    written = re.findall(r"synthesise_record\([^,]+,\s*\"([^\"]+)\"", example)
+    written += [d for d in re.findall(r"--out (\S+)", example) if d != "DIR"]  # DIR: the usage line
+    read = re.findall(r"cm\.compare\([^,]+,\s*\"([^\"]+)\"", example)
+    assert len(written) == 3 and len(read) == 1, (written, read)
+    for p in written + read:
+        assert p.startswith("work/"), p
+    with open(os.path.join(ROOT, "docs", "measured_records_calibration.yaml"), encoding="utf-8") as f:
+        cal = yaml.safe_load(f)
+    record = os.path.normpath(os.path.join(ROOT, "docs", cal["record"]))
+    assert record == os.path.join(ROOT, "work", "measured_run.csv")
+    for p in written + [os.path.relpath(record, ROOT)]:
+        r = subprocess.run(["git", "check-ignore", "-q", "--no-index", p], cwd=ROOT, timeout=60)
+        assert r.returncode == 0, f"{p} is not ignored by git"
+
+
+@pytest.mark.parametrize("kw, field", [
+    ({"sample_rate_hz": 5e6}, "sample_rate_hz"),          # finer than the time column's 1 us
+    ({"sample_rate_hz": 0.01}, "sample_rate_hz"),         # fewer than 3 rows over the pass
+    ({"supports": "all"}, "supports"),
+    ({"supports": 5}, "supports"),
+    ({"head": "no"}, "head"),
+    ({"path": "y.yaml"}, "path"),                         # the CSV where its side YAML belongs
+    ({"path": "run.txt"}, "path"),
+    ({"path": "missing/run.csv"}, "path"),
+    ({"path": "."}, "path"),
+])
+def test_synthesise_record_refuses_bad_arguments_before_writing(tmp_path, kw, field):
+    kw = dict(kw)
+    path = str(tmp_path / kw.pop("path", "run.csv"))
+    with pytest.raises(cs.SceneError) as e:
+        cm.synthesise_record(REFERENCE, path, overrides=SHORT, **kw)
+    assert e.value.field == field, str(e.value)
+    assert f"{field} = " in str(e.value) and "allowed" in str(e.value)
+    assert os.listdir(tmp_path) == []
+
+
+def test_synthesise_record_leaves_nothing_when_a_file_cannot_be_placed(tmp_path, monkeypatch):
+    # The CSV cannot be moved into place after its side YAML was: neither is left, nor a staged file.
+    real = os.replace
+
+    def replace(src, dst):
+        if dst.endswith(".csv"):
+            raise PermissionError(13, "Permission denied")
+        return real(src, dst)
+    monkeypatch.setattr(os, "replace", replace)
+    with pytest.raises(cs.SceneError) as e:
+        cm.synthesise_record(REFERENCE, str(tmp_path / "run.csv"), overrides=SHORT)
+    assert e.value.field == "path" and "Permission denied" in str(e.value)
+    assert os.listdir(tmp_path) == []
+
+
+# --------------------------------------------------------------------------------------------
+# Filters no longer than the record
+# --------------------------------------------------------------------------------------------
+def test_a_band_whose_period_exceeds_the_record_is_refused_by_its_name(tmp_path, clean):
+    # The record spans rows / sample rate seconds; a low-pass whose period is longer has no whole
+    # period of it to act on: refused, naming the least cutoff for this record.
+    duration = len(clean.station_m) / clean.sample_rate_hz
+    least = 1.0 / duration
+    err = refused(write(tmp_path, clean, meta=lambda d: d.update(bandwidth_hz=0.5 * least)), "metadata",
+                  "bandwidth_hz")
+    assert f"at least {least:.4g} Hz" in str(err)
+    with pytest.raises(cs.SceneError) as e:
+        cm.compare(REFERENCE, clean, overrides=SHORT, cutoff_hz=0.5 * least)
+    assert e.value.field == "cutoff_hz" and f"at least {least:.4g} Hz" in str(e.value)
+    with pytest.raises(cs.SceneError) as e:  # the scene's own cutoff, as low
+        cm.compare(REFERENCE, clean, overrides=SHORT + [f"output.filter_cutoff={0.5 * least!r}"])
+    assert e.value.field == "cutoff_hz" and "output.filter_cutoff" in str(e.value)
+    cm.compare(REFERENCE, clean, overrides=SHORT, cutoff_hz=1.01 * least)  # one period within: accepted
+    out = tmp_path / "never"
+    r = cli(REFERENCE, clean.path, "--out", out, "--set", SHORT[0], "--set", SHORT[1], "--cutoff", 0.5 * least)
+    assert r.returncode == 2 and "--cutoff = " in r.stderr and f"at least {least:.4g} Hz" in r.stderr, r.stderr
+    assert not out.exists()
+    with pytest.raises(cs.SceneError) as e:
+        cm.synthesise_record(REFERENCE, str(tmp_path / "s.csv"), overrides=SHORT, bandwidth_hz=1e-3)
+    assert e.value.field == "bandwidth_hz" and "exceeds the record's duration" in str(e.value)
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_a_bandwidth_beyond_the_measuring_pantographs_is_named_as_the_records(tmp_path, clean):
+    # The record's bandwidth becomes the simulated measuring pantograph's output.sensor_bandwidth:
+    # one beyond that field's range is the record's field, not a scene field the user never wrote.
+    err = refused(write(tmp_path, clean, meta=lambda d: d.update(bandwidth_hz=1e6)), "metadata", "bandwidth_hz",
+                  scene=True)
+    assert "output.sensor_bandwidth" in err.allowed
+    with pytest.raises(cs.SceneError) as e:
+        cm.synthesise_record(REFERENCE, str(tmp_path / "s.csv"), overrides=SHORT, bandwidth_hz=1e6)
+    assert e.value.field == "bandwidth_hz", str(e.value)
+    assert not (tmp_path / "s.csv").exists()
+
+
+# --------------------------------------------------------------------------------------------
+# Files as spreadsheets and editors write them
+# --------------------------------------------------------------------------------------------
+def test_a_byte_order_mark_and_trailing_commas_read_as_the_plain_record(tmp_path, clean):
+    with open(clean.path) as f:
+        lines = f.read().splitlines()
+    with open(os.path.splitext(clean.path)[0] + ".yaml") as f:
+        doc = yaml.safe_load(f)
+    header = ["# " + ln for ln in yaml.safe_dump(doc).splitlines()]
+    variants = {
+        # a UTF-8 byte order mark before the '#' metadata lines
+        "bom": ("\ufeff" + "\n".join(header + lines) + "\n", None),
+        # ... and before a side YAML
+        "bom_side": ("\n".join(lines) + "\n", "\ufeff" + yaml.safe_dump(doc)),
+        # a trailing comma on every data row, on the header and the rows, on the header alone
+        "rows": ("\n".join(lines[:1] + [ln + "," for ln in lines[1:]]) + "\n", yaml.safe_dump(doc)),
+        "both": ("\n".join(ln + "," for ln in lines) + "\n", yaml.safe_dump(doc)),
+        "head": ("\n".join([lines[0] + ","] + lines[1:]) + "\n", yaml.safe_dump(doc)),
+    }
+    for name, (csv_text, side) in variants.items():
+        (tmp_path / f"{name}.csv").write_text(csv_text, encoding="utf-8")
+        if side is not None:
+            (tmp_path / f"{name}.yaml").write_text(side, encoding="utf-8")
+        r = cm.read_record(str(tmp_path / f"{name}.csv"))
+        assert list(r.columns.values()) == list(clean.columns.values()), name
+        assert np.array_equal(r.station_m, clean.station_m), name
+        assert np.array_equal(r.force_N["leading"], clean.force_N["leading"]), name
+        assert r.support_station_m == clean.support_station_m, name
+    # A row with a field more than the header (not an empty trailing one) is refused by its line.
+    refused(write(tmp_path, clean, {20: lambda r, h: r + ["7"]}), "format", "row", 22)
+
+
+def test_metadata_of_the_wrong_shape_is_refused_saying_what_was_read(tmp_path, clean):
+    refused(write(tmp_path, clean, meta=lambda d: d.update(station_of=["leading"])), "metadata", "station_of")
+    refused(write(tmp_path, clean, meta=lambda d: d.update(station_of={"a": 1})), "metadata", "station_of")
+    refused(write(tmp_path, clean, meta=lambda d: d.update(pantographs=[{"a": 1}])), "metadata", "pantographs")
+    refused(write(tmp_path, clean, meta=lambda d: d.update(pantographs=[["leading"]])), "metadata", "pantographs")
+    # A quoted number is text: shown quoted, as read, not as the number it looks like.
+    err = refused(write(tmp_path, clean, meta=lambda d: d.update(sample_rate_hz="200")), "metadata",
+                  "sample_rate_hz")
+    assert "'sample_rate_hz' = '200'" in str(err) and "not a number" in str(err)
+
+
+def test_a_section_of_fewer_than_three_rows_is_refused_with_the_rows_it_holds(tmp_path, clean):
+    x = clean.station_m
+    k = int(np.searchsorted(x, 160.0))  # inside the analysis section, within one span (110-165 m)
+    two = [float(x[k]), float(x[k + 1])]  # bounds included: two rows
+    err = refused(write(tmp_path, clean, meta=lambda d: d.update(section_m=two), name="two.csv"), "short_section",
+                  "section_m", scene=True)
+    assert "holds 2 of the record's rows" in str(err) and "at least 3 rows" in str(err)
+    # Three rows are enough for every statistic and the spectrum, without a warning.
+    three = write(tmp_path, clean, meta=lambda d: d.update(section_m=[float(x[k]), float(x[k + 2])]), name="3.csv")
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        c = cm.compare(REFERENCE, three, overrides=SHORT)
+    assert c.settings["rows_in_section"] == 3
+
+
+def test_the_span_passing_frequency_is_the_lines_span_at_the_mean_speed(tmp_path, clean):
+    # A section inside one span holds no two supports: the span is still the line's (55 m here),
+    # not the section's length. Both sides of the check are the same division: 1e-12 relative.
+    with open(REFERENCE) as f:
+        span = yaml.safe_load(f)["line"]["span_length"]
+    for section in ([150.0, 160.0], [100.0, 250.0]):
+        rec = write(tmp_path, clean, meta=lambda d: d.update(section_m=section), name="sec.csv")
+        c = cm.compare(REFERENCE, rec, overrides=SHORT)
+        v = c.settings["mean_speed_kmh"] / 3.6
+        assert c.settings["span_passing_hz"] == pytest.approx(v / span, rel=1e-12), section
+
+
+@pytest.mark.parametrize("tolerances, words", [
+    # a difference of the two sides has no record's value to take a percentage of
+    ({"force_rms_difference_N": "10%"}, "is itself a difference"),
+    ({"leading.spectrum_rms_difference_dB": "5 %"}, "is itself a difference"),
+    # an owner without such a row, a quantity no owner has
+    ({"A2.mean_force_N": 1}, "A2 has no mean_force_N"),
+    ({"leading.max_uplift_m": 0.01}, "leading has no max_uplift_m"),
+    ({"trailing.mean_force_N": 1}, "'trailing.mean_force_N'"),
+])
+def test_a_tolerance_the_comparison_cannot_apply_is_refused(clean, tolerances, words):
+    with pytest.raises(cs.SceneError) as e:
+        cm.compare(REFERENCE, clean, overrides=SHORT, tolerances=tolerances)
+    assert words in str(e.value) and "allowed" in str(e.value), str(e.value)
+
+
+def test_a_tolerance_of_the_head_needs_a_head_column(tmp_path, clean):
+    with open(clean.path) as f:
+        rows = [ln.split(",") for ln in f.read().splitlines()]
+    k = rows[0].index("head_leading_mm")
+    (tmp_path / "bare.csv").write_text("\n".join(",".join(r[:k] + r[k + 1:]) for r in rows) + "\n")
+    with open(os.path.splitext(clean.path)[0] + ".yaml") as f:
+        (tmp_path / "bare.yaml").write_text(f.read())
+    with pytest.raises(cs.SceneError) as e:
+        cm.compare(REFERENCE, str(tmp_path / "bare.csv"), overrides=SHORT, tolerances={"head_std_m": 1e-3})
+    assert "the record has no head_std_m" in str(e.value) and "head column" in str(e.value)
+
+
+@pytest.mark.parametrize("call, named", [
+    (lambda: cm.lowpass([1.0, 2.0, 3.0, 4.0], 100.0, "a"), "cutoff fc = 'a'"),
+    (lambda: cm.lowpass([1.0, 2.0, 3.0, 4.0], None, 20.0), "sample rate fs = None"),
+    (lambda: cm.lowpass([[1.0, 2.0], [3.0, 4.0]], 100.0, 20.0), "x = [[1.0, 2.0], [3.0, 4.0]]"),
+    (lambda: cm.lowpass(["a", "b"], 100.0, 20.0), "x = ['a', 'b']"),
+    (lambda: cm.section_statistics([1.0, 2.0, 3.0], [0, 1, 1]), "inside = [0, 1, 1]"),  # not an index
+    (lambda: cm.section_statistics([1.0, 2.0, 3.0], np.array([True, True])), "inside = "),
+    (lambda: cm.section_statistics([1.0, float("nan"), 3.0], np.ones(3, bool)), "force[1] = nan"),
+    (lambda: cm.section_statistics([1.0, 2.0, 3.0], np.ones(3, bool), [1.0, 2.0]), "loss_force = [1.0, 2.0]"),
+    (lambda: cm.noise_after_filters(-3.0, 200.0, [20.0]), "noise_std = -3.0"),
+    (lambda: cm.noise_after_filters(3.0, float("nan"), [20.0]), "fs = nan"),
+    (lambda: cm.noise_after_filters(3.0, 200.0, [0.0]), "cutoffs[0] = 0.0"),
+    (lambda: cm.noise_after_filters(3.0, 200.0, 20.0), "cutoffs = 20.0"),
+    (lambda: cm.noise_after_filters(3.0, 200.0, [20.0], n=0), "n = 0"),
+    (lambda: cm.simulate_run(REFERENCE, None, SHORT, 280.0, max_steps=float("nan")), "max_steps = nan"),
+    (lambda: cm.simulate_run(REFERENCE, None, SHORT, 280.0, max_steps="many"), "max_steps = 'many'"),
+    (lambda: cm.simulate_run(REFERENCE, 5, SHORT), "record = 5"),
+])
+def test_the_functions_refuse_bad_arguments_by_name(call, named):
+    with pytest.raises(ValueError) as e:
+        call()
+    assert named in str(e.value) and "allowed" in str(e.value), str(e.value)
+
+
+def test_a_record_error_crosses_processes_whole():
+    # A calibration's Dask worker sends its errors back pickled: the kind, field and line survive.
+    import pickle
+    err = cm.RecordError("nan", "run.csv", "force_leading_N", "'x'", "a finite number", "not a number", row=12)
+    back = pickle.loads(pickle.dumps(err))
+    assert type(back) is cm.RecordError and str(back) == str(err)
+    assert (back.kind, back.field, back.row, back.path) == ("nan", "force_leading_N", 12, "run.csv")
