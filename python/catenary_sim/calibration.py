@@ -289,8 +289,11 @@ def evaluate(cal, keys, values):
     """One evaluation (runs on a Dask worker): the residuals at these parameter values."""
     ov = dict(cal["overrides"])
     ov.update(zip(keys, values))
-    c = cm.compare(cal["scene"], cal["record"], overrides=ov, speed_profile=cal["speed_profile"],
-                   cutoff_hz=cal["cutoff"], meta=cal["meta"])
+    try:
+        c = cm.compare(cal["scene"], cal["record"], overrides=ov, speed_profile=cal["speed_profile"],
+                       cutoff_hz=cal["cutoff"], meta=cal["meta"])
+    except RuntimeError as e:  # the watchdog stopped the pass: say at which parameter values
+        raise RuntimeError("the pass at %s: %s" % (", ".join("%s = %.6g" % kv for kv in zip(keys, values)), e)) from None
     return {"residuals": residuals(c, cal["objective"]).tolist(),
             "band_hz": min(c.settings["cutoff_hz"], c.record.bandwidth_hz)}
 
@@ -443,7 +446,10 @@ def uncertainty(params, u, r, jac_u, correlated=1.0):
 
 
 def calibrate(path, out, scheduler=None, workers=2, report=True):
-    """Runs a calibration file into DIR (resumable); returns the dict of calibration.json."""
+    """Runs a calibration file into DIR (resumable); returns the dict of calibration.json.
+    Raises CalibrationError (or SceneError) for bad input, with nothing written, and RuntimeError
+    naming the parameter values where the watchdog stopped a diverging pass (the evaluations kept
+    before it stay in DIR)."""
     from dask.distributed import Client, LocalCluster
     import dask
 
@@ -598,6 +604,9 @@ def main():
     except (CalibrationError, SceneError) as e:
         sys.stderr.write(f"calibrate: {e}\n")
         return 2
+    except RuntimeError as e:  # a pass diverged (the evaluations before it are kept in --out)
+        sys.stderr.write(f"calibrate: {e}\n")
+        return 3
     if not result["converged"]:
         print("NOT CONVERGED: %s (the values below are where the optimiser stopped)" % result["message"])
     if not result["uncertainty_available"]:

@@ -209,6 +209,19 @@ def test_a_cutoff_longer_than_the_record_is_refused_before_anything_runs(tmp_pat
     assert not (tmp_path / "out").exists()
 
 
+def test_a_diverging_pass_is_said_with_its_parameter_values(tmp_path):
+    # A divergence limit of 2 cm lies within the pass's own uplift (several centimetres at
+    # 270 km/h), so the watchdog stops the first pass: the command names the parameter values it
+    # ran at and exits 3 (as compare_measurement does for a diverging pass), no traceback.
+    overrides = dict(FAST, **{"numerics.divergence_limit": 0.02})
+    path = _fast_calibration(tmp_path, "a", 3e-4, overrides=overrides)
+    r = subprocess.run([sys.executable, CLI, path, "--out", str(tmp_path / "out"), "--workers", "1", "--no-report"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert r.returncode == 3, r.stdout[-3000:]
+    assert "the pass at damping.beta = 0.0001: diverged" in r.stdout and "Traceback" not in r.stdout
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.mark.parametrize("kw,words", [
     ({"workers": 0}, "workers = 0"), ({"workers": -1}, "workers = -1"), ({"workers": "two"}, "workers = 'two'"),
     ({"workers": 2.5}, "workers = 2.5"), ({"path": None}, "path = None"), ({"path": 5}, "path = 5"),
