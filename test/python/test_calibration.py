@@ -130,6 +130,12 @@ def _fast_calibration(tmp_path, name, beta, **fields):
     return str(path)
 
 
+def _run_cli(path, out):
+    """scripts/calibrate on one local worker without the before/after reports (output and errors together)."""
+    return subprocess.run([sys.executable, CLI, path, "--out", str(out), "--workers", "1", "--no-report"],
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+
+
 def test_a_directory_of_another_calibration_replays_none_of_its_evaluations(tmp_path):
     a = _fast_calibration(tmp_path, "a", 3e-4)
     b = _fast_calibration(tmp_path, "b", 6e-4)
@@ -161,8 +167,7 @@ def test_non_convergence_and_a_rough_objective_are_said_plainly(tmp_path):
     # cannot converge; the fast preset's objective is rough at the difference step (the last bit
     # of a parameter moves it by tens of per cent), so no uncertainty can be given.
     path = _fast_calibration(tmp_path, "a", 3e-4, optimiser={"method": "least_squares", "max_evaluations": 5})
-    r = subprocess.run([sys.executable, CLI, path, "--out", str(tmp_path / "out"), "--workers", "1", "--no-report"],
-                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    r = _run_cli(path, tmp_path / "out")
     assert r.returncode == 0, r.stdout[-3000:]
     result = json.loads((tmp_path / "out" / "calibration.json").read_text())
     assert not result["converged"] and "NOT CONVERGED" in r.stdout
@@ -176,8 +181,7 @@ def test_max_evaluations_bounds_every_pass_the_calibration_runs(tmp_path):
     # function and Jacobian passes and the uncertainty's at the end together stay within the
     # bound, and a calibration stopped by it says so.
     path = _fast_calibration(tmp_path, "a", 3e-4, optimiser={"method": "least_squares", "max_evaluations": 7})
-    r = subprocess.run([sys.executable, CLI, path, "--out", str(tmp_path / "out"), "--workers", "1", "--no-report"],
-                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    r = _run_cli(path, tmp_path / "out")
     assert r.returncode == 0, r.stdout[-3000:]
     result = json.loads((tmp_path / "out" / "calibration.json").read_text())
     kept = _kept(tmp_path / "out" / "evaluations")
@@ -215,8 +219,7 @@ def test_a_diverging_pass_is_said_with_its_parameter_values(tmp_path):
     # ran at and exits 3 (as compare_measurement does for a diverging pass), no traceback.
     overrides = dict(FAST, **{"numerics.divergence_limit": 0.02})
     path = _fast_calibration(tmp_path, "a", 3e-4, overrides=overrides)
-    r = subprocess.run([sys.executable, CLI, path, "--out", str(tmp_path / "out"), "--workers", "1", "--no-report"],
-                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    r = _run_cli(path, tmp_path / "out")
     assert r.returncode == 3, r.stdout[-3000:]
     assert "the pass at damping.beta = 0.0001: diverged" in r.stdout and "Traceback" not in r.stdout
     assert not (tmp_path / "out").exists()

@@ -269,14 +269,19 @@ def test_the_cli_refuses_bad_input_and_writes_nothing(tmp_path, clean):
     assert sorted(os.listdir(tmp_path)) == sorted(["bad.csv", "bad.yaml", "never"])
 
 
+def _lines_and_metadata(record):
+    """A record's CSV lines and its side YAML's metadata, as written."""
+    with open(record.path) as f:
+        lines = f.read().splitlines()
+    with open(os.path.splitext(record.path)[0] + ".yaml") as f:
+        return lines, yaml.safe_load(f)
+
+
 # --------------------------------------------------------------------------------------------
 # Other shapes of the same record
 # --------------------------------------------------------------------------------------------
 def test_a_header_a_railways_stations_and_a_time_based_record_read_alike(tmp_path, clean):
-    with open(clean.path) as f:
-        lines = f.read().splitlines()
-    with open(os.path.splitext(clean.path)[0] + ".yaml") as f:
-        doc = yaml.safe_load(f)
+    lines, doc = _lines_and_metadata(clean)
     # The metadata as '#' lines atop the CSV instead of beside it.
     header = ["# " + ln for ln in yaml.safe_dump(doc).splitlines()]
     (tmp_path / "h.csv").write_text("\n".join(header + lines) + "\n")
@@ -468,10 +473,7 @@ def test_a_bandwidth_beyond_the_measuring_pantographs_is_named_as_the_records(tm
 # Files as spreadsheets and editors write them
 # --------------------------------------------------------------------------------------------
 def test_a_byte_order_mark_and_trailing_commas_read_as_the_plain_record(tmp_path, clean):
-    with open(clean.path) as f:
-        lines = f.read().splitlines()
-    with open(os.path.splitext(clean.path)[0] + ".yaml") as f:
-        doc = yaml.safe_load(f)
+    lines, doc = _lines_and_metadata(clean)
     header = ["# " + ln for ln in yaml.safe_dump(doc).splitlines()]
     variants = {
         # a UTF-8 byte order mark before the '#' metadata lines
