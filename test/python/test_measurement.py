@@ -264,9 +264,21 @@ def test_the_cli_refuses_bad_input_and_writes_nothing(tmp_path, clean):
     out.mkdir()
     (out / "keep.txt").write_text("x")
     r = cli(REFERENCE, clean.path, "--out", out, "--set", SHORT[0], "--set", SHORT[1], "--tolerance", "spread=1")
-    assert r.returncode == 2 and "tolerances key 'spread'" in r.stderr, r.stderr
+    assert r.returncode == 2 and "--tolerance spread=1 rejected" in r.stderr, r.stderr
     assert sorted(os.listdir(out)) == ["keep.txt"]
     assert sorted(os.listdir(tmp_path)) == sorted(["bad.csv", "bad.yaml", "never"])
+
+
+def test_the_cli_names_a_refused_tolerance_as_the_option_gave_it(tmp_path, clean):
+    # compare() names its tolerances' keys; the command line gave them as options.
+    (tmp_path / "tol.yaml").write_text("std_force_N: abc\n")
+    for args, words in ((["--tolerance", "std_force_N=abc"], "--tolerance std_force_N=abc rejected"),
+                        (["--tolerance", "force_rms_difference_N=10%"],
+                         "--tolerance force_rms_difference_N=10% rejected"),
+                        (["--tolerances", str(tmp_path / "tol.yaml")], "tol.yaml: std_force_N: 'abc' rejected")):
+        r = cli(REFERENCE, clean.path, "--out", tmp_path / "never", "--set", SHORT[0], "--set", SHORT[1], *args)
+        assert r.returncode == 2 and words in r.stderr and "tolerances[" not in r.stderr, r.stderr
+        assert not (tmp_path / "never").exists()
 
 
 def _lines_and_metadata(record):
