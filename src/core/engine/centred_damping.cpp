@@ -266,7 +266,7 @@ bool centred_sweep_pack(const Model& m, const WireLanes& pack, State& s, int lo,
   c.limit = m.scene.numerics.divergence_limit;
   c.twin = twin;
   c.single = single;
-  c.record = s.work->sweep.data() + kSweepRecord * pack.offset;
+  c.record = s.work->sweep.data() + kCentredRecord * pack.offset;
   return centred_sweep(c) != 0;
 }
 
@@ -290,7 +290,7 @@ int centred_sweep_both_planes(const Model& m, std::size_t pk, State& s) {
   c.limit = m.scene.numerics.divergence_limit;
   c.twin = lat.centred_joint_twin[pk].data();
   c.single = lat.centred_joint_single[pk].data();
-  c.record = lw.sweep.data() + 2 * kSweepRecord * pack.offset;  // (both planes' room: make_lateral_state)
+  c.record = lw.sweep.data() + 2 * kCentredRecord * pack.offset;  // (both planes' room: make_lateral_state)
   return centred_sweep(c);
 }
 

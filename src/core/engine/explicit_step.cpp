@@ -192,11 +192,11 @@ int explicit_fused_update(const Model& m, State& s, bool windowed) {
   // force so far into the force vector, where the pantographs' contact adds to it.
   double* rec = join ? s.lateral.work->sweep.data() : s.work->sweep.data();
   const int* f_at = join ? m.wire_packs->dof_joint_force.data() : m.wire_packs->dof_sweep_force.data();
-  const int* z_at = join ? m.wire_packs->dof_joint_z.data() : m.wire_packs->dof_sweep_z.data();
   auto force_at = [rec, f_at](int i) -> double& { return rec[f_at[i]]; };
-  auto z_rec = [rec, z_at](int i) { return rec[z_at[i]]; };
-  if (leaning(m, s)) add_wire_point_forces<true>(m, s, u, v, force_at, z_rec, false);
-  else add_wire_point_forces<false>(m, s, u, v, force_at, z_rec, false);
+  const double beta = m.beta;
+  auto z_at = [u, v, beta](int i) { return u[i] + beta * v[i]; };  // (the sweep's z, to the bit)
+  if (leaning(m, s)) add_wire_point_forces<true>(m, s, u, v, force_at, z_at, false);
+  else add_wire_point_forces<false>(m, s, u, v, force_at, z_at, false);
   for (int q = 0; q < contacts; ++q) f[contact_node[q]] = force_at(contact_node[q]);
   add_pantograph_forces(m, s, u, v, f);
   const double* im = m.inv_mass.data();

@@ -162,7 +162,7 @@ bool lead_step(const Model& m, State& s) {
     c.limit = 1e300;  // (checked below, on the trapezoidal rule's positions)
     c.twin = lw.lead_twin.data() + lw.lead_twin_at[pk];
     c.single = lw.lead_single.data() + lw.lead_single_at[pk];
-    c.record = lw.lead_record.data() + kSweepRecord * p.offset;
+    c.record = lw.lead_record.data() + kCentredRecord * p.offset;
     centred_sweep(c);
   }
   double* yn = lw.lead_y_next.data();

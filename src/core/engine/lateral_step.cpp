@@ -121,7 +121,7 @@ LateralState make_lateral_state(const Model& m) {
   work.y_next = s.y;
   work.v_next = Eigen::VectorXd::Zero(lat.n);
   work.accel = Eigen::VectorXd::Zero(lat.n);
-  work.sweep.assign(2 * kSweepRecord * sweep_size(m), 0.0);  // (both planes' records when joint)
+  work.sweep.assign(2 * kCentredRecord * sweep_size(m), 0.0);  // (both planes' records when joint)
   int longest = 0;
   for (const Wire& w : lat.wires) longest = std::max(longest, w.nodes());
   work.theta.assign(longest, 0.0);
@@ -194,7 +194,7 @@ LateralState make_lateral_state(const Model& m) {
     work.lead_twin.assign(twin, 0.0);
     work.lead_single.assign(single, 0.0);
     work.lead_scratch.assign(static_cast<std::size_t>(longest) * kCdValues, 0.0);
-    work.lead_record.assign(kSweepRecord * sweep_size(m), 0.0);
+    work.lead_record.assign(kCentredRecord * sweep_size(m), 0.0);
   }
   work.window_points.assign(work.cut_node.size() + lat.springs.size() + 2 * lat.pendulums.size() + 2 * lat.clamps.size() +
                                 kRegistrationRow * lat.registrations.size(),
@@ -493,7 +493,7 @@ bool centred_substep(const Model& m, State& s, bool windowed) {
     c.limit = m.scene.numerics.divergence_limit;
     c.twin = windowed ? lw.centred_twin.data() + lw.centred_twin_at[pk] : lat.centred_twin[pk].data();
     c.single = windowed ? lw.centred_single.data() + lw.centred_single_at[pk] : lat.centred_single[pk].data();
-    c.record = lw.sweep.data() + kSweepRecord * p.offset;
+    c.record = lw.sweep.data() + kCentredRecord * p.offset;
     out |= centred_sweep(c) != 0;
   }
   if (out) return true;

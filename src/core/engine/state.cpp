@@ -45,7 +45,7 @@ State make_state(const Model& m) {
   if (m.wire_packs || m.scene.numerics.damping == DampingStep::kCentred) {
     s.work->u_next = Eigen::VectorXd::Zero(m.n_dof);
     s.work->v_next = Eigen::VectorXd::Zero(m.n_dof);
-    s.work->sweep.assign(kSweepRecord * sweep_size(m), 0.0);
+    s.work->sweep.assign(kCentredRecord * sweep_size(m), 0.0);
     s.work->point_node.assign(m.collectors.size() * m.contact_wires.size() * m.max_contact_nodes, 0);
     if (m.scene.numerics.windowed() && m.scene.numerics.damping != DampingStep::kCentred) {
       s.work->sweep_factors.assign(2 * sweep_size(m), 0.0);  // (the half-step sweep's window factors)

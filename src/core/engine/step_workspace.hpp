@@ -14,8 +14,8 @@ struct StepWorkspace {
   // `force` between steps: clear_point_forces).
   Eigen::VectorXd force, z;
   // Fused explicit step: the new displacements and velocities (swapped in, or copied back in the
-  // window, once all are good); per node and lane of every wire pack the sweep's record (rotation,
-  // z, load less damping, band force: engine/wire_lanes.hpp); the window's LDL^T factors laid
+  // window, once all are good); per node and lane of every wire pack the sweep's record (rotation
+  // and band force: engine/wire_lanes.hpp; or the centred step's); the window's LDL^T factors laid
   // out as WireLanes::factors; the contact wire's nodes under the collectors this step.
   Eigen::VectorXd u_next, v_next;
   std::vector<double> sweep, sweep_factors;

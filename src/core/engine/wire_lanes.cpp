@@ -216,19 +216,17 @@ struct Sweeper : Access {
   using Access::lower;
   using Access::set;
   T zp, zc, y;              // forward: z at the last two nodes, the L sweep's value
-  T th1, th2, z1, z2;       // backward: theta and z at the two nodes after the current one
+  T th1, th2, z1, z2, v1;   // backward: theta and z at the two nodes after the current one, v at the next
   typename Access::Mask ok;  // every new displacement inside the limit so far
 
   using Access::Access;
 
-  // Forward: z = u + beta v and the load less the damping (init), kept for the backward sweep;
-  // and K_tt theta = -K_tw z, the L of LDL^T (condensed_band_force's first loop).
-  __attribute__((always_inline)) T start(int i, T ui, T vi) {
-    const T z = ui + this->beta * vi;
-    set(i, kRecZ, z);
-    set(i, kRecInit, this->init(i, vi));
-    return z;
-  }
+  // Forward: z = u + beta v, and K_tt theta = -K_tw z, the L of LDL^T (condensed_band_force's
+  // first loop). z and the load less the damping (init) are not kept: the backward sweep computes
+  // them again from the u and v its update reads anyway, the same operations on the same values
+  // (the same bits), which is cheaper than a record's round trip through memory on a long line.
+  __attribute__((always_inline)) T z_of(T ui, T vi) const { return ui + this->beta * vi; }
+  __attribute__((always_inline)) T start(int, T ui, T vi) { return z_of(ui, vi); }
   __attribute__((always_inline)) void forward(int i, T zn) {
     const T r = (-c(i, W::kDwt) * zc - c(i, W::kEtw) * zn) - c(i - 1, W::kEwt) * zp;
     y = r - lower(i) * y;
@@ -268,35 +266,42 @@ struct Sweeper : Access {
     set(j, kRecForce, f);
     return this->inv_mass(j) * f;
   }
+  // z at node i from the state, and v there kept for the node's init one node on.
+  __attribute__((always_inline)) T z_at(int i, T& vi) const {
+    T ui;
+    this->state(i, ui, vi);
+    return z_of(ui, vi);
+  }
   __attribute__((always_inline)) T backward(int i) {
     const T th0 = get(i, kRecTheta) * ip(i) - lower(i + 1) * th1;
-    set(i, kRecTheta, th0);
-    const T z0 = get(i, kRecZ);
+    T v0;
+    const T z0 = z_at(i, v0);
     const int j = i + 1;
     const T A = ((c(j, W::kDww) * z1 + c(j, W::kDwt) * th1) + c(i, W::kEww) * z0) + c(i, W::kEtw) * th0;
     const T B = c(j, W::kEww) * z2 + c(j, W::kEwt) * th2;
-    const T f = (get(j, kRecInit) - A) - B;
+    const T f = (this->init(j, v1) - A) - B;
     th2 = th1;
     th1 = th0;
     z2 = z1;
     z1 = z0;
+    v1 = v0;
     return accel(j, f);
   }
   __attribute__((always_inline)) void backward_begin() {
     const int hi = this->hi, i = hi - 1;
     ok = Access::all();
     th1 = y * ip(hi);  // theta_{i+1}, theta_{i+2}, z likewise
-    set(hi, kRecTheta, th1);
-    z1 = get(hi, kRecZ);
+    T v_hi, v0;
+    z1 = z_at(hi, v_hi);
     const T th0 = get(i, kRecTheta) * ip(i) - lower(i + 1) * th1;
-    set(i, kRecTheta, th0);
-    const T z0 = get(i, kRecZ);
+    const T z0 = z_at(i, v0);
     const T A = ((this->ww_hi * z1 + this->wt_hi * th1) + c(i, W::kEww) * z0) + c(i, W::kEtw) * th0;
-    this->update(hi, accel(hi, get(hi, kRecInit) - A), ok);
+    this->update(hi, accel(hi, this->init(hi, v_hi) - A), ok);
     th2 = th1;
     th1 = th0;
     z2 = z1;
     z1 = z0;
+    v1 = v0;
   }
   // Nodes i + 1 and i complete: updated as a block.
   __attribute__((always_inline)) void backward_two(int i) {
@@ -310,7 +315,7 @@ struct Sweeper : Access {
     const int lo = this->lo;
     const T A = this->ww_lo * z1 + this->wt_lo * th1;
     const T B = c(lo, W::kEww) * z2 + c(lo, W::kEwt) * th2;
-    this->update(lo, accel(lo, (get(lo, kRecInit) - A) - B), ok);
+    this->update(lo, accel(lo, (this->init(lo, v1) - A) - B), ok);
   }
 };
 

@@ -65,8 +65,7 @@ std::shared_ptr<WirePacks> build_wire_packs(const Model& m) {
     }
     pk.packs.push_back(std::move(p));
   }
-  for (std::vector<int>* at : {&pk.dof_sweep_force, &pk.dof_sweep_z, &pk.dof_joint_force, &pk.dof_joint_z})
-    at->assign(m.n_catenary_dof, 0);
+  for (std::vector<int>* at : {&pk.dof_sweep_force, &pk.dof_joint_force}) at->assign(m.n_catenary_dof, 0);
   for (const WireLanes& p : pk.packs)
     for (int k = 0; k < p.lanes; ++k)
       for (int i = 0; i < p.nodes; ++i) {
@@ -74,11 +73,9 @@ std::shared_ptr<WirePacks> build_wire_packs(const Model& m) {
         // [node][value][lane] from the pack's offset; in the joint records [node][value][2 lanes
         // per wire] from twice that offset, the vertical plane's first: 2 r - k.
         const std::size_t r = kSweepRecord * p.offset + static_cast<std::size_t>(i) * kSweepRecord * p.lanes + k;
-        const std::size_t f = r + kRecForce * p.lanes, z = r + kRecZ * p.lanes;
+        const std::size_t f = r + kRecForce * p.lanes;
         pk.dof_sweep_force[dof] = static_cast<int>(f);
-        pk.dof_sweep_z[dof] = static_cast<int>(z);
         pk.dof_joint_force[dof] = static_cast<int>(2 * f - k);
-        pk.dof_joint_z[dof] = static_cast<int>(2 * z - k);
       }
   return packs;
 }

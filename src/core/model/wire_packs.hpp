@@ -32,21 +32,24 @@ struct WireLanes {
 };
 
 // The fused step's record per node and lane (StepWorkspace::sweep, kSweepRecord values per node,
-// each for every lane; the engine's sweep writes them, WirePacks::dof_sweep_force and dof_sweep_z
-// point into them): the rotation, z = u + beta v, the load less the damping, and the band force.
-enum { kRecTheta, kRecZ, kRecInit, kRecForce, kSweepRecord };
+// each for every lane; the engine's sweep writes them, WirePacks::dof_sweep_force points into
+// them): the rotation of the forward sweep, and the band force.
+enum { kRecTheta, kRecForce, kSweepRecord };
+// The centred-damping step's record per node and lane in the same scratch (c = S y, then u and v:
+// engine/centred_damping.cpp): the scratch holds this many values per node-lane, room for either.
+constexpr int kCentredRecord = 4;
 
 struct WirePacks {
   std::vector<WireLanes> packs;
   std::vector<int> wire_pack, wire_lane;  // per wire (Model::wires): its pack and lane
   std::vector<int> centred_fixed_dofs;    // the wires' fixed vertical DOFs (centred damping step)
   double centred_v_ratio = 0.0;           // (2 / dt) / D_i per mass (centred damping step)
-  // Per catenary DOF: where the sweep leaves its band force and its z in StepWorkspace::sweep;
-  // and where the vertical step's sweep with the lateral plane's taken along (sweep_pack_pair)
-  // leaves them, in the joint records (2 kSweepRecord values per node-lane: the pack's at twice
-  // its offset, per node [value][the vertical plane's lanes, then the lateral plane's]).
-  std::vector<int> dof_sweep_force, dof_sweep_z, dof_joint_force, dof_joint_z;
-  std::size_t sweep_size = 0;  // node-lanes of all packs (StepWorkspace::sweep holds 4 values for each)
+  // Per catenary DOF: where the sweep leaves its band force in StepWorkspace::sweep; and where the
+  // vertical step's sweep with the lateral plane's taken along (sweep_pack_pair) leaves it, in the
+  // joint records (2 kSweepRecord values per node-lane: the pack's at twice its offset, per node
+  // [value][the vertical plane's lanes, then the lateral plane's]).
+  std::vector<int> dof_sweep_force, dof_joint_force;
+  std::size_t sweep_size = 0;  // node-lanes of all packs (StepWorkspace::sweep holds kCentredRecord values for each)
 };
 
 // Packs the wires for the fused step when the model is explicit with condensed rotations; null
