@@ -273,9 +273,13 @@ struct Sweeper : Access {
     return z_of(ui, vi);
   }
   __attribute__((always_inline)) T backward(int i) {
-    const T th0 = get(i, kRecTheta) * ip(i) - lower(i + 1) * th1;
     T v0;
     const T z0 = z_at(i, v0);
+    return backward(i, z0, v0);
+  }
+  // Node i's z0 and v0 given (loaded with a neighbour's as a block).
+  __attribute__((always_inline)) T backward(int i, T z0, T v0) {
+    const T th0 = get(i, kRecTheta) * ip(i) - lower(i + 1) * th1;
     const int j = i + 1;
     const T A = ((c(j, W::kDww) * z1 + c(j, W::kDwt) * th1) + c(i, W::kEww) * z0) + c(i, W::kEtw) * th0;
     const T B = c(j, W::kEww) * z2 + c(j, W::kEwt) * th2;
@@ -305,8 +309,10 @@ struct Sweeper : Access {
   }
   // Nodes i + 1 and i complete: updated as a block.
   __attribute__((always_inline)) void backward_two(int i) {
-    const T a1 = backward(i);
-    const T a0 = backward(i - 1);
+    T u0, u1, v0, v1;  // nodes i - 1 and i, loaded as blocks
+    this->state2(i - 1, u0, u1, v0, v1);
+    const T a1 = backward(i, z_of(u1, v1), v1);
+    const T a0 = backward(i - 1, z_of(u0, v0), v0);
     this->update2(i, a0, a1, ok);
   }
   __attribute__((always_inline)) void backward_one() { this->update(this->lo + 1, backward(this->lo), ok); }
