@@ -33,7 +33,6 @@ import hashlib
 import json
 import math
 import os
-import tempfile
 
 import numpy as np
 import yaml
@@ -41,6 +40,7 @@ from scipy import optimize
 
 from . import SceneError
 from . import measurement as cm
+from ._files import write_atomically
 
 METHODS = ("least_squares", "minimize:Nelder-Mead", "minimize:Powell")
 FIELDS = {"scene", "record", "meta", "overrides", "speed_profile", "cutoff", "parameters", "objective", "optimiser"}
@@ -327,18 +327,6 @@ def _key(context, values):
     return hashlib.sha1(json.dumps([context, [float("%.12g" % v) for v in values]]).encode()).hexdigest()[:16]
 
 
-def _write_atomically(path, text):
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=os.path.dirname(path))
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
-
-
 class _Evaluator:
     """Evaluations by their parameter values, on the cluster, each kept in DIR/evaluations/."""
 
@@ -394,7 +382,7 @@ class _Evaluator:
                 f"calibration {self.cal['path']}: objective = {self.cal['objective']!r} gives "
                 f"{'no residuals' if not r['residuals'] else 'non-finite residuals'} at "
                 f"{dict(zip(self.keys, values))}; allowed an objective the record and the pass can measure")
-        _write_atomically(os.path.join(self.dir, _key(self.context, values) + ".json"),
+        write_atomically(os.path.join(self.dir, _key(self.context, values) + ".json"),
                           json.dumps({"context": self.context, "values": dict(zip(self.keys, values)), **r}))
 
     def jacobian(self, u):
@@ -572,12 +560,12 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
         for part in parts[:-1]:
             node = node.setdefault(part, {})
         node[parts[-1]] = float("%.6g" % p["value"])
-    _write_atomically(os.path.join(out, "calibrated.yaml"),
+    write_atomically(os.path.join(out, "calibrated.yaml"),
                       "# calibrated against %s (rms residual %.4g, was %.4g)%s\n" % (
                           cal["record"], result["rms_residual_after"], result["rms_residual_before"],
                           "" if result["converged"] else "; NOT CONVERGED: " + result["message"])
                       + yaml.safe_dump(snippet, sort_keys=False))
-    _write_atomically(os.path.join(out, "calibration.json"), json.dumps(result, indent=2, allow_nan=False) + "\n")
+    write_atomically(os.path.join(out, "calibration.json"), json.dumps(result, indent=2, allow_nan=False) + "\n")
     if report:
         for name, values in (("before", to_values(params, u0)), ("after", [p["value"] for p in table])):
             ov = dict(cal["overrides"])

@@ -31,6 +31,7 @@ import yaml
 from scipy import signal
 
 from . import SceneError, Simulation, _core, _override_list, _path, _real, _integer
+from . import _files
 
 __all__ = ["RecordError", "Record", "read_record", "simulate_run", "compare", "Comparison",
            "synthesise_record", "lowpass", "section_statistics", "STATISTICS"]
@@ -730,7 +731,7 @@ class Comparison:
                 self.run.write_files(os.path.join(stage, "simulated"))
             if not os.path.exists(target):
                 os.rename(stage, target)
-                os.chmod(target, 0o777 & ~_umask())
+                os.chmod(target, 0o777 & ~_files.umask())
                 return target
             for top, _dirs, names in os.walk(stage):
                 rel = os.path.relpath(top, stage)
@@ -740,12 +741,6 @@ class Comparison:
         finally:
             shutil.rmtree(stage, ignore_errors=True)
         return target
-
-
-def _umask():
-    m = os.umask(0)
-    os.umask(m)
-    return m
 
 
 def least_band_hz(rows, sample_rate_hz):
@@ -1032,7 +1027,7 @@ def synthesise_record(scene, path, overrides=None, speed_profile=300.0, sample_r
     try:
         for target, text in ((path, table.to_csv(index=False, float_format="%.6f")),
                              (side, yaml.safe_dump(meta, sort_keys=False))):
-            staged.append((_stage(target, text), target))
+            staged.append((_files.stage(target, text), target))
         record = read_record(staged[0][0], meta=staged[1][0])
         new_side = not os.path.lexists(side)
         os.replace(staged[1][0], side)
@@ -1081,16 +1076,3 @@ def _record_paths(path):
         if os.path.isdir(p):
             refuse(f"{p} is a directory")
     return path, side
-
-
-def _stage(path, text):
-    """TEXT in a new file beside PATH (made with the umask's mode); returns its path."""
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=os.path.dirname(os.path.abspath(path)))
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o666 & ~_umask())
-    except BaseException:
-        os.remove(tmp)
-        raise
-    return tmp

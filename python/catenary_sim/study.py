@@ -40,13 +40,13 @@ import itertools
 import json
 import math
 import os
-import tempfile
 import time
 
 import numpy as np
 import yaml
 
 from . import SceneError
+from ._files import write_atomically
 
 SAMPLINGS = ("grid", "random", "lhs", "sobol", "saltelli")
 DISTRIBUTIONS = ("uniform", "normal", "truncated_normal", "integers")
@@ -450,22 +450,6 @@ def run_case(scene, overrides, case, outputs, report_dir=None):
 # --------------------------------------------------------------------------------------------
 # Files: whole or not at all
 # --------------------------------------------------------------------------------------------
-def _write_atomically(path, text):
-    d = os.path.dirname(path) or "."
-    fd, tmp = tempfile.mkstemp(dir=d, prefix="." + os.path.basename(path) + ".")
-    try:
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def _case_path(out, i):
     return os.path.join(out, "cases", f"{i:06d}.json")
 
@@ -547,7 +531,7 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
                              "numbered by that plan and cannot be reused: run the changed study with a new --out "
                              f"(or delete '{out}' to start afresh)")
     else:
-        _write_atomically(plan_path, json.dumps(plan, indent=1))
+        write_atomically(plan_path, json.dumps(plan, indent=1))
     todo = []
     for i in range(len(cases)):
         if _read_case(out, i, len(study["outputs"]), warn=True) is None:
@@ -581,7 +565,7 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
                 # (an output that is not a number, a failed case's, as null: strict JSON)
                 record["outputs"] = {k: None if isinstance(v, float) and math.isnan(v) else v
                                      for k, v in record["outputs"].items()}
-                _write_atomically(_case_path(out, i), json.dumps(record, allow_nan=False))
+                write_atomically(_case_path(out, i), json.dumps(record, allow_nan=False))
                 bar.update(1)
             bar.close()
         finally:
@@ -605,12 +589,12 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
             row["report"] = os.path.relpath(r["report"], out) if r.get("report") else ""
         rows.append(row)
     table = pd.DataFrame(rows)
-    _write_atomically(os.path.join(out, "results.csv"), table.to_csv(index=False))
+    write_atomically(os.path.join(out, "results.csv"), table.to_csv(index=False))
     if study["report"]:
-        _write_atomically(os.path.join(out, "index.html"), _index_page(study, table))
+        write_atomically(os.path.join(out, "index.html"), _index_page(study, table))
     if study["sampling"] == "saltelli":
         sens = sobol_indices_from_table(table, study)
-        _write_atomically(os.path.join(out, "sensitivity.json"), json.dumps(sens, indent=1))
+        write_atomically(os.path.join(out, "sensitivity.json"), json.dumps(sens, indent=1))
     if plots:
         from . import study_plots
         study_plots.plot_study(study, table, out)
