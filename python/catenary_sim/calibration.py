@@ -453,7 +453,8 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     if os.path.lexists(out) and not os.path.isdir(out):
         raise CalibrationError(f"--out {out}: exists and is not a directory; allowed a directory (made if absent)")
     params = cal["parameters"]
-    # Checked here, before any cluster starts: the record, the scene, each parameter at its initial value.
+    # Checked here, before any cluster starts: the record and the cutoff (load_calibration checked the
+    # scene at each bound and at the initial values).
     rec = cm.read_record(cal["record"], cal["meta"])
     measurable(cal, rec)
     try:
@@ -464,13 +465,6 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     # trust-region method needs.
     u0 = np.array([to_unit([p], [p["initial"]])[0] if "initial" in p else 0.5 for p in params])
     u0 = np.clip(u0, 1e-6, 1.0 - 1e-6)
-    try:
-        ov = dict(cal["overrides"])
-        ov.update(zip([p["key"] for p in params], to_values(params, u0)))
-        from . import check_scene
-        check_scene(cal["scene"], ov)
-    except SceneError as e:
-        raise CalibrationError(f"calibration {path}: {e}") from None
     # The first evaluation here, before a cluster starts or DIR is made (unless DIR keeps it):
     # what only the comparison refuses (the record's section, supports or bandwidth against the
     # scene) is refused with nothing written; the cluster then reads it back.
