@@ -85,14 +85,14 @@ void read_conductor_rail(Reader& r, const std::string& pre, SectionSpec& sec) {
   sec.rigid = true;
   sec.contact_wire = ContactWireSpec{};
   sec.contact_wire.linear_mass = c.number("linear_mass", 0.0, 100.0, std::nullopt, true);
-  sec.contact_wire.bending_stiffness = c.number("bending_stiffness", 0.0, 1e8, std::nullopt, true);
+  sec.contact_wire.bending_stiffness = c.number("bending_stiffness", 0.0, kMaxRailBendingStiffness, std::nullopt, true);
   if (c.has("lateral_bending_stiffness"))
-    sec.rail_lateral_bending_stiffness = c.number("lateral_bending_stiffness", 0.0, 1e8, std::nullopt, true);
+    sec.rail_lateral_bending_stiffness = c.number("lateral_bending_stiffness", 0.0, kMaxRailBendingStiffness, std::nullopt, true);
   if (c.has("transition_piece")) {
     Reader t(c.child("transition_piece"), pre + "conductor_rail.transition_piece");
     SectionSpec::TransitionPiece piece;
     piece.length = t.number("length", 0.0, 500.0, std::nullopt, true);  // (within the end span: validate_rigid)
-    piece.end_bending_stiffness = t.number("end_bending_stiffness", 0.0, 1e8, std::nullopt, true);
+    piece.end_bending_stiffness = t.number("end_bending_stiffness", 0.0, kMaxRailBendingStiffness, std::nullopt, true);
     t.finish();
     sec.rail_transition_piece = piece;
   }

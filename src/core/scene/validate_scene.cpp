@@ -340,9 +340,11 @@ void validate_rigid(const Scene& s) {
                             ? 0.5 * s.wind->air_density * s.wind->conductor_rail.drag_coefficient *
                                   s.wind->conductor_rail.diameter * s.wind->speed * s.wind->speed
                             : 0.0;
+  // The least EI a span of the profile needs under q per metre: 5 q L^4 / (384 EI) <= L / 50.
+  auto least_ei = [](double q, double span) { return 250.0 * q * span * span * span / 384.0; };
   auto stiff_enough = [&](const std::string& field, double ei, double span, double q, const char* under,
                           const char* way, const std::string& note = "") {
-    const double least = 250.0 * q * span * span * span / 384.0;
+    const double least = least_ei(q, span);
     if (!(ei >= least))
       fail(field, fmt(ei) + note,
            "at least " + fmt(least) + " N m^2 here: the profile would " + way + " " + fmt(5.0 * q * std::pow(span, 4) / (384.0 * ei)) +
@@ -353,11 +355,12 @@ void validate_rigid(const Scene& s) {
     if (!sec.rigid) continue;
     const std::string f = s.section_field(i, "conductor_rail");
     const double longest = *std::max_element(sec.spans.begin(), sec.spans.end());
-    // A span no profile of the allowed EI (1e8 N m^2) could take under its weight is the span's to shorten.
-    const double q_weight = sec.contact_wire.linear_mass * s.gravity, least = 250.0 * q_weight * std::pow(longest, 3) / 384.0;
-    if (least > 1e8)
+    // A span no profile of the allowed EI could take under its weight is the span's to shorten.
+    const double q_weight = sec.contact_wire.linear_mass * s.gravity, least = least_ei(q_weight, longest);
+    if (least > kMaxRailBendingStiffness)
       fail(s.sections.size() > 1 ? "sections[" + std::to_string(i) + "].spans" : "line.spans", fmt(longest) + " m",
-           "a rigid rail's span short enough for a profile of at most 1e8 N m^2 (this one needs " + fmt(least) +
+           "a rigid rail's span short enough for a profile of at most " + fmt(kMaxRailBendingStiffness) +
+               " N m^2 (this one needs " + fmt(least) +
                " N m^2 so as to sag less than a fiftieth of it under its weight); supports every 8-12 m in service");
     stiff_enough(f + ".bending_stiffness", sec.contact_wire.bending_stiffness, longest, q_weight, "its weight", "sag");
     if (wind_q > 0.0)

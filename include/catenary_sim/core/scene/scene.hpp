@@ -558,6 +558,10 @@ struct TrainSpeedLimit {
 };
 TrainSpeedLimit train_speed_limit(const Scene& scene);
 
+// A rigid rail's profile's bending stiffness, vertical or lateral, at most (N m^2): several times
+// the stiffest profiles in service (about 3e5), and the bound a span's length is checked against.
+constexpr double kMaxRailBendingStiffness = 1e8;
+
 // The lateral contact histogram has at most this many bins across pantograph_head.horn_width.
 constexpr double kMaxHistogramBins = 10000.0;
 // The turbulent wind field has at most this many points along the line (wind.turbulence.spacing).
