@@ -97,10 +97,9 @@ def pictures(c):
             ok = v > 0
             ax.semilogy(f[ok], v[ok], color=color, lw=1.0, ls="-" if lab == "record" else "--",
                         alpha=1.0 if i == 0 else 0.6, label="%s %s" % (p, lab))
-    sp = c.settings["span_passing_hz"]
-    for h in range(1, 200 if sp else 1):
-        if h * sp > 1.5 * fmax:
-            break
+    sp = c.settings["span_passing_hz"]  # None without a span (a line of fewer than two supports)
+    harmonics = range(1, min(199, int(1.5 * fmax / sp)) + 1) if sp else ()  # (at most 199 lines)
+    for h in harmonics:
         ax.axvline(h * sp, color="tab:green", lw=1.2 if h == 1 else 0.5, ls="-" if h == 1 else ":",
                    label="span passing %.2f Hz and harmonics" % sp if h == 1 else None)
     ax.axvline(fmax, color="k", lw=1.0, ls="-.", label="compared up to %g Hz" % fmax)
