@@ -17,7 +17,6 @@ statistics that are applied identically to both sides.
 import csv
 import json
 import math
-import numbers
 import os
 import re
 import shutil
@@ -30,7 +29,7 @@ import pandas as pd
 import yaml
 from scipy import signal
 
-from . import SceneError, Simulation, _core, _override_list, _path, _real, _integer
+from . import SceneError, Simulation, _core, _override_list, _path, _real, _integer, _refuse, _shown
 from . import _files
 
 __all__ = ["RecordError", "Record", "read_record", "simulate_run", "compare", "Comparison",
@@ -113,12 +112,6 @@ class Record:
 # --------------------------------------------------------------------------------------------
 # Reading and checking a record
 # --------------------------------------------------------------------------------------------
-def _shown(v):
-    """A value as it was read: text quoted (a quoted '200' is not the number 200)."""
-    text = repr(v)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def _read_metadata(path, meta, comment_lines):
     side = meta
     if side is None:
@@ -395,13 +388,11 @@ def lowpass(x, fs, fc):
     """The core's zero-phase low-pass (output/zero_phase_filter.cpp), the filter of stats.json: a
     4th-order Butterworth run forward and backward with odd reflection at both ends; a cutoff at or
     above Nyquist passes the series through. x: a 1-D sequence of numbers; fs, fc: numbers (the
-    core refuses values out of range by name)."""
-    x = _series("x", x, finite=False)  # the core names a sample that is not finite
-    for name, v in (("sample rate fs", fs), ("cutoff fc", fc)):
-        if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
-            raise SceneError(f"{name} = {_shown(v)} rejected: allowed a finite frequency > 0 Hz (a number)",
-                             field=name.split()[-1], value=_shown(v), allowed="a finite frequency > 0 Hz")
-    return np.asarray(_core._lowpass_zero_phase(x, float(fs), float(fc)))
+    core names a sample that is not finite)."""
+    x = _series("x", x, finite=False)
+    fs = _real("sample rate fs", fs, "a finite rate > 0 Hz", 1e-300)
+    fc = _real("cutoff fc", fc, "a finite frequency > 0 Hz", 1e-300)
+    return np.asarray(_core._lowpass_zero_phase(x, fs, fc))
 
 
 def _series(name, x, length=None, finite=True):
@@ -411,14 +402,11 @@ def _series(name, x, length=None, finite=True):
     except (TypeError, ValueError):
         a = None
     if a is None or a.ndim != 1 or (length is not None and len(a) != length):
-        allowed = "a 1-D sequence of numbers" + (f" of length {length}" if length is not None else "")
-        raise SceneError(f"{name} = {_shown(x)} rejected: allowed {allowed}", field=name, value=_shown(x),
-                         allowed=allowed)
+        _refuse(name, x, "a 1-D sequence of numbers" + (f" of length {length}" if length is not None else ""))
     bad = ~np.isfinite(a) if finite else np.zeros(a.shape, dtype=bool)
     if bad.any():
         k = int(np.argmax(bad))
-        raise SceneError(f"{name}[{k}] = {a[k]!r} rejected: allowed finite numbers", field=name, value=repr(a[k]),
-                         allowed="finite numbers")
+        _refuse(f"{name}[{k}]", a[k], "finite numbers")
     return a
 
 
@@ -429,9 +417,7 @@ def section_statistics(force, inside, loss_force=None):
     force = _series("force", force)
     mask = np.asarray(inside)
     if mask.dtype != bool or mask.shape != force.shape:
-        allowed = f"a boolean mask of the force's length ({len(force)})"
-        raise SceneError(f"inside = {_shown(inside)} rejected: allowed {allowed}", field="inside",
-                         value=_shown(inside), allowed=allowed)
+        _refuse("inside", inside, f"a boolean mask of the force's length ({len(force)})")
     loss = _series("loss_force", loss_force, len(force)) if loss_force is not None else force
     f = force[mask]
     lf = loss[mask]
@@ -530,8 +516,7 @@ def simulate_run(scene, record=None, overrides=None, speed_profile=None, sensor_
     stations and held beyond its ends. The measuring pantograph's bandwidth is the record's (or
     sensor_bandwidth_hz). Refuses a record's pantograph or support the scene lacks."""
     if record is not None and not isinstance(record, Record):
-        raise SceneError(f"record = {_shown(record)} rejected: allowed None or a Record (read_record's)",
-                         field="record", value=_shown(record), allowed="None or a Record")
+        _refuse("record", record, "None or a Record (read_record's)")
     max_steps = _real("max_steps", max_steps, "a number of steps >= 1", 1.0)
     ov = _override_list(overrides)
     px, pv, source = _profile(record, speed_profile)
@@ -940,8 +925,7 @@ def noise_after_filters(noise_std, fs, cutoffs, n=1 << 16):
     noise_std = _real("noise_std", noise_std, "a noise std >= 0", 0.0)
     fs = _real("fs", fs, "a sample rate in Hz > 0", 1e-300)
     if isinstance(cutoffs, (str, bytes)) or not isinstance(cutoffs, Iterable):
-        raise SceneError(f"cutoffs = {_shown(cutoffs)} rejected: allowed a sequence of cutoffs in Hz > 0",
-                         field="cutoffs", value=_shown(cutoffs), allowed="a sequence of cutoffs in Hz > 0")
+        _refuse("cutoffs", cutoffs, "a sequence of cutoffs in Hz > 0")
     cutoffs = [_real(f"cutoffs[{k}]", c, "a cutoff in Hz > 0", 1e-300) for k, c in enumerate(cutoffs)]
     n = _integer("n", n, "an integer number of frequencies >= 2", 2, 1 << 26)
     f = np.linspace(0.0, 0.5 * fs, n)
@@ -971,12 +955,10 @@ def synthesise_record(scene, path, overrides=None, speed_profile=300.0, sample_r
     seed = _integer("seed", seed, "an integer >= 0", 0, 2 ** 63 - 1)
     origin = _real("station_origin_m", station_origin_m, "a station in m", -1e7, 1e7)
     if not (supports is None or (isinstance(supports, str) and supports == "section")):
-        raise SceneError(f"supports = {_shown(supports)} rejected: allowed 'section' (the steady arms of the "
-                         "analysis section) or None (no uplift columns)", field="supports", value=_shown(supports),
-                         allowed="'section' or None")
+        _refuse("supports", supports, "'section' (the steady arms of the analysis section) or None (no uplift "
+                "columns)")
     if not isinstance(head, (bool, np.bool_)):
-        raise SceneError(f"head = {_shown(head)} rejected: allowed True or False (head displacement columns or "
-                         "none)", field="head", value=_shown(head), allowed="True or False")
+        _refuse("head", head, "True or False (head displacement columns or none)")
     try:
         run = simulate_run(scene, None, overrides, speed_profile, sensor_bandwidth_hz=bw)
     except SceneError as e:
@@ -1059,9 +1041,8 @@ def _record_paths(path):
     both can be made in an existing, writable directory."""
     path = os.fspath(_path("path", path, "a CSV file path ending in .csv"))
 
-    def refuse(why, allowed="a path ending in .csv in an existing, writable directory"):
-        raise SceneError(f"path = {path!r} rejected: {why}; allowed {allowed}", field="path", value=repr(path),
-                         allowed=allowed)
+    def refuse(why):
+        _refuse("path", path, "a path ending in .csv in an existing, writable directory", why)
 
     stem, ext = os.path.splitext(path)
     if ext.lower() != ".csv" or not os.path.basename(stem):
