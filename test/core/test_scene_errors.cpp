@@ -483,6 +483,16 @@ TEST(SceneErrors, DesignStaticsRefusalsNameTheKindsFields) {
                   "'hangers.positions_per_span'");
 }
 
+// A field of a line of several sections is named by its section where the section gives it, in
+// reading and in the checks across a section's fields alike.
+TEST(SceneErrors, ASectionsFieldIsNamedByItsSection) {
+  const std::string mixed = test_scenes::scene_path("catenary_to_trolley_wire.yaml");
+  EXPECT_MENTIONS(test_scenes::refusal_of(mixed, {"sections[1].contact_wire_count=2"}), "'sections[1].contact_wire_count' = 2",
+                  "add droppers");
+  EXPECT_MENTIONS(test_scenes::refusal_of(mixed, {"sections[1].messenger_supports={stiffness: 1e5}"}),
+                  "'sections[1].messenger_supports' = (given)");
+}
+
 // Two stations of a wire (supports, droppers, hangers, the clamps of stitch wires and bridles)
 // closer than a dropper's or a clamp's fitting, 1 cm, are refused by the field that put the one
 // beside the support or the other station there. A stitch wire or bridle of 10 um would put 5 um

@@ -389,11 +389,10 @@ void design_statics(const Scene& scene, const std::vector<std::vector<double>>& 
   for (std::size_t q = 0; q < hinged.size(); ++q) {
     SupportSpring& sp = m.springs[hinged[q]];
     const int section = wire_of(m, sp.dof).section;
-    const std::string pre = scene.section_field(section, "");
     const HingedArmSpec& arm = *scene.sections[section].steady_arms->hinged_arm;
     // (The arms a 3-D line's lateral plane moves: pulled to one side, LateralModel::registrations.)
     const bool in_plan = scene.lateral() && wire[q].side != 0.0;
-    set_hinged_arm(arm, scene.gravity, wire[q], pre + "steady_arms", in_plan, sp);
+    set_hinged_arm(arm, scene.gravity, wire[q], scene.section_field(section, "steady_arms"), in_plan, sp);
     // The tip's sideways share of inertia: mass without weight, so the preload carries it too.
     const double sideways = sp.arm_tip_mass - arm.tip_mass();
     m.mass[sp.dof] += sideways;

@@ -14,45 +14,49 @@ namespace catenary_sim {
 using namespace scene_reading;
 namespace {
 
+// What makes a line 3-D (Scene::lateral()), as refusals name it.
+constexpr const char* kLateralFields = "stagger, alignment, wind or pantograph_head.sway";
+const std::string kOnlyOnThreeD = std::string("only on a 3-D line (") + kLateralFields + ")";
+
 // Every section's droppers hang from its messenger, inside their spans, in order.
 void validate_sections(const Scene& s) {
   if (s.sections.empty()) fail("line", "(no tension section)", "at least one section of spans");
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
-    const std::string pre = s.section_field(si, "");
+    const auto in_section = [&](const std::string& name) { return s.section_field(si, name); };
     if (sec.rigid) {
       // The rail's beam carries no tension: anything hung from a messenger, a presag set by
       // droppers or a support-less profile has no meaning here.
       if (sec.messenger || sec.droppers || sec.messenger_supports || sec.contact_wire_count != 1)
-        fail(pre + "conductor_rail", "(with a messenger, droppers or a twin wire)",
+        fail(in_section("conductor_rail"), "(with a messenger, droppers or a twin wire)",
              "a rigid conductor rail alone: remove messenger, droppers, messenger_supports, contact_wire_count");
       if (!sec.steady_arms || !(sec.steady_arms->stiffness > 0.0))
-        fail(pre + "conductor_rail.support_stiffness", "(missing)", "> 0 N/m at every support");
+        fail(in_section("conductor_rail.support_stiffness"), "(missing)", "> 0 N/m at every support");
       if (sec.contact_wire.tension != 0.0 || sec.contact_wire.presag != 0.0)
-        fail(pre + "conductor_rail", "(tension or presag set)", "tension 0 and presag 0: the profile is not tensioned");
+        fail(in_section("conductor_rail"), "(tension or presag set)", "tension 0 and presag 0: the profile is not tensioned");
       if (!(sec.contact_wire.bending_stiffness > 0.0))
-        fail(pre + "conductor_rail.bending_stiffness", fmt(sec.contact_wire.bending_stiffness), "> 0 N m^2");
+        fail(in_section("conductor_rail.bending_stiffness"), fmt(sec.contact_wire.bending_stiffness), "> 0 N m^2");
       if (sec.spans.size() < 2)
-        fail(pre + "spans", std::to_string(sec.spans.size()) + " span",
+        fail(in_section("spans"), std::to_string(sec.spans.size()) + " span",
              "at least 2 spans in a rigid section (its ends are held, its intermediate supports are elastic)");
       continue;
     }
     if (!(sec.contact_wire.tension > 0.0))
-      fail(pre + "contact_wire.tension", fmt(sec.contact_wire.tension), "> 0 N (a tensioned wire; a profile without tension is a conductor_rail)");
+      fail(in_section("contact_wire.tension"), fmt(sec.contact_wire.tension), "> 0 N (a tensioned wire; a profile without tension is a conductor_rail)");
     if (sec.droppers && !sec.messenger)
-      fail(pre + "droppers", "(given)", "droppers hang the contact wire from a messenger: add a messenger section or remove droppers");
-    if (sec.messenger_supports && !sec.messenger) fail(pre + "messenger_supports", "(given)", "needs a messenger section");
+      fail(in_section("droppers"), "(given)", "droppers hang the contact wire from a messenger: add a messenger section or remove droppers");
+    if (sec.messenger_supports && !sec.messenger) fail(in_section("messenger_supports"), "(given)", "needs a messenger section");
     if (sec.contact_wire_count == 2 && !sec.droppers)
-      fail(pre + "contact_wire_count", "2", "a twin contact wire hangs from droppers: add droppers and a messenger");
+      fail(in_section("contact_wire_count"), "2", "a twin contact wire hangs from droppers: add droppers and a messenger");
     if (sec.contact_wire.presag != 0.0 && !sec.droppers)
-      fail(pre + "contact_wire.presag", fmt(sec.contact_wire.presag), "0 without droppers (the presag is set by the dropper lengths)");
+      fail(in_section("contact_wire.presag"), fmt(sec.contact_wire.presag), "0 without droppers (the presag is set by the dropper lengths)");
     if (sec.steady_arms && sec.steady_arms->hinged_arm) {
       const std::optional<double>& pull_off = sec.steady_arms->hinged_arm->pull_off;
       if (s.lateral() && pull_off)
-        fail(pre + "steady_arms.pull_off", fmt(*pull_off) + " (on a 3-D line)",
+        fail(in_section("steady_arms.pull_off"), fmt(*pull_off) + " (on a 3-D line)",
              "not given on a 3-D line: there each arm's pull-off comes from the stagger and the curves (remove it)");
       if (!s.lateral() && !pull_off)
-        fail(pre + "steady_arms.pull_off", "(missing)",
+        fail(in_section("steady_arms.pull_off"), "(missing)",
              "required on a 2-D line, N > 0: the wire's horizontal pull on the arm (4 T s / L for a zigzag of +-s on "
              "straight track, + T L / R on a curve)");
     }
@@ -60,11 +64,11 @@ void validate_sections(const Scene& s) {
       if (!*part) continue;
       const DropperSpec& d = **part;
       if (d.positions.size() != sec.spans.size())
-        fail(pre + key + ".positions_per_span", std::to_string(d.positions.size()) + " lists", "one per span");
+        fail(in_section(key + std::string(".positions_per_span")), std::to_string(d.positions.size()) + " lists", "one per span");
       for (std::size_t i = 0; i < sec.spans.size(); ++i) {
         const auto& p = d.positions[i];
         for (std::size_t j = 0; j < p.size(); ++j) {
-          const std::string f = pre + key + ".positions (span " + std::to_string(i) + ", position " + std::to_string(j) + ")";
+          const std::string f = in_section(key + std::string(".positions (span ")) + std::to_string(i) + ", position " + std::to_string(j) + ")";
           if (p[j] <= 0.0 || p[j] >= sec.spans[i])
             fail(f, fmt(p[j]), "strictly inside the span (0, " + fmt(sec.spans[i]) + ") m");
           if (j > 0 && p[j] <= p[j - 1]) fail(f, fmt(p[j]), "increasing along the span (previous " + fmt(p[j - 1]) + ")");
@@ -130,7 +134,7 @@ void validate_acting_fields(const Scene& s) {
       if (s.sections[i].rail_lateral_bending_stiffness)
         fail(s.section_field(i, "conductor_rail.lateral_bending_stiffness"),
              fmt(*s.sections[i].rail_lateral_bending_stiffness),
-             "only on a 3-D line (stagger, alignment or pantograph_head.sway): a 2-D line does not bend the "
+             kOnlyOnThreeD + ": a 2-D line does not bend the "
              "profile across the track");
   if (s.stagger && std::none_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.messenger.has_value(); })) {
     // A messenger's stagger or support on a line without one would hold nothing.
@@ -162,7 +166,7 @@ void validate_acting_fields(const Scene& s) {
   }
   if (!s.lateral() && s.overlap && s.overlap->lateral_separation != 0.0)
     fail("overlap.lateral_separation", fmt(s.overlap->lateral_separation),
-         "0 on a 2-D line, or a 3-D line (stagger, alignment, wind or pantograph_head.sway) that has the wires' "
+         "0 on a 2-D line, or a 3-D line (" + std::string(kLateralFields) + ") that has the wires' "
          "positions in plan");
   if (!s.lateral())
     for (std::size_t i = 0; i < s.pantographs.size(); ++i) {
@@ -171,7 +175,7 @@ void validate_acting_fields(const Scene& s) {
         for (std::size_t j = 0; j < cs.size(); ++j)
           if (cs[j].working_width)
             fail(field + "[" + std::to_string(j) + "].working_width", fmt(*cs[j].working_width),
-                 "only on a 3-D line (stagger, alignment, wind or pantograph_head.sway): a 2-D line has no lateral "
+                 kOnlyOnThreeD + ": a 2-D line has no lateral "
                  "contact point to keep on the strip; remove it here");
       };
       const std::string pf = "pantographs[" + std::to_string(i) + "]";
@@ -483,10 +487,10 @@ void validate_compound(const Scene& s) {
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     if (!sec.auxiliary_messenger && !sec.hangers) continue;
-    const std::string pre = s.section_field(si, "");
+    const auto in_section = [&](const std::string& name) { return s.section_field(si, name); };
     if (!sec.auxiliary_messenger)
-      fail(pre + "hangers", "(given)", "hangers hang the contact wire from an auxiliary messenger: add auxiliary_messenger or remove hangers");
-    const std::string f = pre + "auxiliary_messenger";
+      fail(in_section("hangers"), "(given)", "hangers hang the contact wire from an auxiliary messenger: add auxiliary_messenger or remove hangers");
+    const std::string f = in_section("auxiliary_messenger");
     if (!sec.hangers)
       fail(f, "(given without hangers)", "hangers from it to the contact wire (positions, axial_stiffness, ...)");
     if (!sec.messenger || !sec.droppers)
@@ -496,8 +500,8 @@ void validate_compound(const Scene& s) {
       fail(f + ".height", fmt(sec.auxiliary_messenger->height),
            "(0, " + fmt(s.encumbrance) + ") m: below the messenger (line.encumbrance above the contact wire at the supports)");
     if (sec.contact_wire_count != 1)
-      fail(pre + "contact_wire_count", std::to_string(sec.contact_wire_count), "1 on a compound catenary (its hangers hold one contact wire)");
-    if (sec.stitch_wire) fail(pre + "stitch_wire", "(given with auxiliary_messenger)", "none: a line is stitched or compound, not both");
+      fail(in_section("contact_wire_count"), std::to_string(sec.contact_wire_count), "1 on a compound catenary (its hangers hold one contact wire)");
+    if (sec.stitch_wire) fail(in_section("stitch_wire"), "(given with auxiliary_messenger)", "none: a line is stitched or compound, not both");
   }
 }
 
@@ -507,16 +511,16 @@ void validate_bridles(const Scene& s) {
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     if (!sec.bridle) continue;
-    const std::string pre = s.section_field(si, "");
-    const std::string f = pre + "bridle";
+    const auto in_section = [&](const std::string& name) { return s.section_field(si, name); };
+    const std::string f = in_section("bridle");
     if (sec.messenger)
       fail(f, "(given with messenger)",
            "a trolley wire's: a bridle hangs the contact wire from its supports; on a catenary the messenger carries it "
            "(stitch_wire evens its supports)");
     if (sec.contact_wire_count != 1)
-      fail(pre + "contact_wire_count", std::to_string(sec.contact_wire_count), "1 with a bridle (its clamps hold one contact wire)");
+      fail(in_section("contact_wire_count"), std::to_string(sec.contact_wire_count), "1 with a bridle (its clamps hold one contact wire)");
     if (sec.steady_arms && sec.steady_arms->hinged_arm)
-      fail(pre + "steady_arms", "(a hinged arm, with a bridle)",
+      fail(in_section("steady_arms"), "(a hinged arm, with a bridle)",
            "a spring (stiffness, mass) or none: the support holds the bridle's middle, which a registration arm does not");
     // The contact wire is free at its supports, which hardly reflect its waves: they run the
     // section's length and back, and a window that holds only what is near the pantograph misses
