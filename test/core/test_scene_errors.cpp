@@ -493,6 +493,15 @@ TEST(SceneErrors, ASectionsFieldIsNamedByItsSection) {
                   "'sections[1].messenger_supports' = (given)");
 }
 
+// A hinged arm is known by any of its own fields: one without its length is refused for the
+// length, not for a spring's stiffness.
+TEST(SceneErrors, AHingedArmWithoutItsLengthIsRefusedForTheLength) {
+  const std::string hinged = test_scenes::scene_path("reference_55m_hinged_arms.yaml");
+  EXPECT_MENTIONS(test_scenes::refusal_of(hinged, {"steady_arms.length=null"}), "'steady_arms.length' = (missing)");
+  EXPECT_MENTIONS(test_scenes::refusal_of(hinged, {"steady_arms.length=null", "steady_arms.stiffness=1e4"}),
+                  "'steady_arms.stiffness' = (given with linear_mass)");
+}
+
 // Two stations of a wire (supports, droppers, hangers, the clamps of stitch wires and bridles)
 // closer than a dropper's or a clamp's fitting, 1 cm, are refused by the field that put the one
 // beside the support or the other station there. A stitch wire or bridle of 10 um would put 5 um

@@ -36,10 +36,14 @@ SupportSpec read_support(Reader& r) {
 // Steady arms: a spring of eq. 4 (`stiffness`, `mass`), or a hinged arm as built (`length`,
 // `linear_mass`, `clamp_mass`, `pull_off`) whose k_A and tip mass follow from it.
 SupportSpec read_steady_arms(Reader& r, const std::string& path) {
-  if (!r.has("length")) return read_support(r);
+  // Any of the arm's own fields makes it a hinged arm, so that a missing length is named as such.
+  const char* arm_field = nullptr;
+  for (const char* k : {"length", "linear_mass", "clamp_mass", "pull_off"})
+    if (!arm_field && r.has(k)) arm_field = k;
+  if (!arm_field) return read_support(r);
   for (const char* spring : {"stiffness", "mass"})
     if (r.has(spring))
-      fail(path + "." + spring, "(given with length)",
+      fail(path + "." + spring, std::string("(given with ") + arm_field + ")",
            "either a spring (stiffness, mass) or a hinged arm (length, linear_mass, clamp_mass, pull_off), not both: "
            "a hinged arm's stiffness and mass follow from its geometry and pull-off");
   HingedArmSpec a;
