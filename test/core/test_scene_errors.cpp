@@ -481,6 +481,9 @@ TEST(SceneErrors, DesignStaticsRefusalsNameTheKindsFields) {
   // A one-section line's per-span list is its top-level field's, not under line.
   EXPECT_MENTIONS(test_scenes::refusal_of(compound, {"hangers.positions=null", "hangers.positions_per_span=[[2.5],[2.5]]"}),
                   "'hangers.positions_per_span'");
+  // Found in building, named with the file as a refusal found in reading is.
+  const std::string named = stitched + ": droppers: at x = ";
+  EXPECT_MENTIONS(test_scenes::refusal_of(stitched, {"stitch_wire.tension=1"}), named.c_str());
 }
 
 // A field of a line of several sections is named by its section where the section gives it, in

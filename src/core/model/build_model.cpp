@@ -671,9 +671,9 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
   return m;
 }
 
-}  // namespace
 
-Model build_model(const Scene& scene, const BuildOptions& options) {
+// The model with the checks that need it built: the centred step's factors, the filter's cutoff.
+Model build_model_checked(const Scene& scene, const BuildOptions& options) {
   Model m = build_model_unchecked(scene, options);
   // Built here, filled further for the centred damping step below, then only read.
   const std::shared_ptr<WirePacks> packs = build_wire_packs(m);
@@ -696,6 +696,19 @@ Model build_model(const Scene& scene, const BuildOptions& options) {
                      fmt(nyquist) + " Hz, the Nyquist frequency of the time step (dt " + fmt(m.dt) + " s)");
   if (scene.lateral()) m.lateral = build_lateral(m);  // the 3-D line; nothing built for a 2-D scene
   return m;
+}
+
+}  // namespace
+
+Model build_model(const Scene& scene, const BuildOptions& options) {
+  try {
+    return build_model_checked(scene, options);
+  } catch (const SceneError& e) {
+    // A refusal found in building (the design statics, the stability limit) names the scene's
+    // file as one found in reading it does.
+    if (scene.file.empty()) throw;
+    throw SceneError(scene.file + ": " + e.what());
+  }
 }
 
 Model build_model(const Scene& scene) { return build_model(scene, BuildOptions{}); }

@@ -58,7 +58,9 @@ Scene load_scene_file(const std::string& path, const std::vector<std::string>& o
   if (in.bad()) throw SceneError("scene file '" + path + "': read error (" + std::strerror(errno) + ")");
   try {
     const std::size_t slash = path.rfind('/');
-    return load_scene_string(text, overrides, slash == std::string::npos ? "" : path.substr(0, slash == 0 ? 1 : slash));
+    Scene scene = load_scene_string(text, overrides, slash == std::string::npos ? "" : path.substr(0, slash == 0 ? 1 : slash));
+    scene.file = path;
+    return scene;
   } catch (const SceneError& e) {
     throw SceneError(path + ": " + e.what());
   }

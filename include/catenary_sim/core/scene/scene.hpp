@@ -494,6 +494,7 @@ struct PantographHeadSpec {
 
 struct Scene {
   std::string name;
+  std::string file;  // the YAML file it was read from (load_scene_file), named in refusals; "" otherwise
   double gravity = 9.81;               // m/s^2
   double contact_wire_height = 5.3;    // m above the rail at the supports
   double encumbrance = 1.2;            // m, messenger above contact wire at the supports
