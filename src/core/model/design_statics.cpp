@@ -55,20 +55,29 @@ void bridle_statics(const Scene& scene, const Section& info, Model& m, std::vect
   }
   if (!steepest || worst <= kSteepestBridleArm) return;
   // The tension that would do: the string's share of a slope falls as 1 / tension, the bridle's
-  // bending's does not, so the steepest is hung again at the string's estimate and the slope
-  // taken as a / T + b through the two.
-  const double t1 = steepest->spec.tension, t2 = t1 * worst / kSteepestBridleArm;
+  // bending's does not, so the steepest is hung again and its slope taken as a / T + b through the
+  // last two tensions (a secant in 1 / T) until it meets the limit. Far below it a V's slope is not
+  // that line (the arms are no longer small angles): the string's estimate from the last slope
+  // then raises the tension until the fit holds.
+  double t = steepest->spec.tension, s = worst, needed = t * worst / kSteepestBridleArm;
   Wire again = *steepest;
-  again.spec.tension = t2;
-  assemble_band(again, {});
-  std::vector<double> reaction;
-  const double s2 = hang_bridle(scene, m, again, reaction);
-  const double a = (worst - s2) / (1.0 / t1 - 1.0 / t2), b = worst - a / t1;
-  const double needed = a > 0.0 && b < kSteepestBridleArm ? a / (kSteepestBridleArm - b) : t2;
+  for (int tries = 0; tries < 30; ++tries) {
+    again.spec.tension = needed;
+    assemble_band(again, {});
+    std::vector<double> reaction;
+    const double s2 = hang_bridle(scene, m, again, reaction);
+    if (!std::isfinite(s2)) break;
+    if (std::fabs(s2 - kSteepestBridleArm) < 1e-4 * kSteepestBridleArm) break;  // (T to about 0.01 %)
+    const double a = (s - s2) / (1.0 / t - 1.0 / needed), b = s - a / t;
+    t = needed;
+    s = s2;
+    needed = a > 0.0 && b < kSteepestBridleArm ? a / (kSteepestBridleArm - b) : t * s / kSteepestBridleArm;
+  }
   refuse_slack_bridle(scene, *steepest, worst,
                       "in its V, its middle " +
                           fmt(steepest->height[steepest->support_nodes.front()] - scene.contact_wire_height) + " m above the wire",
-                      "", needed);
+                      scene.lateral() ? "; on a 3-D line the arms' turn in plan is checked once the V holds, and may need more" : "",
+                      std::isfinite(needed) ? std::optional<double>(needed) : std::nullopt);
 }
 
 }  // namespace
@@ -85,7 +94,7 @@ void refuse_slack_bridle(const Scene& scene, const Wire& w, double slope, const 
   throw SceneError("scene field '" + field + ".tension' = " + fmt(tension) + " N: to carry the contact wire, the bridle at station " +
                    fmt(w.x[w.support_nodes.front()]) + " m would run its arms at a slope of " + fmt(slope) + " (" + how +
                    "); at most " + fmt(kSteepestBridleArm) + ", the model's small angles: raise " + field + ".tension (about " +
-                   (needed ? fmt(*needed) + " N, from the bridles' statics at a second tension" :
+                   (needed ? fmt(*needed) + " N, from the bridles' statics hung again" :
                              fmt(tension * slope / kSteepestBridleArm) + " N; the slopes fall nearly as 1 / tension") +
                    ", at most 1e5)" + advice);
 }
