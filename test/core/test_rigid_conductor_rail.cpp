@@ -858,6 +858,36 @@ TEST(RigidConductorRail, ATransitionPieceSoftensTheProfilesEndAsABeamOfVaryingSt
   const std::string long_piece = test_scenes::refusal_of_yaml(rail_then_catenary("{length: 60, end_bending_stiffness: 7e4}"));
   EXPECT_NE(long_piece.find("within the end span"), std::string::npos) << long_piece;
   refused(rail_then_catenary("{length: 5.0}"), f + ".end_bending_stiffness");
+  // The softened end span holds its sag below a fiftieth of it as every span does, its EI rising
+  // over the piece. On this profile, whose 10 m span sags a sixth of that at its full EI, any end
+  // holds: M / EI stays finite where the piece's EI and the moment both vanish at the held end.
+  EXPECT_EQ(test_scenes::refusal_of_yaml(rail_then_catenary("{length: 10, end_bending_stiffness: 1}")), "");
+  // On a profile 2 % above the least EI for its spans (250 q L^3 / 384), the named least end EI is
+  // accepted 1 % above and refused 1 % below (the bisection's and the integration's errors are
+  // far smaller), it lies below that least EI (a piece ending there is nowhere softer than a
+  // uniform span that holds) and a shorter piece may end softer.
+  const double q = 7.27 * 9.81, least_uniform = 250.0 * q * 1000.0 / 384.0;
+  auto stiff_enough_only = [&](double piece_length, double end_ei) {
+    std::string y = rail_then_catenary("{length: " + std::to_string(piece_length) +
+                                       ", end_bending_stiffness: " + std::to_string(end_ei) + "}");
+    y.replace(y.find("bending_stiffness: 2.8e5"), 24, "bending_stiffness: " + std::to_string(1.02 * least_uniform));
+    return test_scenes::refusal_of_yaml(y);
+  };
+  auto least_named = [&](double piece_length) {
+    const std::string m = stiff_enough_only(piece_length, 1.0);
+    const std::size_t at = m.find("at least ");
+    EXPECT_NE(m.find(f + ".end_bending_stiffness"), std::string::npos) << m;
+    return at == std::string::npos ? 0.0 : std::stod(m.substr(at + 9));
+  };
+  const double whole = least_named(10.0), half = least_named(5.0);
+  EXPECT_GT(whole, 0.0);
+  EXPECT_LT(whole, least_uniform);
+  EXPECT_LT(half, whole);
+  for (const double piece_length : {10.0, 5.0}) {
+    const double least = piece_length == 10.0 ? whole : half;
+    EXPECT_EQ(stiff_enough_only(piece_length, 1.01 * least), "") << piece_length;
+    EXPECT_NE(stiff_enough_only(piece_length, 0.99 * least).find(f + ".end_bending_stiffness"), std::string::npos) << piece_length;
+  }
   refused(rail_then_catenary("{length: 5.0, end_bending_stiffness: 7e4, shape: linear}"), f + ".shape");
   // A rail no catenary joins has no end for a piece.
   std::string alone = rail_yaml(3, 5e6, 0.25);

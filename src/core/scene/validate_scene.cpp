@@ -14,6 +14,31 @@ namespace catenary_sim {
 using namespace scene_reading;
 namespace {
 
+// The largest sag under q per metre of a simply supported span whose EI rises linearly from
+// end_ei at one end to ei at `length` from it (a rail's transition piece), ei beyond: the
+// curvature M / EI, M = q x (span - x) / 2, integrated twice (trapezoids; 2000 steps put the
+// uniform span's 5 q L^4 / (384 EI) within 1e-6 of itself).
+double softened_span_sag(double q, double span, double ei, double end_ei, double length) {
+  constexpr int kSteps = 2000;
+  const double h = span / kSteps;
+  auto curvature = [&](double x) {
+    const double e = x < length ? end_ei + (ei - end_ei) * x / length : ei;
+    return q * x * (span - x) / (2.0 * e);
+  };
+  // g'' = M / EI with g(0) = g'(0) = 0; the sag is the chord's height above g: x g(L) / L - g(x).
+  std::vector<double> g(kSteps + 1, 0.0);
+  double slope = 0.0, k0 = curvature(0.0);
+  for (int j = 1; j <= kSteps; ++j) {
+    const double k1 = curvature(j * h), before = slope;
+    slope += 0.5 * h * (k0 + k1);
+    g[j] = g[j - 1] + 0.5 * h * (before + slope);
+    k0 = k1;
+  }
+  double sag = 0.0;
+  for (int j = 0; j <= kSteps; ++j) sag = std::max(sag, g[kSteps] * j / kSteps - g[j]);
+  return sag;
+}
+
 // What makes a line 3-D (Scene::lateral()), as refusals name it.
 constexpr const char* kLateralFields = "stagger, alignment, wind or pantograph_head.sway";
 const std::string kOnlyOnThreeD = std::string("only on a 3-D line (") + kLateralFields + ")";
@@ -372,11 +397,22 @@ void validate_rigid(const Scene& s) {
                    longest, wind_q, "the mean wind (wind.speed)", "blow out",
                    sec.rail_lateral_bending_stiffness ? "" : " (absent: the bending_stiffness)");
     if (sec.rail_transition_piece) {
-      const double end_span = std::max(transition_piece_at_start(s, i) ? sec.spans.front() : 0.0,
-                                       transition_piece_at_end(s, i) ? sec.spans.back() : 0.0);
-      if (end_span > 0.0)
-        stiff_enough(f + ".transition_piece.end_bending_stiffness", sec.rail_transition_piece->end_bending_stiffness, end_span,
-                     sec.contact_wire.linear_mass * s.gravity, "its weight", "sag");
+      // The softened end span, its EI rising over the piece: the same fiftieth, from its sag.
+      const SectionSpec::TransitionPiece& piece = *sec.rail_transition_piece;
+      const double ei = sec.contact_wire.bending_stiffness, end_ei = piece.end_bending_stiffness;
+      for (const bool at_start : {true, false}) {
+        if (!(at_start ? transition_piece_at_start(s, i) : transition_piece_at_end(s, i))) continue;
+        const double span = at_start ? sec.spans.front() : sec.spans.back();
+        const double length = std::min(piece.length, span);  // (a longer piece is refused below)
+        auto sag = [&](double e) { return softened_span_sag(q_weight, span, ei, e, length); };
+        if (sag(end_ei) <= span / 50.0) continue;
+        double low = 0.0, high = ei;  // (the whole span at ei sags less: checked above)
+        for (int k = 0; k < 60; ++k) (sag(0.5 * (low + high)) <= span / 50.0 ? high : low) = 0.5 * (low + high);
+        fail(f + ".transition_piece.end_bending_stiffness", fmt(end_ei),
+             "at least " + fmt(high) + " N m^2 with this piece's length " + fmt(length) + " m: the profile would sag " +
+                 fmt(sag(end_ei)) + " m under its weight over its " + fmt(span) + " m end span (simply supported, its EI "
+                 "rising over the piece), more than a fiftieth of it");
+      }
     }
   }
   for (std::size_t i = 0; i < s.sections.size(); ++i) {
