@@ -496,6 +496,21 @@ TEST(SceneErrors, ASectionsFieldIsNamedByItsSection) {
                   "'sections[1].messenger_supports' = (given)");
 }
 
+// Values the design cannot start from, refused by the field that makes them so: no weight to
+// hang droppers by, no force for eq. 6's overlap rise, an endless pass that ends where it starts.
+// A refusal found in a section's own statics names the file once.
+TEST(SceneErrors, ADesignWithoutWeightForceOrTravelIsRefusedByItsField) {
+  using test_scenes::refusal_of;
+  using test_scenes::scene_path;
+  EXPECT_MENTIONS(refusal_of(scene_path("reference_55m.yaml"), {"gravity=0"}), "'gravity' = 0", "droppers");
+  const std::string two = scene_path("reference_55m_two_sections.yaml");
+  EXPECT_MENTIONS(refusal_of(two, {"pantographs[0].static_uplift=0"}), "'overlap.design_force' = (missing)", "overlap.support_rise");
+  const std::string deep = refusal_of(two, {"contact_wire.presag=0.5"});
+  EXPECT_EQ(deep.find(two + ": "), 0u) << deep;
+  EXPECT_EQ(deep.find(two, 1), std::string::npos) << deep;
+  EXPECT_MENTIONS(refusal_of(scene_path("reference_55m_endless.yaml"), {"train.end=0"}), "'train.end' = 0", "beyond 0 m");
+}
+
 // A hinged arm is known by any of its own fields: one without its length is refused for the
 // length, not for a spring's stiffness.
 TEST(SceneErrors, AHingedArmWithoutItsLengthIsRefusedForTheLength) {

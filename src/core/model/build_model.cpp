@@ -514,9 +514,9 @@ void set_train_travel(const Scene& scene, double endless_front, Model& m) {
   m.train_end = scene.train_end ? *scene.train_end : m.line_length - lead;
   if (m.endless) {
     check_endless_block(m);
-    if (m.train_end < endless_front)
-      throw SceneError("train.end: " + fmt(m.train_end) + " m is behind the start of the pass (train front at " +
-                       fmt(endless_front + 0.0) + " m)");
+    if (!(m.train_end > endless_front))
+      throw SceneError("scene field 'train.end' = " + fmt(m.train_end) + ": allowed beyond " + fmt(endless_front + 0.0) +
+                       " m, the train front's station at the start of the pass");
   } else {
     // Every collector starts and ends on the line: the statics (eq. 23) need each pantograph
     // pressed against a wire or held by its own springs at a design height under the wire.
@@ -705,9 +705,10 @@ Model build_model(const Scene& scene, const BuildOptions& options) {
     return build_model_checked(scene, options);
   } catch (const SceneError& e) {
     // A refusal found in building (the design statics, the stability limit) names the scene's
-    // file as one found in reading it does.
-    if (scene.file.empty()) throw;
-    throw SceneError(scene.file + ": " + e.what());
+    // file as one found in reading it does; once (a section's statics build a model of their own).
+    const std::string named = scene.file + ": ";
+    if (scene.file.empty() || std::string(e.what()).rfind(named, 0) == 0) throw;
+    throw SceneError(named + e.what());
   }
 }
 

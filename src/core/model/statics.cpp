@@ -2,6 +2,7 @@
 
 #include "model/assembly.hpp"
 #include "model/spd_solver.hpp"
+#include "util/format.hpp"
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -448,6 +449,10 @@ std::vector<double> transition_support_rises(const Scene& scene) {
     for (const PantographSpec& p : scene.pantographs) force += p.static_uplift;
     force /= scene.pantographs.size();
   }
+  if (!(force > 0.0))
+    throw SceneError("scene field 'overlap.design_force' = (missing): the pantographs' mean static_uplift is " + fmt(force) +
+                     " N, and eq. 6 derives the support rise from the uplift under a force > 0: give overlap.design_force "
+                     "(N) or overlap.support_rise (m)");
   // E at mid-span of a current span, measured on the model with the supports not yet raised.
   const ElasticityProbe probe(scene, force, std::vector<double>(2 * ns, 0.0));
   for (std::size_t i = 0; i < ns; ++i) {
@@ -473,7 +478,7 @@ std::vector<double> transition_support_rises(const Scene& scene) {
       if (probe.model().wires[probe.model().contact_wires[k]].section == static_cast<int>(i) && std::isfinite(up[k]))
         h = std::max(h, up[k]);
     if (!(h > 0.0))
-      throw SceneError("overlap: the static uplift under " + std::to_string(force) + " N at mid-span of span " +
+      throw SceneError("overlap: the static uplift under " + fmt(force) + " N at mid-span of span " +
                        std::to_string(best) + " of section " + std::to_string(i) +
                        " could not be measured (eq. 6); give overlap.support_rise");
     const double p = sec.contact_wire.linear_mass * scene.gravity, T = sec.contact_wire.tension;

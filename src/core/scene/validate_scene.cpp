@@ -46,6 +46,12 @@ const std::string kOnlyOnThreeD = std::string("only on a 3-D line (") + kLateral
 // Every section's droppers hang from its messenger, inside their spans, in order.
 void validate_sections(const Scene& s) {
   if (s.sections.empty()) fail("line", "(no tension section)", "at least one section of spans");
+  // Droppers and hangers hang the wires below them by their weight: without it they carry nothing
+  // and the design statics cannot set the presag.
+  if (s.gravity == 0.0)
+    for (std::size_t si = 0; si < s.sections.size(); ++si)
+      if (s.sections[si].droppers)
+        fail("gravity", "0", "> 0 m/s^2 on a line with droppers (they hang the contact wire by its weight)");
   for (std::size_t si = 0; si < s.sections.size(); ++si) {
     const SectionSpec& sec = s.sections[si];
     const auto in_section = [&](const std::string& name) { return s.section_field(si, name); };
