@@ -185,7 +185,7 @@ int build_pass(const Options& o, Scene* scene, std::unique_ptr<Simulation>* sim)
   if (!(steps_needed <= o.max_steps)) {
     std::ostringstream s;
     s.precision(3);
-    s << "simulate_pass: the pass would take " << steps_needed << " steps (" << (m.train_end - m.train_start)
+    s << "simulate_pass: the pass would take " << steps_needed << " steps (" << pass_distance(m)
       << " m at " << scene->train_speed * 3.6 << " km/h with dt " << m.dt << " s), more than --max-steps "
       << o.max_steps << "; raise --max-steps if that is meant, or check train.speed_kmh, the line length and "
       << "the masses that set dt";

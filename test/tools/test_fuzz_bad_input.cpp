@@ -173,6 +173,12 @@ TEST(FuzzBadInput, OverridePathsAndValues) {
                                                             "--set", "stitch_wire.length=0.05", "--max-steps", "1e5"},
                                   {"shortest element is 0.025 m"}},
                   dir, &count);
+  // An endless line's pass of 10 m is refused by --max-steps with its own length (the block
+  // starts the train front 10 m before train.end, not at the line's station 0).
+  expect_rejected(kSimulatePass, {"an endless line's 10 m pass", {"--scene", test_scenes::scene_path("reference_55m_endless.yaml"),
+                                                                 "--out", "@OUT", "--set", "train.end=10", "--max-steps", "1"},
+                                  {"(10 m at 300 km/h"}},
+                  dir, &count);
   // Outputs that cannot be written, found before the pass.
   expect_rejected(kSimulatePass, {"--out is a file", {"--scene", kReference, "--out", kReference}, {kReference}}, dir, &count);
   expect_rejected(kSimulatePass, {"--out under /proc", {"--scene", kReference, "--out", "/proc/catenary_sim_out"}, {"/proc/catenary_sim_out"}},

@@ -66,11 +66,14 @@ void check_model_memory(const Scene& scene) {
   }
 }
 
+double pass_distance(const Model& m) {
+  return m.train_end - m.train_start - (m.endless ? m.initial_line_offset : 0.0);
+}
+
 double pass_step_count(const Model& m) {
-  const double distance = m.train_end - m.train_start - (m.endless ? m.initial_line_offset : 0.0);
   const double v = m.scene.train_speed;
   if (!(v > 0.0)) return std::numeric_limits<double>::infinity();
-  return std::max(0.0, distance) / v / m.dt;
+  return std::max(0.0, pass_distance(m)) / v / m.dt;
 }
 
 }  // namespace catenary_sim

@@ -18,6 +18,8 @@ double estimate_wind_field_bytes(const Scene& scene);  // its turbulent wind fie
 double model_memory_limit_bytes();
 void check_model_memory(const Scene& scene);
 
+// The train front's travel over a whole pass, m (on an endless line, from where the block starts it).
+double pass_distance(const Model& model);
 // Steps a whole pass takes at the scene's train speed (inf at speed 0): offline tools refuse a
 // pass above their bound unless asked for.
 double pass_step_count(const Model& model);
