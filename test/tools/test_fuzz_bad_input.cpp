@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "../support/child_process.hpp"
+#include "../support/scene_refusal.hpp"
 #include "../support/scenes.hpp"
 
 using namespace catenary_sim_test;
@@ -113,6 +114,33 @@ TEST(FuzzBadInput, SetOverridesOfEveryField) {
   }
   RecordProperty("cases", count);
   std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+// Every shipped scene's numeric fields, read in-process: values no range allows are refused
+// naming the field (or its list), in whichever section or block of a newer kind it lies.
+TEST(FuzzBadInput, EveryShippedScenesFieldsRefuseValuesNoRangeAllows) {
+  const std::vector<std::string> scenes = {
+      "calpe_example.yaml", "catenary_to_rigid_rail.yaml", "catenary_to_trolley_wire.yaml", "compound_catenary.yaml",
+      "compound_catenary_3d.yaml", "reference_55m_3d.yaml", "reference_55m_3d_hinged_arms.yaml", "reference_55m_endless.yaml",
+      "reference_55m_hinged_arms.yaml", "reference_55m_stitched.yaml", "reference_55m_stitched_3d.yaml",
+      "reference_55m_two_heads.yaml", "reference_55m_two_pantographs.yaml", "reference_55m_two_sections.yaml",
+      "rigid_conductor_rail.yaml", "rigid_conductor_rail_3d.yaml", "stitched_catenary_to_rigid_rail.yaml", "trolley_wire.yaml",
+      "trolley_wire_bridle.yaml", "trolley_wire_bridle_3d.yaml"};
+  int count = 0;
+  for (const std::string& name : scenes) {
+    const std::string path = test_scenes::scene_path(name);
+    std::vector<Field> numeric, maps;
+    collect(YAML::LoadFile(path), "", "", &numeric, &maps);
+    for (const Field& f : numeric)
+      for (const char* v : {".nan", "-.inf", "1e300", "abc"}) {
+        const std::string message = test_scenes::refusal_of(path, {f.key + "=" + v});
+        ++count;
+        const bool named = message.find("'" + f.message + "'") != std::string::npos ||
+                           (f.in_list && message.find("'" + f.message.substr(0, f.message.rfind('[')) + "'") != std::string::npos);
+        EXPECT_TRUE(named) << name << " --set " << f.key << "=" << v << ": " << (message.empty() ? "accepted" : message);
+      }
+  }
+  RecordProperty("cases", count);
 }
 
 TEST(FuzzBadInput, OverridePathsAndValues) {
