@@ -73,6 +73,21 @@ TEST(Extremes, ContactStiffnessFrom1e3To1e7) {
   run_finite(implicit, 2000);
 }
 
+// The centred step leaves the springs' damping beta k explicit, and a link between two light
+// masses (a bridle's or a stitch wire's clamp, a dropper, a hanger) moves them against each other
+// at sqrt(k (1/m_a + 1/m_b)), above either mass's sqrt(k / m): with damping.beta at its bound the
+// estimate's dt must hold there too (a bridled trolley wire with it at one mass diverged within
+// 100 steps, its bridle's clamp the first to run away; on a 3-D line, across the track too).
+TEST(Extremes, StiffnessDampingAtItsBoundOnTheCentredStep) {
+  for (const char* scene : {"trolley_wire_bridle.yaml", "trolley_wire_bridle_3d.yaml", "reference_55m_stitched.yaml",
+                            "compound_catenary.yaml"}) {
+    Simulation sim(load_scene_file(test_scenes::scene_path(scene),
+                                   {"damping.beta=0.1", "numerics.damping=centred", "numerics.preset=accurate"}));
+    SCOPED_TRACE(std::string(scene) + ", dt = " + std::to_string(sim.model().dt));
+    run_finite(sim, 3000);
+  }
+}
+
 TEST(Extremes, ElementLengthsFrom5cmTo2m) {
   for (double h : {0.05, 0.5, 2.0}) {
     Simulation sim(load_scene_file(kScene, {"numerics.element_length=" + std::to_string(h)}));

@@ -463,15 +463,12 @@ void set_substeps(const Model& m, LateralModel* lat) {
   if (centred) {
     // The centred step takes the wires' band at the step's middle, but the support springs and
     // clamps act as point forces on y + beta v: their beta k is explicit damping on their nodes
-    // (as in the vertical plane: compute_stability_limit). Each as one DOF, w^2 = k / m, damping
-    // beta k / m; a stiff lateral spring (5e7 N/m on a 1 kg bracket: 2 / (beta k / m) = 0.4 ms)
-    // binds here, not in the band.
-    auto limit_by = [&](double k, int dof) {
-      if (lat->inv_mass[dof] > 0.0) dt_crit = std::min(dt_crit, point_time_step(k, m.beta * k, lat->mass[dof]));
-    };
-    for (const LateralSpring& sp : lat->springs) limit_by(sp.stiffness, sp.dof);
-    for (const LateralClamp& c : lat->clamps)
-      for (int dof : {c.upper, c.lower}) limit_by(c.stiffness, dof);
+    // (as in the vertical plane: compute_stability_limit); a stiff lateral spring (5e7 N/m on a
+    // 1 kg bracket: 2 / (beta k / m) = 0.4 ms) binds here, not in the band.
+    SpringDampingLimit springs(lat->inv_mass);
+    for (const LateralSpring& sp : lat->springs) springs.ground(sp.stiffness, sp.dof);
+    for (const LateralClamp& c : lat->clamps) springs.link(c.stiffness, c.upper, c.lower);
+    dt_crit = std::min(dt_crit, springs.time_step(m.beta));
   }
   lat->substeps = std::max(1, static_cast<int>(std::ceil(m.dt / (0.9 * dt_crit))));
   if (lat->substeps > 1000)

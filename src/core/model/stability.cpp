@@ -63,14 +63,11 @@ void compute_stability_limit(Model& m) {
   // reference's lower frame: 33 ms), binding on absurdly light ones, which then get a dt that holds.
   auto limit_by = [&](double k, double c, double mass) { m.dt_critical = std::min(m.dt_critical, point_time_step(k, c, mass)); };
   if (centred) {
-    for (const SupportSpring& sp : m.springs)
-      if (m.mass[sp.dof] > 0.0) limit_by(sp.stiffness, m.beta * sp.stiffness, m.mass[sp.dof]);
-    for (const Dropper& d : m.droppers)
-      for (int dof : {d.contact_dof, d.messenger_dof})
-        if (m.mass[dof] > 0.0) limit_by(d.stiffness, m.beta * d.stiffness, m.mass[dof]);
-    for (const WireClamp& c : m.clamps)
-      for (int dof : {c.lower_dof, c.upper_dof})
-        if (m.mass[dof] > 0.0) limit_by(c.stiffness, m.beta * c.stiffness, m.mass[dof]);
+    SpringDampingLimit springs(m.inv_mass);
+    for (const SupportSpring& sp : m.springs) springs.ground(sp.stiffness, sp.dof);
+    for (const Dropper& d : m.droppers) springs.link(d.stiffness, d.messenger_dof, d.contact_dof);
+    for (const WireClamp& c : m.clamps) springs.link(c.stiffness, c.upper_dof, c.lower_dof);
+    m.dt_critical = std::min(m.dt_critical, springs.time_step(m.beta));
   }
   for (const Pantograph& p : m.pantographs) {
     if (p.moving_force) continue;

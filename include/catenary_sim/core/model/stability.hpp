@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "catenary_sim/core/model/model.hpp"
@@ -56,6 +57,36 @@ double critical_time_step(double omega_max, double alpha, double beta);
 // limit (infinity) without a damper. What a point spring's explicit beta k, or a pantograph's
 // damper, allows where the band's own limit does not bind.
 double point_time_step(double k, double c, double mass);
+
+// The limit the point springs' explicit damping beta k sets where the wires' band takes its own
+// damping at the step's middle (the centred step): each DOF's highest frequency among the springs
+// bounded by its Gershgorin row of M^-1/2 K M^-1/2 (a link between two masses adds
+// k / m_i + k / sqrt(m_i m_j): its relative mode, sqrt(k (1/m_i + 1/m_j)), is above either mass's
+// sqrt(k / m) alone), the step then the stiffness-proportional one at that frequency.
+class SpringDampingLimit {
+ public:
+  explicit SpringDampingLimit(const Eigen::VectorXd& inv_mass) : inv_mass_(inv_mass), row_(inv_mass.size(), 0.0) {}
+  // A spring from DOF `dof` to the ground (a support).
+  void ground(double k, int dof) { row_[dof] += k * inv_mass_[dof]; }
+  // A spring between DOFs a and b (a dropper, a clamp).
+  void link(double k, int a, int b) {
+    const double cross = k * std::sqrt(inv_mass_[a] * inv_mass_[b]);
+    row_[a] += k * inv_mass_[a] + cross;
+    row_[b] += k * inv_mass_[b] + cross;
+  }
+  // The least step over the DOFs; infinity without damping (beta 0) or springs.
+  double time_step(double beta) const {
+    double dt = std::numeric_limits<double>::infinity();
+    if (!(beta > 0.0)) return dt;
+    for (double r : row_)
+      if (r > 0.0) dt = std::min(dt, critical_time_step(std::sqrt(r), 0.0, beta));
+    return dt;
+  }
+
+ private:
+  const Eigen::VectorXd& inv_mass_;
+  std::vector<double> row_;
+};
 
 // Sets model.omega_max (the estimate with a 0.2 % safety margin, plus a bound for the contacts
 // wherever they are along the line) and model.dt_critical.
