@@ -539,7 +539,7 @@ TEST(Lateral, LeanLiftsTheContactWireAsTheSpringsInSeriesSay) {
                             "contact_wire: {linear_mass: 1.35, bending_stiffness: 195.0, tension: 22000.0}\n"
                             "messenger: {linear_mass: 1.08, bending_stiffness: 131.7, tension: 16000.0}\n"
                             "droppers: {positions: [30.0], axial_stiffness: 200000.0, linear_mass: 0.117}\n"
-                            "damping: {alpha: 12.0, beta: 0.0}\n"
+                            "damping: {alpha: 12.0, beta: 1.0e-4}\n"
                             "stagger: {contact_wire: [0.2], messenger: [0.0]}\n";
   Model m = build_model(load_scene_string(scene));
   ASSERT_TRUE(m.lateral);

@@ -582,8 +582,9 @@ void mark_springs_at_middle(const NumericsSpec& num, Model& m) {
   for (std::size_t k = 0; k < m.clamps.size(); ++k) m.clamp_at_middle[k] = take(m.clamps[k].upper_dof, m.clamps[k].lower_dof);
 }
 
-// The explicit stability limit (validation.md section 5) and the step, or the implicit matrix.
-void choose_time_step(const Scene& scene, Model& m) {
+// The explicit stability limit (validation.md section 5; at least coupled_omega, BuildOptions) and
+// the step, or the implicit matrix.
+void choose_time_step(const Scene& scene, double coupled_omega, Model& m) {
   if (scene.numerics.windowed() &&
       (scene.numerics.integrator != Integrator::kExplicit || scene.numerics.rotary_inertia != RotaryInertia::kCondensed)) {
     const bool implicit = scene.numerics.integrator != Integrator::kExplicit;
@@ -614,7 +615,7 @@ void choose_time_step(const Scene& scene, Model& m) {
     return;
   }
   mark_springs_at_middle(scene.numerics, m);
-  compute_stability_limit(m);
+  compute_stability_limit(m, coupled_omega);
   if (scene.numerics.dt) {
     if (*scene.numerics.dt > m.dt_critical)
       throw SceneError("numerics.dt = " + fmt(*scene.numerics.dt) + " s: above the explicit stability limit " +
@@ -667,7 +668,7 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
     m.dt = m.dt_critical = scene.numerics.dt ? *scene.numerics.dt : 1e-4;
     return m;
   }
-  choose_time_step(scene, m);
+  choose_time_step(scene, options.coupled_omega, m);
   return m;
 }
 
@@ -695,6 +696,18 @@ Model build_model_checked(const Scene& scene, const BuildOptions& options) {
     throw SceneError("scene field 'output.filter_cutoff' = " + fmt(scene.output.filter_cutoff) + ": allowed below " +
                      fmt(nyquist) + " Hz, the Nyquist frequency of the time step (dt " + fmt(m.dt) + " s)");
   if (scene.lateral()) m.lateral = build_lateral(m);  // the 3-D line; nothing built for a 2-D scene
+  // The droppers' lean couples the planes (a mode neither plane's estimate holds): where it is
+  // the highest, the model again with its limit.
+  if (m.lateral && options.stability && !m.implicit && options.coupled_omega == 0.0) {
+    const double coupled = lean_coupled_omega_max(m, *m.lateral);
+    // (Where a plane's own mode is the highest both iterations find it, to about 1e-9: the same
+    // frequency, not a coupled one above it.)
+    if (coupled > (1.0 + 1e-6) * m.omega_wires) {
+      BuildOptions again = options;
+      again.coupled_omega = coupled;
+      return build_model_checked(scene, again);
+    }
+  }
   return m;
 }
 

@@ -976,4 +976,33 @@ std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
   return lat;
 }
 
+double lean_coupled_omega_max(const Model& m, const LateralModel& lat) {
+  const int nv = m.n_dof, n = nv + lat.n;
+  Eigen::VectorXd s(n);
+  s.head(nv) = m.inv_mass.cwiseSqrt();
+  s.tail(lat.n) = lat.inv_mass.cwiseSqrt();
+  int max_nodes = 1;
+  for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
+  std::vector<double> scratch(std::max(max_nodes, lat.n)), theta(lat.n);
+  return 1.002 * power_iteration_omega(n, s.data(), 3000, [&](const double* x, double* y) {
+    apply_stiffness(m, m.train_start, x, y, scratch.data(), true);  // y_v = K_v x_v
+    double* yl = y + nv;
+    const double* xl = x + nv;
+    std::fill(yl, yl + lat.n, 0.0);
+    elastic_force(m, lat, nullptr, xl, yl, theta.data());
+    for (int i = 0; i < lat.n; ++i) yl[i] = -yl[i];
+    for (const LateralPendulum& p : lat.pendulums) {
+      const Dropper& d = m.droppers[p.dropper];
+      const double slope = (lat.initial[p.messenger] - lat.initial[p.contact]) * p.inv_length;  // (lean0_sq's dy0)
+      const double ks = d.stiffness * slope;
+      const double dz = x[d.messenger_dof] - x[d.contact_dof], dy = xl[p.messenger] - xl[p.contact];
+      y[d.messenger_dof] += ks * dy;
+      y[d.contact_dof] -= ks * dy;
+      yl[p.messenger] += ks * dz + ks * slope * dy;
+      yl[p.contact] -= ks * dz + ks * slope * dy;
+    }
+  });
+}
+
+
 }  // namespace catenary_sim

@@ -30,7 +30,7 @@ double point_time_step(double k, double c, double mass) {
   return w > 0.0 ? critical_time_step(w, c / mass, 0.0) : 2.0 * mass / c;
 }
 
-void compute_stability_limit(Model& m) {
+void compute_stability_limit(Model& m, double coupled_omega) {
   // A Rayleigh quotient can only underestimate omega_max; the 0.2 % margin covers what the
   // iteration has not converged (measured: 3e-4 after 400 iterations on the HRZ variant), so the
   // refusal of a user dt is on the safe side.
@@ -38,7 +38,8 @@ void compute_stability_limit(Model& m) {
   // implicit) are left out: with them the step is central differences on the mass M + (dt^2/4) K_I
   // and the stiffness K_E + K_I, stable for dt < 2 / omega_max(K_E, M) whatever K_I
   // (explicit_step.cpp). A slack dropper only takes its K_I away.
-  m.omega_max = 1.002 * highest_eigenfrequency(m, 3000, true);
+  m.omega_wires = std::max(1.002 * highest_eigenfrequency(m, 3000, true), coupled_omega);
+  m.omega_max = m.omega_wires;
   // The contacts move along the wire: where one meets a light node its frequency is highest, and
   // the power iteration sees it only where the train starts. Add every contact's worst case as a
   // bound (Weyl: lambda_max(A + B) <= lambda_max(A) + lambda_max(B)), with the contact as a

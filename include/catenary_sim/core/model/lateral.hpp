@@ -249,6 +249,12 @@ std::vector<RegistrationLateral> registration_lateral(const Model& model, const 
 
 // Builds the lateral plane of a model whose scene asks for one (Scene::lateral()); throws SceneError.
 std::shared_ptr<const LateralModel> build_lateral(const Model& model);
+// Highest eigenfrequency (rad/s, with the planes' 0.2 % margin) of both planes together with the
+// droppers' lean coupling, of the K the explicit step takes at q_n: about the static state a
+// dropper of stiffness k leaning by s = dy0 / l couples its ends' relative height and position
+// across the track through [[k, k s], [k s, T0 / l + k s^2]] (its stretch takes s dy, its
+// pendulum the tension's change), which neither plane's own estimate holds.
+double lean_coupled_omega_max(const Model& model, const LateralModel& lateral);
 // Designs the line in plan alone (the bridles' registrations, the wires inside the working
 // width, the static states) and throws SceneError for what build_lateral would refuse there. For
 // a model built without its numerics (BuildOptions::stability false), e.g. the elasticity's probe.

@@ -88,8 +88,9 @@ class SpringDampingLimit {
   std::vector<double> row_;
 };
 
-// Sets model.omega_max (the estimate with a 0.2 % safety margin, plus a bound for the contacts
-// wherever they are along the line) and model.dt_critical.
-void compute_stability_limit(Model& model);
+// Sets model.omega_wires (the estimate with a 0.2 % safety margin, at least `coupled_omega`),
+// model.omega_max (that plus a bound for the contacts wherever they are along the line) and
+// model.dt_critical.
+void compute_stability_limit(Model& model, double coupled_omega = 0.0);
 
 }  // namespace catenary_sim
