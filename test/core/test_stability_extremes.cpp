@@ -118,6 +118,22 @@ TEST(Extremes, LeaningDroppersCoupleThePlanesWithinTheStep) {
   }
 }
 
+// A pantograph's damper between two of its masses moves them against each other at
+// c (1/m_a + 1/m_b), above either's c / m: with 1e6 N s/m between the head (7.5 kg) and the
+// upper frame (9 kg), or on a head's suspension, the estimate's dt must hold (each diverged within
+// 100 steps when the limit took each mass alone).
+TEST(Extremes, StiffDampersBetweenPantographMasses) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"reference_55m.yaml", "pantographs.0.damping=[1.0e6, 0.0, 100.0]"},
+      {"reference_55m.yaml", "pantographs.0.damping=[0.0, 1.0e6, 100.0]"},
+      {"reference_55m_two_heads.yaml", "pantographs.0.heads.0.damping=1.0e6"}};
+  for (const auto& [scene, damping] : cases) {
+    Simulation sim(load_scene_file(test_scenes::scene_path(scene), {damping}));
+    SCOPED_TRACE(scene + " " + damping + ", dt = " + std::to_string(sim.model().dt));
+    run_finite(sim, 3000);
+  }
+}
+
 TEST(Extremes, ElementLengthsFrom5cmTo2m) {
   for (double h : {0.05, 0.5, 2.0}) {
     Simulation sim(load_scene_file(kScene, {"numerics.element_length=" + std::to_string(h)}));

@@ -24,12 +24,6 @@ double critical_time_step(double w, double alpha, double beta) {
   return (2.0 / w) * (std::sqrt(1.0 + xi * xi) - xi);
 }
 
-double point_time_step(double k, double c, double mass) {
-  if (!(c > 0.0)) return std::numeric_limits<double>::infinity();
-  const double w = std::sqrt(k / mass);
-  return w > 0.0 ? critical_time_step(w, c / mass, 0.0) : 2.0 * mass / c;
-}
-
 void compute_stability_limit(Model& m, double coupled_omega) {
   // A Rayleigh quotient can only underestimate omega_max; the 0.2 % margin covers what the
   // iteration has not converged (measured: 3e-4 after 400 iterations on the HRZ variant), so the
@@ -57,12 +51,6 @@ void compute_stability_limit(Model& m, double coupled_omega) {
   // supports' and droppers' springs keep their explicit share beta k (below).
   const bool centred = m.scene.numerics.damping == DampingStep::kCentred;
   m.dt_critical = centred ? critical_time_step(m.omega_max, 0.0, 0.0) : critical_time_step(m.omega_max, m.alpha, m.beta);
-  // The pantographs' dampers are not Rayleigh damping: the half-step velocity of eq. 19-21 takes
-  // them explicitly, and a damper c on a light mass m needs dt < 2 m / c even without a spring.
-  // Each mass with its own springs and dampers as one DOF (w^2 = k/m, mass-proportional damping
-  // c/m in the formula of validation.md section 5): far from binding on real pantographs (the
-  // reference's lower frame: 33 ms), binding on absurdly light ones, which then get a dt that holds.
-  auto limit_by = [&](double k, double c, double mass) { m.dt_critical = std::min(m.dt_critical, point_time_step(k, c, mass)); };
   if (centred) {
     SpringDampingLimit springs(m.inv_mass);
     for (const SupportSpring& sp : m.springs) springs.ground(sp.stiffness, sp.dof);
@@ -70,20 +58,40 @@ void compute_stability_limit(Model& m, double coupled_omega) {
     for (const WireClamp& c : m.clamps) springs.link(c.stiffness, c.upper_dof, c.lower_dof);
     m.dt_critical = std::min(m.dt_critical, springs.time_step(m.beta));
   }
+  // The pantographs' dampers are not Rayleigh damping: the half-step velocity of eq. 19-21 takes
+  // them explicitly, and a damper c on a light mass m needs dt < 2 m / c even without a spring.
+  // Each mass's springs and dampers bounded by its Gershgorin rows of M^-1/2 K M^-1/2 and
+  // M^-1/2 C M^-1/2 (a damper between two masses moves them against each other faster than either
+  // alone: the links' rule of SpringDampingLimit), the contact springs held at the wire, taken as
+  // one DOF (w^2 and the damping rate in the formula of validation.md section 5): far from binding
+  // on real pantographs (the reference's lower frame: 33 ms), binding on absurdly light or
+  // damped ones, which then get a dt that holds.
   for (const Pantograph& p : m.pantographs) {
     if (p.moving_force) continue;
-    for (int i = 0; i < p.masses_count(); ++i) {
-      double k = p.stiffness[i], c = p.damping[i];
-      if (i > 0) k += p.stiffness[i - 1], c += p.damping[i - 1];
-      if (i == 0 && p.heads.empty()) k += m.contact_stiffness * static_cast<double>(p.collectors.size() * m.contact_wires.size());
-      if (i == 0)
-        for (const Head& h : p.heads) k += h.stiffness, c += h.damping;
-      limit_by(k, c, p.masses[i]);
+    const int n = p.masses_count(), nh = static_cast<int>(p.heads.size());
+    std::vector<double> mass(p.masses.begin(), p.masses.end()), k_row(n + nh, 0.0), c_row(n + nh, 0.0);
+    for (const Head& h : p.heads) mass.push_back(h.mass);
+    auto ground = [&](int a, double k, double c) {
+      k_row[a] += k / mass[a];
+      c_row[a] += c / mass[a];
+    };
+    auto link = [&](int a, int b, double k, double c) {
+      const double cross = 1.0 / std::sqrt(mass[a] * mass[b]);
+      k_row[a] += k * (1.0 / mass[a] + cross);
+      k_row[b] += k * (1.0 / mass[b] + cross);
+      c_row[a] += c * (1.0 / mass[a] + cross);
+      c_row[b] += c * (1.0 / mass[b] + cross);
+    };
+    for (int i = 0; i + 1 < n; ++i) link(i, i + 1, p.stiffness[i], p.damping[i]);
+    ground(n - 1, p.stiffness[n - 1], p.damping[n - 1]);  // (the last to the roof)
+    const double wires = static_cast<double>(m.contact_wires.size());
+    if (p.heads.empty()) ground(0, m.contact_stiffness * static_cast<double>(p.collectors.size()) * wires, 0.0);
+    for (int h = 0; h < nh; ++h) {
+      link(0, n + h, p.heads[h].stiffness, p.heads[h].damping);
+      ground(n + h, m.contact_stiffness * static_cast<double>(p.heads[h].collectors.size()) * wires, 0.0);
     }
-    // Each head: its suspension to the frame and its strips' contact springs.
-    for (const Head& h : p.heads)
-      limit_by(h.stiffness + m.contact_stiffness * static_cast<double>(h.collectors.size() * m.contact_wires.size()),
-               h.damping, h.mass);
+    for (int a = 0; a < n + nh; ++a)
+      if (c_row[a] > 0.0) m.dt_critical = std::min(m.dt_critical, critical_time_step(std::sqrt(k_row[a]), c_row[a], 0.0));
   }
 }
 

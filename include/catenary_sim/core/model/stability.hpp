@@ -52,11 +52,6 @@ double highest_eigenfrequency(const Model& model, int iterations = 3000, bool ex
 
 // dt_crit = (2 / w_max) (sqrt(1 + xi^2) - xi), xi = alpha / (2 w_max) + beta w_max / 2.
 double critical_time_step(double omega_max, double alpha, double beta);
-// The limit of one mass on its own spring k and explicit damper c (w^2 = k / mass, the damping
-// c / mass taken as mass-proportional in the formula above; 2 mass / c without a spring); no
-// limit (infinity) without a damper. What a point spring's explicit beta k, or a pantograph's
-// damper, allows where the band's own limit does not bind.
-double point_time_step(double k, double c, double mass);
 
 // The limit the point springs' explicit damping beta k sets where the wires' band takes its own
 // damping at the step's middle (the centred step): each DOF's highest frequency among the springs
