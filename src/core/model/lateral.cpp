@@ -476,10 +476,10 @@ void set_substeps(const Model& m, LateralModel* lat) {
     // clamps act as point forces on y + beta v: their beta k is explicit damping on their nodes
     // (as in the vertical plane: compute_stability_limit); a stiff lateral spring (5e7 N/m on a
     // 1 kg bracket: 2 / (beta k / m) = 0.4 ms) binds here, not in the band.
-    SpringDampingLimit springs(lat->inv_mass);
-    for (const LateralSpring& sp : lat->springs) springs.ground(sp.stiffness, sp.dof);
-    for (const LateralClamp& c : lat->clamps) springs.link(c.stiffness, c.upper, c.lower);
-    dt_crit = std::min(dt_crit, springs.time_step(m.beta));
+    PointDampingLimit points(lat->inv_mass);
+    for (const LateralSpring& sp : lat->springs) points.ground(sp.dof, sp.stiffness, m.beta * sp.stiffness);
+    for (const LateralClamp& c : lat->clamps) points.link(c.upper, c.lower, c.stiffness, m.beta * c.stiffness);
+    dt_crit = std::min(dt_crit, points.time_step());
   }
   lat->substeps = std::max(1, static_cast<int>(std::ceil(m.dt / (0.9 * dt_crit))));
   if (lat->substeps > 1000)

@@ -51,48 +51,31 @@ void compute_stability_limit(Model& m, double coupled_omega) {
   // supports' and droppers' springs keep their explicit share beta k (below).
   const bool centred = m.scene.numerics.damping == DampingStep::kCentred;
   m.dt_critical = centred ? critical_time_step(m.omega_max, 0.0, 0.0) : critical_time_step(m.omega_max, m.alpha, m.beta);
+  PointDampingLimit points(m.inv_mass);
   if (centred) {
-    SpringDampingLimit springs(m.inv_mass);
-    for (const SupportSpring& sp : m.springs) springs.ground(sp.stiffness, sp.dof);
-    for (const Dropper& d : m.droppers) springs.link(d.stiffness, d.messenger_dof, d.contact_dof);
-    for (const WireClamp& c : m.clamps) springs.link(c.stiffness, c.upper_dof, c.lower_dof);
-    m.dt_critical = std::min(m.dt_critical, springs.time_step(m.beta));
+    const double b = m.beta;
+    for (const SupportSpring& sp : m.springs) points.ground(sp.dof, sp.stiffness, b * sp.stiffness);
+    for (const Dropper& d : m.droppers) points.link(d.messenger_dof, d.contact_dof, d.stiffness, b * d.stiffness);
+    for (const WireClamp& c : m.clamps) points.link(c.upper_dof, c.lower_dof, c.stiffness, b * c.stiffness);
   }
   // The pantographs' dampers are not Rayleigh damping: the half-step velocity of eq. 19-21 takes
   // them explicitly, and a damper c on a light mass m needs dt < 2 m / c even without a spring.
-  // Each mass's springs and dampers bounded by its Gershgorin rows of M^-1/2 K M^-1/2 and
-  // M^-1/2 C M^-1/2 (a damper between two masses moves them against each other faster than either
-  // alone: the links' rule of SpringDampingLimit), the contact springs held at the wire, taken as
-  // one DOF (w^2 and the damping rate in the formula of validation.md section 5): far from binding
-  // on real pantographs (the reference's lower frame: 33 ms), binding on absurdly light or
-  // damped ones, which then get a dt that holds.
+  // With their springs and the contact springs (the wire taken held): far from binding on real
+  // pantographs (the reference's lower frame: 33 ms), binding on absurdly light or damped ones,
+  // which then get a dt that holds.
+  const double wires = static_cast<double>(m.contact_wires.size());
   for (const Pantograph& p : m.pantographs) {
     if (p.moving_force) continue;
-    const int n = p.masses_count(), nh = static_cast<int>(p.heads.size());
-    std::vector<double> mass(p.masses.begin(), p.masses.end()), k_row(n + nh, 0.0), c_row(n + nh, 0.0);
-    for (const Head& h : p.heads) mass.push_back(h.mass);
-    auto ground = [&](int a, double k, double c) {
-      k_row[a] += k / mass[a];
-      c_row[a] += c / mass[a];
-    };
-    auto link = [&](int a, int b, double k, double c) {
-      const double cross = 1.0 / std::sqrt(mass[a] * mass[b]);
-      k_row[a] += k * (1.0 / mass[a] + cross);
-      k_row[b] += k * (1.0 / mass[b] + cross);
-      c_row[a] += c * (1.0 / mass[a] + cross);
-      c_row[b] += c * (1.0 / mass[b] + cross);
-    };
-    for (int i = 0; i + 1 < n; ++i) link(i, i + 1, p.stiffness[i], p.damping[i]);
-    ground(n - 1, p.stiffness[n - 1], p.damping[n - 1]);  // (the last to the roof)
-    const double wires = static_cast<double>(m.contact_wires.size());
-    if (p.heads.empty()) ground(0, m.contact_stiffness * static_cast<double>(p.collectors.size()) * wires, 0.0);
-    for (int h = 0; h < nh; ++h) {
-      link(0, n + h, p.heads[h].stiffness, p.heads[h].damping);
-      ground(n + h, m.contact_stiffness * static_cast<double>(p.heads[h].collectors.size()) * wires, 0.0);
+    const int n = p.masses_count(), top = p.first_dof;
+    for (int i = 0; i + 1 < n; ++i) points.link(top + i, top + i + 1, p.stiffness[i], p.damping[i]);
+    points.ground(top + n - 1, p.stiffness[n - 1], p.damping[n - 1]);  // (the last to the roof)
+    if (p.heads.empty()) points.ground(top, m.contact_stiffness * static_cast<double>(p.collectors.size()) * wires, 0.0);
+    for (const Head& h : p.heads) {
+      points.link(top, h.dof, h.stiffness, h.damping);
+      points.ground(h.dof, m.contact_stiffness * static_cast<double>(h.collectors.size()) * wires, 0.0);
     }
-    for (int a = 0; a < n + nh; ++a)
-      if (c_row[a] > 0.0) m.dt_critical = std::min(m.dt_critical, critical_time_step(std::sqrt(k_row[a]), c_row[a], 0.0));
   }
+  m.dt_critical = std::min(m.dt_critical, points.time_step());
 }
 
 }  // namespace catenary_sim

@@ -53,34 +53,43 @@ double highest_eigenfrequency(const Model& model, int iterations = 3000, bool ex
 // dt_crit = (2 / w_max) (sqrt(1 + xi^2) - xi), xi = alpha / (2 w_max) + beta w_max / 2.
 double critical_time_step(double omega_max, double alpha, double beta);
 
-// The limit the point springs' explicit damping beta k sets where the wires' band takes its own
-// damping at the step's middle (the centred step): each DOF's highest frequency among the springs
-// bounded by its Gershgorin row of M^-1/2 K M^-1/2 (a link between two masses adds
-// k / m_i + k / sqrt(m_i m_j): its relative mode, sqrt(k (1/m_i + 1/m_j)), is above either mass's
-// sqrt(k / m) alone), the step then the stiffness-proportional one at that frequency.
-class SpringDampingLimit {
+// The limit explicit dampers on point springs and masses set where no band estimate holds them
+// (the centred step's springs with their beta k, the pantographs' dampers): each DOF's springs
+// and dampers bounded by its Gershgorin rows of M^-1/2 K M^-1/2 and M^-1/2 C M^-1/2 (a link
+// between two masses adds k / m_i + k / sqrt(m_i m_j): its relative mode, sqrt(k (1/m_i + 1/m_j)),
+// is above either mass's sqrt(k / m) alone), taken as one DOF: w^2 and the damping rate in the
+// formula above (validation.md section 5).
+class PointDampingLimit {
  public:
-  explicit SpringDampingLimit(const Eigen::VectorXd& inv_mass) : inv_mass_(inv_mass), row_(inv_mass.size(), 0.0) {}
-  // A spring from DOF `dof` to the ground (a support).
-  void ground(double k, int dof) { row_[dof] += k * inv_mass_[dof]; }
-  // A spring between DOFs a and b (a dropper, a clamp).
-  void link(double k, int a, int b) {
-    const double cross = k * std::sqrt(inv_mass_[a] * inv_mass_[b]);
-    row_[a] += k * inv_mass_[a] + cross;
-    row_[b] += k * inv_mass_[b] + cross;
+  explicit PointDampingLimit(const Eigen::VectorXd& inv_mass)
+      : inv_mass_(inv_mass), k_row_(inv_mass.size(), 0.0), c_row_(inv_mass.size(), 0.0) {}
+  // A spring k and damper c from DOF `dof` to the ground (a support, the roof, a wire taken held).
+  void ground(int dof, double k, double c) {
+    k_row_[dof] += k * inv_mass_[dof];
+    c_row_[dof] += c * inv_mass_[dof];
   }
-  // The least step over the DOFs; infinity without damping (beta 0) or springs.
-  double time_step(double beta) const {
+  // A spring k and damper c between DOFs a and b (a dropper, a clamp, a pantograph's frame).
+  void link(int a, int b, double k, double c) {
+    const double cross = std::sqrt(inv_mass_[a] * inv_mass_[b]);
+    for (const int i : {a, b}) {
+      k_row_[i] += k * (inv_mass_[i] + cross);
+      c_row_[i] += c * (inv_mass_[i] + cross);
+    }
+  }
+  // The least step over the DOFs with a damper (2 / rate for a damper without a spring); infinity
+  // without one.
+  double time_step() const {
     double dt = std::numeric_limits<double>::infinity();
-    if (!(beta > 0.0)) return dt;
-    for (double r : row_)
-      if (r > 0.0) dt = std::min(dt, critical_time_step(std::sqrt(r), 0.0, beta));
+    for (std::size_t i = 0; i < k_row_.size(); ++i) {
+      if (!(c_row_[i] > 0.0)) continue;
+      dt = std::min(dt, k_row_[i] > 0.0 ? critical_time_step(std::sqrt(k_row_[i]), c_row_[i], 0.0) : 2.0 / c_row_[i]);
+    }
     return dt;
   }
 
  private:
   const Eigen::VectorXd& inv_mass_;
-  std::vector<double> row_;
+  std::vector<double> k_row_, c_row_;
 };
 
 // Sets model.omega_wires (the estimate with a 0.2 % safety margin, at least `coupled_omega`),
