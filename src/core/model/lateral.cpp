@@ -983,7 +983,7 @@ double lean_coupled_omega_max(const Model& m, const LateralModel& lat) {
   s.tail(lat.n) = lat.inv_mass.cwiseSqrt();
   int max_nodes = 1;
   for (const Wire& w : m.wires) max_nodes = std::max(max_nodes, w.nodes());
-  std::vector<double> scratch(std::max(max_nodes, lat.n)), theta(lat.n);
+  std::vector<double> scratch(max_nodes), theta(lat.n);
   return 1.002 * power_iteration_omega(n, s.data(), 3000, [&](const double* x, double* y) {
     apply_stiffness(m, m.train_start, x, y, scratch.data(), true);  // y_v = K_v x_v
     double* yl = y + nv;
