@@ -698,10 +698,12 @@ Model build_model_checked(const Scene& scene, const BuildOptions& options) {
   if (scene.lateral()) m.lateral = build_lateral(m);  // the 3-D line; nothing built for a 2-D scene
   // The droppers' lean couples the planes (a mode neither plane's estimate holds): where it is
   // the highest, the model again with its limit.
-  if (m.lateral && options.stability && !m.implicit && options.coupled_omega == 0.0) {
+  // (Where a plane's own mode is the highest both iterations find it, to about 1e-9: the same
+  // frequency, not a coupled one above it. Droppers hanging plumb couple nothing.)
+  const auto leans = [](const LateralPendulum& p) { return p.lean0_sq > 0.0; };
+  if (m.lateral && options.stability && !m.implicit && options.coupled_omega == 0.0 &&
+      std::any_of(m.lateral->pendulums.begin(), m.lateral->pendulums.end(), leans)) {
     const double coupled = lean_coupled_omega_max(m, *m.lateral);
-    // (Where a plane's own mode is the highest both iterations find it, to about 1e-9: the same
-    // frequency, not a coupled one above it.)
     if (coupled > (1.0 + 1e-6) * m.omega_wires) {
       BuildOptions again = options;
       again.coupled_omega = coupled;

@@ -32,7 +32,9 @@ void compute_stability_limit(Model& m, double coupled_omega) {
   // implicit) are left out: with them the step is central differences on the mass M + (dt^2/4) K_I
   // and the stiffness K_E + K_I, stable for dt < 2 / omega_max(K_E, M) whatever K_I
   // (explicit_step.cpp). A slack dropper only takes its K_I away.
-  m.omega_wires = std::max(1.002 * highest_eigenfrequency(m, 3000, true), coupled_omega);
+  // A coupled frequency is given only where it was found above this model's own (build_model):
+  // the plane's own iteration is not run again.
+  m.omega_wires = coupled_omega > 0.0 ? coupled_omega : 1.002 * highest_eigenfrequency(m, 3000, true);
   m.omega_max = m.omega_wires;
   // The contacts move along the wire: where one meets a light node its frequency is highest, and
   // the power iteration sees it only where the train starts. Add every contact's worst case as a
