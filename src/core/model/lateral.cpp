@@ -18,6 +18,7 @@
 #include "model/centred_factors.hpp"
 #include "model/design_statics.hpp"
 #include "model/normal_errors.hpp"
+#include "model/selected_inverse.hpp"
 #include "model/wire_packs.hpp"
 
 namespace catenary_sim {
@@ -596,7 +597,10 @@ void add_stiffness(const Model& m, const LateralModel& lat, Add&& add) {
 // unconstrained matrix (full(), kept on request) gives the reactions.
 class LateralSystem {
  public:
-  LateralSystem(const Model& m, const LateralModel& lat, const std::vector<bool>& fixed, bool keep_full)
+  // `also_pattern`: pairs of free rows put on the factor's pattern (as stored zeros) for the
+  // entries of the inverse that inverse() gives.
+  LateralSystem(const Model& m, const LateralModel& lat, const std::vector<bool>& fixed, bool keep_full,
+                const std::vector<std::pair<int, int>>& also_pattern = {})
       : n_(lat.n), fixed_(fixed) {
     const int N = 2 * n_;
     std::vector<Eigen::Triplet<double>> full, reduced;
@@ -609,6 +613,7 @@ class LateralSystem {
     });
     for (int i = 0; i < n_; ++i)
       if (fixed_[i]) reduced.emplace_back(i, i, 1.0);
+    for (const auto& [a, b] : also_pattern) reduced.emplace_back(std::max(a, b), std::min(a, b), 0.0);
     Eigen::SparseMatrix<double> K(N, N);
     K.setFromTriplets(reduced.begin(), reduced.end());
     if (keep_full) {
@@ -634,6 +639,8 @@ class LateralSystem {
     return x;
   }
   const Eigen::SparseMatrix<double>& full() const { return full_; }
+  // The reduced system's inverse on its factor's pattern (the held rows' are the identity's).
+  SelectedInverse inverse() const { return SelectedInverse(solver_); }
 
  private:
   int n_;
@@ -860,22 +867,40 @@ std::vector<RegistrationLateral> registration_lateral(const Model& m, const std:
   const int n = lat.n;
   auto lateral_dof = [&](int vertical) { return lateral_dof_of(m, lat, vertical); };
   // Every support held (rows y_i = 0), then each asked node let go in turn: its stiffness is the
-  // Schur complement K_ii - K_ir K_rr^-1 K_ri over the rest r of the plane.
+  // Schur complement K_ii - K_ir K_rr^-1 K_ri over the rest r of the plane. K_ri is nonzero on
+  // the node's few neighbours, so only those entries of K_rr^-1 are needed: the selected inverse
+  // gives them all in one sweep. (A solve per node cost the whole plane's factor each: the build
+  // grew as the square of the spans, since stitch wires chain the messenger's spans along the
+  // whole line and no arm's solve stays local.)
   std::vector<bool> fixed(n, false);
   for (const LateralSupport& sup : lat.supports) fixed[lat.wires[sup.wire].w_dof + sup.node] = true;
-  const LateralSystem held(m, lat, fixed, true);
-  const Eigen::SparseMatrix<double>& Kf = held.full();
-  const Eigen::VectorXd at_rest = Eigen::VectorXd::Zero(n);
+  std::vector<Eigen::Triplet<double>> entries;
+  add_stiffness(m, lat, [&](int i, int j, double v) { entries.emplace_back(i, j, v); });
+  Eigen::SparseMatrix<double> Kf(2 * n, 2 * n);
+  Kf.setFromTriplets(entries.begin(), entries.end());
+  std::vector<std::vector<std::pair<int, double>>> coupling(dofs.size());  // K_ri: (r, value)
+  std::vector<std::pair<int, int>> pairs;
+  for (std::size_t q = 0; q < dofs.size(); ++q) {
+    const int i = lateral_dof(dofs[q]);
+    for (Eigen::SparseMatrix<double>::InnerIterator it(Kf, i); it; ++it)
+      if (!(it.row() < n && fixed[it.row()]) && it.value() != 0.0) coupling[q].emplace_back(it.row(), it.value());
+    for (const auto& [a, va] : coupling[q])
+      for (const auto& [b, vb] : coupling[q])
+        if (a > b) pairs.emplace_back(a, b);
+  }
+  const LateralSystem held(m, lat, fixed, false, pairs);
+  const SelectedInverse z = held.inverse();
   std::vector<RegistrationLateral> out(dofs.size());
   for (std::size_t q = 0; q < dofs.size(); ++q) {
     const int i = lateral_dof(dofs[q]);
-    const Eigen::VectorXd c = Kf.col(i);
-    const Eigen::VectorXd x = held.solve(c, at_rest);  // K_rr^-1 K_ri, 0 on the held rows
+    double through_rest = 0.0;  // K_ir K_rr^-1 K_ri
+    for (const auto& [a, va] : coupling[q])
+      for (const auto& [b, vb] : coupling[q]) through_rest += va * z(a, b) * vb;
     // (Without the support's own lateral spring: that is the arm itself, stiff along its length.)
     double own = 0.0;
     for (const LateralSpring& sp : lat.springs)
       if (sp.dof == i) own += sp.stiffness;
-    out[q].stiffness = Kf.coeff(i, i) - own - c.dot(x);
+    out[q].stiffness = Kf.coeff(i, i) - own - through_rest;
   }
   if (!m.scene.lateral()) return out;
   // The calm statics in plan: each support's share of the wire's pull (the pull-off).
