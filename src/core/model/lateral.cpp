@@ -5,6 +5,7 @@
 #include <Eigen/LU>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
 
 #include <algorithm>
 #include <cmath>
@@ -653,9 +654,8 @@ class LateralSystem {
 // Bridles in plan: the stagger is where the contact wire passes each support, where only the
 // bridle's clamps hold it, so the bridle's middle is registered beyond it, far enough that its
 // arms carry the wire's pull-off (T_b (b - y_c) / a at a clamp, a the arm, y_c the clamp's
-// position). The design in plan holds the middles there rigidly, and is linear in the
-// registrations b: solved with them at 0, and for each at 1 alone, in one factorisation, b is the
-// one that puts the contact wire at its stagger at every support. A lateral spring
+// position). The design in plan holds the middles there rigidly, at the registrations b that
+// put the contact wire at its stagger at every support (plan_bridles). A lateral spring
 // (stagger.steady_arm_stiffness) pulls the middle toward its registration, as a steady arm's pulls
 // the wire toward its stagger.
 struct BridlePlan {
@@ -692,51 +692,57 @@ BridlePlan plan_bridles(const Model& m, const LateralModel& lat) {
   }
   const int nb = static_cast<int>(p.held.size());
   if (nb == 0) return p;
-  const int n = lat.n;
-  std::vector<bool> fixed(n, false);
-  Eigen::VectorXd base_value = Eigen::VectorXd::Zero(n);
-  for (const LateralSupport& s : lat.supports)
-    if (s.rigid) {
-      fixed[lat.wires[s.wire].w_dof + s.node] = true;
-      base_value[lat.wires[s.wire].w_dof + s.node] = s.stagger;
-    }
-  // The rows wanted: the contact wire at each support (0..nb), each bridle's ends (nb + 2 j, + 1).
-  std::vector<int> rows(at);
+  const int n = lat.n, N = 2 * n;
+  // One square system for the plane and the registrations together: each middle's y is an
+  // unknown (its b), and its row, where its reaction would balance it, says instead that the
+  // contact wire at its support is at the stagger: one sparse solve, where the plane solved once
+  // per registration and then a dense system for the b would cost the square of the line's
+  // length and more (the contact wire, free at its supports, ties every bridle to the next).
+  // Rigid nodes' rows are y_i = their value, their columns moved to the loads, as in LateralSystem.
+  std::vector<bool> rigid(n, false);
+  std::vector<int> middle_of(n, -1);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(N);
+  rhs.head(n) = lat.load;
   p.middle.resize(nb);
   for (int j = 0; j < nb; ++j) {
     const LateralSupport& s = lat.supports[p.held[j]];
     p.middle[j] = lat.wires[s.wire].w_dof + s.node;
-    fixed[p.middle[j]] = true;
-    base_value[p.middle[j]] = 0.0;
-    rows.push_back(lat.wires[s.wire].w_dof);
-    rows.push_back(lat.wires[s.wire].w_dof + lat.wires[s.wire].nodes() - 1);
+    middle_of[p.middle[j]] = j;
+    rhs[p.middle[j]] = p.target[j];
   }
-  const LateralSystem system(m, lat, fixed, false);
-  // Case 0: every middle at 0; case 1 + j: middle j at 1 alone, nothing else loaded or held off 0.
-  // Solved a block of cases at a time, keeping the wanted rows: memory in the line's length.
-  const int cases = nb + 1, block = 32;
-  Eigen::MatrixXd kept(rows.size(), cases);
-  for (int c0 = 0; c0 < cases; c0 += block) {
-    const int nc = std::min(block, cases - c0);
-    Eigen::MatrixXd F = Eigen::MatrixXd::Zero(2 * n, nc), value = Eigen::MatrixXd::Zero(n, nc);
-    for (int c = 0; c < nc; ++c) {
-      if (c0 + c == 0) {
-        F.col(c).head(n) = lat.load;
-        value.col(c) = base_value;
-      } else {
-        value(p.middle[c0 + c - 1], c) = 1.0;
-      }
+  for (const LateralSupport& s : lat.supports) {
+    const int i = lat.wires[s.wire].w_dof + s.node;
+    if (s.rigid && middle_of[i] < 0) {  // (a bridle's middle is held where its b says)
+      rigid[i] = true;
+      rhs[i] = s.stagger;
     }
-    const Eigen::MatrixXd y = system.solve(F, value);
-    for (std::size_t r = 0; r < rows.size(); ++r) kept.row(r).segment(c0, nc) = y.row(rows[r]);
   }
-  const Eigen::MatrixXd A = kept.topRightCorner(nb, nb);
-  p.registration =
-      A.partialPivLu().solve(Eigen::Map<const Eigen::VectorXd>(p.target.data(), nb) - kept.col(0).head(nb));
-  if (!p.registration.allFinite())
+  std::vector<Eigen::Triplet<double>> entries;
+  add_stiffness(m, lat, [&](int i, int j, double v) {
+    if (i < n && (rigid[i] || middle_of[i] >= 0)) return;
+    if (j < n && rigid[j]) rhs[i] -= v * rhs[j];
+    else entries.emplace_back(i, j, v);
+  });
+  for (int i = 0; i < n; ++i) {
+    if (rigid[i]) entries.emplace_back(i, i, 1.0);
+    if (middle_of[i] >= 0) entries.emplace_back(i, at[middle_of[i]], 1.0);
+  }
+  Eigen::SparseMatrix<double> K(N, N);
+  K.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(K);
+  Eigen::VectorXd y;
+  if (lu.info() == Eigen::Success) y = lu.solve(rhs);
+  if (lu.info() != Eigen::Success || !y.allFinite())
     throw SceneError("bridle: no registration of the bridles' middles puts the contact wire at its stagger (the wire "
                      "is not held across the track through their clamps); report this with the scene");
-  p.ends = kept.col(0).tail(2 * nb) + kept.bottomRightCorner(2 * nb, nb) * p.registration;
+  p.registration.resize(nb);
+  p.ends.resize(2 * nb);
+  for (int j = 0; j < nb; ++j) {
+    const Wire& w = lat.wires[lat.supports[p.held[j]].wire];
+    p.registration[j] = y[p.middle[j]];
+    p.ends[2 * j] = y[w.w_dof];
+    p.ends[2 * j + 1] = y[w.w_dof + w.nodes() - 1];
+  }
   return p;
 }
 
@@ -869,9 +875,9 @@ std::vector<RegistrationLateral> registration_lateral(const Model& m, const std:
   // Every support held (rows y_i = 0), then each asked node let go in turn: its stiffness is the
   // Schur complement K_ii - K_ir K_rr^-1 K_ri over the rest r of the plane. K_ri is nonzero on
   // the node's few neighbours, so only those entries of K_rr^-1 are needed: the selected inverse
-  // gives them all in one sweep. (A solve per node cost the whole plane's factor each: the build
-  // grew as the square of the spans, since stitch wires chain the messenger's spans along the
-  // whole line and no arm's solve stays local.)
+  // gives them all in one sweep. (A solve per node would cost the whole plane's factor each, the
+  // square of the spans: stitch wires chain the messenger's spans along the whole line, so no
+  // arm's solve stays local.)
   std::vector<bool> fixed(n, false);
   for (const LateralSupport& sup : lat.supports) fixed[lat.wires[sup.wire].w_dof + sup.node] = true;
   std::vector<Eigen::Triplet<double>> entries;
