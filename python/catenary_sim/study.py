@@ -392,6 +392,26 @@ def check_study_against_scene(study):
             if e.value == "(unknown field)":
                 raise StudyError(f"study field 'parameters[{i}].key' = '{p['key']}': no such scene field "
                                  f"({e}); allowed the dotted key of a field, as docs/scene_reference.md lists") from None
+    # Every case's values as the scene reads them (a millisecond a case): a value no field allows
+    # would only fail its case after the cases before it ran (hours, on a large study). What only
+    # the model's build finds (a dt above the stability limit, a slack bridle) still fails its case.
+    keys = [p["key"] for p in study["parameters"]]
+    for c, case in enumerate(make_cases(study)):
+        try:
+            cs.check_scene(study["scene"], overrides={**study["overrides"], **case})
+        except SceneError as e:
+            i = _parameter_of(e, keys)
+            p = study["parameters"][i] if i is not None else None
+            if p is None:  # refused for another field (a check across fields): the values together
+                field, hint = "parameters", "choose values that the scene takes together"
+            elif "values" in p:
+                field = f"parameters[{i}].values[{_index_of(p['values'], case[p['key']])}]"
+                hint = "leave it out of the values"
+            else:
+                field = f"parameters[{i}].distribution"
+                hint = "keep the distribution inside what the field allows (e.g. a truncated_normal's low and high)"
+            given = ", ".join(f"{k} = {_label(v)}" for k, v in case.items())
+            raise StudyError(f"study field '{field}': case {c} ({given}) is refused by the scene: {e}; {hint}") from None
     stats = cs.Simulation(study["scene"], overrides=study["overrides"]).statistics(0.0)
     for j, o in enumerate(study["outputs"]):
         try:
@@ -403,6 +423,17 @@ def check_study_against_scene(study):
         if why:
             raise StudyError(f"study field 'outputs[{j}]' = '{o}': {why}; allowed a number of the pass's stats.json, "
                              "e.g. pantographs.0.std_force_N")
+
+
+def _parameter_of(error, keys):
+    """The index of the study parameter a scene's refusal names (its dotted key as the scene's
+    field, `pantographs.0.x` as `pantographs[0].x`), or None."""
+    field = getattr(error, "field", None) or ""
+    for i, key in enumerate(keys):
+        dotted = ".".join(f"[{part}]" if part.isdigit() else part for part in key.split(".")).replace(".[", "[")
+        if field == dotted or field.startswith(dotted + ".") or field.startswith(dotted + "[") or dotted in str(error):
+            return i
+    return None
 
 
 def _pass_report_script():

@@ -88,11 +88,12 @@ def test_a_study_killed_half_way_resumes_to_the_same_table(tmp_path):
 
 
 def test_failed_cases_are_recorded_and_the_others_go_on(tmp_path):
+    # A dt the scene reads but the model's stability limit refuses: only the build finds it.
     spec = write_study(str(tmp_path / "s.yaml"), sampling="grid",
-                       parameters=[{"key": "pantographs.0.static_uplift", "values": [100, -5, 120]}])
+                       parameters=[{"key": "numerics.dt", "values": [0.0005, 0.01, 0.0006]}])
     table = study.run_study(spec, str(tmp_path / "out"), workers=2, progress=False, plots=True)
     assert list(table["status"]) == ["ok", "failed", "ok"]
-    assert "pantographs[0].static_uplift" in table["message"][1]
+    assert "numerics.dt" in table["message"][1] and "stability limit" in table["message"][1]
     assert math.isnan(table["pantographs.0.std_force_N"][1])
     assert os.path.exists(str(tmp_path / "out" / "pantographs_0_std_force_N.png"))
     # The failed case's file is strict JSON: its outputs null, not NaN.
@@ -119,6 +120,26 @@ def test_fields_the_scene_lacks_are_refused_before_any_case_runs(tmp_path):
     assert p.wait(timeout=300) == 2
     assert "outputs[1]" in p.stdout.read().decode()
     assert not (tmp_path / "cli").exists()
+
+
+def test_values_the_scene_refuses_are_refused_before_any_case_runs(tmp_path):
+    # A grid value or a sampled value no field allows would fail its case only once the cases
+    # before it had run: refused up front, naming the study's field, the case and the scene's words.
+    grid = dict(parameters=[{"key": "pantographs.0.static_uplift", "values": [100, -5, 120]}])
+    tails = dict(sampling="random", samples=400, seed=1,
+                 parameters=[{"key": "pantographs.0.static_uplift",
+                              "distribution": {"type": "normal", "mean": 100, "std": 50}}])  # 2 % below 0
+    across = dict(parameters=[{"key": "line.span_length", "values": [55.0, 40.0]}])  # the droppers lie beyond 40 m
+    for name, fields, field, words in [
+            ("grid", grid, "parameters[0].values[1]", "pantographs[0].static_uplift"),
+            ("tails", tails, "parameters[0].distribution", "pantographs[0].static_uplift"),
+            ("across", across, "parameters", "droppers")]:
+        out = tmp_path / ("out_" + name)
+        with pytest.raises(study.StudyError) as e:
+            study.run_study(write_study(str(tmp_path / "s.yaml"), **fields), str(out), workers=1, progress=False)
+        assert f"study field '{field}'" in str(e.value), str(e.value)
+        assert words in str(e.value), str(e.value)
+        assert not out.exists(), name
 
 
 def test_bad_study_files_name_the_field(tmp_path):
