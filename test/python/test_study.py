@@ -272,10 +272,10 @@ def run_cli_err(args, timeout=120):
 
 
 def test_a_damaged_output_directory_is_named_or_redone(tmp_path):
-    # Cases that fail at once (an uplift the scene refuses) keep it quick; what is checked is the
-    # directory's handling, not the passes.
+    # Cases that fail at once (a dt above the model's stability limit, refused by its build) keep
+    # it quick; what is checked is the directory's handling, not the passes.
     spec = write_study(str(tmp_path / "s.yaml"), sampling="grid",
-                       parameters=[{"key": "pantographs.0.static_uplift", "values": [-5, -6]}])
+                       parameters=[{"key": "numerics.dt", "values": [0.01, 0.02]}])
     out = tmp_path / "out"
     r = run_cli_err([spec, "--out", str(out)], timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
@@ -295,7 +295,7 @@ def test_a_damaged_output_directory_is_named_or_redone(tmp_path):
     r = run_cli_err([spec, "--out", str(out)], timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
     changed = write_study(str(tmp_path / "s2.yaml"), sampling="grid",
-                          parameters=[{"key": "pantographs.0.static_uplift", "values": [-5, -6, -7]}])
+                          parameters=[{"key": "numerics.dt", "values": [0.01, 0.02, 0.03]}])
     r = run_cli_err([changed, "--out", str(out)])
     assert r.returncode == 2 and "'parameters' differs" in r.stderr and "new --out" in r.stderr, r.stderr
 
