@@ -582,7 +582,8 @@ void mark_springs_at_middle(const NumericsSpec& num, Model& m) {
   for (std::size_t k = 0; k < m.clamps.size(); ++k) m.clamp_at_middle[k] = take(m.clamps[k].upper_dof, m.clamps[k].lower_dof);
 }
 
-// The explicit stability limit (validation.md section 5; at least coupled_omega, BuildOptions) and
+// The explicit stability limit (validation.md section 5; `coupled_omega`, where given, for the
+// wires' band: lean_coupled_omega_max) and
 // the step, or the implicit matrix.
 void choose_time_step(const Scene& scene, double coupled_omega, Model& m) {
   if (scene.numerics.windowed() &&
@@ -668,18 +669,18 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
     m.dt = m.dt_critical = scene.numerics.dt ? *scene.numerics.dt : 1e-4;
     return m;
   }
-  choose_time_step(scene, options.coupled_omega, m);
+  choose_time_step(scene, 0.0, m);
   return m;
 }
 
 
-// The model with the checks that need it built: the centred step's factors, the filter's cutoff.
-Model build_model_checked(const Scene& scene, const BuildOptions& options) {
-  Model m = build_model_unchecked(scene, options);
+// What follows from the model's dt: the wire packs with the centred step's factors, the filter's
+// cutoff checked against it, and the lateral plane timed from its design (designed here once, on
+// the first call: `design`).
+void time_numerics(const Scene& scene, Model& m, std::shared_ptr<const LateralModel>& design) {
   // Built here, filled further for the centred damping step below, then only read.
   const std::shared_ptr<WirePacks> packs = build_wire_packs(m);
   m.wire_packs = packs;
-  if (!options.stability) return m;
   if (scene.numerics.damping == DampingStep::kCentred) {
     if (!packs)  // (condensed rotations on every wire node give packs)
       throw SceneError("numerics.damping = 'centred': needs the wires' rotations condensed; allowed otherwise: half_step");
@@ -695,19 +696,31 @@ Model build_model_checked(const Scene& scene, const BuildOptions& options) {
   if (!(scene.output.filter_cutoff < nyquist))
     throw SceneError("scene field 'output.filter_cutoff' = " + fmt(scene.output.filter_cutoff) + ": allowed below " +
                      fmt(nyquist) + " Hz, the Nyquist frequency of the time step (dt " + fmt(m.dt) + " s)");
-  if (scene.lateral()) m.lateral = build_lateral(m);  // the 3-D line; nothing built for a 2-D scene
+  if (!scene.lateral()) return;  // the 3-D line; nothing built for a 2-D scene
+  if (!design) design = design_lateral(m);
+  m.lateral = build_lateral(m, *design);
+}
+
+// The model with the checks that need it built: the centred step's factors, the filter's cutoff.
+Model build_model_checked(const Scene& scene, const BuildOptions& options) {
+  Model m = build_model_unchecked(scene, options);
+  if (!options.stability) {
+    m.wire_packs = build_wire_packs(m);
+    return m;
+  }
+  std::shared_ptr<const LateralModel> design;
+  time_numerics(scene, m, design);
   // The droppers' lean couples the planes (a mode neither plane's estimate holds): where it is
-  // the highest, the model again with its limit.
+  // the highest, the model's dt again with its limit, and what follows from dt (the line and its
+  // statics in both planes do not depend on it).
   // (Where a plane's own mode is the highest both iterations find it, to about 1e-9: the same
   // frequency, not a coupled one above it. Droppers hanging plumb couple nothing.)
   const auto leans = [](const LateralPendulum& p) { return p.lean0_sq > 0.0; };
-  if (m.lateral && options.stability && !m.implicit && options.coupled_omega == 0.0 &&
-      std::any_of(m.lateral->pendulums.begin(), m.lateral->pendulums.end(), leans)) {
+  if (m.lateral && !m.implicit && std::any_of(m.lateral->pendulums.begin(), m.lateral->pendulums.end(), leans)) {
     const double coupled = lean_coupled_omega_max(m, *m.lateral);
     if (coupled > (1.0 + 1e-6) * m.omega_wires) {
-      BuildOptions again = options;
-      again.coupled_omega = coupled;
-      return build_model_checked(scene, again);
+      choose_time_step(scene, coupled, m);
+      time_numerics(scene, m, design);
     }
   }
   return m;

@@ -971,11 +971,7 @@ void set_lead_step(const Model& m, LateralModel& lat, int every) {
   }
 }
 
-namespace {
-
-// The line in plan as designed: its wires, supports, registrations and wind, and its static
-// states (calm and under the mean wind). No numerics: nothing here reads dt or the damping step.
-std::shared_ptr<LateralModel> design_lateral(const Model& m) {
+std::shared_ptr<const LateralModel> design_lateral(const Model& m) {
   auto lat = std::make_shared<LateralModel>();
   add_wires_and_supports(m, lat.get());
   add_pendulums(m, lat.get());
@@ -987,13 +983,13 @@ std::shared_ptr<LateralModel> design_lateral(const Model& m) {
   return lat;
 }
 
-}  // namespace
-
 void check_lateral_design(const Model& m) { design_lateral(m); }
 
-std::shared_ptr<const LateralModel> build_lateral(const Model& m) {
+std::shared_ptr<const LateralModel> build_lateral(const Model& m) { return build_lateral(m, *design_lateral(m)); }
+
+std::shared_ptr<const LateralModel> build_lateral(const Model& m, const LateralModel& design) {
   const Scene& sc = m.scene;
-  std::shared_ptr<LateralModel> lat = design_lateral(m);
+  auto lat = std::make_shared<LateralModel>(design);
   lat->windowed = sc.numerics.windowed() && (m.endless || lat->field.empty() || sc.numerics.gust_lead.has_value());
   lat->gust_lead = lat->windowed ? gust_lead_time(sc) : 0.0;
   const PantographHeadSpec& head = sc.pantograph_head;

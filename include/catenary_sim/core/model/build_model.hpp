@@ -20,10 +20,6 @@ struct BuildOptions {
   bool stability = true;  // false: skip the stability limit (static probes)
   // Raised supports per section (first, last, first, last, ...), m; empty: from the scene / eq. 6-8.
   std::optional<std::vector<double>> support_rises;
-  // rad/s: the wires' and springs' highest frequency where the planes' lean coupling
-  // (lean_coupled_omega_max, found once the lateral plane is built) puts it above the vertical
-  // plane's own; 0: the vertical plane's estimate.
-  double coupled_omega = 0.0;
 };
 Model build_model(const Scene& scene, const BuildOptions& options);
 

@@ -247,8 +247,14 @@ struct RegistrationLateral {
 // One per vertical DOF of `dofs` (support nodes of a contact wire).
 std::vector<RegistrationLateral> registration_lateral(const Model& model, const std::vector<int>& dofs);
 
-// Builds the lateral plane of a model whose scene asks for one (Scene::lateral()); throws SceneError.
-std::shared_ptr<const LateralModel> build_lateral(const Model& model);
+// The line in plan as designed: its wires, supports, registrations and wind, and its static
+// states (calm and under the mean wind). No numerics: nothing here reads dt or the damping step.
+// Throws SceneError.
+std::shared_ptr<const LateralModel> design_lateral(const Model& model);
+// Builds the lateral plane of a model whose scene asks for one (Scene::lateral()): `design`, the
+// model's line in plan, with the numerics of the model's dt; throws SceneError.
+std::shared_ptr<const LateralModel> build_lateral(const Model& model, const LateralModel& design);
+std::shared_ptr<const LateralModel> build_lateral(const Model& model);  // designed here
 // Highest eigenfrequency (rad/s, with the planes' 0.2 % margin) of both planes together with the
 // droppers' lean coupling, of the K the explicit step takes at q_n: about the static state a
 // dropper of stiffness k leaning by s = dy0 / l couples its ends' relative height and position
