@@ -598,32 +598,28 @@ void add_stiffness(const Model& m, const LateralModel& lat, Add&& add) {
 // unconstrained matrix (full(), kept on request) gives the reactions.
 class LateralSystem {
  public:
-  // `also_pattern`: pairs of free rows put on the factor's pattern (as stored zeros) for the
-  // entries of the inverse that inverse() gives.
-  LateralSystem(const Model& m, const LateralModel& lat, const std::vector<bool>& fixed, bool keep_full,
-                const std::vector<std::pair<int, int>>& also_pattern = {})
+  LateralSystem(const Model& m, const LateralModel& lat, const std::vector<bool>& fixed, bool keep_full)
       : n_(lat.n), fixed_(fixed) {
-    const int N = 2 * n_;
-    std::vector<Eigen::Triplet<double>> full, reduced;
-    add_stiffness(m, lat, [&](int i, int j, double v) {
-      if (keep_full) full.emplace_back(i, j, v);
-      const bool fi = i < n_ && fixed_[i], fj = j < n_ && fixed_[j];
-      if (fi) return;
-      if (fj) moved_.emplace_back(i, j, v);  // (in this order: the loads take them as assembled)
-      else reduced.emplace_back(i, j, v);
-    });
-    for (int i = 0; i < n_; ++i)
-      if (fixed_[i]) reduced.emplace_back(i, i, 1.0);
-    for (const auto& [a, b] : also_pattern) reduced.emplace_back(std::max(a, b), std::min(a, b), 0.0);
-    Eigen::SparseMatrix<double> K(N, N);
-    K.setFromTriplets(reduced.begin(), reduced.end());
+    std::vector<Eigen::Triplet<double>> full;
+    factorise([&](auto&& add) { add_stiffness(m, lat, add); }, keep_full ? &full : nullptr, {});
     if (keep_full) {
-      full_.resize(N, N);
+      full_.resize(2 * n_, 2 * n_);
       full_.setFromTriplets(full.begin(), full.end());
     }
-    solver_.compute(K);
-    if (solver_.info() != Eigen::Success)
-      throw SceneError("scene: the lateral statics has no solution: a wire is free to move sideways (check stagger.steady_arm_stiffness and stagger.messenger_support_stiffness)");
+  }
+  // From the plane's whole stiffness `full` (add_stiffness's, assembled), kept as full();
+  // `also_pattern`: pairs of free rows put on the factor's pattern (as stored zeros) for the
+  // entries of the inverse that inverse() gives.
+  LateralSystem(Eigen::SparseMatrix<double> full, const std::vector<bool>& fixed,
+                const std::vector<std::pair<int, int>>& also_pattern)
+      : n_(static_cast<int>(full.rows() / 2)), fixed_(fixed), full_(std::move(full)) {
+    factorise(
+        [&](auto&& add) {
+          for (int j = 0; j < full_.outerSize(); ++j)
+            for (Eigen::SparseMatrix<double>::InnerIterator it(full_, j); it; ++it)
+              add(static_cast<int>(it.row()), j, it.value());
+        },
+        nullptr, also_pattern);
   }
   // The displacements (2n rows) under loads F (2n rows, the rotations' 0) with the rigid nodes at
   // `fixed_value` (n rows), a column per case.
@@ -644,6 +640,30 @@ class LateralSystem {
   SelectedInverse inverse() const { return SelectedInverse(solver_); }
 
  private:
+  // `entries(add)` calls add(i, j, value) for each entry of the whole stiffness (`full` keeps
+  // them, if given).
+  template <class Entries>
+  void factorise(Entries&& entries, std::vector<Eigen::Triplet<double>>* full,
+                 const std::vector<std::pair<int, int>>& also_pattern) {
+    const int N = 2 * n_;
+    std::vector<Eigen::Triplet<double>> reduced;
+    entries([&](int i, int j, double v) {
+      if (full) full->emplace_back(i, j, v);
+      const bool fi = i < n_ && fixed_[i], fj = j < n_ && fixed_[j];
+      if (fi) return;
+      if (fj) moved_.emplace_back(i, j, v);  // (in this order: the loads take them as assembled)
+      else reduced.emplace_back(i, j, v);
+    });
+    for (int i = 0; i < n_; ++i)
+      if (fixed_[i]) reduced.emplace_back(i, i, 1.0);
+    for (const auto& [a, b] : also_pattern) reduced.emplace_back(std::max(a, b), std::min(a, b), 0.0);
+    Eigen::SparseMatrix<double> K(N, N);
+    K.setFromTriplets(reduced.begin(), reduced.end());
+    solver_.compute(K);
+    if (solver_.info() != Eigen::Success)
+      throw SceneError("scene: the lateral statics has no solution: a wire is free to move sideways (check stagger.steady_arm_stiffness and stagger.messenger_support_stiffness)");
+  }
+
   int n_;
   std::vector<bool> fixed_;
   std::vector<Eigen::Triplet<double>> moved_;  // the entries in the rigid nodes' columns
@@ -879,22 +899,29 @@ std::vector<RegistrationLateral> registration_lateral(const Model& m, const std:
   // square of the spans: stitch wires chain the messenger's spans along the whole line, so no
   // arm's solve stays local.)
   std::vector<bool> fixed(n, false);
-  for (const LateralSupport& sup : lat.supports) fixed[lat.wires[sup.wire].w_dof + sup.node] = true;
+  std::vector<int> support_at(n, -1);  // a lateral DOF's support in lat.supports
+  for (std::size_t k = 0; k < lat.supports.size(); ++k) {
+    const int i = lat.wires[lat.supports[k].wire].w_dof + lat.supports[k].node;
+    fixed[i] = true;
+    support_at[i] = static_cast<int>(k);
+  }
+  // (Without the support's own lateral spring: that is the arm itself, stiff along its length.)
+  std::vector<double> own(n, 0.0);
+  for (const LateralSpring& sp : lat.springs) own[sp.dof] += sp.stiffness;
   std::vector<Eigen::Triplet<double>> entries;
   add_stiffness(m, lat, [&](int i, int j, double v) { entries.emplace_back(i, j, v); });
-  Eigen::SparseMatrix<double> Kf(2 * n, 2 * n);
-  Kf.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseMatrix<double> whole(2 * n, 2 * n);
+  whole.setFromTriplets(entries.begin(), entries.end());
   std::vector<std::vector<std::pair<int, double>>> coupling(dofs.size());  // K_ri: (r, value)
   std::vector<std::pair<int, int>> pairs;
   for (std::size_t q = 0; q < dofs.size(); ++q) {
-    const int i = lateral_dof(dofs[q]);
-    for (Eigen::SparseMatrix<double>::InnerIterator it(Kf, i); it; ++it)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(whole, lateral_dof(dofs[q])); it; ++it)
       if (!(it.row() < n && fixed[it.row()]) && it.value() != 0.0) coupling[q].emplace_back(it.row(), it.value());
     for (const auto& [a, va] : coupling[q])
       for (const auto& [b, vb] : coupling[q])
         if (a > b) pairs.emplace_back(a, b);
   }
-  const LateralSystem held(m, lat, fixed, false, pairs);
+  const LateralSystem held(std::move(whole), fixed, pairs);
   const SelectedInverse z = held.inverse();
   std::vector<RegistrationLateral> out(dofs.size());
   for (std::size_t q = 0; q < dofs.size(); ++q) {
@@ -902,11 +929,7 @@ std::vector<RegistrationLateral> registration_lateral(const Model& m, const std:
     double through_rest = 0.0;  // K_ir K_rr^-1 K_ri
     for (const auto& [a, va] : coupling[q])
       for (const auto& [b, vb] : coupling[q]) through_rest += va * z(a, b) * vb;
-    // (Without the support's own lateral spring: that is the arm itself, stiff along its length.)
-    double own = 0.0;
-    for (const LateralSpring& sp : lat.springs)
-      if (sp.dof == i) own += sp.stiffness;
-    out[q].stiffness = Kf.coeff(i, i) - own - through_rest;
+    out[q].stiffness = held.full().coeff(i, i) - own[i] - through_rest;
   }
   if (!m.scene.lateral()) return out;
   // The calm statics in plan: each support's share of the wire's pull (the pull-off).
@@ -914,12 +937,10 @@ std::vector<RegistrationLateral> registration_lateral(const Model& m, const std:
   std::vector<double> force;
   solve_lateral_statics(m, lat, false, &y, &force);
   for (std::size_t q = 0; q < dofs.size(); ++q) {
-    const int i = lateral_dof(dofs[q]);
-    for (std::size_t k = 0; k < lat.supports.size(); ++k)
-      if (lat.wires[lat.supports[k].wire].w_dof + lat.supports[k].node == i) {
-        out[q].pull_off = std::abs(force[k]);
-        out[q].side = force[k] > 0.0 ? 1.0 : (force[k] < 0.0 ? -1.0 : 0.0);
-      }
+    const int k = support_at[lateral_dof(dofs[q])];
+    if (k < 0) continue;
+    out[q].pull_off = std::abs(force[k]);
+    out[q].side = force[k] > 0.0 ? 1.0 : (force[k] < 0.0 ? -1.0 : 0.0);
   }
   return out;
 }
