@@ -583,9 +583,9 @@ void mark_springs_at_middle(const NumericsSpec& num, Model& m) {
 }
 
 // The explicit stability limit (validation.md section 5; `coupled_omega`, where given, for the
-// wires' band: lean_coupled_omega_max) and
-// the step, or the implicit matrix.
-void choose_time_step(const Scene& scene, double coupled_omega, Model& m) {
+// wires' band: lean_coupled_omega_max) and the step, or the implicit matrix. Returns the wires'
+// highest frequency (compute_stability_limit's), 0 for the implicit integrator.
+double choose_time_step(const Scene& scene, double coupled_omega, Model& m) {
   if (scene.numerics.windowed() &&
       (scene.numerics.integrator != Integrator::kExplicit || scene.numerics.rotary_inertia != RotaryInertia::kCondensed)) {
     const bool implicit = scene.numerics.integrator != Integrator::kExplicit;
@@ -613,10 +613,10 @@ void choose_time_step(const Scene& scene, double coupled_omega, Model& m) {
     m.dt_critical = std::numeric_limits<double>::infinity();
     m.dt = scene.numerics.dt ? *scene.numerics.dt : 1e-3;
     m.implicit = newmark_matrix(m, m.dt);
-    return;
+    return 0.0;
   }
   mark_springs_at_middle(scene.numerics, m);
-  compute_stability_limit(m, coupled_omega);
+  const double wires = compute_stability_limit(m, coupled_omega);
   if (scene.numerics.dt) {
     if (*scene.numerics.dt > m.dt_critical)
       throw SceneError("numerics.dt = " + fmt(*scene.numerics.dt) + " s: above the explicit stability limit " +
@@ -626,6 +626,7 @@ void choose_time_step(const Scene& scene, double coupled_omega, Model& m) {
   } else {
     m.dt = scene.numerics.safety_factor * m.dt_critical;
   }
+  return wires;
 }
 
 Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) {
@@ -663,13 +664,9 @@ Model build_model_unchecked(const Scene& scene_in, const BuildOptions& options) 
   set_inverse_mass(m, fixed);
   set_line_order(scene, m);
   set_train_travel(scene, endless_front, m);
-  // Initial pantograph references (eq. 23) and the stability limit (validation.md section 5).
+  // Initial pantograph references (eq. 23); the stability limit and the step: build_model_checked.
   set_pantograph_references(m);
-  if (!options.stability) {
-    m.dt = m.dt_critical = scene.numerics.dt ? *scene.numerics.dt : 1e-4;
-    return m;
-  }
-  choose_time_step(scene, 0.0, m);
+  if (!options.stability) m.dt = m.dt_critical = scene.numerics.dt ? *scene.numerics.dt : 1e-4;
   return m;
 }
 
@@ -708,6 +705,7 @@ Model build_model_checked(const Scene& scene, const BuildOptions& options) {
     m.wire_packs = build_wire_packs(m);
     return m;
   }
+  const double wires = choose_time_step(m.scene, 0.0, m);
   std::shared_ptr<const LateralModel> design;
   time_numerics(scene, m, design);
   // The droppers' lean couples the planes (a mode neither plane's estimate holds): where it is
@@ -718,8 +716,8 @@ Model build_model_checked(const Scene& scene, const BuildOptions& options) {
   const auto leans = [](const LateralPendulum& p) { return p.lean0_sq > 0.0; };
   if (m.lateral && !m.implicit && std::any_of(m.lateral->pendulums.begin(), m.lateral->pendulums.end(), leans)) {
     const double coupled = lean_coupled_omega_max(m, *m.lateral);
-    if (coupled > (1.0 + 1e-6) * m.omega_wires) {
-      choose_time_step(scene, coupled, m);
+    if (coupled > (1.0 + 1e-6) * wires) {
+      choose_time_step(m.scene, coupled, m);
       time_numerics(scene, m, design);
     }
   }

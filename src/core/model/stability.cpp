@@ -24,7 +24,7 @@ double critical_time_step(double w, double alpha, double beta) {
   return (2.0 / w) * (std::sqrt(1.0 + xi * xi) - xi);
 }
 
-void compute_stability_limit(Model& m, double coupled_omega) {
+double compute_stability_limit(Model& m, double coupled_omega) {
   // A Rayleigh quotient can only underestimate omega_max; the 0.2 % margin covers what the
   // iteration has not converged (measured: 3e-4 after 400 iterations on the HRZ variant), so the
   // refusal of a user dt is on the safe side.
@@ -34,8 +34,8 @@ void compute_stability_limit(Model& m, double coupled_omega) {
   // (explicit_step.cpp). A slack dropper only takes its K_I away.
   // A coupled frequency is given only where it was found above this model's own (build_model):
   // the plane's own iteration is not run again.
-  m.omega_wires = coupled_omega > 0.0 ? coupled_omega : 1.002 * highest_eigenfrequency(m, 3000, true);
-  m.omega_max = m.omega_wires;
+  const double band = coupled_omega > 0.0 ? coupled_omega : 1.002 * highest_eigenfrequency(m, 3000, true);
+  m.omega_max = band;
   // The contacts move along the wire: where one meets a light node its frequency is highest, and
   // the power iteration sees it only where the train starts. Add every contact's worst case as a
   // bound (Weyl: lambda_max(A + B) <= lambda_max(A) + lambda_max(B)), with the contact as a
@@ -78,6 +78,7 @@ void compute_stability_limit(Model& m, double coupled_omega) {
     }
   }
   m.dt_critical = std::min(m.dt_critical, points.time_step());
+  return band;
 }
 
 }  // namespace catenary_sim

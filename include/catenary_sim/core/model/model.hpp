@@ -196,7 +196,6 @@ struct Model {
   int max_contact_nodes = 2;    // nodes a distributed contact can touch (sizes the workspace)
 
   double omega_max = 0.0;       // rad/s, highest eigenfrequency of the assembled system
-  double omega_wires = 0.0;     // rad/s, omega_max before the contacts' bound along the line
   double dt_critical = 0.0;     // s, explicit stability limit incl. the damping reduction (inf: implicit)
   double dt = 0.0;              // s, the step in use
   // numerics.supports implicit: the explicit step takes support springs at its middle, and

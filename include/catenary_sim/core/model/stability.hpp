@@ -92,10 +92,9 @@ class PointDampingLimit {
   std::vector<double> k_row_, c_row_;
 };
 
-// Sets model.omega_wires (the estimate with a 0.2 % safety margin, or `coupled_omega` when given:
-// the planes' lean-coupled frequency, found above that estimate),
-// model.omega_max (that plus a bound for the contacts wherever they are along the line) and
-// model.dt_critical.
-void compute_stability_limit(Model& model, double coupled_omega = 0.0);
+// Sets model.omega_max (the wires' estimate with a 0.2 % safety margin, or `coupled_omega` when
+// given: the planes' lean-coupled frequency, found above that estimate, plus a bound for the
+// contacts wherever they are along the line) and model.dt_critical; returns the wires' part.
+double compute_stability_limit(Model& model, double coupled_omega = 0.0);
 
 }  // namespace catenary_sim
