@@ -370,38 +370,29 @@ def _output(stats, path):
     return float(node)
 
 
-def check_study_against_scene(study):
+def check_study_against_scene(study, cases=None):
     """What the scene decides, before any case runs. The scene with the study's overrides must be
-    valid, each parameter a field of it and each output a number of its stats.json: a refused value
-    is one case's failure, but a field that does not exist fails every case. Raises StudyError."""
+    valid, each parameter a field of it, each case's values ones it reads (`cases`: make_cases's,
+    made here if not given) and each output a number of its stats.json. What only the model's
+    build or the pass refuses is one case's failure. Raises StudyError."""
     import catenary_sim as cs
     try:
         cs.check_scene(study["scene"], overrides=study["overrides"])
     except SceneError as e:
         raise StudyError(f"study fields 'scene' and 'overrides': the scene they give is refused: {e}") from None
-    for i, p in enumerate(study["parameters"]):
-        if "values" in p:
-            value = p["values"][0]
-        else:
-            value = float(_ppf(p["distribution"], 0.5))
-            if p["distribution"]["type"] == "integers":
-                value = int(value)
-        try:
-            cs.check_scene(study["scene"], overrides={**study["overrides"], p["key"]: value})
-        except SceneError as e:
-            if e.value == "(unknown field)":
-                raise StudyError(f"study field 'parameters[{i}].key' = '{p['key']}': no such scene field "
-                                 f"({e}); allowed the dotted key of a field, as docs/scene_reference.md lists") from None
     # Every case's values as the scene reads them (a millisecond a case): a value no field allows
     # would only fail its case after the cases before it ran (hours, on a large study). What only
     # the model's build finds (a dt above the stability limit, a slack bridle) still fails its case.
     keys = [p["key"] for p in study["parameters"]]
-    for c, case in enumerate(make_cases(study)):
+    for c, case in enumerate(make_cases(study) if cases is None else cases):
         try:
             cs.check_scene(study["scene"], overrides={**study["overrides"], **case})
         except SceneError as e:
             i = _parameter_of(e, keys)
             p = study["parameters"][i] if i is not None else None
+            if p is not None and e.value == "(unknown field)":
+                raise StudyError(f"study field 'parameters[{i}].key' = '{p['key']}': no such scene field "
+                                 f"({e}); allowed the dotted key of a field, as docs/scene_reference.md lists") from None
             if p is None:  # refused for another field (a check across fields): the values together
                 field, hint = "parameters", "choose values that the scene takes together"
             elif "values" in p:
@@ -431,7 +422,7 @@ def _parameter_of(error, keys):
     field = getattr(error, "field", None) or ""
     for i, key in enumerate(keys):
         dotted = ".".join(f"[{part}]" if part.isdigit() else part for part in key.split(".")).replace(".[", "[")
-        if field == dotted or field.startswith(dotted + ".") or field.startswith(dotted + "[") or dotted in str(error):
+        if field == dotted or field.startswith(dotted + ".") or field.startswith(dotted + "["):
             return i
     return None
 
@@ -539,14 +530,14 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
     study = load_study(study_path)
     if not isinstance(workers, int) or not 1 <= workers <= 1024:
         raise StudyError(f"workers = {workers!r}: allowed 1 to 1024")
-    check_study_against_scene(study)
+    cases = make_cases(study)
+    check_study_against_scene(study, cases)
     os.makedirs(os.path.join(out, "cases"), exist_ok=True)
     lock = open(os.path.join(out, ".catenary_sim.lock"), "w")
     try:
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
         raise StudyError(f"output directory '{out}' is being written by another study run") from None
-    cases = make_cases(study)
     plan = {"study": study, "cases": cases}
     plan_path = os.path.join(out, "plan.json")
     if os.path.exists(plan_path):
