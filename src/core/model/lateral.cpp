@@ -315,6 +315,12 @@ void add_registrations(const Model& m, LateralModel* lat) {
   std::vector<int> arm_at(m.n_dof, -1);  // per vertical DOF: its hinged arm in Model::springs
   for (std::size_t k = 0; k < m.springs.size(); ++k)
     if (m.springs[k].hinged_arm() && m.springs[k].arm_pull_side != 0.0) arm_at[m.springs[k].dof] = static_cast<int>(k);
+  // Per lateral DOF: its spring in LateralModel::springs, and the pendulums hanging there (found
+  // once, not per arm: a long line has as many arms as droppers' tenths).
+  std::vector<int> spring_at(lat->n, -1);
+  for (std::size_t j = 0; j < lat->springs.size(); ++j) spring_at[lat->springs[j].dof] = static_cast<int>(j);
+  std::vector<std::vector<int>> pendulums_at(lat->n);
+  for (std::size_t j = 0; j < lat->pendulums.size(); ++j) pendulums_at[lat->pendulums[j].contact].push_back(static_cast<int>(j));
   for (const LateralSupport& sup : lat->supports) {
     const Wire& w = m.wires[sup.wire];
     if (!w.is_contact_wire || sup.anchor) continue;
@@ -324,16 +330,14 @@ void add_registrations(const Model& m, LateralModel* lat) {
     LateralRegistration r;
     r.dof = lat->wires[sup.wire].w_dof + sup.node;
     r.vertical = vertical;
-    for (std::size_t j = 0; j < lat->springs.size(); ++j)
-      if (lat->springs[j].dof == r.dof) r.spring = static_cast<int>(j);
+    r.spring = spring_at[r.dof];
     r.wire = sup.wire;
     r.node = sup.node;
     r.length = sp.arm_length;
     r.sin0 = std::sin(sp.arm_inclination);
     r.cos0 = std::cos(sp.arm_inclination);
     r.side = sp.arm_pull_side;
-    for (std::size_t j = 0; j < lat->pendulums.size(); ++j)
-      if (lat->pendulums[j].contact == r.dof) r.pendulums.push_back(static_cast<int>(j));
+    r.pendulums = pendulums_at[r.dof];
     lat->registrations.push_back(r);
   }
 }

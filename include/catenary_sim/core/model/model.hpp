@@ -236,11 +236,14 @@ struct Model {
 
 // The index in `wires` of the wire one of whose nodes is the DOF `dof` of their plane (Model::wires
 // and the vertical DOFs, or LateralModel::wires and the lateral ones, which keep the same order);
-// -1 for a pantograph's DOF.
+// -1 for a pantograph's DOF. The wires are numbered in line order of their DOFs (w_dof
+// ascending), so the search halves: a dropper's wires are found without walking a long line's
+// stitch wires.
 inline int wire_holding(const std::vector<Wire>& wires, int dof) {
-  for (std::size_t wi = 0; wi < wires.size(); ++wi)
-    if (dof >= wires[wi].w_dof && dof < wires[wi].w_dof + wires[wi].nodes()) return static_cast<int>(wi);
-  return -1;
+  const auto after = std::upper_bound(wires.begin(), wires.end(), dof, [](int d, const Wire& w) { return d < w.w_dof; });
+  if (after == wires.begin()) return -1;
+  const Wire& w = *(after - 1);
+  return dof < w.w_dof + w.nodes() ? static_cast<int>(after - 1 - wires.begin()) : -1;
 }
 inline int wire_holding(const Model& m, int dof) { return wire_holding(m.wires, dof); }
 
