@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "catenary_sim/core/simulation.hpp"
+#include "catenary_sim/core/model/stability.hpp"
 #include "catenary_sim/core/output/statistics.hpp"
 #include "../support/scenes.hpp"
 
@@ -179,4 +180,32 @@ TEST(Extremes, SuddenSpeedAndUpliftSteps) {
   ASSERT_TRUE(sim.set_target_speed(400.0 / 3.6, &err));
   ASSERT_TRUE(sim.set_uplift(-1, 0.0, &err));
   run_finite(sim, 1500);
+}
+
+// A mass of next to nothing on a spring puts lambda = omega^2 beyond 1e154, where the power
+// iteration's squared norm overflows (it then returned 0, and the contacts' bound alone set a dt
+// five times the line's: a pass diverged at t = 0). Two masses m on springs k (to the ground and
+// between them): omega_max^2 = (k / m) (3 + sqrt 5) / 2 exactly. The iteration's error falls by
+// (3 - sqrt 5) / (3 + sqrt 5) = 0.146 a step, so 1e-9 is far above what is left after it settles.
+TEST(Extremes, TheStabilityEstimateHoldsForMassesOfNextToNothing) {
+  for (const double m : {1.0, 1e-200, 1e-300}) {
+    const double k = 1e4, inv_sqrt_m[2] = {1.0 / std::sqrt(m), 1.0 / std::sqrt(m)};
+    const double w = power_iteration_omega(2, inv_sqrt_m, 3000, [k](const double* x, double* y) {
+      y[0] = 2.0 * k * x[0] - k * x[1];
+      y[1] = k * x[1] - k * x[0];
+    });
+    const double exact = std::sqrt(k / m * (3.0 + std::sqrt(5.0)) / 2.0);
+    EXPECT_NEAR(w / exact, 1.0, 1e-9) << "m = " << m;
+  }
+}
+
+// dt = (2 / w)(sqrt(1 + xi^2) - xi) with xi = beta w / 2 tends to 2 / (beta w^2) as xi grows (the
+// stiffness damping's own limit): written as a difference it cancelled to 0 once xi^2 passed
+// 1/epsilon. Relative 1e-12: the quotient form loses no digits; the asymptote's error is 1/(4 xi^2).
+TEST(Extremes, TheCriticalStepKeepsItsDigitsUnderHeavyStiffnessDamping) {
+  const double beta = 1e-4;
+  for (const double w : {1e12, 1e20, 1e100}) {
+    const double xi = 0.5 * beta * w;
+    EXPECT_NEAR(critical_time_step(w, 0.0, beta) / (2.0 / (beta * w * w)), 1.0, 1e-12 + 1.0 / (4.0 * xi * xi)) << "w = " << w;
+  }
 }

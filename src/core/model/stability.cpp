@@ -1,5 +1,7 @@
 #include "catenary_sim/core/model/stability.hpp"
 
+#include "util/format.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -21,6 +23,10 @@ double highest_eigenfrequency(const Model& m, int iterations, bool explicit_part
 double critical_time_step(double w, double alpha, double beta) {
   if (w <= 0.0) return 1.0;
   const double xi = alpha / (2.0 * w) + 0.5 * beta * w;
+  // sqrt(1 + xi^2) - xi cancels to 0 once xi^2 passes 1/epsilon (a stiff spring on a mass of
+  // next to nothing); there its equal 1 / (sqrt(1 + xi^2) + xi) keeps its digits. Below, the
+  // difference as written, whose bits every shipped scene's dt has.
+  if (xi > 1e4) return (2.0 / w) / (std::sqrt(1.0 + xi * xi) + xi);
   return (2.0 / w) * (std::sqrt(1.0 + xi * xi) - xi);
 }
 
@@ -78,6 +84,16 @@ double compute_stability_limit(Model& m, double coupled_omega) {
     }
   }
   m.dt_critical = std::min(m.dt_critical, points.time_step());
+  // A mass of next to nothing on a spring (a wire's or pantograph's mass of 1e-200) puts omega_max
+  // beyond double precision: no step could follow it, and a NaN here would pass every check below.
+  const char* check = "some mass is next to nothing against its stiffness; check the wires' linear_mass and the "
+                      "pantographs' masses";
+  if (!std::isfinite(m.omega_max))
+    throw SceneError("the line's highest natural frequency is beyond double precision (omega_max " + fmt(m.omega_max) +
+                     " rad/s): " + check);
+  if (!(m.dt_critical > 0.0))
+    throw SceneError("the explicit stability limit is not a positive time (" + fmt(m.dt_critical) + " s, omega_max " +
+                     fmt(m.omega_max) + " rad/s): " + check);
   return band;
 }
 

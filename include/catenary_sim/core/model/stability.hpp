@@ -31,6 +31,20 @@ double power_iteration_omega(int n, const double* inv_sqrt_mass, int iterations,
     double norm = 0.0;
     for (int i = 0; i < n; ++i) norm += x[i] * x[i];
     norm = std::sqrt(norm);
+    if (!std::isfinite(norm)) {
+      // The squares overflowed (lambda above about 1e154: a mass of next to nothing on a spring):
+      // x scaled by its largest entry first. Never taken on a line the step can run, so that its
+      // estimate keeps its bits.
+      double largest = 0.0;
+      for (int i = 0; i < n; ++i) largest = std::max(largest, std::fabs(x[i]));
+      if (!std::isfinite(largest)) return std::numeric_limits<double>::infinity();
+      norm = 0.0;
+      for (int i = 0; i < n; ++i) {
+        x[i] /= largest;
+        norm += x[i] * x[i];
+      }
+      norm = std::sqrt(norm);
+    }
     if (norm == 0.0) return 0.0;
     for (int i = 0; i < n; ++i) tmp[i] = s[i] * x[i] / norm;
     apply(tmp.data(), y.data());
@@ -42,7 +56,7 @@ double power_iteration_omega(int n, const double* inv_sqrt_mass, int iterations,
     lambda = rq;
     x.swap(y);
   }
-  return std::sqrt(std::max(lambda, 0.0));
+  return std::isnan(lambda) ? std::numeric_limits<double>::infinity() : std::sqrt(std::max(lambda, 0.0));
 }
 
 // Highest eigenfrequency (rad/s) of M^-1 K with every dropper and contact active, by power
