@@ -387,11 +387,12 @@ def read_record(path, meta=None):
 def lowpass(x, fs, fc):
     """The core's zero-phase low-pass (output/zero_phase_filter.cpp), the filter of stats.json: a
     4th-order Butterworth run forward and backward with odd reflection at both ends; a cutoff at or
-    above Nyquist passes the series through. x: a 1-D sequence of numbers; fs, fc: numbers (the
-    core names a sample that is not finite)."""
+    above Nyquist passes the series through. x: a 1-D sequence of numbers; fs, fc: numbers, fc at
+    least 0.1 Hz, the scene's least output.filter_cutoff (the core names a sample that is not
+    finite)."""
     x = _series("x", x, finite=False)
     fs = _real("sample rate fs", fs, "a finite rate > 0 Hz", 1e-300)
-    fc = _real("cutoff fc", fc, "a finite frequency > 0 Hz", 1e-300)
+    fc = _real("cutoff fc", fc, "a finite frequency of at least 0.1 Hz", 0.1)
     return np.asarray(_core._lowpass_zero_phase(x, fs, fc))
 
 

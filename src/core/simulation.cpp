@@ -30,7 +30,7 @@ std::string wire_at(const std::vector<Wire>& wires, int dof, double line_offset)
   const int wi = wire_holding(wires, dof);
   if (wi < 0) return "";
   const Wire& w = wires[wi];
-  return w.name + " at x = " + std::to_string(w.x[dof - w.w_dof] + line_offset) + " m";
+  return w.name + " at x = " + fmt(w.x[dof - w.w_dof] + line_offset) + " m";
 }
 
 }  // namespace
@@ -51,6 +51,21 @@ Simulation::Simulation(const Scene& scene) : model_(build_model(speed_checked(sc
     update_head_wind(model_, initial_, nullptr, nullptr);
   }
   solve_initial_state(model_, initial_);
+  // A wire's static state already at the watchdog's limit would stop the pass at its first step
+  // as a divergence: the scene's doing (a limit below the line's own sag, or loads that sag it
+  // that far), refused as such. (A pantograph's, from a contact spring too soft to hold it, is
+  // left to the watchdog, whose message names the contact's stiffness: divergence_cause.)
+  const double limit = model_.scene.numerics.divergence_limit;
+  double reach = 0.0;
+  int at = -1;
+  for (const Wire& w : model_.wires)
+    for (int i = 0; i < w.nodes(); ++i)
+      if (!(std::fabs(initial_.u[w.w_dof + i]) < reach)) reach = std::fabs(initial_.u[w.w_dof + i]), at = w.w_dof + i;
+  if (at >= 0 && !(reach < limit))
+    throw SceneError("scene field 'numerics.divergence_limit' = " + fmt_given(limit) + " m: the line's static state " +
+                     "already reaches " + fmt(reach) + " m (" + wire_at(model_.wires, at, initial_.line_offset) +
+                     "); allowed above that (5 m by default), or lighten what sags the line so far (imperfections.point_masses, "
+                     "a wire's weight against its tension)");
   observe(model_, initial_);
   if (model_.lateral) lateral_observe(model_, initial_);  // (make_state gave it its lateral plane)
   state_ = initial_;

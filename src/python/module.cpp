@@ -185,8 +185,9 @@ void bind_scene_checks(py::module& m) {
       [](const std::vector<double>& x, double fs, double fc) {
         if (!(std::isfinite(fs) && fs > 0.0))
           throw py::value_error("sample rate fs = " + fmt_given(fs) + " Hz rejected: allowed a finite rate > 0 Hz");
-        if (!(std::isfinite(fc) && fc > 0.0))
-          throw py::value_error("cutoff fc = " + fmt_given(fc) + " Hz rejected: allowed a finite frequency > 0 Hz");
+        if (!(std::isfinite(fc) && fc >= kLeastFilterCutoff))
+          throw py::value_error("cutoff fc = " + fmt_given(fc) + " Hz rejected: allowed a finite frequency of at least " +
+                                fmt(kLeastFilterCutoff) + " Hz (below it the filter does not settle within a record)");
         for (std::size_t i = 0; i < x.size(); ++i)
           if (!std::isfinite(x[i]))
             throw py::value_error("sample " + std::to_string(i) + " = " + fmt_given(x[i]) + " rejected: allowed finite values");

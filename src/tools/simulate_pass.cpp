@@ -160,8 +160,14 @@ Scene load_pass_scene(const Options& o) {
       throw SceneError("scene field 'pantographs[" + std::to_string(i) + "].type' = 'external': needs a live rig that "
                        "measures the contact force (catenary_sim_hil_udp, the HIL node, or Python's "
                        "set_external_force); an offline pass takes lumped or moving_force");
+  // The core steps a line without pantographs (its free vibration; elasticity_curve loads the line
+  // statically); a pass has nothing to report without one.
+  if (scene.pantographs.empty())
+    throw SceneError("scene field 'pantographs' = (none): an offline pass needs at least one pantograph (a list of "
+                     "pantographs[i] with type lumped or moving_force; the line's static elasticity alone: "
+                     "elasticity_curve)");
   if (!(scene.train_speed > 0.0))
-    throw SceneError("scene field 'train.speed_kmh' = 0: an offline pass needs a train speed > 0 (give "
+    throw SceneError("scene field 'train.speed_kmh' = 0 (or not given): an offline pass needs a train speed > 0 (give "
                      "train.speed_kmh in the scene or --speed; the live node accepts 0 and waits for a speed command)");
   return scene;
 }

@@ -71,7 +71,7 @@ TEST(SceneErrors, OutputLimitsAndMeasurementFields) {
   EXPECT_MENTIONS(error_of({"output.max_stat_force=.nan"}), "output.max_stat_force", "allowed range");
   EXPECT_MENTIONS(error_of({"output.max_contact_loss_percent=101"}), "output.max_contact_loss_percent", "101", "[0, 100]");
   EXPECT_MENTIONS(error_of({"output.min_stat_force=low"}), "output.min_stat_force", "'low'", "a number");
-  EXPECT_MENTIONS(error_of({"output.sensor_bandwidth=0"}), "output.sensor_bandwidth", "(0, ");
+  EXPECT_MENTIONS(error_of({"output.sensor_bandwidth=0"}), "output.sensor_bandwidth", "[0.1, ");
   EXPECT_MENTIONS(error_of({"output.dropper_series=sometimes"}), "output.dropper_series", "'sometimes'", "true or false");
   EXPECT_MENTIONS(error_of({"output.allowed_uplfit=0.1"}), "output.allowed_uplfit", "unknown field");
   const Scene s = load_scene_file(kReference);
@@ -444,9 +444,13 @@ TEST(SceneErrors, DivergenceNamesItsLikelyCause) {
     EXPECT_EQ(sim.state().status, StepStatus::kDiverged);
     return sim.status_message();
   };
-  // Static displacements are millimetres: a limit of 1e-9 m stops a sound run at once.
-  const std::string limit = message({"numerics.divergence_limit=1e-9"});
-  EXPECT_MENTIONS(limit, "numerics.divergence_limit");
+  // Static displacements are millimetres: a limit of 1e-9 m, below them, is refused before the
+  // pass; one of twice the static state's reach stops a sound run within steps.
+  EXPECT_MENTIONS(error_of({"numerics.divergence_limit=1e-9"}), "'numerics.divergence_limit' = 1e-09 m",
+                  "static state already reaches", " at x = ");
+  const double reach = Simulation(load_scene_file(kReference)).state().u.cwiseAbs().maxCoeff();
+  const std::string limit = message({"numerics.divergence_limit=" + std::to_string(2.0 * reach)});
+  EXPECT_MENTIONS(limit, "numerics.divergence_limit", "within the line's own displacements");
   EXPECT_EQ(limit.find("numerics.dt"), std::string::npos) << limit;
   EXPECT_EQ(limit.find("stability estimate"), std::string::npos) << limit;
   // The contact wire rises by centimetres under the reference pantograph (validation.md section 2:
@@ -553,4 +557,52 @@ TEST(SceneErrors, StationsCloserThanAFittingAreRefusedByTheirField) {
   EXPECT_EQ(refusal_of(scene_path("reference_55m_stitched.yaml"), {"stitch_wire.length=0.02"}), "");
   EXPECT_EQ(refusal_of(scene_path("compound_catenary.yaml"), {"hangers.positions=[2.5,5.0,12.5,17.5,22.5,27.5,32.5,37.5,42.5,47.5]"}),
             "");  // (a hanger at a dropper's station: one node)
+}
+
+// A limit computed from the scene is printed rounded toward what it allows, so that the number a
+// refusal gives is accepted when given back: on the reference hinged-arm line the least pull-off
+// is 233.85102 N (to nearest, 233.851: refused again), on the reference rail the least profile EI
+// 46431.4453 N m^2 (to ten digits, 46431.44531: refused again).
+TEST(SceneErrors, TheLimitARefusalPrintsIsItselfAllowed) {
+  using test_scenes::refusal_of;
+  using test_scenes::scene_path;
+  struct Case {
+    const char* file;
+    const char* key;
+    const char* too_low;
+  };
+  for (const Case& c : {Case{"reference_55m_hinged_arms.yaml", "steady_arms.pull_off", "100"},
+                        Case{"rigid_conductor_rail.yaml", "conductor_rail.bending_stiffness", "1000"}}) {
+    SCOPED_TRACE(c.key);
+    const std::string message = refusal_of(scene_path(c.file), {std::string(c.key) + "=" + c.too_low});
+    const std::size_t at = message.find("at least ");
+    ASSERT_NE(at, std::string::npos) << message;
+    const std::string least = message.substr(at + 9, message.find(' ', at + 9) - (at + 9));
+    EXPECT_EQ(refusal_of(scene_path(c.file), {std::string(c.key) + "=" + least}), "") << "printed: " << least;
+  }
+}
+
+// A required key that is missing while a key within two letters of it is given names that key:
+// the map's unknown keys are otherwise reported only after the refusal, never.
+TEST(SceneErrors, AMissingKeyNamesTheMisspeltOneGiven) {
+  EXPECT_MENTIONS(error_of({"contact_wire.tension=null", "contact_wire.tenson=20000"}), "'contact_wire.tension' = (missing)",
+                  "'tenson', misspelt?");
+  EXPECT_MENTIONS(test_scenes::refusal_of(test_scenes::scene_path("rigid_conductor_rail.yaml"),
+                                          {"conductor_rail.support_stiffness=null", "conductor_rail.support_stifness=1e7"}),
+                  "'conductor_rail.support_stiffness' = (missing)", "'support_stifness', misspelt?");
+  // Nothing near: the refusal as it was.
+  EXPECT_EQ(error_of({"contact_wire.tension=null"}).find("misspelt"), std::string::npos);
+}
+
+// A negative speed is refused with the range the line allows (0 up to below the wave speed), not
+// the reader's [0, inf); the filters' cutoffs with their least, 0.1 Hz; a rail section of one span
+// by the field that gave its spans.
+TEST(SceneErrors, SpeedFiltersAndARailSectionsSpansAreRefusedByWhatAllowsThem) {
+  EXPECT_MENTIONS(error_of({"train.speed_kmh=-100"}), "'train.speed_kmh' = -100", "wave speed");
+  EXPECT_MENTIONS(error_of({"output.filter_cutoff=1e-300"}), "'output.filter_cutoff' = 1e-300", "[0.1, 10000]");
+  EXPECT_MENTIONS(error_of({"output.sensor_bandwidth=0.05"}), "'output.sensor_bandwidth' = 0.05", "[0.1, 10000]");
+  EXPECT_EQ(error_of({"output.filter_cutoff=0.1", "output.sensor_bandwidth=0.1"}), "");
+  EXPECT_MENTIONS(test_scenes::refusal_of(test_scenes::scene_path("rigid_conductor_rail.yaml"),
+                                          {"sections=[{span_length: 10, span_count: 1}]", "overlap=null", "output.analysis_spans=null"}),
+                  "'sections[0].span_count' = 1 span", "at least 2 spans");
 }

@@ -463,9 +463,14 @@ def test_a_band_whose_period_exceeds_the_record_is_refused_by_its_name(tmp_path,
     r = cli(REFERENCE, clean.path, "--out", out, "--set", SHORT[0], "--set", SHORT[1], "--cutoff", 0.5 * least)
     assert r.returncode == 2 and "--cutoff = " in r.stderr and f"at least {least:.4g} Hz" in r.stderr, r.stderr
     assert not out.exists()
+    # The short pass lasts about 4 s (330 m at 300 km/h): 0.15 Hz is above the filter's least,
+    # 0.1 Hz, and below one period within the record, about 0.25 Hz.
     with pytest.raises(cs.SceneError) as e:
-        cm.synthesise_record(REFERENCE, str(tmp_path / "s.csv"), overrides=SHORT, bandwidth_hz=1e-3)
+        cm.synthesise_record(REFERENCE, str(tmp_path / "s.csv"), overrides=SHORT, bandwidth_hz=0.15)
     assert e.value.field == "bandwidth_hz" and "exceeds the record's duration" in str(e.value)
+    with pytest.raises(cs.SceneError) as e:  # below the filter's least, whatever the record
+        cm.synthesise_record(REFERENCE, str(tmp_path / "s.csv"), overrides=SHORT, bandwidth_hz=1e-3)
+    assert e.value.field == "bandwidth_hz" and "[0.1, 10000]" in str(e.value)
     assert not (tmp_path / "s.csv").exists()
 
 

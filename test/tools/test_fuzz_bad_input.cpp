@@ -478,3 +478,48 @@ TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
   RecordProperty("cases", count);
   std::system(("rm -rf '" + dir + "'").c_str());
 }
+
+// Found by fuzzing the newer kinds of line: a wire or pantograph mass of next to nothing (its
+// stability estimate overflowed: a NaN step blamed on the filter's cutoff, or a step five times
+// too long that diverged at t = 0, exit 3), a pass without a pantograph and a filter below what
+// it can settle on (both ran and reported 0 N), a negative speed (refused with the reader's [0,
+// inf), not the line's range), a static state beyond the divergence limit (the pass stopped at
+// its first step). Each is refused as bad input, status 2, by what sets it.
+TEST(FuzzBadInput, LightMassesNoPantographAndFiltersWithoutARecordAreRefused) {
+  const std::string dir = temp_dir("catenary_sim_fuzz_");
+  const std::string stitched = test_scenes::kReferenceStitched;
+  struct SetCase {
+    std::string scene;
+    std::vector<std::string> sets;
+    std::string names;
+  };
+  const std::vector<SetCase> cases = {
+      {stitched, {"stitch_wire.linear_mass=1e-200"}, "the masses that set dt"},
+      {stitched, {"stitch_wire.linear_mass=1e-300"}, "the masses that set dt"},
+      {test_scenes::kCompound, {"auxiliary_messenger.linear_mass=1e-300"}, "the masses that set dt"},
+      {kReference, {"pantographs[0].masses=[1e-300, 9.0, 6.0]"}, "the masses that set dt"},
+      {stitched, {"pantographs=[]"}, "'pantographs' = (none)"},
+      {stitched, {"output.filter_cutoff=1e-300"}, "'output.filter_cutoff' = 1e-300"},
+      {stitched, {"output.sensor_bandwidth=1e-300"}, "'output.sensor_bandwidth' = 1e-300"},
+      {test_scenes::kCompound, {"train.speed_kmh=-100"}, "wave speed"},
+      // A tonne at one point of a trolley wire on bridles: a static sag of 8.8 m, beyond the
+      // watchdog's 5 m before the pass starts (it stopped the pass at its first step, status 3).
+      {test_scenes::scene_path("trolley_wire_bridle.yaml"), {"imperfections={point_masses: [{station: 100, mass: 1000}]}"},
+       "'numerics.divergence_limit' = 5 m: the line's static state already reaches"},
+      {test_scenes::scene_path("trolley_wire_bridle.yaml"), {"numerics.divergence_limit=1e-300"},
+       "'numerics.divergence_limit' = 1e-300 m"},
+  };
+  for (const SetCase& c : cases) {
+    std::vector<std::string> args{kSimulatePass, "--scene", c.scene, "--out", dir + "/out", "--max-steps", "200000"};
+    for (const std::string& s : c.sets) {
+      args.push_back("--set");
+      args.push_back(s);
+    }
+    const ChildRun r = run(args, dir, 60.0);
+    SCOPED_TRACE(c.sets.front() + "\n  message: " + r.out);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.out.find(c.names), std::string::npos);
+    EXPECT_FALSE(exists(dir + "/out/stats.json"));
+    std::system(("rm -rf '" + dir + "/out'").c_str());
+  }
+}

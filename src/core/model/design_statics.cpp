@@ -334,11 +334,11 @@ void set_hinged_arm(const HingedArmSpec& arm, double g, const RegistrationLatera
   // beyond any step; arms as built hang a few degrees.
   constexpr double kMaxInclination = 0.25 * M_PI;
   if (std::abs(theta) > kMaxInclination) {
-    const std::string need = fmt(std::abs(bracket) / std::tan(kMaxInclination));
+    const std::string need = fmt_limit(std::abs(bracket) / std::tan(kMaxInclination), true);
     const std::string hangs = " m would hang " + fmt(theta * 180.0 / M_PI) + " degrees from its hinge under the " +
                               fmt(bracket) + " N the wire and its weight put on it";
     if (arm.pull_off)
-      throw SceneError("scene field '" + field + ".pull_off' = " + fmt(pull_off) + " N: the arm at station " + fmt(sp.x) +
+      throw SceneError("scene field '" + field + ".pull_off' = " + fmt_given(pull_off) + " N: the arm at station " + fmt(sp.x) +
                        hangs + "; allowed: a pull-off of at least " + need + " N (within 45 degrees of horizontal)");
     throw SceneError("scene field 'stagger.contact_wire': the pull-off " + fmt(pull_off) + " N it gives the hinged arm at station " +
                      fmt(sp.x) + hangs + "; allowed: stagger and curves that pull each arm with at least " + need +

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "catenary_sim/core/output/zero_phase_filter.hpp"
 #include "scene/read_imperfections.hpp"
 #include "scene/read_lateral_scene.hpp"
 #include "scene/read_pantographs.hpp"
@@ -433,9 +434,10 @@ void read_train(Reader& top, Scene& s) {
   if (top.has("train")) {
     Reader r(top.child("train"), "train");
     if (r.has("speed") && r.has("speed_kmh")) fail("train.speed", "(given with speed_kmh)", "give either speed (m/s) or speed_kmh");
-    // Any finite speed >= 0 here; validate() applies the limit (train_speed_limit).
-    if (r.has("speed_kmh")) s.train_speed = r.number("speed_kmh", 0.0, kInf) / 3.6;
-    else s.train_speed = r.number("speed", 0.0, kInf, 0.0);
+    // Any finite speed here; validate() refuses what is outside the limit, 0 up to below the wave
+    // speed, with that range (train_speed_limit).
+    if (r.has("speed_kmh")) s.train_speed = r.number("speed_kmh", -kInf, kInf) / 3.6;
+    else s.train_speed = r.number("speed", -kInf, kInf, 0.0);
     // Stations in m, finite (within a million km: a line's, not a bound anything reaches).
     if (r.has("start")) s.train_start = r.number("start", -1e9, 1e9);
     if (r.has("end")) s.train_end = r.number("end", -1e9, 1e9);
@@ -582,9 +584,9 @@ void read_output(Reader& top, Scene& s) {
       s.output.analysis_first_span = static_cast<int>(a[0]);
       s.output.analysis_last_span = static_cast<int>(a[1]);
     }
-    s.output.filter_cutoff = r.number("filter_cutoff", 0.0, 10000.0, 20.0, true);
+    s.output.filter_cutoff = r.number("filter_cutoff", kLeastFilterCutoff, 10000.0, 20.0);
     s.output.sample_rate = r.number("sample_rate", 0.0, 1e6, 0.0);
-    s.output.sensor_bandwidth = r.number("sensor_bandwidth", 0.0, 10000.0, 20.0, true);
+    s.output.sensor_bandwidth = r.number("sensor_bandwidth", kLeastFilterCutoff, 10000.0, 20.0);
     s.output.dropper_series = r.boolean("dropper_series", false);
     auto optional_number = [&](const char* key, double lo, double hi, bool lo_open) -> std::optional<double> {
       if (!r.has(key)) return std::nullopt;

@@ -4,6 +4,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -60,13 +61,13 @@ class Reader {
                 bool lo_open = false) {
     if (!has(key)) {
       if (def) return *def;
-      fail(field(key), "(missing)", "required, a number in " + range(lo, hi, lo_open));
+      fail(field(key), "(missing)" + misspelt(key), "required, a number in " + range(lo, hi, lo_open));
     }
     return parse_number(node_[key], field(key), lo, hi, lo_open);
   }
 
   std::vector<double> numbers(const std::string& key, double lo, double hi, bool lo_open = false) {
-    if (!has(key)) fail(field(key), "(missing)", "required, a list of numbers in " + range(lo, hi, lo_open));
+    if (!has(key)) fail(field(key), "(missing)" + misspelt(key), "required, a list of numbers in " + range(lo, hi, lo_open));
     const YAML::Node n = node_[key];
     if (!n.IsSequence()) fail(field(key), "(not a list)", "a list of numbers in " + range(lo, hi, lo_open));
     std::vector<double> out;
@@ -89,6 +90,36 @@ class Reader {
     const YAML::Node n = node_[key];
     if (!n.IsScalar()) fail(field(key), "(not a scalar)", "a string");
     return n.as<std::string>();
+  }
+
+  // For a required key that is missing: a key of the map within two letters of it that nothing
+  // has read, named (" (given: 'support_stifness', misspelt?)"), since the map's unknown keys are
+  // found only by finish(), after the refusal; "" if there is none.
+  std::string misspelt(const std::string& key) const {
+    if (!node_ || !node_.IsMap()) return "";
+    for (const auto& kv : node_) {
+      if (!kv.first.IsScalar()) continue;
+      const std::string given = kv.first.Scalar();
+      if (given != key && !used_.count(given) && edit_distance(given, key) <= 2)
+        return " (given: '" + given + "', misspelt?)";
+    }
+    return "";
+  }
+
+  // Levenshtein distance: insertions, deletions and substitutions.
+  static std::size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      std::size_t diagonal = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        const std::size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        diagonal = up;
+      }
+    }
+    return row[b.size()];
   }
 
   void finish() const {

@@ -8,11 +8,22 @@
 #include <string>
 
 #include "scene/scene_reader.hpp"
+#include "util/format_limit.hpp"
 
 namespace catenary_sim {
 
 using namespace scene_reading;
 namespace {
+
+// Where section i's spans were given: its entry in `sections` (spans, or span_length and
+// span_count), or the line's.
+std::string spans_field(const Scene& s, std::size_t i) {
+  const std::vector<std::string>& given = s.sections[i].given;
+  const auto gives = [&](const char* k) { return std::find(given.begin(), given.end(), k) != given.end(); };
+  if (gives("spans")) return "sections[" + std::to_string(i) + "].spans";
+  if (gives("span_count")) return "sections[" + std::to_string(i) + "].span_count";
+  return "line.spans";
+}
 
 // The largest sag under q per metre of a simply supported span whose EI rises linearly from
 // end_ei at one end to ei at `length` from it (a rail's transition piece), ei beyond: the
@@ -68,7 +79,7 @@ void validate_sections(const Scene& s) {
       if (!(sec.contact_wire.bending_stiffness > 0.0))
         fail(in_section("conductor_rail.bending_stiffness"), fmt(sec.contact_wire.bending_stiffness), "> 0 N m^2");
       if (sec.spans.size() < 2)
-        fail(in_section("spans"), std::to_string(sec.spans.size()) + " span",
+        fail(spans_field(s, si), std::to_string(sec.spans.size()) + " span",
              "at least 2 spans in a rigid section (its ends are held, its intermediate supports are elastic)");
       continue;
     }
@@ -382,7 +393,7 @@ void validate_rigid(const Scene& s) {
     const double least = least_ei(q, span);
     if (!(ei >= least))
       fail(field, fmt(ei) + note,
-           "at least " + fmt(least) + " N m^2 here: the profile would " + way + " " + fmt(5.0 * q * std::pow(span, 4) / (384.0 * ei)) +
+           "at least " + fmt_limit(least, true, 10) + " N m^2 here: the profile would " + way + " " + fmt(5.0 * q * std::pow(span, 4) / (384.0 * ei)) +
                " m under " + under + " over a " + fmt(span) + " m span (5 q L^4 / (384 EI)), more than a fiftieth of it");
   };
   for (std::size_t i = 0; i < s.sections.size(); ++i) {
@@ -393,7 +404,7 @@ void validate_rigid(const Scene& s) {
     // A span no profile of the allowed EI could take under its weight is the span's to shorten.
     const double q_weight = sec.contact_wire.linear_mass * s.gravity, least = least_ei(q_weight, longest);
     if (least > kMaxRailBendingStiffness)
-      fail(s.sections.size() > 1 ? "sections[" + std::to_string(i) + "].spans" : "line.spans", fmt(longest) + " m",
+      fail(spans_field(s, i), fmt(longest) + " m",
            "a rigid rail's span short enough for a profile of at most " + fmt(kMaxRailBendingStiffness) +
                " N m^2 (this one needs " + fmt(least) +
                " N m^2 so as to sag less than a fiftieth of it under its weight); supports every 8-12 m in service");
@@ -415,7 +426,7 @@ void validate_rigid(const Scene& s) {
         double low = 0.0, high = ei;  // (the whole span at ei sags less: checked above)
         for (int k = 0; k < 60; ++k) (sag(0.5 * (low + high)) <= span / 50.0 ? high : low) = 0.5 * (low + high);
         fail(f + ".transition_piece.end_bending_stiffness", fmt(end_ei),
-             "at least " + fmt(high) + " N m^2 with this piece's length " + fmt(length) + " m: the profile would sag " +
+             "at least " + fmt_limit(high, true, 10) + " N m^2 with this piece's length " + fmt(length) + " m: the profile would sag " +
                  fmt(sag(end_ei)) + " m under its weight over its " + fmt(span) + " m end span (simply supported, its EI "
                  "rising over the piece), more than a fiftieth of it");
       }

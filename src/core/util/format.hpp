@@ -6,6 +6,8 @@
 #include <system_error>
 #include <string>
 
+#include "format_limit.hpp"
+
 namespace catenary_sim {
 
 inline std::string fmt(double v) {
