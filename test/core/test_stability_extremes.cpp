@@ -183,8 +183,8 @@ TEST(Extremes, SuddenSpeedAndUpliftSteps) {
 }
 
 // A mass of next to nothing on a spring puts lambda = omega^2 beyond 1e154, where the power
-// iteration's squared norm overflows (it then returned 0, and the contacts' bound alone set a dt
-// five times the line's: a pass diverged at t = 0). Two masses m on springs k (to the ground and
+// iteration's squared norm overflows (unscaled, the estimate falls to 0, and the contacts' bound
+// alone would set a dt five times the line's). Two masses m on springs k (to the ground and
 // between them): omega_max^2 = (k / m) (3 + sqrt 5) / 2 exactly. The iteration's error falls by
 // (3 - sqrt 5) / (3 + sqrt 5) = 0.146 a step, so 1e-9 is far above what is left after it settles.
 TEST(Extremes, TheStabilityEstimateHoldsForMassesOfNextToNothing) {
@@ -200,7 +200,7 @@ TEST(Extremes, TheStabilityEstimateHoldsForMassesOfNextToNothing) {
 }
 
 // dt = (2 / w)(sqrt(1 + xi^2) - xi) with xi = beta w / 2 tends to 2 / (beta w^2) as xi grows (the
-// stiffness damping's own limit): written as a difference it cancelled to 0 once xi^2 passed
+// stiffness damping's own limit): written as a difference it cancels to 0 once xi^2 passes
 // 1/epsilon. Relative 1e-12: the quotient form loses no digits; the asymptote's error is 1/(4 xi^2).
 TEST(Extremes, TheCriticalStepKeepsItsDigitsUnderHeavyStiffnessDamping) {
   const double beta = 1e-4;

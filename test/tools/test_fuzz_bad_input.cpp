@@ -479,12 +479,11 @@ TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
   std::system(("rm -rf '" + dir + "'").c_str());
 }
 
-// Found by fuzzing the newer kinds of line: a wire or pantograph mass of next to nothing (its
-// stability estimate overflowed: a NaN step blamed on the filter's cutoff, or a step five times
-// too long that diverged at t = 0, exit 3), a pass without a pantograph and a filter below what
-// it can settle on (both ran and reported 0 N), a negative speed (refused with the reader's [0,
-// inf), not the line's range), a static state beyond the divergence limit (the pass stopped at
-// its first step). Each is refused as bad input, status 2, by what sets it.
+// Inputs that once ran into trouble past the reader: a wire or pantograph mass of next to nothing
+// (an overflowing stability estimate gives a NaN step or one far too long), a pass without a
+// pantograph and a filter below what it can settle on (a pass that reports 0 N), a negative speed
+// (to be refused with the line's range), a static state beyond the divergence limit (a pass that
+// stops at its first step). Each is refused as bad input, status 2, by what sets it.
 TEST(FuzzBadInput, LightMassesNoPantographAndFiltersWithoutARecordAreRefused) {
   const std::string dir = temp_dir("catenary_sim_fuzz_");
   const std::string stitched = test_scenes::kReferenceStitched;

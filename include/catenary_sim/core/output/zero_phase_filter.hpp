@@ -7,7 +7,7 @@ namespace catenary_sim {
 
 // The lowest cutoff (Hz) the statistics' filter takes: its settling, about 1 / fc, is then 10 s, a
 // pass's length; far below it the filter, started at rest on a record shorter than its memory,
-// returns its own start (a cutoff of 1e-300 Hz gave a force of 0 N throughout), not the record's
+// returns its own start (at 1e-300 Hz a force of 0 N throughout), not the record's
 // low-frequency content. The standards' cutoff is 20 Hz; the span-passing frequency above 1 Hz.
 constexpr double kLeastFilterCutoff = 0.1;
 
