@@ -15,6 +15,7 @@
 #include "catenary_sim/core/output/output_files.hpp"
 #include "catenary_sim/tools/package_files.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
+#include "../core/util/edit_distance.hpp"
 #include "../core/util/format.hpp"  // the core's numbers in messages: one way for all
 
 namespace catenary_sim {
@@ -105,23 +106,6 @@ std::vector<std::string> unknown_parameters(const std::vector<std::string>& all,
   std::sort(out.begin(), out.end());
   return out;
 }
-
-namespace {
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diag = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diag = up;
-    }
-  }
-  return row[b.size()];
-}
-}  // namespace
 
 std::string unknown_parameter_warning(const std::string& name, const std::vector<std::string>& known) {
   std::string best;
