@@ -235,8 +235,10 @@ void print_scene(const Scene& scene, const Model& m) {
               << m.scene.spans.size() << " moves along under the train), ";
   else
     std::cout << "scene " << scene.name << ": " << scene.spans.size() << " spans, " << m.line_length << " m, ";
-  std::cout << m.n_dof << " DOFs, dt " << m.dt * 1e3 << " ms (stability limit " << m.dt_critical * 1e3
-            << " ms), speed " << scene.train_speed * 3.6 << " km/h" << std::endl;
+  // The damping step a preset may choose by the line (centred where a section's wires do not pair up).
+  std::cout << m.n_dof << " DOFs, dt " << m.dt * 1e3 << " ms (stability limit " << m.dt_critical * 1e3 << " ms"
+            << (scene.numerics.damping == DampingStep::kCentred ? ", centred damping" : "") << "), speed "
+            << scene.train_speed * 3.6 << " km/h" << std::endl;
 }
 
 // The pass stepped to its end, every state into the recorders (and the bag).
