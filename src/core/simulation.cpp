@@ -59,8 +59,11 @@ Simulation::Simulation(const Scene& scene) : model_(build_model(speed_checked(sc
   double reach = 0.0;
   int at = -1;
   for (const Wire& w : model_.wires)
-    for (int i = 0; i < w.nodes(); ++i)
-      if (!(std::fabs(initial_.u[w.w_dof + i]) < reach)) reach = std::fabs(initial_.u[w.w_dof + i]), at = w.w_dof + i;
+    for (int i = w.w_dof; i < w.w_dof + w.nodes() && !std::isnan(reach); ++i)
+      if (!(std::fabs(initial_.u[i]) <= reach)) {  // (a NaN is kept, and refused below)
+        reach = std::fabs(initial_.u[i]);
+        at = i;
+      }
   if (at >= 0 && !(reach < limit))
     throw SceneError("scene field 'numerics.divergence_limit' = " + fmt_given(limit) + " m: the line's static state " +
                      "already reaches " + fmt(reach) + " m (" + wire_at(model_.wires, at, initial_.line_offset) +

@@ -235,7 +235,7 @@ void print_scene(const Scene& scene, const Model& m) {
               << m.scene.spans.size() << " moves along under the train), ";
   else
     std::cout << "scene " << scene.name << ": " << scene.spans.size() << " spans, " << m.line_length << " m, ";
-  // The damping step a preset may choose by the line (centred where a section's wires do not pair up).
+  // The centred damping step named where the scene takes it: its dt is the undamped limit, above the half-step's.
   std::cout << m.n_dof << " DOFs, dt " << m.dt * 1e3 << " ms (stability limit " << m.dt_critical * 1e3 << " ms"
             << (scene.numerics.damping == DampingStep::kCentred ? ", centred damping" : "") << "), speed "
             << scene.train_speed * 3.6 << " km/h" << std::endl;
