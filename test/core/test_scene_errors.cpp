@@ -606,3 +606,21 @@ TEST(SceneErrors, SpeedFiltersAndARailSectionsSpansAreRefusedByWhatAllowsThem) {
                                           {"sections=[{span_length: 10, span_count: 1}]", "overlap=null", "output.analysis_spans=null"}),
                   "'sections[0].span_count' = 1 span", "at least 2 spans");
 }
+
+// A binary file is refused as no text, by the line and column of its first byte that no UTF-8 text
+// holds, before the YAML parser echoes its bytes into the message (which Python cannot decode) or
+// reads past a NUL; a speed that is no number is refused with the range a speed has.
+TEST(SceneErrors, BinaryFilesAndSpeedsThatAreNoNumbers) {
+  const std::string nul = error_of_yaml(std::string("\0\xff\xfe", 3));
+  EXPECT_MENTIONS(nul, "not text (a NUL byte at line 1, column 1)");
+  const std::string high = error_of_yaml("line:\n  spans: [55]\n  \xff: 1\n");
+  EXPECT_MENTIONS(high, "not UTF-8 text (byte 0xFF at line 3, column 3)");
+  const std::string overlong = error_of_yaml("name: \xc0\xaf\n");  // '/' written in two bytes
+  EXPECT_MENTIONS(overlong, "not UTF-8 text (byte 0xC0 at line 1, column 7)");
+  const std::string set = error_of({"contact_wire.tension=\xff"});
+  EXPECT_MENTIONS(set, "an override (--set): not UTF-8 text");
+  for (const std::string& m : {nul, high, overlong, set}) EXPECT_EQ(m.find('\xff'), std::string::npos) << m;
+  EXPECT_EQ(error_of_yaml("name: \"caten\xc3\xa4ry\"\n").find("UTF-8"), std::string::npos);  // (UTF-8 passes)
+  EXPECT_MENTIONS(error_of({"train.speed_kmh=abc"}), "'train.speed_kmh' = 'abc'", "from 0 to below the contact wire's wave speed");
+  EXPECT_MENTIONS(error_of({"train.speed_kmh=.nan"}), "'train.speed_kmh' = '.nan'", "at most 540");
+}

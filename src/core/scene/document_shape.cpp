@@ -3,6 +3,8 @@
 #include <yaml-cpp/eventhandler.h>
 
 #include <cstdint>
+#include <cstdio>
+#include <initializer_list>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -166,6 +168,45 @@ void check_yaml_shape(const std::string& text, const std::string& what) {
     }
   } catch (const YAML::Exception& e) {
     throw SceneError(what + ": not valid YAML: " + e.what());
+  }
+}
+
+void check_text(const std::string& text, const std::string& what) {
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
+  const auto starts = [&](std::initializer_list<unsigned char> mark) {
+    if (text.size() < mark.size()) return false;
+    std::size_t i = 0;
+    for (unsigned char c : mark)
+      if (byte(i++) != c) return false;
+    return true;
+  };
+  if (starts({0xFE, 0xFF}) || starts({0xFF, 0xFE}) || starts({0x00, 0x00, 0xFE, 0xFF})) return;
+  std::size_t line = 1, column = 1;
+  for (std::size_t i = 0; i < text.size();) {
+    const unsigned char c = byte(i);
+    // The sequence's length and the least code point it may hold (overlong forms are not UTF-8).
+    std::size_t n = 1;
+    unsigned long cp = c, least = 0;
+    if (c >= 0xF0 && c <= 0xF4) n = 4, cp = c & 0x07, least = 0x10000;
+    else if (c >= 0xE0 && c <= 0xEF) n = 3, cp = c & 0x0F, least = 0x800;
+    else if (c >= 0xC2 && c <= 0xDF) n = 2, cp = c & 0x1F, least = 0x80;
+    else if (c >= 0x80) n = 0;
+    bool ok = n > 0 && i + n <= text.size();
+    for (std::size_t k = 1; ok && k < n; ++k) {
+      ok = (byte(i + k) & 0xC0) == 0x80;
+      cp = (cp << 6) | (byte(i + k) & 0x3F);
+    }
+    ok = ok && cp >= least && cp <= 0x10FFFF && !(cp >= 0xD800 && cp <= 0xDFFF);
+    const std::string at = " at line " + std::to_string(line) + ", column " + std::to_string(column);
+    if (!ok) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", c);
+      throw SceneError(what + ": not UTF-8 text (byte " + hex + at + "): expected YAML text, UTF-8");
+    }
+    if (c == 0) throw SceneError(what + ": not text (a NUL byte" + at + "): expected YAML text, UTF-8");
+    if (c == '\n') ++line, column = 1;
+    else ++column;
+    i += n;
   }
 }
 

@@ -15,4 +15,10 @@ void check_document(const YAML::Node& n, const std::string& path);
 // Throws SceneError (naming `what`) for YAML that is not one acyclic document of bounded expansion.
 void check_yaml_shape(const std::string& text, const std::string& what);
 
+// Throws SceneError (naming `what`, the line and the column) for text that is not UTF-8 or holds a
+// NUL byte: a binary file, whose bytes the YAML parser would echo into its message (a message
+// Python cannot decode) or read past. Text starting with a UTF-16 or UTF-32 byte-order mark is
+// left to the parser, which reads those encodings.
+void check_text(const std::string& text, const std::string& what);
+
 }  // namespace catenary_sim

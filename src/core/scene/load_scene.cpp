@@ -33,6 +33,7 @@ Scene load_from_node(YAML::Node root, const std::vector<std::string>& overrides,
 }  // namespace
 
 Scene load_scene_string(const std::string& yaml, const std::vector<std::string>& overrides, const std::string& base_dir) {
+  check_text(yaml, "scene");
   YAML::Node root;
   try {
     root = YAML::Load(yaml);

@@ -435,9 +435,20 @@ void read_train(Reader& top, Scene& s) {
     Reader r(top.child("train"), "train");
     if (r.has("speed") && r.has("speed_kmh")) fail("train.speed", "(given with speed_kmh)", "give either speed (m/s) or speed_kmh");
     // Any finite speed here; validate() refuses what is outside the limit, 0 up to below the wave
-    // speed, with that range (train_speed_limit).
-    if (r.has("speed_kmh")) s.train_speed = r.number("speed_kmh", -kInf, kInf) / 3.6;
-    else s.train_speed = r.number("speed", -kInf, kInf, 0.0);
+    // speed, with that range (train_speed_limit). What is not a finite number is refused with the
+    // same words, the wave speed being the sections' to set.
+    auto speed = [&](const char* key, const char* unit, double per_m_s) {
+      const YAML::Node n = r.child(key);
+      try {
+        return Reader::parse_number(n, r.field(key), -kInf, kInf, false);
+      } catch (const SceneError&) {
+        fail(r.field(key), n.IsScalar() ? "'" + n.Scalar() + "'" : "(not a scalar)",
+             std::string("a number in ") + unit + ", from 0 to below the contact wire's wave speed, at most " +
+                 fmt(kMaxTrainSpeed * per_m_s));
+      }
+    };
+    if (r.has("speed_kmh")) s.train_speed = speed("speed_kmh", "km/h", 3.6) / 3.6;
+    else if (r.has("speed")) s.train_speed = speed("speed", "m/s", 1.0);
     // Stations in m, finite (within a million km: a line's, not a bound anything reaches).
     if (r.has("start")) s.train_start = r.number("start", -1e9, 1e9);
     if (r.has("end")) s.train_end = r.number("end", -1e9, 1e9);

@@ -21,6 +21,7 @@ bool index_of(const std::string& part, std::size_t* idx) {
 }  // namespace
 
 void apply_override(YAML::Node root, const std::string& assignment) {
+  check_text(assignment, "an override (--set)");  // (before its bytes go into any message)
   const auto eq = assignment.find('=');
   auto bad = [&](const std::string& why) -> SceneError {
     return SceneError("override '" + assignment + "': " + why);
