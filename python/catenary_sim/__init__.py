@@ -336,7 +336,8 @@ class Simulation:
 
     # Commands (checked; a rejected one raises SceneError and changes nothing) -------------------
     def set_speed(self, speed_mps):
-        v = _real("speed_mps", speed_mps, f"0 to {_core._MAX_SPEED:g} m/s")
+        v = _real("speed_mps", speed_mps,
+                  f"0 to below the contact wire's wave speed, at most {_core._MAX_SPEED:g} m/s")
         _command(lambda: self._sim.set_speed(v), "speed_mps", speed_mps)
 
     def set_max_acceleration(self, accel_mps2):

@@ -167,7 +167,9 @@ def _parse_columns(path, names):
         quantity, unit = parts[0], parts[-1]
         allowed_cols = ("station_m|km, time_s|ms, speed_kmh|mps, force_PANTOGRAPH_N|kN, uplift_SUPPORT_mm|m, "
                         "head_PANTOGRAPH_mm|m")
-        if quantity not in UNITS or len(parts) < 2 or (quantity in NAMED) != (len(parts) >= 3):
+        # (a named quantity's name not empty: force__N names no pantograph)
+        if (quantity not in UNITS or len(parts) < 2 or (quantity in NAMED) != (len(parts) >= 3)
+                or (quantity in NAMED and not "_".join(parts[1:-1]))):
             raise RecordError("unknown_column", path, col, "(header)", allowed_cols, "not a column of a record")
         if unit not in UNITS[quantity]:
             raise RecordError("unknown_unit", path, col, unit, f"{quantity} in " + ", ".join(UNITS[quantity]),
@@ -179,7 +181,11 @@ def _parse_columns(path, names):
 def _check_fields(path, lines, skip):
     """Refuses a row with more fields than the header (pandas would drop them); returns whether
     the header ends in an empty field (a trailing comma) with every row as long or one shorter."""
-    rows = list(csv.reader(lines[skip:]))
+    try:
+        rows = list(csv.reader(lines[skip:]))
+    except csv.Error as e:
+        raise RecordError("format", path, "file", path, "a CSV with a header line and one row per sample",
+                          str(e)) from None
     if not rows or not rows[0]:
         return False
     head = rows[0]
@@ -218,7 +224,7 @@ def read_record(path, meta=None):
         # columns by one (the first taken as the index); _check_fields refuses longer rows.
         frame = pd.read_csv(path, skiprows=len(comments), dtype=str, keep_default_na=False, skip_blank_lines=False,
                             comment=None, encoding="utf-8-sig", index_col=False)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError) as e:
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv.Error) as e:
         raise RecordError("format", path, "file", path, "a CSV with a header line and one row per sample",
                           str(e).strip().splitlines()[0]) from None
     if trailing:
@@ -397,9 +403,9 @@ def lowpass(x, fs, fc):
 
 
 def _series(name, x, length=None, finite=True):
-    """x as a 1-D float array, refused by name unless it is one of (finite) numbers (of `length`)."""
+    """x as a 1-D float array, refused by name unless it is one of (finite) real numbers (of `length`)."""
     try:
-        a = np.asarray(x, dtype=float)
+        a = None if np.iscomplexobj(np.asarray(x)) else np.asarray(x, dtype=float)  # (an imaginary part is no force)
     except (TypeError, ValueError):
         a = None
     if a is None or a.ndim != 1 or (length is not None and len(a) != length):
@@ -434,7 +440,11 @@ def welch_spectrum(force, fs, segment_s):
     """Welch's PSD as the core takes it (line_measures.cpp): periodic Hann, half-overlapping
     segments of segment_s (the whole series when shorter), mean removed per segment, one-sided
     density, zero-padded to a power of two."""
-    x = np.asarray(force, dtype=float)
+    x = _series("force", force)
+    fs = _real("fs", fs, "a sample rate in Hz > 0", 1e-300)
+    segment_s = _real("segment_s", segment_s, "a segment length in s > 0", 1e-300)
+    if len(x) < 2:
+        _refuse("force", force, "at least 2 samples")
     nper = int(min(len(x), max(8, round(segment_s * fs))))
     nfft = 1 << (nper - 1).bit_length()
     return signal.welch(x, fs=fs, window="hann", nperseg=nper, noverlap=nper // 2, nfft=nfft,
@@ -444,6 +454,10 @@ def welch_spectrum(force, fs, segment_s):
 def spectral_peaks(f, p, fmax, count=5):
     """The strongest local maxima between 2 resolutions and fmax at least 4 resolutions apart,
     with the amplitude of the equivalent sine, sqrt(2 x the power within +-3 resolutions)."""
+    f = _series("f", f)
+    p = _series("p", p, length=len(f))
+    fmax = _real("fmax", fmax, "a frequency in Hz", 0.0)
+    count = _integer("count", count, "a whole number of peaks >= 1", 1, 10 ** 6)
     df = f[1] - f[0] if len(f) > 1 else 1.0
     sel = (f >= 2 * df) & (f <= fmax)
     idx, _ = signal.find_peaks(np.where(sel, p, 0.0), distance=4)
@@ -469,7 +483,7 @@ def _profile(record, speed_profile):
                              value="None", allowed="a speed in km/h or a profile (stations m, speeds km/h)")
         return record.station_m, record.speed_mps, "the record's speed column"
     if isinstance(speed_profile, (int, float, np.floating, np.integer)) and not isinstance(speed_profile, bool):
-        v = _real("speed_profile", speed_profile, "a speed in km/h > 0", 1e-6, 540.0)
+        v = _real("speed_profile", speed_profile, "a speed in km/h, 1e-6 to 540", 1e-6, 540.0)
         return np.array([0.0]), np.array([v / 3.6]), f"{v:g} km/h throughout"
     try:
         x, v = (np.asarray(a, dtype=float) for a in speed_profile)
@@ -490,10 +504,16 @@ def read_speed_profile(path):
     path = _path("speed_profile", path, "a CSV path with columns station_m, speed_kmh")
     try:
         t = pd.read_csv(path)
-        return t["station_m"].to_numpy(float), t["speed_kmh"].to_numpy(float)
+        x, v = t["station_m"].to_numpy(float), t["speed_kmh"].to_numpy(float)
     except (OSError, KeyError, ValueError, pd.errors.ParserError, pd.errors.EmptyDataError) as e:
         raise SceneError(f"speed profile {path} rejected ({e}); allowed a CSV with columns station_m, speed_kmh",
                          field="speed_profile", value=path, allowed="a CSV with columns station_m, speed_kmh") from None
+    try:
+        _profile(None, (x, v))  # the same checks as a profile given in code
+    except SceneError as e:
+        raise SceneError(f"speed profile {path} rejected: {e.allowed}", field="speed_profile", value=path,
+                         allowed=e.allowed) from None
+    return x, v
 
 
 class SimulatedRun:
@@ -695,6 +715,11 @@ class Comparison:
         place file by file (each whole); a DIR that does not exist appears whole or not at all."""
         from . import measurement_report
         target = _path("directory", directory, "a directory path (str or os.PathLike)")
+        if not target:
+            _refuse("directory", directory, "a directory path (str or os.PathLike)", "an empty path")
+        for name, flag in (("report", report), ("pass_files", pass_files)):
+            if not isinstance(flag, (bool, np.bool_)):
+                _refuse(name, flag, "True or False")
         target = os.path.abspath(target)
         if os.path.lexists(target) and not os.path.isdir(target):
             raise SceneError(f"directory = {target!r} rejected: it exists and is not a directory; allowed a "
@@ -719,11 +744,30 @@ class Comparison:
                 os.rename(stage, target)
                 os.chmod(target, 0o777 & ~_files.umask())
                 return target
-            for top, _dirs, names in os.walk(stage):
+            # Into an existing directory: every place checked before anything moves, so that a
+            # directory where a file goes (or a file where a directory goes) moves nothing.
+            moves = []
+            for top, dirs, names in os.walk(stage):
                 rel = os.path.relpath(top, stage)
-                os.makedirs(os.path.join(target, rel), exist_ok=True)
+                for name in dirs:
+                    there = os.path.normpath(os.path.join(target, rel, name))
+                    if os.path.lexists(there) and not os.path.isdir(there):
+                        _refuse("directory", directory, "a directory whose outputs' places hold no other kind of "
+                                "entry", f"{there} is not a directory")
                 for name in names:
-                    os.replace(os.path.join(top, name), os.path.join(target, rel, name))
+                    there = os.path.normpath(os.path.join(target, rel, name))
+                    if os.path.isdir(there):
+                        _refuse("directory", directory, "a directory whose outputs' places hold no other kind of "
+                                "entry", f"{there} is a directory")
+                    moves.append((os.path.join(top, name), there))
+            try:
+                for source, there in moves:
+                    os.makedirs(os.path.dirname(there), exist_ok=True)
+                    os.replace(source, there)
+            except OSError as e:
+                raise SceneError(f"directory = {target!r} rejected: cannot be written ({e.strerror or e}); allowed "
+                                 "a writable directory", field="directory", value=repr(target),
+                                 allowed="a writable directory") from None
         finally:
             shutil.rmtree(stage, ignore_errors=True)
         return target
@@ -732,8 +776,9 @@ class Comparison:
 def least_band_hz(rows, sample_rate_hz):
     """The lowest cutoff or bandwidth a record of `rows` samples at sample_rate_hz is filtered with:
     one period within its duration (rows / sample_rate_hz). A filter whose period is longer has no
-    whole period of the record to act on; its edge padding, not the record, makes the result."""
-    return sample_rate_hz / rows
+    whole period of the record to act on; its edge padding, not the record, makes the result. At
+    least 0.1 Hz, the statistics' filter's least cutoff (output.filter_cutoff's)."""
+    return max(sample_rate_hz / rows, 0.1)
 
 
 def _cutoff(cutoff_hz, record, stats=None):
@@ -753,7 +798,7 @@ def _cutoff(cutoff_hz, record, stats=None):
                              f"period longer than the record; allowed {duration}, or 'bandwidth'",
                              field="cutoff_hz", value="'scene'", allowed=duration)
         return fc, "the scene's output.filter_cutoff"
-    fc = _real("cutoff_hz", cutoff_hz, "a cutoff in Hz > 0, 'scene' or 'bandwidth'", 1e-6)
+    fc = _real("cutoff_hz", cutoff_hz, "a cutoff of at least 0.1 Hz, 'scene' or 'bandwidth'", 0.1)
     if fc < least:
         raise SceneError(f"cutoff_hz = {fc:g} rejected: its period exceeds the record's duration; allowed {duration}",
                          field="cutoff_hz", value=f"{fc:g}", allowed=duration)
@@ -1011,7 +1056,14 @@ def synthesise_record(scene, path, overrides=None, speed_profile=300.0, sample_r
         for target, text in ((path, table.to_csv(index=False, float_format="%.6f")),
                              (side, yaml.safe_dump(meta, sort_keys=False))):
             staged.append((_files.stage(target, text), target))
-        record = read_record(staged[0][0], meta=staged[1][0])
+        try:
+            record = read_record(staged[0][0], meta=staged[1][0])
+        except RecordError as e:
+            # What the record's checks refuse comes of the arguments that made it (a noise that
+            # carries the force beyond a plausible record's), not of the staged file it names.
+            raise SceneError(f"the synthesised record would be refused ({e.kind}: {e.field} = {e.value}, allowed "
+                             f"{e.allowed}); check noise_std_N = {sigma:g}, sample_rate_hz and the scene's forces",
+                             field="noise_std_N", value=f"{sigma:g}", allowed=e.allowed) from None
         new_side = not os.path.lexists(side)
         os.replace(staged[1][0], side)
         try:

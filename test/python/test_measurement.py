@@ -612,3 +612,63 @@ def test_a_record_error_crosses_processes_whole():
     back = pickle.loads(pickle.dumps(err))
     assert type(back) is cm.RecordError and str(back) == str(err)
     assert (back.kind, back.field, back.row, back.path) == ("nan", "force_leading_N", 12, "run.csv")
+
+
+# --------------------------------------------------------------------------------------------
+# Arguments and files each refused by name, with nothing left behind
+# --------------------------------------------------------------------------------------------
+def test_the_filters_and_spectra_refuse_what_is_no_real_series_or_rate():
+    # An imaginary part is no force: numpy would drop it with a warning.
+    with pytest.raises(cs.SceneError) as e:
+        cm.lowpass(np.full(50, 100 + 5j), 200.0, 20.0)
+    assert e.value.field == "x"
+    for fs in (0.0, float("nan"), -5.0):
+        with pytest.raises(cs.SceneError) as e:
+            cm.welch_spectrum(np.ones(100), fs, 1.0)
+        assert e.value.field == "fs"
+    with pytest.raises(cs.SceneError) as e:
+        cm.spectral_peaks(np.arange(10.0), np.ones(10), 50.0, 1.5)
+    assert e.value.field == "count"
+    with pytest.raises(cs.SceneError) as e:
+        cm.spectral_peaks(np.arange(10.0), np.ones(9), 50.0)
+    assert e.value.field == "p"
+
+
+def test_a_speed_profile_file_and_a_record_header_are_checked_as_their_code_forms(tmp_path, clean):
+    profile = tmp_path / "profile.csv"
+    profile.write_text("station_m,speed_kmh\n0,nan\n100,250\n")
+    with pytest.raises(cs.SceneError) as e:
+        cm.read_speed_profile(str(profile))
+    assert e.value.field == "speed_profile" and "540 km/h" in str(e.value)
+    # A force column that names no pantograph (force__N) is no column of a record.
+    bad = write(tmp_path, clean, header=lambda h: [("force__N" if c.startswith("force_") else c) for c in h])
+    refused(bad, "unknown_column", "force__N")
+    # A field beyond the csv module's limit is a format fault of the file, by name.
+    refused(write(tmp_path, clean, header=lambda h: h + ["9" * 200000], name="long.csv"), "format", "file")
+
+
+def test_a_comparison_is_written_whole_or_refused_with_nothing_moved(tmp_path, clean):
+    c = cm.compare(REFERENCE, clean, overrides=SHORT)
+    for directory, flags, field in (("", {}, "directory"), (tmp_path / "a", {"report": "no"}, "report"),
+                                    (tmp_path / "a", {"pass_files": 1}, "pass_files")):
+        with pytest.raises(cs.SceneError) as e:
+            c.write(directory, **flags)
+        assert e.value.field == field
+    assert not (tmp_path / "a").exists()
+    # Into an existing directory whose comparison.json is a directory: nothing moves in.
+    target = tmp_path / "cmp"
+    (target / "comparison.json").mkdir(parents=True)
+    with pytest.raises(cs.SceneError) as e:
+        c.write(target, pass_files=False)
+    assert e.value.field == "directory" and "comparison.json is a directory" in str(e.value)
+    assert sorted(os.listdir(target)) == ["comparison.json"]
+    assert [n for n in os.listdir(tmp_path) if n.startswith(".cmp.")] == []
+
+
+def test_a_synthesised_record_the_records_checks_refuse_names_the_noise(tmp_path):
+    # 5 kN of noise on a force of about 100 N carries the record beyond a plausible one's forces.
+    path = tmp_path / "n.csv"
+    with pytest.raises(cs.SceneError) as e:
+        cm.synthesise_record(REFERENCE, str(path), overrides=SHORT, speed_profile=250.0, noise_std_N=5000.0)
+    assert e.value.field == "noise_std_N" and "n.csv." not in str(e.value)
+    assert os.listdir(tmp_path) == []
