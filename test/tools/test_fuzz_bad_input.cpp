@@ -483,7 +483,7 @@ TEST(FuzzBadInput, ThreeDLineHeadsAndYamlShapes) {
 // (an overflowing stability estimate gives a NaN step or one far too long), a pass without a
 // pantograph and a filter below what it can settle on (a pass that reports 0 N), a negative speed
 // (to be refused with the line's range), a static state beyond the divergence limit (a pass that
-// stops at its first step). Each is refused as bad input, status 2, by what sets it.
+// stops at its first step), a stiffness of next to nothing (a singular start). Each is refused as bad input, status 2, by what sets it.
 TEST(FuzzBadInput, LightMassesNoPantographAndFiltersWithoutARecordAreRefused) {
   const std::string dir = temp_dir("catenary_sim_fuzz_");
   const std::string stitched = test_scenes::kReferenceStitched;
@@ -501,6 +501,9 @@ TEST(FuzzBadInput, LightMassesNoPantographAndFiltersWithoutARecordAreRefused) {
       {stitched, {"output.filter_cutoff=1e-300"}, "'output.filter_cutoff' = 1e-300"},
       {stitched, {"output.sensor_bandwidth=1e-300"}, "'output.sensor_bandwidth' = 1e-300"},
       {test_scenes::kCompound, {"train.speed_kmh=-100"}, "wave speed"},
+      // A contact spring of 1e-308 N/m (its range is open at 0) leaves the start's statics nothing
+      // to hold the pantograph by: named among what to check.
+      {kReference, {"contact.stiffness=1e-308"}, "contact.stiffness"},
       // A tonne at one point of a trolley wire on bridles: a static sag of 8.8 m, beyond the
       // watchdog's 5 m before the pass starts (it stopped the pass at its first step, status 3).
       {test_scenes::scene_path("trolley_wire_bridle.yaml"), {"imperfections={point_masses: [{station: 100, mass: 1000}]}"},

@@ -23,10 +23,14 @@ Eigen::VectorXd SpdSolver::solve(const Eigen::SparseMatrix<double>& k, const Eig
     analysed_ = true;
   }
   ldlt_.factorize(k);
+  // Beside a part held by nothing, a stiffness next to nothing against the rest (a contact spring
+  // or a dropper's EA of 1e-308, within their open ranges) leaves the solve nothing to hold.
+  const char* check = "; check the scene's smallest stiffnesses and tensions (contact.stiffness, "
+                      "droppers.axial_stiffness, the wires' tension) against the rest";
   if (ldlt_.info() != Eigen::Success)
-    throw SceneError("statics: " + what + " is singular (a part of the system is not held by any support)");
+    throw SceneError("statics: " + what + " is singular (a part of the system is not held by any support)" + check);
   Eigen::VectorXd x = ldlt_.solve(r);
-  if (!x.allFinite()) throw SceneError("statics: " + what + " has no finite solution");
+  if (!x.allFinite()) throw SceneError("statics: " + what + " has no finite solution" + check);
   return x;
 }
 
