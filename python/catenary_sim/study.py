@@ -522,16 +522,36 @@ def _report_dir(out, i):
 # --------------------------------------------------------------------------------------------
 def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=True):
     """Runs (or resumes) a study into `out`; returns the results table (pandas.DataFrame)."""
-    import pandas as pd
-    import dask
-    from dask.distributed import Client, LocalCluster, as_completed
-    from tqdm import tqdm
+    from dask.distributed import Client
 
     study = load_study(study_path)
     if not isinstance(workers, int) or not 1 <= workers <= 1024:
         raise StudyError(f"workers = {workers!r}: allowed 1 to 1024")
     cases = make_cases(study)
     check_study_against_scene(study, cases)
+    # The scheduler is reached before anything is written: a refused address leaves no DIR.
+    remote = None
+    if scheduler:
+        try:
+            remote = Client(scheduler, timeout=10)
+        except Exception as e:  # a bad address or no scheduler there: dask raises several kinds
+            raise StudyError(f"--scheduler {scheduler!r}: cannot reach a Dask scheduler ({type(e).__name__}: "
+                             f"{e}); allowed the address of a running dask-scheduler, e.g. tcp://host:8786") from None
+    try:
+        return _run_into(out, study, cases, remote, workers, progress, plots)
+    finally:
+        if remote is not None:
+            remote.close()
+
+
+def _run_into(out, study, cases, remote, workers, progress, plots):
+    """run_study's part that writes DIR: the plan, the cases (on `remote`, a connected Client, or a
+    local cluster of `workers`), the table and the plots."""
+    import pandas as pd
+    import dask
+    from dask.distributed import Client, LocalCluster, as_completed
+    from tqdm import tqdm
+
     os.makedirs(os.path.join(out, "cases"), exist_ok=True)
     lock = open(os.path.join(out, ".catenary_sim.lock"), "w")
     try:
@@ -561,12 +581,8 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
 
     if todo:
         own = None
-        if scheduler:
-            try:
-                client = Client(scheduler, timeout=10)
-            except Exception as e:  # a bad address or no scheduler there: dask raises several kinds
-                raise StudyError(f"--scheduler {scheduler!r}: cannot reach a Dask scheduler ({type(e).__name__}: "
-                                 f"{e}); allowed the address of a running dask-scheduler, e.g. tcp://host:8786") from None
+        if remote is not None:
+            client = remote
         else:
             # Without the workers' statistical profiler: it samples every 10 ms a thread that sits in
             # one C++ call, learns nothing, and takes CPU from the other worker on a 2-core machine
@@ -591,8 +607,8 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
                 bar.update(1)
             bar.close()
         finally:
-            client.close()
             if own is not None:
+                client.close()
                 own.close()
 
     rows = []

@@ -307,6 +307,12 @@ def test_a_bad_scheduler_address_is_named(tmp_path):
         r = run_cli_err([spec, "--out", str(tmp_path / "out"), "--scheduler", address], timeout=120)
         assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
         assert "--scheduler" in r.stderr and address in r.stderr
+        assert not (tmp_path / "out").exists()
+    # Nothing is made in a directory that was there either, and the directory stays.
+    (tmp_path / "there").mkdir()
+    with pytest.raises(study.StudyError, match="cannot reach a Dask scheduler"):
+        study.run_study(spec, str(tmp_path / "there"), scheduler="tcp://127.0.0.1:1", progress=False, plots=False)
+    assert os.listdir(tmp_path / "there") == []
 
 
 def test_a_map_draws_a_grid_value_whose_cases_all_failed(tmp_path, monkeypatch):
