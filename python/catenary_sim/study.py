@@ -287,6 +287,12 @@ def _check_distribution(d, f):
         _fail(f + ".std", out["std"], "> 0")
     if "low" in out and not out["low"] < out["high"]:
         _fail(f + ".high", out["high"], f"> low ({out['low']})")
+    if "low" in out and not math.isfinite(out["high"] - out["low"]):  # the samples would be inf
+        _fail(f + ".high", out["high"], f"a number whose distance from low ({out['low']}) is finite: high - low "
+              "overflows a double (about 1.8e+308)")
+    if d["type"] == "normal" and not math.isfinite(abs(out["mean"]) + 8 * out["std"]):  # draws reach 7 std
+        _fail(f + ".std", out["std"], f"a std whose 8 std from the mean ({out['mean']}) are finite (a double's "
+              "largest is about 1.8e+308)")
     return out
 
 

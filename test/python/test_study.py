@@ -153,6 +153,15 @@ def test_bad_study_files_name_the_field(tmp_path):
                                      parameters=[{"key": "a", "distribution": {"type": "uniform", "low": 0, "high": 1}}]))
     with pytest.raises(study.StudyError, match="spam"):
         study.load_study(write_study(str(tmp_path / "d.yaml"), spam=1, parameters=[{"key": "a", "values": [1]}]))
+    # Bounds each finite but so far apart that high - low overflows: the samples would be inf.
+    with pytest.raises(study.StudyError, match=r"parameters\[0\]\.distribution\.high' = 1e\+308.*overflows"):
+        study.load_study(write_study(str(tmp_path / "h.yaml"), sampling="random", samples=4,
+                                     parameters=[{"key": "a", "distribution": {"type": "uniform", "low": -1.0e308,
+                                                                               "high": 1.0e308}}]))
+    with pytest.raises(study.StudyError, match=r"parameters\[0\]\.distribution\.std' = 1e\+308"):
+        study.load_study(write_study(str(tmp_path / "n.yaml"), sampling="random", samples=4,
+                                     parameters=[{"key": "a", "distribution": {"type": "normal", "mean": 0,
+                                                                               "std": 1.0e308}}]))
     # NaN or infinity in the overrides (plan.json holds neither) is refused by its key and value.
     for bad in (float("nan"), float("inf"), [1.0, float("nan")]):
         with pytest.raises(study.StudyError, match=r"study field 'overrides\.bridle\.length' = .*(nan|inf)"):
