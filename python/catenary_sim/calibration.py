@@ -41,6 +41,7 @@ from scipy import optimize
 from . import SceneError
 from . import measurement as cm
 from ._files import write_atomically
+from .study import _StrictLoader
 
 METHODS = ("least_squares", "minimize:Nelder-Mead", "minimize:Powell")
 FIELDS = {"scene", "record", "meta", "overrides", "speed_profile", "cutoff", "parameters", "objective", "optimiser"}
@@ -64,6 +65,11 @@ class CalibrationError(ValueError):
 
 def _fail(field, value, allowed):
     raise CalibrationError(f"calibration field '{field}' = {value!r}: {allowed}")
+
+
+class _Loader(_StrictLoader):
+    """The study files' YAML reader: a key given twice in one map, or an alias, is refused."""
+    error, what = CalibrationError, "calibration file"
 
 
 def _number(v, field, allowed, positive=False):
@@ -99,8 +105,8 @@ def load_calibration(path):
     """Reads and checks a calibration file; returns a dict with absolute paths."""
     try:
         with open(path, encoding="utf-8") as f:
-            doc = yaml.safe_load(f)
-    except (OSError, yaml.YAMLError, UnicodeDecodeError) as e:
+            doc = _Loader.load(f.read(), path)
+    except (OSError, yaml.YAMLError, UnicodeDecodeError, RecursionError) as e:
         raise CalibrationError(f"calibration file {path!r} cannot be read: {e}") from None
     if not isinstance(doc, dict):
         _fail("", doc, "a YAML map (scene, record, parameters, objective, ...)")

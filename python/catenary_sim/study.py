@@ -75,7 +75,20 @@ def _fail(field, value, allowed):
 class _StrictLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
     """YAML as safe_load reads it (libyaml's parser where present: a 100,000-value grid in seconds),
     but a key given twice in one map is refused (not last-wins) and aliases are refused (a
-    self-referencing or exponentially expanding one cannot be a plan)."""
+    self-referencing or exponentially expanding one cannot be a plan). Its refusals are `error`s
+    naming the file as `what` (a calibration file's loader is this one with its own)."""
+
+    error, what = StudyError, "study file"
+
+    @classmethod
+    def load(cls, text, name):
+        """The one document of `text`; `name` (the file) for the messages."""
+        loader = cls(text)
+        loader.name = name
+        try:
+            return loader.get_single_data()
+        finally:
+            loader.dispose()
 
     def get_single_data(self):
         node = self.get_single_node()
@@ -87,11 +100,11 @@ class _StrictLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
         while stack:
             n, depth = stack.pop()
             if depth > 64:  # a plan is a few levels deep; thousands overflow Python's recursion
-                raise StudyError(f"study file '{self.name}' line {n.start_mark.line + 1}: nested more than 64 levels "
-                                 "deep; a study file is a few levels of maps and lists")
+                raise self.error(f"{self.what} '{self.name}' line {n.start_mark.line + 1}: nested more than 64 levels "
+                                 f"deep; a {self.what} is a few levels of maps and lists")
             if id(n) in seen:
-                raise StudyError(f"study file '{self.name}' line {n.start_mark.line + 1}: this value is used again "
-                                 "through an alias (*name): aliases and anchors are not allowed in a study file; "
+                raise self.error(f"{self.what} '{self.name}' line {n.start_mark.line + 1}: this value is used again "
+                                 f"through an alias (*name): aliases and anchors are not allowed in a {self.what}; "
                                  "write the value out")
             seen.add(id(n))
             if isinstance(n, yaml.SequenceNode):
@@ -108,10 +121,10 @@ class _StrictLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
             try:
                 hash(key)
             except TypeError:
-                raise StudyError(f"study file '{self.name}' line {key_node.start_mark.line + 1}: a key that is a "
+                raise self.error(f"{self.what} '{self.name}' line {key_node.start_mark.line + 1}: a key that is a "
                                  "list or map; allowed text or number keys") from None
             if key in seen:
-                raise StudyError(f"study file '{self.name}' line {key_node.start_mark.line + 1}: key '{key}' is given "
+                raise self.error(f"{self.what} '{self.name}' line {key_node.start_mark.line + 1}: key '{key}' is given "
                                  f"twice in one map (first on line {seen[key] + 1}); allowed each key once")
             seen[key] = key_node.start_mark.line
         return super().construct_mapping(node, deep)
@@ -131,12 +144,7 @@ def load_study(path):
     except UnicodeDecodeError as e:
         raise StudyError(f"study file '{path}': not UTF-8 text ({e.reason} at byte {e.start})") from None
     try:
-        loader = _StrictLoader(text)
-        loader.name = path  # for the messages
-        try:
-            doc = loader.get_single_data()
-        finally:
-            loader.dispose()
+        doc = _StrictLoader.load(text, path)
     except yaml.YAMLError as e:
         raise StudyError(f"study file '{path}': not valid YAML: {e}") from None
     except RecursionError:

@@ -241,3 +241,16 @@ def test_bad_arguments_of_calibrate_are_refused_by_name(tmp_path, kw, words):
         calibration.calibrate(**args)
     assert words in str(e.value)
     assert not (tmp_path / "out").exists()
+
+
+def test_a_key_given_twice_is_refused_by_name(tmp_path):
+    # As in a study file: not the last one silently winning.
+    path = tmp_path / "cal.yaml"
+    path.write_text(f"scene: {REFERENCE}\nrecord: rec.csv\nparameters: [{{key: damping.beta, low: 2.0e-5, "
+                    "high: 2.0e-3}]\noptimiser: {max_evaluations: 10}\noptimiser: {method: least_squares}\n")
+    with pytest.raises(calibration.CalibrationError, match=r"line 5: key 'optimiser' is given twice.*first on line 4"):
+        calibration.load_calibration(str(path))
+    path.write_text(f"scene: {REFERENCE}\nrecord: rec.csv\nparameters: [{{key: damping.beta, low: 2.0e-5, "
+                    "high: 2.0e-3}]\nobjective: &o {time_history: 1.0}\nspectrum: *o\n")
+    with pytest.raises(calibration.CalibrationError, match="alias"):
+        calibration.load_calibration(str(path))
