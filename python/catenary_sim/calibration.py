@@ -228,6 +228,14 @@ def check_bounds(cal):
             return False
 
     for i, p in enumerate(params):
+        # A field the scene takes text for (a name) also takes a bound, as its text: it is not a
+        # number the optimiser can move, though the bounds pass.
+        try:
+            check_scene(cal["scene"], dict(cal["overrides"], **{p["key"]: "text"}))
+        except SceneError:
+            pass
+        else:
+            _fail(f"parameters[{i}].key", p["key"], "a number field of the scene (this one takes text)")
         for bound in ("low", "high"):
             try:
                 check_scene(cal["scene"], dict(cal["overrides"], **{p["key"]: p[bound]}))

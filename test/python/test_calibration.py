@@ -98,10 +98,13 @@ def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path)
     (lambda d: d["parameters"][0].update(high=0.5), "parameters[0].high"),
     (lambda d: d["parameters"][0].update(low=-1e-3), "parameters[0].low"),
     (lambda d: d["parameters"][0].update(key="damping.gamma"), "parameters[0].key"),
+    # a field that takes text (the scene's name) takes the bounds too, as text
+    (lambda d: d["parameters"][0].update(key="name", low=1, high=2), "parameters[0].key"),
 ], ids=["no parameters", "bounds reversed", "unknown scale", "unknown statistic", "unknown method", "unknown field",
         "weight as text", "negative weight", "all weights 0", "cutoff word", "cutoff negative", "cutoff as text",
         "speed as text", "speed beyond 540 km/h", "optimiser a list", "unknown optimiser key", "meta a number",
-        "high beyond the scene's range", "low beyond the scene's range", "key not a scene field"])
+        "high beyond the scene's range", "low beyond the scene's range", "key not a scene field",
+        "key a text field"])
 def test_a_bad_calibration_file_is_refused_by_field(tmp_path, edit, words):
     spec = {"scene": REFERENCE, "record": "rec.csv",
             "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3}]}
