@@ -123,9 +123,10 @@ def load_calibration(path):
     if doc.get("meta") is not None and not isinstance(doc["meta"], str):
         _fail("meta", doc["meta"], "null (beside the record or in its '#' lines) or a YAML file path")
     out["meta"] = os.path.join(base, doc["meta"]) if isinstance(doc.get("meta"), str) else None
-    ov = doc.get("overrides") or {}
+    # A section left empty (null) takes its default; anything but a map is refused, not read as one.
+    ov = {} if doc.get("overrides") is None else doc["overrides"]
     if not isinstance(ov, dict):
-        _fail("overrides", ov, "a map {dotted.key: value}")
+        _fail("overrides", ov, "a map {dotted.key: value} (or null: none)")
     out["overrides"] = ov
     v = out["speed_profile"] = doc.get("speed_profile")
     # Numbers as YAML reads them: text ("300") is refused rather than read as one.
@@ -160,15 +161,15 @@ def load_calibration(path):
         for k in p:
             if k not in ("key", "low", "high", "scale", "initial"):
                 _fail(f"{where}.{k}", p[k], "not a field; allowed key, low, high, scale, initial")
-    obj = doc.get("objective") or {"time_history": 1.0}
+    obj = {"time_history": 1.0} if doc.get("objective") is None else doc["objective"]
     if not isinstance(obj, dict):
-        _fail("objective", obj, "a map with statistics, time_history, spectrum")
+        _fail("objective", obj, "a map with statistics, time_history, spectrum (or null: {time_history: 1})")
     for k in obj:
         if k not in ("statistics", "time_history", "spectrum"):
             _fail(f"objective.{k}", obj[k], "statistics, time_history or spectrum")
-    stats = obj.get("statistics") or {}
+    stats = {} if obj.get("statistics") is None else obj["statistics"]
     if not isinstance(stats, dict):
-        _fail("objective.statistics", stats, "a map NAME: weight")
+        _fail("objective.statistics", stats, "a map NAME: weight (or null: none)")
     weights = {}
     for k, w in stats.items():
         if k not in cm.TOLERANCE_NAMES or k in cm.DIFFERENCES:
@@ -179,10 +180,10 @@ def load_calibration(path):
                         "time_history": _weight(obj.get("time_history", 0.0), "objective.time_history"),
                         "spectrum": _weight(obj.get("spectrum", 0.0), "objective.spectrum")}
     if not any(weights.values()) and not out["objective"]["time_history"] and not out["objective"]["spectrum"]:
-        _fail("objective", obj, "at least one weight above 0")
-    opt = doc.get("optimiser") or {}
+        _fail("objective", obj, "at least one weight above 0 (left out or null: {time_history: 1})")
+    opt = {} if doc.get("optimiser") is None else doc["optimiser"]
     if not isinstance(opt, dict):
-        _fail("optimiser", opt, "a map {method, max_evaluations}")
+        _fail("optimiser", opt, "a map {method, max_evaluations} (or null: least_squares, 100)")
     for k in opt:
         if k not in ("method", "max_evaluations"):
             _fail(f"optimiser.{k}", opt[k], "not a field; allowed method, max_evaluations")

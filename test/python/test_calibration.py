@@ -86,6 +86,15 @@ def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path)
     (lambda d: d.update(objective={"statistics": {"std_force_N": "1e0"}}), "objective.statistics.std_force_N"),
     (lambda d: d.update(objective={"time_history": -1}), "objective.time_history"),
     (lambda d: d.update(objective={"statistics": {"std_force_N": 0}, "time_history": 0}), "objective"),
+    # a section of the wrong type is refused, not replaced by its default
+    (lambda d: d.update(objective={}), "objective"),
+    (lambda d: d.update(objective=[]), "objective"),
+    (lambda d: d.update(objective=False), "objective"),
+    (lambda d: d.update(objective={"statistics": []}), "objective.statistics"),
+    (lambda d: d.update(optimiser=0), "optimiser"),
+    (lambda d: d.update(optimiser=[]), "optimiser"),
+    (lambda d: d.update(overrides=[]), "overrides"),
+    (lambda d: d.update(overrides=False), "overrides"),
     (lambda d: d.update(cutoff="abc"), "cutoff"),
     (lambda d: d.update(cutoff=-5), "cutoff"),
     (lambda d: d.update(cutoff="20"), "cutoff"),
@@ -101,7 +110,9 @@ def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path)
     # a field that takes text (the scene's name) takes the bounds too, as text
     (lambda d: d["parameters"][0].update(key="name", low=1, high=2), "parameters[0].key"),
 ], ids=["no parameters", "bounds reversed", "unknown scale", "unknown statistic", "unknown method", "unknown field",
-        "weight as text", "negative weight", "all weights 0", "cutoff word", "cutoff negative", "cutoff as text",
+        "weight as text", "negative weight", "all weights 0", "objective empty", "objective a list",
+        "objective false", "statistics a list", "optimiser 0", "optimiser empty list", "overrides a list",
+        "overrides false", "cutoff word", "cutoff negative", "cutoff as text",
         "speed as text", "speed beyond 540 km/h", "optimiser a list", "unknown optimiser key", "meta a number",
         "high beyond the scene's range", "low beyond the scene's range", "key not a scene field",
         "key a text field"])
