@@ -194,6 +194,9 @@ def load_study(path):
             _fail(f + ".key", p["key"], "each parameter once")
         seen.add(p["key"])
         if s["sampling"] == "grid":
+            if "distribution" in p:  # it would be ignored: a grid's cases are its values
+                _fail(f + ".distribution", p["distribution"], "only with sampling: random, lhs, sobol or saltelli; "
+                      "a grid parameter has values")
             v = p.get("values")
             if not isinstance(v, list) or not v:
                 _fail(f + ".values", v, "a non-empty list of values (sampling: grid)")
@@ -210,8 +213,14 @@ def load_study(path):
             s["parameters"].append({"key": p["key"], "values": v, "labels": labels})
         elif "labels" in p:
             _fail(f + ".labels", p["labels"], "only with sampling: grid")
+        elif "values" in p:
+            _fail(f + ".values", p["values"], f"only with sampling: grid; a parameter of sampling: {s['sampling']} "
+                  "has a distribution")
         else:
             s["parameters"].append({"key": p["key"], "distribution": _check_distribution(p.get("distribution"), f)})
+    if s["sampling"] == "grid" and "samples" in doc:
+        _fail("samples", doc["samples"], "only with sampling: random, lhs, sobol or saltelli; a grid's cases are "
+              "the combinations of its values")
     if s["sampling"] != "grid":
         n = doc.get("samples")
         if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 1_000_000:

@@ -153,6 +153,15 @@ def test_bad_study_files_name_the_field(tmp_path):
                                      parameters=[{"key": "a", "distribution": {"type": "uniform", "low": 0, "high": 1}}]))
     with pytest.raises(study.StudyError, match="spam"):
         study.load_study(write_study(str(tmp_path / "d.yaml"), spam=1, parameters=[{"key": "a", "values": [1]}]))
+    # Fields that could not act under the study's sampling: refused, not ignored.
+    with pytest.raises(study.StudyError, match=r"'parameters\[0\]\.distribution' = .*only with sampling"):
+        study.load_study(write_study(str(tmp_path / "f.yaml"), parameters=[
+            {"key": "a", "values": [1], "distribution": {"type": "uniform", "low": 1, "high": 2}}]))
+    with pytest.raises(study.StudyError, match=r"'samples' = -7: only with sampling"):
+        study.load_study(write_study(str(tmp_path / "g.yaml"), samples=-7, parameters=[{"key": "a", "values": [1]}]))
+    with pytest.raises(study.StudyError, match=r"'parameters\[0\]\.values' = \[1\]: only with sampling: grid"):
+        study.load_study(write_study(str(tmp_path / "v.yaml"), sampling="random", samples=4, parameters=[
+            {"key": "a", "values": [1], "distribution": {"type": "uniform", "low": 1, "high": 2}}]))
     # Bounds each finite but so far apart that high - low overflows: the samples would be inf.
     with pytest.raises(study.StudyError, match=r"parameters\[0\]\.distribution\.high' = 1e\+308.*overflows"):
         study.load_study(write_study(str(tmp_path / "h.yaml"), sampling="random", samples=4,
