@@ -163,9 +163,9 @@ def load_study(path):
     s["scene"] = scene if os.path.isabs(scene) else os.path.normpath(os.path.join(base, scene))
     if not os.path.isfile(s["scene"]):
         _fail("scene", scene, f"a scene file; '{s['scene']}' " + ("is a directory" if os.path.isdir(s["scene"]) else "does not exist"))
-    ov = doc.get("overrides", {}) or {}
-    if not isinstance(ov, dict):
-        _fail("overrides", ov, "a map {dotted.key: value}")
+    ov = {} if doc.get("overrides") is None else doc["overrides"]  # left out or null: none
+    if not isinstance(ov, dict):  # a list, 0 or false is not read as no overrides
+        _fail("overrides", ov, "a map {dotted.key: value} (or null: none)")
     for key, value in ov.items():  # named here, not by the whole file's check below
         try:
             json.dumps(value, allow_nan=False)

@@ -171,6 +171,13 @@ def test_bad_study_files_name_the_field(tmp_path):
         study.load_study(write_study(str(tmp_path / "n.yaml"), sampling="random", samples=4,
                                      parameters=[{"key": "a", "distribution": {"type": "normal", "mean": 0,
                                                                                "std": 1.0e308}}]))
+    # Overrides of another type than a map are refused, not taken as none.
+    for bad in ([], 0, False, "numerics.preset=fast"):
+        with pytest.raises(study.StudyError, match=r"study field 'overrides' = .*a map"):
+            study.load_study(write_study(str(tmp_path / "o.yaml"), overrides=bad, parameters=[{"key": "a",
+                                                                                               "values": [1]}]))
+    assert study.load_study(write_study(str(tmp_path / "o.yaml"), overrides=None,
+                                        parameters=[{"key": "a", "values": [1]}]))["overrides"] == {}
     # NaN or infinity in the overrides (plan.json holds neither) is refused by its key and value.
     for bad in (float("nan"), float("inf"), [1.0, float("nan")]):
         with pytest.raises(study.StudyError, match=r"study field 'overrides\.bridle\.length' = .*(nan|inf)"):
