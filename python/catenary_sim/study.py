@@ -299,6 +299,8 @@ def _check_distribution(d, f):
         v = d.get(k)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             _fail(f"{f}.{k}", v, "a finite number")
+        if d["type"] == "integers" and not float(v).is_integer():  # drawn from floor(low) on: below low
+            _fail(f"{f}.{k}", v, "a whole number (an integers distribution draws low, low + 1, ..., high - 1)")
         out[k] = float(v)
     if "std" in out and not out["std"] > 0:
         _fail(f + ".std", out["std"], "> 0")

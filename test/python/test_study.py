@@ -162,6 +162,11 @@ def test_bad_study_files_name_the_field(tmp_path):
     with pytest.raises(study.StudyError, match=r"'parameters\[0\]\.values' = \[1\]: only with sampling: grid"):
         study.load_study(write_study(str(tmp_path / "v.yaml"), sampling="random", samples=4, parameters=[
             {"key": "a", "values": [1], "distribution": {"type": "uniform", "low": 1, "high": 2}}]))
+    # An integers distribution's bounds are whole numbers (its draws are low, low + 1, ...).
+    for bound, low, high in (("low", 0.5, 2), ("high", 0, 1.2)):
+        with pytest.raises(study.StudyError, match=rf"'parameters\[0\]\.distribution\.{bound}' = .*a whole number"):
+            study.load_study(write_study(str(tmp_path / "i.yaml"), sampling="random", samples=4, parameters=[
+                {"key": "a", "distribution": {"type": "integers", "low": low, "high": high}}]))
     # Bounds each finite but so far apart that high - low overflows: the samples would be inf.
     with pytest.raises(study.StudyError, match=r"parameters\[0\]\.distribution\.high' = 1e\+308.*overflows"):
         study.load_study(write_study(str(tmp_path / "h.yaml"), sampling="random", samples=4,
