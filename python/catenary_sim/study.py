@@ -130,12 +130,23 @@ class _StrictLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
         return super().construct_mapping(node, deep)
 
 
+def _check_path(name, value):
+    """A path argument: refused by its name unless text or os.PathLike."""
+    if not isinstance(value, (str, os.PathLike)):
+        raise StudyError(f"{name} = {value!r}: allowed a file path (str or os.PathLike)")
+
+
 def load_study(path):
     """Reads and checks a study file; returns a dict with absolute paths. Raises StudyError."""
+    _check_path("path", path)
     if os.path.isdir(path):
         raise StudyError(f"study file '{path}' is a directory; expected a YAML file")
-    with open(path, "rb") as f:
-        raw = f.read(MAX_STUDY_BYTES + 1)
+    try:
+        with open(path, "rb") as f:
+            raw = f.read(MAX_STUDY_BYTES + 1)
+    except OSError as e:
+        raise StudyError(f"study file '{path}' cannot be read ({e.strerror or e}); allowed a readable YAML "
+                         "file") from None
     if len(raw) > MAX_STUDY_BYTES:
         raise StudyError(f"study file '{path}' is larger than {MAX_STUDY_BYTES >> 20} MiB: allowed at most "
                          f"{MAX_STUDY_BYTES >> 20} MiB (a study is a page of YAML)")
@@ -549,6 +560,10 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
     """Runs (or resumes) a study into `out`; returns the results table (pandas.DataFrame)."""
     from dask.distributed import Client
 
+    _check_path("study_path", study_path)
+    _check_path("out", out)
+    if os.path.lexists(out) and not os.path.isdir(out):
+        raise StudyError(f"--out {out}: exists and is not a directory; allowed a directory (made if absent)")
     study = load_study(study_path)
     if not isinstance(workers, int) or not 1 <= workers <= 1024:
         raise StudyError(f"workers = {workers!r}: allowed 1 to 1024")
@@ -577,8 +592,12 @@ def _run_into(out, study, cases, remote, workers, progress, plots):
     from dask.distributed import Client, LocalCluster, as_completed
     from tqdm import tqdm
 
-    os.makedirs(os.path.join(out, "cases"), exist_ok=True)
-    lock = open(os.path.join(out, ".catenary_sim.lock"), "w")
+    try:
+        os.makedirs(os.path.join(out, "cases"), exist_ok=True)
+        lock = open(os.path.join(out, ".catenary_sim.lock"), "w")
+    except OSError as e:
+        raise StudyError(f"--out {out}: cannot be written ({e.strerror or e}); allowed a directory that can be "
+                         "made and written") from None
     try:
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:

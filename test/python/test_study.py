@@ -369,3 +369,20 @@ def test_a_map_draws_a_grid_value_whose_cases_all_failed(tmp_path, monkeypatch):
     assert sorted((p.get_x(), p.get_y()) for p in hatched) == [(2, 0), (2, 1)]
     legend = ax.get_legend()
     assert legend is not None and "failed" in legend.get_texts()[0].get_text()
+
+
+def test_bad_path_arguments_are_refused_by_name(tmp_path):
+    spec = write_study(str(tmp_path / "s.yaml"), parameters=[{"key": "train.speed_kmh", "values": [200]}])
+    (tmp_path / "file").write_text("")
+    for call, words in [
+            (lambda: study.load_study(None), "path = None: allowed a file path"),
+            (lambda: study.load_study(str(tmp_path / "none.yaml")), "none.yaml' cannot be read"),
+            (lambda: study.run_study(None, str(tmp_path / "out")), "study_path = None: allowed a file path"),
+            (lambda: study.run_study(spec, None), "out = None: allowed a file path"),
+            (lambda: study.run_study(spec, str(tmp_path / "file")), "exists and is not a directory"),
+            # a directory that cannot be made (/proc takes no new entries)
+            (lambda: study.run_study(spec, "/proc/catenary_sim_out"), "--out /proc/catenary_sim_out: cannot be written")]:
+        with pytest.raises(study.StudyError) as e:
+            call()
+        assert words in str(e.value)
+    assert not (tmp_path / "out").exists()
