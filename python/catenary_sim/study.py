@@ -565,8 +565,8 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
     if os.path.lexists(out) and not os.path.isdir(out):
         raise StudyError(f"--out {out}: exists and is not a directory; allowed a directory (made if absent)")
     study = load_study(study_path)
-    if not isinstance(workers, int) or not 1 <= workers <= 1024:
-        raise StudyError(f"workers = {workers!r}: allowed 1 to 1024")
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:  # True is not 1 worker
+        raise StudyError(f"workers = {workers!r}: allowed an integer from 1 to 1024")
     cases = make_cases(study)
     check_study_against_scene(study, cases)
     # The scheduler is reached before anything is written: a refused address leaves no DIR.

@@ -371,7 +371,7 @@ def test_a_map_draws_a_grid_value_whose_cases_all_failed(tmp_path, monkeypatch):
     assert legend is not None and "failed" in legend.get_texts()[0].get_text()
 
 
-def test_bad_path_arguments_are_refused_by_name(tmp_path):
+def test_bad_arguments_are_refused_by_name(tmp_path):
     spec = write_study(str(tmp_path / "s.yaml"), parameters=[{"key": "train.speed_kmh", "values": [200]}])
     (tmp_path / "file").write_text("")
     for call, words in [
@@ -381,7 +381,10 @@ def test_bad_path_arguments_are_refused_by_name(tmp_path):
             (lambda: study.run_study(spec, None), "out = None: allowed a file path"),
             (lambda: study.run_study(spec, str(tmp_path / "file")), "exists and is not a directory"),
             # a directory that cannot be made (/proc takes no new entries)
-            (lambda: study.run_study(spec, "/proc/catenary_sim_out"), "--out /proc/catenary_sim_out: cannot be written")]:
+            (lambda: study.run_study(spec, "/proc/catenary_sim_out"), "--out /proc/catenary_sim_out: cannot be written"),
+            # as calibrate: true is not one worker
+            (lambda: study.run_study(spec, str(tmp_path / "out"), workers=True), "workers = True: allowed an integer"),
+            (lambda: study.run_study(spec, str(tmp_path / "out"), workers=2.0), "workers = 2.0: allowed an integer")]:
         with pytest.raises(study.StudyError) as e:
             call()
         assert words in str(e.value)
