@@ -65,6 +65,10 @@ class StudyError(ValueError):
     """A study file that cannot be run: names the field, the value and what is allowed."""
 
 
+# What a number written as text is refused with, in study and calibration files alike.
+TEXT_NUMBER_HINT = "not text (YAML 1.1 reads an exponent without a sign, e.g. 1.0e308, as text: write 1.0e+308)"
+
+
 def _fail(field, value, allowed):
     raise StudyError(f"study field '{field}' = {value!r}: {allowed}")
 
@@ -309,7 +313,7 @@ def _check_distribution(d, f):
     for k in need:
         v = d.get(k)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            _fail(f"{f}.{k}", v, "a finite number")
+            _fail(f"{f}.{k}", v, "a finite number" + (", " + TEXT_NUMBER_HINT if isinstance(v, str) else ""))
         if d["type"] == "integers" and not float(v).is_integer():  # drawn from floor(low) on: below low
             _fail(f"{f}.{k}", v, "a whole number (an integers distribution draws low, low + 1, ..., high - 1)")
         out[k] = float(v)

@@ -167,6 +167,12 @@ def test_bad_study_files_name_the_field(tmp_path):
         with pytest.raises(study.StudyError, match=rf"'parameters\[0\]\.distribution\.{bound}' = .*a whole number"):
             study.load_study(write_study(str(tmp_path / "i.yaml"), sampling="random", samples=4, parameters=[
                 {"key": "a", "distribution": {"type": "integers", "low": low, "high": high}}]))
+    # A number YAML 1.1 reads as text: refused with how to write it.
+    path = tmp_path / "t.yaml"
+    path.write_text(f"scene: {REFERENCE}\noutputs: [a]\nsampling: random\nsamples: 4\nparameters:\n"
+                    "  - {key: a, distribution: {type: uniform, low: -1.0e308, high: 1.0e+308}}\n")
+    with pytest.raises(study.StudyError, match=r"distribution\.low' = '-1\.0e308': a finite number, not text .*1\.0e\+308"):
+        study.load_study(str(path))
     # Bounds each finite but so far apart that high - low overflows: the samples would be inf.
     with pytest.raises(study.StudyError, match=r"parameters\[0\]\.distribution\.high' = 1e\+308.*overflows"):
         study.load_study(write_study(str(tmp_path / "h.yaml"), sampling="random", samples=4,
