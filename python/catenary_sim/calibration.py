@@ -13,7 +13,7 @@ A calibration file (YAML; paths relative to it):
     cutoff: scene                       # the comparison's low-pass: scene, bandwidth or Hz
     parameters:                         # any scene field, with its bounds
       - {key: damping.beta, low: 5.0e-5, high: 1.0e-3, scale: log}       # scale: linear (default) or log
-      - {key: droppers.axial_stiffness, low: 2.0e4, high: 4.0e5, scale: log}
+      - {key: droppers.axial_stiffness, low: 2.0e+4, high: 4.0e+5, scale: log}
     objective:                          # weights; the residuals are squared and summed
       statistics: {std_force_N: 1, max_force_N: 1, min_force_N: 1}       # relative deviations
       time_history: 1                   # (simulated - record) / std(record), rms over the section
@@ -41,7 +41,7 @@ from scipy import optimize
 from . import SceneError
 from . import measurement as cm
 from ._files import write_atomically
-from .study import _StrictLoader
+from .study import TEXT_NUMBER_HINT, _StrictLoader
 
 METHODS = ("least_squares", "minimize:Nelder-Mead", "minimize:Powell")
 FIELDS = {"scene", "record", "meta", "overrides", "speed_profile", "cutoff", "parameters", "objective", "optimiser"}
@@ -73,13 +73,10 @@ class _Loader(_StrictLoader):
 
 
 def _number(v, field, allowed, positive=False):
-    if isinstance(v, str):  # YAML 1.1 reads 2.0e4 (no sign in the exponent) as text
-        try:
-            v = float(v)
-        except ValueError:
-            pass
+    # A number as YAML reads it, as in a study file: text (2.0e4, which YAML 1.1 reads as text, or
+    # a quoted number) is refused with how to write it.
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or (positive and v <= 0):
-        _fail(field, v, allowed)
+        _fail(field, v, allowed + (", " + TEXT_NUMBER_HINT if isinstance(v, str) else ""))
     return float(v)
 
 

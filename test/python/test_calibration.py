@@ -257,6 +257,16 @@ def test_bad_arguments_of_calibrate_are_refused_by_name(tmp_path, kw, words):
     assert not (tmp_path / "out").exists()
 
 
+def test_a_number_yaml_reads_as_text_is_refused_with_how_to_write_it(tmp_path):
+    # As in a study file: 2.0e4 (no sign in the exponent) is text to YAML 1.1.
+    path = tmp_path / "cal.yaml"
+    path.write_text(f"scene: {REFERENCE}\nrecord: rec.csv\n"
+                    "parameters: [{key: droppers.axial_stiffness, low: 2.0e4, high: 4.0e+5}]\n")
+    with pytest.raises(calibration.CalibrationError,
+                       match=r"'parameters\[0\]\.low' = '2\.0e4': a finite number, not text .*write 1\.0e\+308"):
+        calibration.load_calibration(str(path))
+
+
 def test_a_key_given_twice_is_refused_by_name(tmp_path):
     # As in a study file: not the last one silently winning.
     path = tmp_path / "cal.yaml"
