@@ -13,7 +13,7 @@ A calibration file (YAML; paths relative to it):
     cutoff: scene                       # the comparison's low-pass: scene, bandwidth or Hz
     parameters:                         # any scene field, with its bounds
       - {key: damping.beta, low: 5.0e-5, high: 1.0e-3, scale: log}       # scale: linear (default) or log
-      - {key: droppers.axial_stiffness, low: 2.0e4, high: 4.0e5, scale: log}
+      - {key: droppers.axial_stiffness, low: 2.0e+4, high: 4.0e+5, scale: log}
     objective:                          # weights; the residuals are squared and summed
       statistics: {std_force_N: 1, max_force_N: 1, min_force_N: 1}       # relative deviations
       time_history: 1                   # (simulated - record) / std(record), rms over the section
@@ -41,6 +41,7 @@ from scipy import optimize
 from . import SceneError
 from . import measurement as cm
 from ._files import write_atomically
+from .study import TEXT_NUMBER_HINT, _StrictLoader
 
 METHODS = ("least_squares", "minimize:Nelder-Mead", "minimize:Powell")
 FIELDS = {"scene", "record", "meta", "overrides", "speed_profile", "cutoff", "parameters", "objective", "optimiser"}
@@ -66,14 +67,16 @@ def _fail(field, value, allowed):
     raise CalibrationError(f"calibration field '{field}' = {value!r}: {allowed}")
 
 
+class _Loader(_StrictLoader):
+    """The study files' YAML reader: a key given twice in one map, or an alias, is refused."""
+    error, what = CalibrationError, "calibration file"
+
+
 def _number(v, field, allowed, positive=False):
-    if isinstance(v, str):  # YAML 1.1 reads 2.0e4 (no sign in the exponent) as text
-        try:
-            v = float(v)
-        except ValueError:
-            pass
+    # A number as YAML reads it, as in a study file: text (2.0e4, which YAML 1.1 reads as text, or
+    # a quoted number) is refused with how to write it.
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or (positive and v <= 0):
-        _fail(field, v, allowed)
+        _fail(field, v, allowed + (", " + TEXT_NUMBER_HINT if isinstance(v, str) else ""))
     return float(v)
 
 
@@ -99,8 +102,8 @@ def load_calibration(path):
     """Reads and checks a calibration file; returns a dict with absolute paths."""
     try:
         with open(path, encoding="utf-8") as f:
-            doc = yaml.safe_load(f)
-    except (OSError, yaml.YAMLError, UnicodeDecodeError) as e:
+            doc = _Loader.load(f.read(), path)
+    except (OSError, yaml.YAMLError, UnicodeDecodeError, RecursionError) as e:
         raise CalibrationError(f"calibration file {path!r} cannot be read: {e}") from None
     if not isinstance(doc, dict):
         _fail("", doc, "a YAML map (scene, record, parameters, objective, ...)")
@@ -117,9 +120,10 @@ def load_calibration(path):
     if doc.get("meta") is not None and not isinstance(doc["meta"], str):
         _fail("meta", doc["meta"], "null (beside the record or in its '#' lines) or a YAML file path")
     out["meta"] = os.path.join(base, doc["meta"]) if isinstance(doc.get("meta"), str) else None
-    ov = doc.get("overrides") or {}
+    # A section left empty (null) takes its default; anything but a map is refused, not read as one.
+    ov = {} if doc.get("overrides") is None else doc["overrides"]
     if not isinstance(ov, dict):
-        _fail("overrides", ov, "a map {dotted.key: value}")
+        _fail("overrides", ov, "a map {dotted.key: value} (or null: none)")
     out["overrides"] = ov
     v = out["speed_profile"] = doc.get("speed_profile")
     # Numbers as YAML reads them: text ("300") is refused rather than read as one.
@@ -154,15 +158,15 @@ def load_calibration(path):
         for k in p:
             if k not in ("key", "low", "high", "scale", "initial"):
                 _fail(f"{where}.{k}", p[k], "not a field; allowed key, low, high, scale, initial")
-    obj = doc.get("objective") or {"time_history": 1.0}
+    obj = {"time_history": 1.0} if doc.get("objective") is None else doc["objective"]
     if not isinstance(obj, dict):
-        _fail("objective", obj, "a map with statistics, time_history, spectrum")
+        _fail("objective", obj, "a map with statistics, time_history, spectrum (or null: {time_history: 1})")
     for k in obj:
         if k not in ("statistics", "time_history", "spectrum"):
             _fail(f"objective.{k}", obj[k], "statistics, time_history or spectrum")
-    stats = obj.get("statistics") or {}
+    stats = {} if obj.get("statistics") is None else obj["statistics"]
     if not isinstance(stats, dict):
-        _fail("objective.statistics", stats, "a map NAME: weight")
+        _fail("objective.statistics", stats, "a map NAME: weight (or null: none)")
     weights = {}
     for k, w in stats.items():
         if k not in cm.TOLERANCE_NAMES or k in cm.DIFFERENCES:
@@ -173,10 +177,10 @@ def load_calibration(path):
                         "time_history": _weight(obj.get("time_history", 0.0), "objective.time_history"),
                         "spectrum": _weight(obj.get("spectrum", 0.0), "objective.spectrum")}
     if not any(weights.values()) and not out["objective"]["time_history"] and not out["objective"]["spectrum"]:
-        _fail("objective", obj, "at least one weight above 0")
-    opt = doc.get("optimiser") or {}
+        _fail("objective", obj, "at least one weight above 0 (left out or null: {time_history: 1})")
+    opt = {} if doc.get("optimiser") is None else doc["optimiser"]
     if not isinstance(opt, dict):
-        _fail("optimiser", opt, "a map {method, max_evaluations}")
+        _fail("optimiser", opt, "a map {method, max_evaluations} (or null: least_squares, 100)")
     for k in opt:
         if k not in ("method", "max_evaluations"):
             _fail(f"optimiser.{k}", opt[k], "not a field; allowed method, max_evaluations")
@@ -222,6 +226,14 @@ def check_bounds(cal):
             return False
 
     for i, p in enumerate(params):
+        # A field the scene takes text for (a name) also takes a bound, as its text: it is not a
+        # number the optimiser can move, though the bounds pass.
+        try:
+            check_scene(cal["scene"], dict(cal["overrides"], **{p["key"]: "text"}))
+        except SceneError:
+            pass
+        else:
+            _fail(f"parameters[{i}].key", p["key"], "a number field of the scene (this one takes text)")
         for bound in ("low", "high"):
             try:
                 check_scene(cal["scene"], dict(cal["overrides"], **{p["key"]: p[bound]}))

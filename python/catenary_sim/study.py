@@ -65,6 +65,10 @@ class StudyError(ValueError):
     """A study file that cannot be run: names the field, the value and what is allowed."""
 
 
+# What a number written as text is refused with, in study and calibration files alike.
+TEXT_NUMBER_HINT = "not text (YAML 1.1 reads an exponent without a sign, e.g. 1.0e308, as text: write 1.0e+308)"
+
+
 def _fail(field, value, allowed):
     raise StudyError(f"study field '{field}' = {value!r}: {allowed}")
 
@@ -75,7 +79,20 @@ def _fail(field, value, allowed):
 class _StrictLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
     """YAML as safe_load reads it (libyaml's parser where present: a 100,000-value grid in seconds),
     but a key given twice in one map is refused (not last-wins) and aliases are refused (a
-    self-referencing or exponentially expanding one cannot be a plan)."""
+    self-referencing or exponentially expanding one cannot be a plan). Its refusals are `error`s
+    naming the file as `what` (a calibration file's loader is this one with its own)."""
+
+    error, what = StudyError, "study file"
+
+    @classmethod
+    def load(cls, text, name):
+        """The one document of `text`; `name` (the file) for the messages."""
+        loader = cls(text)
+        loader.name = name
+        try:
+            return loader.get_single_data()
+        finally:
+            loader.dispose()
 
     def get_single_data(self):
         node = self.get_single_node()
@@ -87,11 +104,11 @@ class _StrictLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
         while stack:
             n, depth = stack.pop()
             if depth > 64:  # a plan is a few levels deep; thousands overflow Python's recursion
-                raise StudyError(f"study file '{self.name}' line {n.start_mark.line + 1}: nested more than 64 levels "
-                                 "deep; a study file is a few levels of maps and lists")
+                raise self.error(f"{self.what} '{self.name}' line {n.start_mark.line + 1}: nested more than 64 levels "
+                                 f"deep; a {self.what} is a few levels of maps and lists")
             if id(n) in seen:
-                raise StudyError(f"study file '{self.name}' line {n.start_mark.line + 1}: this value is used again "
-                                 "through an alias (*name): aliases and anchors are not allowed in a study file; "
+                raise self.error(f"{self.what} '{self.name}' line {n.start_mark.line + 1}: this value is used again "
+                                 f"through an alias (*name): aliases and anchors are not allowed in a {self.what}; "
                                  "write the value out")
             seen.add(id(n))
             if isinstance(n, yaml.SequenceNode):
@@ -108,21 +125,32 @@ class _StrictLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
             try:
                 hash(key)
             except TypeError:
-                raise StudyError(f"study file '{self.name}' line {key_node.start_mark.line + 1}: a key that is a "
+                raise self.error(f"{self.what} '{self.name}' line {key_node.start_mark.line + 1}: a key that is a "
                                  "list or map; allowed text or number keys") from None
             if key in seen:
-                raise StudyError(f"study file '{self.name}' line {key_node.start_mark.line + 1}: key '{key}' is given "
+                raise self.error(f"{self.what} '{self.name}' line {key_node.start_mark.line + 1}: key '{key}' is given "
                                  f"twice in one map (first on line {seen[key] + 1}); allowed each key once")
             seen[key] = key_node.start_mark.line
         return super().construct_mapping(node, deep)
 
 
+def _check_path(name, value):
+    """A path argument: refused by its name unless text or os.PathLike."""
+    if not isinstance(value, (str, os.PathLike)):
+        raise StudyError(f"{name} = {value!r}: allowed a file path (str or os.PathLike)")
+
+
 def load_study(path):
     """Reads and checks a study file; returns a dict with absolute paths. Raises StudyError."""
+    _check_path("path", path)
     if os.path.isdir(path):
         raise StudyError(f"study file '{path}' is a directory; expected a YAML file")
-    with open(path, "rb") as f:
-        raw = f.read(MAX_STUDY_BYTES + 1)
+    try:
+        with open(path, "rb") as f:
+            raw = f.read(MAX_STUDY_BYTES + 1)
+    except OSError as e:
+        raise StudyError(f"study file '{path}' cannot be read ({e.strerror or e}); allowed a readable YAML "
+                         "file") from None
     if len(raw) > MAX_STUDY_BYTES:
         raise StudyError(f"study file '{path}' is larger than {MAX_STUDY_BYTES >> 20} MiB: allowed at most "
                          f"{MAX_STUDY_BYTES >> 20} MiB (a study is a page of YAML)")
@@ -131,12 +159,7 @@ def load_study(path):
     except UnicodeDecodeError as e:
         raise StudyError(f"study file '{path}': not UTF-8 text ({e.reason} at byte {e.start})") from None
     try:
-        loader = _StrictLoader(text)
-        loader.name = path  # for the messages
-        try:
-            doc = loader.get_single_data()
-        finally:
-            loader.dispose()
+        doc = _StrictLoader.load(text, path)
     except yaml.YAMLError as e:
         raise StudyError(f"study file '{path}': not valid YAML: {e}") from None
     except RecursionError:
@@ -155,9 +178,9 @@ def load_study(path):
     s["scene"] = scene if os.path.isabs(scene) else os.path.normpath(os.path.join(base, scene))
     if not os.path.isfile(s["scene"]):
         _fail("scene", scene, f"a scene file; '{s['scene']}' " + ("is a directory" if os.path.isdir(s["scene"]) else "does not exist"))
-    ov = doc.get("overrides", {}) or {}
-    if not isinstance(ov, dict):
-        _fail("overrides", ov, "a map {dotted.key: value}")
+    ov = {} if doc.get("overrides") is None else doc["overrides"]  # left out or null: none
+    if not isinstance(ov, dict):  # a list, 0 or false is not read as no overrides
+        _fail("overrides", ov, "a map {dotted.key: value} (or null: none)")
     for key, value in ov.items():  # named here, not by the whole file's check below
         try:
             json.dumps(value, allow_nan=False)
@@ -186,6 +209,9 @@ def load_study(path):
             _fail(f + ".key", p["key"], "each parameter once")
         seen.add(p["key"])
         if s["sampling"] == "grid":
+            if "distribution" in p:  # it would be ignored: a grid's cases are its values
+                _fail(f + ".distribution", p["distribution"], "only with sampling: random, lhs, sobol or saltelli; "
+                      "a grid parameter has values")
             v = p.get("values")
             if not isinstance(v, list) or not v:
                 _fail(f + ".values", v, "a non-empty list of values (sampling: grid)")
@@ -202,8 +228,14 @@ def load_study(path):
             s["parameters"].append({"key": p["key"], "values": v, "labels": labels})
         elif "labels" in p:
             _fail(f + ".labels", p["labels"], "only with sampling: grid")
+        elif "values" in p:
+            _fail(f + ".values", p["values"], f"only with sampling: grid; a parameter of sampling: {s['sampling']} "
+                  "has a distribution")
         else:
             s["parameters"].append({"key": p["key"], "distribution": _check_distribution(p.get("distribution"), f)})
+    if s["sampling"] == "grid" and "samples" in doc:
+        _fail("samples", doc["samples"], "only with sampling: random, lhs, sobol or saltelli; a grid's cases are "
+              "the combinations of its values")
     if s["sampling"] != "grid":
         n = doc.get("samples")
         if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 1_000_000:
@@ -281,12 +313,20 @@ def _check_distribution(d, f):
     for k in need:
         v = d.get(k)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            _fail(f"{f}.{k}", v, "a finite number")
+            _fail(f"{f}.{k}", v, "a finite number" + (", " + TEXT_NUMBER_HINT if isinstance(v, str) else ""))
+        if d["type"] == "integers" and not float(v).is_integer():  # drawn from floor(low) on: below low
+            _fail(f"{f}.{k}", v, "a whole number (an integers distribution draws low, low + 1, ..., high - 1)")
         out[k] = float(v)
     if "std" in out and not out["std"] > 0:
         _fail(f + ".std", out["std"], "> 0")
     if "low" in out and not out["low"] < out["high"]:
         _fail(f + ".high", out["high"], f"> low ({out['low']})")
+    if "low" in out and not math.isfinite(out["high"] - out["low"]):  # the samples would be inf
+        _fail(f + ".high", out["high"], f"a number whose distance from low ({out['low']}) is finite: high - low "
+              "overflows a double (about 1.8e+308)")
+    if d["type"] == "normal" and not math.isfinite(abs(out["mean"]) + 8 * out["std"]):  # draws reach 7 std
+        _fail(f + ".std", out["std"], f"a std whose 8 std from the mean ({out['mean']}) are finite (a double's "
+              "largest is about 1.8e+308)")
     return out
 
 
@@ -522,18 +562,46 @@ def _report_dir(out, i):
 # --------------------------------------------------------------------------------------------
 def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=True):
     """Runs (or resumes) a study into `out`; returns the results table (pandas.DataFrame)."""
+    from dask.distributed import Client
+
+    _check_path("study_path", study_path)
+    _check_path("out", out)
+    if os.path.lexists(out) and not os.path.isdir(out):
+        raise StudyError(f"--out {out}: exists and is not a directory; allowed a directory (made if absent)")
+    study = load_study(study_path)
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:  # True is not 1 worker
+        raise StudyError(f"workers = {workers!r}: allowed an integer from 1 to 1024")
+    cases = make_cases(study)
+    check_study_against_scene(study, cases)
+    # The scheduler is reached before anything is written: a refused address leaves no DIR.
+    remote = None
+    if scheduler:
+        try:
+            remote = Client(scheduler, timeout=10)
+        except Exception as e:  # a bad address or no scheduler there: dask raises several kinds
+            raise StudyError(f"--scheduler {scheduler!r}: cannot reach a Dask scheduler ({type(e).__name__}: "
+                             f"{e}); allowed the address of a running dask-scheduler, e.g. tcp://host:8786") from None
+    try:
+        return _run_into(out, study, cases, remote, workers, progress, plots)
+    finally:
+        if remote is not None:
+            remote.close()
+
+
+def _run_into(out, study, cases, remote, workers, progress, plots):
+    """run_study's part that writes DIR: the plan, the cases (on `remote`, a connected Client, or a
+    local cluster of `workers`), the table and the plots."""
     import pandas as pd
     import dask
     from dask.distributed import Client, LocalCluster, as_completed
     from tqdm import tqdm
 
-    study = load_study(study_path)
-    if not isinstance(workers, int) or not 1 <= workers <= 1024:
-        raise StudyError(f"workers = {workers!r}: allowed 1 to 1024")
-    cases = make_cases(study)
-    check_study_against_scene(study, cases)
-    os.makedirs(os.path.join(out, "cases"), exist_ok=True)
-    lock = open(os.path.join(out, ".catenary_sim.lock"), "w")
+    try:
+        os.makedirs(os.path.join(out, "cases"), exist_ok=True)
+        lock = open(os.path.join(out, ".catenary_sim.lock"), "w")
+    except OSError as e:
+        raise StudyError(f"--out {out}: cannot be written ({e.strerror or e}); allowed a directory that can be "
+                         "made and written") from None
     try:
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
@@ -561,12 +629,8 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
 
     if todo:
         own = None
-        if scheduler:
-            try:
-                client = Client(scheduler, timeout=10)
-            except Exception as e:  # a bad address or no scheduler there: dask raises several kinds
-                raise StudyError(f"--scheduler {scheduler!r}: cannot reach a Dask scheduler ({type(e).__name__}: "
-                                 f"{e}); allowed the address of a running dask-scheduler, e.g. tcp://host:8786") from None
+        if remote is not None:
+            client = remote
         else:
             # Without the workers' statistical profiler: it samples every 10 ms a thread that sits in
             # one C++ call, learns nothing, and takes CPU from the other worker on a 2-core machine
@@ -591,8 +655,8 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
                 bar.update(1)
             bar.close()
         finally:
-            client.close()
             if own is not None:
+                client.close()
                 own.close()
 
     rows = []

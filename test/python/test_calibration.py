@@ -86,6 +86,15 @@ def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path)
     (lambda d: d.update(objective={"statistics": {"std_force_N": "1e0"}}), "objective.statistics.std_force_N"),
     (lambda d: d.update(objective={"time_history": -1}), "objective.time_history"),
     (lambda d: d.update(objective={"statistics": {"std_force_N": 0}, "time_history": 0}), "objective"),
+    # a section of the wrong type is refused, not replaced by its default
+    (lambda d: d.update(objective={}), "objective"),
+    (lambda d: d.update(objective=[]), "objective"),
+    (lambda d: d.update(objective=False), "objective"),
+    (lambda d: d.update(objective={"statistics": []}), "objective.statistics"),
+    (lambda d: d.update(optimiser=0), "optimiser"),
+    (lambda d: d.update(optimiser=[]), "optimiser"),
+    (lambda d: d.update(overrides=[]), "overrides"),
+    (lambda d: d.update(overrides=False), "overrides"),
     (lambda d: d.update(cutoff="abc"), "cutoff"),
     (lambda d: d.update(cutoff=-5), "cutoff"),
     (lambda d: d.update(cutoff="20"), "cutoff"),
@@ -98,10 +107,15 @@ def test_a_calibration_recovers_the_parameters_of_a_synthesised_record(tmp_path)
     (lambda d: d["parameters"][0].update(high=0.5), "parameters[0].high"),
     (lambda d: d["parameters"][0].update(low=-1e-3), "parameters[0].low"),
     (lambda d: d["parameters"][0].update(key="damping.gamma"), "parameters[0].key"),
+    # a field that takes text (the scene's name) takes the bounds too, as text
+    (lambda d: d["parameters"][0].update(key="name", low=1, high=2), "parameters[0].key"),
 ], ids=["no parameters", "bounds reversed", "unknown scale", "unknown statistic", "unknown method", "unknown field",
-        "weight as text", "negative weight", "all weights 0", "cutoff word", "cutoff negative", "cutoff as text",
+        "weight as text", "negative weight", "all weights 0", "objective empty", "objective a list",
+        "objective false", "statistics a list", "optimiser 0", "optimiser empty list", "overrides a list",
+        "overrides false", "cutoff word", "cutoff negative", "cutoff as text",
         "speed as text", "speed beyond 540 km/h", "optimiser a list", "unknown optimiser key", "meta a number",
-        "high beyond the scene's range", "low beyond the scene's range", "key not a scene field"])
+        "high beyond the scene's range", "low beyond the scene's range", "key not a scene field",
+        "key a text field"])
 def test_a_bad_calibration_file_is_refused_by_field(tmp_path, edit, words):
     spec = {"scene": REFERENCE, "record": "rec.csv",
             "parameters": [{"key": "damping.beta", "low": 2e-5, "high": 2e-3}]}
@@ -241,3 +255,26 @@ def test_bad_arguments_of_calibrate_are_refused_by_name(tmp_path, kw, words):
         calibration.calibrate(**args)
     assert words in str(e.value)
     assert not (tmp_path / "out").exists()
+
+
+def test_a_number_yaml_reads_as_text_is_refused_with_how_to_write_it(tmp_path):
+    # As in a study file: 2.0e4 (no sign in the exponent) is text to YAML 1.1.
+    path = tmp_path / "cal.yaml"
+    path.write_text(f"scene: {REFERENCE}\nrecord: rec.csv\n"
+                    "parameters: [{key: droppers.axial_stiffness, low: 2.0e4, high: 4.0e+5}]\n")
+    with pytest.raises(calibration.CalibrationError,
+                       match=r"'parameters\[0\]\.low' = '2\.0e4': a finite number, not text .*write 1\.0e\+308"):
+        calibration.load_calibration(str(path))
+
+
+def test_a_key_given_twice_is_refused_by_name(tmp_path):
+    # As in a study file: not the last one silently winning.
+    path = tmp_path / "cal.yaml"
+    path.write_text(f"scene: {REFERENCE}\nrecord: rec.csv\nparameters: [{{key: damping.beta, low: 2.0e-5, "
+                    "high: 2.0e-3}]\noptimiser: {max_evaluations: 10}\noptimiser: {method: least_squares}\n")
+    with pytest.raises(calibration.CalibrationError, match=r"line 5: key 'optimiser' is given twice.*first on line 4"):
+        calibration.load_calibration(str(path))
+    path.write_text(f"scene: {REFERENCE}\nrecord: rec.csv\nparameters: [{{key: damping.beta, low: 2.0e-5, "
+                    "high: 2.0e-3}]\nobjective: &o {time_history: 1.0}\nspectrum: *o\n")
+    with pytest.raises(calibration.CalibrationError, match="alias"):
+        calibration.load_calibration(str(path))

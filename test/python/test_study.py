@@ -153,6 +153,42 @@ def test_bad_study_files_name_the_field(tmp_path):
                                      parameters=[{"key": "a", "distribution": {"type": "uniform", "low": 0, "high": 1}}]))
     with pytest.raises(study.StudyError, match="spam"):
         study.load_study(write_study(str(tmp_path / "d.yaml"), spam=1, parameters=[{"key": "a", "values": [1]}]))
+    # Fields that could not act under the study's sampling: refused, not ignored.
+    with pytest.raises(study.StudyError, match=r"'parameters\[0\]\.distribution' = .*only with sampling"):
+        study.load_study(write_study(str(tmp_path / "f.yaml"), parameters=[
+            {"key": "a", "values": [1], "distribution": {"type": "uniform", "low": 1, "high": 2}}]))
+    with pytest.raises(study.StudyError, match=r"'samples' = -7: only with sampling"):
+        study.load_study(write_study(str(tmp_path / "g.yaml"), samples=-7, parameters=[{"key": "a", "values": [1]}]))
+    with pytest.raises(study.StudyError, match=r"'parameters\[0\]\.values' = \[1\]: only with sampling: grid"):
+        study.load_study(write_study(str(tmp_path / "v.yaml"), sampling="random", samples=4, parameters=[
+            {"key": "a", "values": [1], "distribution": {"type": "uniform", "low": 1, "high": 2}}]))
+    # An integers distribution's bounds are whole numbers (its draws are low, low + 1, ...).
+    for bound, low, high in (("low", 0.5, 2), ("high", 0, 1.2)):
+        with pytest.raises(study.StudyError, match=rf"'parameters\[0\]\.distribution\.{bound}' = .*a whole number"):
+            study.load_study(write_study(str(tmp_path / "i.yaml"), sampling="random", samples=4, parameters=[
+                {"key": "a", "distribution": {"type": "integers", "low": low, "high": high}}]))
+    # A number YAML 1.1 reads as text: refused with how to write it.
+    path = tmp_path / "t.yaml"
+    path.write_text(f"scene: {REFERENCE}\noutputs: [a]\nsampling: random\nsamples: 4\nparameters:\n"
+                    "  - {key: a, distribution: {type: uniform, low: -1.0e308, high: 1.0e+308}}\n")
+    with pytest.raises(study.StudyError, match=r"distribution\.low' = '-1\.0e308': a finite number, not text .*1\.0e\+308"):
+        study.load_study(str(path))
+    # Bounds each finite but so far apart that high - low overflows: the samples would be inf.
+    with pytest.raises(study.StudyError, match=r"parameters\[0\]\.distribution\.high' = 1e\+308.*overflows"):
+        study.load_study(write_study(str(tmp_path / "h.yaml"), sampling="random", samples=4,
+                                     parameters=[{"key": "a", "distribution": {"type": "uniform", "low": -1.0e308,
+                                                                               "high": 1.0e308}}]))
+    with pytest.raises(study.StudyError, match=r"parameters\[0\]\.distribution\.std' = 1e\+308"):
+        study.load_study(write_study(str(tmp_path / "n.yaml"), sampling="random", samples=4,
+                                     parameters=[{"key": "a", "distribution": {"type": "normal", "mean": 0,
+                                                                               "std": 1.0e308}}]))
+    # Overrides of another type than a map are refused, not taken as none.
+    for bad in ([], 0, False, "numerics.preset=fast"):
+        with pytest.raises(study.StudyError, match=r"study field 'overrides' = .*a map"):
+            study.load_study(write_study(str(tmp_path / "o.yaml"), overrides=bad, parameters=[{"key": "a",
+                                                                                               "values": [1]}]))
+    assert study.load_study(write_study(str(tmp_path / "o.yaml"), overrides=None,
+                                        parameters=[{"key": "a", "values": [1]}]))["overrides"] == {}
     # NaN or infinity in the overrides (plan.json holds neither) is refused by its key and value.
     for bad in (float("nan"), float("inf"), [1.0, float("nan")]):
         with pytest.raises(study.StudyError, match=r"study field 'overrides\.bridle\.length' = .*(nan|inf)"):
@@ -307,6 +343,12 @@ def test_a_bad_scheduler_address_is_named(tmp_path):
         r = run_cli_err([spec, "--out", str(tmp_path / "out"), "--scheduler", address], timeout=120)
         assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
         assert "--scheduler" in r.stderr and address in r.stderr
+        assert not (tmp_path / "out").exists()
+    # Nothing is made in a directory that was there either, and the directory stays.
+    (tmp_path / "there").mkdir()
+    with pytest.raises(study.StudyError, match="cannot reach a Dask scheduler"):
+        study.run_study(spec, str(tmp_path / "there"), scheduler="tcp://127.0.0.1:1", progress=False, plots=False)
+    assert os.listdir(tmp_path / "there") == []
 
 
 def test_a_map_draws_a_grid_value_whose_cases_all_failed(tmp_path, monkeypatch):
@@ -333,3 +375,23 @@ def test_a_map_draws_a_grid_value_whose_cases_all_failed(tmp_path, monkeypatch):
     assert sorted((p.get_x(), p.get_y()) for p in hatched) == [(2, 0), (2, 1)]
     legend = ax.get_legend()
     assert legend is not None and "failed" in legend.get_texts()[0].get_text()
+
+
+def test_bad_arguments_are_refused_by_name(tmp_path):
+    spec = write_study(str(tmp_path / "s.yaml"), parameters=[{"key": "train.speed_kmh", "values": [200]}])
+    (tmp_path / "file").write_text("")
+    for call, words in [
+            (lambda: study.load_study(None), "path = None: allowed a file path"),
+            (lambda: study.load_study(str(tmp_path / "none.yaml")), "none.yaml' cannot be read"),
+            (lambda: study.run_study(None, str(tmp_path / "out")), "study_path = None: allowed a file path"),
+            (lambda: study.run_study(spec, None), "out = None: allowed a file path"),
+            (lambda: study.run_study(spec, str(tmp_path / "file")), "exists and is not a directory"),
+            # a directory that cannot be made (/proc takes no new entries)
+            (lambda: study.run_study(spec, "/proc/catenary_sim_out"), "--out /proc/catenary_sim_out: cannot be written"),
+            # as calibrate: true is not one worker
+            (lambda: study.run_study(spec, str(tmp_path / "out"), workers=True), "workers = True: allowed an integer"),
+            (lambda: study.run_study(spec, str(tmp_path / "out"), workers=2.0), "workers = 2.0: allowed an integer")]:
+        with pytest.raises(study.StudyError) as e:
+            call()
+        assert words in str(e.value)
+    assert not (tmp_path / "out").exists()
