@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <numeric>
@@ -1685,4 +1686,28 @@ TEST(Lateral, HeadWindAddsToThePantographsAerodynamicUplift) {
   received("180", &windy, &n_windy);
   ASSERT_EQ(n_calm, n_windy);
   EXPECT_NEAR(windy - calm, a * ((v + U) * (v + U) - v * v), 1e-6);
+}
+
+// Both planes number their wires in the order of their DOFs, which wire_holding's halving search
+// takes for granted: on every shipped scene it finds each DOF's wire as a scan of the wires does
+// (and -1 for the pantographs' DOFs).
+TEST(Lateral, EveryShippedSceneFindsEachDofsWireAsAScanDoes) {
+  auto scan = [](const std::vector<catenary_sim::Wire>& wires, int dof) {
+    for (std::size_t wi = 0; wi < wires.size(); ++wi)
+      if (dof >= wires[wi].w_dof && dof < wires[wi].w_dof + wires[wi].nodes()) return static_cast<int>(wi);
+    return -1;
+  };
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(test_scenes::kConfigDir)) {
+    const std::string file = entry.path().filename().string();
+    if (entry.path().extension() != ".yaml" || file == "diagnostics.yaml") continue;
+    SCOPED_TRACE(file);
+    const Model m = build_model(load_scene_file(entry.path().string()));
+    ++scenes;
+    for (std::size_t wi = 1; wi < m.wires.size(); ++wi) EXPECT_GT(m.wires[wi].w_dof, m.wires[wi - 1].w_dof);
+    for (int d = 0; d < m.n_dof; ++d) ASSERT_EQ(wire_holding(m.wires, d), scan(m.wires, d)) << "DOF " << d;
+    if (!m.lateral) continue;
+    for (int d = 0; d < m.lateral->n; ++d) ASSERT_EQ(wire_holding(m.lateral->wires, d), scan(m.lateral->wires, d));
+  }
+  EXPECT_GE(scenes, 20);  // (the shipped scenes were found)
 }
