@@ -672,3 +672,14 @@ def test_a_synthesised_record_the_records_checks_refuse_names_the_noise(tmp_path
         cm.synthesise_record(REFERENCE, str(path), overrides=SHORT, speed_profile=250.0, noise_std_N=5000.0)
     assert e.value.field == "noise_std_N" and "n.csv." not in str(e.value)
     assert os.listdir(tmp_path) == []
+
+
+def test_a_profile_faster_than_the_line_allows_is_refused_by_the_profile(clean):
+    # The reference contact wire's wave speed is about 460 km/h: 500 km/h is within the argument's
+    # 540 but beyond the scene, and named by the profile, not the scene's train.speed_kmh.
+    with pytest.raises(cs.SceneError) as e:
+        cm.compare(REFERENCE, clean, overrides=SHORT, speed_profile=500.0)
+    assert e.value.field == "speed_profile" and "wave speed" in str(e.value)
+    with pytest.raises(cs.SceneError) as e:
+        cm.compare(REFERENCE, clean, overrides=SHORT, speed_profile=([0.0, 200.0], [250.0, 500.0]))
+    assert e.value.field == "speed_profile"
