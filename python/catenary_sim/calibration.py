@@ -41,7 +41,7 @@ from scipy import optimize
 from . import SceneError
 from . import measurement as cm
 from ._files import write_atomically
-from .study import TEXT_NUMBER_HINT, _StrictLoader
+from .study import TEXT_NUMBER_HINT, _StrictLoader, _check_path, _check_workers
 
 METHODS = ("least_squares", "minimize:Nelder-Mead", "minimize:Powell")
 FIELDS = {"scene", "record", "meta", "overrides", "speed_profile", "cutoff", "parameters", "objective", "optimiser"}
@@ -454,10 +454,8 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
     import dask
 
     for name, v in (("path", path), ("out", out)):
-        if not isinstance(v, (str, os.PathLike)):
-            raise CalibrationError(f"{name} = {v!r}: allowed a file path (str or os.PathLike)")
-    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:
-        raise CalibrationError(f"workers = {workers!r}: allowed an integer from 1 to 1024")
+        _check_path(name, v, CalibrationError)
+    _check_workers(workers, CalibrationError)
     if scheduler is not None and not isinstance(scheduler, str):
         raise CalibrationError(f"scheduler = {scheduler!r}: allowed None or an address such as tcp://host:8786")
     cal = load_calibration(path)

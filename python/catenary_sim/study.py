@@ -134,10 +134,17 @@ class _StrictLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
         return super().construct_mapping(node, deep)
 
 
-def _check_path(name, value):
-    """A path argument: refused by its name unless text or os.PathLike."""
+def _check_path(name, value, error=StudyError):
+    """A path argument: refused by its name unless text or os.PathLike (as `error`: a calibration
+    refuses its arguments alike)."""
     if not isinstance(value, (str, os.PathLike)):
-        raise StudyError(f"{name} = {value!r}: allowed a file path (str or os.PathLike)")
+        raise error(f"{name} = {value!r}: allowed a file path (str or os.PathLike)")
+
+
+def _check_workers(workers, error=StudyError):
+    """The local cluster's worker count: an integer from 1 to 1024 (True is not 1 worker)."""
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:
+        raise error(f"workers = {workers!r}: allowed an integer from 1 to 1024")
 
 
 def load_study(path):
@@ -569,8 +576,7 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
     if os.path.lexists(out) and not os.path.isdir(out):
         raise StudyError(f"--out {out}: exists and is not a directory; allowed a directory (made if absent)")
     study = load_study(study_path)
-    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:  # True is not 1 worker
-        raise StudyError(f"workers = {workers!r}: allowed an integer from 1 to 1024")
+    _check_workers(workers)
     cases = make_cases(study)
     check_study_against_scene(study, cases)
     # The scheduler is reached before anything is written: a refused address leaves no DIR.
