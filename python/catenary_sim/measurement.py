@@ -29,7 +29,7 @@ import pandas as pd
 import yaml
 from scipy import signal
 
-from . import SceneError, Simulation, _core, check_scene, _override_list, _path, _real, _integer, _refuse, _shown
+from . import SceneError, Simulation, _core, _override_list, _path, _real, _integer, _refuse, _shown
 from . import _files
 
 __all__ = ["RecordError", "Record", "read_record", "simulate_run", "compare", "Comparison",
@@ -545,13 +545,13 @@ def simulate_run(scene, record=None, overrides=None, speed_profile=None, sensor_
     if bw is not None:
         bw = _real("sensor_bandwidth_hz", bw, "a bandwidth in Hz > 0", 1e-6)
         ov = ov + [f"output.sensor_bandwidth={bw!r}"]
-    # The profile's fastest speed against the scene's limit (below the contact wire's wave speed),
-    # named by where the profile comes from rather than by the scene's train.speed_kmh.
+    # The probe (the pantographs' names and places) at the profile's fastest speed: the scene's
+    # limit on it (below the contact wire's wave speed) is the profile's, named by where the profile
+    # comes from rather than by the scene's train.speed_kmh.
     fastest = 3.6 * float(np.max(pv))
     try:
-        check_scene(scene, ov + ["train.speed=null", f"train.speed_kmh={fastest!r}"])
+        probe = Simulation(scene, ov + ["train.speed=null", f"train.speed_kmh={fastest!r}"], sample_rate=0)
     except SceneError as e:
-        # Another field's refusal is the scene's own: the probe below gives it in its words.
         if e.field == "train.speed_kmh":
             if speed_profile is None:
                 column = record.columns.get(("speed", None), "station_m")
@@ -560,9 +560,6 @@ def simulate_run(scene, record=None, overrides=None, speed_profile=None, sensor_
             raise SceneError(f"speed_profile = {_shown(speed_profile)} rejected: {fastest:.4g} km/h is faster than "
                              f"the scene allows; allowed {e.allowed}", field="speed_profile",
                              value=_shown(speed_profile), allowed=e.allowed) from None
-    try:
-        probe = Simulation(scene, ov, sample_rate=0)
-    except SceneError as e:
         if bw is None or e.field != "output.sensor_bandwidth":
             raise
         allowed = f"the measuring pantograph's bandwidth, output.sensor_bandwidth's {e.allowed}"
