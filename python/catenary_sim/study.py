@@ -10,7 +10,7 @@ A study file (YAML; paths relative to it):
     overrides: {numerics.preset: balanced}          # applied to every case
     sampling: grid                                  # grid | random | lhs | sobol | saltelli
     samples: 64                                     # random, lhs, sobol, saltelli (base samples N)
-    seed: 1
+    seed: 1                                         # random, lhs, sobol, saltelli
     parameters:
       - key: pantographs.0.static_uplift            # any scene field, as simulate_pass --set
         values: [80, 100, 120]                      # grid; any YAML value: a list for a list field,
@@ -248,6 +248,9 @@ def load_study(path):
         if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 1_000_000:
             _fail("samples", n, "a whole number of samples in [1, 1000000]")
         s["samples"] = n
+    if s["sampling"] == "grid" and "seed" in doc:  # it would be ignored: a grid draws nothing
+        _fail("seed", doc["seed"], "only with sampling: random, lhs, sobol or saltelli; a grid's cases are "
+              "the combinations of its values and draw nothing")
     seed = doc.get("seed", 0)
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         _fail("seed", seed, "a whole number >= 0")
@@ -256,6 +259,9 @@ def load_study(path):
     if not isinstance(outs, list) or not outs or not all(isinstance(o, str) and o for o in outs):
         _fail("outputs", outs, "a non-empty list of paths into stats.json, e.g. pantographs.0.std_force_N")
     s["outputs"] = outs
+    if s["sampling"] != "saltelli" and "bootstrap" in doc:  # it would be ignored: only Sobol indices have intervals
+        _fail("bootstrap", doc["bootstrap"], "only with sampling: saltelli (resamples for the Sobol indices' "
+              f"intervals); sampling: {s['sampling']} computes no indices")
     b = doc.get("bootstrap", 200)
     if not isinstance(b, int) or isinstance(b, bool) or not 0 <= b <= 100_000:
         _fail("bootstrap", b, "a whole number of resamples in [0, 100000]")

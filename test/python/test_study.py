@@ -159,6 +159,11 @@ def test_bad_study_files_name_the_field(tmp_path):
             {"key": "a", "values": [1], "distribution": {"type": "uniform", "low": 1, "high": 2}}]))
     with pytest.raises(study.StudyError, match=r"'samples' = -7: only with sampling"):
         study.load_study(write_study(str(tmp_path / "g.yaml"), samples=-7, parameters=[{"key": "a", "values": [1]}]))
+    with pytest.raises(study.StudyError, match=r"'seed' = 3: only with sampling"):  # a grid draws nothing
+        study.load_study(write_study(str(tmp_path / "s.yaml"), seed=3, parameters=[{"key": "a", "values": [1]}]))
+    with pytest.raises(study.StudyError, match=r"'bootstrap' = 50: only with sampling: saltelli"):
+        study.load_study(write_study(str(tmp_path / "b.yaml"), sampling="lhs", samples=4, bootstrap=50, parameters=[
+            {"key": "a", "distribution": {"type": "uniform", "low": 1, "high": 2}}]))
     with pytest.raises(study.StudyError, match=r"'parameters\[0\]\.values' = \[1\]: only with sampling: grid"):
         study.load_study(write_study(str(tmp_path / "v.yaml"), sampling="random", samples=4, parameters=[
             {"key": "a", "values": [1], "distribution": {"type": "uniform", "low": 1, "high": 2}}]))
