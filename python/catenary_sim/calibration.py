@@ -41,7 +41,7 @@ from scipy import optimize
 from . import SceneError
 from . import measurement as cm
 from ._files import write_atomically
-from .study import TEXT_NUMBER_HINT, _StrictLoader, _check_path, _check_workers
+from .study import TEXT_NUMBER_HINT, _StrictLoader, _check_output_dir, _check_path, _check_workers, _make_output_dir
 
 METHODS = ("least_squares", "minimize:Nelder-Mead", "minimize:Powell")
 FIELDS = {"scene", "record", "meta", "overrides", "speed_profile", "cutoff", "parameters", "objective", "optimiser"}
@@ -460,8 +460,7 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
         raise CalibrationError(f"scheduler = {scheduler!r}: allowed None or an address such as tcp://host:8786")
     cal = load_calibration(path)
     out = os.path.abspath(out)
-    if os.path.lexists(out) and not os.path.isdir(out):
-        raise CalibrationError(f"--out {out}: exists and is not a directory; allowed a directory (made if absent)")
+    _check_output_dir(out, CalibrationError)
     params = cal["parameters"]
     # Checked here, before any cluster starts: the record and the cutoff (load_calibration checked the
     # scene at each bound and at the initial values).
@@ -500,7 +499,7 @@ def calibrate(path, out, scheduler=None, workers=2, report=True):
             own = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(own)
     try:
-        os.makedirs(out, exist_ok=True)
+        _make_output_dir(out, "evaluations", CalibrationError)
         ev = _Evaluator(cal, out, client)
         if first is not None:
             ev.keep(v0, first)

@@ -141,6 +141,45 @@ def _check_path(name, value, error=StudyError):
         raise error(f"{name} = {value!r}: allowed a file path (str or os.PathLike)")
 
 
+def _check_output_dir(out, error=StudyError):
+    """An output directory (made if absent): refused by `error` if it is something else, or if the
+    nearest part of its path that exists cannot take new entries, before any case runs."""
+    if os.path.lexists(out) and not os.path.isdir(out):
+        raise error(f"--out {out}: exists and is not a directory; allowed a directory (made if absent)")
+    there = os.path.abspath(out)
+    while not os.path.lexists(there):
+        there = os.path.dirname(there)
+    if not os.path.isdir(there) or not os.access(there, os.W_OK | os.X_OK):
+        raise error(f"--out {out}: cannot be written ('{there}' " + ("is not a directory" if not os.path.isdir(there)
+                    else "takes no new entries") + "); allowed a directory that can be made and written")
+
+
+def _make_output_dir(out, sub, error=StudyError):
+    """Makes out/sub and what of its path is missing; returns the directories made, deepest first
+    (for _unmake). An OSError is `error` naming --out, with nothing made left behind."""
+    made, d = [], os.path.abspath(os.path.join(out, sub))
+    while not os.path.lexists(d):
+        made.append(d)
+        d = os.path.dirname(d)
+    try:
+        os.makedirs(os.path.join(out, sub), exist_ok=True)
+    except OSError as e:
+        _unmake(made)
+        raise error(f"--out {out}: cannot be written ({e.strerror or e}); allowed a directory that can be made "
+                    "and written") from None
+    return made
+
+
+def _unmake(made):
+    """Takes away directories _make_output_dir made, if they are still empty (nothing of anyone
+    else's goes)."""
+    for d in made:
+        try:
+            os.rmdir(d)
+        except OSError:
+            pass
+
+
 def _check_workers(workers, error=StudyError):
     """The local cluster's worker count: an integer from 1 to 1024 (True is not 1 worker)."""
     if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:
@@ -579,8 +618,7 @@ def run_study(study_path, out, scheduler=None, workers=2, progress=True, plots=T
 
     _check_path("study_path", study_path)
     _check_path("out", out)
-    if os.path.lexists(out) and not os.path.isdir(out):
-        raise StudyError(f"--out {out}: exists and is not a directory; allowed a directory (made if absent)")
+    _check_output_dir(out)
     study = load_study(study_path)
     _check_workers(workers)
     cases = make_cases(study)
@@ -608,10 +646,11 @@ def _run_into(out, study, cases, remote, workers, progress, plots):
     from dask.distributed import Client, LocalCluster, as_completed
     from tqdm import tqdm
 
+    made = _make_output_dir(out, "cases")
     try:
-        os.makedirs(os.path.join(out, "cases"), exist_ok=True)
         lock = open(os.path.join(out, ".catenary_sim.lock"), "w")
     except OSError as e:
+        _unmake(made)
         raise StudyError(f"--out {out}: cannot be written ({e.strerror or e}); allowed a directory that can be "
                          "made and written") from None
     try:

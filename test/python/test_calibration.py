@@ -245,8 +245,10 @@ def test_a_diverging_pass_is_said_with_its_parameter_values(tmp_path):
     ({"out": None}, "out = None"), ({"scheduler": 5}, "scheduler = 5"),
     # port 1 is reserved (tcpmux) and not served here: nothing answers
     ({"scheduler": "tcp://127.0.0.1:1"}, "scheduler = 'tcp://127.0.0.1:1'"),
+    # a directory that cannot be made (/proc takes no new entries)
+    ({"out": "/proc/catenary_sim_out"}, "--out /proc/catenary_sim_out: cannot be written"),
 ], ids=["workers 0", "workers -1", "workers text", "workers fraction", "path None", "path a number", "out None",
-        "scheduler a number", "scheduler unreachable"])
+        "scheduler a number", "scheduler unreachable", "out not writable"])
 def test_bad_arguments_of_calibrate_are_refused_by_name(tmp_path, kw, words):
     args = {"path": _fast_calibration(tmp_path, "a", 3e-4), "out": str(tmp_path / "out"), "workers": 1,
             "report": False}

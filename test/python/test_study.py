@@ -400,3 +400,27 @@ def test_bad_arguments_are_refused_by_name(tmp_path):
             call()
         assert words in str(e.value)
     assert not (tmp_path / "out").exists()
+
+
+def test_an_output_directory_whose_lock_cannot_be_opened_is_taken_away(tmp_path, monkeypatch):
+    # The lock is opened after DIR and DIR/cases are made; a file system that then refuses the file
+    # (full, a quota) must not leave the new, empty directories behind.
+    spec = write_study(str(tmp_path / "s.yaml"), parameters=[{"key": "train.speed_kmh", "values": [200]}])
+    real_open = open
+
+    def refusing_open(path, *args, **kwargs):
+        if str(path).endswith(".catenary_sim.lock"):
+            raise OSError(28, "No space left on device")
+        return real_open(path, *args, **kwargs)
+
+    monkeypatch.setattr(study, "open", refusing_open, raising=False)
+    out = tmp_path / "new" / "out"
+    with pytest.raises(study.StudyError, match="cannot be written .No space left on device"):
+        study.run_study(spec, str(out))
+    assert not (tmp_path / "new").exists()  # nor the parent made for it
+    # A directory that was there already keeps what it holds.
+    kept = tmp_path / "kept"
+    (kept / "cases").mkdir(parents=True)
+    with pytest.raises(study.StudyError, match="cannot be written"):
+        study.run_study(spec, str(kept))
+    assert (kept / "cases").is_dir()
