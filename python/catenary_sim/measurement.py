@@ -359,6 +359,12 @@ def read_record(path, meta=None):
     supports = doc.get("supports", {}) or {}
     if not isinstance(supports, dict):
         raise RecordError("metadata", path, "supports", _shown(supports), "a map SUPPORT: station (m)", "not a map")
+    for name, x in supports.items():  # YAML reads an unquoted 2 as a number: the column's name is text
+        if not isinstance(name, str):
+            raise RecordError("metadata", path, f"supports.{name}", _shown(x),
+                              f"a support's name as text, as in its uplift column (write '{name}': in quotes)",
+                              "YAML read the key as " + ("a number" if isinstance(name, (int, float)) else
+                                                         type(name).__name__) + ", not as text")
     uplift = {name: v for (q, name), v in data.items() if q == "uplift"}
     for name in uplift:
         if name not in supports:

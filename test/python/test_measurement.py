@@ -217,6 +217,9 @@ def test_bad_metadata_is_refused_by_field(tmp_path, clean):
     refused(write(tmp_path, clean, meta=lambda d: d.update(bandwith_hz=20)), "metadata", "bandwith_hz")
     refused(write(tmp_path, clean, meta=lambda d: d.update(sample_rate_hz=1000.0)), "wrong_unit", "time_s")
     refused(write(tmp_path, clean, {3: setcol("speed_kmh", "0")}), "speed_profile", "speed_kmh", 5)
+    # YAML reads an unquoted support name 2 as a number: said so, not "no such support".
+    err = refused(write(tmp_path, clean, meta=lambda d: d["supports"].update({2: 12.5})), "metadata", "supports.2")
+    assert "in quotes" in err.allowed, str(err)
 
 
 def test_what_the_scene_lacks_is_refused_by_name(tmp_path, clean):
