@@ -624,3 +624,15 @@ TEST(SceneErrors, BinaryFilesAndSpeedsThatAreNoNumbers) {
   EXPECT_MENTIONS(error_of({"train.speed_kmh=abc"}), "'train.speed_kmh' = 'abc'", "from 0 to below the contact wire's wave speed");
   EXPECT_MENTIONS(error_of({"train.speed_kmh=.nan"}), "'train.speed_kmh' = '.nan'", "at most 540");
 }
+
+// Nesting beyond the YAML reader's depth limit is said so (the reader's own message is "bad
+// file"), and an override's long value is shown by its start and length, not echoed whole.
+TEST(SceneErrors, DeepNestingAndLongOverridesAreSaidPlainly) {
+  const std::string deep = std::string(10000, '[') + std::string(10000, ']');
+  const std::string file = error_of_yaml("name: x\nline: " + deep + "\n");
+  EXPECT_MENTIONS(file, "not valid YAML: nested", "levels deep", "the YAML reader's limit");
+  EXPECT_EQ(file.find("bad file"), std::string::npos) << file;
+  const std::string set = error_of({"line=" + deep});
+  EXPECT_MENTIONS(set, "(20005 characters)", "levels deep");
+  EXPECT_LT(set.size(), 600u) << set;
+}

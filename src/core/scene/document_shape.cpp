@@ -1,5 +1,6 @@
 #include "scene/document_shape.hpp"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/eventhandler.h>
 
 #include <cstdint>
@@ -167,8 +168,16 @@ void check_yaml_shape(const std::string& text, const std::string& what) {
     while (parser.HandleNextDocument(shape)) {
     }
   } catch (const YAML::Exception& e) {
-    throw SceneError(what + ": not valid YAML: " + e.what());
+    throw SceneError(what + ": not valid YAML: " + yaml_error_text(e));
   }
+}
+
+std::string yaml_error_text(const YAML::Exception& e) {
+  if (const auto* deep = dynamic_cast<const YAML::DeepRecursion*>(&e))
+    return "nested " + std::to_string(deep->depth()) + " levels deep at line " + std::to_string(e.mark.line + 1) +
+           ", column " + std::to_string(e.mark.column + 1) +
+           ": the YAML reader's limit; a scene's fields nest a few levels";
+  return e.what();
 }
 
 void check_text(const std::string& text, const std::string& what) {

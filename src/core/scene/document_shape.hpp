@@ -15,6 +15,10 @@ void check_document(const YAML::Node& n, const std::string& path);
 // Throws SceneError (naming `what`) for YAML that is not one acyclic document of bounded expansion.
 void check_yaml_shape(const std::string& text, const std::string& what);
 
+// The parser's message for a YAML error; nesting deeper than the parser's limit is said so (the
+// parser's own message for it is "bad file").
+std::string yaml_error_text(const YAML::Exception& e);
+
 // Throws SceneError (naming `what`, the line and the column) for text that is not UTF-8 or holds a
 // NUL byte: a binary file, whose bytes the YAML parser would echo into its message (a message
 // Python cannot decode) or read past. Text starting with a UTF-16 or UTF-32 byte-order mark is

@@ -38,7 +38,7 @@ Scene load_scene_string(const std::string& yaml, const std::vector<std::string>&
   try {
     root = YAML::Load(yaml);
   } catch (const YAML::Exception& e) {
-    throw SceneError(std::string("scene: not valid YAML: ") + e.what());
+    throw SceneError("scene: not valid YAML: " + yaml_error_text(e));
   }
   check_yaml_shape(yaml, "scene");
   return load_from_node(root, overrides, base_dir);

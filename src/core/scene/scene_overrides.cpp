@@ -24,7 +24,12 @@ void apply_override(YAML::Node root, const std::string& assignment) {
   check_text(assignment, "an override (--set)");  // (before its bytes go into any message)
   const auto eq = assignment.find('=');
   auto bad = [&](const std::string& why) -> SceneError {
-    return SceneError("override '" + assignment + "': " + why);
+    // A long value (a list of hundreds of stations) is shown by its start and its length.
+    std::size_t shown = 200;
+    if (assignment.size() <= shown) return SceneError("override '" + assignment + "': " + why);
+    while (shown > 0 && (static_cast<unsigned char>(assignment[shown]) & 0xC0) == 0x80) --shown;  // whole characters
+    return SceneError("override '" + assignment.substr(0, shown) + "...' (" + std::to_string(assignment.size()) +
+                      " characters): " + why);
   };
   if (eq == std::string::npos || eq == 0) throw bad("expected key.path=value, e.g. numerics.element_length=0.125");
   // A list entry as the error messages name it, name[i], is name.i: a field named in an error can
@@ -50,7 +55,7 @@ void apply_override(YAML::Node root, const std::string& assignment) {
   try {
     value = YAML::Load(assignment.substr(eq + 1));
   } catch (const YAML::Exception& e) {
-    throw bad(std::string("value is not valid YAML (") + e.what() + ")");
+    throw bad("value is not valid YAML (" + yaml_error_text(e) + ")");
   }
   check_yaml_shape(assignment.substr(eq + 1), "override '" + assignment + "'");
   std::vector<std::string> parts;
