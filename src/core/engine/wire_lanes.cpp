@@ -2,7 +2,8 @@
 // independent tridiagonal recurrences (eq. 3 condensed): run side by side in the two lanes of a
 // vector register, each sweep's latency is paid once for both wires, and the band force, load,
 // damping and update (eq. 19-21) ride along in the backward sweep instead of taking passes of their
-// own. Reproducibility: only +, -, * of IEEE doubles, in the order of the generic step, no FMA
+// own. A wire with no partner fills both lanes on its own, swept from both ends at once
+// (TwistedLone). Reproducibility: only +, -, * of IEEE doubles, in the order of the generic step, no FMA
 // contraction (-ffp-contract=off), no reassociation: packed lanes round exactly like scalars, so
 // every clone (AVX-512, AVX2, x86-64 baseline) gives the generic step's bits.
 #include "engine/wire_lanes.hpp"
@@ -348,6 +349,136 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   return !OnePlane<L, Plane, Drag>::inside(s.ok);  // some new displacement beyond the limit or NaN
 }
 
+// A lone wire in both lanes (WireLanes::twisted_meeting): station k is node k in lane 0 and node
+// top - k in lane 1, whose coefficients are the mirrored wire's (its rotations negated), so that
+// the sweeps above run unchanged on stations 0..meeting; the state is read and written per lane.
+struct TwistedLone {
+  using V = Lane<2>;
+  using T = Double2;
+  using Mask = Long2;
+  static constexpr int NC = WireLanes::kCoefficients, NR = kSweepRecord;
+  const double* coef;
+  const double* fac;
+  double* rec;
+  const double *u, *v;
+  double *un, *vn, *acc;
+  int top;  // the wire's last node
+  T beta, dt, ww_lo, wt_lo, ww_hi, wt_hi, above, below;
+  int lo, hi;  // stations 0 and the meeting
+
+  explicit TwistedLone(const PackSweep& a)
+      : coef(a.pack->twisted_coef.data()), fac(a.factors), rec(a.record), u(a.u[0]), v(a.v[0]), un(a.u_next[0]),
+        vn(a.v_next[0]), acc(a.accel[0]), top(a.hi), beta(V::splat(a.beta)), dt(V::splat(a.dt)),
+        ww_lo(V::pair(a.ww_lo)), wt_lo(V::pair(a.wt_lo)), ww_hi(V::pair(a.ww_hi)), wt_hi(V::pair(a.wt_hi)),
+        above(V::splat(a.limit)), below(V::splat(-a.limit)), lo(0), hi(a.pack->twisted_meeting) {}
+
+  __attribute__((always_inline)) T c(int i, int k) const { return V::at(coef, static_cast<std::ptrdiff_t>(i) * NC + k); }
+  __attribute__((always_inline)) T lower(int i) const { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i)); }
+  __attribute__((always_inline)) T ip(int i) const { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i) + 1); }
+  __attribute__((always_inline)) T get(int i, int k) const { return V::at(rec, static_cast<std::ptrdiff_t>(i) * NR + k); }
+  __attribute__((always_inline)) void set(int i, int k, T x) { V::put(rec, static_cast<std::ptrdiff_t>(i) * NR + k, x); }
+  __attribute__((always_inline)) T inv_mass(int i) const { return c(i, WireLanes::kInvMass); }
+  __attribute__((always_inline)) T init(int i, T vi) const {
+    return c(i, WireLanes::kLoad) - c(i, WireLanes::kDampingMass) * vi;
+  }
+  __attribute__((always_inline)) void state(int i, T& ui, T& vi) const {
+    ui = T{u[i], u[top - i]};
+    vi = T{v[i], v[top - i]};
+  }
+  // Stations i and i + 1: lane 0's nodes i, i + 1 and lane 1's top - i - 1, top - i as blocks.
+  __attribute__((always_inline)) static void split(const double* p, int i, int j, T& x0, T& x1) {
+    const T a = V::row(p + i), b = V::row(p + j);
+    x0 = __builtin_shuffle(a, b, Long2{0, 3});
+    x1 = __builtin_shuffle(a, b, Long2{1, 2});
+  }
+  __attribute__((always_inline)) void state2(int i, T& u0, T& u1, T& v0, T& v1) const {
+    split(u, i, top - i - 1, u0, u1);
+    split(v, i, top - i - 1, v0, v1);
+  }
+  __attribute__((always_inline)) void update(int i, T a, Mask& ok) {
+    const T vi = T{v[i], v[top - i]} + dt * a, ui = T{u[i], u[top - i]} + dt * vi;
+    ok = V::inside(ok, ui, above, below);
+    acc[i] = a[0];
+    acc[top - i] = a[1];
+    vn[i] = vi[0];
+    vn[top - i] = vi[1];
+    un[i] = ui[0];
+    un[top - i] = ui[1];
+  }
+  __attribute__((always_inline)) void update2(int i, T a0, T a1, Mask& ok) {
+    const int j = top - i - 1;
+    const T aa = __builtin_shuffle(a0, a1, Long2{0, 2}), ab = __builtin_shuffle(a0, a1, Long2{3, 1});
+    const T va = V::row(v + i) + dt * aa, vb = V::row(v + j) + dt * ab;
+    const T ua = V::row(u + i) + dt * va, ub = V::row(u + j) + dt * vb;
+    ok = V::inside(V::inside(ok, ua, above, below), ub, above, below);
+    V::put_row(acc + i, aa);
+    V::put_row(acc + j, ab);
+    V::put_row(vn + i, va);
+    V::put_row(vn + j, vb);
+    V::put_row(un + i, ua);
+    V::put_row(un + j, ub);
+  }
+  // The meeting node alone (lane 0; lane 1 holds the same node, mirrored).
+  __attribute__((always_inline)) void update_meeting(T a, Mask& ok) {
+    const int i = hi;
+    const double vi = v[i] + dt[0] * a[0], ui = u[i] + dt[0] * vi;
+    ok = V::inside(ok, T{ui, ui}, above, below);
+    acc[i] = a[0];
+    vn[i] = vi;
+    un[i] = ui;
+  }
+  static Mask all() { return V::all(); }
+  static bool inside(Mask m) { return V::ok(m); }
+};
+
+// The sweeps of a lone wire from both ends (TwistedLone): stations 0..meeting - 1 as any pack's,
+// then the meeting node. Its forward row r and both sides' eliminations give its rotation,
+// theta = (y+ + y- - r) / gamma (y- is lane 1's, of the mirrored wire: -y there); the first step
+// back gives both neighbours' rotations, and with them the meeting node's band force.
+template <class S>
+__attribute__((always_inline)) inline void drive_twisted(S& s, double inv_gamma) {
+  using T = Double2;
+  using W = WireLanes;
+  const int meet = s.hi;
+  s.forward_begin();
+  int i = 1;
+  for (; i + 1 < meet; i += 2) s.forward_two(i);
+  if (i < meet) s.forward_one(i);
+  // Station meet: lane 0's node meet + 1 and lane 1's node meet - 1 are the stations beyond it.
+  T un_, vn_;
+  s.state(meet + 1, un_, vn_);
+  const T zn = s.z_of(un_, vn_);
+  const T r = (-s.c(meet, W::kDwt) * s.zc - s.c(meet, W::kEtw) * zn) - s.c(meet - 1, W::kEwt) * s.zp;
+  const T y = r - s.lower(meet) * s.y;
+  const double theta = ((y[0] - y[1]) - r[0]) * inv_gamma;
+  // Back from the meeting: station meet - 1 in both lanes (nodes meet - 1 and meet + 1).
+  s.ok = S::all();
+  s.th1 = T{theta, -theta};
+  s.z1 = s.zc;
+  T u_meet, v_meet, u0, v0;
+  s.state(meet, u_meet, v_meet);
+  s.state(meet - 1, u0, v0);
+  const T z0 = s.z_of(u0, v0);
+  const T th0 = s.get(meet - 1, kRecTheta) * s.ip(meet - 1) - s.lower(meet) * s.th1;
+  // Beyond the meeting node in each lane: the other lane's neighbour (its rotation negated).
+  const T th2 = -__builtin_shuffle(th0, Long2{1, 0});
+  const T z2 = zn;
+  const T A = ((s.c(meet, W::kDww) * s.z1 + s.c(meet, W::kDwt) * s.th1) + s.c(meet - 1, W::kEww) * z0) +
+              s.c(meet - 1, W::kEtw) * th0;
+  const T B = s.c(meet, W::kEww) * z2 + s.c(meet, W::kEwt) * th2;
+  const T f = (s.init(meet, v_meet) - A) - B;
+  s.update_meeting(s.accel(meet, f), s.ok);
+  s.th2 = s.th1;
+  s.th1 = th0;
+  s.z2 = s.z1;
+  s.z1 = z0;
+  s.v1 = v0;
+  i = meet - 2;
+  for (; i - 1 >= 0; i -= 2) s.backward_two(i);
+  if (i == 0) s.backward_one();
+  s.backward_end();
+}
+
 // Both planes of an L-wire pack in 2L lanes, [vertical: wire 0 (, wire 1); lateral: wire 0 (,
 // wire 1)]: the band and its factors are the same both ways (a round wire bends alike), so each
 // coefficient is loaded once for both and every band operation does both planes at once; each
@@ -463,6 +594,11 @@ __attribute__((always_inline)) inline bool sweep_pair(const PackSweep& a, const 
 #endif
 
 CATENARY_SIM_CLONES bool sweep_pack(const PackSweep& a) {
+  if (a.pack->twisted_meeting >= 0 && !a.plane) {
+    Sweeper<TwistedLone> s(a);
+    drive_twisted(s, a.pack->twisted_inv_gamma);
+    return !TwistedLone::inside(s.ok);
+  }
   if (a.plane) {
     if (a.wind[0]) return a.pack->lanes == 2 ? sweep<2, true, true>(a) : sweep<1, true, true>(a);
     return a.pack->lanes == 2 ? sweep<2, true, false>(a) : sweep<1, true, false>(a);
@@ -487,6 +623,21 @@ bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const 
   a.hi = windowed ? ww0.hi : p.nodes - 1;
   if (a.hi < a.lo) return false;
   a.factors = windowed ? window_factors + 2 * p.offset : p.factors.data();
+  if (p.twisted_meeting >= 0 && !windowed) {  // both lanes' first stations: the wire's two ends, the second mirrored
+    const Wire& w = wires[p.wire[0]];
+    a.factors = p.twisted_factors.data();
+    a.ww_lo[0] = w.d_ww[0];
+    a.wt_lo[0] = w.d_wt[0];
+    a.ww_lo[1] = w.d_ww[a.hi];
+    a.wt_lo[1] = -w.d_wt[a.hi];
+    a.u[0] = x + w.w_dof;
+    a.v[0] = v + w.w_dof;
+    a.u_next[0] = x_next + w.w_dof;
+    a.v_next[0] = v_next + w.w_dof;
+    a.accel[0] = accel + w.w_dof;
+    a.record = records + kSweepRecord * p.offset;
+    return true;
+  }
   for (int k = 0; k < p.lanes; ++k) {
     const Wire& w = wires[p.wire[k]];
     const WireWindow& ww = windowed ? (*windows)[p.wire[k]] : none;

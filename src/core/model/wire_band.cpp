@@ -9,6 +9,7 @@
 #include "catenary_sim/core/model/beam.hpp"
 #include "catenary_sim/core/model/model.hpp"
 #include "catenary_sim/core/scene/scene.hpp"
+#include "model/twisted_half.hpp"
 
 namespace catenary_sim {
 
@@ -119,8 +120,102 @@ void condensed_band_force(const Wire& wire, int lo, int hi, const double end_cor
   band_w_rows(wire, lo, hi, end_correction, w, theta, fw);
 }
 
+void twist_condensation(Wire& w) {
+  const int n = w.nodes(), top = n - 1, meet = top / 2;
+  w.twisted_meeting = meet;
+  w.twisted_lower.assign(meet + 1, 0.0);
+  w.twisted_inv_pivot.assign(meet + 1, 0.0);
+  // The mirrored K_theta_theta (x' = L - x negates each rotation: its entries are the wire's, in
+  // reverse order) from its first node, as assemble_band's LDL^T.
+  double d = w.d_tt[top];
+  w.twisted_inv_pivot[0] = 1.0 / d;
+  for (int k = 1; k <= meet; ++k) {
+    const double e = w.e_tt[top - k], l = e / d;
+    d = w.d_tt[top - k] - l * e;
+    w.twisted_lower[k] = l;
+    w.twisted_inv_pivot[k] = 1.0 / d;
+  }
+  double d_plus = w.d_tt[0];
+  for (int i = 1; i <= meet; ++i) {
+    const double l = w.e_tt[i - 1] / d_plus;
+    d_plus = w.d_tt[i] - l * w.e_tt[i - 1];
+  }
+  // The meeting row with both neighbours eliminated: gamma = d+ + d- - d (Parlett and Dhillon,
+  // "Fernando's solution to Wilkinson's problem", 1997; Meurant 1992's twisted factorisation).
+  w.twisted_inv_gamma = 1.0 / (d_plus + d - w.d_tt[meet]);
+}
+
+namespace {
+
+// f -= K z with the rotations condensed from both ends (twist_condensation): each half as
+// condensed_band_force on its own nodes, in the fused kernel's order of operations (TwistedLone in
+// engine/wire_lanes.cpp: the same bits), the meeting node's rotation from both sides' eliminations.
+void twisted_band_force(const Wire& wire, const double* z, double* f, double* theta) {
+  const int top = wire.nodes() - 1, meet = wire.twisted_meeting;
+  const double* zw = z + wire.w_dof;
+  double* fw = f + wire.w_dof;
+  const TwistedHalf half[2] = {{wire, top, false}, {wire, top, true}};
+  double r_meet[2], y_meet[2], th_before[2];
+  // Forward (K_tt theta = -K_tw z, L of LDL^T) up to the meeting in each half; theta holds y.
+  for (int lane = 0; lane < 2; ++lane) {
+    const TwistedHalf& h = half[lane];
+    auto zs = [&](int k) { return zw[h.node(k)]; };
+    double y = -h.dwt(0) * zs(0) - h.etw(0) * zs(1);
+    theta[h.node(0)] = y;
+    for (int k = 1; k < meet; ++k) {
+      const double r = (-h.dwt(k) * zs(k) - h.etw(k) * zs(k + 1)) - h.ewt(k - 1) * zs(k - 1);
+      y = r - h.lower(k) * y;
+      theta[h.node(k)] = y;
+    }
+    r_meet[lane] = (-h.dwt(meet) * zs(meet) - h.etw(meet) * zs(meet + 1)) - h.ewt(meet - 1) * zs(meet - 1);
+    y_meet[lane] = r_meet[lane] - h.lower(meet) * y;
+  }
+  // The meeting node: y+ + y- - r over gamma (lane 1's y is the mirrored wire's, -y-).
+  const double t_meet = ((y_meet[0] - y_meet[1]) - r_meet[0]) * wire.twisted_inv_gamma;
+  for (int lane = 0; lane < 2; ++lane) {
+    const TwistedHalf& h = half[lane];
+    th_before[lane] = theta[h.node(meet - 1)] * h.inv_pivot(meet - 1) - h.lower(meet) * (lane ? -t_meet : t_meet);
+  }
+  {
+    const TwistedHalf& h = half[0];
+    const double A = ((h.dww(meet) * zw[meet] + h.dwt(meet) * t_meet) + h.eww(meet - 1) * zw[meet - 1]) +
+                     h.etw(meet - 1) * th_before[0];
+    const double B = h.eww(meet) * zw[meet + 1] + h.ewt(meet) * -th_before[1];
+    fw[meet] = (fw[meet] - A) - B;
+    theta[meet] = t_meet;
+  }
+  // Back from the meeting in each half: rotation k, and node k + 1's band force behind it.
+  for (int lane = 0; lane < 2; ++lane) {
+    const TwistedHalf& h = half[lane];
+    auto zs = [&](int k) { return zw[h.node(k)]; };
+    double th2 = lane ? -t_meet : t_meet, th1 = th_before[lane];
+    for (int k = meet - 2; k >= 0; --k) {
+      const double th0 = theta[h.node(k)] * h.inv_pivot(k) - h.lower(k + 1) * th1;
+      const int j = k + 1;
+      const double A = ((h.dww(j) * zs(j) + h.dwt(j) * th1) + h.eww(k) * zs(k)) + h.etw(k) * th0;
+      const double B = h.eww(j) * zs(j + 1) + h.ewt(j) * th2;
+      double& fj = fw[h.node(j)];
+      fj = (fj - A) - B;
+      theta[h.node(j)] = lane ? -th1 : th1;
+      th2 = th1;
+      th1 = th0;
+    }
+    const double A = h.dww(0) * zs(0) + h.dwt(0) * th1;
+    const double B = h.eww(0) * zs(1) + h.ewt(0) * th2;
+    double& f0 = fw[h.node(0)];
+    f0 = (f0 - A) - B;
+    theta[h.node(0)] = lane ? -th1 : th1;
+  }
+}
+
+}  // namespace
+
 void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta) {
   const int n = wire.nodes();
+  if (wire.theta_dof < 0 && wire.twisted_meeting >= 0) {
+    twisted_band_force(wire, z, f, theta);
+    return;
+  }
   if (wire.theta_dof < 0) {
     static constexpr double kNone[4] = {0.0, 0.0, 0.0, 0.0};
     condensed_band_force(wire, 0, n - 1, kNone, wire.tt_lower.data(), wire.tt_inv_pivot.data(), z, f, theta);

@@ -5,11 +5,58 @@
 
 #include <cassert>
 
+#include "catenary_sim/core/model/wire_band.hpp"
 #include "catenary_sim/core/model/wire_packs.hpp"
+#include "model/twisted_half.hpp"
 
 namespace catenary_sim {
 
-std::shared_ptr<WirePacks> build_wire_packs(const Model& m) {
+namespace {
+
+// Whether pack p's lone wire is swept from both ends (WireLanes::twisted_meeting): on a 2-D line
+// stepped whole with the half-step damping (the window, the endless line, the lateral plane and
+// the centred step lay out their own sweeps per node), an odd count of nodes so that the two
+// halves meet at one. (A bridle's 33 nodes so swept measured 0.98-0.99 of one lane's cost.)
+bool sweeps_from_both_ends(const Model& m, const WireLanes& p) {
+  return p.lanes == 1 && p.nodes >= 3 && p.nodes % 2 == 1 && !m.scene.lateral() &&
+         !m.scene.numerics.windowed() && !m.endless && m.scene.numerics.damping != DampingStep::kCentred;
+}
+
+// The pack of a lone wire swept from both ends (twist_condensation's factors): station k is node k
+// in lane 0 and node top - k of the wire mirrored in lane 1 (x' = L - x negates each rotation, so
+// the couplings of a displacement with a rotation change sign, and each element's ends swap).
+void lay_out_twisted(const Model& m, WireLanes& p) {
+  const Wire& w = m.wires[p.wire[0]];
+  const int top = p.nodes - 1, meet = w.twisted_meeting;
+  constexpr int L = 2, NC = WireLanes::kCoefficients;
+  p.twisted_meeting = meet;
+  p.twisted_inv_gamma = w.twisted_inv_gamma;
+  p.twisted_coef.assign(static_cast<std::size_t>(meet + 1) * NC * L, 0.0);
+  p.twisted_factors.assign(static_cast<std::size_t>(meet + 1) * 2 * L, 0.0);
+  for (int k = 0; k <= meet; ++k) {
+    double* c = p.twisted_coef.data() + static_cast<std::size_t>(k) * NC * L;
+    double* f = p.twisted_factors.data() + static_cast<std::size_t>(k) * 2 * L;
+    for (int lane = 0; lane < L; ++lane) {
+      const TwistedHalf h{w, top, lane == 1};
+      const int dof = w.w_dof + h.node(k);
+      c[WireLanes::kDww * L + lane] = h.dww(k);
+      c[WireLanes::kDwt * L + lane] = h.dwt(k);
+      c[WireLanes::kEww * L + lane] = h.eww(k);
+      c[WireLanes::kEwt * L + lane] = h.ewt(k);
+      c[WireLanes::kEtw * L + lane] = h.etw(k);
+      c[WireLanes::kLoad * L + lane] = m.load[dof];
+      c[WireLanes::kDampingMass * L + lane] = m.alpha * m.mass[dof];
+      c[WireLanes::kInvMass * L + lane] = m.inv_mass[dof];
+      f[lane] = h.lower(k);
+      f[L + lane] = h.inv_pivot(k);
+    }
+  }
+}
+
+}  // namespace
+
+std::shared_ptr<WirePacks> build_wire_packs(Model& m) {
+  for (Wire& w : m.wires) w.twisted_meeting = -1;  // (chosen again below)
   if (m.implicit || m.wires.empty()) return nullptr;
   int catenary = 0;
   for (const Wire& w : m.wires) {
@@ -63,10 +110,24 @@ std::shared_ptr<WirePacks> build_wire_packs(const Model& m) {
         p.factors[(static_cast<std::size_t>(i) * 2 + 1) * L + k] = w.tt_inv_pivot[i];
       }
     }
+    if (sweeps_from_both_ends(m, p)) {
+      twist_condensation(m.wires[p.wire[0]]);
+      lay_out_twisted(m, p);
+      pk.sweep_size += 1;  // stations up to the meeting in both lanes: the meeting node twice
+    }
     pk.packs.push_back(std::move(p));
   }
   for (std::vector<int>* at : {&pk.dof_sweep_force, &pk.dof_joint_force}) at->assign(m.n_catenary_dof, 0);
-  for (const WireLanes& p : pk.packs)
+  for (const WireLanes& p : pk.packs) {
+    if (p.twisted_meeting >= 0) {  // node i at station i in lane 0 up to the meeting, then mirrored in lane 1
+      for (int i = 0; i < p.nodes; ++i) {
+        const int lane = i > p.twisted_meeting ? 1 : 0, station = lane ? p.nodes - 1 - i : i;
+        const std::size_t f = kSweepRecord * p.offset + static_cast<std::size_t>(station) * kSweepRecord * 2 + kRecForce * 2 + lane;
+        pk.dof_sweep_force[m.wires[p.wire[0]].w_dof + i] = static_cast<int>(f);
+        pk.dof_joint_force[m.wires[p.wire[0]].w_dof + i] = -1;  // (no lateral plane)
+      }
+      continue;
+    }
     for (int k = 0; k < p.lanes; ++k)
       for (int i = 0; i < p.nodes; ++i) {
         const int dof = m.wires[p.wire[k]].w_dof + i;
@@ -77,6 +138,7 @@ std::shared_ptr<WirePacks> build_wire_packs(const Model& m) {
         pk.dof_sweep_force[dof] = static_cast<int>(f);
         pk.dof_joint_force[dof] = static_cast<int>(2 * f - k);
       }
+  }
   return packs;
 }
 

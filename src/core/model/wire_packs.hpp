@@ -29,6 +29,16 @@ struct WireLanes {
   // the twisted order (src/core/model/centred_factors.hpp): [pair][value][2 lanes], and the meeting and
   // extra nodes' [value][lane]. Empty with the half-step damping.
   std::vector<double> centred_twin, centred_single;
+  // A lone wire swept from both ends at once (twisted_meeting >= 0), so that it fills both lanes:
+  // the condensation's factorisation runs up from node 0 in lane 0 and down from the last node in
+  // lane 1 (the wire mirrored: its rotations negated), the two meeting at the middle node
+  // (twisted_meeting, of an odd count), which takes both sides' eliminations (a twisted
+  // factorisation). Per station k, node k in lane 0 and node nodes - 1 - k in lane 1, up to the
+  // meeting: coefficients as `coef` and factors as `factors`, in two lanes; the meeting node's
+  // 1 / gamma. Its records: [station][value][2 lanes], the meeting node's in lane 0.
+  int twisted_meeting = -1;
+  std::vector<double> twisted_coef, twisted_factors;
+  double twisted_inv_gamma = 0.0;
 };
 
 // The fused step's record per node and lane (StepWorkspace::sweep, kSweepRecord values per node,
@@ -53,8 +63,9 @@ struct WirePacks {
 };
 
 // Packs the wires for the fused step when the model is explicit with condensed rotations; null
-// otherwise (the generic step).
-std::shared_ptr<WirePacks> build_wire_packs(const Model& model);
+// otherwise (the generic step). A lone wire that fills both lanes from its two ends has its
+// condensation twisted (twist_condensation), the generic step's too.
+std::shared_ptr<WirePacks> build_wire_packs(Model& model);
 
 // The model's packs; empty without (the generic step).
 inline const std::vector<WireLanes>& packs_of(const Model& model) {

@@ -27,8 +27,15 @@ std::vector<double> transition_piece_factors(const Scene& scene, const Wire& w);
 void apply_stiffness(const Model& model, double front, const double* x, double* y, double* scratch,
                      bool explicit_part = false);
 
+// Has the wire's condensed rotations swept from both ends, meeting at its middle node (an odd
+// count of nodes): the factors of Wire::twisted_meeting. A lone wire of the fused step is swept so
+// (model/wire_packs.cpp), its two halves in the two lanes of a register; the same numbers to the
+// bit wherever its band force is taken (wire_elastic_force).
+void twist_condensation(Wire& w);
+
 // Stiffness-only internal force of one wire: f(w) -= K z over the wire's nodes (rotations
-// condensed or taken from z). `theta` is scratch (nodes entries) and returns the rotations used.
+// condensed, from both ends for a twisted wire, or taken from z). `theta` is scratch (nodes
+// entries) and returns the rotations used.
 void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta);
 
 // The condensed band's force on nodes lo..hi of a wire (f -= K z), given the LDL^T factors of
