@@ -352,35 +352,18 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
 // A lone wire in both lanes (WireLanes::twisted_meeting): station k is node k in lane 0 and node
 // top - k in lane 1, whose coefficients are the mirrored wire's (its rotations negated), so that
 // the sweeps above run unchanged on stations 0..meeting; the state is read and written per lane.
-struct TwistedLone {
+struct TwistedLone : OnePlane<2, false, false> {
   using V = Lane<2>;
   using T = Double2;
   using Mask = Long2;
-  static constexpr int NC = WireLanes::kCoefficients, NR = kSweepRecord;
-  const double* coef;
-  const double* fac;
-  double* rec;
-  const double *u, *v;
-  double *un, *vn, *acc;
   int top;  // the wire's last node
-  T beta, dt, ww_lo, wt_lo, ww_hi, wt_hi, above, below;
-  int lo, hi;  // stations 0 and the meeting
 
-  explicit TwistedLone(const PackSweep& a)
-      : coef(a.pack->twisted_coef.data()), fac(a.factors), rec(a.record), u(a.u[0]), v(a.v[0]), un(a.u_next[0]),
-        vn(a.v_next[0]), acc(a.accel[0]), top(a.hi), beta(V::splat(a.beta)), dt(V::splat(a.dt)),
-        ww_lo(V::pair(a.ww_lo)), wt_lo(V::pair(a.wt_lo)), ww_hi(V::pair(a.ww_hi)), wt_hi(V::pair(a.wt_hi)),
-        above(V::splat(a.limit)), below(V::splat(-a.limit)), lo(0), hi(a.pack->twisted_meeting) {}
-
-  __attribute__((always_inline)) T c(int i, int k) const { return V::at(coef, static_cast<std::ptrdiff_t>(i) * NC + k); }
-  __attribute__((always_inline)) T lower(int i) const { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i)); }
-  __attribute__((always_inline)) T ip(int i) const { return V::at(fac, 2 * static_cast<std::ptrdiff_t>(i) + 1); }
-  __attribute__((always_inline)) T get(int i, int k) const { return V::at(rec, static_cast<std::ptrdiff_t>(i) * NR + k); }
-  __attribute__((always_inline)) void set(int i, int k, T x) { V::put(rec, static_cast<std::ptrdiff_t>(i) * NR + k, x); }
-  __attribute__((always_inline)) T inv_mass(int i) const { return c(i, WireLanes::kInvMass); }
-  __attribute__((always_inline)) T init(int i, T vi) const {
-    return c(i, WireLanes::kLoad) - c(i, WireLanes::kDampingMass) * vi;
+  // The pack's two-lane sweep on the wire's twisted coefficients, over stations 0..the meeting.
+  explicit TwistedLone(const PackSweep& a) : OnePlane(a), top(a.hi) {
+    coef = a.pack->twisted_coef.data();
+    hi = a.pack->twisted_meeting;
   }
+
   __attribute__((always_inline)) void state(int i, T& ui, T& vi) const {
     ui = T{u[i], u[top - i]};
     vi = T{v[i], v[top - i]};
@@ -427,8 +410,6 @@ struct TwistedLone {
     vn[i] = vi;
     un[i] = ui;
   }
-  static Mask all() { return V::all(); }
-  static bool inside(Mask m) { return V::ok(m); }
 };
 
 // The sweeps of a lone wire from both ends (TwistedLone): stations 0..meeting - 1 as any pack's,
@@ -630,7 +611,7 @@ bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const 
     a.wt_lo[0] = w.d_wt[0];
     a.ww_lo[1] = w.d_ww[a.hi];
     a.wt_lo[1] = -w.d_wt[a.hi];
-    a.u[0] = x + w.w_dof;
+    a.u[0] = a.u[1] = x + w.w_dof;  // (one wire: no second lane's offset)
     a.v[0] = v + w.w_dof;
     a.u_next[0] = x_next + w.w_dof;
     a.v_next[0] = v_next + w.w_dof;
