@@ -12,6 +12,8 @@
 #include "catenary_sim/core/model/lateral.hpp"
 #include "engine/step_workspace.hpp"
 #include "model/centred_factors.hpp"
+#include "model/twisted_half.hpp"
+#include "model/wire_packs.hpp"
 
 namespace catenary_sim {
 
@@ -60,6 +62,7 @@ void shift_endless_block(const Model& m, State& s) {
 
 void set_wire_window(const Wire& w, double a, double b, WireWindow& ww) {
   const int n = w.nodes();
+  ww.meet = -1;
   ww.lo = static_cast<int>(std::lower_bound(w.x.begin(), w.x.end(), a - 1e-9) - w.x.begin());
   ww.hi = static_cast<int>(std::upper_bound(w.x.begin(), w.x.end(), b + 1e-9) - w.x.begin()) - 1;
   // A wire whose end node alone lies in the window (a section starting at its front support) has
@@ -97,6 +100,12 @@ void set_wire_window(const Wire& w, double a, double b, WireWindow& ww) {
       ww.tt_lower[i] = l;
     }
     ww.tt_inv_pivot[i] = 1.0 / d;
+  }
+  // A wire swept from both ends (Wire::twisted), over an odd count of nodes: the mirrored half's
+  // factors from hi, meeting in the middle.
+  if (w.twisted && (ww.hi - ww.lo) % 2 == 0 && ww.hi - ww.lo >= 2) {
+    ww.meet = (ww.hi - ww.lo) / 2;
+    ww.inv_gamma = twist_range(w, ww.lo, ww.hi, ww.lo_tt, ww.hi_tt, ww.twisted_lower.data(), ww.twisted_inv_pivot.data());
   }
 }
 
@@ -178,6 +187,11 @@ void update_window(const Model& m, State& s) {
   // sweep's LDL^T of K_theta_theta.
   if (m.scene.numerics.damping == DampingStep::kCentred) factor_centred_window(m, s);
   else interleave_window_factors(packs_of(m), s.window, s.work->sweep_factors.data());
+  for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {  // the wires swept from both ends: their two lanes
+    WireWindow& ww = s.window[wi];
+    if (m.wires[wi].twisted && ww.meet > 0)
+      lay_out_twisted(m, window_range(m.wires[wi], ww), ww.twisted_coef.data(), ww.twisted_factors.data());
+  }
   // Index lists sized once in make_state (a copied State keeps their size): no allocation. Only
   // the droppers and supports between the window's ends are looked at, so moving the window costs
   // what the window holds, not the line.
@@ -240,6 +254,10 @@ void commit_window(const Model& m, State& s, const double* u_new, const double* 
 
 void wire_elastic_force_window(const Wire& wire, const WireWindow& ww, const double* z, double* f, double* theta) {
   if (ww.hi < ww.lo) return;
+  if (wire.twisted && ww.meet > 0) {
+    twisted_band_force(window_range(wire, ww), z, f, theta);
+    return;
+  }
   const double ends[4] = {ww.lo_ww, ww.lo_wt, ww.hi_ww, ww.hi_wt};
   condensed_band_force(wire, ww.lo, ww.hi, ends, ww.tt_lower.data(), ww.tt_inv_pivot.data(), z, f, theta);
 }

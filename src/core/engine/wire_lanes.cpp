@@ -14,6 +14,7 @@
 #include "catenary_sim/core/model/lateral.hpp"
 #include "engine/lateral_workspace.hpp"
 #include "engine/step_workspace.hpp"
+#include "model/twisted_half.hpp"
 
 namespace catenary_sim {
 
@@ -352,16 +353,32 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
 // A lone wire in both lanes (WireLanes::twisted_meeting): station k is node k in lane 0 and node
 // top - k in lane 1, whose coefficients are the mirrored wire's (its rotations negated), so that
 // the sweeps above run unchanged on stations 0..meeting; the state is read and written per lane.
+// NodeRecords: the records in the wire's node order (a window's), else by station.
+template <bool NodeRecords>
 struct TwistedLone : OnePlane<2, false, false> {
   using V = Lane<2>;
   using T = Double2;
   using Mask = Long2;
-  int top;  // the wire's last node
+  int top;  // the range's last node, from its first (the state's pointers are at the first)
 
-  // The pack's two-lane sweep on the wire's twisted coefficients, over stations 0..the meeting.
-  explicit TwistedLone(const PackSweep& a) : OnePlane(a), top(a.hi) {
-    coef = a.pack->twisted_coef.data();
-    hi = a.pack->twisted_meeting;
+  // The pack's two-lane sweep on the range's twisted coefficients, over stations 0..the meeting.
+  explicit TwistedLone(const PackSweep& a) : OnePlane(a), top(a.hi - a.lo) {
+    coef = a.twisted_coef;
+    lo = 0;
+    hi = a.twisted_meet;
+  }
+
+  __attribute__((always_inline)) T get(int i, int k) const {
+    if constexpr (NodeRecords) return T{rec[i * NR + k], rec[(top - i) * NR + k]};
+    else return OnePlane::get(i, k);
+  }
+  __attribute__((always_inline)) void set(int i, int k, T x) {
+    if constexpr (NodeRecords) {
+      rec[(top - i) * NR + k] = x[1];
+      rec[i * NR + k] = x[0];  // (last: at the meeting both lanes are its node, lane 0's holds)
+    } else {
+      OnePlane::set(i, k, x);
+    }
   }
 
   __attribute__((always_inline)) void state(int i, T& ui, T& vi) const {
@@ -575,10 +592,15 @@ __attribute__((always_inline)) inline bool sweep_pair(const PackSweep& a, const 
 #endif
 
 CATENARY_SIM_CLONES bool sweep_pack(const PackSweep& a) {
-  if (a.pack->twisted_meeting >= 0 && !a.plane) {
-    Sweeper<TwistedLone> s(a);
-    drive_twisted(s, a.pack->twisted_inv_gamma);
-    return !TwistedLone::inside(s.ok);
+  if (a.twisted_meet >= 0 && !a.plane) {
+    if (a.node_records) {
+      Sweeper<TwistedLone<true>> s(a);
+      drive_twisted(s, a.twisted_inv_gamma);
+      return !Lane<2>::ok(s.ok);
+    }
+    Sweeper<TwistedLone<false>> s(a);
+    drive_twisted(s, a.twisted_inv_gamma);
+    return !Lane<2>::ok(s.ok);
   }
   if (a.plane) {
     if (a.wind[0]) return a.pack->lanes == 2 ? sweep<2, true, true>(a) : sweep<1, true, true>(a);
@@ -604,19 +626,28 @@ bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const 
   a.hi = windowed ? ww0.hi : p.nodes - 1;
   if (a.hi < a.lo) return false;
   a.factors = windowed ? window_factors + 2 * p.offset : p.factors.data();
-  if (p.twisted_meeting >= 0 && !windowed) {  // both lanes' first stations: the wire's two ends, the second mirrored
-    const Wire& w = wires[p.wire[0]];
-    a.factors = p.twisted_factors.data();
-    a.ww_lo[0] = w.d_ww[0];
-    a.wt_lo[0] = w.d_wt[0];
-    a.ww_lo[1] = w.d_ww[a.hi];
-    a.wt_lo[1] = -w.d_wt[a.hi];
-    a.u[0] = a.u[1] = x + w.w_dof;  // (one wire: no second lane's offset)
-    a.v[0] = v + w.w_dof;
-    a.u_next[0] = x_next + w.w_dof;
-    a.v_next[0] = v_next + w.w_dof;
-    a.accel[0] = accel + w.w_dof;
-    a.record = records + kSweepRecord * p.offset;
+  // A lone wire swept from both ends: the whole wire (its pack's layout), or a window of an odd
+  // count of nodes (the window's). Both lanes' first stations are the range's two ends.
+  const Wire& w0 = wires[p.wire[0]];
+  const bool whole = p.twisted_meeting >= 0 && !windowed, in_window = windowed && w0.twisted && ww0.meet > 0;
+  if (whole || in_window) {
+    const TwistedRange r = whole ? whole_wire_range(w0) : window_range(w0, ww0);
+    a.twisted_meet = r.meet;
+    a.twisted_inv_gamma = r.inv_gamma;
+    a.twisted_coef = whole ? p.twisted_coef.data() : ww0.twisted_coef.data();
+    a.factors = whole ? p.twisted_factors.data() : ww0.twisted_factors.data();
+    a.node_records = in_window;
+    for (int lane = 0; lane < 2; ++lane) {
+      a.ww_lo[lane] = r.end_ww[lane];
+      a.wt_lo[lane] = r.end_wt[lane];
+    }
+    const int at = w0.w_dof + a.lo;
+    a.u[0] = a.u[1] = x + at;  // (one wire: no second lane's offset)
+    a.v[0] = v + at;
+    a.u_next[0] = x_next + at;
+    a.v_next[0] = v_next + at;
+    a.accel[0] = accel + at;
+    a.record = records + kSweepRecord * (p.offset + (in_window ? a.lo : 0));
     return true;
   }
   for (int k = 0; k < p.lanes; ++k) {

@@ -32,6 +32,14 @@ struct PackSweep {
   // wire W; the drag cw (W - v)|W - v| (the wire's own velocity v gives the aerodynamic damping) is
   // added to the load. Null: none.
   const double* wind[2] = {nullptr, nullptr};
+  // A lone wire swept from both ends (Wire::twisted; the state's pointers at node lo): the
+  // meeting's station (-1: one lane), its 1 / gamma, the two lanes' coefficients by station
+  // (lay_out_twisted; `factors` holds theirs), and whether the records are in node order (a
+  // window's) or by station (the whole wire's: WirePacks::dof_sweep_force).
+  int twisted_meet = -1;
+  double twisted_inv_gamma = 0.0;
+  const double* twisted_coef = nullptr;
+  bool node_records = false;
 };
 
 // z = u + beta v, the condensed rotations (forward and backward tridiagonal sweeps), the band

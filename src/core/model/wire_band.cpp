@@ -120,41 +120,83 @@ void condensed_band_force(const Wire& wire, int lo, int hi, const double end_cor
   band_w_rows(wire, lo, hi, end_correction, w, theta, fw);
 }
 
-void twist_condensation(Wire& w) {
-  const int n = w.nodes(), top = n - 1, meet = top / 2;
-  w.twisted_meeting = meet;
-  w.twisted_lower.assign(meet + 1, 0.0);
-  w.twisted_inv_pivot.assign(meet + 1, 0.0);
+double twist_range(const Wire& w, int lo, int hi, double tt_lo, double tt_hi, double* lower, double* inv_pivot) {
+  const int meet = (hi - lo) / 2;
   // The mirrored K_theta_theta (x' = L - x negates each rotation: its entries are the wire's, in
-  // reverse order) from its first node, as assemble_band's LDL^T.
-  double d = w.d_tt[top];
-  w.twisted_inv_pivot[0] = 1.0 / d;
+  // reverse order) from its first node, as assemble_band's and set_wire_window's LDL^T.
+  double d = w.d_tt[hi] - tt_hi;
+  lower[0] = 0.0;
+  inv_pivot[0] = 1.0 / d;
   for (int k = 1; k <= meet; ++k) {
-    const double e = w.e_tt[top - k], l = e / d;
-    d = w.d_tt[top - k] - l * e;
-    w.twisted_lower[k] = l;
-    w.twisted_inv_pivot[k] = 1.0 / d;
+    const int t = hi - k;
+    const double e = w.e_tt[t], l = e / d;
+    d = w.d_tt[t] - l * e;
+    lower[k] = l;
+    inv_pivot[k] = 1.0 / d;
   }
-  double d_plus = w.d_tt[0];
-  for (int i = 1; i <= meet; ++i) {
+  double d_plus = w.d_tt[lo] - tt_lo;
+  for (int i = lo + 1; i <= lo + meet; ++i) {
     const double l = w.e_tt[i - 1] / d_plus;
     d_plus = w.d_tt[i] - l * w.e_tt[i - 1];
   }
   // The meeting row with both neighbours eliminated: gamma = d+ + d- - d (Parlett and Dhillon,
   // "Fernando's solution to Wilkinson's problem", 1997; Meurant 1992's twisted factorisation).
-  w.twisted_inv_gamma = 1.0 / (d_plus + d - w.d_tt[meet]);
+  return 1.0 / (d_plus + d - w.d_tt[lo + meet]);
 }
 
-namespace {
+void twist_condensation(Wire& w) {
+  const int top = w.nodes() - 1;
+  w.twisted = true;
+  w.twisted_meeting = top / 2;
+  w.twisted_lower.assign(w.twisted_meeting + 1, 0.0);
+  w.twisted_inv_pivot.assign(w.twisted_meeting + 1, 0.0);
+  w.twisted_inv_gamma = twist_range(w, 0, top, 0.0, 0.0, w.twisted_lower.data(), w.twisted_inv_pivot.data());
+}
 
-// f -= K z with the rotations condensed from both ends (twist_condensation): each half as
-// condensed_band_force on its own nodes, in the fused kernel's order of operations (TwistedLone in
-// engine/wire_lanes.cpp: the same bits), the meeting node's rotation from both sides' eliminations.
-void twisted_band_force(const Wire& wire, const double* z, double* f, double* theta) {
-  const int top = wire.nodes() - 1, meet = wire.twisted_meeting;
-  const double* zw = z + wire.w_dof;
-  double* fw = f + wire.w_dof;
-  const TwistedHalf half[2] = {{wire, top, false}, {wire, top, true}};
+TwistedRange whole_wire_range(const Wire& w) {
+  TwistedRange r;
+  r.w = &w;
+  r.lo = 0;
+  r.hi = w.nodes() - 1;
+  r.meet = w.twisted_meeting;
+  r.end_ww[0] = w.d_ww[0];
+  r.end_wt[0] = w.d_wt[0];
+  r.end_ww[1] = w.d_ww[r.hi];
+  r.end_wt[1] = -w.d_wt[r.hi];
+  r.lower[0] = w.tt_lower.data();
+  r.inv_pivot[0] = w.tt_inv_pivot.data();
+  r.lower[1] = w.twisted_lower.data();
+  r.inv_pivot[1] = w.twisted_inv_pivot.data();
+  r.inv_gamma = w.twisted_inv_gamma;
+  return r;
+}
+
+TwistedRange window_range(const Wire& w, const WireWindow& ww) {
+  TwistedRange r;
+  r.w = &w;
+  r.lo = ww.lo;
+  r.hi = ww.hi;
+  r.meet = ww.meet;
+  r.end_ww[0] = w.d_ww[ww.lo] - ww.lo_ww;
+  r.end_wt[0] = w.d_wt[ww.lo] - ww.lo_wt;
+  r.end_ww[1] = w.d_ww[ww.hi] - ww.hi_ww;
+  r.end_wt[1] = -(w.d_wt[ww.hi] - ww.hi_wt);
+  r.lower[0] = ww.tt_lower.data() + ww.lo;
+  r.inv_pivot[0] = ww.tt_inv_pivot.data() + ww.lo;
+  r.lower[1] = ww.twisted_lower.data();
+  r.inv_pivot[1] = ww.twisted_inv_pivot.data();
+  r.inv_gamma = ww.inv_gamma;
+  return r;
+}
+
+// Each half as condensed_band_force on its own nodes, in the fused kernel's order of operations
+// (TwistedLone in engine/wire_lanes.cpp: the same bits), the meeting node's rotation from both
+// sides' eliminations.
+void twisted_band_force(const TwistedRange& range, const double* z, double* f, double* theta) {
+  const int meet = range.meet;
+  const double* zw = z + range.w->w_dof;
+  double* fw = f + range.w->w_dof;
+  const TwistedHalf half[2] = {{range, false}, {range, true}};
   double r_meet[2], y_meet[2], th_before[2];
   // Forward (K_tt theta = -K_tw z, L of LDL^T) up to the meeting in each half; theta holds y.
   for (int lane = 0; lane < 2; ++lane) {
@@ -171,18 +213,19 @@ void twisted_band_force(const Wire& wire, const double* z, double* f, double* th
     y_meet[lane] = r_meet[lane] - h.lower(meet) * y;
   }
   // The meeting node: y+ + y- - r over gamma (lane 1's y is the mirrored wire's, -y-).
-  const double t_meet = ((y_meet[0] - y_meet[1]) - r_meet[0]) * wire.twisted_inv_gamma;
+  const double t_meet = ((y_meet[0] - y_meet[1]) - r_meet[0]) * range.inv_gamma;
   for (int lane = 0; lane < 2; ++lane) {
     const TwistedHalf& h = half[lane];
     th_before[lane] = theta[h.node(meet - 1)] * h.inv_pivot(meet - 1) - h.lower(meet) * (lane ? -t_meet : t_meet);
   }
   {
     const TwistedHalf& h = half[0];
-    const double A = ((h.dww(meet) * zw[meet] + h.dwt(meet) * t_meet) + h.eww(meet - 1) * zw[meet - 1]) +
+    const int c = h.node(meet);
+    const double A = ((h.dww(meet) * zw[c] + h.dwt(meet) * t_meet) + h.eww(meet - 1) * zw[c - 1]) +
                      h.etw(meet - 1) * th_before[0];
-    const double B = h.eww(meet) * zw[meet + 1] + h.ewt(meet) * -th_before[1];
-    fw[meet] = (fw[meet] - A) - B;
-    theta[meet] = t_meet;
+    const double B = h.eww(meet) * zw[c + 1] + h.ewt(meet) * -th_before[1];
+    fw[c] = (fw[c] - A) - B;
+    theta[c] = t_meet;
   }
   // Back from the meeting in each half: rotation k, and node k + 1's band force behind it.
   for (int lane = 0; lane < 2; ++lane) {
@@ -208,12 +251,10 @@ void twisted_band_force(const Wire& wire, const double* z, double* f, double* th
   }
 }
 
-}  // namespace
-
 void wire_elastic_force(const Wire& wire, const double* z, double* f, double* theta) {
   const int n = wire.nodes();
   if (wire.theta_dof < 0 && wire.twisted_meeting >= 0) {
-    twisted_band_force(wire, z, f, theta);
+    twisted_band_force(whole_wire_range(wire), z, f, theta);
     return;
   }
   if (wire.theta_dof < 0) {

@@ -13,32 +13,26 @@ namespace catenary_sim {
 
 namespace {
 
-// Whether pack p's lone wire is swept from both ends (WireLanes::twisted_meeting): on a 2-D line
-// stepped whole with the half-step damping (the window, the endless line, the lateral plane and
-// the centred step lay out their own sweeps per node), an odd count of nodes so that the two
-// halves meet at one. (A bridle's 33 nodes so swept measured 0.98-0.99 of one lane's cost.)
+// Whether pack p's lone wire is swept from both ends (Wire::twisted): on a 2-D line with the
+// half-step damping (the lateral plane and the centred step lay out their own sweeps per node).
+// A wire stepped whole needs an odd count of nodes, so that the two halves meet at one; in a
+// window the window's count decides (WireWindow::meet). (A bridle's 33 nodes so swept measured
+// 0.98-0.99 of one lane's cost.)
 bool sweeps_from_both_ends(const Model& m, const WireLanes& p) {
-  return p.lanes == 1 && p.nodes >= 3 && p.nodes % 2 == 1 && !m.scene.lateral() &&
-         !m.scene.numerics.windowed() && !m.endless && m.scene.numerics.damping != DampingStep::kCentred;
+  return p.lanes == 1 && p.nodes >= 3 && !m.scene.lateral() && m.scene.numerics.damping != DampingStep::kCentred &&
+         (m.scene.numerics.windowed() || p.nodes % 2 == 1);
 }
 
-// The pack of a lone wire swept from both ends (twist_condensation's factors): station k is node k
-// in lane 0 and node top - k of the wire mirrored in lane 1 (x' = L - x negates each rotation, so
-// the couplings of a displacement with a rotation change sign, and each element's ends swap).
-void lay_out_twisted(const Model& m, WireLanes& p) {
-  const Wire& w = m.wires[p.wire[0]];
-  const int top = p.nodes - 1, meet = w.twisted_meeting;
+}  // namespace
+
+void lay_out_twisted(const Model& m, const TwistedRange& r, double* coef, double* factors) {
   constexpr int L = 2, NC = WireLanes::kCoefficients;
-  p.twisted_meeting = meet;
-  p.twisted_inv_gamma = w.twisted_inv_gamma;
-  p.twisted_coef.assign(static_cast<std::size_t>(meet + 1) * NC * L, 0.0);
-  p.twisted_factors.assign(static_cast<std::size_t>(meet + 1) * 2 * L, 0.0);
-  for (int k = 0; k <= meet; ++k) {
-    double* c = p.twisted_coef.data() + static_cast<std::size_t>(k) * NC * L;
-    double* f = p.twisted_factors.data() + static_cast<std::size_t>(k) * 2 * L;
+  for (int k = 0; k <= r.meet; ++k) {
+    double* c = coef + static_cast<std::size_t>(k) * NC * L;
+    double* f = factors + static_cast<std::size_t>(k) * 2 * L;
     for (int lane = 0; lane < L; ++lane) {
-      const TwistedHalf h{w, top, lane == 1};
-      const int dof = w.w_dof + h.node(k);
+      const TwistedHalf h{r, lane == 1};
+      const int dof = r.w->w_dof + h.node(k);
       c[WireLanes::kDww * L + lane] = h.dww(k);
       c[WireLanes::kDwt * L + lane] = h.dwt(k);
       c[WireLanes::kEww * L + lane] = h.eww(k);
@@ -53,10 +47,11 @@ void lay_out_twisted(const Model& m, WireLanes& p) {
   }
 }
 
-}  // namespace
-
 std::shared_ptr<WirePacks> build_wire_packs(Model& m) {
-  for (Wire& w : m.wires) w.twisted_meeting = -1;  // (chosen again below)
+  for (Wire& w : m.wires) {  // (chosen again below)
+    w.twisted = false;
+    w.twisted_meeting = -1;
+  }
   if (m.implicit || m.wires.empty()) return nullptr;
   int catenary = 0;
   for (const Wire& w : m.wires) {
@@ -111,9 +106,18 @@ std::shared_ptr<WirePacks> build_wire_packs(Model& m) {
       }
     }
     if (sweeps_from_both_ends(m, p)) {
-      twist_condensation(m.wires[p.wire[0]]);
-      lay_out_twisted(m, p);
-      pk.sweep_size += 1;  // stations up to the meeting in both lanes: the meeting node twice
+      Wire& w = m.wires[p.wire[0]];
+      w.twisted = true;
+      if (!m.scene.numerics.windowed()) {
+        twist_condensation(w);
+        const TwistedRange r = whole_wire_range(w);
+        p.twisted_meeting = r.meet;
+        p.twisted_inv_gamma = r.inv_gamma;
+        p.twisted_coef.assign(static_cast<std::size_t>(r.meet + 1) * WireLanes::kCoefficients * 2, 0.0);
+        p.twisted_factors.assign(static_cast<std::size_t>(r.meet + 1) * 2 * 2, 0.0);
+        lay_out_twisted(m, r, p.twisted_coef.data(), p.twisted_factors.data());
+        pk.sweep_size += 1;  // stations up to the meeting in both lanes: the meeting node twice
+      }
     }
     pk.packs.push_back(std::move(p));
   }

@@ -29,13 +29,14 @@ struct WireLanes {
   // the twisted order (src/core/model/centred_factors.hpp): [pair][value][2 lanes], and the meeting and
   // extra nodes' [value][lane]. Empty with the half-step damping.
   std::vector<double> centred_twin, centred_single;
-  // A lone wire swept from both ends at once (twisted_meeting >= 0), so that it fills both lanes:
-  // the condensation's factorisation runs up from node 0 in lane 0 and down from the last node in
-  // lane 1 (the wire mirrored: its rotations negated), the two meeting at the middle node
-  // (twisted_meeting, of an odd count), which takes both sides' eliminations (a twisted
-  // factorisation). Per station k, node k in lane 0 and node nodes - 1 - k in lane 1, up to the
-  // meeting: coefficients as `coef` and factors as `factors`, in two lanes; the meeting node's
-  // 1 / gamma. Its records: [station][value][2 lanes], the meeting node's in lane 0.
+  // A lone wire swept from both ends at once (Wire::twisted), so that it fills both lanes: the
+  // condensation's factorisation runs up from node 0 in lane 0 and down from the last node in
+  // lane 1 (the wire mirrored: its rotations negated), the two meeting at the middle node, which
+  // takes both sides' eliminations (a twisted factorisation). Stepped whole (twisted_meeting >= 0,
+  // an odd count): per station k, node k in lane 0 and node nodes - 1 - k in lane 1, up to the
+  // meeting, lay_out_twisted's coefficients and factors and the meeting node's 1 / gamma; its
+  // records [station][value][2 lanes], the meeting node's in lane 0. In a window the window's
+  // (WireWindow::meet), its records in node order.
   int twisted_meeting = -1;
   std::vector<double> twisted_coef, twisted_factors;
   double twisted_inv_gamma = 0.0;
@@ -61,6 +62,12 @@ struct WirePacks {
   std::vector<int> dof_sweep_force, dof_joint_force;
   std::size_t sweep_size = 0;  // node-lanes of all packs (StepWorkspace::sweep holds kCentredRecord values for each)
 };
+
+struct TwistedRange;
+// The fused kernel's coefficients and factors of a range swept from both ends (TwistedLone in
+// engine/wire_lanes.cpp): per station up to the meeting, [station][value][2 lanes] as `coef`, and
+// [station][lower, inv_pivot][2 lanes].
+void lay_out_twisted(const Model& m, const TwistedRange& r, double* coef, double* factors);
 
 // Packs the wires for the fused step when the model is explicit with condensed rotations; null
 // otherwise (the generic step). A lone wire that fills both lanes from its two ends has its

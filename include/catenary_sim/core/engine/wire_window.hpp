@@ -14,6 +14,13 @@ struct WireWindow {
   bool cut_lo = false, cut_hi = false;
   double lo_ww = 0, lo_wt = 0, lo_tt = 0, hi_ww = 0, hi_wt = 0, hi_tt = 0;  // outside element's share of the end blocks
   std::vector<double> tt_lower, tt_inv_pivot;  // LDL^T of the window's K_theta_theta
+  // A wire swept from both ends (Wire::twisted) whose window holds an odd count of nodes: the
+  // meeting's station (its middle, from lo), the mirrored half's factors by station (from hi) and
+  // 1 / gamma; and the fused kernel's coefficients and factors in the two lanes (lay_out_twisted).
+  // meet -1: one lane for this window.
+  int meet = -1;
+  std::vector<double> twisted_lower, twisted_inv_pivot, twisted_coef, twisted_factors;
+  double inv_gamma = 0.0;
 };
 
 }  // namespace catenary_sim

@@ -44,9 +44,11 @@ struct Wire {
   std::vector<double> e_ww, e_wt, e_tw, e_tt;  // size nodes-1; e_wt = K(w_e, theta_e+1), e_tw = K(theta_e, w_e+1)
   // Condensed rotations: LDL^T factors of the tridiagonal K_theta_theta, reused every step.
   std::vector<double> tt_inv_pivot, tt_lower;
-  // Condensed rotations swept from both ends (twisted_meeting >= 0; twist_condensation): the LDL^T
-  // of the wire mirrored (its rotations negated) from its last node to the meeting node, station k
-  // being node nodes() - 1 - k, and 1 / gamma of the meeting row, where the two sides meet.
+  // Condensed rotations swept from both ends (twisted: a lone wire of the fused step), the whole
+  // wire's (twisted_meeting >= 0; twist_condensation) or a moving window's part (WireWindow::meet):
+  // the LDL^T of the wire mirrored (its rotations negated) from its last node to the meeting node,
+  // station k being node nodes() - 1 - k, and 1 / gamma of the meeting row, where the two sides meet.
+  bool twisted = false;
   int twisted_meeting = -1;
   std::vector<double> twisted_lower, twisted_inv_pivot;
   double twisted_inv_gamma = 0.0;
