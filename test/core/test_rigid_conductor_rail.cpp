@@ -166,7 +166,11 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
   refused(y + "droppers:\n  positions: [5.0]\n  axial_stiffness: 1e5\n", "droppers");
   refused(with("conductor_rail:\n", "conductor_rail:\n  tension: 1000\n"), "conductor_rail.tension");
   refused(with("span_count: 3", "span_count: 1"), "spans");
-  refused(with("numerics:\n", "numerics:\n  window: auto\n"), "numerics.window");
+  // The window holds whole sections (test_window.cpp): lengths of its own are refused.
+  refused(with("numerics:\n", "numerics:\n  window: {ahead: 100, behind: 100}\n"), "numerics.window");
+  // The 3-D line's lateral window is not laid by sections.
+  const std::string lateral = test_scenes::refusal_of(test_scenes::scene_path("rigid_conductor_rail_3d.yaml"), {"numerics.window=auto"});
+  EXPECT_NE(lateral.find("'numerics.window' = auto (on a 3-D line"), std::string::npos) << lateral;
   // The wind's drag on the profile: its height and coefficient in range, and drag blocks only for
   // the wires the line has (a rail-only line has no tensioned contact wire, a catenary no profile).
   refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\nwind: {speed: 20, contact_wire: {diameter: 0.012}}\n",
@@ -229,7 +233,7 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
       "sections:\n  - {span_length: 10.0, span_count: 4}\n"
       "  - {span_length: 10.0, span_count: 4, contact_wire: {linear_mass: 1.35, tension: 20000}}\n";
   refused(mixed + "overlap: {spans: 1}\n", "overlap.support_rise");
-  refused(mixed + "overlap: {spans: 1, support_rise: 0.02}\nnumerics: {window: auto}\n", "numerics.window");
+  refused(mixed + "overlap: {spans: 1, support_rise: 0.02}\nnumerics: {window: {ahead: 50, behind: 50}}\n", "numerics.window");
   // A tensioned wire without tension, set in code, is refused by validate().
   cs::Scene tensionless = cs::load_scene_string(
       "name: t\nline: {spans: [20.0]}\ncontact_wire: {linear_mass: 1.35, tension: 20000}\n");

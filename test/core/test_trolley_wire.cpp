@@ -573,7 +573,7 @@ TEST(TrolleyWire, BridlesBadInputIsRefusedByName) {
   const std::string slack = test_scenes::refusal(
       [&] { return cs::load_scene_string(with("tension: 1500", "tension: 600") + "stagger:\n  contact_wire: [0.2, -0.2]\n"); });
   for (const char* word : {"bridle.tension", "at most 0.25"}) EXPECT_NE(slack.find(word), std::string::npos) << slack;
-  refused(with("element_length: 0.25\n", "element_length: 0.25\n  window: auto\n"), "numerics.window");
+  refused(with("element_length: 0.25\n", "element_length: 0.25\n  window: {ahead: 100, behind: 100}\n"), "numerics.window");
   refused(with("steady_arms:\n  stiffness: 20000\n", "steady_arms:\n  length: 1.0\n  linear_mass: 1.0\n  pull_off: 200\n"),
           "steady_arms");
   const std::string message = test_scenes::refusal_of_yaml(with("length: 8", "length: 25"));

@@ -158,12 +158,30 @@ void update_window(const Model& m, State& s) {
   }
   if (m.pantographs.empty()) x_min = x_max = s.front;
   const std::vector<double>& sx = m.support_x;
-  double ahead = 0.0, behind = 0.0;
-  window_lengths(m, s.speed, &ahead, &behind);
-  const double lo_x = x_min - behind, hi_x = x_max + ahead;
+  double lo_x = 0.0, hi_x = 0.0;
+  // Whole sections (Model::window_holds_sections): those within a span of a pantograph. Sections
+  // touch only through the pantographs, so one ahead is at rest until they reach it and one they
+  // have left changes nothing they feel: the contact is the whole line's, to the bit.
+  int sec_first = -1, sec_last = -1;
+  if (m.window_holds_sections) {
+    for (std::size_t k = 0; k < m.sections.size(); ++k)
+      if (m.sections[k].start <= x_max + m.longest_span && m.sections[k].end >= x_min - m.longest_span) {
+        if (sec_first < 0) sec_first = static_cast<int>(k);
+        sec_last = static_cast<int>(k);
+      }
+    if (sec_first < 0) sec_first = sec_last = 0;  // (the train beyond the line: its first section)
+    lo_x = m.sections[sec_first].start;
+    hi_x = m.sections[sec_last].end;
+    for (int k = sec_first; k <= sec_last; ++k) hi_x = std::max(hi_x, m.sections[k].end);
+  } else {
+    double ahead = 0.0, behind = 0.0;
+    window_lengths(m, s.speed, &ahead, &behind);
+    lo_x = x_min - behind;
+    hi_x = x_max + ahead;
+  }
   // Snap outward to supports.
-  int first = static_cast<int>(std::upper_bound(sx.begin(), sx.end(), lo_x) - sx.begin()) - 1;
-  int last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x) - sx.begin());
+  int first = static_cast<int>(std::upper_bound(sx.begin(), sx.end(), lo_x + 1e-9) - sx.begin()) - 1;
+  int last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x - 1e-9) - sx.begin());
   first = std::clamp(first, 0, static_cast<int>(sx.size()) - 1);
   last = std::clamp(last, 0, static_cast<int>(sx.size()) - 1);
   if (first == s.window_first_support && last == s.window_last_support) return;
@@ -175,7 +193,16 @@ void update_window(const Model& m, State& s) {
     const Wire& w = m.wires[wi];
     WireWindow& ww = s.window[wi];
     const int old_lo = ww.lo, old_hi = ww.hi;
-    set_wire_window(w, a, b, ww);
+    if (!m.window_holds_sections) {
+      set_wire_window(w, a, b, ww);
+    } else if (w.section >= sec_first && w.section <= sec_last) {
+      set_wire_window(w, w.x.front(), w.x.back(), ww);  // whole: no cut
+    } else {
+      ww.lo = 0;  // another section: none of its nodes
+      ww.hi = -1;
+      ww.cut_lo = ww.cut_hi = false;
+      ww.meet = -1;
+    }
     // Nodes that left the window return to the static state.
     for (int i = old_lo; i <= old_hi; ++i)
       if (i < ww.lo || i > ww.hi) {

@@ -485,6 +485,9 @@ void set_inverse_mass(Model& m, const std::vector<bool>& fixed) {
 
 // The wave speed and its warning, the longest span, and the droppers and supports in line order.
 void set_line_order(const Scene& scene, Model& m) {
+  m.window_holds_sections =
+      scene.numerics.windowed() && std::any_of(scene.sections.begin(), scene.sections.end(),
+                                               [](const SectionSpec& sec) { return sec.rigid || sec.bridle.has_value(); });
   m.wave_speed = 1e300;
   for (int wi : m.contact_wires)
     if (!scene.sections[m.wires[wi].section].rigid)  // a tension-free profile: no string wave, no such limit

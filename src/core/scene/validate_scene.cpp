@@ -369,9 +369,11 @@ void validate_rigid(const Scene& s) {
   if (std::none_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.rigid; })) return;
   if (s.endless)
     fail("line.endless", "true (with conductor_rail)", "false: the endless block is laid by the tensioned wire's wave speed");
-  if (s.numerics.windowed())
-    fail("numerics.window", "(given with conductor_rail)",
-         "off: the window's absorbing ends are matched to a tensioned wire's waves, a tension-free profile has none");
+  if (s.numerics.windowed() && (!s.numerics.window_auto || s.lateral()))
+    fail("numerics.window", s.numerics.window_auto ? "auto (on a 3-D line, with conductor_rail)" : "(lengths given with conductor_rail)",
+         "auto on a 2-D line, or off: a tension-free profile's bending waves run the whole section, so the window holds "
+         "whole sections (those a pantograph is in); its lengths cannot be given, and the 3-D line's lateral window "
+         "is not laid by sections");
   // Wear thins the contact wire alone; the model's beam is profile and wire together, whose
   // mass and EI a worn wire changes by another law (not modelled).
   if (s.imperfections.contact_wire_wear.any())
@@ -581,10 +583,11 @@ void validate_bridles(const Scene& s) {
     if (s.endless)
       fail(f, "(given on the endless line)",
            "a finite line: the endless line needs the moving window, which a bridled wire's far-running waves defeat");
-    if (s.numerics.windowed())
-      fail("numerics.window", "(given with a bridle)",
-           "none: under bridles the contact wire's waves run the whole section, beyond any window (the auto window's "
-           "contact-force std 2 % off); run the section whole");
+    if (s.numerics.windowed() && (!s.numerics.window_auto || s.lateral()))
+      fail("numerics.window", s.numerics.window_auto ? "auto (on a 3-D line, with a bridle)" : "(lengths given with a bridle)",
+           "auto on a 2-D line, or off: under bridles the contact wire's waves run the whole section, so the window "
+           "holds whole sections (those a pantograph is in); its lengths cannot be given, and the 3-D line's lateral "
+           "window is not laid by sections");
     const std::size_t n = sec.spans.size();
     if (n < 2)
       fail(f, "(given on a section of 1 span)", "a section with intermediate supports (2 spans or more): a bridle hangs at one");

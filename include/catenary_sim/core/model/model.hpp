@@ -220,6 +220,9 @@ struct Model {
   double train_start = 0.0, train_end = 0.0;  // m, front of the train
   double line_length = 0.0;
   double wave_speed = 0.0;      // m/s, sqrt(T/rhoA) of the contact wire (the slowest one)
+  // The moving window holds whole tension sections (numerics.window auto on a line with a rigid
+  // rail or bridles, whose waves run the whole section): those a pantograph is in.
+  bool window_holds_sections = false;
   // Endless line (Scene::endless): the wires are a block of equal spans starting at station 0;
   // whenever the rearmost collector runs a span past endless_home, step() moves the state back a
   // span and adds it to State::line_offset (a station along the line = block station + offset).
