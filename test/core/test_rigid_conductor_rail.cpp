@@ -168,9 +168,6 @@ TEST(RigidConductorRail, BadInputIsRefusedByName) {
   refused(with("span_count: 3", "span_count: 1"), "spans");
   // The window holds whole sections (test_window.cpp): lengths of its own are refused.
   refused(with("numerics:\n", "numerics:\n  window: {ahead: 100, behind: 100}\n"), "numerics.window");
-  // The 3-D line's lateral window is not laid by sections.
-  const std::string lateral = test_scenes::refusal_of(test_scenes::scene_path("rigid_conductor_rail_3d.yaml"), {"numerics.window=auto"});
-  EXPECT_NE(lateral.find("'numerics.window' = auto (on a 3-D line"), std::string::npos) << lateral;
   // The wind's drag on the profile: its height and coefficient in range, and drag blocks only for
   // the wires the line has (a rail-only line has no tensioned contact wire, a catenary no profile).
   refused(y + "stagger:\n  contact_wire: [0.2, -0.2]\nwind: {speed: 20, contact_wire: {diameter: 0.012}}\n",

@@ -200,7 +200,8 @@ TEST(Window, RefusedWithTheImplicitIntegratorOrLumpedRotations) {
 // (CentredDampingOverTheWholeLineIsTheWholeLine). The bound, 1e-8 N, is 1e-10 of the 70-170 N
 // contact force, ten times the largest difference seen over 30,000-95,000 steps (4e-10 and
 // 1.2e-9 N); a section taken in late or left early moves the force by newtons. Four sections, the
-// pass across two of their joints, the window never more than two of them.
+// pass across two of their joints, the window never more than two of them; on a 3-D line the
+// lateral plane's window too.
 TEST(Window, WholeSectionsOfARailAndOfBridlesGiveTheWholeLinesContact) {
   struct Case {
     std::string file;
@@ -218,6 +219,12 @@ TEST(Window, WholeSectionsOfARailAndOfBridlesGiveTheWholeLinesContact) {
         "sections=[{span_length: 25, span_count: 8}, {span_length: 25, span_count: 8}, "
         "{span_length: 25, span_count: 8}, {span_length: 25, span_count: 8}]",
         "train.end=560"},
+       1e-8},
+      // A 3-D line: the lateral plane's window holds the same sections (the rail in a cross wind).
+      {"rigid_conductor_rail_3d.yaml",
+       {"sections=[{span_length: 10, span_count: 12}, {span_length: 10, span_count: 12}, "
+        "{span_length: 10, span_count: 12}, {span_length: 10, span_count: 12}]",
+        "wind.speed=30", "train.end=260"},
        1e-8}};
   for (const Case& c : cases) {
     SCOPED_TRACE(c.file);
@@ -236,11 +243,31 @@ TEST(Window, WholeSectionsOfARailAndOfBridlesGiveTheWholeLinesContact) {
       ++steps;
       worst = std::max(worst, std::fabs(total_contact_force(a.model(), a.state(), 0) - total_contact_force(b.model(), b.state(), 0)));
       int held = 0;
-      for (const WireWindow& ww : b.state().window) held += std::max(0, ww.hi - ww.lo + 1);
+      for (std::size_t wi = 0; wi < b.state().window.size(); ++wi) {
+        const WireWindow& ww = b.state().window[wi];
+        held += std::max(0, ww.hi - ww.lo + 1);
+        ASSERT_TRUE(ww.hi < ww.lo || (ww.lo == 0 && ww.hi == b.model().wires[wi].nodes() - 1)) << "wire " << wi << " cut";
+        if (b.model().lateral) {  // the lateral plane's window holds the same wires whole
+          const WireWindow& lw = b.state().lateral.window[wi];
+          ASSERT_TRUE((lw.hi < lw.lo && ww.hi < ww.lo) || (lw.lo == ww.lo && lw.hi == ww.hi)) << "wire " << wi << " step " << steps;
+        }
+      }
       most = std::max(most, held);
     }
     EXPECT_GT(steps, 1000);
     EXPECT_LE(worst, c.bound);
     EXPECT_LT(most, 0.6 * b.model().n_catenary_dof) << "the window held " << most << " of " << b.model().n_catenary_dof;
+    // The window's wires across the track: the whole line's to rounding (3.5e-12 m seen; 1e-10 m
+    // is 1e-8 of the profile's 1-3 cm blow-off in the wind, which a section out of step misses).
+    if (b.model().lateral) {
+      double y_worst = 0.0;
+      for (std::size_t wi = 0; wi < b.model().wires.size(); ++wi) {
+        const WireWindow& ww = b.state().lateral.window[wi];
+        const int o = b.model().lateral->wires[wi].w_dof;
+        for (int i = ww.lo; i <= ww.hi; ++i)
+          y_worst = std::max(y_worst, std::fabs(a.state().lateral.y[o + i] - b.state().lateral.y[o + i]));
+      }
+      EXPECT_LE(y_worst, 1e-10);
+    }
   }
 }

@@ -165,7 +165,12 @@ void sync_window(const Model& m, State& s) {
   lw.cut_count = 0;
   lw.window_fused = !lat.planes.empty();
   const double xa = first >= 0 ? sx[first] : 0.0, xb = first >= 0 ? sx[last] : -1.0;
-  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) move_wire_window(m, s, wi, first, xa, xb, turbulent);
+  for (std::size_t wi = 0; wi < lat.wires.size(); ++wi) {
+    const WireWindow& vertical = s.window[wi];
+    if (!m.window_holds_sections) move_wire_window(m, s, wi, first, xa, xb, turbulent);
+    else if (vertical.hi >= vertical.lo) move_wire_window(m, s, wi, first, lat.wires[wi].x.front(), lat.wires[wi].x.back(), turbulent);
+    else move_wire_window(m, s, wi, -1, 0.0, -1.0, turbulent);  // (whole sections: the vertical window's)
+  }
   for (const WireLanes& p : packs_of(m))
     if (p.lanes == 2 && (ls.window[p.wire[0]].lo != ls.window[p.wire[1]].lo || ls.window[p.wire[0]].hi != ls.window[p.wire[1]].hi))
       lw.window_fused = false;

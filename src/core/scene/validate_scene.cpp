@@ -369,11 +369,10 @@ void validate_rigid(const Scene& s) {
   if (std::none_of(s.sections.begin(), s.sections.end(), [](const SectionSpec& sec) { return sec.rigid; })) return;
   if (s.endless)
     fail("line.endless", "true (with conductor_rail)", "false: the endless block is laid by the tensioned wire's wave speed");
-  if (s.numerics.windowed() && (!s.numerics.window_auto || s.lateral()))
-    fail("numerics.window", s.numerics.window_auto ? "auto (on a 3-D line, with conductor_rail)" : "(lengths given with conductor_rail)",
-         "auto on a 2-D line, or off: a tension-free profile's bending waves run the whole section, so the window holds "
-         "whole sections (those a pantograph is in); its lengths cannot be given, and the 3-D line's lateral window "
-         "is not laid by sections");
+  if (s.numerics.windowed() && !s.numerics.window_auto)
+    fail("numerics.window", "(lengths given with conductor_rail)",
+         "auto, or off: a tension-free profile's bending waves run the whole section, so the window holds whole "
+         "sections (those within a span of a pantograph), not lengths of its own");
   // Wear thins the contact wire alone; the model's beam is profile and wire together, whose
   // mass and EI a worn wire changes by another law (not modelled).
   if (s.imperfections.contact_wire_wear.any())
@@ -583,11 +582,10 @@ void validate_bridles(const Scene& s) {
     if (s.endless)
       fail(f, "(given on the endless line)",
            "a finite line: the endless line needs the moving window, which a bridled wire's far-running waves defeat");
-    if (s.numerics.windowed() && (!s.numerics.window_auto || s.lateral()))
-      fail("numerics.window", s.numerics.window_auto ? "auto (on a 3-D line, with a bridle)" : "(lengths given with a bridle)",
-           "auto on a 2-D line, or off: under bridles the contact wire's waves run the whole section, so the window "
-           "holds whole sections (those a pantograph is in); its lengths cannot be given, and the 3-D line's lateral "
-           "window is not laid by sections");
+    if (s.numerics.windowed() && !s.numerics.window_auto)
+      fail("numerics.window", "(lengths given with a bridle)",
+           "auto, or off: under bridles the contact wire's waves run the whole section, so the window holds whole "
+           "sections (those within a span of a pantograph), not lengths of its own");
     const std::size_t n = sec.spans.size();
     if (n < 2)
       fail(f, "(given on a section of 1 span)", "a section with intermediate supports (2 spans or more): a bridle hangs at one");
