@@ -161,7 +161,8 @@ void update_window(const Model& m, State& s) {
   double lo_x = 0.0, hi_x = 0.0;
   // Whole sections (Model::window_holds_sections): those within a span of a pantograph. Sections
   // touch only through the pantographs, so one ahead is at rest until they reach it and one they
-  // have left changes nothing they feel: the contact is the whole line's, to the bit.
+  // have left changes nothing they feel: the contact is the whole line's (to rounding: the
+  // window's factors are formed in another order).
   int sec_first = -1, sec_last = -1;
   if (m.window_holds_sections) {
     for (std::size_t k = 0; k < m.sections.size(); ++k)
@@ -179,9 +180,10 @@ void update_window(const Model& m, State& s) {
     lo_x = x_min - behind;
     hi_x = x_max + ahead;
   }
-  // Snap outward to supports.
-  int first = static_cast<int>(std::upper_bound(sx.begin(), sx.end(), lo_x + 1e-9) - sx.begin()) - 1;
-  int last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x - 1e-9) - sx.begin());
+  // Snap outward to supports (whole sections: their end supports themselves).
+  const double on = m.window_holds_sections ? 1e-9 : 0.0;
+  int first = static_cast<int>(std::upper_bound(sx.begin(), sx.end(), lo_x + on) - sx.begin()) - 1;
+  int last = static_cast<int>(std::lower_bound(sx.begin(), sx.end(), hi_x - on) - sx.begin());
   first = std::clamp(first, 0, static_cast<int>(sx.size()) - 1);
   last = std::clamp(last, 0, static_cast<int>(sx.size()) - 1);
   if (first == s.window_first_support && last == s.window_last_support) return;
