@@ -350,7 +350,7 @@ __attribute__((always_inline)) inline bool sweep(const PackSweep& a) {
   return !OnePlane<L, Plane, Drag>::inside(s.ok);  // some new displacement beyond the limit or NaN
 }
 
-// A lone wire in both lanes (WireLanes::twisted_meeting): station k is node k in lane 0 and node
+// A lone wire in both lanes (Wire::twisted): station k is node k in lane 0 and node
 // top - k in lane 1, whose coefficients are the mirrored wire's (its rotations negated), so that
 // the sweeps above run unchanged on stations 0..meeting; the state is read and written per lane.
 // NodeRecords: the records in the wire's node order (a window's), else by station.
@@ -477,6 +477,13 @@ __attribute__((always_inline)) inline void drive_twisted(S& s, double inv_gamma)
   s.backward_end();
 }
 
+template <bool NodeRecords>
+__attribute__((always_inline)) inline bool sweep_twisted(const PackSweep& a) {
+  Sweeper<TwistedLone<NodeRecords>> s(a);
+  drive_twisted(s, a.twisted_inv_gamma);
+  return !Lane<2>::ok(s.ok);  // some new displacement beyond the limit or NaN
+}
+
 // Both planes of an L-wire pack in 2L lanes, [vertical: wire 0 (, wire 1); lateral: wire 0 (,
 // wire 1)]: the band and its factors are the same both ways (a round wire bends alike), so each
 // coefficient is loaded once for both and every band operation does both planes at once; each
@@ -592,16 +599,7 @@ __attribute__((always_inline)) inline bool sweep_pair(const PackSweep& a, const 
 #endif
 
 CATENARY_SIM_CLONES bool sweep_pack(const PackSweep& a) {
-  if (a.twisted_meet >= 0 && !a.plane) {
-    if (a.node_records) {
-      Sweeper<TwistedLone<true>> s(a);
-      drive_twisted(s, a.twisted_inv_gamma);
-      return !Lane<2>::ok(s.ok);
-    }
-    Sweeper<TwistedLone<false>> s(a);
-    drive_twisted(s, a.twisted_inv_gamma);
-    return !Lane<2>::ok(s.ok);
-  }
+  if (a.twisted_meet >= 0 && !a.plane) return a.node_records ? sweep_twisted<true>(a) : sweep_twisted<false>(a);
   if (a.plane) {
     if (a.wind[0]) return a.pack->lanes == 2 ? sweep<2, true, true>(a) : sweep<1, true, true>(a);
     return a.pack->lanes == 2 ? sweep<2, true, false>(a) : sweep<1, true, false>(a);
@@ -629,7 +627,7 @@ bool setup_pack_sweep(const WireLanes& p, const std::vector<Wire>& wires, const 
   // A lone wire swept from both ends: the whole wire (its pack's layout), or a window of an odd
   // count of nodes (the window's). Both lanes' first stations are the range's two ends.
   const Wire& w0 = wires[p.wire[0]];
-  const bool whole = p.twisted_meeting >= 0 && !windowed, in_window = windowed && w0.twisted && ww0.meet > 0;
+  const bool whole = w0.twisted_meeting >= 0 && !windowed, in_window = windowed && w0.twisted && ww0.meet > 0;
   if (whole || in_window) {
     const TwistedRange r = whole ? whole_wire_range(w0) : window_range(w0, ww0);
     a.twisted_meet = r.meet;

@@ -111,8 +111,6 @@ std::shared_ptr<WirePacks> build_wire_packs(Model& m) {
       if (!m.scene.numerics.windowed()) {
         twist_condensation(w);
         const TwistedRange r = whole_wire_range(w);
-        p.twisted_meeting = r.meet;
-        p.twisted_inv_gamma = r.inv_gamma;
         p.twisted_coef.assign(static_cast<std::size_t>(r.meet + 1) * WireLanes::kCoefficients * 2, 0.0);
         p.twisted_factors.assign(static_cast<std::size_t>(r.meet + 1) * 2 * 2, 0.0);
         lay_out_twisted(m, r, p.twisted_coef.data(), p.twisted_factors.data());
@@ -123,9 +121,10 @@ std::shared_ptr<WirePacks> build_wire_packs(Model& m) {
   }
   for (std::vector<int>* at : {&pk.dof_sweep_force, &pk.dof_joint_force}) at->assign(m.n_catenary_dof, 0);
   for (const WireLanes& p : pk.packs) {
-    if (p.twisted_meeting >= 0) {  // node i at station i in lane 0 up to the meeting, then mirrored in lane 1
+    const int meet = m.wires[p.wire[0]].twisted_meeting;
+    if (p.lanes == 1 && meet >= 0) {  // node i at station i in lane 0 up to the meeting, then mirrored in lane 1
       for (int i = 0; i < p.nodes; ++i) {
-        const int lane = i > p.twisted_meeting ? 1 : 0, station = lane ? p.nodes - 1 - i : i;
+        const int lane = i > meet ? 1 : 0, station = lane ? p.nodes - 1 - i : i;
         const std::size_t f = kSweepRecord * p.offset + static_cast<std::size_t>(station) * kSweepRecord * 2 + kRecForce * 2 + lane;
         pk.dof_sweep_force[m.wires[p.wire[0]].w_dof + i] = static_cast<int>(f);
         pk.dof_joint_force[m.wires[p.wire[0]].w_dof + i] = -1;  // (no lateral plane)

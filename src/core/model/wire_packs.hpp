@@ -32,14 +32,12 @@ struct WireLanes {
   // A lone wire swept from both ends at once (Wire::twisted), so that it fills both lanes: the
   // condensation's factorisation runs up from node 0 in lane 0 and down from the last node in
   // lane 1 (the wire mirrored: its rotations negated), the two meeting at the middle node, which
-  // takes both sides' eliminations (a twisted factorisation). Stepped whole (twisted_meeting >= 0,
-  // an odd count): per station k, node k in lane 0 and node nodes - 1 - k in lane 1, up to the
-  // meeting, lay_out_twisted's coefficients and factors and the meeting node's 1 / gamma; its
-  // records [station][value][2 lanes], the meeting node's in lane 0. In a window the window's
+  // takes both sides' eliminations (a twisted factorisation). Stepped whole (the wire's
+  // Wire::twisted_meeting >= 0, an odd count): per station k, node k in lane 0 and node nodes - 1 - k
+  // in lane 1, up to the meeting, lay_out_twisted's coefficients and factors; its records
+  // [station][value][2 lanes], the meeting node's in lane 0. In a window the window's
   // (WireWindow::meet), its records in node order.
-  int twisted_meeting = -1;
   std::vector<double> twisted_coef, twisted_factors;
-  double twisted_inv_gamma = 0.0;
 };
 
 // The fused step's record per node and lane (StepWorkspace::sweep, kSweepRecord values per node,
