@@ -80,7 +80,7 @@ State make_state(const Model& m) {
   for (std::size_t wi = 0; wi < m.wires.size(); ++wi) {
     s.window[wi].tt_lower.assign(m.wires[wi].nodes(), 0.0);
     s.window[wi].tt_inv_pivot.assign(m.wires[wi].nodes(), 0.0);
-    if (m.wires[wi].twisted) {  // stations up to a window's meeting: at most half the wire's nodes, and one
+    if (m.wires[wi].twisted && m.scene.numerics.windowed()) {  // stations up to a window's meeting: at most half the wire's nodes, and one
       const std::size_t stations = static_cast<std::size_t>(m.wires[wi].nodes()) / 2 + 1;
       s.window[wi].twisted_lower.assign(stations, 0.0);
       s.window[wi].twisted_inv_pivot.assign(stations, 0.0);

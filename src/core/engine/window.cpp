@@ -171,9 +171,8 @@ void update_window(const Model& m, State& s) {
         sec_last = static_cast<int>(k);
       }
     if (sec_first < 0) sec_first = sec_last = 0;  // (the train beyond the line: its first section)
-    lo_x = m.sections[sec_first].start;
+    lo_x = m.sections[sec_first].start;  // (sections lie in line order, each beyond the one before)
     hi_x = m.sections[sec_last].end;
-    for (int k = sec_first; k <= sec_last; ++k) hi_x = std::max(hi_x, m.sections[k].end);
   } else {
     double ahead = 0.0, behind = 0.0;
     window_lengths(m, s.speed, &ahead, &behind);
