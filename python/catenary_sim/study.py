@@ -165,9 +165,13 @@ def _make_output_dir(out, sub, error=StudyError):
         os.makedirs(os.path.join(out, sub), exist_ok=True)
     except OSError as e:
         _unmake(made)
-        raise error(f"--out {out}: cannot be written ({e.strerror or e}); allowed a directory that can be made "
-                    "and written") from None
+        raise _unwritable(out, e, error) from None
     return made
+
+
+def _unwritable(out, e, error=StudyError):
+    """`error` for an OSError met writing into --out."""
+    return error(f"--out {out}: cannot be written ({e.strerror or e}); allowed a directory that can be made and written")
 
 
 def _unmake(made):
@@ -651,8 +655,7 @@ def _run_into(out, study, cases, remote, workers, progress, plots):
         lock = open(os.path.join(out, ".catenary_sim.lock"), "w")
     except OSError as e:
         _unmake(made)
-        raise StudyError(f"--out {out}: cannot be written ({e.strerror or e}); allowed a directory that can be "
-                         "made and written") from None
+        raise _unwritable(out, e) from None
     try:
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
